@@ -1,0 +1,100 @@
+# Build/bootstrap for the filippov project.
+#
+#   make figures   build every figure (and the report) with Snakemake
+#   make test      run the test suite
+#   make lock      re-resolve requirements.lock in a throw-away venv
+#   make clean     remove workflow outputs (keeps .venv)
+#
+# The first target that needs Python creates $(VENV) from requirements.lock.
+
+SHELL := /bin/bash
+.SHELLFLAGS := -eu -o pipefail -c
+.DELETE_ON_ERROR:
+
+PYTHON ?= python3
+VENV ?= .venv
+PY = $(VENV)/bin/python
+SNAKEFLAGS ?=
+PYTEST_ARGS ?=
+# Set to 1 to treat "no tests collected" (pytest exit 5) as success.
+ALLOW_NO_TESTS ?=
+
+# Top-level packages resolved by `make lock` (everything else is transitive).
+LOCK_PKGS = numpy scipy xarray netCDF4 matplotlib "snakemake>=8,<10" \
+            pyyaml jsonschema numba pytest pygments
+
+export MPLBACKEND = Agg
+export SOURCE_DATE_EPOCH = 0
+export PIP_DISABLE_PIP_VERSION_CHECK = 1
+export DEBIAN_FRONTEND = noninteractive
+
+# Recipes that run tools from the venv also see it first on PATH, so that
+# `python` inside Snakemake shell rules is the venv's interpreter.
+VENV_PATH = PATH="$(abspath $(VENV))/bin:$$PATH" VIRTUAL_ENV="$(abspath $(VENV))"
+
+.PHONY: all venv figures test lock clean distclean check-python
+
+all: figures
+
+check-python:
+	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else 1)' || \
+	  { echo "error: $(PYTHON) must be Python >= 3.11 (found: $$($(PYTHON) --version 2>&1))" >&2; exit 1; }
+
+# Create the venv with `python3 -m venv`. On Debian without ensurepip that
+# fails (or leaves a venv without pip): then install python3-venv and retry.
+define make_venv
+if ! "$(1)/bin/python" -m pip --version >/dev/null 2>&1; then \
+  rm -rf "$(1)"; \
+  if ! $(PYTHON) -m venv "$(1)"; then \
+    echo "python3 -m venv failed; installing python3-venv with apt-get" >&2; \
+    rm -rf "$(1)"; \
+    SUDO=; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
+    $$SUDO apt-get update -q && $$SUDO apt-get install -y -q python3-venv </dev/null; \
+    $(PYTHON) -m venv "$(1)"; \
+  fi; \
+fi
+endef
+
+$(VENV)/.done: requirements.lock pyproject.toml | check-python
+	@echo "== setting up $(VENV) from requirements.lock"
+	@$(call make_venv,$(VENV))
+	$(PY) -m pip install -r requirements.lock
+	$(PY) -m pip install --no-deps -e .
+	touch $@
+
+venv: $(VENV)/.done
+
+figures: $(VENV)/.done
+	$(VENV_PATH) $(VENV)/bin/snakemake --cores all $(SNAKEFLAGS)
+
+test: $(VENV)/.done
+	@rc=0; $(VENV_PATH) $(PY) -m pytest $(PYTEST_ARGS) || rc=$$?; \
+	if [ $$rc -eq 5 ] && [ -n "$(ALLOW_NO_TESTS)" ]; then \
+	  echo "warning: pytest collected no tests (exit 5); accepted because ALLOW_NO_TESTS is set" >&2; rc=0; \
+	fi; \
+	exit $$rc
+
+lock: | check-python
+	tmp=$$(mktemp -d); trap 'rm -rf "$$tmp"' EXIT; \
+	$(call make_venv,$$tmp/venv); \
+	"$$tmp/venv/bin/python" -m pip install $(LOCK_PKGS); \
+	MPLBACKEND=Agg "$$tmp/venv/bin/python" -c 'import numba, snakemake, netCDF4, xarray, matplotlib, scipy'; \
+	"$$tmp/venv/bin/snakemake" --version >/dev/null; \
+	{ \
+	  echo "# requirements.lock: exact pins (with every transitive dependency) for filippov."; \
+	  echo "# Generated file, do not edit by hand. Regenerate with:  make lock"; \
+	  echo "# (a throw-away 'python3 -m venv', 'pip install' of the Makefile's LOCK_PKGS:"; \
+	  echo "#  $(subst ",,$(LOCK_PKGS))"; \
+	  echo "#  then 'pip freeze'.) Installed by 'make' into $(VENV) with 'pip install -r'."; \
+	  echo "# Resolved with $$("$$tmp/venv/bin/python" -c 'import platform as p; print("Python", p.python_version(), "on", p.system(), p.machine())')."; \
+	  "$$tmp/venv/bin/python" -m pip freeze --exclude-editable --exclude filippov; \
+	} > requirements.lock.tmp; \
+	mv requirements.lock.tmp requirements.lock; \
+	echo "wrote requirements.lock ($$(grep -c '==' requirements.lock) pins)"
+
+clean:
+	rm -rf results/ .snakemake/
+	rm -f figures/*.pdf figures/*.png
+
+distclean: clean
+	rm -rf $(VENV)

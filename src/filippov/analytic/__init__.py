@@ -1,0 +1,1 @@
+"""The paper's closed forms and asymptotic formulas, independent of the solver."""

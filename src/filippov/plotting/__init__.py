@@ -1,0 +1,40 @@
+"""Figures from datasets: `draw(scene_id, ds)` and deterministic `save`.
+
+Plotting reads results only (never calls the solver), one module per figure.
+"""
+from __future__ import annotations
+
+from ..io import atomic_output
+from . import fig01_slidesketch, fig02_cases, fig08_s0theta, style
+
+DRAW = {
+    "fig01_slidesketch": fig01_slidesketch.draw,
+    "fig02_cases": fig02_cases.draw,
+    "fig08_s0theta": fig08_s0theta.draw,
+}
+
+# No timestamps or tool versions in the files: same data -> same bytes.
+PDF_METADATA = {"CreationDate": None, "ModDate": None, "Producer": None, "Creator": None}
+PNG_METADATA = {"Software": None}
+PNG_DPI = 200
+
+
+def draw(scene_id: str, ds):
+    try:
+        fn = DRAW[scene_id]
+    except KeyError:
+        raise ValueError(f"no figure module for scene {scene_id!r}; known: {', '.join(sorted(DRAW))}") from None
+    with style.context():
+        return fn(ds)
+
+
+def _atomic_savefig(fig, path, fmt: str, **kw) -> None:
+    with atomic_output(path) as tmp:
+        fig.savefig(tmp, format=fmt, **kw)
+
+
+def save(fig, pdf_path, png_path) -> None:
+    """Vector PDF plus a 200-dpi PNG, byte-reproducible."""
+    with style.context():
+        _atomic_savefig(fig, pdf_path, "pdf", metadata=PDF_METADATA)
+        _atomic_savefig(fig, png_path, "png", metadata=PNG_METADATA, dpi=PNG_DPI)

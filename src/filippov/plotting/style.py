@@ -1,0 +1,79 @@
+"""One publication style for every figure, in the paper's notation.
+
+Fonts are matplotlib's bundled STIX (Times-like, as in the elsart paper), so
+the output does not depend on which fonts a machine happens to have.
+"""
+from __future__ import annotations
+
+import matplotlib as mpl
+
+WIDTH_SINGLE = 3.4  # inches, one journal column
+WIDTH_DOUBLE = 7.0  # inches, full text width
+
+# The paper's symbols, so every module labels things the same way. Sub-
+# scripts +/- are braced: mathtext spaces a bare `_+` like a binary operator.
+X1, X2 = r"$x_1$", r"$x_2$"
+X, Y = r"$x$", r"$y$"
+EPS, THETA = r"$\varepsilon$", r"$\theta$"
+H_S = r"$\mathcal{H}_s$"
+M_0, M_PLUS, M_MINUS = r"$\mathcal{M}_0$", r"$\mathcal{M}_{+}$", r"$\mathcal{M}_{-}$"
+M_PM = r"$\mathcal{M}_{\pm}$"
+F_PLUS, F_MINUS = r"$f_{+}$", r"$f_{-}$"
+S0 = r"$s_0(\theta)$"
+
+# Colours (colour-blind safe pair) and line widths shared by the figures.
+C_PLUS, C_MINUS, C_SLIDE = "#0072B2", "#D55E00", "#009E73"
+C_AUX = "0.55"  # grey for reference lines (manifolds, asymptotes)
+LW_THIN, LW, LW_BOLD = 0.6, 1.0, 1.8
+
+RC = {
+    "font.family": "serif",
+    "font.serif": ["STIXGeneral", "DejaVu Serif"],
+    "mathtext.fontset": "stix",
+    "font.size": 9,
+    "axes.labelsize": 9,
+    "axes.titlesize": 9,
+    "legend.fontsize": 8,
+    "xtick.labelsize": 8,
+    "ytick.labelsize": 8,
+    "axes.linewidth": 0.6,
+    "lines.linewidth": LW,
+    "xtick.direction": "in",
+    "ytick.direction": "in",
+    "xtick.major.width": 0.6,
+    "ytick.major.width": 0.6,
+    "legend.frameon": False,
+    "figure.dpi": 100,
+    "savefig.dpi": 200,
+    # Determinism: embedded TrueType fonts, fixed SVG id salt.
+    "pdf.fonttype": 42,
+    "ps.fonttype": 42,
+    "svg.hashsalt": "filippov",
+    "path.simplify": False,  # keep every computed point
+}
+
+
+def context():
+    """rc context used both to build figures and to save them: some rcParams
+    (tick fonts, font embedding) are read only at draw time."""
+    return mpl.rc_context(RC)
+
+
+def panel_label(ax, text: str) -> None:
+    """Panel tag like '(a) crossing' above the axes, left-aligned as in the paper."""
+    ax.set_title(text, loc="left")
+
+
+def new_figure(width: float, height: float):
+    """A pyplot-free Figure: no GUI backend, no global figure registry to leak."""
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=(width, height), layout="constrained")
+
+
+def require(ds, scene_id: str, names) -> None:
+    """Fail with the dataset contract's names, not a deep KeyError from a plot call."""
+    missing = [n for n in names if n not in ds.variables]
+    if missing:
+        raise KeyError(f"{scene_id}: dataset lacks {', '.join(missing)} "
+                       f"(has: {', '.join(sorted(map(str, ds.variables)))})")

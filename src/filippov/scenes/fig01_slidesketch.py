@@ -1,0 +1,54 @@
+"""fig:slidesketch: one crossing and one sliding trajectory of concrete planar systems."""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from .. import simulate
+from ..io import finalize
+from ..models import planar_sketch
+from ..progress import Progress
+from .common import require, solver_options
+
+CASES = ("crossing", "sliding")
+
+
+def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    require(scene, "system", {"reduced"})
+    p = scene["parameters"]
+    opts = solver_options(scene)
+    if not scene["ingredients"]["sliding"]:
+        raise ValueError(f"{scene['id']}: ingredients.sliding must be true: panel (b) slides")
+    t = np.linspace(0.0, p["t_end"], p["n_samples"])
+    ax1 = np.linspace(-1.5, 1.5, 7)
+    ax2 = np.array([-0.6, 0.6])
+    g1, g2 = (a.ravel() for a in np.meshgrid(ax1, ax2))
+    out = {k: [] for k in ("x1", "x2", "mode", "hit_x1", "hit_x2", "u", "v")}
+    bar = Progress(scene["id"], len(CASES), progress)
+    for case in CASES:
+        sys_ = planar_sketch.system(case)
+        traj = simulate(sys_, p["start"], p["t_end"], **opts)
+        _, z, mode = traj.sample(t, include_events=False)
+        hit = next(e for e in traj.events if e.kind in ("crossing", "slide_start"))
+        grid = np.stack([g1, g2])
+        field = np.where(g2 < 0, sys_.field_minus(grid), sys_.field_plus(grid))
+        for key, val in (("x1", z[0]), ("x2", z[1]), ("mode", mode), ("hit_x1", hit.state[0]),
+                         ("hit_x2", hit.state[1]), ("u", field[0]), ("v", field[1])):
+            out[key].append(val)
+        bar.step(note=case)
+    ds = xr.Dataset(
+        {"x1": (("case", "t"), np.array(out["x1"]), {"units": "1"}),
+         "x2": (("case", "t"), np.array(out["x2"]), {"units": "1"}),
+         "mode": (("case", "t"), np.array(out["mode"], dtype=np.int8),
+                  {"flag_values": np.array([-1, 0, 1], dtype=np.int8),
+                   "flag_meanings": "minus sliding plus"}),
+         "hit_x1": ("case", np.array(out["hit_x1"])), "hit_x2": ("case", np.array(out["hit_x2"])),
+         "arrow_x1": (("case", "arrow"), np.array([g1, g1])),
+         "arrow_x2": (("case", "arrow"), np.array([g2, g2])),
+         "arrow_u": (("case", "arrow"), np.array(out["u"])),
+         "arrow_v": (("case", "arrow"), np.array(out["v"]))},
+        coords={"case": ("case", list(CASES)), "t": ("t", t, {"units": "1"})})
+    return finalize(ds, scene, title="crossing and sliding at H_s = {x2 = 0}",
+                    switching_function="h = x2",
+                    crossing_fields="f_- = (1, 1 + x1/2), f_+ = (1, 1/2)",
+                    sliding_fields="f_- = (1, 1), f_+ = (1, -1 - x1^2/4)")

@@ -1,0 +1,34 @@
+"""fig:s0theta: s0(theta) for theta < 0, by Lambert W and by root finding."""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ..analytic import s0
+from ..io import finalize
+from .common import require
+
+
+def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    require(scene, "system", {"none"})
+    require(scene, "flow", {"closed_form"})
+    p = scene["parameters"]
+    lo, hi, n = p["theta_min"], p["theta_max"], p["n_theta"]
+    if not lo < hi < 0:
+        raise ValueError(f"{scene['id']}: parameters.theta_min < parameters.theta_max < 0 "
+                         f"required, got {lo!r}, {hi!r}")
+    # geometric in -theta: resolves the square-root-like start of s0 at theta -> 0-
+    theta = np.sort(-np.geomspace(-hi, -lo, n))
+    closed, root = s0.s0_lambert(theta), s0.s0_root(theta)
+    diff = np.abs(closed - root)
+    ds = xr.Dataset(
+        {"s0": ("theta", closed, {"long_name": "s0(theta), closed form via Lambert W_0",
+                                  "units": "1", "equation": "eq:s0def"}),
+         "s0_root": ("theta", root, {"long_name": "s0(theta) by Brent root finding on eq:s0def",
+                                     "units": "1"}),
+         "residual": ("theta", s0.residual(closed, theta),
+                      {"long_name": "left side of eq:s0def at the closed-form s0"})},
+        coords={"theta": ("theta", theta, {"long_name": "theta", "units": "1",
+                                            "spacing": "geometric in -theta"})})
+    return finalize(ds, scene, max_abs_difference=float(diff.max()),
+                    title="s0(theta), the positive root of eq:s0def")

@@ -1,0 +1,412 @@
+"""The event-driven driver: smooth segments, switching decisions, sliding, sections.
+
+The loop is the textbook one for Filippov systems:
+
+1. follow the field of the current mode (``+``, ``-`` or sliding) in segments,
+   each with a dense evaluator ``Z(t)`` -- an exact flow if the system has one
+   and ``method="exact"``, else a DOP853 step with its 7th-order dense output;
+2. scan each segment for the earliest event: ``H`` leaving the region, a hidden
+   grazing crossing (a sign change of ``dH/dt`` whose minimum of ``H`` goes
+   through zero), the end of sliding (``dH.F_-`` or ``dH.F_+`` reaching zero),
+   or a user :class:`Section`; refine it with Brent's method;
+3. at a hit of ``H = 0`` decide from ``a = dH.F_-`` and ``b = dH.F_+`` (eq:atSl,
+   eq:eminus) whether the trajectory crosses or starts sliding, log it, restart.
+
+Guards stop a run with a clear error instead of hanging or handing on NaN: a
+bound on events and steps, and an accumulation (Zeno) detector.
+"""
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+from typing import Callable, Optional, Sequence
+
+import numpy as np
+from scipy.integrate import DOP853
+from scipy.optimize import brentq
+
+from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
+
+
+class SimulationError(RuntimeError):
+    """A trajectory could not be continued (non-finite state, bad input, ...)."""
+
+
+class EventLimitError(SimulationError):
+    """The bound on events or steps was hit (typically rapid switching)."""
+
+
+class ZenoError(SimulationError):
+    """Switching times accumulate: infinitely many switches in finite time."""
+
+
+@dataclass(frozen=True)
+class Section:
+    """A user event ``func(z) = 0``; ``direction`` -1 counts decreasing crossings
+    only, +1 increasing, 0 both; ``where(z)`` must hold at the hit;
+    ``terminal`` stops the run after that many hits (None: never)."""
+
+    name: str
+    func: Callable[[np.ndarray], np.ndarray]
+    direction: int = 0
+    where: Optional[Callable[[np.ndarray], bool]] = None
+    terminal: Optional[int] = None
+
+
+@dataclass(frozen=True)
+class Event:
+    t: float
+    kind: str  # crossing | slide_start | slide_end | touch | section | start | repelling_start
+    state: np.ndarray
+    mode_before: int
+    mode_after: int
+    name: str = ""
+
+
+@dataclass
+class Trajectory:
+    system: PiecewiseSystem
+    t0: float
+    z0: np.ndarray
+    t: float = 0.0
+    z: np.ndarray = None
+    mode: int = PLUS
+    events: list = field(default_factory=list)
+    segments: list = field(default_factory=list)  # (ta, tb, mode, Z)
+    status: str = "running"
+    n_steps: int = 0
+    integrated_modes: set = field(default_factory=set)
+
+    def section_hits(self, name: str) -> list:
+        return [e for e in self.events if e.kind == "section" and e.name == name]
+
+    def switches(self) -> list:
+        return [e for e in self.events if e.mode_before != e.mode_after]
+
+    def sample(self, times: np.ndarray, *, include_events: bool = True):
+        """States on ``times`` (plus event times if asked): ``(t, z[n, m], mode[m])``."""
+        if not self.segments:
+            raise SimulationError("trajectory was run with dense=False: no samples stored")
+        times = np.asarray(times, dtype=float)
+        if include_events:
+            times = np.union1d(times, [e.t for e in self.events])
+        times = times[(times >= self.t0) & (times <= self.t)]
+        ends = np.array([s[1] for s in self.segments])
+        idx = np.minimum(np.searchsorted(ends, times, side="left"), len(ends) - 1)
+        z = np.empty((self.system.dim, times.size))
+        modes = np.empty(times.size, dtype=np.int8)
+        for k in np.unique(idx):
+            sel = idx == k
+            ta, tb, mode, Z = self.segments[k]
+            z[:, sel] = Z(times[sel])
+            modes[sel] = mode
+        return times, z, modes
+
+
+# --------------------------------------------------------------------------- steppers
+class _ExactStepper:
+    """Walks an exact flow in windows of ``h``; the evaluator is the flow itself."""
+
+    def __init__(self, flow, z, t, t_end, h):
+        self.flow, self.za, self.ta, self.t, self.t_end, self.h = flow, z.copy(), t, t, t_end, h
+
+    def step(self):
+        ta = self.t
+        tb = min(ta + self.h, self.t_end)
+        if tb == ta:  # h below the spacing of floats at t
+            tb = np.nextafter(ta, np.inf)
+        self.t = tb
+        flow, za, t0 = self.flow, self.za, self.ta
+        return ta, tb, lambda tt: flow(za, np.asarray(tt, dtype=float) - t0)
+
+
+class _IntegratingStepper:
+    def __init__(self, fun, z, t, t_end, rtol, atol, max_step):
+        def checked(tt, zz):
+            # scipy's step control loops forever on a NaN error norm: stop at the source
+            v = fun(tt, zz)
+            if not np.all(np.isfinite(v)):
+                raise SimulationError(f"non-finite field value at t={tt!r}, state {np.asarray(zz).tolist()}")
+            return v
+
+        self.solver = DOP853(checked, t, z, t_end, rtol=rtol, atol=atol,
+                             max_step=max_step if np.isfinite(max_step) else np.inf)
+
+    def step(self):
+        s = self.solver
+        ta = s.t
+        msg = s.step()
+        if s.status == "failed":
+            raise SimulationError(f"DOP853 failed at t={ta!r}: {msg}")
+        return ta, s.t, s.dense_output()
+
+
+# --------------------------------------------------------------------------- crossings
+_TINY = np.finfo(float).tiny
+
+
+@dataclass(frozen=True)
+class _Crossing:
+    """A sign change to detect between two samples, and how to tell its far side."""
+
+    before: Callable[[float], bool]
+    after: Callable[[float], bool]
+    inside: float  # value a just-entered mode's start sample is clamped towards
+
+    def __call__(self, v0, v1):
+        return self.before(v0) and self.after(v1)
+
+    def clamp(self, v0):
+        return v0 if self.before(v0) else self.inside
+
+
+TO_NEG = _Crossing(lambda v: v >= 0, lambda v: v < 0, 0.0)        # leaves region +
+TO_NONNEG = _Crossing(lambda v: v < 0, lambda v: v >= 0, -_TINY)  # leaves region -
+TO_NONPOS = _Crossing(lambda v: v > 0, lambda v: v <= 0, _TINY)
+
+
+class _EitherWay:
+    def __call__(self, v0, v1):
+        return TO_NONNEG(v0, v1) or TO_NONPOS(v0, v1)
+
+    def after(self, v):  # the far side is wherever the sign flipped to; both refinements end at a root
+        return True
+
+
+def _section_pred(direction):
+    if direction < 0:
+        return TO_NONPOS
+    if direction > 0:
+        return TO_NONNEG
+    return _EitherWay()
+
+
+def _refine(fun, pred, ta, tb, va, vb, xtol):
+    """Root of ``fun`` in [ta, tb], returned on the far side of the crossing."""
+    if va == 0.0:
+        r = ta
+    else:
+        r = brentq(fun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=200)
+    # Brent may stop a hair before the sign flips (rounding in fun near a shallow
+    # crossing): step forward by doubling increments until it has flipped.
+    step = 2 * np.spacing(max(abs(r), _TINY))
+    while not pred.after(fun(r)):
+        if r >= tb:
+            return tb
+        r = min(r + step, tb)
+        step *= 2
+    return r
+
+
+# --------------------------------------------------------------------------- driver
+def initial_mode(system: PiecewiseSystem, z: np.ndarray, touch_tol: float) -> tuple[int, str]:
+    """Region to start in; on H = 0 (to ``touch_tol``) the field directions decide,
+    so a start point that rounding puts a hair on the wrong side is not a switch."""
+    H = float(system.switch(z))
+    if abs(H) > touch_tol:
+        return (PLUS if H > 0 else MINUS), "start"
+    a, b = (float(v) for v in system.normal_speeds(z))
+    if a > 0 and b < 0:
+        return (SLIDING if system.sliding else PLUS), "start"
+    if a < 0 and b < 0:
+        return MINUS, "start"
+    if a > 0 and b > 0:
+        return PLUS, "start"
+    if a < 0 < b:  # repelling sliding: either side is a solution; h >= 0 picks +
+        return PLUS, "repelling_start"
+    return (PLUS if H >= 0 else MINUS), "start"  # a tangency: the sign of H decides
+
+
+def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
+             method: str = "exact", rtol: float = 1e-12, atol: float = 1e-14,
+             max_step: float = np.inf, sections: Sequence[Section] = (),
+             max_events: int = 100_000, max_steps: int = 5_000_000,
+             dense: bool = True, samples_per_step: int = 4, touch_tol: float = 1e-15,
+             event_xtol: float = 1e-15, zeno_count: int = 64,
+             zeno_span: float = 1e-10) -> Trajectory:
+    """Integrate ``system`` from ``z0`` at ``t0`` to ``t_end`` (or a terminal section).
+
+    ``method="exact"`` uses the system's exact flows where it has them (modes
+    without one are integrated, listed in ``Trajectory.integrated_modes``);
+    ``method="integrate"`` integrates every mode with DOP853 at ``rtol``/``atol``.
+    Contacts with ``|H| <= touch_tol`` at a tangency count as touching, not
+    crossing (region + is ``H >= 0``).
+    """
+    if method not in ("exact", "integrate"):
+        raise ValueError(f"method must be 'exact' or 'integrate', got {method!r}")
+    z = np.array(z0, dtype=float).reshape(-1)
+    if z.size != system.dim:
+        raise ValueError(f"initial state has {z.size} components, system has {system.dim} "
+                         f"({', '.join(system.names)})")
+    if not np.all(np.isfinite(z)):
+        raise ValueError(f"initial state must be finite, got {z.tolist()}")
+    if not (np.isfinite(t0) and np.isfinite(t_end) and t_end >= t0):
+        raise ValueError(f"need finite t0 <= t_end, got t0={t0!r}, t_end={t_end!r}")
+    if samples_per_step < 1:
+        raise ValueError("samples_per_step must be >= 1")
+
+    traj = Trajectory(system=system, t0=t0, z0=z.copy(), t=t0, z=z.copy())
+    mode, kind = initial_mode(system, z, touch_tol)
+    traj.mode = mode
+    traj.events.append(Event(t0, kind, z.copy(), mode, mode))
+    preds = [_section_pred(s.direction) for s in sections]
+    hits = [0] * len(sections)
+    recent = deque(maxlen=zeno_count)
+    n_switch = 0
+    t = t0
+    frac = np.linspace(0.0, 1.0, samples_per_step + 1)
+
+    def stop(status):
+        traj.status, traj.t, traj.z, traj.mode = status, t, z.copy(), mode
+        return traj
+
+    while True:
+        if t >= t_end:
+            return stop("t_end")
+        if mode == SLIDING and not system.sliding:
+            raise SimulationError(
+                f"attracting sliding reached at t={t!r}, state {z.tolist()}, but the scene "
+                "does not declare the sliding ingredient")
+        use_flow = method == "exact" and system.has_flow(mode)
+        if use_flow:
+            h = min(system.sample_step, max_step, t_end - t0)
+            stepper = _ExactStepper(system.flows[mode], z, t, t_end, h)
+        else:
+            traj.integrated_modes.add(MODE_NAMES[mode])
+            stepper = _IntegratingStepper(lambda _t, zz, m=mode: system.field(m, zz),
+                                          z, t, t_end, rtol, atol, max_step)
+        # Functions whose crossing ends this mode, with the mode they lead to.
+        if mode == PLUS:
+            leave = [(system.switch, TO_NEG, "switch")]
+        elif mode == MINUS:
+            leave = [(system.switch, TO_NONNEG, "switch")]
+        else:
+            leave = [(lambda zz: system.normal_speeds(zz)[0], TO_NONPOS, "exit_minus"),
+                     (lambda zz: system.normal_speeds(zz)[1], TO_NONNEG, "exit_plus")]
+        first = True
+        restart = False
+        while not restart:
+            traj.n_steps += 1
+            if traj.n_steps > max_steps:
+                raise EventLimitError(
+                    f"step limit {max_steps} hit at t={t!r}, state {z.tolist()}, mode "
+                    f"{MODE_NAMES[mode]}: the run is too long or the step size collapsed")
+            ta, tb, Z = stepper.step()
+            ts = ta + frac * (tb - ta)
+            ts[-1] = tb
+            zs = Z(ts)
+            if not np.all(np.isfinite(zs)):
+                raise SimulationError(
+                    f"non-finite state in mode {MODE_NAMES[mode]} between t={ta!r} and "
+                    f"t={tb!r}, last finite state {z.tolist()}")
+            found = _scan(system, mode, Z, ts, zs, leave, sections, preds, first,
+                          touch_tol, event_xtol, traj)
+            first = False
+            if dense:
+                traj.segments.append((ta, tb, mode, Z))
+            if found is None:
+                t, z = tb, zs[:, -1].copy()
+                if tb >= t_end:
+                    return stop("t_end")
+                continue
+            te, ze, what, idx = found
+            if dense:  # the segment ends at the event
+                traj.segments[-1] = (ta, te, mode, Z)
+            t, z = te, ze
+            restart = True
+            if what == "section":
+                sec = sections[idx]
+                hits[idx] += 1
+                traj.events.append(Event(te, "section", ze.copy(), mode, mode, sec.name))
+                if sec.terminal is not None and hits[idx] >= sec.terminal:
+                    return stop(f"section:{sec.name}")
+                continue
+            new_mode, kind = _decide(system, mode, what, ze)
+            traj.events.append(Event(te, kind, ze.copy(), mode, new_mode))
+            n_switch += new_mode != mode
+            if n_switch > max_events:
+                raise EventLimitError(
+                    f"event limit {max_events} hit: rapid switching near t={te!r}, "
+                    f"state {ze.tolist()}")
+            recent.append(te)
+            if len(recent) == recent.maxlen and recent[-1] - recent[0] <= zeno_span * max(1.0, abs(te)):
+                raise ZenoError(
+                    f"accumulation of switches: {recent.maxlen} switches within "
+                    f"{recent[-1] - recent[0]:.3e} time units near t={te!r}, state "
+                    f"{ze.tolist()} (Zeno point or chattering below the time resolution)")
+            mode = new_mode
+            traj.mode = mode
+
+
+def _decide(system, mode, what, z):
+    """The Filippov decision at a point of H = 0 (eq:atSl)."""
+    a, b = (float(v) for v in system.normal_speeds(z))
+    if what == "exit_minus":
+        return MINUS, "slide_end"
+    if what == "exit_plus":
+        return PLUS, "slide_end"
+    if mode == PLUS:  # arrived from H > 0, F_+ points down
+        if a > 0 and system.sliding:
+            return SLIDING, "slide_start"
+        if a > 0:
+            raise SimulationError(
+                f"attracting sliding reached at state {z.tolist()}, but the scene does not "
+                "declare the sliding ingredient")
+        return MINUS, "crossing"
+    # arrived from H < 0
+    if b < 0 and system.sliding:
+        return SLIDING, "slide_start"
+    if b < 0:
+        raise SimulationError(
+            f"attracting sliding reached at state {z.tolist()}, but the scene does not "
+            "declare the sliding ingredient")
+    return PLUS, "crossing"
+
+
+def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xtol, traj):
+    """Earliest event in the samples ``ts`` of one segment, or None."""
+    vals = []
+    for func, pred, what in leave:
+        v = np.asarray(func(zs), dtype=float)
+        if first:  # just entered this mode: its start is inside by construction
+            v = v.copy()
+            v[0] = pred.clamp(v[0])
+        vals.append(v)
+    if mode != SLIDING:
+        D = np.asarray(system.speed_of_switch(mode, zs), dtype=float)
+    svals = [np.asarray(s.func(zs), dtype=float) for s in sections]
+
+    def scalar(func):
+        return lambda tt: float(func(Z(tt)))
+
+    for i in range(ts.size - 1):
+        best = None  # (t, z, what, idx)
+        ta, tb = ts[i], ts[i + 1]
+        for (func, pred, what), v in zip(leave, vals):
+            if pred(v[i], v[i + 1]):
+                r = _refine(scalar(func), pred, ta, tb, v[i], v[i + 1], xtol)
+                if best is None or r < best[0]:
+                    best = (r, what, -1)
+        if mode != SLIDING and best is None:
+            # a minimum (in +) or maximum (in -) of H hidden between samples
+            H = vals[0]
+            hidden = (D[i] < 0 <= D[i + 1]) if mode == PLUS else (D[i] > 0 >= D[i + 1])
+            if hidden:
+                dfun = scalar(lambda zz: system.speed_of_switch(mode, zz))
+                tm = brentq(dfun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps)
+                Hm = float(system.switch(Z(tm)))
+                pred = leave[0][1]
+                if (mode == PLUS and Hm < -touch_tol) or (mode == MINUS and Hm > touch_tol):
+                    r = _refine(scalar(system.switch), pred, ta, tm, H[i], Hm, xtol)
+                    best = (r, "switch", -1)
+                elif abs(Hm) <= touch_tol:
+                    traj.events.append(Event(tm, "touch", Z(tm).copy(), mode, mode))
+        for k, (sec, pred, sv) in enumerate(zip(sections, preds, svals)):
+            if pred(sv[i], sv[i + 1]):
+                r = _refine(scalar(sec.func), pred, ta, tb, sv[i], sv[i + 1], xtol)
+                if (best is None or r < best[0]) and (sec.where is None or sec.where(Z(r))):
+                    best = (r, "section", k)
+        if best is not None:
+            r, what, k = best
+            return r, np.asarray(Z(r), dtype=float).reshape(-1).copy(), what, k
+    return None

@@ -1,0 +1,13 @@
+"""Thin: scene file -> filippov.scenes.compute -> results/<id>.nc (no numerics here)."""
+import sys
+
+import filippov.io
+import filippov.scenes
+from filippov.config import SceneError, load_scene
+
+try:
+    scene = load_scene(snakemake.input.scene, snakemake.input.schema)  # noqa: F821
+except SceneError as exc:
+    sys.exit(f"error: {exc}")  # a config mistake: one clear line, no traceback
+ds = filippov.scenes.compute(scene, progress=True)
+filippov.io.write_dataset(ds, snakemake.output[0])  # noqa: F821
