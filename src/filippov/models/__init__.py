@@ -2,9 +2,10 @@
 
 A new system is a new module here; neither the solver nor the workflow changes.
 """
-from . import planar_sketch, pseudo_equilibrium
+from . import hopf, planar_sketch, pseudo_equilibrium
 
 REGISTRY = {
+    "hopf": hopf,
     "planar_sketch": planar_sketch,
     "pseudo_equilibrium": pseudo_equilibrium,
 }
