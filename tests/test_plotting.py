@@ -4,7 +4,7 @@ import pytest
 import filippov.plotting as plotting
 import synthetic
 
-CASES = {"fig01_slidesketch": synthetic.fig01, "fig02_cases": synthetic.fig02,
+CASES = {"fig01_slidesketch": synthetic.fig01, "fig02_cases": synthetic.fig02, "fig04_retmaps": synthetic.fig04,
          "fig08_s0theta": synthetic.fig08}
 
 

@@ -71,8 +71,9 @@ class PiecewiseSystem:
 
     def sliding_field(self, z: np.ndarray) -> np.ndarray:
         """Filippov's convex combination (eq:slide): tangent to H = 0."""
-        a, b = self.normal_speeds(z)
-        return (a * self.field_plus(z) - b * self.field_minus(z)) / (a - b)
+        grad, fm, fp = self.switch_grad(z), self.field_minus(z), self.field_plus(z)
+        a, b = np.sum(grad * fm, axis=0), np.sum(grad * fp, axis=0)
+        return (a * fp - b * fm) / (a - b)
 
     def speed_of_switch(self, mode: int, z: np.ndarray) -> np.ndarray:
         """dH/dt along the field of ``mode`` (zero in sliding, by construction)."""

@@ -4,13 +4,17 @@ Plotting reads results only (never calls the solver), one module per figure.
 """
 from __future__ import annotations
 
-from ..io import atomic_output
-from . import fig01_slidesketch, fig02_cases, fig08_s0theta, style
+import importlib
 
+from ..io import atomic_output
+from . import style
+
+# scene id -> module in this package whose draw(ds) makes the figure
 DRAW = {
-    "fig01_slidesketch": fig01_slidesketch.draw,
-    "fig02_cases": fig02_cases.draw,
-    "fig08_s0theta": fig08_s0theta.draw,
+    "fig01_slidesketch": "fig01_slidesketch",
+    "fig02_cases": "fig02_cases",
+    "fig04_retmaps": "fig04_retmaps",
+    "fig08_s0theta": "fig08_s0theta",
 }
 
 # No timestamps or tool versions in the files: same data -> same bytes.
@@ -21,11 +25,11 @@ PNG_DPI = 200
 
 def draw(scene_id: str, ds):
     try:
-        fn = DRAW[scene_id]
+        module = importlib.import_module(f".{DRAW[scene_id]}", __name__)
     except KeyError:
         raise ValueError(f"no figure module for scene {scene_id!r}; known: {', '.join(sorted(DRAW))}") from None
     with style.context():
-        return fn(ds)
+        return module.draw(ds)
 
 
 def _atomic_savefig(fig, path, fmt: str, **kw) -> None:

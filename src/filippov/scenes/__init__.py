@@ -10,6 +10,7 @@ import importlib
 SCENES = {
     "fig01_slidesketch": "fig01_slidesketch",
     "fig02_cases": "fig02_cases",
+    "fig04_retmaps": "fig04_retmaps",
     "fig08_s0theta": "fig08_s0theta",
 }
 

@@ -1,0 +1,94 @@
+"""Return maps: the first return of many start points to a section.
+
+The return map is built from the event-driven solver alone: every start point is
+one :func:`simulate` call that stops at its first section hit. Along with the
+returned state, each return records the time taken, the number of switches and
+the time spent sliding, so a figure can show where the map changes character.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .progress import Progress
+from .simulate import Section, simulate
+from .system import PiecewiseSystem, SLIDING
+
+
+@dataclass(frozen=True)
+class Returns:
+    """First returns of ``starts`` (shape ``(m, dim)``) to one section."""
+
+    state: np.ndarray         # (m, dim) state at the return
+    time: np.ndarray          # (m,) time of flight
+    n_switches: np.ndarray    # (m,) changes of mode on the way
+    sliding_time: np.ndarray  # (m,) time spent sliding on the way
+
+
+def first_returns(system: PiecewiseSystem, starts, section: Section, t_max: float, *,
+                  progress: Progress | None = None, **options) -> Returns:
+    """Follow each start point until it first hits ``section`` (within ``t_max``).
+
+    ``options`` go to :func:`simulate`. A start point that does not return within
+    ``t_max`` is an error naming it: a return map with holes is not a return map.
+    """
+    starts = np.atleast_2d(np.asarray(starts, dtype=float))
+    if section.terminal != 1:
+        section = Section(section.name, section.func, section.direction, section.where, 1)
+    m = starts.shape[0]
+    state = np.empty_like(starts)
+    time = np.empty(m)
+    n_switches = np.empty(m, dtype=np.int64)
+    sliding = np.empty(m)
+    for i, z0 in enumerate(starts):
+        traj = simulate(system, z0, t_max, sections=[section], dense=False, **options)
+        if traj.status != f"section:{section.name}":
+            raise RuntimeError(f"start point {z0.tolist()} did not return to section "
+                               f"{section.name!r} within t_max={t_max!r} (status {traj.status})")
+        hit = traj.events[-1]
+        state[i], time[i] = hit.state, hit.t - traj.t0
+        switches = traj.switches()
+        n_switches[i] = len(switches)
+        sliding[i] = _sliding_time(traj.events)
+        if progress is not None:
+            progress.step()
+    return Returns(state, time, n_switches, sliding)
+
+
+def _sliding_time(events) -> float:
+    total, since = 0.0, None
+    for e in events:
+        if e.mode_after == SLIDING and e.mode_before != SLIDING:
+            since = e.t
+        elif e.mode_before == SLIDING and e.mode_after != SLIDING and since is not None:
+            total += e.t - since
+            since = None
+    if since is not None:
+        total += events[-1].t - since
+    return total
+
+
+def fixed_points(grid: np.ndarray, values: np.ndarray, refine=None, xtol: float = 1e-14):
+    """Fixed points of a 1-D map sampled as ``values = P(grid)``.
+
+    Grid points where ``P(x) = x`` exactly are fixed points; a sign change of
+    ``P(x) - x`` between neighbours is refined with Brent's method on
+    ``refine(x) - x`` if given. A sign change across a jump of ``P`` is not a
+    fixed point, so a refined root is kept only if ``|P(r) - r|`` is small.
+    """
+    from scipy.optimize import brentq
+
+    d = values - grid
+    out = list(grid[d == 0.0])
+    for i in np.flatnonzero(d[:-1] * d[1:] < 0):
+        a, b = grid[i], grid[i + 1]
+        if refine is None:
+            r = a - d[i] * (b - a) / (d[i + 1] - d[i])
+            out.append(r)
+            continue
+        g = lambda x: float(refine(x)) - x
+        r = brentq(g, a, b, xtol=xtol)
+        if abs(g(r)) <= 1e-9 * max(1.0, abs(r)):
+            out.append(r)
+    return np.unique(np.asarray(out, dtype=float))

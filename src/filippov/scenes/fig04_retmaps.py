@@ -1,0 +1,103 @@
+"""fig:retmaps: the return map P to L1 = {x1 = y = 0, x2 > 0} of the slow-fast
+Hopf example (eq:exslow2, eq:exfast2) at the grazing parameter mu = 1.
+
+Start points lie on L1 (so on M_+); P(x2) is x2 at the first return to the
+section x1 = 0 with x1 decreasing and x2 > 0. The grid is uniform plus points
+approaching the grazing value x2 = 1 geometrically from both sides, so the
+jump (theta < 0) and the one-sided slope (theta > 0) are resolved.
+
+Alongside the map the dataset stores, per theta, the quantity of eq:chiminus
+that decides case 1 / case 2 of lemma thm:gen, computed by the solver as the
+rate of change of h along the region-minus field at the grazing point p_g.
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ..io import finalize
+from ..models import hopf
+from ..poincare import first_returns, fixed_points
+from ..progress import Progress
+from ..simulate import Section
+from .common import require, solver_options
+
+
+def section_L1() -> Section:
+    return Section("L1", lambda z: z[0], direction=-1, where=lambda z: z[1] > 0, terminal=1)
+
+
+def x2_grid(p: dict) -> np.ndarray:
+    lo, hi, n = float(p["x2_min"]), float(p["x2_max"]), int(p["n_uniform"])
+    near = np.geomspace(float(p["closest"]), min(1.0 - lo, hi - 1.0), int(p["n_geometric"]))
+    grid = np.concatenate([np.linspace(lo, hi, n), 1.0 - near, 1.0 + near, [1.0]])
+    return np.unique(grid)
+
+
+def return_map(model, x2, method: str, options: dict, progress=None, sliding=True):
+    """P on L1 for the start values ``x2``: (returned x2, residual |y - x1|, Returns)."""
+    system = model.full(sliding=sliding, exact=method == "exact")
+    starts = np.stack([np.zeros_like(x2), x2, np.zeros_like(x2)], axis=1)
+    t_max = 4.0 * 2 * np.pi / abs(model.parameters["omega"])
+    ret = first_returns(system, starts, section_L1(), t_max, progress=progress,
+                        method=method, **options)
+    return ret.state[:, 1], np.abs(ret.state[:, 2] - ret.state[:, 0]), ret
+
+
+def sigma_minus(model) -> tuple[float, float]:
+    """eq:eminus at the grazing point p_g = (-1, 0, -1) of the slow-fast system,
+    from the solver's normal speeds, and eq:chiminus (dh/dx f_- - dh/dx f_+)."""
+    system = model.full()
+    pg = np.array([-1.0, 0.0, -1.0])
+    a, _ = system.normal_speeds(pg)
+    x, y = pg[:2], pg[2:]
+    hx, _ = model.h_grad(x, y)
+    chi = float(hx @ model.f_minus(x, y) - hx @ model.f_plus(x, y))
+    return float(a), chi
+
+
+def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    require(scene, "system", {"slow_fast"})
+    p = scene["parameters"]
+    opts = solver_options(scene)
+    method = opts.pop("method")
+    eps, mu, omega = float(p["eps"]), float(p["mu"]), float(p["omega"])
+    thetas = [float(v) for v in p["theta"]]
+    x2 = x2_grid(p)
+    bar = Progress(scene["id"], len(thetas) * x2.size, progress)
+    P, res, tof, nsw, slide, sig, chi, fps = [], [], [], [], [], [], [], []
+    for theta in thetas:
+        model = hopf.model(eps, theta, mu, omega)
+        px2, r, ret = return_map(model, x2, method, opts, bar, scene["ingredients"]["sliding"])
+        P.append(px2), res.append(r), tof.append(ret.time)
+        nsw.append(ret.n_switches), slide.append(ret.sliding_time)
+        s, c = sigma_minus(model)
+        sig.append(s), chi.append(c)
+        fps.append(fixed_points(x2, px2))
+    n_fp = max(len(f) for f in fps)
+    fp = np.full((len(thetas), max(n_fp, 1)), np.nan)
+    for i, f in enumerate(fps):
+        fp[i, :len(f)] = f
+    dims = ("theta", "x2")
+    ds = xr.Dataset(
+        {"P": (dims, np.array(P), {"long_name": "x2 at the first return to L1", "units": "1"}),
+         "residual": (dims, np.array(res), {"long_name": "|y - x1| at the return (distance to M_+)",
+                                            "units": "1"}),
+         "return_time": (dims, np.array(tof), {"long_name": "time of flight to L1", "units": "1"}),
+         "n_switches": (dims, np.array(nsw, dtype=np.int32),
+                        {"long_name": "mode changes on the way", "units": "1"}),
+         "sliding_time": (dims, np.array(slide), {"long_name": "time spent sliding", "units": "1"}),
+         "fixed_point": (("theta", "fixed"), fp,
+                         {"long_name": "fixed points of P on the grid (NaN: none)", "units": "1"}),
+         "sigma_minus": ("theta", np.array(sig), {
+             "long_name": "dh/dt along (f_-, g/eps) at p_g (eq:eminus); > 0: case 1 of thm:gen",
+             "units": "1"}),
+         "chi_minus": ("theta", np.array(chi), {
+             "long_name": "dh/dx f_- - dh/dx f_+ at p_g (eq:chiminus)", "units": "1"}),
+         "slope_smooth": ((), float(np.exp(-4 * np.pi * mu / omega)), {
+             "long_name": "slope of the smooth return map at x2=1, exp(-4 pi mu/omega)",
+             "units": "1"})},
+        coords={"theta": ("theta", thetas, {"units": "1"}),
+                "x2": ("x2", x2, {"long_name": "x2 of the start point on L1", "units": "1"})})
+    return finalize(ds, scene, method=method,
+                    title="return map P to L1 of the slow-fast Hopf example (fig:retmaps)")

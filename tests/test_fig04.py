@@ -1,0 +1,109 @@
+"""The return map of the slow-fast Hopf example (fig:retmaps): the paper's stated
+facts, each against an independent computation or a limit derived here."""
+import numpy as np
+import pytest
+
+from filippov.analytic.s0 import s0_lambert
+from filippov.models import hopf
+from filippov.poincare import fixed_points
+from filippov.scenes.fig04_retmaps import return_map, sigma_minus, x2_grid
+
+OMEGA, MU = 8 * np.pi, 1.0
+OPTS = {"rtol": 1e-12, "atol": 1e-14}
+SMOOTH_SLOPE = np.exp(-4 * np.pi * MU / OMEGA)
+
+
+def P(eps, theta, x2, method="exact"):
+    return return_map(hopf.model(eps, theta, MU, OMEGA), np.asarray(x2, float), method, OPTS)
+
+
+@pytest.mark.parametrize("theta", [-0.5, 0.5])
+def test_below_grazing_P_is_the_smooth_polar_map(theta):
+    # one revolution of r' = mu r - r^3 in closed form: independent of the solver
+    x2 = np.linspace(0.9, 1.0, 41)
+    T = 2 * np.pi / OMEGA
+    r = np.sqrt(MU * x2**2 / (x2**2 + (MU - x2**2) * np.exp(-2 * MU * T)))
+    got, res, ret = P(0.01, theta, x2)
+    np.testing.assert_allclose(got, r, rtol=0, atol=2e-15)
+    assert np.all(ret.n_switches == 0) and np.all(res == 0)
+    d = np.array([1e-7, 1e-6])
+    slope = (1 - P(0.01, theta, 1 - d)[0]) / d
+    np.testing.assert_allclose(slope, SMOOTH_SLOPE, rtol=2e-6)
+
+
+def test_theta_negative_jump_scales_with_eps():
+    # derived: the jump is eps s0(theta) at the grazing point, carried to L1 by
+    # 3/4 of a revolution, which contracts radii by exp(-3 pi mu / omega)
+    predicted = s0_lambert(np.array([-0.5]))[0] * np.exp(-3 * np.pi * MU / OMEGA)
+    c = np.array([(1 - P(eps, -0.5, [1 + 1e-12])[0][0]) / eps for eps in (1e-2, 1e-3, 1e-4)])
+    err = np.abs(c - predicted)
+    assert err[0] > err[1] > err[2] and err[2] < 1e-3 * predicted
+    assert np.all(c > 0.5)  # a jump of order eps, not smaller
+
+
+def test_theta_negative_one_sided_slope_is_unbounded():
+    d = np.array([1e-12, 1e-10, 1e-8, 1e-6])
+    got = P(0.01, -0.5, 1 + d)[0]
+    slopes = np.abs(np.diff(got) / np.diff(d))
+    assert np.all(np.diff(slopes) < 0)  # steeper closer to x2 = 1
+    # square-root singularity: 100x closer, 10x steeper
+    np.testing.assert_allclose(slopes[:-1] / slopes[1:], 10.0, rtol=0.05)
+
+
+@pytest.mark.parametrize("eps", [1e-2, 1e-3, 1e-4])
+def test_theta_positive_is_continuous_with_order_one_slope(eps):
+    theta = 0.5
+    carried = (theta - 1) / theta * SMOOTH_SLOPE  # slope (theta-1)/theta carried to L1
+    # the sliding layer has width O(eps^2) in x2: probe well inside it, but with
+    # P - 1 large enough (>= 1e-12) that rounding in P leaves 1e-4 of the slope
+    d = np.array([1e-4, 1e-3]) * max(eps**2, 1e-7)
+    got, _, ret = P(eps, theta, np.concatenate([[1.0, 1 + 1e-12], 1 + d]))
+    assert got[0] == 1.0 and abs(got[1] - 1) < 1e-11  # continuous
+    assert np.all(ret.sliding_time[1:] > 0)
+    slope = (got[2:] - 1) / d
+    assert np.all(slope < -0.5)  # negative, order one, for every eps
+    np.testing.assert_allclose(slope, carried, rtol=2e-2)
+
+
+def test_exact_flows_and_integration_agree_on_the_grid():
+    p = dict(x2_min=0.96, x2_max=1.04, n_uniform=21, n_geometric=12, closest=1e-12)
+    x2 = x2_grid(p)
+    for theta in (-0.5, 0.5):
+        exact, res, _ = P(0.01, theta, x2)
+        integ, res_i, _ = P(0.01, theta, x2, method="integrate")
+        # Exactly at grazing the exact flow touches H_s; DOP853's orbit (H error
+        # ~1e-14) may dip across instead. Everywhere else: 1e-10, except where the
+        # map itself is ill-conditioned (theta < 0, slope ~ (x2-1)^-1/2 next to the
+        # jump): there the backward error, difference / slope, is below 1e-12.
+        keep = x2 != 1.0
+        slope = np.ones_like(x2)
+        for side in (x2 < 1, x2 > 1):
+            slope[side] = np.abs(np.gradient(exact[side], x2[side]))
+        diff = np.abs(exact - integ)[keep]
+        assert np.all(diff < 1e-10 + 1e-12 * slope[keep])
+        away = keep & (np.abs(x2 - 1) > 1e-6)
+        assert np.all(np.abs(exact - integ)[away] < 1e-10)
+        assert np.max(np.abs(res - res_i)[away]) < 1e-12
+
+
+def test_residual_at_return_is_about_1e_minus_10():
+    _, res, ret = P(0.01, -0.5, np.linspace(1.001, 1.04, 9))
+    assert np.all(ret.n_switches == 2)
+    assert np.all((1e-11 < res) & (res < 1e-9))
+
+
+@pytest.mark.parametrize("theta,case", [(-0.5, 2), (0.5, 1), (-0.1, 2), (0.9, 1)])
+def test_lemma_case_from_sigma_minus(theta, case):
+    model = hopf.model(0.01, theta, MU, OMEGA)
+    sigma, chi = sigma_minus(model)
+    assert sigma == pytest.approx(chi, abs=1e-12)  # eq:eminus reduces to eq:chiminus at p_g
+    assert (1 if sigma > 0 else 2) == case
+    jump = abs(1 - return_map(model, np.array([1 + 1e-12]), "exact", OPTS)[0][0])
+    assert (jump < 1e-10) if case == 1 else (jump > 1e-3)
+
+
+def test_fixed_points_of_the_map():
+    x2 = np.array([0.98, 0.99, 1.0, 1.01, 1.02])
+    for theta in (-0.5, 0.5):
+        got = P(0.01, theta, x2)[0]
+        np.testing.assert_array_equal(fixed_points(x2, got), [1.0])
