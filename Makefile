@@ -4,6 +4,7 @@
 #   make test      run the test suite
 #   make lock      re-resolve requirements.lock in a throw-away venv
 #   make clean     remove workflow outputs (keeps .venv)
+#   make bench-fig04  time the fig04 return maps against scipy solve_ivp
 #
 # The first target that needs Python creates $(VENV) from requirements.lock.
 
@@ -32,7 +33,7 @@ export DEBIAN_FRONTEND = noninteractive
 # `python` inside Snakemake shell rules is the venv's interpreter.
 VENV_PATH = PATH="$(abspath $(VENV))/bin:$$PATH" VIRTUAL_ENV="$(abspath $(VENV))"
 
-.PHONY: all venv figures test lock clean distclean check-python
+.PHONY: all venv figures test bench-fig04 lock clean distclean check-python
 
 all: figures
 
@@ -73,6 +74,12 @@ test: $(VENV)/.done
 	  echo "warning: pytest collected no tests (exit 5); accepted because ALLOW_NO_TESTS is set" >&2; rc=0; \
 	fi; \
 	exit $$rc
+
+# Speed and accuracy of the fig04 return maps against scipy (prints a table;
+# BENCH_ARGS="--every 10" for a quick run).
+BENCH_ARGS ?=
+bench-fig04: $(VENV)/.done
+	$(VENV_PATH) $(PY) -m filippov.benchmarks.fig04_speed $(BENCH_ARGS)
 
 lock: | check-python
 	tmp=$$(mktemp -d); trap 'rm -rf "$$tmp"' EXIT; \

@@ -122,11 +122,20 @@ class _ExactStepper:
 
 class _IntegratingStepper:
     def __init__(self, fun, z, t, t_end, rtol, atol, max_step):
+        calls = [0]
+
         def checked(tt, zz):
-            # scipy's step control loops forever on a NaN error norm: stop at the source
-            v = fun(tt, zz)
+            # scipy's step control loops forever on a NaN error norm. A non-finite
+            # field at the start state is an error; on a trial stage (an overlong
+            # step into overflow) a huge finite value makes DOP853 reject the step.
+            with np.errstate(over="ignore", invalid="ignore"):
+                v = fun(tt, zz)
+            calls[0] += 1
             if not np.all(np.isfinite(v)):
-                raise SimulationError(f"non-finite field value at t={tt!r}, state {np.asarray(zz).tolist()}")
+                if calls[0] == 1:
+                    raise SimulationError(
+                        f"non-finite field value at t={tt!r}, state {np.asarray(zz).tolist()}")
+                v = np.full(np.shape(v), 1e300)
             return v
 
         self.solver = DOP853(checked, t, z, t_end, rtol=rtol, atol=atol,
