@@ -82,3 +82,115 @@ def fig04(n: int = 81) -> xr.Dataset:
          "n_switches": (("theta", "x2"), (P != 1 + k * (x2 - 1)).astype(np.int32)),
          "fixed_point": (("theta", "fixed"), [[1.0], [1.0]])},
         coords={"theta": [-0.5, 0.5], "x2": x2}, attrs={"eps": 0.01, "mu": 1.0})
+
+
+def fig05(n: int = 400, eps: float = 0.01, theta: float = -0.5) -> xr.Dataset:
+    """Circle arcs near p_g, a straight E_- leg and a crude exp(-t/eps) relaxation."""
+    omega = 8 * np.pi
+    phi = np.linspace(0.0, 2 * np.pi, n)
+    ox1, ox2 = -np.cos(phi), -np.sin(phi)            # unit circle through p_g at phi = 0
+    t = np.linspace(0.0, 0.3, n)
+    r = np.where(t < 0.1, 1.004, 0.95)
+    ang = np.pi - 0.1 + omega * (t - 0.1) * (t > 0.1)
+    x1, x2 = r * np.cos(ang), r * np.sin(ang)
+    leg = (t > 0.05) & (t <= 0.1)                     # E_-: x1 increases, x2 fixed
+    x1 = np.where(leg, -1.0 + (t - 0.05), x1)
+    x2 = np.where(leg, 0.1, x2)
+    y = x1 - 3 * eps * np.where(t > 0.05, np.exp(-np.clip(t - 0.1, 0, None) / eps), 0.0)
+    mode = np.where(leg, -1, 1).astype("int8")
+    g1, g2 = np.linspace(-1.04, -0.9, 8), np.linspace(-0.4, 0.3, 9)
+    X1, X2 = np.meshgrid(g1, g2, indexing="ij")
+    ym = X1 + eps * (X1 - omega * X2 - (X1 ** 2 + X2 ** 2) * X1 - 1.0)
+    return xr.Dataset(
+        {"x1": ("t", x1), "x2": ("t", x2), "y": ("t", y), "mode": ("t", mode),
+         "orbit_x1": ("t_orbit", ox1), "orbit_x2": ("t_orbit", ox2),
+         "orbit_y": ("t_orbit", ox1),
+         "switch_t": ("switch", [0.05, 0.1]), "switch_x1": ("switch", [-1.0, -0.95]),
+         "switch_x2": ("switch", [0.1, 0.1]), "switch_y": ("switch", [-1.0, -0.98]),
+         "y_M_plus": (("x1_grid", "x2_grid"), X1), "y_M_minus": (("x1_grid", "x2_grid"), ym),
+         "y_H_s": (("x1_grid", "x2_grid"), (-1.0 - theta * X1) / (1.0 - theta))},
+        coords={"t": t, "x1_grid": g1, "x2_grid": g2},
+        attrs={"eps": eps, "theta": theta, "mu": 1.0, "omega": omega})
+
+
+def fig03(n: int = 300, omega: float = 8 * np.pi) -> xr.Dataset:
+    """Circles of radius sqrt(mu), clipped at x1 = -1 (a crude stand-in for sliding)."""
+    mus = np.array([0.8, 1.0, 1.2])
+    phi = np.linspace(np.pi / 2, np.pi / 2 + 2 * np.pi, n)
+    x1 = np.sqrt(mus)[:, None] * np.cos(phi)
+    x2 = np.sqrt(mus)[:, None] * np.sin(phi)
+    mode = np.where(x1 < -1.0, 0, 1).astype("int8")
+    x1 = np.maximum(x1, -1.0)
+    nan2 = [np.nan, np.nan]
+    return xr.Dataset(
+        {"x1": (("mu", "sample"), x1), "x2": (("mu", "sample"), x2),
+         "mode": (("mu", "sample"), mode), "fixed_x2": ("mu", np.sqrt(mus)),
+         "x_g": ("component", [-1.0, 0.0]),
+         "x_h": (("mu", "component"), [nan2, nan2, [-1.0, np.sqrt(0.2)]]),
+         "x_l": (("mu", "component"), [nan2, nan2, [-1.0, -np.sqrt(0.2)]])},
+        coords={"mu": mus, "component": ["x1", "x2"]}, attrs={"omega": omega})
+
+
+def fig06(n: int = 200, theta: float = 0.5, omega: float = 8 * np.pi) -> xr.Dataset:
+    """eq:xi1r evaluated naively (no care for cancellation: t_s >= 1e-3 only)."""
+    t = np.geomspace(1e-3, 5.0, n)
+    e = np.exp(-t / theta)
+    d = theta + (1 - theta) * e
+    xi1 = -0.5 * omega ** 2 * theta ** 2 * (((1 - theta) * (1 - e) + t) / d) ** 2
+    img = omega ** 2 * (1 - theta) * (theta - (theta + t) * e) / d
+    return xr.Dataset(
+        {"xi1": ("t_s", xi1), "image": ("t_s", img), "s": ("t_s", img / xi1),
+         "slope_at_zero": (theta - 1) / theta, "image_limit": omega ** 2 * (1 - theta)},
+        coords={"t_s": t}, attrs={"theta": theta, "omega": omega})
+
+
+def _pdm_common(xi, eps, P, extra):
+    """Variables both discontinuity-map figures read, on dims (eps, xi1)."""
+    d2 = ("eps", "xi1")
+    data = {"P_DM": (d2, P), "P_flow": (d2, P.copy())}
+    data.update(extra)
+    return xr.Dataset(data, coords={"eps": eps, "xi1": xi}, attrs={"theta": 0.0})
+
+
+def fig07(n: int = 81, theta: float = -0.5, omega: float = 8 * np.pi) -> xr.Dataset:
+    # the corrected expansion plus a made-up O(eps) remainder
+    from filippov.analytic import pdm as a
+    from filippov.analytic.s0 import s0_lambert
+
+    eps = np.array([1e-2, 1e-3, 1e-4])
+    xi = np.linspace(-2.5, 1.5, n)
+    e = eps[:, None]
+    first = a.pdm_theta_neg(xi, theta, omega, e)
+    P = first + np.where(xi < 0, 5 * e * xi ** 2, 0.0)
+    P[-1, xi < -2] -= 3.0  # a stretch where the true flow re-crosses H_s
+    err = np.abs(P - first).max(axis=1)
+    d2 = ("eps", "xi1")
+    ds = _pdm_common(xi, eps, P, {
+        "P_first_order": (d2, first), "P_zero_order": (d2, np.broadcast_to(a.pdm_theta_neg(xi, theta, omega, e, order=0),
+                                             P.shape).copy()),
+        "P_printed": (d2, a.pdm_theta_neg_printed(xi, theta, omega, e)),
+        "s0": float(s0_lambert(theta)), "theta": theta,
+        "error_first_order": ("eps", err), "error_zero_order": ("eps", 3 * np.sqrt(eps)),
+        "error_printed": ("eps", 2.5 + 0 * eps), "left_limit_error": ("eps", 0.2 * eps)})
+    ds["P_flow"].values[-1, xi < -2] += 1.0
+    return ds
+
+
+def fig09(n: int = 121, theta: float = 0.5, omega: float = 8 * np.pi) -> xr.Dataset:
+    from filippov.analytic import pdm as a
+
+    eps = np.array([1e-2, 1e-3, 1e-4])
+    xi = np.unique(np.concatenate([np.linspace(-600, 60, n), np.linspace(-5, 0, 21)]))
+    zero = a.pdm_theta_pos(xi, theta, omega)
+    P = zero[None, :] * (1 + 10 * eps[:, None])
+    d2 = ("eps", "xi1")
+    ds = _pdm_common(xi, eps, P, {
+        "P_zero_order": (d2, np.broadcast_to(zero, P.shape).copy()),
+        "P_printed": (d2, np.broadcast_to(a.pdm_theta_pos(xi, theta, omega, printed=True),
+                                          P.shape).copy()),
+        "P_linear": ("xi1", a.pdm_theta_pos_linear(xi, theta)),
+        "P_reduced": ("xi1", a.pdm_reduced(xi)), "slope_theory": (theta - 1) / theta,
+        "theta": theta, "error": ("eps", np.abs(P - zero).max(axis=1)),
+        "error_core": ("eps", 30 * eps), "error_printed": ("eps", 20 + 0 * eps)})
+    ds.attrs["core"] = 5.0
+    return ds

@@ -123,3 +123,114 @@ def model(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi) -
         sample_step_reduced=period / 64,
         units={"t": "1", "x1": "1", "x2": "1", "y": "1"},
         parameters={"eps": eps, "theta": theta, "mu": mu, "omega": omega})
+
+
+# --------------------------------------------------------------------------- compiled
+def compiled(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi, *,
+             sliding: bool = True):
+    """The slow-fast system z = (x1, x2, y) with its exact flows, compiled for
+    :mod:`filippov.fastmap`, with the section L1 of fig:retmaps (x1 = 0, x1
+    decreasing, x2 > 0). The same formulas as :func:`model`, in scalar form."""
+    check_parameters(eps, theta, mu, omega)
+    if eps <= 0:
+        raise ValueError("eps must be > 0 for the slow-fast system")
+    from ..fastmap import CompiledModel
+
+    pieces = _compiled_pieces()
+    period = 2 * np.pi / abs(omega)
+    return CompiledModel(
+        name="hopf", names=("x1", "x2", "y"),
+        params=np.array([eps, theta, mu, omega], dtype=float), **pieces,
+        section_direction=-1, sample_step=min(eps / 4, period / 64), sliding=sliding,
+        parameters={"eps": eps, "theta": theta, "mu": mu, "omega": omega})
+
+
+_PIECES = {}
+
+
+def _compiled_pieces() -> dict:
+    """numba versions of the pieces; params p = (eps, theta, mu, omega). Each piece
+    is self-contained (no calls to other compiled functions), so numba caches it."""
+    if _PIECES:
+        return _PIECES
+    from numba import njit
+
+    from ..fastmap import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG
+
+    @njit(FLOW_SIG, cache=True)
+    def flow_plus(z0, tau, p, out):
+        eps, mu, omega = p[0], p[2], p[3]
+        x10, x20 = z0[0], z0[1]
+        r02 = x10 * x10 + x20 * x20
+        if r02 == 0.0:
+            x1, x2 = 0.0, 0.0
+        else:
+            e = np.expm1(-2.0 * mu * tau)
+            scale = np.sqrt(mu / (mu + (mu - r02) * e))
+            c, s = np.cos(omega * tau), np.sin(omega * tau)
+            x1, x2 = scale * (c * x10 - s * x20), scale * (s * x10 + c * x20)
+        out[0] = x1
+        out[1] = x2
+        out[2] = x1 + (z0[2] - z0[0]) * np.exp(-tau / eps)
+
+    @njit(FLOW_SIG, cache=True)
+    def flow_minus(z0, tau, p, out):
+        eps, mu, omega = p[0], p[2], p[3]
+        e2, e3, e4 = eps ** 2, eps ** 3, eps ** 4
+        a1, a2 = z0[0], z0[1]
+        r2 = a1 * a1 + a2 * a2
+        ym0 = (a1 + eps * (mu * a1 - omega * a2 - r2 * a1 - 1.0)
+               - e2 * (mu - 3.0 * a1 * a1 - a2 * a2) - 6.0 * e3 * a1 + 6.0 * e4)
+        x1 = z0[0] + tau
+        x2 = z0[1] + 0.0 * tau
+        r2 = x1 * x1 + x2 * x2
+        ym = (x1 + eps * (mu * x1 - omega * x2 - r2 * x1 - 1.0)
+              - e2 * (mu - 3.0 * x1 * x1 - x2 * x2) - 6.0 * e3 * x1 + 6.0 * e4)
+        out[0] = x1
+        out[1] = x2
+        out[2] = ym + (z0[2] - ym0) * np.exp(-tau / eps)
+
+    @njit(FIELD_SIG, cache=True)
+    def field_plus(z, p, out):
+        eps, mu, omega = p[0], p[2], p[3]
+        x1, x2 = z[0], z[1]
+        r2 = x1 * x1 + x2 * x2
+        f1 = mu * x1 - omega * x2 - r2 * x1
+        out[0] = f1
+        out[1] = omega * x1 + mu * x2 - r2 * x2
+        out[2] = (eps * f1 + x1 - z[2]) / eps
+
+    @njit(FIELD_SIG, cache=True)
+    def field_minus(z, p, out):
+        eps, mu, omega = p[0], p[2], p[3]
+        x1, x2 = z[0], z[1]
+        r2 = x1 * x1 + x2 * x2
+        f1 = mu * x1 - omega * x2 - r2 * x1
+        out[0] = 1.0
+        out[1] = 0.0
+        out[2] = (eps * f1 + x1 - z[2]) / eps
+
+    @njit(SCALAR_SIG, cache=True)
+    def h(z, p):
+        theta = p[1]
+        return theta * z[0] + (1 - theta) * z[2] + 1.0
+
+    @njit(FIELD_SIG, cache=True)
+    def grad_h(z, p, out):
+        theta = p[1]
+        out[0] = theta
+        out[1] = 0.0
+        out[2] = 1 - theta
+
+    @njit(SCALAR_SIG, cache=True)
+    def section(z, p):
+        return z[0]
+
+    @njit(WHERE_SIG, cache=True)
+    def section_where(z, p):
+        return z[1] > 0
+
+    _PIECES.update(flow_plus=flow_plus, flow_minus=flow_minus, field_plus=field_plus,
+                   field_minus=field_minus, h=h, grad_h=grad_h, section=section,
+                   section_where=section_where)
+    return _PIECES

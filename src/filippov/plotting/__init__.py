@@ -13,8 +13,13 @@ from . import style
 DRAW = {
     "fig01_slidesketch": "fig01_slidesketch",
     "fig02_cases": "fig02_cases",
+    "fig03_grazingsketch": "fig03_grazingsketch",
     "fig04_retmaps": "fig04_retmaps",
+    "fig05_thetalt0mfs": "fig05_thetalt0mfs",
+    "fig06_sgraph": "fig06_sgraph",
+    "fig07_pdm_theta_neg": "fig07_pdm_theta_neg",
     "fig08_s0theta": "fig08_s0theta",
+    "fig09_pdm_theta_pos": "fig09_pdm_theta_pos",
 }
 
 # No timestamps or tool versions in the files: same data -> same bytes.

@@ -10,8 +10,13 @@ import importlib
 SCENES = {
     "fig01_slidesketch": "fig01_slidesketch",
     "fig02_cases": "fig02_cases",
+    "fig03_grazingsketch": "fig03_grazingsketch",
     "fig04_retmaps": "fig04_retmaps",
+    "fig05_thetalt0mfs": "fig05_thetalt0mfs",
+    "fig06_sgraph": "fig06_sgraph",
+    "fig07_pdm_theta_neg": "fig07_pdm_theta_neg",
     "fig08_s0theta": "fig08_s0theta",
+    "fig09_pdm_theta_pos": "fig09_pdm_theta_pos",
 }
 
 

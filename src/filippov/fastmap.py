@@ -1,0 +1,915 @@
+"""A compiled (numba) fast path for first returns of a piecewise system to a section.
+
+:func:`filippov.poincare.first_returns` runs the event-driven driver of
+:mod:`filippov.simulate` once per start point, in Python. This module runs the
+same algorithm for a whole batch of start points inside one compiled call:
+
+* regions ``+`` (``h >= 0``) and ``-`` are followed with the model's exact
+  flows (both are required), sampled exactly like the reference driver: windows
+  of ``16 sample_step`` from each mode entry, each cut into ``16 samples_per_step``
+  intervals, the flow always taken from the state at the mode entry;
+* the samples are scanned for the same events: ``h`` leaving the region, a
+  hidden grazing crossing (a sign change of ``dh/dt`` whose extremum of ``h``
+  goes through zero; ``|h| <= touch_tol`` there is a touch, not a switch), the
+  section (direction and ``where`` condition); roots are refined with a port of
+  scipy's ``brentq`` (same tolerances) and then stepped to the far side of the
+  crossing;
+* at ``h = 0`` the Filippov decision uses ``a = grad h . F_-`` and
+  ``b = grad h . F_+`` exactly as :func:`filippov.simulate._decide`;
+* sliding is integrated with a port of scipy's ``DOP853`` (same coefficients,
+  step-size control, initial step and 7th-order dense output) with the Filippov
+  field ``(a F_+ - b F_-)/(a - b)``; it ends where ``a`` or ``b`` reaches zero.
+
+Failures never raise inside the compiled code and never hang: each start point
+gets a status code (:data:`STATUS`) -- event or step bound hit, accumulation of
+switches (Zeno), non-finite state, no return within ``t_max``, ...; the wrapper
+:func:`first_returns_compiled` turns a failure into the same exception types as
+the reference driver.
+
+A model enters as a :class:`CompiledModel`: numba-compiled pieces with the
+signatures below (passed to the kernel as first-class functions, so the kernel
+is compiled once -- about 12 s -- cached on disk by numba, and serves every
+model), plus a parameter vector ``params`` handed to every piece. See
+:func:`filippov.models.hopf.compiled`.
+
+One deliberate difference from :func:`filippov.poincare.first_returns`: a start
+point that begins in sliding has that first sliding stretch counted in
+``sliding_time`` (the reference's event bookkeeping skips it). Touches are not
+recorded (they change nothing in a return).
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+import numpy as np
+from numba import njit, types
+from numba.core.errors import NumbaExperimentalFeatureWarning
+from scipy.integrate._ivp import dop853_coefficients as _dop
+
+from .poincare import Returns
+from .progress import Progress
+from .simulate import EXACT_BLOCK, EventLimitError, SimulationError, ZenoError
+from .system import MINUS, PLUS, SLIDING
+
+# ----------------------------------------------------------------------------- signatures
+_vec = types.float64[::1]
+#: ``flow(z0, tau, params, out)``: the exact flow of a region from ``z0`` over ``tau``.
+FLOW_SIG = types.void(_vec, types.float64, _vec, _vec)
+#: ``field(z, params, out)`` (also ``grad_h``).
+FIELD_SIG = types.void(_vec, _vec, _vec)
+#: ``h(z, params)`` and ``section(z, params)``.
+SCALAR_SIG = types.float64(_vec, _vec)
+#: ``where(z, params)``: the condition a section hit must satisfy.
+WHERE_SIG = types.boolean(_vec, _vec)
+
+_FLOW = types.FunctionType(FLOW_SIG)
+_FIELD = types.FunctionType(FIELD_SIG)
+_SCALAR = types.FunctionType(SCALAR_SIG)
+_WHERE = types.FunctionType(WHERE_SIG)
+
+# ----------------------------------------------------------------------------- status codes
+OK = 0
+NO_RETURN = 1      # t_max reached before the section
+EVENT_LIMIT = 2    # more than max_events switches
+STEP_LIMIT = 3     # more than max_steps windows / integration steps
+ZENO = 4           # zeno_count switches within zeno_span
+NON_FINITE = 5     # non-finite state or field value
+NO_SLIDING = 6     # attracting sliding reached, but the model declares no sliding
+STEP_FAILED = 7    # the sliding integrator's step size collapsed
+ROOT_FAILED = 8    # an event could not be bracketed / refined
+BAD_START = 9      # non-finite start point
+
+STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event limit",
+          STEP_LIMIT: "step limit", ZENO: "accumulation of switches (Zeno)",
+          NON_FINITE: "non-finite state or field value",
+          NO_SLIDING: "attracting sliding reached, but the model declares no sliding",
+          STEP_FAILED: "sliding integrator: step size too small",
+          ROOT_FAILED: "event refinement failed (no bracket or no convergence)",
+          BAD_START: "non-finite start point"}
+
+# crossing predicates (simulate.TO_NEG, TO_NONNEG, TO_NONPOS, _EitherWay)
+_TO_NEG, _TO_NONNEG, _TO_NONPOS, _EITHER = 0, 1, 2, 3
+# scalar functions of the state whose zeros are events
+_S_H, _S_A, _S_B, _S_SEC = 0, 1, 2, 3
+# what an event is
+_W_NONE, _W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_SECTION = -1, 0, 1, 2, 3
+
+_TINY = np.finfo(float).tiny
+_EPS = np.finfo(float).eps
+
+# ----------------------------------------------------------------------------- DOP853 tableau
+# The coefficients of scipy's DOP853, which the reference driver integrates sliding
+# with (the sliding field is autonomous: the nodes C are not needed).
+_NS = _dop.N_STAGES              # 12
+_NSE = _dop.N_STAGES_EXTENDED    # 16
+_NI = _dop.INTERPOLATOR_POWER    # 7
+_A = np.ascontiguousarray(_dop.A, dtype=np.float64)
+_B = np.ascontiguousarray(_dop.B, dtype=np.float64)
+_E3 = np.ascontiguousarray(_dop.E3, dtype=np.float64)
+_E5 = np.ascontiguousarray(_dop.E5, dtype=np.float64)
+_D = np.ascontiguousarray(_dop.D, dtype=np.float64)
+_SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
+_ERR_EXP = -1.0 / (7 + 1)  # error estimator order 7
+
+
+# Every helper below works on arrays it is handed and allocates nothing, so it is
+# compiled without numba's reference counting (_nrt=False): otherwise each call
+# of a helper pays an atomic incref/decref per array argument, which was half the
+# run time. Only the kernel _batch allocates (its work arrays, once per call).
+_jit = njit(cache=True, _nrt=False)
+
+
+# ============================================================================= predicates
+@_jit
+def _before(pred, v):
+    if pred == _TO_NEG:
+        return v >= 0.0
+    if pred == _TO_NONNEG:
+        return v < 0.0
+    return v > 0.0  # _TO_NONPOS
+
+
+@_jit
+def _after(pred, v):
+    if pred == _TO_NEG:
+        return v < 0.0
+    if pred == _TO_NONNEG:
+        return v >= 0.0
+    if pred == _TO_NONPOS:
+        return v <= 0.0
+    return True  # _EITHER: both refinements end at a root
+
+
+@_jit
+def _crosses(pred, v0, v1):
+    if pred == _EITHER:
+        return (v0 < 0.0 and v1 >= 0.0) or (v0 > 0.0 and v1 <= 0.0)
+    return _before(pred, v0) and _after(pred, v1)
+
+
+@_jit
+def _clamp(pred, v0):
+    if _before(pred, v0):
+        return v0
+    if pred == _TO_NEG:
+        return 0.0
+    if pred == _TO_NONNEG:
+        return -_TINY
+    return _TINY
+
+
+# ============================================================================= model pieces
+@_jit
+def _dot(u, v):
+    s = 0.0
+    for k in range(u.size):
+        s += u[k] * v[k]
+    return s
+
+
+@_jit
+def _speeds(z, fns, p, wg, wm, wp):
+    """(a, b) = (grad h . F_-, grad h . F_+) at z; fills wg, wm, wp."""
+    fns[5](z, p, wg)
+    fns[3](z, p, wm)
+    fns[2](z, p, wp)
+    return _dot(wg, wm), _dot(wg, wp)
+
+
+@_jit
+def _scalar(sel, z, fns, p, wg, wf):
+    if sel == _S_H:
+        return fns[4](z, p)
+    if sel == _S_SEC:
+        return fns[6](z, p)
+    fns[5](z, p, wg)
+    if sel == _S_A:
+        fns[3](z, p, wf)
+    else:
+        fns[2](z, p, wf)
+    return _dot(wg, wf)
+
+
+@_jit
+def _dense_eval(t, t_old, hs, y_old, F, out):
+    """scipy's Dop853DenseOutput at a scalar t."""
+    x = (t - t_old) / hs
+    n = y_old.size
+    for k in range(n):
+        out[k] = 0.0
+    for i in range(_NI):
+        r = _NI - 1 - i
+        for k in range(n):
+            out[k] += F[r, k]
+            if i % 2 == 0:
+                out[k] *= x
+            else:
+                out[k] *= 1.0 - x
+    for k in range(n):
+        out[k] += y_old[k]
+
+
+# A segment of the current mode: exact flow from za at time sg[0], or the dense
+# output (F, y_old) of the sliding step [sg[1], sg[1] + sg[2]].
+@_jit
+def _zat(t, mode, sg, za, F, y_old, fns, p, out):
+    if mode == PLUS:
+        fns[0](za, t - sg[0], p, out)
+    elif mode == MINUS:
+        fns[1](za, t - sg[0], p, out)
+    else:
+        _dense_eval(t, sg[1], sg[2], y_old, F, out)
+
+
+@_jit
+def _fval(sel, t, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
+    _zat(t, mode, sg, za, F, y_old, fns, p, wz)
+    return _scalar(sel, wz, fns, p, wg, wf)
+
+
+# ============================================================================= root finding
+@_jit
+def _brentq(sel, xa, xb, xtol, rtol, maxiter, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
+    """scipy.optimize.brentq (scipy/optimize/Zeros/brentq.c); returns (root, ok)."""
+    xpre, xcur = xa, xb
+    xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
+    fpre = _fval(sel, xpre, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+    fcur = _fval(sel, xcur, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+    if np.isnan(fpre) or np.isnan(fcur):
+        return xcur, False
+    if fpre == 0.0:
+        return xpre, True
+    if fcur == 0.0:
+        return xcur, True
+    if (fpre < 0.0) == (fcur < 0.0):
+        return xcur, False
+    for _ in range(maxiter):
+        if fpre != 0.0 and fcur != 0.0 and ((fpre < 0.0) != (fcur < 0.0)):
+            xblk = xpre
+            fblk = fpre
+            spre = scur = xcur - xpre
+        if abs(fblk) < abs(fcur):
+            xpre = xcur
+            xcur = xblk
+            xblk = xpre
+            fpre = fcur
+            fcur = fblk
+            fblk = fpre
+        delta = (xtol + rtol * abs(xcur)) / 2.0
+        sbis = (xblk - xcur) / 2.0
+        if fcur == 0.0 or abs(sbis) < delta:
+            return xcur, True
+        if abs(spre) > delta and abs(fcur) < abs(fpre):
+            if xpre == xblk:
+                stry = -fcur * (xcur - xpre) / (fcur - fpre)  # interpolate
+            else:  # extrapolate
+                dpre = (fpre - fcur) / (xpre - xcur)
+                dblk = (fblk - fcur) / (xblk - xcur)
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - delta):
+                spre = scur
+                scur = stry
+            else:
+                spre = sbis
+                scur = sbis
+        else:
+            spre = sbis
+            scur = sbis
+        xpre = xcur
+        fpre = fcur
+        if abs(scur) > delta:
+            xcur += scur
+        else:
+            xcur += delta if sbis > 0 else -delta
+        fcur = _fval(sel, xcur, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+        if np.isnan(fcur):
+            return xcur, False
+    return xcur, False
+
+
+@_jit
+def _refine(sel, pred, ta, tb, va, xtol, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
+    """simulate._refine: root in [ta, tb] on the far side of the crossing; (t, ok)."""
+    if va == 0.0:
+        r = ta
+    else:
+        r, ok = _brentq(sel, ta, tb, xtol, 4.0 * _EPS, 200, mode, sg, za, F, y_old, fns, p,
+                        wz, wg, wf)
+        if not ok:
+            return r, False
+    a = max(abs(r), _TINY)
+    step = 2.0 * (np.nextafter(a, np.inf) - a)
+    while not _after(pred, _fval(sel, r, mode, sg, za, F, y_old, fns, p, wz, wg, wf)):
+        if r >= tb:
+            return tb, True
+        r = min(r + step, tb)
+        step *= 2.0
+    return r, True
+
+
+# ============================================================================= event scan
+@_jit
+def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, svals,
+            wz, wg, wf, wp, zlast):
+    """Samples of one window: times ts, the leave functions (h, or a and b when
+    sliding), dh/dt and the section; the last state in zlast. False: non-finite."""
+    for k in range(ns):
+        tk = ta + frac[k] * (tb - ta) if k < ns - 1 else tb
+        ts[k] = tk
+        _zat(tk, mode, sg, za, F, y_old, fns, p, wz)
+        for c in range(wz.size):
+            if not np.isfinite(wz[c]):
+                return False
+        if mode == SLIDING:
+            a, b = _speeds(wz, fns, p, wg, wf, wp)
+            vals[0, k] = a
+            vals[1, k] = b
+        else:
+            vals[0, k] = fns[4](wz, p)
+            fns[5](wz, p, wg)
+            if mode == PLUS:
+                fns[2](wz, p, wf)
+            else:
+                fns[3](wz, p, wf)
+            dvals[k] = _dot(wg, wf)
+        svals[k] = fns[6](wz, p)
+    for c in range(wz.size):
+        zlast[c] = wz[c]
+    return True
+
+
+@_jit
+def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, sg, za, F, y_old, fns, p,
+          vals, dvals, svals, wz, wg, wf):
+    """simulate._scan on the samples: the earliest event; (status, t, what)."""
+    if mode == PLUS:
+        nleave, sel0, pred0, what0, sel_d = 1, _S_H, _TO_NEG, _W_SWITCH, _S_B
+    elif mode == MINUS:
+        nleave, sel0, pred0, what0, sel_d = 1, _S_H, _TO_NONNEG, _W_SWITCH, _S_A
+    else:
+        nleave, sel0, pred0, what0, sel_d = 2, _S_A, _TO_NONPOS, _W_EXIT_MINUS, _S_A
+    if first:  # just entered this mode: its start is inside by construction
+        vals[0, 0] = _clamp(pred0, vals[0, 0])
+        if nleave == 2:
+            vals[1, 0] = _clamp(_TO_NONNEG, vals[1, 0])
+    for i in range(ns - 1):
+        c0 = _crosses(pred0, vals[0, i], vals[0, i + 1])
+        c1 = nleave == 2 and _crosses(_TO_NONNEG, vals[1, i], vals[1, i + 1])
+        if mode == PLUS:
+            cd = dvals[i] < 0.0 and dvals[i + 1] >= 0.0
+        elif mode == MINUS:
+            cd = dvals[i] > 0.0 and dvals[i + 1] <= 0.0
+        else:
+            cd = False
+        cs = _crosses(sec_pred, svals[i], svals[i + 1])
+        if not (c0 or c1 or cd or cs):
+            continue
+        ta, tb = ts[i], ts[i + 1]
+        best_t, best_w = np.inf, _W_NONE
+        if c0:
+            r, ok = _refine(sel0, pred0, ta, tb, vals[0, i], xtol, mode, sg, za, F, y_old,
+                            fns, p, wz, wg, wf)
+            if not ok:
+                return ROOT_FAILED, r, _W_NONE
+            best_t, best_w = r, what0
+        if c1:
+            r, ok = _refine(_S_B, _TO_NONNEG, ta, tb, vals[1, i], xtol, mode, sg, za, F,
+                            y_old, fns, p, wz, wg, wf)
+            if not ok:
+                return ROOT_FAILED, r, _W_NONE
+            if best_w == _W_NONE or r < best_t:
+                best_t, best_w = r, _W_EXIT_PLUS
+        if mode != SLIDING and best_w == _W_NONE and cd:
+            # a minimum (in +) or maximum (in -) of h hidden between samples
+            tm, ok = _brentq(sel_d, ta, tb, xtol, 4.0 * _EPS, 100, mode, sg, za, F, y_old,
+                             fns, p, wz, wg, wf)
+            if not ok:
+                return ROOT_FAILED, tm, _W_NONE
+            hm = _fval(_S_H, tm, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+            if (mode == PLUS and hm < -touch_tol) or (mode == MINUS and hm > touch_tol):
+                r, ok = _refine(_S_H, pred0, ta, tm, vals[0, i], xtol, mode, sg, za, F,
+                                y_old, fns, p, wz, wg, wf)
+                if not ok:
+                    return ROOT_FAILED, r, _W_NONE
+                best_t, best_w = r, _W_SWITCH
+            # |hm| <= touch_tol: a touch, not an event
+        if cs:
+            r, ok = _refine(_S_SEC, sec_pred, ta, tb, svals[i], xtol, mode, sg, za, F, y_old,
+                            fns, p, wz, wg, wf)
+            if not ok:
+                return ROOT_FAILED, r, _W_NONE
+            if best_w == _W_NONE or r < best_t:
+                _zat(r, mode, sg, za, F, y_old, fns, p, wz)
+                if fns[7](wz, p):
+                    best_t, best_w = r, _W_SECTION
+        if best_w != _W_NONE:
+            return OK, best_t, best_w
+    return OK, np.inf, _W_NONE
+
+
+# ============================================================================= DOP853
+@_jit
+def _checked_field(z, first_call, fns, p, wg, wm, wp, out):
+    """The sliding field with simulate._IntegratingStepper's guard: a non-finite
+    value at the first call is an error (False), on a trial stage it is 1e300."""
+    a, b = _speeds(z, fns, p, wg, wm, wp)
+    finite = True
+    for k in range(z.size):
+        out[k] = (a * wp[k] - b * wm[k]) / (a - b)
+        if not np.isfinite(out[k]):
+            finite = False
+    if not finite:
+        if first_call:
+            return False
+        for k in range(z.size):
+            out[k] = 1e300
+    return True
+
+
+@_jit
+def _rms(x, scale):
+    s = 0.0
+    for k in range(x.size):
+        q = x[k] / scale[k]
+        s += q * q
+    return np.sqrt(s) / np.sqrt(x.size)
+
+
+@_jit
+def _dop_initial_step(t0, y0, f0, t_bound, max_step, rtol, atol, fns, p, wg, wm, wp,
+                      y1, f1, scale):
+    """scipy.integrate._ivp.common.select_initial_step for DOP853 (order 7)."""
+    interval = abs(t_bound - t0)
+    if interval == 0.0:
+        return 0.0
+    n = y0.size
+    for k in range(n):
+        scale[k] = atol + abs(y0[k]) * rtol
+    d0 = _rms(y0, scale)
+    d1 = _rms(f0, scale)
+    if d0 < 1e-5 or d1 < 1e-5:
+        h0 = 1e-6
+    else:
+        h0 = 0.01 * d0 / d1
+    h0 = min(h0, interval)
+    for k in range(n):
+        y1[k] = y0[k] + h0 * f0[k]
+    _checked_field(y1, False, fns, p, wg, wm, wp, f1)
+    s = 0.0
+    for k in range(n):
+        q = (f1[k] - f0[k]) / scale[k]
+        s += q * q
+    d2 = np.sqrt(s) / np.sqrt(n) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, interval, max_step)
+
+
+@_jit
+def _dop_step(t, y, f, h_abs, t_bound, max_step, rtol, atol, fns, p, wg, wm, wp,
+              K, ynew, ytmp, scale):
+    """One accepted step of scipy's DOP853 (RungeKutta._step_impl).
+
+    Returns (ok, t_new, h, h_abs_next); K holds the stages, ynew the new state,
+    K[_NS] the field there."""
+    n = y.size
+    min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+    if h_abs > max_step:
+        h_abs = max_step
+    elif h_abs < min_step:
+        h_abs = min_step
+    rejected = False
+    while True:
+        if not h_abs >= min_step:  # also stops a NaN step size
+            return False, t, 0.0, h_abs
+        h = h_abs
+        t_new = t + h
+        if t_new - t_bound > 0.0:
+            t_new = t_bound
+        h = t_new - t
+        h_abs = abs(h)
+        # rk_step
+        for k in range(n):
+            K[0, k] = f[k]
+        for s in range(1, _NS):
+            for k in range(n):
+                acc = 0.0
+                for j in range(s):
+                    acc += K[j, k] * _A[s, j]
+                ytmp[k] = y[k] + acc * h
+            _checked_field(ytmp, False, fns, p, wg, wm, wp, K[s])
+        for k in range(n):
+            acc = 0.0
+            for j in range(_NS):
+                acc += K[j, k] * _B[j]
+            ynew[k] = y[k] + h * acc
+        _checked_field(ynew, False, fns, p, wg, wm, wp, K[_NS])
+        # error norm (DOP853._estimate_error_norm)
+        for k in range(n):
+            scale[k] = atol + max(abs(y[k]), abs(ynew[k])) * rtol
+        e5, e3 = 0.0, 0.0
+        for k in range(n):
+            a5, a3 = 0.0, 0.0
+            for j in range(_NS + 1):
+                a5 += K[j, k] * _E5[j]
+                a3 += K[j, k] * _E3[j]
+            a5 /= scale[k]
+            a3 /= scale[k]
+            e5 += a5 * a5
+            e3 += a3 * a3
+        e5 = np.sqrt(e5) ** 2
+        e3 = np.sqrt(e3) ** 2
+        if e5 == 0.0 and e3 == 0.0:
+            err = 0.0
+        else:
+            err = abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * n)
+        if err < 1.0:
+            if err == 0.0:
+                factor = _MAX_FACTOR
+            else:
+                factor = min(_MAX_FACTOR, _SAFETY * err ** _ERR_EXP)
+            if rejected:
+                factor = min(1.0, factor)
+            return True, t_new, h, h_abs * factor
+        q = _SAFETY * err ** _ERR_EXP
+        h_abs *= q if q > _MIN_FACTOR else _MIN_FACTOR  # max(MIN_FACTOR, q), NaN -> MIN_FACTOR
+        rejected = True
+
+
+@_jit
+def _dop_dense(h, y_old, y, f_old, f, fns, p, wg, wm, wp, K, ytmp, F):
+    """DOP853._dense_output_impl: extra stages and the interpolant F (7, n)."""
+    n = y.size
+    for s in range(_NS + 1, _NSE):
+        for k in range(n):
+            acc = 0.0
+            for j in range(s):
+                acc += K[j, k] * _A[s, j]
+            ytmp[k] = y_old[k] + acc * h
+        _checked_field(ytmp, False, fns, p, wg, wm, wp, K[s])
+    for k in range(n):
+        dy = y[k] - y_old[k]
+        F[0, k] = dy
+        F[1, k] = h * f_old[k] - dy
+        F[2, k] = 2.0 * dy - h * (f[k] + f_old[k])
+        for r in range(_NI - 3):
+            acc = 0.0
+            for j in range(_NSE):
+                acc += _D[r, j] * K[j, k]
+            F[3 + r, k] = h * acc
+
+
+# ============================================================================= one start point
+@_jit
+def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
+    """simulate.initial_mode."""
+    H = fns[4](z, p)
+    if abs(H) > touch_tol:
+        return PLUS if H > 0 else MINUS
+    a, b = _speeds(z, fns, p, wg, wm, wp)
+    if a > 0 and b < 0:
+        return SLIDING if sliding else PLUS
+    if a < 0 and b < 0:
+        return MINUS
+    if a > 0 and b > 0:
+        return PLUS
+    if a < 0 < b:
+        return PLUS
+    return PLUS if H >= 0 else MINUS
+
+
+@_jit
+def _one(z0, fns, p, t_max, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
+         ts, vals, dvals, svals, recent, sg, za, y, f, y_old, f_old, K, ynew, ytmp, scale,
+         F, wz, wg, wf, wp, z):
+    """First return of z0 (the state at the return, or where the run stopped, in z);
+    (status, t, n_switches, sliding_time)."""
+    rtol, atol, touch_tol, xtol = fopts[0], fopts[1], fopts[2], fopts[3]
+    zeno_span, max_step = fopts[4], fopts[5]
+    max_events, max_steps, zeno_count = iopts[0], iopts[1], iopts[2]
+    n = z0.size
+    t = 0.0
+    for k in range(n):
+        z[k] = z0[k]
+        if not np.isfinite(z0[k]):
+            return BAD_START, t, 0, 0.0
+    mode = _initial_mode(z, fns, p, touch_tol, sliding, wg, wf, wp)
+    n_switch = 0
+    n_steps = 0
+    slide_time = 0.0
+    slide_since = t
+    n_recent = 0
+    while True:
+        if t >= t_max:
+            return NO_RETURN, t, n_switch, slide_time
+        if mode == SLIDING and not sliding:
+            return NO_SLIDING, t, n_switch, slide_time
+        first = True
+        what = _W_NONE
+        te = t
+        if mode != SLIDING:
+            # the exact flow from the mode entry, in windows of hwin
+            for k in range(n):
+                za[k] = z[k]
+            sg[0] = t
+            ns = frac_ex.size
+            ta = t
+            while True:
+                n_steps += 1
+                if n_steps > max_steps:
+                    return STEP_LIMIT, t, n_switch, slide_time
+                tb = min(ta + hwin, t_max)
+                if tb == ta:
+                    tb = np.nextafter(ta, np.inf)
+                if not _sample(mode, ta, tb, frac_ex, ns, sg, za, F, y_old, fns, p, ts, vals,
+                               dvals, svals, wz, wg, wf, wp, ynew):
+                    return NON_FINITE, ta, n_switch, slide_time
+                st, te, what = _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, sg, za,
+                                     F, y_old, fns, p, vals, dvals, svals, wz, wg, wf)
+                if st != OK:
+                    return st, ta, n_switch, slide_time
+                first = False
+                if what == _W_NONE:
+                    t = tb
+                    for c in range(n):
+                        z[c] = ynew[c]
+                    if tb >= t_max:
+                        return NO_RETURN, t, n_switch, slide_time
+                    ta = tb
+                    continue
+                _zat(te, mode, sg, za, F, y_old, fns, p, z)
+                t = te
+                break
+        else:
+            # DOP853 from (t, z) to t_max with the Filippov sliding field
+            for k in range(n):
+                y[k] = z[k]
+            if not _checked_field(y, True, fns, p, wg, wf, wp, f):
+                return NON_FINITE, t, n_switch, slide_time
+            h_abs = _dop_initial_step(t, y, f, t_max, max_step, rtol, atol, fns, p, wg, wf, wp,
+                                      ynew, ytmp, scale)
+            ns = frac_in.size
+            tcur = t
+            while True:
+                n_steps += 1
+                if n_steps > max_steps:
+                    return STEP_LIMIT, t, n_switch, slide_time
+                ok, t_new, hstep, h_abs = _dop_step(tcur, y, f, h_abs, t_max, max_step, rtol,
+                                                    atol, fns, p, wg, wf, wp, K, ynew, ytmp,
+                                                    scale)
+                if not ok:
+                    return STEP_FAILED, tcur, n_switch, slide_time
+                for k in range(n):
+                    y_old[k] = y[k]
+                    f_old[k] = f[k]
+                    y[k] = ynew[k]
+                    f[k] = K[_NS, k]
+                ta, tb = tcur, t_new
+                tcur = t_new
+                _dop_dense(hstep, y_old, y, f_old, f, fns, p, wg, wf, wp, K, ytmp, F)
+                sg[1] = ta
+                sg[2] = tb - ta
+                if not _sample(mode, ta, tb, frac_in, ns, sg, za, F, y_old, fns, p, ts, vals,
+                               dvals, svals, wz, wg, wf, wp, ynew):
+                    return NON_FINITE, ta, n_switch, slide_time
+                st, te, what = _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, sg, za,
+                                     F, y_old, fns, p, vals, dvals, svals, wz, wg, wf)
+                if st != OK:
+                    return st, ta, n_switch, slide_time
+                first = False
+                if what == _W_NONE:
+                    t = tb
+                    for c in range(n):
+                        z[c] = ynew[c]
+                    if tb >= t_max:
+                        return NO_RETURN, t, n_switch, slide_time
+                    continue
+                _zat(te, mode, sg, za, F, y_old, fns, p, z)
+                t = te
+                break
+        # ---- an event at (t, z)
+        if what == _W_SECTION:
+            if mode == SLIDING:
+                slide_time += t - slide_since
+            return OK, t, n_switch, slide_time
+        a, b = _speeds(z, fns, p, wg, wf, wp)
+        if what == _W_EXIT_MINUS:
+            new_mode = MINUS
+        elif what == _W_EXIT_PLUS:
+            new_mode = PLUS
+        elif mode == PLUS:
+            new_mode = SLIDING if a > 0 else MINUS
+        else:
+            new_mode = SLIDING if b < 0 else PLUS
+        if new_mode == SLIDING and not sliding:
+            return NO_SLIDING, t, n_switch, slide_time
+        if mode == SLIDING:
+            slide_time += t - slide_since
+        if new_mode == SLIDING:
+            slide_since = t
+        if new_mode != mode:
+            n_switch += 1
+        if n_switch > max_events:
+            return EVENT_LIMIT, t, n_switch, slide_time
+        recent[n_recent % zeno_count] = t
+        n_recent += 1
+        if n_recent >= zeno_count:
+            oldest = recent[n_recent % zeno_count]
+            if t - oldest <= zeno_span * max(1.0, abs(t)):
+                return ZENO, t, n_switch, slide_time
+        mode = new_mode
+
+
+_KERNEL_SIG = types.void(
+    _FLOW, _FLOW, _FIELD, _FIELD, _SCALAR, _FIELD, _SCALAR, _WHERE,  # the model
+    _vec,                       # params
+    types.float64[:, ::1],      # starts (m, n)
+    types.float64,              # t_max
+    types.float64,              # window length of the exact flows
+    types.int64,                # section predicate
+    types.boolean,              # sliding declared
+    _vec, _vec,                 # sample fractions: exact windows, integration steps
+    _vec,                       # rtol, atol, touch_tol, event_xtol, zeno_span, max_step
+    types.int64[::1],           # max_events, max_steps, zeno_count
+    types.float64[:, ::1], _vec, types.int64[::1], _vec, types.int64[::1])  # outputs
+
+
+@njit(cache=True)
+def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, p,
+           starts, t_max, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
+           out_state, out_time, out_nsw, out_slide, out_status):
+    fns = (flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where)
+    m, n = starts.shape
+    nsmax = max(frac_ex.size, frac_in.size)
+    ts = np.empty(nsmax)
+    vals = np.empty((2, nsmax))
+    dvals = np.empty(nsmax)
+    svals = np.empty(nsmax)
+    recent = np.empty(max(iopts[2], 1))
+    sg = np.zeros(3)
+    za, y, f = np.zeros(n), np.zeros(n), np.zeros(n)
+    y_old, f_old, ynew, ytmp, scale = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+                                       np.zeros(n))
+    wz, wg, wf, wp = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+    K = np.zeros((_NSE, n))
+    F = np.zeros((_NI, n))
+    z = np.zeros(n)
+    for i in range(m):
+        st, t, nsw, sl = _one(starts[i], fns, p, t_max, hwin, sec_pred, sliding, frac_ex,
+                              frac_in, fopts, iopts, ts, vals, dvals, svals, recent, sg, za, y,
+                              f, y_old, f_old, K, ynew, ytmp, scale, F, wz, wg, wf, wp, z)
+        for c in range(n):
+            out_state[i, c] = z[c]
+        out_status[i] = st
+        out_time[i] = t
+        out_nsw[i] = nsw
+        out_slide[i] = sl
+
+
+# ============================================================================= Python side
+def compile_kernel() -> bool:
+    """Compile the kernel for its one signature (or load it from numba's on-disk
+    cache); done on first use. Returns True if it was loaded from the cache."""
+    if not _batch.signatures:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)
+            _batch.compile(_KERNEL_SIG)
+        _batch.disable_compile()  # any other argument types are an error, not a recompile
+    return sum(_batch.stats.cache_hits.values()) > 0
+
+
+@dataclass(frozen=True)
+class CompiledModel:
+    """A piecewise system (region + is ``h >= 0``) with exact flows in both regions
+    and a section, as numba-compiled functions with the module's signatures.
+
+    ``flow_plus``/``flow_minus``: :data:`FLOW_SIG`; ``field_plus``/``field_minus``/
+    ``grad_h``: :data:`FIELD_SIG`; ``h``/``section``: :data:`SCALAR_SIG`;
+    ``section_where``: :data:`WHERE_SIG`. Every piece receives ``params``.
+    ``section_direction`` -1 counts decreasing crossings of ``section(z) = 0``,
+    +1 increasing, 0 both. ``sample_step`` is the longest time between samples
+    of an exact flow (it must resolve the fastest time scale).
+    """
+
+    name: str
+    names: tuple
+    params: np.ndarray
+    flow_plus: Any
+    flow_minus: Any
+    field_plus: Any
+    field_minus: Any
+    h: Any
+    grad_h: Any
+    section: Any
+    section_where: Any
+    section_direction: int
+    sample_step: float
+    sliding: bool = True
+    parameters: Mapping[str, float] = field(default_factory=dict)
+
+    @property
+    def dim(self) -> int:
+        return len(self.names)
+
+
+@dataclass(frozen=True)
+class BatchReturns:
+    """Raw kernel output: ``status[i] == OK`` where start ``i`` returned; elsewhere
+    ``state``/``time`` are where the run stopped (see :data:`STATUS`)."""
+
+    state: np.ndarray
+    time: np.ndarray
+    n_switches: np.ndarray
+    sliding_time: np.ndarray
+    status: np.ndarray
+
+
+def _section_pred(direction: int) -> int:
+    if direction < 0:
+        return _TO_NONPOS
+    if direction > 0:
+        return _TO_NONNEG
+    return _EITHER
+
+
+def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float = 1e-12,
+                    atol: float = 1e-14, max_step: float = np.inf, max_events: int = 100_000,
+                    max_steps: int = 5_000_000, samples_per_step: int = 4,
+                    touch_tol: float = 1e-15, event_xtol: float = 1e-15, zeno_count: int = 64,
+                    zeno_span: float = 1e-10) -> BatchReturns:
+    """First returns of ``starts`` (``(m, dim)``) to the model's section, one compiled call.
+
+    Options mean what they mean for :func:`filippov.simulate.simulate`. Nothing is
+    raised for a start point that fails: see ``status``.
+    """
+    starts = np.ascontiguousarray(np.atleast_2d(np.asarray(starts, dtype=float)))
+    if starts.ndim != 2 or starts.shape[1] != cmodel.dim:
+        raise ValueError(f"start points must have shape (m, {cmodel.dim}) "
+                         f"({', '.join(cmodel.names)}), got {starts.shape}")
+    if not np.all(np.isfinite(starts)):
+        raise ValueError("start points must be finite")
+    if not (np.isfinite(t_max) and t_max >= 0):
+        raise ValueError(f"need a finite t_max >= 0, got {t_max!r}")
+    if samples_per_step < 1:
+        raise ValueError("samples_per_step must be >= 1")
+    if not max_step > 0:
+        raise ValueError(f"max_step must be > 0, got {max_step!r}")
+    if zeno_count < 1:
+        raise ValueError("zeno_count must be >= 1")
+    if not (np.isfinite(cmodel.sample_step) and cmodel.sample_step > 0):
+        raise ValueError(f"the compiled model needs a finite sample_step > 0, "
+                         f"got {cmodel.sample_step!r}")
+    hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max)
+    frac_ex = np.linspace(0.0, 1.0, EXACT_BLOCK * samples_per_step + 1)
+    frac_in = np.linspace(0.0, 1.0, samples_per_step + 1)
+    fopts = np.array([rtol, atol, touch_tol, event_xtol, zeno_span, max_step], dtype=float)
+    iopts = np.array([max_events, max_steps, zeno_count], dtype=np.int64)
+    m = starts.shape[0]
+    state = np.empty_like(starts)
+    time = np.empty(m)
+    nsw = np.empty(m, dtype=np.int64)
+    slide = np.empty(m)
+    status = np.empty(m, dtype=np.int64)
+    params = np.ascontiguousarray(cmodel.params, dtype=float)
+    compile_kernel()
+    _batch(cmodel.flow_plus, cmodel.flow_minus, cmodel.field_plus, cmodel.field_minus,
+           cmodel.h, cmodel.grad_h, cmodel.section, cmodel.section_where, params,
+           starts, float(t_max), float(hwin), _section_pred(cmodel.section_direction),
+           bool(cmodel.sliding), frac_ex, frac_in, fopts, iopts, state, time, nsw, slide, status)
+    return BatchReturns(state, time, nsw, slide, status)
+
+
+_ERRORS = {EVENT_LIMIT: EventLimitError, STEP_LIMIT: EventLimitError, ZENO: ZenoError}
+
+
+def first_returns_compiled(cmodel: CompiledModel, starts, t_max: float, *,
+                           progress: Progress | None = None, **options) -> Returns:
+    """:func:`filippov.poincare.first_returns` on the compiled path.
+
+    ``options`` go to :func:`compute_returns`; ``progress`` is stepped once by
+    the number of start points, after the batch. A start point that does not return
+    is an error naming it (the first one, with its status), raised as the
+    reference driver would: :class:`EventLimitError` for the event and step
+    bounds, :class:`ZenoError`, :class:`SimulationError` for a numerical
+    failure, RuntimeError for no return within ``t_max``.
+    """
+    out = compute_returns(cmodel, starts, t_max, **options)
+    if progress is not None:
+        progress.step(out.status.size)
+    bad = np.flatnonzero(out.status != OK)
+    if bad.size:
+        i = int(bad[0])
+        code = int(out.status[i])
+        z0 = np.atleast_2d(np.asarray(starts, dtype=float))[i]
+        msg = (f"start point {z0.tolist()} did not return to the section of "
+               f"{cmodel.name!r} within t_max={t_max!r}: {STATUS[code]} at t={out.time[i]!r}, "
+               f"state {out.state[i].tolist()} ({bad.size} of {out.status.size} start "
+               f"points failed)")
+        if code == NO_RETURN:
+            raise RuntimeError(msg)
+        raise _ERRORS.get(code, SimulationError)(msg)
+    return Returns(out.state, out.time, out.n_switches, out.sliding_time)

@@ -1,0 +1,48 @@
+"""fig:p:xi12: the graph s(theta, omega, xi1, 0) xi1 against xi1 (eq:xi1r),
+parametrised by the sliding time t_s, from the closed forms in analytic.sgraph."""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ..analytic import sgraph
+from ..io import finalize
+from .common import require
+
+
+def t_grid(p: dict) -> np.ndarray:
+    """Geometric in t_s from t_min (resolves xi1 ~ t_s^2 near 0) joined to a uniform grid."""
+    lo, hi = float(p["t_min"]), float(p["t_max"])
+    geo = np.geomspace(lo, hi, int(p["n_geometric"]))
+    lin = np.linspace(0.0, hi, int(p["n_linear"]))[1:]
+    return np.unique(np.concatenate([geo, lin[lin > lo]]))
+
+
+def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    require(scene, "system", {"none"})
+    require(scene, "flow", {"closed_form"})
+    p = scene["parameters"]
+    if not 0 < p["t_min"] < p["t_max"]:
+        raise ValueError(f"{scene['id']}: 0 < parameters.t_min < parameters.t_max required, "
+                         f"got {p['t_min']!r}, {p['t_max']!r}")
+    theta, omega = float(p["theta"]), float(p["omega"])
+    t = t_grid(p)
+    xi1 = sgraph.xi1(t, theta, omega)
+    img = sgraph.image(t, theta, omega)
+    s_direct = sgraph.slope(t, theta, omega)
+    s = img / xi1
+    ds = xr.Dataset(
+        {"xi1": ("t_s", xi1, {"long_name": "xi1, rescaled x1 before sliding (eq:xi1r)",
+                              "units": "1", "equation": "eq:xi1r"}),
+         "image": ("t_s", img, {"long_name": "s(theta, omega, xi1, 0) xi1 = P_DM(xi1) (eq:xi1r)",
+                                "units": "1", "equation": "eq:xi1r"}),
+         "s": ("t_s", s, {"long_name": "slope s(theta, omega, xi1, 0) = image / xi1",
+                          "units": "1"}),
+         "slope_at_zero": ((), sgraph.slope_at_zero(theta), {
+             "long_name": "limit of s as t_s -> 0 (xi1 -> 0-): (theta - 1)/theta", "units": "1"}),
+         "image_limit": ((), sgraph.image_limit(theta, omega), {
+             "long_name": "limit of s xi1 as t_s -> infinity: omega^2 (1 - theta)", "units": "1"})},
+        coords={"t_s": ("t_s", t, {"long_name": "sliding time t_s", "units": "1",
+                                   "spacing": "geometric from t_min joined to uniform"})})
+    return finalize(ds, scene, title="graph of s(theta, omega, ., 0) from eq:xi1r (fig:p:xi12)",
+                    max_abs_difference_s=float(np.max(np.abs(s - s_direct))))

@@ -1,0 +1,83 @@
+"""fig:pdmthlt0: the discontinuity map P_DM for theta < 0 in the coordinates of
+eq:scal (x1 = -1 + eps xi1, mu = 1 + eps q), computed by the solver from the full
+slow-fast system for several eps, against the expansions of eq:pdmdisc.
+
+Stored asymptotics (see filippov.analytic.pdm): the corrected expansion
+xi1 + s0 + sqrt(eps) s0 sqrt(-2 xi1) [omega/(theta+s0) - 2/omega] (first order)
+and xi1 + s0 (zero order), and eq:pdmdisc as printed. Convergence: per eps the
+largest difference over the grid points xi1 < 0, and its observed rate in eps.
+The pieces Pi_1 (eq:xi2int) and Pi_2 (eq:hittime) are compared separately.
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ..analytic import pdm as asym
+from ..analytic.s0 import s0_lambert
+from ..io import finalize
+from .pdm_common import base_dataset, max_error, numerical_pdm, rates
+
+
+def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    p = scene["parameters"]
+    theta, omega, mu = float(p["theta"]), float(p["omega"]), float(p["mu"])
+    if not theta < 0:
+        raise ValueError(f"{scene['id']}: parameters.theta must be < 0, got {theta!r}")
+    if mu != 1.0:
+        raise ValueError(f"{scene['id']}: the stored asymptotics are for q = 0 (mu = 1)")
+    eps, xi, f = numerical_pdm(scene, theta, progress)
+    ds = base_dataset(eps, xi, f, theta)
+    x = f["xi1"]
+    e2 = eps[:, None]
+    first = asym.pdm_theta_neg(x, theta, omega, e2, order=1)
+    zero = asym.pdm_theta_neg(x, theta, omega, e2, order=0)
+    printed = asym.pdm_theta_neg_printed(x, theta, omega, e2, order=1)
+    s0 = float(s0_lambert(theta))
+    u = {"units": "1"}
+    d2 = ("eps", "xi1")
+    ds["P_first_order"] = (d2, first, {
+        "long_name": "xi1 + s0 + sqrt(eps) s0 sqrt(-2 xi1) (omega/(theta+s0) - 2/omega): "
+                     "eq:pdmdisc with Pi_3 corrected", **u})
+    ds["P_zero_order"] = (d2, zero, {"long_name": "xi1 + s0(theta) for xi1 < 0 (corrected "
+                                                  "zero order)", **u})
+    ds["P_printed"] = (d2, printed, {"long_name": "eq:pdmdisc / eq:pdmtlt0 as printed", **u})
+    ds["xi2_entry_asym"] = (d2, asym.xi2_entry_theta_neg(x, omega, e2), {
+        "long_name": "xi2 at H_s from eq:xi2int", **u})
+    ds["excursion_time_asym"] = (d2, asym.hit_time_theta_neg(f["xi2_entry"], theta, omega, e2), {
+        "long_name": "s_* from eq:hittime at the numerical xi2_entry", **u})
+    ds["pi3_drop_asym"] = (d2, 0.5 * f["xi2_exit"] ** 2, {
+        "long_name": "xi2(p2)^2 / 2: leading-order drop of xi1 under Pi_3 (the printed "
+                     "eq:xi14 has 0)", **u})
+
+    neg = xi < 0
+    err1 = max_error(f["P"], first, neg)
+    err0 = max_error(f["P"], zero, neg)
+    errp = max_error(f["P"], printed, neg)
+    loc1, fit1 = rates(eps, err1)
+    loc0, fit0 = rates(eps, err0)
+    for name, val, what in [
+            ("error_first_order", err1, "first-order corrected expansion"),
+            ("error_zero_order", err0, "xi1 + s0"),
+            ("error_printed", errp, "eq:pdmdisc as printed")]:
+        ds[name] = ("eps", val, {"long_name": f"max over xi1 < 0 of |P_DM - ({what})|", **u})
+    ds["rate_first_order"] = ("eps", loc1, {"long_name": "local slope of log error_first_order "
+                                                         "against log eps", **u})
+    ds["rate_zero_order"] = ("eps", loc0, {"long_name": "local slope of log error_zero_order "
+                                                        "against log eps", **u})
+    ds["error_xi2_entry"] = ("eps", max_error(f["xi2_entry"], ds["xi2_entry_asym"].values, neg),
+                             {"long_name": "max |xi2_entry - eq:xi2int|", **u})
+    ds["error_excursion_time"] = ("eps", max_error(f["excursion_time"],
+                                                   ds["excursion_time_asym"].values, neg),
+                                  {"long_name": "max |s_* - eq:hittime|", **u})
+    k = int(np.argmax(neg & (xi == xi[neg].max())))  # the grid point closest to 0-
+    ds["xi1_left"] = ((), float(xi[k]), {"long_name": "grid point closest to 0 from below", **u})
+    ds["P_left"] = ("eps", f["P"][:, k], {"long_name": "numerical P_DM at xi1_left", **u})
+    ds["left_limit_error"] = ("eps", np.abs(f["P"][:, k] - s0), {
+        "long_name": "|P_DM(xi1_left) - s0(theta)|", **u})
+    ds["s0"] = ((), s0, {"long_name": "s0(theta), eq:s0def", **u})
+    ds["jump_x1"] = ("eps", eps * s0, {"long_name": "jump of P_DM at 0 in original units, "
+                                                    "eps s0", **u})
+    return finalize(ds, scene, method=scene["ingredients"]["flow"],
+                    rate_first_order_fit=fit1, rate_zero_order_fit=fit0,
+                    title="discontinuity map P_DM for theta < 0 (fig:pdmthlt0)")

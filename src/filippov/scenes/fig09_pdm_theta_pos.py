@@ -1,0 +1,88 @@
+"""fig:pdmthgt0: the discontinuity map P_DM for theta > 0 in the coordinates of
+eq:p:scal (x1 = -1 + eps^2 xi1, mu = 1 + eps^2 q), computed by the solver from the
+full slow-fast system (with sliding) for several eps, against the zero-order
+curve parametrised by the sliding time (eq:p:xi10t2 with eq:p:xi14t2, i.e. the
+graph s xi1 of eq:xi1r), its corrected form, and the linear map eq:p:pdm.
+
+The sliding layer where the asymptotics hold has xi2 < theta/((1 - theta) omega eps)
+(eq:p:tangency), so it widens like 1/eps^2 in xi1: convergence is measured both
+over the whole grid and over a fixed window |xi1| <= core.
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ..analytic import pdm as asym
+from ..io import finalize
+from .pdm_common import base_dataset, max_error, numerical_pdm, rates
+
+
+def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    p = scene["parameters"]
+    theta, omega, mu = float(p["theta"]), float(p["omega"]), float(p["mu"])
+    if not 0 < theta < 1:
+        raise ValueError(f"{scene['id']}: parameters.theta must lie in (0, 1), got {theta!r}")
+    if mu != 1.0:
+        raise ValueError(f"{scene['id']}: the stored asymptotics are for q = 0 (mu = 1)")
+    eps, xi, f = numerical_pdm(scene, theta, progress)
+    ds = base_dataset(eps, xi, f, theta)
+    x = f["xi1"]
+    corrected = asym.pdm_theta_pos(x, theta, omega)
+    printed = asym.pdm_theta_pos(x, theta, omega, printed=True)
+    t2 = asym.sliding_time_theta_pos(x, theta, omega)
+    _, xi21, xi12 = asym.sliding_curve(np.nan_to_num(t2), theta, omega)
+    u = {"units": "1"}
+    d2 = ("eps", "xi1")
+    ds["P_zero_order"] = (d2, corrected, {
+        "long_name": "zero-order P_DM, xi_{1,2} - xi_{1,2}^2/(2 omega^2) along the sliding "
+                     "time (eq:p:xi14t2 with Pi_3 corrected)", **u})
+    ds["P_printed"] = (d2, printed, {"long_name": "eq:p:xi14t2 as printed (= s xi1 of eq:xi1r)",
+                                     **u})
+    ds["P_linear"] = ("xi1", asym.pdm_theta_pos_linear(xi, theta), {
+        "long_name": "eq:p:pdm: slope (theta-1)/theta for xi1 < 0", **u})
+    ds["P_reduced"] = ("xi1", asym.pdm_reduced(xi), {"long_name": "reduced model (eps = 0)",
+                                                     **u})
+    ds["excursion_time_asym"] = (d2, t2, {"long_name": "sliding time t2 from eq:p:xi10t2", **u})
+    ds["xi2_entry_asym"] = (d2, np.where(x < 0, xi21, np.nan),
+                            {"long_name": "xi_{2,1} from eq:p:xi21", **u})
+    ds["xi1_exit_asym"] = (d2, np.where(x < 0, xi12, np.nan),
+                           {"long_name": "xi_{1,2} from eq:p:xi12", **u})
+    ds["pi3_drop_asym"] = (d2, 0.5 * f["xi2_exit"] ** 2, {
+        "long_name": "xi2(p2)^2 / 2: leading-order drop of xi1 under Pi_3 (eq:p:xi14t2 "
+                     "as printed has 0)", **u})
+
+    core = float(p["core"])
+    neg = xi < 0
+    in_core = neg & (xi >= -core)
+    err = max_error(f["P"], corrected, neg)
+    err_core = max_error(f["P"], corrected, in_core)
+    errp = max_error(f["P"], printed, neg)
+    rel = max_error(f["P"] / np.where(neg, xi, 1.0), corrected / np.where(neg, xi, 1.0), neg)
+    loc, fit = rates(eps, err)
+    loc_c, fit_c = rates(eps, err_core)
+    for name, val, what in [
+            ("error", err, "max over xi1 < 0 of |P_DM - zero-order corrected|"),
+            ("error_core", err_core, f"the same over -{core:g} <= xi1 < 0"),
+            ("error_printed", errp, "max over xi1 < 0 of |P_DM - eq:p:xi14t2 as printed|"),
+            ("error_slope", rel, "max over xi1 < 0 of |P_DM/xi1 - zero-order s|")]:
+        ds[name] = ("eps", val, {"long_name": what, **u})
+    ds["rate"] = ("eps", loc, {"long_name": "local slope of log error against log eps", **u})
+    ds["rate_core"] = ("eps", loc_c, {"long_name": "local slope of log error_core against "
+                                                   "log eps", **u})
+    ds["error_xi1_exit"] = ("eps", max_error(f["xi1_exit"], ds["xi1_exit_asym"].values, in_core),
+                            {"long_name": f"max over the core |xi1(p2) - eq:p:xi12|", **u})
+    k = int(np.flatnonzero(neg)[-1])  # grid point closest to 0 from below
+    slope = f["P"][:, k] / xi[k]
+    ds["xi1_left"] = ((), float(xi[k]), {"long_name": "grid point closest to 0 from below", **u})
+    ds["P_left"] = ("eps", f["P"][:, k], {"long_name": "numerical P_DM at xi1_left "
+                                                       "(continuity: -> 0)", **u})
+    ds["slope_left"] = ("eps", slope, {"long_name": "P_DM(xi1_left)/xi1_left", **u})
+    ds["slope_theory"] = ((), (theta - 1) / theta, {"long_name": "(theta-1)/theta (eq:p:pdm)",
+                                                    **u})
+    ds["sliding_limit_xi2"] = ("eps", theta / ((1 - theta) * omega * eps), {
+        "long_name": "xi2 above which f_- no longer points to H_s (eq:p:tangency): end of the "
+                     "sliding regime", **u})
+    return finalize(ds, scene, method=scene["ingredients"]["flow"], rate_fit=fit,
+                    rate_core_fit=fit_c, core=core,
+                    title="discontinuity map P_DM for theta > 0 (fig:pdmthgt0)")

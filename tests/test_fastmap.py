@@ -1,0 +1,213 @@
+"""The compiled first-return kernel (filippov.fastmap) against the reference driver.
+
+The reference is the pure-Python event-driven driver (simulate.py) through the
+fig04 scene's return map; the compiled path must make the same decisions (same
+number of switches) and land on the same returns, and must stop with a status
+code -- never hang -- where the reference raises.
+"""
+import numpy as np
+import pytest
+from numba import njit
+
+from filippov import EventLimitError, SimulationError, ZenoError, simulate
+from filippov import fastmap
+from filippov.models import hopf, pseudo_equilibrium
+from filippov.poincare import Returns
+from filippov.scenes.fig04_retmaps import return_map
+from filippov.simulate import Section
+
+EPS, MU, OMEGA = 0.01, 1.0, 8 * np.pi
+OPTS = {"rtol": 1e-12, "atol": 1e-14}
+T_MAX = 4.0 * 2 * np.pi / OMEGA  # as in fig04_retmaps.return_map
+
+
+def grid():
+    k = np.arange(2, 13)
+    return np.unique(np.concatenate([np.linspace(0.96, 1.04, 21), 1 - 10.0 ** -k,
+                                     1 + 10.0 ** -k, [1.0]]))
+
+
+def starts(x2):
+    return np.stack([np.zeros_like(x2), x2, np.zeros_like(x2)], axis=1)
+
+
+@pytest.fixture(scope="module", params=[-0.5, 0.5])
+def both(request):
+    theta = request.param
+    x2 = grid()
+    _, _, ref = return_map(hopf.model(EPS, theta, MU, OMEGA), x2, "exact", OPTS)
+    fast = fastmap.first_returns_compiled(hopf.compiled(EPS, theta, MU, OMEGA), starts(x2),
+                                          T_MAX, **OPTS)
+    return theta, x2, ref, fast
+
+
+def test_compiled_returns_agree_with_the_reference(both):
+    theta, x2, ref, fast = both
+    assert isinstance(fast, Returns)
+    np.testing.assert_array_equal(fast.n_switches, ref.n_switches)
+    diff = np.abs(fast.state - ref.state).max(axis=1)
+    # Away from grazing: 1e-11 absolute. At x2 -> 1+ for theta < 0 the map has a
+    # square-root singularity (slope ~ (x2 - 1)^-1/2): there the backward error,
+    # difference / |slope|, is what is bounded (as in test_fig04).
+    P = ref.state[:, 1]
+    slope = np.ones_like(x2)
+    for side in (x2 < 1, x2 > 1):
+        slope[side] = np.abs(np.gradient(P[side], x2[side]))
+    away = np.abs(x2 - 1) > 1e-6
+    assert np.all(diff[away] <= 1e-11)
+    assert np.all(diff <= 1e-11 + 1e-12 * slope)
+    assert np.all(np.abs(fast.time - ref.time)[away] <= 1e-11)
+    assert np.all(np.abs(fast.sliding_time - ref.sliding_time)[away] <= 1e-11)
+    if theta > 0:  # continuous: sliding returns, and the sliding time is used
+        assert np.any(ref.sliding_time > 0)
+        assert np.all(diff <= 1e-11)
+
+
+def test_exactly_at_grazing_the_orbit_touches(both):
+    theta, x2, ref, fast = both
+    i = np.flatnonzero(x2 == 1.0)[0]
+    assert ref.n_switches[i] == fast.n_switches[i] == 0
+    assert fast.state[i, 1] == pytest.approx(1.0, abs=1e-15)
+
+
+def test_compute_returns_reports_status_and_matches_wrapper():
+    cm = hopf.compiled(EPS, 0.5, MU, OMEGA)
+    x2 = np.array([0.97, 1.0, 1.001, 1.03])
+    raw = fastmap.compute_returns(cm, starts(x2), T_MAX)
+    assert np.all(raw.status == fastmap.OK)
+    wrapped = fastmap.first_returns_compiled(cm, starts(x2), T_MAX)
+    np.testing.assert_array_equal(raw.state, wrapped.state)
+    np.testing.assert_array_equal(raw.n_switches, wrapped.n_switches)
+
+
+def test_compiled_hopf_pieces_are_the_model_formulas():
+    theta = 0.5
+    model = hopf.model(EPS, theta, MU, OMEGA)
+    system = model.full()
+    cm = hopf.compiled(EPS, theta, MU, OMEGA)
+    rng = np.random.default_rng(1)
+    out = np.empty(3)
+    for z in rng.uniform(-1.5, 1.5, size=(20, 3)):
+        for tau in (0.0, 1e-3, 0.07):
+            cm.flow_plus(z, tau, cm.params, out)
+            np.testing.assert_allclose(out, system.flows[1](z, tau), rtol=0, atol=1e-14)
+            cm.flow_minus(z, tau, cm.params, out)
+            np.testing.assert_allclose(out, system.flows[-1](z, tau), rtol=0, atol=1e-14)
+        cm.field_plus(z, cm.params, out)
+        np.testing.assert_allclose(out, system.field_plus(z), rtol=1e-15, atol=1e-13)
+        cm.field_minus(z, cm.params, out)
+        np.testing.assert_allclose(out, system.field_minus(z), rtol=1e-15, atol=1e-13)
+        assert cm.h(z, cm.params) == pytest.approx(float(system.switch(z)), abs=1e-15)
+        cm.grad_h(z, cm.params, out)
+        np.testing.assert_array_equal(out, system.switch_grad(z))
+
+
+# --------------------------------------------------------------------------- guards
+# A second model, written in the test: the kernel is model-agnostic. The
+# pseudo-equilibrium example x' = -sign(h), eps y' = x - y chatters for theta < 0;
+# its section x = 10 is never reached.
+from filippov.fastmap import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG  # noqa: E402
+
+
+@njit(FLOW_SIG)
+def _pe_flow_plus(z0, tau, p, out):
+    eps = p[0]
+    out[0] = z0[0] - tau
+    out[1] = out[0] + eps + (z0[1] - z0[0] - eps) * np.exp(-tau / eps)
+
+
+@njit(FLOW_SIG)
+def _pe_flow_minus(z0, tau, p, out):
+    eps = p[0]
+    out[0] = z0[0] + tau
+    out[1] = out[0] - eps + (z0[1] - z0[0] + eps) * np.exp(-tau / eps)
+
+
+@njit(FIELD_SIG)
+def _pe_field_plus(z, p, out):
+    out[0] = -1.0
+    out[1] = (z[0] - z[1]) / p[0]
+
+
+@njit(FIELD_SIG)
+def _pe_field_minus(z, p, out):
+    out[0] = 1.0
+    out[1] = (z[0] - z[1]) / p[0]
+
+
+@njit(SCALAR_SIG)
+def _pe_h(z, p):
+    return p[1] * z[0] + (1 - p[1]) * z[1]
+
+
+@njit(FIELD_SIG)
+def _pe_grad_h(z, p, out):
+    out[0] = p[1]
+    out[1] = 1 - p[1]
+
+
+@njit(SCALAR_SIG)
+def _pe_section(z, p):
+    return z[0] - 10.0
+
+
+@njit(WHERE_SIG)
+def _pe_where(z, p):
+    return True
+
+
+def pseudo_compiled(eps, theta):
+    return fastmap.CompiledModel(
+        name="pseudo_equilibrium", names=("x", "y"), params=np.array([eps, theta]),
+        flow_plus=_pe_flow_plus, flow_minus=_pe_flow_minus, field_plus=_pe_field_plus,
+        field_minus=_pe_field_minus, h=_pe_h, grad_h=_pe_grad_h, section=_pe_section,
+        section_where=_pe_where, section_direction=-1, sample_step=eps / 4)
+
+
+def test_endless_switching_stops_at_the_event_bound_where_the_reference_does():
+    eps, theta, z0 = 1e-3, -0.5, [0.01, 0.0]
+    cm = pseudo_compiled(eps, theta)
+    out = fastmap.compute_returns(cm, [z0], 10.0, max_events=100)
+    assert out.status[0] == fastmap.EVENT_LIMIT and out.n_switches[0] == 101
+    # the reference's 101st switch, from an unbounded run of the same length
+    system = pseudo_equilibrium.model(eps, theta).full()
+    ref = simulate(system, z0, out.time[0] * (1 + 1e-9), dense=False, max_events=10_000)
+    sw = ref.switches()
+    assert len(sw) >= 101
+    assert out.time[0] == pytest.approx(sw[100].t, rel=1e-12)
+    np.testing.assert_allclose(out.state[0], sw[100].state, rtol=0, atol=1e-12)
+    with pytest.raises(EventLimitError, match="event limit"):
+        fastmap.first_returns_compiled(cm, [z0], 10.0, max_events=100)
+
+
+def test_chatter_below_time_resolution_is_zeno():
+    cm = pseudo_compiled(1e-13, -0.5)
+    out = fastmap.compute_returns(cm, [[1e-12, 0.0]], 1.0)
+    assert out.status[0] == fastmap.ZENO
+    with pytest.raises(ZenoError):
+        fastmap.first_returns_compiled(cm, [[1e-12, 0.0]], 1.0)
+
+
+def test_no_return_step_limit_and_undeclared_sliding_are_status_codes():
+    cm = hopf.compiled(EPS, 0.5, MU, OMEGA)
+    s = starts(np.array([1.01]))
+    assert fastmap.compute_returns(cm, s, 0.1).status[0] == fastmap.NO_RETURN
+    with pytest.raises(RuntimeError, match="did not return"):
+        fastmap.first_returns_compiled(cm, s, 0.1)
+    assert fastmap.compute_returns(cm, s, T_MAX, max_steps=3).status[0] == fastmap.STEP_LIMIT
+    no_slide = hopf.compiled(EPS, 0.5, MU, OMEGA, sliding=False)
+    assert fastmap.compute_returns(no_slide, s, T_MAX).status[0] == fastmap.NO_SLIDING
+    with pytest.raises(SimulationError, match="sliding"):
+        fastmap.first_returns_compiled(no_slide, s, T_MAX)
+    # the reference refuses the same orbit for the same reason
+    with pytest.raises(SimulationError, match="sliding"):
+        return_map(hopf.model(EPS, 0.5, MU, OMEGA), np.array([1.01]), "exact", OPTS,
+                   sliding=False)
+
+
+def test_bad_input_is_rejected():
+    cm = hopf.compiled(EPS, 0.5, MU, OMEGA)
+    with pytest.raises(ValueError, match="finite"):
+        fastmap.compute_returns(cm, [[0.0, np.nan, 0.0]], T_MAX)
+    with pytest.raises(ValueError, match="shape"):
+        fastmap.compute_returns(cm, [[0.0, 1.0]], T_MAX)
