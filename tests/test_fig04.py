@@ -107,3 +107,30 @@ def test_fixed_points_of_the_map():
     for theta in (-0.5, 0.5):
         got = P(0.01, theta, x2)[0]
         np.testing.assert_array_equal(fixed_points(x2, got), [1.0])
+
+
+def test_compiled_engine_needs_exact_flows():
+    from filippov.scenes.common import engine
+    scene = {"id": "fig04_retmaps", "ingredients": {"flow": "integrate"},
+             "solver": {"engine": "compiled"}}
+    with pytest.raises(ValueError, match="solver.engine"):
+        engine(scene)
+    scene["ingredients"]["flow"] = "exact"
+    assert engine(scene) == "compiled"
+    assert engine({"id": "x", "ingredients": {"flow": "exact"}}) == "python"
+
+
+def test_scene_engines_agree():
+    """The scene's compiled engine and the reference driver give the same map."""
+    from filippov.scenes.fig04_retmaps import return_map
+    x2 = np.array([0.97, 0.999, 1.0, 1.0 + 1e-9, 1.001, 1.03])
+    for theta in (-0.5, 0.5):
+        model = hopf.model(0.01, theta, 1.0, OMEGA)
+        opts = {"rtol": 1e-12, "atol": 1e-14}
+        ref, _, rr = return_map(model, x2, "exact", opts)
+        fast, _, rf = return_map(model, x2, "exact", opts, engine="compiled")
+        np.testing.assert_allclose(fast, ref, rtol=0, atol=1e-14)
+        # the first switching time: none below grazing, the same instant above it
+        assert np.all(np.isnan(rr.first_switch[:2])) and np.all(np.isnan(rf.first_switch[:2]))
+        assert np.all(rr.first_switch[3:] > 0)
+        np.testing.assert_allclose(rf.first_switch[3:], rr.first_switch[3:], rtol=0, atol=1e-14)

@@ -585,9 +585,10 @@ def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
 @_jit
 def _one(z0, fns, p, t_max, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
          ts, vals, dvals, svals, recent, sg, za, y, f, y_old, f_old, K, ynew, ytmp, scale,
-         F, wz, wg, wf, wp, z):
+         F, wz, wg, wf, wp, z, first_sw):
     """First return of z0 (the state at the return, or where the run stopped, in z);
-    (status, t, n_switches, sliding_time)."""
+    (status, t, n_switches, sliding_time). first_sw[0]: time of the first change of mode
+    (left untouched if there is none)."""
     rtol, atol, touch_tol, xtol = fopts[0], fopts[1], fopts[2], fopts[3]
     zeno_span, max_step = fopts[4], fopts[5]
     max_events, max_steps, zeno_count = iopts[0], iopts[1], iopts[2]
@@ -713,6 +714,8 @@ def _one(z0, fns, p, t_max, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, io
             slide_since = t
         if new_mode != mode:
             n_switch += 1
+            if n_switch == 1:
+                first_sw[0] = t
         if n_switch > max_events:
             return EVENT_LIMIT, t, n_switch, slide_time
         recent[n_recent % zeno_count] = t
@@ -735,13 +738,13 @@ _KERNEL_SIG = types.void(
     _vec, _vec,                 # sample fractions: exact windows, integration steps
     _vec,                       # rtol, atol, touch_tol, event_xtol, zeno_span, max_step
     types.int64[::1],           # max_events, max_steps, zeno_count
-    types.float64[:, ::1], _vec, types.int64[::1], _vec, types.int64[::1])  # outputs
+    types.float64[:, ::1], _vec, types.int64[::1], _vec, types.int64[::1], _vec)  # outputs
 
 
 @njit(cache=True)
 def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, p,
            starts, t_max, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
-           out_state, out_time, out_nsw, out_slide, out_status):
+           out_state, out_time, out_nsw, out_slide, out_status, out_first):
     fns = (flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where)
     m, n = starts.shape
     nsmax = max(frac_ex.size, frac_in.size)
@@ -758,10 +761,13 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
     K = np.zeros((_NSE, n))
     F = np.zeros((_NI, n))
     z = np.zeros(n)
+    first = np.zeros(1)
     for i in range(m):
+        first[0] = np.nan
         st, t, nsw, sl = _one(starts[i], fns, p, t_max, hwin, sec_pred, sliding, frac_ex,
                               frac_in, fopts, iopts, ts, vals, dvals, svals, recent, sg, za, y,
-                              f, y_old, f_old, K, ynew, ytmp, scale, F, wz, wg, wf, wp, z)
+                              f, y_old, f_old, K, ynew, ytmp, scale, F, wz, wg, wf, wp, z, first)
+        out_first[i] = first[0]
         for c in range(n):
             out_state[i, c] = z[c]
         out_status[i] = st
@@ -826,6 +832,7 @@ class BatchReturns:
     n_switches: np.ndarray
     sliding_time: np.ndarray
     status: np.ndarray
+    first_switch: np.ndarray  # time of the first change of mode (NaN: none)
 
 
 def _section_pred(direction: int) -> int:
@@ -874,13 +881,15 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     nsw = np.empty(m, dtype=np.int64)
     slide = np.empty(m)
     status = np.empty(m, dtype=np.int64)
+    first = np.empty(m)
     params = np.ascontiguousarray(cmodel.params, dtype=float)
     compile_kernel()
     _batch(cmodel.flow_plus, cmodel.flow_minus, cmodel.field_plus, cmodel.field_minus,
            cmodel.h, cmodel.grad_h, cmodel.section, cmodel.section_where, params,
            starts, float(t_max), float(hwin), _section_pred(cmodel.section_direction),
-           bool(cmodel.sliding), frac_ex, frac_in, fopts, iopts, state, time, nsw, slide, status)
-    return BatchReturns(state, time, nsw, slide, status)
+           bool(cmodel.sliding), frac_ex, frac_in, fopts, iopts, state, time, nsw, slide, status,
+           first)
+    return BatchReturns(state, time, nsw, slide, status, first)
 
 
 _ERRORS = {EVENT_LIMIT: EventLimitError, STEP_LIMIT: EventLimitError, ZENO: ZenoError}
@@ -912,4 +921,4 @@ def first_returns_compiled(cmodel: CompiledModel, starts, t_max: float, *,
         if code == NO_RETURN:
             raise RuntimeError(msg)
         raise _ERRORS.get(code, SimulationError)(msg)
-    return Returns(out.state, out.time, out.n_switches, out.sliding_time)
+    return Returns(out.state, out.time, out.n_switches, out.sliding_time, out.first_switch)

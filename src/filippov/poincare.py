@@ -24,6 +24,7 @@ class Returns:
     time: np.ndarray          # (m,) time of flight
     n_switches: np.ndarray    # (m,) changes of mode on the way
     sliding_time: np.ndarray  # (m,) time spent sliding on the way
+    first_switch: np.ndarray  # (m,) time of the first change of mode (NaN: none)
 
 
 def first_returns(system: PiecewiseSystem, starts, section: Section, t_max: float, *,
@@ -41,6 +42,7 @@ def first_returns(system: PiecewiseSystem, starts, section: Section, t_max: floa
     time = np.empty(m)
     n_switches = np.empty(m, dtype=np.int64)
     sliding = np.empty(m)
+    first = np.full(m, np.nan)
     for i, z0 in enumerate(starts):
         traj = simulate(system, z0, t_max, sections=[section], dense=False, **options)
         if traj.status != f"section:{section.name}":
@@ -50,10 +52,12 @@ def first_returns(system: PiecewiseSystem, starts, section: Section, t_max: floa
         state[i], time[i] = hit.state, hit.t - traj.t0
         switches = traj.switches()
         n_switches[i] = len(switches)
+        if switches:
+            first[i] = switches[0].t - traj.t0
         sliding[i] = _sliding_time(traj.events)
         if progress is not None:
             progress.step()
-    return Returns(state, time, n_switches, sliding)
+    return Returns(state, time, n_switches, sliding, first)
 
 
 def _sliding_time(events) -> float:

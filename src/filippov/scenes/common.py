@@ -5,10 +5,24 @@ SOLVER_DEFAULTS = {"rtol": 1e-12, "atol": 1e-14}
 
 
 def solver_options(scene: dict) -> dict:
+    """Options for :func:`filippov.simulate.simulate`: tolerances and the method
+    the scene's ``flow`` ingredient asks for (the engine is chosen separately)."""
     opts = dict(SOLVER_DEFAULTS)
-    opts.update(scene.get("solver", {}))
+    opts.update({k: v for k, v in scene.get("solver", {}).items() if k != "engine"})
     opts["method"] = "exact" if scene["ingredients"]["flow"] == "exact" else "integrate"
     return opts
+
+
+def engine(scene: dict) -> str:
+    """``solver.engine``: "python" (the reference driver, default) or "compiled".
+
+    The compiled kernel runs exact flows only, so it needs ``flow: exact``.
+    """
+    name = scene.get("solver", {}).get("engine", "python")
+    if name == "compiled" and scene["ingredients"]["flow"] != "exact":
+        raise ValueError(f"{scene['id']}: solver.engine: 'compiled' runs exact flows only, "
+                         f"but ingredients.flow is {scene['ingredients']['flow']!r}")
+    return name
 
 
 def require(scene: dict, field: str, allowed) -> str:

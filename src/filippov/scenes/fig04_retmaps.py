@@ -20,7 +20,8 @@ from ..models import hopf
 from ..poincare import first_returns, fixed_points
 from ..progress import Progress
 from ..simulate import Section
-from .common import require, solver_options
+from ..fastmap import first_returns_compiled
+from .common import engine, require, solver_options
 
 
 def section_L1() -> Section:
@@ -34,13 +35,26 @@ def x2_grid(p: dict) -> np.ndarray:
     return np.unique(grid)
 
 
-def return_map(model, x2, method: str, options: dict, progress=None, sliding=True):
-    """P on L1 for the start values ``x2``: (returned x2, residual |y - x1|, Returns)."""
-    system = model.full(sliding=sliding, exact=method == "exact")
+def return_map(model, x2, method: str, options: dict, progress=None, sliding=True,
+               engine: str = "python"):
+    """P on L1 for the start values ``x2``: (returned x2, residual |y - x1|, Returns).
+
+    ``engine="compiled"`` runs the numba kernel of :mod:`filippov.fastmap` (exact
+    flows only); it follows the reference driver's algorithm step for step.
+    """
     starts = np.stack([np.zeros_like(x2), x2, np.zeros_like(x2)], axis=1)
     t_max = 4.0 * 2 * np.pi / abs(model.parameters["omega"])
-    ret = first_returns(system, starts, section_L1(), t_max, progress=progress,
-                        method=method, **options)
+    if engine == "compiled":
+        if method != "exact":
+            raise ValueError("the compiled engine runs exact flows only")
+        par = model.parameters
+        cmodel = hopf.compiled(par["eps"], par["theta"], par["mu"], par["omega"],
+                               sliding=sliding)
+        ret = first_returns_compiled(cmodel, starts, t_max, progress=progress, **options)
+    else:
+        system = model.full(sliding=sliding, exact=method == "exact")
+        ret = first_returns(system, starts, section_L1(), t_max, progress=progress,
+                            method=method, **options)
     return ret.state[:, 1], np.abs(ret.state[:, 2] - ret.state[:, 0]), ret
 
 
@@ -61,16 +75,18 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     p = scene["parameters"]
     opts = solver_options(scene)
     method = opts.pop("method")
+    kernel = engine(scene)
     eps, mu, omega = float(p["eps"]), float(p["mu"]), float(p["omega"])
     thetas = [float(v) for v in p["theta"]]
     x2 = x2_grid(p)
     bar = Progress(scene["id"], len(thetas) * x2.size, progress)
-    P, res, tof, nsw, slide, sig, chi, fps = [], [], [], [], [], [], [], []
+    P, res, tof, nsw, slide, first, sig, chi, fps = [], [], [], [], [], [], [], [], []
     for theta in thetas:
         model = hopf.model(eps, theta, mu, omega)
-        px2, r, ret = return_map(model, x2, method, opts, bar, scene["ingredients"]["sliding"])
+        px2, r, ret = return_map(model, x2, method, opts, bar, scene["ingredients"]["sliding"],
+                                 kernel)
         P.append(px2), res.append(r), tof.append(ret.time)
-        nsw.append(ret.n_switches), slide.append(ret.sliding_time)
+        nsw.append(ret.n_switches), slide.append(ret.sliding_time), first.append(ret.first_switch)
         s, c = sigma_minus(model)
         sig.append(s), chi.append(c)
         fps.append(fixed_points(x2, px2))
@@ -86,6 +102,9 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
          "return_time": (dims, np.array(tof), {"long_name": "time of flight to L1", "units": "1"}),
          "n_switches": (dims, np.array(nsw, dtype=np.int32),
                         {"long_name": "mode changes on the way", "units": "1"}),
+         "first_switch_time": (dims, np.array(first), {
+             "long_name": "time of the first change of mode after leaving L1 (NaN: none)",
+             "units": "1"}),
          "sliding_time": (dims, np.array(slide), {"long_name": "time spent sliding", "units": "1"}),
          "fixed_point": (("theta", "fixed"), fp,
                          {"long_name": "fixed points of P on the grid (NaN: none)", "units": "1"}),
@@ -99,5 +118,5 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
              "units": "1"})},
         coords={"theta": ("theta", thetas, {"units": "1"}),
                 "x2": ("x2", x2, {"long_name": "x2 of the start point on L1", "units": "1"})})
-    return finalize(ds, scene, method=method,
+    return finalize(ds, scene, method=method, engine=kernel,
                     title="return map P to L1 of the slow-fast Hopf example (fig:retmaps)")
