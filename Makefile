@@ -4,6 +4,8 @@
 #   make test      run the test suite
 #   make lock      re-resolve requirements.lock in a throw-away venv
 #   make clean     remove workflow outputs (keeps .venv)
+#   make bench        work-precision sweep and cost of each model ingredient
+#                     (results/bench_*.nc, figures/bench_work_precision.pdf)
 #   make bench-fig04  time the fig04 return maps against scipy solve_ivp
 #
 # The first target that needs Python creates $(VENV) from requirements.lock.
@@ -33,7 +35,7 @@ export DEBIAN_FRONTEND = noninteractive
 # `python` inside Snakemake shell rules is the venv's interpreter.
 VENV_PATH = PATH="$(abspath $(VENV))/bin:$$PATH" VIRTUAL_ENV="$(abspath $(VENV))"
 
-.PHONY: all venv figures test bench-fig04 lock clean distclean check-python
+.PHONY: all venv figures test bench bench-fig04 lock clean distclean check-python
 
 all: figures
 
@@ -74,6 +76,10 @@ test: $(VENV)/.done
 	  echo "warning: pytest collected no tests (exit 5); accepted because ALLOW_NO_TESTS is set" >&2; rc=0; \
 	fi; \
 	exit $$rc
+
+# Work-precision of every method on the fig04 maps, and what each ingredient costs.
+bench: $(VENV)/.done
+	$(VENV_PATH) $(VENV)/bin/snakemake --cores 1 bench $(SNAKEFLAGS)
 
 # Speed and accuracy of the fig04 return maps against scipy (prints a table;
 # BENCH_ARGS="--every 10" for a quick run).

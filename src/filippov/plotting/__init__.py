@@ -20,6 +20,7 @@ DRAW = {
     "fig07_pdm_theta_neg": "fig07_pdm_theta_neg",
     "fig08_s0theta": "fig08_s0theta",
     "fig09_pdm_theta_pos": "fig09_pdm_theta_pos",
+    "bench_work_precision": "bench_work_precision",
 }
 
 # No timestamps or tool versions in the files: same data -> same bytes.

@@ -1,0 +1,47 @@
+"""Work-precision diagram: error of the return map against wall time, log-log,
+one panel per problem, one line per method swept over its tolerance."""
+from __future__ import annotations
+
+import numpy as np
+
+from . import style as st
+
+VARS = ["error_map", "wall_time", "status", "reference_check"]
+# the project's modes solid, scipy's dashed; markers tell the families apart
+LOOK = {"project compiled exact": ("o", "-", "black"),
+        "project python exact": ("s", "-", "0.45"),
+        "project DOP853": ("D", "-", st.C_PLUS),
+        "solve_ivp RK45": ("^", "--", st.C_MINUS),
+        "solve_ivp DOP853": ("v", "--", "#7b3294"),
+        "solve_ivp Radau": ("P", "--", "#1b9e77"),
+        "solve_ivp LSODA": ("X", "--", "#d95f02")}
+FLOOR = 1e-16  # an error of exactly zero is drawn here
+
+
+def draw(ds):
+    st.require(ds, "bench_work_precision", VARS)
+    n = ds.sizes["problem"]
+    fig = st.new_figure(st.WIDTH_DOUBLE, 3.2)
+    axes = np.atleast_1d(fig.subplots(1, n, sharey=True))
+    methods = list(dict.fromkeys(str(m) for m in ds.method.values))
+    for i, ax in enumerate(axes):
+        for fam in methods:
+            sel = np.flatnonzero(ds.method.values == fam)
+            err = np.maximum(ds.error_map.values[i, sel], FLOOR)
+            t = ds.wall_time.values[i, sel]
+            ok = np.isfinite(err) & np.isfinite(t)
+            marker, ls, color = LOOK.get(fam, (".", ":", "0.3"))
+            if ok.any():
+                order = np.argsort(t[ok])
+                ax.plot(t[ok][order], err[ok][order], marker=marker, ls=ls, color=color,
+                        ms=4, lw=1.0, label=fam)
+        check = max(float(ds.reference_check.values[i]), FLOOR)
+        ax.axhline(check, color=st.C_AUX, lw=0.8, ls=":", label="reference check")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("wall time of one map [s]")
+        st.panel_label(ax, f"({'abcd'[i]}) {ds.problem.values[i]}, "
+                           f"{int(ds.n_points.values[i])} points")
+    axes[0].set_ylabel(r"max $|P - P_{\mathrm{ref}}|$")
+    axes[-1].legend(loc="upper right", fontsize=6.5, ncol=1)
+    return fig

@@ -1,0 +1,59 @@
+"""The benchmarks run, keep failing methods in the table, and score errors right.
+
+Speed is not asserted here (machines are shared and noisy): the numbers live in
+`make bench`. What is asserted is what a timing run must never get wrong.
+"""
+import numpy as np
+
+from filippov.benchmarks import effect_cost, work_precision as wp
+
+
+def test_work_precision_smoke(tmp_path):
+    probs = [wp.Problem(p.name, p.x2[[0, 5, -1]], p.model, p.scored[[0, 5, -1]])
+             for p in wp.fig04_problems(every=97)]
+    fams = [("project compiled exact", [1e-10]), ("solve_ivp RK45", [1e-5]),
+            ("solve_ivp nonsense", [1e-6])]
+    ds = wp.run(probs, fams, repeat=1, time_cap=60.0, log=lambda s: None)
+    assert ds.sizes == {"problem": 2, "config": 3}
+    assert list(ds.method.values) == [f for f, _ in fams]
+    # the exact flows agree with the independent DOP853 check to the reference floor
+    assert np.all(ds.reference_check.values < 1e-11)
+    assert np.all(ds.error_map.values[:, 0] < 1e-11)
+    assert np.all(ds.status.values[:, :2] == "ok")
+    # a method that fails stays in the table, with its reason and no numbers
+    assert all(s.startswith("failed:") for s in ds.status.values[:, 2])
+    assert np.all(np.isnan(ds.wall_time.values[:, 2]))
+    text = wp.table(ds)
+    assert "solve_ivp nonsense" in text and "failed" in text
+
+
+def test_time_at_error_interpolates_log_log():
+    errs, times = np.array([1e-4, 1e-6, 1e-10]), np.array([1.0, 2.0, 8.0])
+    assert wp.time_at_error(errs, times, 1e-6) == 2.0
+    assert np.isclose(wp.time_at_error(errs, times, 1e-8), 4.0)  # halfway in log
+    assert np.isnan(wp.time_at_error(errs, times, 1e-12))          # never reached
+    assert wp.time_at_error(np.array([1e-12, 1e-13]), np.array([3.0, 5.0]), 1e-8) == 3.0
+
+
+def test_max_dev_counts_one_sided_switches():
+    a, b = np.array([1.0, np.nan, 2.0, np.nan]), np.array([1.5, 1.0, 2.0, np.nan])
+    err, odd = wp.max_dev(a, b, np.ones(4, bool))
+    assert err == 0.5 and odd == 1
+
+
+def test_effect_variants_switch_one_ingredient_each():
+    scene = {"id": "fig04_retmaps", "ingredients": {"system": "slow_fast", "flow": "exact",
+                                                     "sliding": True},
+             "solver": {"rtol": 1e-12, "engine": "compiled"}}
+    labels = [label for label, _ in effect_cost.variants(scene)]
+    assert labels == ["as declared", "system: slow_fast -> reduced", "flow: exact -> integrate",
+                      "sliding: True -> False", "engine: compiled -> python"]
+    by = dict(effect_cost.variants(scene))
+    assert "engine" not in by["flow: exact -> integrate"]["solver"]  # compiled needs exact
+    assert scene["ingredients"]["flow"] == "exact"                    # the original untouched
+
+
+def test_effect_cost_reports_unsupported_variants(tmp_path):
+    ds = effect_cost.measure(["fig08_s0theta"], cap=120.0, log=lambda s: None)
+    assert ds.status.values[0] == "ok" and ds.relative.values[0] == 1.0
+    assert ds.sizes["variant"] >= 1
