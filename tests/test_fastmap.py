@@ -7,7 +7,6 @@ code -- never hang -- where the reference raises.
 """
 import numpy as np
 import pytest
-from numba import njit
 
 from filippov import EventLimitError, SimulationError, ZenoError, simulate
 from filippov import fastmap
@@ -103,65 +102,10 @@ def test_compiled_hopf_pieces_are_the_model_formulas():
 
 
 # --------------------------------------------------------------------------- guards
-# A second model, written in the test: the kernel is model-agnostic. The
-# pseudo-equilibrium example x' = -sign(h), eps y' = x - y chatters for theta < 0;
-# its section x = 10 is never reached.
-from filippov.fastmap import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG  # noqa: E402
-
-
-@njit(FLOW_SIG)
-def _pe_flow_plus(z0, tau, p, out):
-    eps = p[0]
-    out[0] = z0[0] - tau
-    out[1] = out[0] + eps + (z0[1] - z0[0] - eps) * np.exp(-tau / eps)
-
-
-@njit(FLOW_SIG)
-def _pe_flow_minus(z0, tau, p, out):
-    eps = p[0]
-    out[0] = z0[0] + tau
-    out[1] = out[0] - eps + (z0[1] - z0[0] + eps) * np.exp(-tau / eps)
-
-
-@njit(FIELD_SIG)
-def _pe_field_plus(z, p, out):
-    out[0] = -1.0
-    out[1] = (z[0] - z[1]) / p[0]
-
-
-@njit(FIELD_SIG)
-def _pe_field_minus(z, p, out):
-    out[0] = 1.0
-    out[1] = (z[0] - z[1]) / p[0]
-
-
-@njit(SCALAR_SIG)
-def _pe_h(z, p):
-    return p[1] * z[0] + (1 - p[1]) * z[1]
-
-
-@njit(FIELD_SIG)
-def _pe_grad_h(z, p, out):
-    out[0] = p[1]
-    out[1] = 1 - p[1]
-
-
-@njit(SCALAR_SIG)
-def _pe_section(z, p):
-    return z[0] - 10.0
-
-
-@njit(WHERE_SIG)
-def _pe_where(z, p):
-    return True
-
-
-def pseudo_compiled(eps, theta):
-    return fastmap.CompiledModel(
-        name="pseudo_equilibrium", names=("x", "y"), params=np.array([eps, theta]),
-        flow_plus=_pe_flow_plus, flow_minus=_pe_flow_minus, field_plus=_pe_field_plus,
-        field_minus=_pe_field_minus, h=_pe_h, grad_h=_pe_grad_h, section=_pe_section,
-        section_where=_pe_where, section_direction=-1, sample_step=eps / 4)
+# A second model: the kernel is model-agnostic. The pseudo-equilibrium example
+# x' = -sign(h), eps y' = x - y chatters for theta < 0; its default section
+# x = 10 is never reached.
+pseudo_compiled = pseudo_equilibrium.compiled
 
 
 def test_endless_switching_stops_at_the_event_bound_where_the_reference_does():

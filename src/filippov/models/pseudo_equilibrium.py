@@ -63,3 +63,78 @@ def model(eps: float, theta: float) -> SlowFastModel:
         exact_flows={"full": flows_full, "reduced": flows_reduced},
         sample_step_full=eps / 4 if eps > 0 else np.inf, sample_step_reduced=0.25,
         units={"t": "1", "x": "1", "y": "1"}, parameters={"eps": eps, "theta": theta})
+
+
+# --------------------------------------------------------------------------- compiled
+def compiled(eps: float, theta: float, *, section_x: float = 10.0):
+    """The slow-fast system z = (x, y) with its exact flows, compiled for
+    :mod:`filippov.fastmap`; the section is ``x = section_x`` crossed with x
+    decreasing (the default is never reached near the origin, so a run counts
+    switches until ``t_max``). Sliding is not compiled: the kernel integrates
+    it with DOP853, as the reference driver does without ``method="exact"``."""
+    _check(eps, theta)
+    if eps <= 0:
+        raise ValueError("eps must be > 0 for the slow-fast system")
+    from ..fastmap import CompiledModel
+
+    return CompiledModel(
+        name="pseudo_equilibrium", names=("x", "y"),
+        params=np.array([eps, theta, section_x], dtype=float), **_compiled_pieces(),
+        section_direction=-1, sample_step=eps / 4,
+        parameters={"eps": eps, "theta": theta})
+
+
+_PIECES = {}
+
+
+def _compiled_pieces() -> dict:
+    """numba versions of the pieces; params p = (eps, theta, section_x)."""
+    if _PIECES:
+        return _PIECES
+    from numba import njit
+
+    from ..fastmap import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG
+
+    @njit(FLOW_SIG, cache=True)
+    def flow_plus(z0, tau, p, out):  # x' = -1: y relaxes to x + eps
+        eps = p[0]
+        out[0] = z0[0] - tau
+        out[1] = out[0] + eps + (z0[1] - z0[0] - eps) * np.exp(-tau / eps)
+
+    @njit(FLOW_SIG, cache=True)
+    def flow_minus(z0, tau, p, out):  # x' = +1: y relaxes to x - eps
+        eps = p[0]
+        out[0] = z0[0] + tau
+        out[1] = out[0] - eps + (z0[1] - z0[0] + eps) * np.exp(-tau / eps)
+
+    @njit(FIELD_SIG, cache=True)
+    def field_plus(z, p, out):
+        out[0] = -1.0
+        out[1] = (z[0] - z[1]) / p[0]
+
+    @njit(FIELD_SIG, cache=True)
+    def field_minus(z, p, out):
+        out[0] = 1.0
+        out[1] = (z[0] - z[1]) / p[0]
+
+    @njit(SCALAR_SIG, cache=True)
+    def h(z, p):
+        return p[1] * z[0] + (1 - p[1]) * z[1]
+
+    @njit(FIELD_SIG, cache=True)
+    def grad_h(z, p, out):
+        out[0] = p[1]
+        out[1] = 1 - p[1]
+
+    @njit(SCALAR_SIG, cache=True)
+    def section(z, p):
+        return z[0] - p[2]
+
+    @njit(WHERE_SIG, cache=True)
+    def section_where(z, p):
+        return True
+
+    _PIECES.update(flow_plus=flow_plus, flow_minus=flow_minus, field_plus=field_plus,
+                   field_minus=field_minus, h=h, grad_h=grad_h, section=section,
+                   section_where=section_where)
+    return _PIECES

@@ -1,0 +1,230 @@
+"""Hard cases: tiny eps, theta near 0 and 1, exact tangency, thousands of rapid
+switches, long runs, and inputs that are wrong rather than hard.
+
+Each test bounds its work (event and step limits, t_max) and asserts what the
+theory says the result must be, so a silent NaN, a wrong side at a tangency or a
+drift cannot pass. Speed is measured in `make bench`, not here.
+"""
+import numpy as np
+import pytest
+
+from filippov import SimulationError, ZenoError, fastmap, simulate
+from filippov.analytic import chatter
+from filippov.models import hopf, pseudo_equilibrium
+
+OMEGA, MU = 8 * np.pi, 1.0
+T_MAX = 4 * 2 * np.pi / OMEGA
+SMOOTH_SLOPE = np.exp(-4 * np.pi * MU / OMEGA)
+
+
+def hopf_map(eps, theta, x2, mu=MU, **opts):
+    """P on L1 from the compiled kernel, with the raw output (status, switches)."""
+    x2 = np.asarray(x2, dtype=float)
+    starts = np.stack([np.zeros_like(x2), x2, np.zeros_like(x2)], axis=1)
+    out = fastmap.compute_returns(hopf.compiled(eps, theta, mu, OMEGA), starts, T_MAX, **opts)
+    assert np.all(out.status == fastmap.OK), [fastmap.STATUS[s] for s in out.status]
+    assert np.all(np.isfinite(out.state))
+    return out.state[:, 1], out
+
+
+# ----------------------------------------------------------------------- eps to 1e-6
+EPS_SWEEP = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6]
+
+
+def test_theta_negative_jump_scales_like_eps_down_to_1e_6():
+    jumps = np.array([1.0 - hopf_map(eps, -0.5, [1.0 + 1e-13])[0][0] for eps in EPS_SWEEP])
+    c = jumps / np.array(EPS_SWEEP)
+    # jump/eps converges (to 0.6008...): the differences shrink like eps
+    assert np.all((0.55 < c) & (c < 0.65)), c
+    d = np.abs(np.diff(c))
+    assert np.all(d[1:] < d[:-1] * 0.5) and d[-1] < 1e-4
+
+
+def test_theta_positive_slope_stays_order_one_down_to_1e_6():
+    slopes = []
+    for eps in EPS_SWEEP:
+        # the kink's width in x2 is O(eps^2): probe inside it, but not below the
+        # spacing of doubles near 1 (the step actually taken is what 1 + dx rounds to)
+        x2 = 1.0 + max(1e-3 * eps * eps, 1e-13)
+        P, out = hopf_map(eps, 0.5, [1.0, x2])
+        assert P[0] == 1.0 and out.sliding_time[1] > 0
+        slopes.append((P[1] - P[0]) / (x2 - 1.0))
+    slopes = np.array(slopes)
+    # negative and of order one for every eps, not shrinking as eps -> 0
+    assert np.all((-0.7 < slopes) & (slopes < -0.5)), slopes
+    assert np.ptp(slopes) < 0.03, slopes
+
+
+@pytest.mark.parametrize("eps", EPS_SWEEP)
+def test_chatter_period_scales_like_eps(eps):
+    theta = -0.5
+    orbit = chatter.orbit(eps, theta)
+    system = pseudo_equilibrium.model(eps, theta).full()
+    traj = simulate(system, [orbit["x_switch"], orbit["y_switch"]], 20.25 * orbit["period"],
+                    dense=False, max_events=100)
+    t = np.array([e.t for e in traj.switches()])
+    assert t.size == 40 and np.all(np.isfinite(t))
+    periods = np.diff(t[::2])
+    np.testing.assert_allclose(periods, orbit["period"], rtol=1e-9)
+    assert orbit["period"] / eps == pytest.approx(chatter.orbit(1.0, theta)["period"], rel=1e-12)
+
+
+@pytest.mark.parametrize("eps", EPS_SWEEP)
+def test_pseudo_equilibrium_theta_positive_slides_in_for_every_eps(eps):
+    # theta = 0.6: the relaxed + flow meets H_s at x = -(1 - theta) eps, inside the
+    # attracting band |x| < theta eps (at theta = 0.5 it would hit the band's edge).
+    # Start 30 eps away (the reference driver samples on the eps scale; an O(1)
+    # approach is the compiled kernel's job, below) and slide into the origin.
+    theta = 0.6
+    system = pseudo_equilibrium.model(eps, theta).full()
+    traj = simulate(system, [30 * eps, 0.0], 100 * eps, dense=False, max_events=100)
+    assert [e.kind for e in traj.events[1:]] == ["slide_start"] and traj.mode == 0
+    assert abs(traj.events[1].state[0] + (1 - theta) * eps) < 1e-12
+    assert abs(traj.z[0]) < 1e-12 and np.all(np.isfinite(traj.z))
+    # from O(1) away: the compiled kernel (exact flows, sliding by DOP853)
+    out = fastmap.compute_returns(pseudo_equilibrium.compiled(eps, theta), [[0.3, 0.0]], 0.5)
+    assert out.status[0] == fastmap.NO_RETURN and out.n_switches[0] == 1
+    assert abs(out.state[0, 0]) < 1e-12 and np.all(np.isfinite(out.state))
+
+
+# ----------------------------------------------------------------------- theta near 0 and 1
+@pytest.mark.parametrize("theta", [-0.01, 0.01, 0.99])
+def test_theta_near_zero_and_one_hopf(theta):
+    x2 = np.array([1.0 - 1e-5, 1.0 - 1e-9, 1.0, 1.0 + 1e-9, 1.0 + 1e-6, 1.01])
+    P, out = hopf_map(0.01, theta, x2)
+    np.testing.assert_allclose(P[:2] - 1, SMOOTH_SLOPE * (x2[:2] - 1), rtol=1e-4)
+    assert P[2] == 1.0
+    assert np.all((0.8 < P) & (P < 1.1))
+    if theta < 0:   # case 2: a jump of order eps times s0(theta), small near theta = 0
+        assert out.n_switches[3] == 2 and 1e-5 < 1.0 - P[3] < 0.01
+    else:           # case 1: continuous, by sliding
+        assert out.sliding_time[3] > 0 and abs(P[3] - 1.0) < 1e-7
+
+
+@pytest.mark.parametrize("theta", [-0.01, 0.01, 0.99])
+def test_theta_near_zero_and_one_pseudo_equilibrium(theta):
+    eps = 1e-3
+    system = pseudo_equilibrium.model(eps, theta).full()
+    if theta < 0:
+        orbit = chatter.orbit(eps, theta)
+        traj = simulate(system, [orbit["x_switch"], orbit["y_switch"]], 10.5 * orbit["period"],
+                        dense=False, max_events=100)
+        t = np.array([e.t for e in traj.switches()])
+        np.testing.assert_allclose(np.diff(t[::2]), orbit["period"], rtol=1e-8)
+    else:  # slides into the pseudo-equilibrium; the sliding band is |x| < eps theta
+        traj = simulate(system, [0.05, 0.0], 1.0, dense=False, max_events=100)
+        start = next(e for e in traj.events if e.kind == "slide_start")
+        assert abs(start.state[0]) <= eps * theta * (1 + 1e-9)
+        assert abs(traj.z[0]) < 1e-12
+
+
+# ----------------------------------------------------------------------- exact tangency
+@pytest.mark.parametrize("theta", [-0.5, 0.5])
+def test_start_on_the_tangency_is_deterministic_and_on_the_right_side(theta):
+    x2 = np.array([1.0 - 1e-14, 1.0, 1.0 + 1e-14])
+    P1, out1 = hopf_map(0.01, theta, x2)
+    P2, out2 = hopf_map(0.01, theta, x2)
+    np.testing.assert_array_equal(P1, P2)            # bit for bit
+    np.testing.assert_array_equal(out1.n_switches, out2.n_switches)
+    # below and at grazing: no switch, the smooth map; above: the nonsmooth branch
+    assert list(out1.n_switches[:2]) == [0, 0] and P1[1] == 1.0
+    assert P1[0] < 1.0 and 1.0 - P1[0] < 1e-14
+    assert out1.n_switches[2] == 2
+    if theta < 0:
+        assert 1.0 - P1[2] == pytest.approx(0.62 * 0.01, rel=0.01)   # the jump
+    else:
+        assert out1.sliding_time[2] > 0 and 0 < 1.0 - P1[2] < 1e-13  # continuous
+
+
+def test_start_exactly_at_the_grazing_point_chooses_region_plus():
+    # at p_g the + flow is tangent to H_s (b = 0); the driver must not slide or cross
+    for theta in (-0.5, 0.5):
+        system = hopf.model(0.01, theta, MU, OMEGA).full()
+        traj = simulate(system, [-1.0, 0.0, -1.0], 0.05, dense=False)
+        assert traj.mode == 1 and not traj.switches()
+        assert traj.z[0] > -1.0
+
+
+# ----------------------------------------------------------------------- many switches, Zeno
+def test_chatter_with_1e5_switches_finishes_within_its_bound():
+    eps, theta = 1e-4, -0.5
+    orbit = chatter.orbit(eps, theta)
+    n_half = 100_000
+    cm = pseudo_equilibrium.compiled(eps, theta)
+    z0 = [[orbit["x_switch"], orbit["y_switch"]]]
+    out = fastmap.compute_returns(cm, z0, (n_half + 0.5) * orbit["period"] / 2,
+                                  max_events=n_half + 10)
+    assert out.status[0] == fastmap.NO_RETURN  # ran to t_max: neither bound nor Zeno hit
+    assert out.n_switches[0] == n_half
+    # still on the chatter orbit after 1e5 switches: no drift
+    assert abs(out.state[0, 0]) <= orbit["x_switch"] * (1 + 1e-6)
+    assert np.all(np.isfinite(out.state))
+
+
+def test_event_bound_stops_endless_chatter_with_a_message():
+    cm = pseudo_equilibrium.compiled(1e-4, -0.5)
+    out = fastmap.compute_returns(cm, [[1e-3, 0.0]], 1e3, max_events=5_000)
+    assert out.status[0] == fastmap.EVENT_LIMIT and out.n_switches[0] == 5_001
+
+
+@pytest.mark.parametrize("eps", [1e-13, 1e-15])
+def test_accumulating_switches_are_reported_as_zeno(eps):
+    system = pseudo_equilibrium.model(eps, -0.5).full()
+    with pytest.raises(ZenoError, match=r"accumulation of switches: 64 switches within"):
+        simulate(system, [10 * eps, 0.0], 1.0)
+    out = fastmap.compute_returns(pseudo_equilibrium.compiled(eps, -0.5), [[10 * eps, 0.0]], 1.0)
+    assert out.status[0] == fastmap.ZENO
+
+
+# ----------------------------------------------------------------------- long runs
+def test_ten_thousand_periods_stay_near_M_plus_without_drift():
+    """Iterate the full 3-D return map 1e4 times just past grazing (mu = 1 + eps/2,
+    theta < 0: a periodic orbit that visits region - every few turns). At each return
+    the distance to M_+ is what the relaxation after the last switch leaves: an O(eps)
+    jump decayed over the time 3 pi/(2 omega) from p_g to L1."""
+    eps, theta = 0.01, -0.5
+    cm = hopf.compiled(eps, theta, 1.0 + 0.5 * eps, OMEGA)
+    z = np.array([[0.0, 1.02, 0.0]])
+    res, x2, nsw = [], [], []
+    for _ in range(10_000):
+        out = fastmap.compute_returns(cm, z, T_MAX)
+        assert out.status[0] == fastmap.OK
+        z = out.state.copy()
+        res.append(abs(z[0, 2] - z[0, 0])), x2.append(z[0, 1]), nsw.append(out.n_switches[0])
+    res, x2, nsw = map(np.array, (res, x2, nsw))
+    assert np.all(np.isfinite(x2)) and 0.95 < x2.min() and x2.max() < 1.03
+    switched = nsw > 0
+    assert switched.sum() > 1000                      # it keeps visiting region -
+    assert np.all(nsw[switched] == 2)                 # in and out, no chatter
+    level = eps * np.exp(-3 * np.pi / (2 * OMEGA * eps))
+    ratio = res[switched] / level
+    assert np.all((0.5 < ratio) & (ratio < 5)), (ratio.min(), ratio.max())
+    assert np.all(res[~switched] < 1e-6 * level)      # no switch: decayed beyond all orders
+    # no drift: the last thousand returns look like the first thousand
+    assert res[-1000:][switched[-1000:]].max() < 10 * res[:1000][switched[:1000]].max()
+
+
+# ----------------------------------------------------------------------- wrong inputs
+@pytest.mark.parametrize("kwargs,field", [
+    ({"eps": -1e-3, "theta": 0.5}, "eps"), ({"eps": 1e-3, "theta": 1.0}, "theta"),
+    ({"eps": np.nan, "theta": 0.5}, "eps"), ({"eps": 1e-3, "theta": np.inf}, "theta")])
+def test_wrong_parameters_are_rejected(kwargs, field):
+    for make in (lambda: hopf.model(**kwargs), lambda: hopf.compiled(**kwargs),
+                 lambda: pseudo_equilibrium.model(**kwargs),
+                 lambda: pseudo_equilibrium.compiled(**kwargs)):
+        with pytest.raises(ValueError, match=field):
+            make()
+
+
+def test_nan_initial_state_is_rejected():
+    system = hopf.model(0.01, -0.5).full()
+    with pytest.raises(ValueError, match="finite"):
+        simulate(system, [0.0, np.nan, 0.0], 1.0)
+    with pytest.raises(ValueError, match="finite"):
+        fastmap.compute_returns(hopf.compiled(0.01, -0.5), [[0.0, np.nan, 0.0]], 1.0)
+
+
+def test_chatter_formula_rejects_theta_without_a_chatter_orbit():
+    for theta in (0.0, 0.5, 1.0, np.nan):
+        with pytest.raises(ValueError, match="theta"):
+            chatter.half_time(theta)
