@@ -2,6 +2,8 @@
 #
 #   make figures   build every figure (and the report) with Snakemake
 #   make test      run the test suite
+#   make report    the reproduction report paper/main.pdf (needs TeX)
+#   make report-html  snakemake's HTML report (report.html): figures, rules, parameters
 #   make lock      re-resolve requirements.lock in a throw-away venv
 #   make clean     remove workflow outputs (keeps .venv)
 #   make bench        work-precision sweep and cost of each model ingredient
@@ -35,7 +37,7 @@ export DEBIAN_FRONTEND = noninteractive
 # `python` inside Snakemake shell rules is the venv's interpreter.
 VENV_PATH = PATH="$(abspath $(VENV))/bin:$$PATH" VIRTUAL_ENV="$(abspath $(VENV))"
 
-.PHONY: all venv figures test bench bench-fig04 lock clean distclean check-python
+.PHONY: all venv figures test report report-html bench bench-fig04 lock clean distclean check-python
 
 all: figures
 
@@ -77,6 +79,13 @@ test: $(VENV)/.done
 	fi; \
 	exit $$rc
 
+report: $(VENV)/.done
+	$(VENV_PATH) $(VENV)/bin/snakemake --cores all $(SNAKEFLAGS) paper/main.pdf
+
+report-html: $(VENV)/.done
+	$(VENV_PATH) $(VENV)/bin/snakemake --cores all $(SNAKEFLAGS)
+	$(VENV_PATH) $(VENV)/bin/snakemake --cores 1 --report report.html
+
 # Work-precision of every method on the fig04 maps, and what each ingredient costs.
 bench: $(VENV)/.done
 	$(VENV_PATH) $(VENV)/bin/snakemake --cores 1 bench $(SNAKEFLAGS)
@@ -106,8 +115,9 @@ lock: | check-python
 	echo "wrote requirements.lock ($$(grep -c '==' requirements.lock) pins)"
 
 clean:
-	rm -rf results/ .snakemake/
+	rm -rf results/ .snakemake/ paper/generated paper/.build.* report.html
 	rm -f figures/*.pdf figures/*.png
+	rm -f paper/main.pdf paper/main.log paper/main.fls paper/main.build.log
 
 distclean: clean
 	rm -rf $(VENV)

@@ -13,8 +13,23 @@ wildcard_constraints:
 include: "workflow/rules/common.smk"
 include: "workflow/rules/compute.smk"
 include: "workflow/rules/plot.smk"
+include: "workflow/rules/report.smk"
+
+# The reproduction report paper/main.pdf is part of `all` only when TeX is
+# installed (and paper/ is present); otherwise say how to get it.
+REPORT_PDF = []
+if Path("paper/main.tex").exists():
+    if tex_available():
+        REPORT_PDF = ["paper/main.pdf"]
+    else:
+        print("note: TeX not found, so paper/main.pdf (the reproduction report) is skipped.\n"
+              f"      Install it with:  sudo apt-get install -y --no-install-recommends {TEX_PACKAGES}",
+              file=sys.stderr)
+include: "workflow/rules/bench.smk"
 
 
 rule all:
+    default_target: True
     input:
         expand("figures/{scene}.{ext}", scene=config["scenes"], ext=["pdf", "png"]),
+        REPORT_PDF,

@@ -1,0 +1,243 @@
+"""The reproduction report paper/main.pdf, built by the Snakemake rule `paper` in a
+scratch copy of the project.
+
+The copy reuses results/ and figures/ of the working tree when every scene of
+the report is there (a quick build: tables + LaTeX only); otherwise (a fresh
+clone, as in CI) Snakemake computes them first. Without TeX the build tests skip
+locally, but fail when CI=true: CI must install TeX (.ci/run does).
+"""
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from conftest import copy_project, run_snakemake
+from filippov import report
+
+ROOT = Path(__file__).resolve().parents[1]
+TEX_PACKAGES = ("texlive-publishers texlive-latex-extra texlive-latex-recommended "
+                "texlive-fonts-recommended latexmk")
+
+
+# ----------------------------------------------------------------------------- no TeX needed
+def test_number_formatting_round_trips():
+    for x in (0.0, 1.0, -0.5, 0.874217, 8.74e-3, 2.2e-13, -1.9e-22, 315.83, 25000.0, 1e-8,
+              1.2e-8, 9.99e-4, 3979.0, -0.9936):
+        text = report.num(x)
+        assert report.parse_num(text) == pytest.approx(x, rel=5e-3, abs=0), (x, text)
+    assert report.num(8.74e-4) == r"8.74\times10^{-4}" and report.num(8.74e-3) == "0.00874"
+    assert report.num(1e-6) == "10^{-6}"
+    assert report.num(0.999999e-3, 2) == "10^{-3}"
+
+
+def test_absent_optional_results_say_not_yet_computed():
+    m = report.Macros()
+    t10, t11 = report.dry_friction(None, None, m)
+    tb = report.bench(None, m)
+    for text in (t10, t11, tb):
+        assert report.NOT_YET in text
+    assert m.flags == {"rpHaveTen": False, "rpHaveEleven": False, "rpHaveBench": False}
+
+
+def test_optional_tables_show_whatever_the_datasets_hold():
+    ds = xr.Dataset({"v_hopf": ((), 2.5, {"long_name": "Hopf point"}),
+                     "v_gs": ((), 3.25, {"long_name": "grazing-sliding point"})})
+    m = report.Macros()
+    t10, _ = report.dry_friction(ds, None, m)
+    assert "v\\_hopf" in t10 and "2.5" in t10 and report.NOT_YET not in t10
+    assert m.values()["rpTenVGS"][0] == 3.25
+    bench = xr.Dataset({"error": (("method", "tol"), [[1e-3, 1e-6]]),
+                        "seconds": (("method", "tol"), [[0.1, 0.4]])},
+                       coords={"method": ["exact"], "tol": [1e-6, 1e-10]})
+    text = report.bench(bench, m)
+    assert r"\texttt{method}" in text and r"\texttt{exact}" in text and "$0.001$" in text
+    assert m.flags["rpHaveBench"]
+
+
+def test_every_test_named_in_the_report_exists():
+    named = set()
+    for tex in (ROOT / "paper").glob("*.tex"):
+        named |= set(re.findall(r"\\testref\{([A-Za-z0-9_]+)\}", tex.read_text()))
+    assert len(named) > 40
+    defined = set()
+    for py in (ROOT / "tests").glob("test_*.py"):
+        defined |= set(re.findall(r"^def (test_[A-Za-z0-9_]+)\(", py.read_text(), re.M))
+    assert not named - defined, f"the report names tests that do not exist: {sorted(named - defined)}"
+
+
+def test_no_number_typed_in_the_figure_prose():
+    # numbers in the text come from macros; digits left in the prose are labels,
+    # equation constants and the paper's own parameters (listed here)
+    allowed = {"0", "1", "2", "3", "4", "8", "12", "-12", "-1", "-4", "0.5", "10", "60", "-0.5",
+               "0.1", "0.01", "3.32", "3.1", "-2", "0.3", "2.5", "10^{-10}",
+               "10^{-2}", "10^{-3}", "10^{-4}"}  # the last: parameters of named tests
+    for name in ("sec_figures.tex", "sec_pdm.tex"):
+        text = (ROOT / "paper" / name).read_text()
+        text = re.sub(r"\\(plabel|testref|label|ref|eqref|includegraphics|input)(\[[^]]*\])?\{[^}]*\}",
+                      "", text)
+        text = re.sub(r"\\[A-Za-z]+", "", text)   # macro names (rpTwoPeriod, ...)
+        found = set(re.findall(r"(?<![A-Za-z_0-9.])-?\d+(?:\.\d+)?(?:\^\{-?\d+\})?", text))
+        assert not found - allowed, f"{name}: numbers typed by hand: {sorted(found - allowed)}"
+
+
+# ----------------------------------------------------------------------------- the build
+def _tex_available():
+    if not all(shutil.which(t) for t in ("latexmk", "pdflatex", "kpsewhich")):
+        return False
+    found = subprocess.run(["kpsewhich", "elsarticle.cls"], capture_output=True, text=True)
+    return found.returncode == 0 and bool(found.stdout.strip())
+
+
+def _require_tex():
+    if _tex_available():
+        return
+    msg = ("TeX is not installed (need latexmk, pdflatex, elsarticle.cls); install with: "
+           f"apt-get install -y --no-install-recommends {TEX_PACKAGES}")
+    if os.environ.get("CI", "").lower() in ("true", "1", "yes"):
+        pytest.fail("CI=true but " + msg)
+    pytest.skip(msg)
+
+
+def _snakemake(work, *args, cores="1", timeout=3000):
+    return run_snakemake(work, *args, cores=cores, timeout=timeout)
+
+
+@pytest.fixture(scope="module")
+def built(workflow_build):
+    """The shared build of rule `all`, which includes paper/main.pdf when TeX is there."""
+    _require_tex()
+    work, run = workflow_build["work"], workflow_build["run"]
+    assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-4000:]
+    scenes = yaml.safe_load((work / "config" / "config.yaml").read_text())["scenes"]
+    return {"work": work, "scenes": scenes, "run": run, "seconds": workflow_build["seconds"]}
+
+
+def test_pdf_is_built_with_every_figure(built):
+    work = built["work"]
+    pdf = work / "paper" / "main.pdf"
+    assert pdf.read_bytes().startswith(b"%PDF") and pdf.stat().st_size > 100_000
+    fls = (work / "paper" / "main.fls").read_text()
+    inputs = {os.path.normpath(p) for p in re.findall(r"^INPUT (.+)$", fls, re.M)}
+    for s in built["scenes"]:
+        if s in report.CORE or s in report.OPTIONAL:
+            assert f"../figures/{s}.pdf" in inputs, f"figure {s} not included"
+    log = (work / "paper" / "main.log").read_text(errors="replace")
+    pages = int(re.search(r"Output written on \S+ \((\d+) pages?", log).group(1))
+    assert pages >= 10, pages
+    assert built["seconds"] < 600
+
+
+def test_log_has_no_undefined_references_or_missing_files(built):
+    log = (built["work"] / "paper" / "main.log").read_text(errors="replace")
+    for bad in ("undefined references", "There were undefined", "Reference `",
+                "Citation `", "multiply defined", "not found", "Undefined control sequence",
+                "Rerun to get"):
+        assert bad not in log, f"main.log contains {bad!r}"
+
+
+def _value(ds_dir: Path, source: str):
+    """Re-read `dataset:variable[sel]` or `dataset:attrs.name` (None for derived)."""
+    m = re.fullmatch(r"(fig\d\d_[a-z0-9_]+):([A-Za-z0-9_]+)(?:\.([A-Za-z0-9_]+))?(\[(.*)\])?",
+                     source)
+    if not m or source.startswith("derived"):
+        return None
+    sid, var, attr, _, sel = m.groups()
+    with xr.open_dataset(ds_dir / f"{sid}.nc") as ds:
+        if var == "attrs":
+            v = ds.attrs[attr]
+            return float(np.atleast_1d(v)[int(sel)] if sel is not None else v)
+        if sel is None:
+            return float(ds[var].values)
+        if re.fullmatch(r"-?\d+", sel):
+            return float(ds[var].values[int(sel)])
+        kw = dict(re.findall(r"(\w+)=('[^']*'|[^,]+)", sel))
+        kw = {k: (v.strip("'") if v.startswith("'") else float(v)) for k, v in kw.items()}
+        pos = {k: int(v) for k, v in kw.items() if k not in ds.coords}
+        lab = {k: v for k, v in kw.items() if k in ds.coords}
+        return float(ds[var].isel(**pos).sel(**lab).values)
+
+
+def test_macros_match_their_source_variables(built):
+    work = built["work"]
+    macros = report.read_macros((work / "paper/generated/macros.tex").read_text())
+    assert len(macros) > 100
+    checked = 0
+    for name, (body, source) in macros.items():
+        if body.startswith("\\text"):
+            continue
+        source, digits = source.rsplit(" | digits=", 1)
+        value = _value(work / "results", source)
+        if value is None:
+            continue
+        got = report.parse_num(body)
+        rel = 0.51 * 10.0 ** (1 - int(digits))  # rounding to that many digits
+        assert got == pytest.approx(value, rel=rel, abs=1e-300), (name, body, source, value)
+        checked += 1
+    assert checked > 60
+
+
+def test_derived_macros_match_the_datasets(built):
+    work = built["work"]
+    macros = report.read_macros((work / "paper/generated/macros.tex").read_text())
+    val = {k: report.parse_num(b) for k, (b, _) in macros.items() if not b.startswith("\\text")}
+    with xr.open_dataset(work / "results/fig04_retmaps.nc") as ds:
+        x2 = ds.x2.values
+        P = ds.P.sel(theta=-0.5).values
+        j = np.where(x2 > 1)[0][0]
+        assert val["rpFourJump"] == pytest.approx(1 - P[j], rel=1e-3)
+        assert val["rpFourJumpOverEps"] == pytest.approx((1 - P[j]) / ds.attrs["eps"], rel=1e-2)
+        assert val["rpFourSlopeSmooth"] == pytest.approx(np.exp(-4 * np.pi / (8 * np.pi)), rel=1e-3)
+    with xr.open_dataset(work / "results/fig02_cases.nc") as ds:
+        assert val["rpTwoPeriodOverEps"] == pytest.approx(float(ds.period) / ds.attrs["eps"], rel=1e-2)
+    with xr.open_dataset(work / "results/fig07_pdm_theta_neg.nc") as ds:
+        tab = (work / "paper/generated/tab_fig07.tex").read_text()
+        rows = [r for r in tab.splitlines() if r.startswith("$") and "epsilon" not in r]
+        assert len(rows) == ds.sizes["eps"]
+        for row, e in zip(rows, ds.eps.values):
+            cells = [c.strip().strip("$") for c in row[:-2].split("&")]
+            assert report.parse_num(cells[0]) == pytest.approx(e, rel=1e-6)
+            assert report.parse_num(cells[3]) == pytest.approx(float(ds.error_printed.sel(eps=e)), rel=6e-3)
+            assert report.parse_num(cells[5]) == pytest.approx(float(ds.error_first_order.sel(eps=e)), rel=6e-3)
+    with xr.open_dataset(work / "results/fig09_pdm_theta_pos.nc") as ds:
+        tab = (work / "paper/generated/tab_fig09.tex").read_text()
+        rows = [r for r in tab.splitlines() if r.startswith("$") and "epsilon" not in r]
+        for row, e in zip(rows, ds.eps.values):
+            cells = [c.strip().strip("$") for c in row[:-2].split("&")]
+            assert report.parse_num(cells[4]) == pytest.approx(float(ds.error_core.sel(eps=e)), rel=6e-3)
+
+
+def test_optional_sections_follow_the_results(built):
+    work = built["work"]
+    macros = (work / "paper/generated/macros.tex").read_text()
+    for sid, flag, tab in (("fig10_dfo", "rpHaveTen", "tab_fig10.tex"),
+                           ("fig11_dfo_retmaps", "rpHaveEleven", "tab_fig11.tex"),
+                           ("bench_work_precision", "rpHaveBench", "tab_bench.tex")):
+        present = (work / f"results/{sid}.nc").exists()
+        assert f"\\{flag}{'true' if present else 'false'}" in macros
+        assert (report.NOT_YET in (work / "paper/generated" / tab).read_text()) != present
+
+
+def test_failed_build_leaves_no_pdf(built, tmp_path):
+    # a copy (timestamps kept, so only the report is out of date): the shared build
+    # stays untouched for the other tests
+    work = tmp_path / "project"
+    shutil.copytree(built["work"], work, symlinks=True)
+    sec = work / "paper" / "sec_bench.tex"
+    good = sec.read_text()
+    try:
+        sec.write_text(good + "\n\\thiscommanddoesnotexist\n")
+        run = _snakemake(work, "paper/main.pdf")
+        assert run.returncode != 0
+        assert not (work / "paper" / "main.pdf").exists()
+        assert not list((work / "paper").glob(".build.*"))
+        assert "thiscommanddoesnotexist" in (work / "paper" / "main.log").read_text(errors="replace")
+    finally:
+        sec.write_text(good)

@@ -1,0 +1,92 @@
+# The reproduction report: results/*.nc -> paper/generated/*.tex (numbers and
+# tables, never typed by hand) and figures/*.pdf + paper/*.tex -> paper/main.pdf.
+# Optional inputs: the dry-friction scenes (fig10_dfo, fig11_dfo_retmaps) are
+# used when they are listed in config["scenes"]; the work-precision benchmark
+# when results/bench_work_precision.nc exists. The report says "not yet
+# computed" for whatever is absent. Rule `all` asks for paper/main.pdf only when
+# TeX is installed (see TEX_OK in the Snakefile).
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+REPORT_CORE = [
+    "fig01_slidesketch", "fig02_cases", "fig03_grazingsketch", "fig04_retmaps",
+    "fig05_thetalt0mfs", "fig06_sgraph", "fig07_pdm_theta_neg", "fig08_s0theta",
+    "fig09_pdm_theta_pos",
+]
+REPORT_OPTIONAL = ["fig10_dfo", "fig11_dfo_retmaps"]
+
+report: "../report/workflow.rst"
+
+REPORT_GENERATED = ["macros.tex", "tab_fig07.tex", "tab_fig09.tex", "tab_fig10.tex",
+                    "tab_fig11.tex", "tab_bench.tex"]
+TEX_PACKAGES = ("texlive-publishers texlive-latex-extra texlive-latex-recommended "
+                "texlive-fonts-recommended latexmk")
+
+
+def tex_available():
+    """pdflatex, latexmk and elsarticle.cls are all installed."""
+    if not (shutil.which("latexmk") and shutil.which("pdflatex") and shutil.which("kpsewhich")):
+        return False
+    found = subprocess.run(["kpsewhich", "elsarticle.cls"], capture_output=True, text=True)
+    return found.returncode == 0 and bool(found.stdout.strip())
+
+
+def report_scenes():
+    listed = list(config["scenes"])
+    return [s for s in listed if s in REPORT_CORE + REPORT_OPTIONAL] + \
+           [s for s in listed if s not in REPORT_CORE + REPORT_OPTIONAL]
+
+
+def report_data(wildcards):
+    data = [f"results/{s}.nc" for s in report_scenes()]
+    if Path("results/bench_work_precision.nc").exists():
+        data.append("results/bench_work_precision.nc")
+    return data
+
+
+rule report_tables:
+    input:
+        data=report_data,
+        script="workflow/scripts/report_tables.py",
+    output:
+        [f"paper/generated/{name}" for name in REPORT_GENERATED],
+    params:
+        code=library_hash(exclude="plotting"),  # filippov.report and what it imports
+    script:
+        "../scripts/report_tables.py"
+
+
+# latexmk builds in a fresh directory under paper/; only a complete PDF is moved
+# onto paper/main.pdf (same file system: atomic). The build log is kept in
+# paper/main.build.log (and the TeX log/recorder file next to it) even on failure.
+rule paper:
+    input:
+        tex=sorted(str(p) for p in Path("paper").glob("*.tex")),
+        generated=[f"paper/generated/{name}" for name in REPORT_GENERATED],
+        figures=[f"figures/{s}.pdf" for s in report_scenes()],
+    output:
+        report("paper/main.pdf", category="Reproduction report",
+               caption="../report/paper.rst"),
+    log:
+        "paper/main.build.log",
+    shell:
+        r"""
+        set -u
+        build=$(mktemp -d paper/.build.XXXXXX)
+        trap 'rm -rf "$build"' EXIT
+        rc=0
+        ( cd paper && SOURCE_DATE_EPOCH=0 FORCE_SOURCE_DATE=1 \
+            latexmk -pdf -interaction=nonstopmode -halt-on-error -file-line-error \
+                    -recorder -outdir="${{build#paper/}}" main.tex ) > {log:q} 2>&1 || rc=$?
+        for ext in log fls; do
+            if [ -f "$build/main.$ext" ]; then cp "$build/main.$ext" "paper/main.$ext"; fi
+        done
+        if [ "$rc" -ne 0 ]; then
+            echo "latexmk failed (exit $rc); see {log} and paper/main.log" >&2
+            grep -n -A3 '^!\|:[0-9]*: ' paper/main.log >&2 || true
+            exit "$rc"
+        fi
+        mv "$build/main.pdf" {output:q}
+        """

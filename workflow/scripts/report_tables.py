@@ -1,0 +1,17 @@
+"""Thin: results/*.nc -> filippov.report.generate -> paper/generated/*.tex."""
+from pathlib import Path
+
+import xarray as xr
+
+import filippov.report
+
+datasets = {}
+for path in snakemake.input.data:  # noqa: F821
+    with xr.open_dataset(path) as ds:
+        datasets[Path(path).stem] = ds.load()
+texts = filippov.report.generate(datasets)
+for out in snakemake.output:  # noqa: F821
+    out = Path(out)
+    tmp = out.with_suffix(".tmp")
+    tmp.write_text(texts[out.name])
+    tmp.replace(out)  # atomic: no half-written table
