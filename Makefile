@@ -2,6 +2,9 @@
 #
 #   make figures   build every figure (and the report) with Snakemake
 #   make test      run the test suite
+#   make verify    two clean builds in a temporary directory: byte-identical,
+#                  and in agreement with tests/reference/manifest.json
+#   make manifest  rewrite the manifest from results/ and figures/ (prints changes)
 #   make report    the reproduction report paper/main.pdf (needs TeX)
 #   make report-html  snakemake's HTML report (report.html): figures, rules, parameters
 #   make lock      re-resolve requirements.lock in a throw-away venv
@@ -37,7 +40,7 @@ export DEBIAN_FRONTEND = noninteractive
 # `python` inside Snakemake shell rules is the venv's interpreter.
 VENV_PATH = PATH="$(abspath $(VENV))/bin:$$PATH" VIRTUAL_ENV="$(abspath $(VENV))"
 
-.PHONY: all venv figures test report report-html bench bench-fig04 lock clean distclean check-python
+.PHONY: all venv figures test verify manifest report report-html bench bench-fig04 lock clean distclean check-python
 
 all: figures
 
@@ -78,6 +81,12 @@ test: $(VENV)/.done
 	  echo "warning: pytest collected no tests (exit 5); accepted because ALLOW_NO_TESTS is set" >&2; rc=0; \
 	fi; \
 	exit $$rc
+
+verify: $(VENV)/.done
+	$(VENV_PATH) $(PY) workflow/scripts/verify.py
+
+manifest: figures
+	$(VENV_PATH) $(PY) -m filippov.manifest update
 
 report: $(VENV)/.done
 	$(VENV_PATH) $(VENV)/bin/snakemake --cores all $(SNAKEFLAGS) paper/main.pdf

@@ -2,9 +2,6 @@
 
 Makes `src/` importable when the package is not installed.
 """
-import os
-import shutil
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -17,26 +14,10 @@ if str(SRC) not in sys.path:
     sys.path.insert(0, str(SRC))
 
 
-def copy_project(dest: Path) -> Path:
-    """What a fresh clone needs to run the workflow: Snakefile, config, workflow, paper."""
-    dest.mkdir(parents=True)
-    shutil.copy(ROOT / "Snakefile", dest / "Snakefile")
-    for folder in ("config", "workflow"):
-        shutil.copytree(ROOT / folder, dest / folder)
-    if (ROOT / "paper").is_dir():
-        (dest / "paper").mkdir()
-        for tex in (ROOT / "paper").glob("*.tex"):
-            shutil.copy(tex, dest / "paper" / tex.name)
-    return dest
-
-
-def run_snakemake(work: Path, *args, cores: str = "1", timeout: float = 3000):
-    env = dict(os.environ, MPLBACKEND="Agg", SOURCE_DATE_EPOCH="0")
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))
-    env["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), env.get("PATH", "")])
-    cmd = [sys.executable, "-m", "snakemake", "--cores", cores, "--directory", str(work), *args]
-    return subprocess.run(cmd, cwd=work, env=env, capture_output=True, text=True,
-                          timeout=timeout)
+# one definition of "a fresh copy of the project" and "run snakemake there",
+# shared with `make verify`
+sys.path.insert(0, str(ROOT / "workflow" / "scripts"))
+from verify import copy_project, run_snakemake  # noqa: E402
 
 
 @pytest.fixture(scope="session")

@@ -2,13 +2,12 @@
 
 Skipped only while the compute package `filippov.scenes` cannot be imported.
 """
-import os
+import re
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+import yaml
 
 pytest.importorskip("filippov.scenes", reason="compute code (filippov.scenes) not importable yet")
 
@@ -26,7 +25,6 @@ def _snakemake(work: Path, *args):
 def test_builds_every_figure_then_nothing_to_do(workflow_build):
     work, run = workflow_build["work"], workflow_build["run"]
     assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-4000:]
-    import yaml
     for scene in yaml.safe_load((work / "config" / "config.yaml").read_text())["scenes"]:
         for ext in ("pdf", "png"):
             assert (work / "figures" / f"{scene}.{ext}").stat().st_size > 0
@@ -44,3 +42,58 @@ def test_invalid_scene_fails_cleanly(tmp_path):
     assert run.returncode != 0
     assert "parameters.eps" in run.stdout + run.stderr
     assert not (work / "results" / "fig02_cases.nc").exists()
+
+
+def _copy_of_build(workflow_build, tmp_path) -> Path:
+    """The shared build, copied with its timestamps and Snakemake's metadata."""
+    run = workflow_build["run"]
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    work = tmp_path / "project"
+    shutil.copytree(workflow_build["work"], work, symlinks=True)
+    return work
+
+
+def _planned(work: Path) -> dict[str, set]:
+    """Jobs a dry run would execute: rule -> set of scene wildcards ('' if none)."""
+    run = _snakemake(work, "-n")
+    assert run.returncode == 0, run.stdout + run.stderr
+    jobs: dict[str, set] = {}
+    rule = None
+    for line in (run.stdout + run.stderr).splitlines():
+        m = re.match(r"^(?:local)?rule (\w+):", line)
+        if m:
+            rule = m.group(1)
+            jobs.setdefault(rule, set()).add("")
+            continue
+        m = re.match(r"^\s+wildcards: scene=(\w+)", line)
+        if m and rule:
+            jobs[rule].discard("")
+            jobs[rule].add(m.group(1))
+    return jobs
+
+
+def test_changing_one_scene_reruns_only_its_chain(workflow_build, tmp_path):
+    work = _copy_of_build(workflow_build, tmp_path)
+    assert _planned(work) == {}
+    scene = work / "config" / "scenes" / "fig08_s0theta.yaml"
+    text = scene.read_text()
+    assert "n_theta: 400" in text
+    scene.write_text(text.replace("n_theta: 400", "n_theta: 401"))
+    jobs = _planned(work)
+    assert jobs.pop("compute") == {"fig08_s0theta"}
+    assert jobs.pop("plot") == {"fig08_s0theta"}
+    jobs.pop("all", None)
+    # the report (if built) quotes every dataset: it follows; nothing else does
+    assert set(jobs) <= {"report_tables", "paper"}, jobs
+
+
+def test_editing_a_workflow_script_reruns_its_rule_only(workflow_build, tmp_path):
+    work = _copy_of_build(workflow_build, tmp_path)
+    script = work / "workflow" / "scripts" / "plot_scene.py"
+    script.write_text(script.read_text() + "\n# an edit\n")
+    jobs = _planned(work)
+    scenes = set(yaml.safe_load((work / "config" / "config.yaml").read_text())["scenes"])
+    assert "compute" not in jobs
+    assert jobs.pop("plot") == scenes
+    jobs.pop("all", None)
+    assert set(jobs) <= {"paper"}, jobs   # the report includes the redrawn figures

@@ -432,11 +432,56 @@ def dry_friction(ds10, ds11, m: Macros) -> tuple[str, str]:
     return tab10, tab11
 
 
-def bench(ds, m: Macros) -> str:
+def bench(ds, m: Macros, effects=None) -> str:
+    """The work-precision table (one row per method and tolerance, error / time /
+    missed switches per problem), the speed-up at the target error, and the cost
+    of each model ingredient when results/bench_effect_cost.nc is there."""
     m.flag("rpHaveBench", ds is not None)
     if ds is None:
         return _not_yet("Work--precision benchmark", "results/bench_work_precision.nc")
-    return table_frame(ds)
+    if "method" not in ds.coords or "problem" not in ds.dims:
+        return table_frame(ds)
+    probs = [str(p) for p in ds.problem.values]
+    head = " & ".join(rf"\multicolumn{{3}}{{c}}{{\texttt{{{tex_escape(p)}}}}}" for p in probs)
+    sub = " & ".join(["error & time [s] & missed"] * len(probs))
+    lines = [r"\begin{tabular}{ll" + "rrr" * len(probs) + "}", r"\toprule",
+             rf"method & rtol & {head} \\", rf" & & {sub} \\", r"\midrule"]
+    for j in range(ds.sizes["config"]):
+        cells = [tex_escape(str(ds.method.values[j])), f"${num(float(ds.tolerance.values[j]), 2)}$"]
+        for i in range(len(probs)):
+            status = str(ds.status.values[i, j])
+            if status != "ok":
+                cells.append(r"\multicolumn{3}{l}{\emph{" + tex_escape(status.split(":")[0]) + "}}")
+                continue
+            cells += [f"${num(float(ds.error_map.values[i, j]), 2)}$",
+                      f"${num(float(ds.wall_time.values[i, j]), 2)}$",
+                      str(int(ds.missed_switches.values[i, j]))]
+        lines.append(" & ".join(cells) + r" \\")
+    lines += [r"\bottomrule", r"\end{tabular}", ""]
+    for i, p in enumerate(probs):
+        key = "A" if i == 0 else "B"
+        m.add(f"rpBenchSpeedup{key}", float(ds.speedup_vs_rk45.values[i]),
+              _src("bench_work_precision", f"speedup_vs_rk45[{i}]"), 3)
+        m.add(f"rpBenchFloor{key}", float(ds.reference_check.values[i]),
+              _src("bench_work_precision", f"reference_check[{i}]"), 2)
+        m.add(f"rpBenchPoints{key}", float(ds.n_points.values[i]),
+              _src("bench_work_precision", f"n_points[{i}]"), 4)
+    m.flag("rpHaveEffects", effects is not None)
+    if effects is not None:
+        lines += [r"\medskip", "", r"\begin{tabular}{llrrl}", r"\toprule",
+                  r"scene & ingredient switched & time [s] & $\times$ declared & outcome \\",
+                  r"\midrule"]
+        for k in range(effects.sizes["variant"]):
+            status = str(effects.status.values[k])
+            outcome = "ok" if status == "ok" else status.split(":")[0]
+            lines.append(" & ".join([
+                r"\texttt{" + tex_escape(str(effects.scene.values[k])) + "}",
+                tex_escape(str(effects.change.values[k])).replace("->", r"$\to$"),
+                f"${num(float(effects.seconds.values[k]), 3)}$",
+                f"${num(float(effects.relative.values[k]), 3)}$",
+                r"\emph{" + tex_escape(outcome) + "}"]) + r" \\")
+        lines += [r"\bottomrule", r"\end{tabular}", ""]
+    return "\n".join(lines)
 
 
 # ----------------------------------------------------------------------------- entry point
@@ -457,7 +502,7 @@ def generate(datasets: Mapping[str, Optional[xr.Dataset]]) -> dict[str, str]:
         except KeyError as exc:
             raise KeyError(f"{sid}: the report reads {exc} but the dataset lacks it") from None
     tab10, tab11 = dry_friction(datasets.get("fig10_dfo"), datasets.get("fig11_dfo_retmaps"), m)
-    tab_bench = bench(datasets.get("bench_work_precision"), m)
+    tab_bench = bench(datasets.get("bench_work_precision"), m, datasets.get("bench_effect_cost"))
     return {
         "macros.tex": m.tex(),
         "tab_fig07.tex": fig07_table(datasets["fig07_pdm_theta_neg"]),

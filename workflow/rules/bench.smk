@@ -5,7 +5,7 @@ rule bench_work_precision:
     output:
         "results/bench_work_precision.nc",
     params:
-        code=library_hash(exclude="plotting"),
+        code=library_hash(exclude=("plotting", "report.py", "manifest.py")),
         every=config.get("bench", {}).get("every", 10),
     script:
         "../scripts/bench_work_precision.py"

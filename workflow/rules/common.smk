@@ -5,17 +5,24 @@ import hashlib
 import importlib.util
 from pathlib import Path
 
+# Library parts no scene computation imports: editing them must not recompute data.
+NOT_COMPUTE = ("plotting/", "benchmarks/", "report.py", "manifest.py")
 
-def library_hash(include="", exclude=None):
-    """sha256 over filippov's *.py files under `include`, minus `exclude`."""
+
+def library_hash(include="", exclude=()):
+    """sha256 over filippov's *.py files under `include`, minus the paths in
+    `exclude` (a folder "name/" or a file "name.py", relative to the package)."""
     spec = importlib.util.find_spec("filippov")  # locates without importing numerics
     if spec is None or not spec.origin:
         return "filippov-not-found"
     root = Path(spec.origin).parent
+    exclude = (exclude,) if isinstance(exclude, str) else tuple(exclude)
+    # a bare name is a folder ("plotting" == "plotting/")
+    exclude = tuple(e if e.endswith((".py", "/")) else e + "/" for e in exclude)
     digest = hashlib.sha256()
     for path in sorted((root / include).rglob("*.py")):
         rel = path.relative_to(root).as_posix()
-        if exclude and rel.startswith(exclude + "/"):
+        if any(rel == e or (e.endswith("/") and rel.startswith(e)) for e in exclude):
             continue
         digest.update(rel.encode() + b"\0" + path.read_bytes() + b"\0")
     return digest.hexdigest()[:16]

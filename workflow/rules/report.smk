@@ -41,9 +41,17 @@ def report_scenes():
 
 def report_data(wildcards):
     data = [f"results/{s}.nc" for s in report_scenes()]
-    if Path("results/bench_work_precision.nc").exists():
-        data.append("results/bench_work_precision.nc")
+    for bench in ("bench_work_precision", "bench_effect_cost"):
+        if Path(f"results/{bench}.nc").exists():  # measured by `make bench`, if at all
+            data.append(f"results/{bench}.nc")
     return data
+
+
+def report_figures(wildcards):
+    figs = [f"figures/{s}.pdf" for s in report_scenes()]
+    if Path("figures/bench_work_precision.pdf").exists():
+        figs.append("figures/bench_work_precision.pdf")
+    return figs
 
 
 rule report_tables:
@@ -65,7 +73,7 @@ rule paper:
     input:
         tex=sorted(str(p) for p in Path("paper").glob("*.tex")),
         generated=[f"paper/generated/{name}" for name in REPORT_GENERATED],
-        figures=[f"figures/{s}.pdf" for s in report_scenes()],
+        figures=report_figures,
     output:
         report("paper/main.pdf", category="Reproduction report",
                caption="../report/paper.rst"),

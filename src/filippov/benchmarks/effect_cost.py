@@ -101,7 +101,7 @@ def measure(scene_ids, cap: float, log=print) -> xr.Dataset:
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("scenes", nargs="*", default=DEFAULT_SCENES)
-    ap.add_argument("--time-cap", type=float, default=300.0, help="seconds per variant")
+    ap.add_argument("--time-cap", type=float, default=120.0, help="seconds per variant")
     ap.add_argument("--out", default=str(ROOT / "results" / "bench_effect_cost.nc"))
     args = ap.parse_args(argv)
     ds = measure(args.scenes, args.time_cap, log=lambda s: print(s, file=sys.stderr, flush=True))

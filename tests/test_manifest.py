@@ -1,0 +1,115 @@
+"""The reproducibility manifest: it catches changed data, changed figures and
+missing or extra outputs, tolerates last-bit noise, and the shared fresh build
+agrees with the committed manifest."""
+import json
+import shutil
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from filippov import manifest
+from filippov.io import write_dataset
+
+
+def _dataset(path, scale=1.0):
+    x = np.linspace(0.0, 1.0, 500)
+    ds = xr.Dataset({"P": ("x", np.sin(7 * x) * scale), "n": ("x", np.arange(500)),
+                     "label": ((), "text is not compared")}, coords={"x": x})
+    write_dataset(ds, path)
+    return path
+
+
+def test_data_within_tolerance_passes_and_beyond_fails(tmp_path):
+    ref = manifest.summarize(_dataset(tmp_path / "a.nc"))
+    assert set(ref) == {"P", "n", "x"}
+    near = manifest.summarize(_dataset(tmp_path / "b.nc", scale=1 + 1e-13))
+    assert manifest.compare_data(near, ref, 1e-9, 1e-12) == []
+    far = manifest.summarize(_dataset(tmp_path / "c.nc", scale=1 + 1e-6))
+    problems = manifest.compare_data(far, ref, 1e-9, 1e-12)
+    assert len(problems) == 1 and problems[0].startswith("P: differs by up to")
+
+
+def test_shape_and_missing_variables_are_reported(tmp_path):
+    ref = manifest.summarize(_dataset(tmp_path / "a.nc"))
+    got = dict(ref)
+    del got["n"]
+    got["extra"] = ref["P"]
+    problems = manifest.compare_data(got, ref, 1e-9, 1e-12)
+    assert "n: missing" in problems and "extra: not in the manifest" in problems
+
+
+def _figure(path, box=False):
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(3, 2))
+    ax = fig.subplots()
+    ax.plot([0, 1], [0, 1])
+    if box:
+        ax.fill_between([0.1, 0.9], 0.1, 0.9, color="black")
+    fig.savefig(path, dpi=200, metadata={"Software": None})
+    return path
+
+
+def test_image_comparison_tolerates_equal_and_catches_changes(tmp_path):
+    png = _figure(tmp_path / "f.png")
+    manifest.write_thumbnail(png, tmp_path / "ref" / "f.png")
+    assert manifest.compare_image(png, tmp_path / "ref" / "f.png") is None
+    changed = _figure(tmp_path / "g.png", box=True)
+    assert "image differs" in manifest.compare_image(changed, tmp_path / "ref" / "f.png")
+
+
+def test_check_in_another_environment_compares_images(tmp_path):
+    res, figs = tmp_path / "results", tmp_path / "figures"
+    res.mkdir(), figs.mkdir()
+    _dataset(res / "fig99_test.nc")
+    _figure(figs / "fig99_test.png")
+    _figure(figs / "fig99_test.pdf")
+    man = manifest.build_manifest(res, figs)
+    thumbs = tmp_path / "reference" / "figures"
+    manifest.write_thumbnail(figs / "fig99_test.png", thumbs / "fig99_test.png")
+    assert manifest.check(res, figs, man, thumbs) == []
+    # a different environment: the PDF's hash no longer matters, the image does
+    man["environment"] = "elsewhere"
+    (figs / "fig99_test.pdf").write_bytes(b"%PDF other bytes")
+    assert manifest.check(res, figs, man, thumbs) == []
+    _figure(figs / "fig99_test.png", box=True)
+    assert any("image differs" in p for p in manifest.check(res, figs, man, thumbs))
+    # the manifest's environment: hashes are compared exactly
+    man["environment"] = manifest.environment()
+    assert any("hash differs" in p for p in manifest.check(res, figs, man, thumbs))
+    # missing and unlisted outputs
+    shutil.copy(res / "fig99_test.nc", res / "fig98_new.nc")
+    (res / "fig99_test.nc").unlink()
+    problems = manifest.check(res, figs, man, thumbs)
+    assert "results/fig99_test.nc: missing" in problems
+    assert any("fig98_new.nc: not in the manifest" in p for p in problems)
+
+
+def test_update_prints_what_changed(tmp_path, capsys):
+    res, figs = tmp_path / "results", tmp_path / "figures"
+    res.mkdir(), figs.mkdir()
+    _dataset(res / "fig99_test.nc")
+    _figure(figs / "fig99_test.png"), _figure(figs / "fig99_test.pdf")
+    path = tmp_path / "ref" / "manifest.json"
+    args = ["update", "--results", str(res), "--figures", str(figs), "--manifest", str(path)]
+    assert manifest.main(args) == 0
+    assert "+ results/fig99_test.nc (new)" in capsys.readouterr().out
+    _dataset(res / "fig99_test.nc", scale=2.0)
+    assert manifest.main(args) == 0
+    out = capsys.readouterr().out
+    assert "~ results/fig99_test.nc: P: differs" in out
+    assert manifest.main(["check", "--results", str(res), "--figures", str(figs),
+                          "--manifest", str(path)]) == 0
+    assert json.loads(path.read_text())["data"]["fig99_test"]["tolerance"]["rtol"] == 1e-9
+
+
+def test_fresh_build_agrees_with_the_committed_manifest(workflow_build):
+    """The reproducibility check of CI: a clean build of every scene against the
+    committed reference values (data: tolerance; figures: hash or image)."""
+    run = workflow_build["run"]
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    work = workflow_build["work"]
+    man = json.loads(manifest.MANIFEST.read_text())
+    problems = manifest.check(work / "results", work / "figures", man)
+    assert problems == [], "\n".join(problems)

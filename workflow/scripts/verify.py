@@ -1,0 +1,111 @@
+"""`make verify`: rebuild everything twice from scratch and check it.
+
+1. Two fresh copies of the project (what a clone has: Snakefile, config/,
+   workflow/, paper/*.tex) are built with `snakemake` (rule all: every figure,
+   and the report when TeX is installed).
+2. The two builds must be byte-identical: every file in results/, figures/ and
+   paper/main.pdf.
+3. The first build is compared with the committed manifest
+   (tests/reference/manifest.json, see filippov.manifest).
+
+Run by make, not by a Snakemake rule. tests/conftest.py reuses copy_project and
+run_snakemake from here.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+OUTPUTS = ("results", "figures", "paper/main.pdf")
+
+
+def copy_project(dest: Path) -> Path:
+    """What a fresh clone needs to run the workflow: Snakefile, config, workflow, paper."""
+    dest.mkdir(parents=True)
+    shutil.copy(ROOT / "Snakefile", dest / "Snakefile")
+    for folder in ("config", "workflow"):
+        shutil.copytree(ROOT / folder, dest / folder)
+    if (ROOT / "paper").is_dir():
+        (dest / "paper").mkdir()
+        for tex in (ROOT / "paper").glob("*.tex"):
+            shutil.copy(tex, dest / "paper" / tex.name)
+    return dest
+
+
+def run_snakemake(work: Path, *args, cores: str = "1", timeout: float = 3000, capture=True):
+    env = dict(os.environ, MPLBACKEND="Agg", SOURCE_DATE_EPOCH="0")
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT / "src"), env.get("PYTHONPATH")]))
+    env["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), env.get("PATH", "")])
+    cmd = [sys.executable, "-m", "snakemake", "--cores", cores, "--directory", str(work), *args]
+    return subprocess.run(cmd, cwd=work, env=env, capture_output=capture, text=True,
+                          timeout=timeout)
+
+
+def files(work: Path) -> dict[str, bytes]:
+    out = {}
+    for name in OUTPUTS:
+        path = work / name
+        paths = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else \
+            [path] if path.exists() else []
+        for p in paths:
+            out[p.relative_to(work).as_posix()] = p.read_bytes()
+    return out
+
+
+def identical(a: Path, b: Path) -> list[str]:
+    fa, fb = files(a), files(b)
+    diff = [f"{n}: only in one build" for n in sorted(set(fa) ^ set(fb))]
+    diff += [f"{n}: bytes differ" for n in sorted(set(fa) & set(fb)) if fa[n] != fb[n]]
+    return diff
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--keep", action="store_true", help="keep the build directories")
+    args = ap.parse_args(argv)
+    sys.path.insert(0, str(ROOT / "src"))
+    from filippov import manifest
+
+    tmp = Path(tempfile.mkdtemp(prefix="filippov-verify-"))
+    try:
+        builds = []
+        for name in ("a", "b"):
+            work = copy_project(tmp / name)
+            t0 = time.perf_counter()
+            print(f"== clean build {name} in {work}", flush=True)
+            run = run_snakemake(work, cores="all", capture=False)
+            if run.returncode != 0:
+                print(f"verify: build {name} failed (exit {run.returncode})", file=sys.stderr)
+                return 1
+            print(f"== build {name}: {time.perf_counter() - t0:.0f} s", flush=True)
+            builds.append(work)
+        diff = identical(*builds)
+        n = len(files(builds[0]))
+        for line in diff:
+            print(f"NOT REPRODUCIBLE {line}")
+        print(f"two clean builds: {n} files, {'byte-identical' if not diff else f'{len(diff)} differ'}")
+        man = manifest.json.loads(manifest.MANIFEST.read_text())
+        problems = manifest.check(builds[0] / "results", builds[0] / "figures", man)
+        for p in problems:
+            print(f"MISMATCH {p}")
+        same = man["environment"] == manifest.environment()
+        print(f"manifest: {len(man['data'])} datasets, {len(man['figures'])} figures "
+              f"({'hashes' if same else 'other environment: images'} compared): "
+              f"{'OK' if not problems else f'{len(problems)} mismatches'}")
+        return 1 if diff or problems else 0
+    finally:
+        if args.keep:
+            print(f"builds kept in {tmp}")
+        else:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
