@@ -132,7 +132,6 @@ def test_pdf_is_built_with_every_figure(built):
     log = (work / "paper" / "main.log").read_text(errors="replace")
     pages = int(re.search(r"Output written on \S+ \((\d+) pages?", log).group(1))
     assert pages >= 10, pages
-    assert built["seconds"] < 600
 
 
 def test_log_has_no_undefined_references_or_missing_files(built):
