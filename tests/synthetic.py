@@ -194,3 +194,35 @@ def fig09(n: int = 121, theta: float = 0.5, omega: float = 8 * np.pi) -> xr.Data
         "error_core": ("eps", 30 * eps), "error_printed": ("eps", 20 + 0 * eps)})
     ds.attrs["core"] = 5.0
     return ds
+
+
+def fig10(n: int = 40) -> xr.Dataset:
+    """Rough shapes: equilibrium line, a square-root Hopf branch, a stick-slip line."""
+    vh, vgs = 2.12, 3.156
+    ev = np.linspace(0.5, 3.6, n)
+    pv = np.linspace(vh + 0.01, vgs, n)
+    sv = np.linspace(0.5, vgs, n)
+    nu = np.linspace(-6, 6, 121)
+    nu = nu[nu != 0]
+    F = np.sign(nu) * (2 - 2.5 * (1 - np.exp(-np.abs(nu)))) + 0.3 * nu
+    return xr.Dataset(
+        {"v_hopf": vh, "v_gs": vgs, "x1_gs": 4.52, "F_c_static": 2.0,
+         "eq_v": ("eq", ev), "eq_x1": ("eq", 0.4 + 0.05 * ev),
+         "eq_stable": ("eq", (ev > vh).astype(np.int8)),
+         "po_v": ("po", pv), "po_x1": ("po", 0.5 + 4 * np.sqrt((pv - vh) / (vgs - vh))),
+         "po_stable": ("po", np.zeros(n, np.int8)),
+         "ss_v": ("ss", sv), "ss_x1": ("ss", 2.5 + 0.6 * sv), "ss_stable": ("ss", np.ones(n, np.int8)),
+         "nu": ("nu", nu), "F_c": ("nu", F), "F_c_literal": ("nu", -F)})
+
+
+def fig11(n: int = 41) -> xr.Dataset:
+    x1 = np.linspace(4.15, 4.6, n)
+    P = np.array([np.where(x1 < 4.3, x1 + 2 * (x1 - 4.29), 4.43 - 0.1 * (x1 - 4.3)),
+                  np.where(x1 < 4.3, x1 + 2 * (x1 - 4.29), 4.43 + 0 * x1)])
+    sl = np.where(x1 < 4.3, 0.0, x1 - 4.3)
+    return xr.Dataset(
+        {"P": (("panel", "x1"), P), "sliding_length": (("panel", "x1"), np.stack([sl, sl])),
+         "fixed_point": (("panel", "fixed"), [[4.29, 4.43], [4.29, 4.43]]),
+         "eps": ("panel", [0.1, 0.01]), "v0": ("panel", [3.32, 3.1]),
+         "v0_sn": ("panel", [3.3228, 3.1721])},
+        coords={"panel": [0, 1], "x1": x1})

@@ -6,7 +6,8 @@ import synthetic
 
 CASES = {"fig01_slidesketch": synthetic.fig01, "fig02_cases": synthetic.fig02, "fig03_grazingsketch": synthetic.fig03, "fig04_retmaps": synthetic.fig04, "fig05_thetalt0mfs": synthetic.fig05, "fig06_sgraph": synthetic.fig06,
          "fig07_pdm_theta_neg": synthetic.fig07, "fig08_s0theta": synthetic.fig08,
-         "fig09_pdm_theta_pos": synthetic.fig09}
+         "fig09_pdm_theta_pos": synthetic.fig09, "fig10_dfo": synthetic.fig10,
+         "fig11_dfo_retmaps": synthetic.fig11}
 
 
 @pytest.mark.parametrize("scene_id", sorted(CASES))

@@ -43,6 +43,7 @@ import numpy as np
 
 from .model import SlowFastModel
 from .models.hopf import hopf_rhs, polar_flow
+from .poincare import sliding_time
 from .progress import Progress
 from .simulate import Section, simulate
 from .system import MINUS, PLUS, SLIDING, PiecewiseSystem
@@ -112,17 +113,6 @@ def _first_excursion(events):
     return entry, None
 
 
-def _sliding_time(events) -> float:
-    total, since = 0.0, None
-    for e in events:
-        if e.mode_after == SLIDING and e.mode_before != SLIDING:
-            since = e.t
-        elif e.mode_before == SLIDING and e.mode_after != SLIDING and since is not None:
-            total += e.t - since
-            since = None
-    return total
-
-
 def discontinuity_map(model: SlowFastModel, xi1, *, scale: float | None = None,
                       sliding: bool = True, method: str = "exact",
                       rtol: float = 1e-12, atol: float = 1e-14, back: float = 1.3,
@@ -167,7 +157,7 @@ def discontinuity_map(model: SlowFastModel, xi1, *, scale: float | None = None,
                                f"(status {traj.status})")
         out["P_flow"][idx] = (traj.events[-1].state[0] + 1.0) / scale
         n_sw[idx] = len(traj.switches())
-        out["sliding_time"][idx] = _sliding_time(traj.events) / eps
+        out["sliding_time"][idx] = sliding_time(traj.events) / eps
         entry, exit_ = _first_excursion(traj.events)
         if entry is None:  # no contact with H_s: P_DM is the identity here
             out["P"][idx] = out["P_flow"][idx]

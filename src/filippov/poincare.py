@@ -54,13 +54,14 @@ def first_returns(system: PiecewiseSystem, starts, section: Section, t_max: floa
         n_switches[i] = len(switches)
         if switches:
             first[i] = switches[0].t - traj.t0
-        sliding[i] = _sliding_time(traj.events)
+        sliding[i] = sliding_time(traj.events)
         if progress is not None:
             progress.step()
     return Returns(state, time, n_switches, sliding, first)
 
 
-def _sliding_time(events) -> float:
+def sliding_time(events) -> float:
+    """Time spent sliding along an event log (a stretch still open at the end counts)."""
     total, since = 0.0, None
     for e in events:
         if e.mode_after == SLIDING and e.mode_before != SLIDING:
@@ -71,6 +72,9 @@ def _sliding_time(events) -> float:
     if since is not None:
         total += events[-1].t - since
     return total
+
+
+_sliding_time = sliding_time  # old private name, until its last caller moves
 
 
 def fixed_points(grid: np.ndarray, values: np.ndarray, refine=None, xtol: float = 1e-14):

@@ -2,6 +2,34 @@
 # library's hash is a param, so editing any of them reruns the scene. A failed
 # job leaves no results/<id>.nc: the library writes atomically and Snakemake
 # removes outputs of failed jobs.
+import re
+
+import yaml
+
+
+def scene_chunks():
+    """{id: N} for the scene files with a top-level `chunks: N` (N >= 1).
+
+    Read when the DAG is built, so the chunk jobs are known statically (no
+    checkpoint). A malformed file or `chunks` value is left to rule `compute`,
+    whose job reports it (schema validation names the field).
+    """
+    found = {}
+    for path in sorted(Path("config/scenes").glob("*.yaml")):
+        try:
+            data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, yaml.YAMLError):
+            continue
+        n = data.get("chunks") if isinstance(data, dict) else None
+        if isinstance(n, int) and not isinstance(n, bool) and n >= 1:
+            found[path.stem] = n
+    return found
+
+
+CHUNKS = scene_chunks()
+CHUNKED_SCENES = "|".join(re.escape(s) for s in CHUNKS) or "(?!)"  # (?!): matches nothing
+
+
 rule compute:
     input:
         scene="config/scenes/{scene}.yaml",
@@ -10,6 +38,50 @@ rule compute:
     output:
         "results/{scene}.nc",
     params:
-        code=library_hash(exclude="plotting"),
+        code=library_hash(exclude=NOT_COMPUTE),  # see common.smk
     script:
         "../scripts/compute_scene.py"
+
+
+# A scene with `chunks: N` is computed as N jobs, each on a contiguous part of
+# the scene's grid (filippov.scenes.chunking), and merged into results/<id>.nc
+# by one job that also computes what depends on the whole grid (fixed points,
+# errors, rates). The merged file is byte-identical to the one rule `compute`
+# writes. The chunk files are temporary: removed once the merge has succeeded.
+rule compute_chunk:
+    input:
+        scene="config/scenes/{scene}.yaml",
+        schema=config["schema"],
+        script="workflow/scripts/compute_chunk.py",
+    output:
+        temp("results/chunks/{scene}/{chunk}.nc"),
+    wildcard_constraints:
+        scene=CHUNKED_SCENES,
+        chunk="[0-9]+",
+    params:
+        code=library_hash(exclude=NOT_COMPUTE),  # see common.smk
+    script:
+        "../scripts/compute_chunk.py"
+
+
+rule merge_chunks:
+    input:
+        scene="config/scenes/{scene}.yaml",
+        schema=config["schema"],
+        script="workflow/scripts/merge_chunks.py",
+        chunks=lambda wc: [f"results/chunks/{wc.scene}/{i}.nc" for i in range(CHUNKS[wc.scene])],
+    output:
+        "results/{scene}.nc",
+    wildcard_constraints:
+        scene=CHUNKED_SCENES,
+    params:
+        code=library_hash(exclude=NOT_COMPUTE),  # see common.smk
+    script:
+        "../scripts/merge_chunks.py"
+
+
+# results/<id>.nc of a chunked scene comes from the merge (rule compute does
+# not apply to it); the merge is cheap, so on a cluster it runs on the
+# submitting host instead of waiting in the queue.
+ruleorder: merge_chunks > compute
+localrules: merge_chunks

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import importlib
 
+from . import chunking
+
 SCENES = {
     "fig01_slidesketch": "fig01_slidesketch",
     "fig02_cases": "fig02_cases",
@@ -17,12 +19,37 @@ SCENES = {
     "fig07_pdm_theta_neg": "fig07_pdm_theta_neg",
     "fig08_s0theta": "fig08_s0theta",
     "fig09_pdm_theta_pos": "fig09_pdm_theta_pos",
+    "fig10_dfo": "fig10_dfo",
+    "fig11_dfo_retmaps": "fig11_dfo_retmaps",
 }
 
 
-def compute(scene: dict, *, progress: bool = False):
+def _module(scene: dict):
     sid = scene.get("id")
     if sid not in SCENES:
         raise ValueError(f"id: unknown scene {sid!r}; known scenes: {', '.join(sorted(SCENES))}")
-    module = importlib.import_module(f".{SCENES[sid]}", __name__)
-    return module.compute(scene, progress=progress)
+    return importlib.import_module(f".{SCENES[sid]}", __name__)
+
+
+def compute(scene: dict, *, progress: bool = False):
+    # `chunks` (how to split the work, see .chunking) is not part of the result
+    return _module(scene).compute(chunking.without_layout(scene), progress=progress)
+
+
+def _chunkable(scene: dict):
+    module = _module(scene)
+    if not chunking.supports_chunks(module):
+        raise ValueError(f"{scene.get('id')}: chunks: this scene cannot be split into chunks")
+    return module
+
+
+def compute_chunk(scene: dict, i: int, n: int | None = None, *, progress: bool = False):
+    """Chunk ``i`` (0-based) of ``n`` (default: the scene's ``chunks``): raw results
+    on part of the scene's grid; :func:`merge` of all chunks equals :func:`compute`."""
+    n = chunking.n_chunks(scene) if n is None else n
+    return chunking.compute_chunk(_chunkable(scene), scene, i, n, progress=progress)
+
+
+def merge(scene: dict, parts):
+    """The scene's dataset from all its chunks (identical to :func:`compute`)."""
+    return chunking.merge(_chunkable(scene), scene, parts)

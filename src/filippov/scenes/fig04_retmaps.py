@@ -70,7 +70,21 @@ def sigma_minus(model) -> tuple[float, float]:
     return float(a), chi
 
 
-def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+# Chunking (filippov.scenes.chunking): the x2 grid is split into contiguous
+# pieces, each piece's returns are computed by `sweep` (every start point is
+# independent of the others), and `assemble` builds the dataset from the whole
+# grid -- the fixed points and everything else derived from the whole map are
+# computed there, so compute() and a merge of chunks give identical datasets.
+CHUNK_AXIS = "x2"
+
+
+def chunk_grid(scene: dict) -> np.ndarray:
+    return x2_grid(scene["parameters"])
+
+
+def sweep(scene: dict, x2: np.ndarray, *, progress: bool = False) -> xr.Dataset:
+    """The solver's raw returns for the start values ``x2`` (any part of the grid), per
+    theta: P, residual, return_time, n_switches, first_switch_time, sliding_time."""
     require(scene, "system", {"slow_fast"})
     p = scene["parameters"]
     opts = solver_options(scene)
@@ -78,15 +92,43 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     kernel = engine(scene)
     eps, mu, omega = float(p["eps"]), float(p["mu"]), float(p["omega"])
     thetas = [float(v) for v in p["theta"]]
-    x2 = x2_grid(p)
+    x2 = np.asarray(x2, dtype=float)
     bar = Progress(scene["id"], len(thetas) * x2.size, progress)
-    P, res, tof, nsw, slide, first, sig, chi, fps = [], [], [], [], [], [], [], [], []
+    P, res, tof, nsw, slide, first = [], [], [], [], [], []
     for theta in thetas:
         model = hopf.model(eps, theta, mu, omega)
         px2, r, ret = return_map(model, x2, method, opts, bar, scene["ingredients"]["sliding"],
                                  kernel)
         P.append(px2), res.append(r), tof.append(ret.time)
         nsw.append(ret.n_switches), slide.append(ret.sliding_time), first.append(ret.first_switch)
+    dims = ("theta", "x2")
+    return xr.Dataset(
+        {"P": (dims, np.array(P)), "residual": (dims, np.array(res)),
+         "return_time": (dims, np.array(tof)), "n_switches": (dims, np.array(nsw, dtype=np.int32)),
+         "first_switch_time": (dims, np.array(first)), "sliding_time": (dims, np.array(slide))},
+        coords={"theta": ("theta", thetas), "x2": ("x2", x2)})
+
+
+def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    return assemble(scene, sweep(scene, chunk_grid(scene), progress=progress))
+
+
+def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
+    """The figure's dataset from the raw returns on the whole grid (see `sweep`)."""
+    p = scene["parameters"]
+    method = solver_options(scene)["method"]
+    kernel = engine(scene)
+    eps, mu, omega = float(p["eps"]), float(p["mu"]), float(p["omega"])
+    thetas = [float(v) for v in p["theta"]]
+    x2 = x2_grid(p)
+    if not (np.array_equal(raw["x2"].values, x2) and raw["theta"].values.tolist() == thetas):
+        raise ValueError(f"{scene['id']}: the raw returns are not on the scene's (theta, x2) grid")
+    P = [raw["P"].values[i] for i in range(len(thetas))]
+    res, tof, nsw = raw["residual"].values, raw["return_time"].values, raw["n_switches"].values
+    slide, first = raw["sliding_time"].values, raw["first_switch_time"].values
+    sig, chi, fps = [], [], []
+    for theta, px2 in zip(thetas, P):
+        model = hopf.model(eps, theta, mu, omega)
         s, c = sigma_minus(model)
         sig.append(s), chi.append(c)
         fps.append(fixed_points(x2, px2))

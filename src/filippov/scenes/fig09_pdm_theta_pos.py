@@ -15,17 +15,36 @@ import xarray as xr
 
 from ..analytic import pdm as asym
 from ..io import finalize
-from .pdm_common import base_dataset, max_error, numerical_pdm, rates
+from .pdm_common import (CHUNK_AXIS, base_dataset, chunk_grid, fields_from_dataset,
+                         max_error, rates, sweep_dataset)
+# CHUNK_AXIS, chunk_grid, sweep and assemble make the scene splittable (see .chunking)
 
 
-def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+def _theta(scene: dict) -> float:
     p = scene["parameters"]
     theta, omega, mu = float(p["theta"]), float(p["omega"]), float(p["mu"])
     if not 0 < theta < 1:
         raise ValueError(f"{scene['id']}: parameters.theta must lie in (0, 1), got {theta!r}")
     if mu != 1.0:
         raise ValueError(f"{scene['id']}: the stored asymptotics are for q = 0 (mu = 1)")
-    eps, xi, f = numerical_pdm(scene, theta, progress)
+    return theta
+
+
+def sweep(scene: dict, xi: np.ndarray, *, progress: bool = False) -> xr.Dataset:
+    """The solver's P_DM fields on the points ``xi`` of the xi1 grid (raw)."""
+    return sweep_dataset(scene, _theta(scene), xi, progress)
+
+
+def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    return assemble(scene, sweep(scene, chunk_grid(scene), progress=progress))
+
+
+def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
+    """The figure's dataset from the fields on the whole xi1 grid (see `sweep`)."""
+    theta = _theta(scene)
+    p = scene["parameters"]
+    omega, mu = float(p["omega"]), float(p["mu"])
+    eps, xi, f = fields_from_dataset(scene, raw)
     ds = base_dataset(eps, xi, f, theta)
     x = f["xi1"]
     corrected = asym.pdm_theta_pos(x, theta, omega)

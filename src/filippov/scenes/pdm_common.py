@@ -34,12 +34,19 @@ def eps_list(p: dict) -> np.ndarray:
 
 def numerical_pdm(scene: dict, theta: float, progress: bool) -> tuple[np.ndarray, np.ndarray, dict]:
     """(eps, xi1, fields) with every PDMResult field stacked to shape (eps, xi1)."""
+    return pdm_fields(scene, theta, xi1_grid(scene["parameters"]), progress)
+
+
+def pdm_fields(scene: dict, theta: float, xi: np.ndarray,
+               progress: bool) -> tuple[np.ndarray, np.ndarray, dict]:
+    """:func:`numerical_pdm` on the points ``xi`` (any part of the xi1 grid): every
+    point is computed on its own, so parts of the grid give parts of the fields."""
     require(scene, "system", {"slow_fast"})
     p = scene["parameters"]
     opts = solver_options(scene)
     method = opts.pop("method")
     mu, omega = float(p["mu"]), float(p["omega"])
-    eps, xi = eps_list(p), xi1_grid(p)
+    eps, xi = eps_list(p), np.asarray(xi, dtype=float)
     bar = Progress(scene["id"], eps.size * xi.size, progress)
     rows = []
     for e in eps:
@@ -52,6 +59,38 @@ def numerical_pdm(scene: dict, theta: float, progress: bool) -> tuple[np.ndarray
         "xi2_exit", "sliding_time")}
     fields["scale"] = np.array([r.scale for r in rows])
     return eps, xi, fields
+
+
+# Chunking (filippov.scenes.chunking) splits the xi1 grid: `sweep` computes the
+# solver's fields on part of it, the scene module's `assemble` builds the
+# dataset (errors, rates, limits: all from the whole grid) from the merged fields.
+CHUNK_AXIS = "xi1"
+FIELDS = ("xi1", "P", "P_flow", "n_switches", "xi2_entry", "excursion_time", "xi1_exit",
+          "xi2_exit", "sliding_time")
+_RAW_NAME = {"xi1": "xi1_start"}  # the field xi1 would clash with the coordinate
+
+
+def chunk_grid(scene: dict) -> np.ndarray:
+    return xi1_grid(scene["parameters"])
+
+
+def sweep_dataset(scene: dict, theta: float, xi: np.ndarray, progress: bool) -> xr.Dataset:
+    """The fields of :func:`pdm_fields` as a Dataset on (eps, xi1) (raw, no attributes)."""
+    eps, xi, f = pdm_fields(scene, theta, xi, progress)
+    d2 = ("eps", "xi1")
+    data = {_RAW_NAME.get(k, k): (d2, f[k].astype(np.int32) if k == "n_switches" else f[k])
+            for k in FIELDS}
+    data["scale"] = ("eps", f["scale"])
+    return xr.Dataset(data, coords={"eps": ("eps", eps), "xi1": ("xi1", xi)})
+
+
+def fields_from_dataset(scene: dict, raw: xr.Dataset) -> tuple[np.ndarray, np.ndarray, dict]:
+    """(eps, xi1, fields) back from :func:`sweep_dataset` on the whole grid."""
+    p = scene["parameters"]
+    eps, xi = eps_list(p), xi1_grid(p)
+    if not (np.array_equal(raw["eps"].values, eps) and np.array_equal(raw["xi1"].values, xi)):
+        raise ValueError(f"{scene['id']}: the raw fields are not on the scene's (eps, xi1) grid")
+    return eps, xi, {k: raw[_RAW_NAME.get(k, k)].values for k in FIELDS + ("scale",)}
 
 
 def max_error(values, reference, mask) -> np.ndarray:

@@ -1,0 +1,311 @@
+"""fig:dfo: the dry-friction oscillator eq:dfo1 (M = K = 1) over the belt speed v.
+
+(b) the friction law F_c (adopted "stribeck" convention, plus the printed law
+read literally for comparison); (c) the bifurcation diagram, measured by the
+largest block position x1 along the orbit (x1 where the orbit crosses
+{x2 = 0, x1 > x1_eq}, the section of fig:dfo-retmap; x1_eq for the equilibrium):
+
+* equilibrium x = (-F_c(-v), 0), stable iff its damping F_c'(-v) = fv - fc e^{-v} > 0;
+  the Hopf point H from that condition and, independently, from the eigenvalues
+  of a finite-difference Jacobian at the numerically found equilibrium;
+* the unstable periodic orbits born at H, lying in region + (x2 < v), by
+  pseudo-arclength continuation of shooting solutions u = (x1, T, v) on the
+  section, multipliers from the variational equations; the branch is followed
+  until it grazes H_s = {x2 = v} (grazing function v - max x2 along the orbit);
+* the stick-slip orbits: they leave the sticking segment at (x1, x2) = (-F_c(0-), v)
+  (= (2, v), where b = 0), so there is one per v, found by one simulation; the
+  Floquet multipliers come from the monodromy matrix with saltation matrices;
+* GS: the v where the orbit through the exit point (2, v) is itself periodic,
+  solved directly (forward and backward flows from (2, v) meet on the section)
+  and cross-checked against the grazing point of the continued branch.
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+from .. import continuation as cont
+from ..io import finalize
+from ..models import dry_friction as df
+from ..progress import Progress
+from ..simulate import Section, simulate
+from .common import require
+
+RTOL, ATOL = 1e-12, 1e-14
+
+
+def _law(p: dict) -> dict:
+    return {"f0": float(p["f0"]), "fv": float(p["fv"]), "fc": float(p["fc"]),
+            "convention": str(p.get("convention", "stribeck"))}
+
+
+def section_event(x1_min: float):
+    """x2 = 0 crossed downward right of the equilibrium: the largest x1 of a turn."""
+    def ev(t, z):
+        return z[1] if z[0] > x1_min else 1.0
+    ev.direction = -1
+    return ev
+
+
+def _to_section(v, z0, law, backward=False, rtol=RTOL, atol=ATOL):
+    """From z0 follow the region-+ field (forward or backward) to the section;
+    returns (x1 there, time)."""
+    f = df.plus_field_reduced(v, **law)[0]
+    sign = -1.0 if backward else 1.0
+    x_eq = float(df.equilibrium(v, **law)[0])
+    ev = section_event(x_eq)
+    ev.terminal = True
+    ev.direction = -1 if not backward else 1
+    sol = solve_ivp(lambda t, z: sign * f(z), (0.0, 50.0), np.asarray(z0, float),
+                    method="DOP853", rtol=rtol, atol=atol, events=ev)
+    if not sol.t_events[0].size:
+        raise RuntimeError(f"no section crossing from {list(z0)} at v={v!r}")
+    return float(sol.y_events[0][0][0]), float(sol.t_events[0][0])
+
+
+def exit_point(law) -> float:
+    """x1 where sticking ends: b = x1 + F_c(0-) = 0 (eq:atSl with h = v - x2)."""
+    return float(-df.friction_branches(law["f0"], law["fv"], law["fc"], law["convention"])[0](0.0))
+
+
+def gs_mismatch(v, law, rtol=RTOL, atol=ATOL):
+    """Forward minus backward section hit of the orbit through the exit point (x_e, v):
+    zero iff that orbit is a closed orbit in region + touching x2 = v (grazing)."""
+    xe = exit_point(law)
+    fwd = _to_section(v, [xe, v], law, rtol=rtol, atol=atol)[0]
+    bwd = _to_section(v, [xe, v], law, backward=True, rtol=rtol, atol=atol)[0]
+    return fwd - bwd
+
+
+def grazing_speed(law, bracket, rtol=RTOL, atol=ATOL) -> float:
+    return brentq(lambda v: gs_mismatch(v, law, rtol, atol), *bracket, xtol=1e-15, rtol=1e-15)
+
+
+def hopf_numeric(law, bracket) -> float:
+    """v where the largest real part of the Jacobian eigenvalues at the numerically
+    found equilibrium crosses zero (Jacobian by central differences)."""
+    def re(v):
+        f = df.plus_field_reduced(v, **law)[0]
+        x = np.array([0.5, 0.0])
+        for _ in range(50):  # Newton on f(x) = 0
+            J = cont.fd_jacobian(f, x, 1e-6)
+            dx = np.linalg.solve(J, -f(x))
+            x += dx
+            if np.max(np.abs(dx)) < 1e-15:
+                break
+        return float(np.max(np.linalg.eigvals(cont.fd_jacobian(f, x, 1e-6)).real))
+    return brentq(re, *bracket, xtol=1e-13)
+
+
+# --------------------------------------------------------------------------- branches
+def hopf_problem(law):
+    """Shooting (G, J, unpack) with u = (x1, T, v), start point (x1, 0)."""
+    return cont.shooting_residual(lambda v: df.plus_field_reduced(v, **law), 1, 0.0, 2)
+
+
+def max_x2(u, law):
+    """Largest x2 along the orbit of u = (x1, T, v): where x2' = 0 with x2 > 0."""
+    x1, T, v = u
+    f = df.plus_field_reduced(v, **law)[0]
+    sol = solve_ivp(lambda t, z: f(z), (0.0, T), [x1, 0.0], method="DOP853", rtol=RTOL,
+                    atol=ATOL, dense_output=True)
+    ev = lambda t, z: f(z)[1]
+    ts = np.linspace(0.0, T, 400)
+    d = np.array([ev(t, sol.sol(t)) for t in ts])
+    best = -np.inf
+    for i in np.flatnonzero((d[:-1] > 0) & (d[1:] <= 0)):
+        tm = brentq(lambda t: ev(t, sol.sol(t)), ts[i], ts[i + 1], xtol=1e-15)
+        best = max(best, float(sol.sol(tm)[1]))
+    return best
+
+
+def start_cycle(v, law, amp=0.2):
+    """An unstable cycle of region + at v, reached by flowing backward in time
+    (it attracts in reverse time) from near the equilibrium, then Newton."""
+    f = df.plus_field_reduced(v, **law)[0]
+    x_eq = float(df.equilibrium(v, **law)[0])
+    sol = solve_ivp(lambda t, z: -f(z), (0.0, 400.0), [x_eq + amp, 0.0], method="DOP853",
+                    rtol=1e-10, atol=1e-12)
+    z = sol.y[:, -1]
+    x1, _ = _to_section(v, z, law)
+    _, T = _to_section(v, [x1, -1e-9], law)  # just past the section: one turn
+    G, J, _ = hopf_problem(law)
+    u, _ = cont.newton(G, J, np.array([x1, T, v]),
+                       extra=lambda w: (w[2] - v, np.array([0.0, 0.0, 1.0])))
+    return u
+
+
+def hopf_branch(law, v_start, v_hopf, amp_min, ds, progress=None):
+    """Unstable periodic orbits from the Hopf point to grazing, as rows u = (x1, T, v)
+    ordered by v, with the grazing point refined on the branch."""
+    G, J, _ = hopf_problem(law)
+    u0 = start_cycle(v_start, law)
+
+    def amp(u):
+        return u[0] - float(df.equilibrium(u[2], **law)[0])
+
+    to_h = cont.pseudo_arclength(G, u0, [0, 0, -1], J=J, ds=ds, ds_max=2 * ds, n_max=400,
+                                 stop=lambda u: "amplitude" if amp(u) < amp_min else "",
+                                 progress=progress)
+    to_gs = cont.pseudo_arclength(G, u0, [0, 0, 1], J=J, ds=ds, ds_max=4 * ds, n_max=400,
+                                  stop=lambda u: "grazing" if max_x2(u, law) > u[2] else "",
+                                  progress=progress)
+    if to_gs.stopped != "grazing":
+        raise RuntimeError(f"Hopf branch did not reach grazing ({to_gs.stopped})")
+    # grazing on the branch: v - max x2 = 0 with G = 0, by Newton from the last two points
+    gfun = lambda u: u[2] - max_x2(u, law)
+    ua, ub = to_gs.u[-2], to_gs.u[-1]
+    ga, gb = gfun(ua), gfun(ub)
+    guess = ua + ga / (ga - gb) * (ub - ua)
+    u_gs, _ = cont.newton(G, J, guess, extra=lambda u: (gfun(u), cont.fd_jacobian(
+        lambda w: np.array([gfun(w)]), u, 1e-6)[0]), tol=1e-12)
+    # past H the shooting solutions continue onto the same small cycles seen from
+    # the other side of the equilibrium (x1 < x1_eq): keep the physical half
+    keep = np.array([amp(u) > 0 for u in to_h.u])
+    branch = np.vstack([to_h.u[keep][::-1], to_gs.u[1:-1], u_gs[None]])
+    folds = [i for i in to_h.folds if keep[i] and keep[i + 1]] + to_gs.folds
+    return branch, u_gs, folds
+
+
+def multipliers_smooth(u, law):
+    """Floquet multipliers of a region-+ cycle u = (x1, T, v) (no switching)."""
+    x1, T, v = u
+    f, dfdx, dfdv = df.plus_field_reduced(v, **law)
+    _, Phi, _, _ = cont.flow_with_sensitivities(f, dfdx, dfdv, [x1, 0.0], T)
+    m = np.linalg.eigvals(Phi)
+    return m[np.argsort(-np.abs(m))]
+
+
+def stick_slip_orbit(v, law, *, rtol=RTOL, atol=ATOL):
+    """The stick-slip orbit at v: leave sticking at (x_e, v), go to the section, then
+    one full period back to it with the event-driven solver. Returns a dict."""
+    system = df.model(0.0, v, **law).reduced()
+    xe = exit_point(law)
+    x_start, _ = _to_section(v, [xe, v], law, rtol=rtol, atol=atol)
+    sec = Section("x2=0", lambda z: z[1], direction=-1,
+                  where=lambda z: z[0] > float(df.equilibrium(v, **law)[0]), terminal=1)
+    traj = simulate(system, [x_start, 0.0], 100.0, method="integrate", rtol=rtol, atol=atol,
+                    sections=[sec], dense=False)
+    if traj.status != "section:x2=0":
+        raise RuntimeError(f"stick-slip orbit at v={v!r} did not return ({traj.status})")
+    kinds = [e.kind for e in traj.events]
+    starts = [e for e in traj.events if e.kind == "slide_start"]
+    ends = [e for e in traj.events if e.kind == "slide_end"]
+    if len(starts) != 1 or len(ends) != 1:
+        raise RuntimeError(f"v={v!r}: expected one sticking phase, got events {kinds}")
+    _, mult = cont.monodromy(system, traj, jacobian=df.reduced_jacobian(v, **law))
+    return {"x1": x_start, "x1_return": float(traj.z[0]), "period": traj.t,
+            "stick_time": ends[0].t - starts[0].t,
+            "stick_length": float(ends[0].state[0] - starts[0].state[0]),
+            "x1_stick": float(starts[0].state[0]), "multipliers": mult, "trajectory": traj}
+
+
+# --------------------------------------------------------------------------- scene
+def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    require(scene, "system", {"reduced"})
+    require(scene, "flow", {"integrate"})
+    if not scene["ingredients"]["sliding"]:
+        raise ValueError(f"{scene['id']}: ingredients.sliding must be true: stick-slip "
+                         "orbits stick (slide on x2 = v)")
+    p = scene["parameters"]
+    law = _law(p)
+    v_min, v_max = float(p["v_min"]), float(p["v_max"])
+    bar = Progress(scene["id"], int(p["n_stick_slip"]) + 60, progress)
+
+    v_hopf = df.hopf_speed(law["fv"], law["fc"], law["convention"])
+    if not np.isfinite(v_hopf):
+        raise ValueError(f"{scene['id']}: parameters: this friction law has no Hopf point")
+    v_hopf_num = hopf_numeric(law, (0.5 * v_hopf, 1.5 * v_hopf))
+    v_gs = grazing_speed(law, (v_hopf + 1e-3, v_max))
+
+    # unstable cycles born at H
+    v_start = 0.5 * (v_hopf + v_gs)
+    br, u_gs, folds = hopf_branch(law, v_start, v_hopf, float(p["amp_min"]),
+                                  float(p["ds"]), bar)
+    mults = np.array([multipliers_smooth(u, law) for u in br])
+    v_gs_branch = float(u_gs[2])
+
+    # stick-slip orbits up to GS: uniform in v plus points accumulating at GS
+    n = int(p["n_stick_slip"])
+    near = np.geomspace(float(p["gs_closest"]), 0.1 * (v_gs - v_min), n // 4)
+    vs = np.unique(np.concatenate([np.linspace(v_min, v_gs, n - n // 4, endpoint=False),
+                                   v_gs - near]))
+    rows = []
+    for v in vs:
+        rows.append(stick_slip_orbit(v, law))
+        bar.step()
+    ss_mult = np.array([r["multipliers"] for r in rows])
+    ss_stable = np.all(np.abs(ss_mult[:, 1:]) < 1, axis=1)
+
+    ve = np.linspace(v_min, v_max, 401)
+    veq = np.unique(np.concatenate([ve, [v_hopf]]))
+    x_eq = df.equilibrium(veq, **law)[0]
+    nu = np.linspace(-float(p["nu_max"]), float(p["nu_max"]), 801)
+    nu = np.unique(np.concatenate([nu, [-1e-12, 1e-12]]))
+    nu = nu[nu != 0]
+    F = df.friction(nu, **law)
+    lit = dict(law, convention="literal")
+    F_lit = df.friction(nu, **lit)
+    Fp, _, Fm, _ = df.friction_branches(**law)
+    one = {"units": "1"}
+
+    ds = xr.Dataset(
+        {"v_hopf": ((), v_hopf, {"long_name": "Hopf point: belt speed with F_c'(-v) = 0, ln(fc/fv)",
+                                 "units": "1"}),
+         "v_hopf_numeric": ((), v_hopf_num, {"long_name": "Hopf point from the eigenvalues of a "
+                                             "finite-difference Jacobian", "units": "1"}),
+         "v_gs": ((), v_gs, {"long_name": "grazing-sliding point GS (orbit through the sticking "
+                             "exit point closes)", "units": "1"}),
+         "v_gs_branch": ((), v_gs_branch, {"long_name": "grazing point of the continued branch "
+                                           "of unstable cycles", "units": "1"}),
+         "x1_gs": ((), float(u_gs[0]), {"long_name": "max x1 of the grazing orbit", "units": "1"}),
+         "period_gs": ((), float(u_gs[1]), {"long_name": "period of the grazing orbit", "units": "1"}),
+         "x1_exit": ((), exit_point(law), {"long_name": "x1 where sticking ends (-F_c(0-))",
+                                           "units": "1"}),
+         "n_folds_hopf_branch": ((), len(folds), {"long_name": "folds on the unstable branch",
+                                                   "units": "1"}),
+         # equilibrium
+         "eq_v": ("eq", veq, {"long_name": "belt speed v", "units": "1"}),
+         "eq_x1": ("eq", x_eq, {"long_name": "x1 of the equilibrium, -F_c(-v)", "units": "1"}),
+         "eq_stable": ("eq", (veq > v_hopf).astype(np.int8),
+                       {"long_name": "1 if the equilibrium is asymptotically stable", "units": "1"}),
+         # unstable cycles in region +
+         "po_v": ("po", br[:, 2], {"long_name": "belt speed v", "units": "1"}),
+         "po_x1": ("po", br[:, 0], {"long_name": "max x1 along the cycle", "units": "1"}),
+         "po_period": ("po", br[:, 1], {"long_name": "period", "units": "1"}),
+         "po_multiplier": ("po", np.abs(mults[:, 0]),
+                           {"long_name": "nontrivial Floquet multiplier (modulus)", "units": "1"}),
+         "po_stable": ("po", (np.abs(mults[:, 0]) < 1).astype(np.int8),
+                       {"long_name": "1 if the cycle is stable", "units": "1"}),
+         # stick-slip orbits
+         "ss_v": ("ss", vs, {"long_name": "belt speed v", "units": "1"}),
+         "ss_x1": ("ss", [r["x1"] for r in rows], {"long_name": "max x1 along the orbit",
+                                                   "units": "1"}),
+         "ss_period": ("ss", [r["period"] for r in rows], {"long_name": "period", "units": "1"}),
+         "ss_stick_time": ("ss", [r["stick_time"] for r in rows],
+                           {"long_name": "time spent sticking (sliding on x2 = v)", "units": "1"}),
+         "ss_stick_length": ("ss", [r["stick_length"] for r in rows],
+                             {"long_name": "x1 distance travelled while sticking", "units": "1"}),
+         "ss_multiplier": ("ss", np.abs(ss_mult[:, 1]),
+                           {"long_name": "nontrivial Floquet multiplier (modulus), with saltation",
+                            "units": "1"}),
+         "ss_trivial_multiplier": ("ss", np.abs(ss_mult[:, 0]),
+                                   {"long_name": "trivial Floquet multiplier (should be 1)",
+                                    "units": "1"}),
+         "ss_closure": ("ss", [abs(r["x1_return"] - r["x1"]) for r in rows],
+                        {"long_name": "|x1 after one period - x1 at start|", "units": "1"}),
+         "ss_stable": ("ss", ss_stable.astype(np.int8),
+                       {"long_name": "1 if the orbit is stable (multipliers)", "units": "1"}),
+         # friction law
+         "nu": ("nu", nu, {"long_name": "relative velocity x2 - v", "units": "1"}),
+         "F_c": ("nu", F, {"long_name": "friction force F_c (adopted convention)", "units": "1"}),
+         "F_c_literal": ("nu", F_lit, {"long_name": "friction force, printed law read literally",
+                                       "units": "1"}),
+         "F_c_static": ((), float(Fm(0.0)), {"long_name": "F_c(0+), the static friction level",
+                                             "units": "1"})},
+    )
+    return finalize(ds, scene, method="integrate", friction_convention=law["convention"],
+                    title="dry-friction oscillator eq:dfo1: friction law and bifurcation "
+                          "diagram (fig:dfo)")

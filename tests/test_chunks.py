@@ -1,0 +1,118 @@
+"""Chunked sweeps (filippov.scenes.chunking): chunks computed apart and merged give
+exactly the dataset of one unsplit compute -- xarray-identical and the same bytes
+on disk -- for the return maps (fig04, split over x2) and the discontinuity maps
+(fig07, fig09, split over xi1). Small grids keep it quick."""
+import random
+
+import numpy as np
+import pytest
+
+pytest.importorskip("filippov.scenes", reason="compute code (filippov.scenes) not importable yet")
+
+import filippov.io
+import filippov.scenes
+from filippov.config import SceneError, load_scene
+from filippov.scenes import chunking
+
+from conftest import ROOT
+
+SCHEMA = ROOT / "config" / "schema" / "scene.schema.json"
+CHUNKED = ("fig04_retmaps", "fig07_pdm_theta_neg", "fig09_pdm_theta_pos")
+
+
+def small_scene(sid: str) -> dict:
+    """The scene file with a short grid (and two eps for the P_DM scenes)."""
+    scene = load_scene(ROOT / "config" / "scenes" / f"{sid}.yaml", SCHEMA)
+    p = scene["parameters"]
+    if sid == "fig04_retmaps":
+        p.update(n_uniform=21, n_geometric=6)
+    else:
+        p.update(n_uniform=9, n_geometric=4)
+        p["eps"] = p["eps"][:2]
+        if "n_core" in p:
+            p["n_core"] = 5
+    return scene
+
+
+def roundtrip(ds, path):
+    """Through a netCDF file, as between the workflow's chunk and merge jobs."""
+    filippov.io.write_dataset(ds, path)
+    return filippov.io.read_dataset(path)
+
+
+@pytest.mark.parametrize("size,n", [(1, 1), (7, 1), (7, 3), (10, 4), (31, 31), (1001, 8)])
+def test_bounds_partition_the_grid_like_array_split(size, n):
+    pieces = [chunking.bounds(size, i, n) for i in range(n)]
+    expected = np.array_split(np.arange(size), n)
+    assert [list(range(a, b)) for a, b in pieces] == [e.tolist() for e in expected]
+
+
+@pytest.mark.parametrize("sid", CHUNKED)
+def test_merged_chunks_identical_to_compute(sid, tmp_path):
+    scene = small_scene(sid)
+    whole = filippov.scenes.compute(scene)
+    n = 3
+    parts = [roundtrip(filippov.scenes.compute_chunk(scene, i, n), tmp_path / f"{i}.nc")
+             for i in range(n)]
+    axis = parts[0].attrs["chunk_axis"]
+    sizes = [p[axis].size for p in parts]
+    assert len(set(sizes)) <= 2 and min(sizes) >= 1  # a real split
+    random.Random(0).shuffle(parts)  # merge orders them itself
+    merged = filippov.scenes.merge(scene, parts)
+    assert merged.identical(whole)
+    filippov.io.write_dataset(whole, tmp_path / "whole.nc")
+    filippov.io.write_dataset(merged, tmp_path / "merged.nc")
+    assert (tmp_path / "merged.nc").read_bytes() == (tmp_path / "whole.nc").read_bytes()
+
+
+def test_chunks_key_is_layout_not_data(tmp_path):
+    """`chunks` does not enter the dataset: with or without it, same result."""
+    scene = small_scene("fig07_pdm_theta_neg")
+    with_key = dict(scene, chunks=2)
+    whole = filippov.scenes.compute(scene)
+    assert filippov.scenes.compute(with_key).identical(whole)
+    parts = [roundtrip(filippov.scenes.compute_chunk(with_key, i), tmp_path / f"{i}.nc")
+             for i in range(2)]  # n from the scene's `chunks`
+    assert filippov.scenes.merge(with_key, parts).identical(whole)
+    assert "chunks" not in whole.attrs["scene_config"]
+
+
+def test_merge_rejects_incomplete_or_foreign_chunks():
+    scene = small_scene("fig07_pdm_theta_neg")
+    parts = [filippov.scenes.compute_chunk(scene, i, 3) for i in range(3)]
+    with pytest.raises(ValueError, match="chunks 0..2"):
+        filippov.scenes.merge(scene, parts[:2])
+    with pytest.raises(ValueError, match="chunks 0..2"):
+        filippov.scenes.merge(scene, [parts[0], parts[0], parts[2]])
+    other = small_scene("fig07_pdm_theta_neg")
+    other["parameters"]["n_uniform"] = 11
+    with pytest.raises(ValueError, match="different scene"):
+        filippov.scenes.merge(other, parts)
+    two = [filippov.scenes.compute_chunk(scene, i, 2) for i in range(2)]
+    with pytest.raises(ValueError, match="different splits"):
+        filippov.scenes.merge(scene, [parts[0], two[1]])
+
+
+def test_bad_chunk_requests_fail_clearly():
+    scene = small_scene("fig07_pdm_theta_neg")
+    n_points = filippov.scenes._module(scene).chunk_grid(scene).size
+    with pytest.raises(ValueError, match="need 1 <= chunks"):
+        filippov.scenes.compute_chunk(scene, 0, n_points + 1)
+    with pytest.raises(ValueError, match="out of range"):
+        filippov.scenes.compute_chunk(scene, 3, 3)
+    sketch = load_scene(ROOT / "config" / "scenes" / "fig08_s0theta.yaml", SCHEMA)
+    with pytest.raises(ValueError, match="cannot be split"):
+        filippov.scenes.compute_chunk(sketch, 0, 2)
+    with pytest.raises(ValueError, match="integer >= 1"):
+        chunking.n_chunks({"id": "x", "chunks": 0})
+
+
+def test_schema_accepts_chunks_and_rejects_bad_values(tmp_path):
+    text = (ROOT / "config" / "scenes" / "fig07_pdm_theta_neg.yaml").read_text()
+    text = "\n".join(l for l in text.splitlines() if not l.startswith("chunks:"))
+    path = tmp_path / "fig07_pdm_theta_neg.yaml"
+    path.write_text(text + "\nchunks: 4\n")
+    assert load_scene(path, SCHEMA)["chunks"] == 4
+    path.write_text(text + "\nchunks: 0\n")
+    with pytest.raises(SceneError, match="chunks"):
+        load_scene(path, SCHEMA)

@@ -1,0 +1,100 @@
+"""Dry-friction oscillator (sec:dfo1): sign convention, Hopf, GS, stick-slip
+stability, slow manifold, reduced vs slow-fast, return-map fixed points and the
+saddle-node, each against an independent check or a refinement."""
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from filippov.models import dry_friction as df
+from filippov.scenes import fig10_dfo as f10
+from filippov.scenes import fig11_dfo_retmaps as f11
+from filippov.simulate import Section, simulate
+
+LAW = {"f0": -2.0, "fv": 0.3, "fc": 2.5, "convention": "stribeck"}
+LAW11 = dict(LAW, gamma=2.0)
+
+
+def test_adopted_law_makes_sticking_attract_and_literal_law_repel():
+    for conv, attracting in (("stribeck", True), ("literal", False)):
+        s = df.model(0.0, 3.0, **dict(LAW, convention=conv)).reduced()
+        a, b = s.normal_speeds(np.array([0.0, 3.0]))
+        assert (a > 0 > b) == attracting
+        assert (a < 0 < b) == (not attracting)
+    # static level 2, decaying to -0.5 + 0.3|nu| (the paper's commented-out curve)
+    nu = np.array([1e-9, 1.0, 5.0])
+    np.testing.assert_allclose(df.friction(nu, **LAW), -0.5 + 2.5 * np.exp(-nu) + 0.3 * nu)
+    np.testing.assert_allclose(df.friction(-nu, **LAW), -df.friction(nu, **LAW))
+
+
+def test_model_fields_match_fast_system_and_reduce_to_dfo1():
+    full, fast = df.model(0.05, 3.1, **LAW11).full(), df.full_system(0.05, 3.1, **LAW11)
+    z = np.array([[1.0, -0.5], [0.2, 2.9], [3.3, 9.0]])
+    for mode in (-1, 0, 1):
+        np.testing.assert_allclose(full.field(mode, z), fast.field(mode, z), rtol=1e-13, atol=1e-13)
+    red = df.model(0.0, 3.1, **LAW11).reduced()
+    f = df.plus_field_reduced(3.1, **LAW)[0]
+    np.testing.assert_allclose(red.field(1, np.array([1.0, 0.2])), f(np.array([1.0, 0.2])))
+
+
+def test_hopf_point_matches_analytic_condition():
+    vh = df.hopf_speed(**{k: LAW[k] for k in ("fv", "fc")})
+    assert abs(vh - np.log(2.5 / 0.3)) < 1e-15
+    assert abs(f10.hopf_numeric(LAW, (1.0, 3.0)) - vh) < 1e-9
+    assert np.isnan(df.hopf_speed(0.3, 2.5, "literal"))
+
+
+def test_grazing_point_converges_under_tolerance_refinement():
+    v = [f10.grazing_speed(LAW, (2.2, 3.6), rtol=r, atol=r * 1e-2) for r in (1e-9, 1e-11, 1e-13)]
+    assert abs(v[1] - v[2]) < 1e-9 and abs(v[1] - v[2]) <= abs(v[0] - v[2]) + 1e-12
+    assert 3.15 < v[2] < 3.16
+    # the orbit grazing at GS passes through the sticking exit point (2, v)
+    assert abs(f10.gs_mismatch(v[2], LAW)) < 1e-10
+
+
+def test_stick_slip_multipliers_match_forward_simulation():
+    v = 2.6
+    r = f10.stick_slip_orbit(v, LAW)
+    m = np.abs(r["multipliers"])
+    assert abs(m[0] - 1) < 1e-6 and m[1] < 1e-6   # sticking collapses the neighbourhood
+    # forward simulation from a perturbed start: back on the orbit after one period
+    system = df.model(0.0, v, **LAW).reduced()
+    sec = Section("s", lambda z: z[1], direction=-1, where=lambda z: z[0] > 1.0, terminal=2)
+    tr = simulate(system, [r["x1"] + 0.05, 0.0], 100.0, method="integrate", sections=[sec],
+                  dense=False)
+    assert abs(tr.section_hits("s")[0].state[0] - r["x1"]) < 1e-9
+    # the unstable cycle in x2 < v: multiplier > 1
+    u = f10.start_cycle(2.64, LAW)
+    assert np.abs(f10.multipliers_smooth(u, LAW)[0]) > 1.5
+
+
+def test_slow_manifold_is_invariant_and_attracting():
+    x1 = np.array([3.0, 4.0])
+    w, est = df.slow_manifold_plus(x1, 0.0, 0.01, 3.1, **LAW11)
+    assert np.all(est < 1e-12)
+    # first-order check: w = v0 + eps gamma F(x2 - v0) + O(eps^2)
+    F = df.friction_branches(**LAW)[0](-3.1)
+    assert np.all(np.abs(w - (3.1 + 0.01 * 2 * F)) < 1e-3)
+
+
+def test_reduced_and_slow_fast_returns_converge_as_eps_to_zero():
+    # a start point whose orbit sticks: P(x1) approaches the reduced stick-slip amplitude
+    v = 3.1
+    ref = f10.stick_slip_orbit(v, LAW)["x1"]
+    errs = []
+    for eps in (0.04, 0.01):
+        r = f11.return_map([4.5], eps, v, LAW11, with_residual=False)
+        errs.append(abs(r["P"][0] - ref))
+    assert errs[1] < errs[0] / 2 and errs[1] < 0.05
+
+
+def test_lemma_case_quantity():
+    chi, a, b = f11.lemma_quantity(LAW11, 3.1)
+    assert chi == pytest.approx(2 * 2.0 * 3.0)   # -2 f0 (1 + gamma) > 0: case 1
+    chi_l, _, _ = f11.lemma_quantity(dict(LAW11, convention="literal"), 3.1)
+    assert chi_l < 0
+
+
+def test_return_map_fixed_point_stable_under_refinement():
+    fp = [f11.P_pair(f11.fixed_point_near(4.43, 3.1, 0.01, LAW11, r, r * 1e-2), 3.1, 0.01,
+                     LAW11, r, r * 1e-2)[0] for r in (1e-10, 1e-12)]
+    assert abs(fp[0] - fp[1]) < 1e-8

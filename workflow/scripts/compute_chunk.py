@@ -1,0 +1,14 @@
+"""Thin: scene file + chunk index -> filippov.scenes.compute_chunk -> results/chunks/<id>/<i>.nc."""
+import sys
+
+import filippov.io
+import filippov.scenes
+from filippov.config import SceneError, load_scene
+
+try:
+    scene = load_scene(snakemake.input.scene, snakemake.input.schema)  # noqa: F821
+except SceneError as exc:
+    sys.exit(f"error: {exc}")
+index = int(snakemake.wildcards.chunk)  # noqa: F821; the count is the scene's `chunks`
+ds = filippov.scenes.compute_chunk(scene, index, progress=True)
+filippov.io.write_dataset(ds, snakemake.output[0])  # noqa: F821
