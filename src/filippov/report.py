@@ -418,14 +418,40 @@ def table_frame(ds: xr.Dataset, max_rows: int = 30) -> str:
 
 
 def dry_friction(ds10, ds11, m: Macros) -> tuple[str, str]:
+    """Macros for the findings of the dry-friction scenes (each read from the
+    variable that holds it, when present) and a table of their scalars."""
     m.flag("rpHaveTen", ds10 is not None)
     m.flag("rpHaveEleven", ds11 is not None)
     if ds10 is not None:
-        for var, name in (("v_hopf", "rpTenVHopf"), ("v_gs", "rpTenVGS")):
+        for var, name, sig in (("v_hopf", "rpTenVHopf", 10), ("v_hopf_numeric", "rpTenVHopfNum", 10),
+                               ("v_gs", "rpTenVGS", 9), ("v_gs_branch", "rpTenVGSBranch", 9),
+                               ("x1_gs", "rpTenXGS", 5), ("period_gs", "rpTenPeriodGS", 5),
+                               ("F_c_static", "rpTenStatic", 3)):
             if var in ds10:
-                m.add(name, _f(ds10, var), _src("fig10_dfo", var), 4)
+                _var(m, name, ds10, "fig10_dfo", var, sig)
             else:
                 m.add(name, None, f"fig10_dfo:{var} (missing)", text=r"\emph{(" + var + " missing)}")
+        if "ss_multiplier" in ds10:
+            m.add("rpTenSSMultMax", float(np.nanmax(ds10.ss_multiplier.values)),
+                  "derived:max(fig10_dfo:ss_multiplier)", 2)
+        if "po_multiplier" in ds10:
+            m.add("rpTenPOMultMin", float(np.nanmin(ds10.po_multiplier.values)),
+                  "derived:min(fig10_dfo:po_multiplier)", 5)
+    if ds11 is not None:
+        for var, name in (("chi_minus", "rpElevenChi"), ("chi_minus_literal", "rpElevenChiLit"),
+                          ("sticking_a", "rpElevenA"), ("sticking_b", "rpElevenB"),
+                          ("sticking_a_literal", "rpElevenALit"),
+                          ("sticking_b_literal", "rpElevenBLit")):
+            if var in ds11:
+                _var(m, name, ds11, "fig11_dfo_retmaps", var, 3)
+        for k, key in ((0, "A"), (1, "B")):
+            if "panel" not in ds11.dims or ds11.sizes["panel"] <= k:
+                continue
+            for var, name, sig in (("eps", "Eps", 3), ("v0_sn", "VSN", 8), ("x1_sn", "XSN", 6),
+                                   ("sliding_length_sn", "SlideSN", 3),
+                                   ("sliding_time_sn", "SlideTimeSN", 3)):
+                if var in ds11:
+                    _var(m, f"rpEleven{name}{key}", ds11, "fig11_dfo_retmaps", var, sig, panel=k)
     tab10 = scalar_table(ds10) if ds10 is not None else _not_yet("fig10", "results/fig10_dfo.nc")
     tab11 = scalar_table(ds11) if ds11 is not None else _not_yet("fig11",
                                                                  "results/fig11_dfo_retmaps.nc")
