@@ -27,6 +27,23 @@ def test_work_precision_smoke(tmp_path):
     assert "solve_ivp nonsense" in text and "failed" in text
 
 
+def test_work_precision_fig11_smoke():
+    prob = wp.fig11_problems(every=1)[1]           # panel (b), eps = 0.01
+    prob = prob.subset([0, 12, 24])                 # 3 start points (4.15, 4.375, 4.6)
+    fams = [("project compiled exact", [1e-10]), ("project DOP853", [1e-8]),
+            ("solve_ivp DOP853", [1e-8])]
+    ds = wp.run([prob], fams, repeat=1, time_cap=120.0, log=lambda s: None)
+    assert ds.sizes == {"problem": 1, "config": 3}
+    assert "solve_ivp DOP853" in str(ds.reference_pair.values[0])
+    # project driver and solve_ivp agree to the reference floor
+    assert ds.reference_check.values[0] < 1e-9
+    # exact flows do not exist for the dry-friction oscillator: listed, no numbers
+    assert ds.status.values[0, 0] == "n/a" and np.isnan(ds.wall_time.values[0, 0])
+    assert np.all(ds.status.values[0, 1:] == "ok")
+    assert np.all(ds.error_map.values[0, 1:] < 1e-6)
+    assert "n/a" in wp.table(ds)
+
+
 def test_time_at_error_interpolates_log_log():
     errs, times = np.array([1e-4, 1e-6, 1e-10]), np.array([1.0, 2.0, 8.0])
     assert wp.time_at_error(errs, times, 1e-6) == 2.0

@@ -98,3 +98,73 @@ def test_return_map_fixed_point_stable_under_refinement():
     fp = [f11.P_pair(f11.fixed_point_near(4.43, 3.1, 0.01, LAW11, r, r * 1e-2), 3.1, 0.01,
                      LAW11, r, r * 1e-2)[0] for r in (1e-10, 1e-12)]
     assert abs(fp[0] - fp[1]) < 1e-8
+
+
+# ---------------------------------------------------------------- fig11: grid, onset, saddle-node
+def test_saddle_node_converges_under_tolerance_refinement():
+    # eps = 0.1 (cheap); search and correction at rtol 1e-9 and at 1e-11
+    out = [f11.saddle_node(0.1, LAW11, 4.25, 4.55, 3.15625 + 1.7 * 0.1, rtol=r, atol=r * 1e-2,
+                           search_rtol=r * 100) for r in (1e-9, 1e-11)]
+    (x_a, v_a, _, vs_a), (x_b, v_b, _, vs_b) = out
+    assert abs(v_a - v_b) < 1e-7          # measured: about 1e-9
+    assert abs(vs_b - v_b) < 1e-7         # search tolerance vs full-tolerance correction
+    assert 3.3227 < v_b < 3.3230 and 4.30 < x_b < 4.37
+    # at the fold, P - x1 has a double zero: G(x) = 0 and the max over x1 is ~ 0
+    g = f11.P_scalar(x_b, v_b, 0.1, LAW11, 1e-11, 1e-13) - x_b
+    assert abs(g) < 1e-7
+
+
+def test_onset_of_sticking_is_located_and_refined_grid_makes_P_continuous():
+    eps, v0 = 0.01, 3.1
+    start = df.slow_manifold_plus_on_L(4.2, 4.4, eps, v0, **LAW11)
+    on = {r: f11.sticking_onset(eps, v0, LAW11, 4.30, 4.32, rtol=r, atol=r * 1e-2, start=start)
+          for r in (1e-12, 1e-13)}
+    x_on = on[1e-12][0]
+    assert on[1e-12][1] < 1e-10                    # the iteration converged
+    assert abs(on[1e-12][0] - on[1e-13][0]) < 1e-10  # and the tolerance (measured: 7e-12)
+    # no sticking just below the onset, sticking just above it, P continuous across
+    r = f11.return_map([x_on - 1e-8, x_on + 1e-8], eps, v0, LAW11, with_residual=False,
+                       start=start)
+    assert r["slide_length"][0] == 0 and r["slide_length"][1] > 0
+    assert abs(r["P"][1] - r["P"][0]) < 1e-5
+    # refined grid (looser rtol, cheap): the onset is a grid point, and neighbouring
+    # values of P differ by at most dP_max everywhere, in particular across the onset
+    dP, rt = 0.03, 1e-10
+    maps, onsets = f11.refined_return_maps(np.linspace(4.27, 4.35, 4), [(eps, v0)], LAW11,
+                                           rtol=rt, atol=rt * 1e-2, dP_max=dP, max_rounds=5,
+                                           starts=[start])
+    x, P = maps[0]["x1"], maps[0]["P"]
+    assert np.all(np.diff(x) > 0) and np.all(np.isfinite(P))
+    assert abs(onsets[0][0] - x_on) < 1e-7           # rtol 1e-10: measured 4e-8
+    k = np.argmin(np.abs(x - onsets[0][0]))
+    assert x[k] == onsets[0][0]
+    assert maps[0]["slide_length"][k - 1] == 0 and maps[0]["slide_length"][k + 1] > 0
+    assert np.max(np.abs(np.diff(P))) <= dP
+    assert np.max(np.abs(np.diff(P)[k - 2:k + 2])) <= dP  # near the onset, explicitly
+
+
+def test_grid_fixed_points_are_fixed_points():
+    # as in the scene: fixed points from sign changes of P - x1 on the grid,
+    # refined by Brent on the same map (same start points on M_+)
+    for eps, v0 in ((0.1, 3.32), (0.01, 3.1)):
+        start = df.slow_manifold_plus_on_L(4.2, 4.55, eps, v0, **LAW11)
+        x = np.linspace(4.25, 4.5, 6)
+        P = lambda a: f11.return_map(a, eps, v0, LAW11, with_residual=False, start=start)["P"]
+        fps = f11.fixed_points(x, P(x), refine=lambda a: P([a])[0], xtol=1e-12)
+        assert len(fps) == 2
+        assert np.max(np.abs(P(fps) - fps)) < 1e-10
+        # the other construction of the start (pulled back along the slow flow,
+        # P_pair; its first hit of L is a hair off x1, amplified by P' - 1 at the
+        # unstable point) agrees to that offset and to the ambiguity of M_+
+        alt = [f11.P_pair(a, v0, eps, LAW11, 1e-12, 1e-14) for a in fps]
+        assert max(abs(b - a) for a, b in alt) < (1e-6 if eps < 0.05 else 1e-4)
+
+
+def test_interpolated_start_points_match_the_relaxation():
+    for eps, v0 in ((0.1, 3.32), (0.01, 3.1)):
+        start = df.slow_manifold_plus_on_L(3.3, 4.6, eps, v0, **LAW11)
+        x = np.array([3.41, 4.217, 4.3049, 4.59])
+        w, _ = df.slow_manifold_plus(x, 0.0, eps, v0, **LAW11)
+        assert np.max(np.abs(start(x)[0] - w)) < 1e-11
+        with pytest.raises(ValueError):
+            start([4.7])

@@ -74,9 +74,6 @@ def sliding_time(events) -> float:
     return total
 
 
-_sliding_time = sliding_time  # old private name, until its last caller moves
-
-
 def fixed_points(grid: np.ndarray, values: np.ndarray, refine=None, xtol: float = 1e-14):
     """Fixed points of a 1-D map sampled as ``values = P(grid)``.
 

@@ -1,19 +1,25 @@
 """Work against precision for the return maps: what each digit costs.
 
 Run ``python -m filippov.benchmarks.work_precision`` (``make bench`` or
-``snakemake bench``). For every problem (the fig04 return maps, one per theta)
-each method is swept over tolerances and scored by
+``snakemake bench``). For every problem (the fig04 return maps, one per theta,
+and the fig11 return maps of the slow-fast dry-friction oscillator, one per
+panel) each method is swept over tolerances and scored by
 
-* ``error_map``: max |P - P_ref| over the grid, points within ``1e-6`` of the
-  grazing value x2 = 1 left out (there the map jumps or has an infinite slope:
-  the error measures the conditioning, not the method);
+* ``error_map``: max |P - P_ref| over the grid; for fig04 the points within
+  ``1e-6`` of the grazing value x2 = 1 are left out (there the map jumps or has
+  an infinite slope: the error measures the conditioning, not the method); the
+  fig11 maps are continuous and every point is scored;
 * ``error_switch``: max |t_switch - t_switch_ref| of the first change of mode;
-* ``wall_time``: the median of ``runs`` runs in this process (one core);
+* ``wall_time``: the median of ``runs`` runs in this process (one core); for
+  fig11 the start points on M_+ are computed once beforehand and not timed;
 
-against a reference computed independently of the method measured: the
-compiled exact flows at rtol 1e-13 for every integrator, and the project's
-DOP853 at rtol 1e-13 for the exact-flow modes themselves (their difference,
-``reference_check``, is the floor no error below it can be trusted).
+against a reference computed independently of the method measured. fig04:
+the compiled exact flows at rtol 1e-13 for every integrator, and the project's
+DOP853 at rtol 1e-13 for the exact-flow modes themselves. fig11 (no exact
+flows; the exact-flow families are "n/a" there): the project's DOP853 at rtol
+1e-13 for every solve_ivp method, and solve_ivp DOP853 at rtol 1e-13 for the
+project's driver. The difference of the two references, ``reference_check``,
+is the floor no error below it can be trusted.
 
 A method that raises or runs over ``--time-cap`` seconds is kept in the table
 with its status, never dropped. A table is printed; the dataset goes to
@@ -34,12 +40,15 @@ import xarray as xr
 import yaml
 
 from ..io import finalize, write_dataset
+from ..models import dry_friction
 from ..models import hopf
 from ..scenes.fig04_retmaps import return_map, x2_grid
 from . import baseline
 
 ROOT = Path(__file__).resolve().parents[3]
 SCENE = ROOT / "config" / "scenes" / "fig04_retmaps.yaml"
+SCENE11 = ROOT / "config" / "scenes" / "fig11_dfo_retmaps.yaml"
+T_MAX11 = 200.0  # time limit of one fig11 return (the scene's)
 TARGET_ERROR = 1e-8
 GRAZING_GAP = 1e-6
 
@@ -57,14 +66,44 @@ QUICK = [("project compiled exact", [1e-10]), ("project DOP853", [1e-8]),
 
 @dataclass(frozen=True)
 class Problem:
+    """One return map to benchmark. fig04: ``x2`` is the start coordinate x2 on
+    the section x1 = 0 (``model``: the Hopf model). fig11: ``x2`` holds the x1
+    of the start points on L = {x2 = 0, x1 > 0} and ``start_states`` the full
+    states (x1, 0, w on M_+), ``model`` the dry-friction PiecewiseSystem."""
     name: str
     x2: np.ndarray
     model: object
     scored: np.ndarray  # grid points the error is taken over
+    kind: str = "fig04"
+    start_states: np.ndarray = None
 
     @property
     def starts(self):
+        if self.start_states is not None:
+            return self.start_states
         return np.stack([np.zeros_like(self.x2), self.x2, np.zeros_like(self.x2)], axis=1)
+
+    @property
+    def reference(self):
+        """(family, rtol) of the reference and of its independent check."""
+        if self.kind == "fig11":
+            return ("project DOP853", 1e-13), ("solve_ivp DOP853", 1e-13)
+        return ("project compiled exact", 1e-13), ("project DOP853", 1e-13)
+
+    def scored_by_check(self, family: str) -> bool:
+        """Whether ``family`` is scored against the check (it is the reference's own method)."""
+        if self.kind == "fig11":
+            return family.startswith("project")
+        return "exact" in family
+
+    def subset(self, idx):
+        """The problem on a subset of its start points."""
+        return Problem(self.name, self.x2[idx], self.model, self.scored[idx], self.kind,
+                       None if self.start_states is None else self.start_states[idx])
+
+
+class NotApplicable(RuntimeError):
+    """The configuration does not apply to the problem (e.g. exact flows for fig11)."""
 
 
 def fig04_problems(every: int) -> list[Problem]:
@@ -74,9 +113,61 @@ def fig04_problems(every: int) -> list[Problem]:
                     np.abs(x2 - 1.0) > GRAZING_GAP) for th in p["theta"]]
 
 
+def fig11_problems(every: int) -> list[Problem]:
+    """The two panels of fig11 (eq:dfo-sf) on every ``every``-th point of the
+    scene's uniform base grid (n_x1 points). Start points on M_+ are computed
+    once (by relaxation, :func:`dry_friction.slow_manifold_plus`), so every
+    method maps the same states; all points are scored (the map is continuous)."""
+    p = yaml.safe_load(SCENE11.read_text())["parameters"]
+    x1 = np.linspace(float(p["x1_min"]), float(p["x1_max"]), int(p["n_x1"]))[::every]
+    ml = {k: p[k] for k in ("gamma", "f0", "fv", "fc")}
+    ml["convention"] = p.get("convention", "stribeck")
+    out = []
+    for k, (eps, v0) in enumerate(zip(p["eps"], p["v0"])):
+        w, _ = dry_friction.slow_manifold_plus(x1, 0.0, float(eps), float(v0), **ml)
+        starts = np.stack([x1, np.zeros_like(x1), w], axis=1)
+        out.append(Problem(f"fig11 ({'ab'[k]}) eps={eps:g}", x1,
+                           dry_friction.full_system(float(eps), float(v0), **ml),
+                           np.ones(x1.size, dtype=bool), "fig11", starts))
+    return out
+
+
+def _fig11_project(problem: Problem, rtol: float, atol: float, time_cap: float):
+    from ..scenes.fig11_dfo_retmaps import section_L
+    from ..simulate import simulate
+
+    t0 = time.perf_counter()
+    P, first = np.empty(len(problem.starts)), np.full(len(problem.starts), np.nan)
+    for i, z0 in enumerate(problem.starts):
+        traj = simulate(problem.model, z0, T_MAX11, method="integrate", rtol=rtol, atol=atol,
+                        sections=[section_L()], dense=False, samples_per_step=1)
+        if traj.status != "section:L":
+            raise RuntimeError(f"start {z0.tolist()}: no return ({traj.status})")
+        P[i] = traj.z[0]
+        sw = traj.switches()
+        if sw:
+            first[i] = sw[0].t
+        if time.perf_counter() - t0 > time_cap:
+            raise baseline.TimeCapExceeded(f"over the {time_cap:g} s cap")
+    return P, first
+
+
 def runner(problem: Problem, family: str, tol: float, time_cap: float) -> Callable:
-    """A function returning ``(P, first switch times)`` for one configuration."""
+    """A function returning ``(P, first switch times)`` for one configuration.
+    Raises :class:`NotApplicable` for a configuration the problem has no use for."""
     opts = {"rtol": tol, "atol": tol * 1e-2}
+    if problem.kind == "fig11":
+        if family == "project DOP853":
+            return lambda: _fig11_project(problem, opts["rtol"], opts["atol"], time_cap)
+        if family.startswith("project"):
+            raise NotApplicable(f"{family}: the dry-friction model has no exact flows")
+
+        def run11():
+            states, _, first = baseline.first_returns(
+                problem.model, problem.starts, lambda z: z[1], lambda z: z[0] > 0, -1,
+                T_MAX11, family.split()[-1], opts["rtol"], opts["atol"], time_cap=time_cap)
+            return states[:, 0], first
+        return run11
     if family.startswith("project"):
         method = "integrate" if family == "project DOP853" else "exact"
         engine = "compiled" if "compiled" in family else "python"
@@ -143,18 +234,23 @@ def run(problems, families, repeat: int, time_cap: float, log=print) -> xr.Datas
     runs, missed = np.zeros(shape, dtype=np.int32), np.zeros(shape, dtype=np.int32)
     status = np.full(shape, "ok", dtype=object)
     ref_check = np.empty(len(problems))
+    ref_names = []
     for i, prob in enumerate(problems):
-        ref_p, ref_sw = runner(prob, "project compiled exact", 1e-13, np.inf)()
-        chk_p, chk_sw = runner(prob, "project DOP853", 1e-13, np.inf)()
+        (ref_fam, ref_tol), (chk_fam, chk_tol) = prob.reference
+        ref_p, ref_sw = runner(prob, ref_fam, ref_tol, np.inf)()
+        chk_p, chk_sw = runner(prob, chk_fam, chk_tol, np.inf)()
         ref_check[i] = max_dev(chk_p, ref_p, prob.scored)[0]
+        ref_names.append(f"{ref_fam} rtol {ref_tol:g} vs {chk_fam} rtol {chk_tol:g}")
         log(f"{prob.name}: {prob.x2.size} start points; reference check "
-            f"(compiled exact vs DOP853 rtol 1e-13): {ref_check[i]:.2e}")
+            f"({ref_names[-1]}): {ref_check[i]:.2e}")
         for j, (fam, tol) in enumerate(configs):
-            # the exact-flow modes are scored against the independent DOP853 check
-            want_p, want_sw = (chk_p, chk_sw) if "exact" in fam else (ref_p, ref_sw)
+            # the reference's own method is scored against the independent check
+            want_p, want_sw = (chk_p, chk_sw) if prob.scored_by_check(fam) else (ref_p, ref_sw)
             try:
                 wall[i, j], runs[i, j], (got_p, got_sw) = timed(
                     runner(prob, fam, tol, time_cap), repeat, time_cap)
+            except NotApplicable:
+                status[i, j] = "n/a"
             except baseline.TimeCapExceeded as exc:
                 status[i, j] = f"time cap: {exc}"
             except Exception as exc:  # listed, not dropped
@@ -187,7 +283,9 @@ def run(problems, families, repeat: int, time_cap: float, log=print) -> xr.Datas
          "runs": (dims, runs, {"long_name": "runs the median is taken over", "units": "1"}),
          "status": (dims, status.astype(str), {"long_name": "ok, failed: ..., or time cap: ..."}),
          "reference_check": ("problem", ref_check, {
-             "long_name": "max |P_exact(rtol 1e-13) - P_DOP853(rtol 1e-13)|", "units": "1"}),
+             "long_name": "max |P_reference - P_check| (see reference_pair)", "units": "1"}),
+         "reference_pair": ("problem", np.array(ref_names, dtype=str), {
+             "long_name": "reference and its independent check"}),
          "n_points": ("problem", np.array([p.x2.size for p in problems], dtype=np.int32),
                       {"long_name": "start points per map", "units": "1"}),
          "time_ours_at_target": ("problem", t_ours, {
@@ -201,7 +299,7 @@ def run(problems, families, repeat: int, time_cap: float, log=print) -> xr.Datas
                 "method": ("config", fam_of), "tolerance": ("config", [c[1] for c in configs])})
     return finalize(ds, None, target_error=TARGET_ERROR, time_cap=time_cap, repeat=repeat,
                     grazing_gap=GRAZING_GAP,
-                    title="work-precision of the fig04 return maps: project vs solve_ivp")
+                    title="work-precision of the fig04 and fig11 return maps: project vs solve_ivp")
 
 
 def table(ds: xr.Dataset) -> str:
@@ -218,22 +316,31 @@ def table(ds: xr.Dataset) -> str:
                          f"{float(ds.error_switch[i, j]):10.2e} {int(ds.missed_switches[i, j]):6d}  {'' if st == 'ok' else st}")
         lines.append(f"at error {TARGET_ERROR:g}: project {float(ds.time_ours_at_target[i]):.4f} s, "
                      f"RK45 {float(ds.time_rk45_at_target[i]):.4f} s, "
-                     f"speed-up {float(ds.speedup_vs_rk45[i]):.0f}x")
+                     f"speed-up {float(ds.speedup_vs_rk45[i]):.2g}x")
     return "\n".join(lines)
 
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--every", type=int, default=10, help="use every k-th fig04 grid point")
+    ap.add_argument("--every11", type=int, default=5,
+                    help="use every k-th point of the fig11 base grid")
+    ap.add_argument("--problems", default="fig04,fig11",
+                    help="comma-separated problem sets: fig04, fig11")
     ap.add_argument("--repeat", type=int, default=3, help="runs per configuration (median)")
     ap.add_argument("--time-cap", type=float, default=120.0, help="seconds per configuration")
     ap.add_argument("--quick", action="store_true", help="three configurations only (smoke test)")
     ap.add_argument("--out", default=str(ROOT / "results" / "bench_work_precision.nc"))
     args = ap.parse_args(argv)
-    if args.every < 1 or args.repeat < 1 or not args.time_cap > 0:
-        ap.error("--every and --repeat must be >= 1 and --time-cap > 0")
+    if args.every < 1 or args.every11 < 1 or args.repeat < 1 or not args.time_cap > 0:
+        ap.error("--every, --every11 and --repeat must be >= 1 and --time-cap > 0")
+    sets = [s.strip() for s in args.problems.split(",") if s.strip()]
+    if not sets or set(sets) - {"fig04", "fig11"}:
+        ap.error(f"--problems: choose from fig04, fig11, got {args.problems!r}")
+    problems = ((fig04_problems(args.every) if "fig04" in sets else [])
+                + (fig11_problems(args.every11) if "fig11" in sets else []))
     families = QUICK if args.quick else PROJECT + SCIPY
-    ds = run(fig04_problems(args.every), families, args.repeat, args.time_cap,
+    ds = run(problems, families, args.repeat, args.time_cap,
              log=lambda s: print(s, file=sys.stderr, flush=True))
     write_dataset(ds, args.out)
     print(table(ds))

@@ -211,8 +211,12 @@ def slow_manifold_plus(x1, x2, eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5,
     def solve(T):
         # backward slow flow on the expansion: the Newton start
         back = lambda t, z: -np.concatenate([z[m:], -z[:m] - Fp(g1 * z[m:] - w2(z[:m], z[m:]))])
+        # fixed steps here too: an adaptive step size depends on an error norm over
+        # the whole batch, a BLAS dot product whose last bit depends on where the
+        # array sits in memory; the Newton start (and so, at its tolerance, the
+        # result) would then differ between two runs of the same build
         s = solve_ivp(back, (0.0, T), np.concatenate([x1, x2]), method="DOP853",
-                      rtol=rtol, atol=atol).y[:, -1]
+                      rtol=1e-3, atol=1e3, first_step=h_fix, max_step=h_fix).y[:, -1]
         a, b = s[:m].copy(), s[m:].copy()
         d = 1e-6
         for _ in range(max_iter):
@@ -303,3 +307,51 @@ def full_system(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribec
         np.broadcast_to(grad[:, None], np.shape(z)).copy(),
         sliding=sliding, units={"t": "1", "x1": "1", "x2": "1", "w": "1"},
         description=f"dry_friction: slow-fast system, eps={eps!r}, v0={v0!r}")
+
+
+def _barycentric(nodes, weights, values, x):
+    """The barycentric interpolant at the points ``x``, its sums taken with
+    math.fsum: exactly rounded, so the result does not depend on how a SIMD
+    reduction splits the sum (which varies with memory alignment, i.e. between
+    two runs of the same build)."""
+    import math
+
+    out = np.empty(np.size(x))
+    for i, xi in enumerate(np.atleast_1d(x)):
+        hit = np.flatnonzero(nodes == xi)
+        if hit.size:
+            out[i] = values[hit[0]]
+            continue
+        t = weights / (xi - nodes)
+        out[i] = math.fsum(t * values) / math.fsum(t)
+    return out
+
+
+def slow_manifold_plus_on_L(x1_lo, x1_hi, eps, v0, n=33, **kwargs):
+    """w on M_+ along the half-line x2 = 0, x1 in [x1_lo, x1_hi], as a callable.
+
+    :func:`slow_manifold_plus` costs about a second per call whatever the number
+    of points (the relaxation runs all points in one batch with fixed steps),
+    so a root search that asks for one or three points at a time pays that
+    second every time. Here it is called once, on ``n`` Chebyshev points of the
+    interval; w_+(x1, 0) is analytic in x1, so barycentric interpolation is
+    accurate to the relaxation's own Newton tolerance (about 1e-13; see
+    tests/test_dry_friction.py). Returns ``start(x1) -> (w, estimate)``, the
+    estimate (distance to M_+, see :func:`slow_manifold_plus`) interpolated
+    the same way. Points outside the interval raise ValueError.
+    """
+    k = np.arange(n)
+    nodes = 0.5 * (x1_lo + x1_hi) + 0.5 * (x1_hi - x1_lo) * np.cos(np.pi * (k + 0.5) / n)
+    w, est = slow_manifold_plus(nodes, 0.0, eps, v0, **kwargs)
+    # barycentric weights of Chebyshev points of the first kind, in closed form
+    weights = (-1.0) ** k * np.sin(np.pi * (2 * k + 1) / (2 * n))
+    iw, ie = (lambda x: _barycentric(nodes, weights, w, x)), \
+        (lambda x: _barycentric(nodes, weights, est, x))
+
+    def start(x1):
+        x1 = np.atleast_1d(np.asarray(x1, dtype=float))
+        if np.any((x1 < x1_lo) | (x1 > x1_hi)):
+            raise ValueError(f"x1 outside [{x1_lo}, {x1_hi}]: {x1[(x1 < x1_lo) | (x1 > x1_hi)]}")
+        return np.asarray(iw(x1), dtype=float), np.abs(np.asarray(ie(x1), dtype=float))
+    start.interval = (x1_lo, x1_hi)
+    return start

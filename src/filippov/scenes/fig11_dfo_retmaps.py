@@ -9,11 +9,19 @@ the event-driven solver (DOP853 on every mode, Filippov sliding). Stored with
 it: the distance of the start and return points to M_+, the time and x1
 distance spent sliding (sticking), the fixed points.
 
-For each eps the stick-slip orbits (fixed points of P with a sliding segment)
-are continued in v0 by pseudo-arclength on G(x1, v0) = P(x1; v0) - x1; the
-saddle-node (fold in v0) is located as the extremum of v0 along that branch,
-and its sliding length is measured. The grazing fixed point (sliding length
-zero) is found as well, so the dataset says whether the fold comes first.
+The grid is the uniform base grid (x1_min, x1_max, n_x1) refined where the
+map is steep: the onset of sticking of each panel (the root of the first
+minimum of h along the smooth region-+ orbit, located to about 1e-11) is a
+grid point, and intervals where |Delta P| exceeds refine_dP in some panel are
+subdivided (deterministic, both panels share the grid). Start points on M_+
+come from one relaxation per panel, interpolated along L
+(:func:`filippov.models.dry_friction.slow_manifold_plus_on_L`).
+
+For each eps the saddle-node of the stick-slip orbits (fixed points of P with
+a sliding segment) is the root in v0 of M(v0) = max_x1 P(x1; v0) - x1: secant
+from the reduced GS point plus O(eps) at a looser search tolerance, then one
+Newton correction at the full tolerance (v0_sn_search and v0_sn are both
+stored); its sliding length is measured.
 
 Finally the quantity of eq:chiminus, dh/dx f_- - dh/dx f_+ at the grazing point
 of the reduced model, decides case 1 (> 0) or case 2 (< 0) of lemma thm:gen; it
@@ -27,10 +35,9 @@ import xarray as xr
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 
-from .. import continuation as cont
 from ..io import finalize
 from ..models import dry_friction as df
-from ..poincare import _sliding_time, fixed_points
+from ..poincare import fixed_points, sliding_time
 from ..progress import Progress
 from ..simulate import Section, simulate
 from ..system import SLIDING
@@ -59,11 +66,17 @@ def _slide_length(events) -> float:
 
 
 def return_map(x1, eps, v0, law, *, rtol=1e-12, atol=1e-14, progress=None,
-               with_residual=True):
-    """P(x1) on L for start points on M_+. Returns a dict of arrays."""
+               with_residual=True, start=None):
+    """P(x1) on L for start points on M_+. Returns a dict of arrays.
+    ``start``: optional ``x1 -> (w, estimate)`` on M_+
+    (:func:`filippov.models.dry_friction.slow_manifold_plus_on_L`), else the
+    relaxation is run for these points."""
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     ml = {k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")}
-    w0, res0 = df.slow_manifold_plus(x1, 0.0, eps, v0, **ml, rtol=rtol, atol=atol)
+    if start is None:
+        w0, res0 = df.slow_manifold_plus(x1, 0.0, eps, v0, **ml, rtol=rtol, atol=atol)
+    else:
+        w0, res0 = start(x1)
     system = df.full_system(eps, v0, **ml)
     out = {k: np.empty(x1.size) for k in ("P", "w", "time", "slide_time", "slide_length")}
     out["n_switches"] = np.empty(x1.size, dtype=np.int32)
@@ -75,7 +88,7 @@ def return_map(x1, eps, v0, law, *, rtol=1e-12, atol=1e-14, progress=None,
             raise RuntimeError(f"start x1={a!r} (eps={eps}, v0={v0}) did not return to L "
                                f"({traj.status})")
         out["P"][i], out["w"][i], out["time"][i] = traj.z[0], traj.z[2], traj.t
-        out["slide_time"][i] = _sliding_time(traj.events)
+        out["slide_time"][i] = sliding_time(traj.events)
         out["slide_length"][i] = _slide_length(traj.events)
         out["n_switches"][i] = len(traj.switches())
         if progress is not None:
@@ -139,29 +152,193 @@ def fixed_point_near(x1_guess, v0, eps, law, rtol, atol, width=0.05):
 
 
 def saddle_node(eps, law, x1_lo, x1_hi, v0_guess, *, rtol=1e-12, atol=1e-14,
-                progress=None):
-    """The fold of the stick-slip fixed points of P in v0. M(v0) = max over x1 in
-    [x1_lo, x1_hi] of P(x1; v0) - x1 (bounded Brent) is positive while the stable
-    and unstable fixed points coexist and negative after they annihilate; the
-    saddle-node is the root of M (Brent). The maximum value is insensitive to
-    the error in its location (quadratic), so v0 comes out to about the
-    accuracy of P. Returns (x1, v0 at the fold, samples (v0, M, argmax))."""
-    samples = []
+                search_rtol=1e-10, window=0.02, progress=None):
+    """The fold of the stick-slip fixed points of P in v0.
 
-    def M(v):
-        res = minimize_scalar(lambda x: -(P_scalar(x, v, eps, law, rtol, atol) - x),
-                              bounds=(x1_lo, x1_hi), method="bounded",
-                              options={"xatol": 1e-4})
+    M(v0) = max over x1 of P(x1; v0) - x1 is positive while the stable and
+    unstable fixed points coexist and negative after they annihilate; the
+    saddle-node is the root of M. The maximum value is insensitive to the
+    error in its location (quadratic), so v0 comes out to about the accuracy
+    of P.
+
+    Cost: M is nearly linear in v0, so the secant method from a good guess
+    (the reduced GS point plus O(eps), see the scene config) needs few
+    evaluations; the search runs at the looser ``search_rtol`` (P changes by
+    about 3e-11 between rtol 1e-10 and 1e-12) and each maximisation after the
+    first one is restricted to +-``window`` around the previous argmax. The
+    result is then verified and corrected by one evaluation of M at the full
+    ``rtol``: v_sn = v_search - M_full(v_search) / M'(v0) (one Newton step;
+    M' from the secant iterates).
+
+    Returns (x1 at the fold, v0 at the fold, samples (v0, M, argmax), v0 from
+    the search tolerance alone).
+    """
+    samples = []
+    state = {"x": None}
+
+    def M(v, rt, win=window, xatol=1e-5):
+        x0 = state["x"]
+        bounds = (x1_lo, x1_hi) if x0 is None else (max(x1_lo, x0 - win),
+                                                       min(x1_hi, x0 + win))
+        f = lambda x: -(P_scalar(x, v, eps, law, rt, rt * atol / rtol) - x)
+        res = minimize_scalar(f, bounds=bounds, method="bounded", options={"xatol": xatol})
+        if x0 is not None and min(res.x - bounds[0], bounds[1] - res.x) < 0.05 * win:
+            # the argmax ran to the window's edge: maximise over the full range
+            res = minimize_scalar(f, bounds=(x1_lo, x1_hi), method="bounded",
+                                  options={"xatol": xatol})
+        state["x"] = float(res.x)
         samples.append((v, -res.fun, res.x))
         if progress is not None:
             progress.step()
         return -res.fun
 
-    # M is nearly linear in v0 near its root: the secant method needs few of
-    # these costly evaluations (each one a maximisation over x1)
-    v_sn = secant(M, v0_guess, v0_guess + 0.01, tol=1e-12)
-    v, m, x = min(samples, key=lambda s: abs(s[0] - v_sn))
-    return float(x), float(v_sn), np.array(sorted(samples))
+    # the search stops at a step of about 1e-8 (M carries noise of about 1e-9 at
+    # search_rtol 1e-8, so smaller steps only wander); the correction at the full
+    # rtol is a Newton step from there: its error is O(step^2)
+    v_search = secant(lambda v: M(v, search_rtol), v0_guess, v0_guess + 1e-3, tol=3e-9,
+                      max_iter=15)
+    # M'(v0) from the widest pair (M is nearly linear; neighbouring iterates are
+    # too close for a difference quotient above the noise)
+    (va, ma, _), (vb, mb, _) = samples[0], samples[-1]
+    slope = (mb - ma) / (vb - va)
+    # same v0: the argmax moves by ~1e-6 at most; a finer argmax, since near the
+    # onset of sticking P - x1 is sharply curved (error G'' dx^2 / 2 in M)
+    m_full = M(v_search, rtol, win=2e-3, xatol=1e-7)
+    v_sn = v_search - m_full / slope
+    return float(samples[-1][2]), float(v_sn), np.array(sorted(samples)), float(v_search)
+
+
+# --------------------------------------------------------------------------- onset of sticking
+def grazing_gap(x1, eps, v0, law, rtol=1e-12, atol=1e-14, start=None):
+    """g(x1): the first local minimum of h = w - (1 + gamma) x2 on the orbit
+    from the start point (x1, 0, w_+) on L, following the region-+ field
+    F_+ continued smoothly across H_s (the friction branch F_plus is analytic
+    for every nu).
+
+    g > 0: the orbit returns without touching H_s (no sticking); g < 0: it
+    reaches H_s, where sliding (sticking) is attracting (case 1), so it sticks.
+    g is a smooth function of x1 (the grazing of a smooth flow), and its root
+    is the onset of sticking. Start points are those of :func:`return_map`
+    (M_+ by relaxation), one batch for all x1.
+    """
+    from ..system import PLUS
+    x1 = np.atleast_1d(np.asarray(x1, dtype=float))
+    ml = {k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")}
+    if start is None:
+        w0, _ = df.slow_manifold_plus(x1, 0.0, eps, v0, **ml, rtol=rtol, atol=atol)
+    else:
+        w0 = start(x1)[0]
+    system = df.full_system(eps, v0, **ml)
+    grad = np.asarray(system.switch_grad(np.zeros(3)), dtype=float)
+    rhs = lambda t, z: system.field(PLUS, z)
+    dh = lambda t, z: float(grad @ system.field(PLUS, z))
+    dh.terminal, dh.direction = True, 1      # h has a minimum: dh/dt goes - to +
+    out = np.empty(x1.size)
+    for i, (a, w) in enumerate(zip(x1, w0)):
+        sol = solve_ivp(rhs, (0.0, 50.0), [a, 0.0, w], method="DOP853", rtol=rtol,
+                        atol=atol, events=dh)
+        if sol.status != 1:
+            raise RuntimeError(f"x1={a!r}: no minimum of h on the region-+ orbit")
+        out[i] = float(system.switch(sol.y_events[0][0]))
+    return out
+
+
+def sticking_onset(eps, v0, law, lo, hi, *, rtol=1e-12, atol=1e-14, xtol=1e-10,
+                   max_rounds=4, start=None):
+    """The x1 on L where sticking begins: the root of :func:`grazing_gap` in
+    [lo, hi] (a bracket from the grid). Batched interpolation rounds (each one
+    batch of start points on M_+): Chebyshev interpolation of g on 5 nodes of
+    the bracket, then quadratic interpolation on 3 points around the estimate
+    with the spacing shrinking, until the estimate moves by less than ``xtol``
+    (at rtol 1e-12 the noise of g puts a floor of a few 1e-11 under the
+    corrections).
+    Returns (x1_onset, last correction, |g| at the last nodes' interpolant)."""
+    nodes = lo + (hi - lo) * 0.5 * (1 - np.cos(np.pi * np.arange(5) / 4))
+    g = grazing_gap(nodes, eps, v0, law, rtol, atol, start)
+    if not (g[0] > 0 > g[-1]):
+        raise RuntimeError(f"eps={eps}, v0={v0}: no onset of sticking in [{lo}, {hi}] "
+                           f"(g = {g[0]:.3e} .. {g[-1]:.3e})")
+    x = _interp_root(nodes, g, lo, hi)
+    d, step = 1e-3 * (hi - lo), np.inf
+    for _ in range(max_rounds):
+        pts = x + d * np.array([-1.0, 0.0, 1.0])
+        gp = grazing_gap(pts, eps, v0, law, rtol, atol, start)
+        xn = _interp_root(pts, gp, pts[0] - 10 * d, pts[-1] + 10 * d)
+        step, x = abs(xn - x), xn
+        if step <= xtol:
+            break
+        d = max(10 * step, 1e-7)
+    return float(x), float(step)
+
+
+def _interp_root(x, g, lo, hi):
+    c = np.polynomial.Polynomial.fit(x, g, len(x) - 1)
+    r = c.roots()
+    r = np.real(r[(np.abs(np.imag(r)) < 1e-12) & (np.real(r) >= lo) & (np.real(r) <= hi)])
+    if r.size == 0:
+        raise RuntimeError("onset of sticking: the interpolant has no root in the bracket")
+    return float(r[np.argmin(np.abs(r - x[np.argmin(np.abs(g))]))])
+
+
+def _merge(maps, new):
+    """Append the point results ``new`` (dict of arrays with key 'x1') to ``maps``, sorted."""
+    out = {k: np.concatenate([maps[k], new[k]]) for k in maps}
+    order = np.argsort(out["x1"], kind="stable")
+    return {k: v[order] for k, v in out.items()}
+
+
+def refined_return_maps(x_base, panels, law, *, rtol, atol, dP_max, max_rounds, bar=None,
+                        starts=None):
+    """P on one x1 grid shared by all panels: the uniform ``x_base``, plus the
+    onset of sticking of each panel, plus points subdividing every interval
+    where |Delta P| > ``dP_max`` in some panel (:func:`_subdivide`, repeated
+    until no interval is too steep, at most ``max_rounds`` rounds;
+    deterministic). ``starts``: one start-point callable per panel (see
+    :func:`return_map`). Returns (maps, onsets)."""
+    starts = [None] * len(panels) if starts is None else starts
+
+    def run(x):
+        outs = []
+        for (eps, v0), st in zip(panels, starts):
+            r = return_map(x, eps, v0, law, rtol=rtol, atol=atol, progress=bar,
+                           with_residual=False, start=st)
+            r["x1"] = np.asarray(x, dtype=float).copy()
+            outs.append(r)
+        return outs
+
+    maps = run(np.asarray(x_base, dtype=float))
+    onsets = []
+    for (eps, v0), m, st in zip(panels, maps, starts):
+        stick = m["slide_length"] > 0
+        i = np.flatnonzero(~stick[:-1] & stick[1:])
+        if i.size != 1:
+            raise RuntimeError(f"eps={eps}: expected one onset of sticking on the grid, "
+                               f"found {i.size}")
+        onsets.append(sticking_onset(eps, v0, law, m["x1"][i[0]], m["x1"][i[0] + 1],
+                                     rtol=rtol, atol=atol, start=st))
+    new = _subdivide(maps, dP_max, extra=[x for x, _ in onsets])
+    for _ in range(max_rounds):
+        if new.size == 0:
+            break
+        maps = [_merge(m, r) for m, r in zip(maps, run(new))]
+        new = _subdivide(maps, dP_max)
+    return maps, onsets
+
+
+def _subdivide(maps, dP_max, extra=()):
+    """New grid points: ``extra`` (the onsets), and in every interval where
+    |Delta P| > dP_max in some panel, ceil(|Delta P| / dP_max) - 1 equally
+    spaced points (one round of this does what several rounds of bisection do
+    where P is close to linear; the next round checks)."""
+    x = maps[0]["x1"]
+    k = np.zeros(x.size - 1, dtype=int)
+    for m in maps:
+        k = np.maximum(k, np.ceil(np.abs(np.diff(m["P"])) / dP_max - 1e-9).astype(int) - 1)
+    pts = [x[i] + (x[i + 1] - x[i]) * np.arange(1, k[i] + 1) / (k[i] + 1)
+           for i in np.flatnonzero(k > 0)]
+    pts = np.concatenate(pts + [np.asarray(extra, dtype=float)])
+    pts = np.unique(pts)
+    return pts[~np.isin(pts, x)]
 
 
 def secant(g, a, b, tol=1e-13, max_iter=30):
@@ -206,22 +383,36 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
         raise ValueError(f"{scene['id']}: parameters.v0: need one v0 per eps "
                          f"({len(v0_list)} != {len(eps_list)})")
     lo, hi, n = float(p["x1_min"]), float(p["x1_max"]), int(p["n_x1"])
-    x1 = np.linspace(lo, hi, n)
-    bar = Progress(scene["id"], len(eps_list) * (n + 40), progress)
+    dP_max, rounds = float(p.get("refine_dP", 0.03)), int(p.get("refine_rounds", 5))
+    search_rtol = float(p.get("sn_search_rtol", 1e-10))
+    vgs, cgs = (float(v) for v in p.get("sn_v0_guess", [3.15625, 1.7]))
+    ml = {k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")}
+    bar = Progress(scene["id"], len(eps_list) * (2 * n + 60), progress)
 
-    maps, fps, sns = [], [], []
-    for eps, v0 in zip(eps_list, v0_list):
-        r = return_map(x1, eps, v0, law, rtol=rtol, atol=atol, progress=bar)
-        maps.append(r)
-        fp = fixed_points(x1, r["P"], refine=lambda x, e=eps, v=v0: P_scalar(x, v, e, law, rtol, atol))
-        fp = np.array([P_pair(x, v0, eps, law, rtol, atol)[0] for x in fp])
-        fps.append(fp)
-        # saddle-node of the stick-slip orbits, from the panel's sliding fixed point
-        xs, vs, br = saddle_node(eps, law, float(p["sn_x1_range"][0]),
-                                 float(p["sn_x1_range"][1]), v0, rtol=rtol, atol=atol,
-                                 progress=bar)
-        at = return_map([xs], eps, vs, law, rtol=rtol, atol=atol)
-        sns.append({"x1": xs, "v0": vs,
+    panels = list(zip(eps_list, v0_list))
+    # start points on M_+ over the grid and over the returns, one relaxation per panel
+    span = (min(lo, float(p.get("x1_return_min", 3.3))), hi)
+    starts = [df.slow_manifold_plus_on_L(*span, eps, v0, **ml, rtol=rtol, atol=atol)
+              for eps, v0 in panels]
+    maps, onsets = refined_return_maps(np.linspace(lo, hi, n), panels, law, rtol=rtol,
+                                       atol=atol, dP_max=dP_max, max_rounds=rounds, bar=bar,
+                                       starts=starts)
+    x1 = maps[0]["x1"]
+    fps, sns = [], []
+    for (eps, v0), r, st in zip(panels, maps, starts):
+        # distance of the returned points to M_+ (relaxation since the last switch)
+        r["return_residual"] = np.abs(r["w"] - st(r["P"])[0])
+        # fixed points of the same map (same start points), Brent in each sign change
+        Pm = lambda x, e=eps, v=v0, s_=st: float(return_map([x], e, v, law, rtol=rtol, atol=atol,
+                                                           with_residual=False, start=s_)["P"][0])
+        fps.append(np.asarray(fixed_points(x1, r["P"], refine=Pm, xtol=1e-12)))
+        # saddle-node of the stick-slip orbits; first guess: reduced GS + c eps
+        xs, vs, br, v_search = saddle_node(eps, law, float(p["sn_x1_range"][0]),
+                                           float(p["sn_x1_range"][1]), vgs + cgs * eps,
+                                           rtol=rtol, atol=atol, search_rtol=search_rtol,
+                                           progress=bar)
+        at = return_map([xs], eps, vs, law, rtol=rtol, atol=atol, with_residual=False)
+        sns.append({"x1": xs, "v0": vs, "v0_search": v_search,
                     "slide_length": float(at["slide_length"][0]),
                     "slide_time": float(at["slide_time"][0]), "branch": br})
 
@@ -234,9 +425,11 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     nb = max(len(s["branch"]) for s in sns)
     br_x1 = np.full((len(eps_list), nb), np.nan)
     br_v0 = np.full((len(eps_list), nb), np.nan)
+    br_M = np.full((len(eps_list), nb), np.nan)
     for i, s in enumerate(sns):
-        br_x1[i, :len(s["branch"])] = s["branch"][:, 0]
-        br_v0[i, :len(s["branch"])] = s["branch"][:, 1]
+        br_x1[i, :len(s["branch"])] = s["branch"][:, 2]
+        br_v0[i, :len(s["branch"])] = s["branch"][:, 0]
+        br_M[i, :len(s["branch"])] = s["branch"][:, 1]
 
     chi, a, b = lemma_quantity({k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")},
                                float(np.mean(v0_list)))
@@ -275,10 +468,26 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
              "long_name": "x1 distance slid by the orbit at the saddle-node", "units": one}),
          "sliding_time_sn": ("panel", [s["slide_time"] for s in sns], {
              "long_name": "time spent sliding by the orbit at the saddle-node", "units": one}),
+         "v0_sn_search": ("panel", [s["v0_search"] for s in sns], {
+             "long_name": "v0 at the fold from the search at rtol sn_search_rtol alone "
+                          "(v0_sn: corrected by one evaluation at the full rtol)",
+             "units": one}),
+         "x1_onset": ("panel", [o[0] for o in onsets], {
+             "long_name": "x1 on L where sticking begins (root of the minimum of h along "
+                          "the region-+ orbit)", "units": one}),
+         "x1_onset_step": ("panel", [o[1] for o in onsets], {
+             "long_name": "last correction of the onset iteration (noise floor at "
+                          "rtol 1e-12: a few 1e-11)", "units": one}),
+         "P_onset": ("panel", [float(np.interp(o[0], x1, m["P"])) for o, m in zip(onsets, maps)], {
+             "long_name": "P at the onset of sticking (a grid point)", "units": one}),
          "sn_branch_x1": (("panel", "branch"), br_x1, {
-             "long_name": "continued stick-slip fixed points: x1", "units": one}),
+             "long_name": "saddle-node search iterates: argmax over x1 of P(x1) - x1",
+             "units": one}),
          "sn_branch_v0": (("panel", "branch"), br_v0, {
-             "long_name": "continued stick-slip fixed points: v0", "units": one}),
+             "long_name": "saddle-node search iterates: v0", "units": one}),
+         "sn_branch_M": (("panel", "branch"), br_M, {
+             "long_name": "saddle-node search iterates: max over x1 of P(x1) - x1",
+             "units": one}),
          "chi_minus": ((), chi, {"long_name": "dh/dx f_- - dh/dx f_+ at the grazing point "
                                  "(eq:chiminus); > 0: case 1 of thm:gen", "units": one}),
          "chi_minus_literal": ((), chi_l, {"long_name": "eq:chiminus for the printed law "
