@@ -4,6 +4,7 @@ Speed is not asserted here (machines are shared and noisy): the numbers live in
 `make bench`. What is asserted is what a timing run must never get wrong.
 """
 import numpy as np
+import pytest
 
 from filippov.benchmarks import effect_cost, work_precision as wp
 
@@ -74,3 +75,21 @@ def test_effect_cost_reports_unsupported_variants(tmp_path):
     ds = effect_cost.measure(["fig08_s0theta"], cap=120.0, log=lambda s: None)
     assert ds.status.values[0] == "ok" and ds.relative.values[0] == 1.0
     assert ds.sizes["variant"] >= 1
+
+
+def test_chunked_benchmark_parts_merge_in_order():
+    probs = [wp.Problem(p.name, p.x2[[0, -1]], p.model, p.scored[[0, -1]])
+             for p in wp.fig04_problems(every=97)]
+    fams = [("project compiled exact", [1e-10])]
+    parts = [wp.run([p], fams, repeat=1, time_cap=60.0, log=lambda s: None) for p in probs]
+    merged = wp.merge(parts)
+    assert list(merged.problem.values) == [p.name for p in probs]
+    assert merged.sizes == {"problem": 2, "config": 1}
+    for i, part in enumerate(parts):
+        np.testing.assert_array_equal(merged.error_map.values[i], part.error_map.values[0])
+    with pytest.raises(ValueError, match="more than one part"):
+        wp.merge([parts[0], parts[0]])
+    other = wp.run([probs[1]], [("project compiled exact", [1e-8])], repeat=1, time_cap=60.0,
+                   log=lambda s: None)
+    with pytest.raises(ValueError, match="method/tolerance"):
+        wp.merge([parts[0], other])

@@ -1,12 +1,29 @@
 # Benchmarks: not part of `all` (they time things and take minutes). Run with
 # `snakemake bench` or `make bench`. Timings vary between runs; the dataset
 # records the machine-independent part (errors) next to the wall times.
-rule bench_work_precision:
+# One job per problem set (fig04: both theta; fig11: both panels), merged: on a
+# cluster the sets run on different nodes.
+BENCH_SETS = ["fig04", "fig11"]
+
+
+rule bench_work_precision_part:
     output:
-        "results/bench_work_precision.nc",
+        temp("results/bench/work_precision_{problems}.nc"),
+    wildcard_constraints:
+        problems="|".join(BENCH_SETS),
     params:
         code=library_hash(exclude=("plotting", "report.py", "manifest.py")),
         every=config.get("bench", {}).get("every", 10),
+    script:
+        "../scripts/bench_work_precision.py"
+
+
+rule bench_work_precision:
+    input:
+        parts=expand("results/bench/work_precision_{problems}.nc", problems=BENCH_SETS),
+        script="workflow/scripts/bench_work_precision.py",
+    output:
+        "results/bench_work_precision.nc",
     script:
         "../scripts/bench_work_precision.py"
 

@@ -1,4 +1,8 @@
-"""Thin: run the work-precision benchmark, write results/bench_work_precision.nc."""
+"""Thin: one problem set of the work-precision benchmark (a chunk job), or the merge."""
 import filippov.benchmarks.work_precision as wp
 
-wp.main(["--every", str(snakemake.params.every), "--out", snakemake.output[0]])  # noqa: F821
+if snakemake.rule == "bench_work_precision":  # noqa: F821
+    wp.main(["--merge", *snakemake.input.parts, "--out", snakemake.output[0]])  # noqa: F821
+else:
+    wp.main(["--problems", snakemake.wildcards.problems, "--every",  # noqa: F821
+             str(snakemake.params.every), "--out", snakemake.output[0]])  # noqa: F821

@@ -302,6 +302,27 @@ def run(problems, families, repeat: int, time_cap: float, log=print) -> xr.Datas
                     title="work-precision of the fig04 and fig11 return maps: project vs solve_ivp")
 
 
+def merge(parts: list[xr.Dataset]) -> xr.Dataset:
+    """Datasets of :func:`run` on disjoint problem sets (chunk jobs) as one, in the
+    order given; they must share the configurations (methods, tolerances) and the
+    settings (target error, time cap, repeats)."""
+    if not parts:
+        raise ValueError("nothing to merge")
+    first = parts[0]
+    for ds in parts[1:]:
+        if not (np.array_equal(ds.method.values, first.method.values)
+                and np.array_equal(ds.tolerance.values, first.tolerance.values)):
+            raise ValueError("benchmark parts were run with different method/tolerance lists")
+        for key in ("target_error", "time_cap", "repeat", "grazing_gap"):
+            if ds.attrs.get(key) != first.attrs.get(key):
+                raise ValueError(f"benchmark parts differ in their setting {key!r}")
+    names = np.concatenate([ds.problem.values for ds in parts])
+    if len(set(names)) != len(names):
+        raise ValueError(f"a problem appears in more than one part: {list(names)}")
+    return xr.concat(parts, dim="problem", data_vars="minimal", coords="minimal",
+                     compat="identical", combine_attrs="override")
+
+
 def table(ds: xr.Dataset) -> str:
     lines = []
     for i, prob in enumerate(ds.problem.values):
@@ -331,7 +352,17 @@ def main(argv=None) -> None:
     ap.add_argument("--time-cap", type=float, default=120.0, help="seconds per configuration")
     ap.add_argument("--quick", action="store_true", help="three configurations only (smoke test)")
     ap.add_argument("--out", default=str(ROOT / "results" / "bench_work_precision.nc"))
+    ap.add_argument("--merge", nargs="+", metavar="PART",
+                    help="merge datasets of earlier runs (chunk jobs) into --out instead")
     args = ap.parse_args(argv)
+    if args.merge:
+        from ..io import read_dataset
+
+        ds = merge([read_dataset(p) for p in args.merge])
+        write_dataset(ds, args.out)
+        print(table(ds))
+        print(f"\nwrote {args.out}")
+        return
     if args.every < 1 or args.every11 < 1 or args.repeat < 1 or not args.time_cap > 0:
         ap.error("--every, --every11 and --repeat must be >= 1 and --time-cap > 0")
     sets = [s.strip() for s in args.problems.split(",") if s.strip()]
