@@ -21,8 +21,13 @@ FLOOR = 1e-16  # an error of exactly zero is drawn here
 def draw(ds):
     st.require(ds, "bench_work_precision", VARS)
     n = ds.sizes["problem"]
-    fig = st.new_figure(st.WIDTH_DOUBLE, 3.2)
-    axes = np.atleast_1d(fig.subplots(1, n, sharey=True))
+    ncols = min(n, 2)
+    nrows = -(-n // ncols)
+    fig = st.new_figure(st.WIDTH_DOUBLE, 3.0 * nrows)
+    axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    axes = axes[:n]
     methods = list(dict.fromkeys(str(m) for m in ds.method.values))
     for i, ax in enumerate(axes):
         for fam in methods:
@@ -42,6 +47,13 @@ def draw(ds):
         ax.set_xlabel("wall time of one map [s]")
         st.panel_label(ax, f"({'abcd'[i]}) {ds.problem.values[i]}, "
                            f"{int(ds.n_points.values[i])} points")
-    axes[0].set_ylabel(r"max $|P - P_{\mathrm{ref}}|$")
-    axes[-1].legend(loc="upper right", fontsize=6.5, ncol=1)
+    for ax in axes[::ncols]:
+        ax.set_ylabel(r"max $|P - P_{\mathrm{ref}}|$")
+    # one legend for all panels, below them
+    handles = {}
+    for ax in axes:
+        for h, label in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(label, h)
+    fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncol=4,
+               fontsize=6.5, frameon=False)
     return fig
