@@ -484,8 +484,8 @@ def bench(ds, m: Macros, effects=None) -> str:
                       str(int(ds.missed_switches.values[i, j]))]
         lines.append(" & ".join(cells) + r" \\")
     lines += [r"\bottomrule", r"\end{tabular}", ""]
-    for i, p in enumerate(probs):
-        key = "A" if i == 0 else "B"
+    for i, p in enumerate(probs[:4]):
+        key = "ABCD"[i]
         m.add(f"rpBenchSpeedup{key}", float(ds.speedup_vs_rk45.values[i]),
               _src("bench_work_precision", f"speedup_vs_rk45[{i}]"), 3)
         m.add(f"rpBenchFloor{key}", float(ds.reference_check.values[i]),
