@@ -32,15 +32,11 @@ def eps_list(p: dict) -> np.ndarray:
     return np.sort(eps)[::-1]  # largest first: the order a reader follows the limit
 
 
-def numerical_pdm(scene: dict, theta: float, progress: bool) -> tuple[np.ndarray, np.ndarray, dict]:
-    """(eps, xi1, fields) with every PDMResult field stacked to shape (eps, xi1)."""
-    return pdm_fields(scene, theta, xi1_grid(scene["parameters"]), progress)
-
-
 def pdm_fields(scene: dict, theta: float, xi: np.ndarray,
                progress: bool) -> tuple[np.ndarray, np.ndarray, dict]:
-    """:func:`numerical_pdm` on the points ``xi`` (any part of the xi1 grid): every
-    point is computed on its own, so parts of the grid give parts of the fields."""
+    """(eps, xi1, fields): every PDMResult field stacked to shape (eps, xi1), on the
+    points ``xi`` (any part of the xi1 grid: every point is computed on its own, so
+    parts of the grid give parts of the fields)."""
     require(scene, "system", {"slow_fast"})
     p = scene["parameters"]
     opts = solver_options(scene)
