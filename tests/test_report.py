@@ -240,3 +240,18 @@ def test_failed_build_leaves_no_pdf(built, tmp_path):
         assert "thiscommanddoesnotexist" in (work / "paper" / "main.log").read_text(errors="replace")
     finally:
         sec.write_text(good)
+
+
+def test_html_report_links_every_figure_to_its_rule(workflow_build, tmp_path):
+    """`snakemake --report` on a finished build: every figure, with the rule that drew it."""
+    work, run = workflow_build["work"], workflow_build["run"]
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    out = tmp_path / "report.html"
+    rep = _snakemake(work, "--report", str(out))
+    assert rep.returncode == 0, rep.stdout[-3000:] + rep.stderr[-3000:]
+    html = out.read_text(errors="replace")
+    scenes = yaml.safe_load((work / "config" / "config.yaml").read_text())["scenes"]
+    for scene in scenes:
+        assert f"{scene}.pdf" in html and f"{scene}.png" in html, scene
+    for rule in ("compute", "plot"):
+        assert rule in html
