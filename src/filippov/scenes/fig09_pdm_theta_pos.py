@@ -15,19 +15,13 @@ import xarray as xr
 
 from ..analytic import pdm as asym
 from ..io import finalize
-from .pdm_common import (CHUNK_AXIS, base_dataset, chunk_grid, fields_from_dataset,
-                         max_error, rates, sweep_dataset)
+from .pdm_common import (CHUNK_AXIS, base_dataset, checked_theta, chunk_grid,
+                         fields_from_dataset, max_error, rates, sweep_dataset)
 # CHUNK_AXIS, chunk_grid, sweep and assemble make the scene splittable (see .chunking)
 
 
 def _theta(scene: dict) -> float:
-    p = scene["parameters"]
-    theta, omega, mu = float(p["theta"]), float(p["omega"]), float(p["mu"])
-    if not 0 < theta < 1:
-        raise ValueError(f"{scene['id']}: parameters.theta must lie in (0, 1), got {theta!r}")
-    if mu != 1.0:
-        raise ValueError(f"{scene['id']}: the stored asymptotics are for q = 0 (mu = 1)")
-    return theta
+    return checked_theta(scene, lambda t: 0 < t < 1, "lie in (0, 1)")
 
 
 def sweep(scene: dict, xi: np.ndarray, *, progress: bool = False) -> xr.Dataset:

@@ -70,6 +70,18 @@ def chunk_grid(scene: dict) -> np.ndarray:
     return xi1_grid(scene["parameters"])
 
 
+def checked_theta(scene: dict, ok, requirement: str) -> float:
+    """parameters.theta if ``ok(theta)`` (the case the scene's asymptotics are for),
+    with mu = 1 (q = 0), else an error naming the field."""
+    p = scene["parameters"]
+    theta, mu = float(p["theta"]), float(p["mu"])
+    if not ok(theta):
+        raise ValueError(f"{scene['id']}: parameters.theta must {requirement}, got {theta!r}")
+    if mu != 1.0:
+        raise ValueError(f"{scene['id']}: the stored asymptotics are for q = 0 (mu = 1)")
+    return theta
+
+
 def sweep_dataset(scene: dict, theta: float, xi: np.ndarray, progress: bool) -> xr.Dataset:
     """The fields of :func:`pdm_fields` as a Dataset on (eps, xi1) (raw, no attributes)."""
     eps, xi, f = pdm_fields(scene, theta, xi, progress)
