@@ -1,7 +1,9 @@
 """Chunked sweeps (filippov.scenes.chunking): chunks computed apart and merged give
 exactly the dataset of one unsplit compute -- xarray-identical and the same bytes
-on disk -- for the return maps (fig04, split over x2) and the discontinuity maps
-(fig07, fig09, split over xi1). Small grids keep it quick."""
+on disk -- for the return maps (fig04, split over x2), the discontinuity maps
+(fig07, fig09, split over xi1) and the dry-friction bifurcation diagram (fig10,
+split over tasks: the two continuation directions and the stick-slip orbits).
+Small grids keep it quick."""
 import random
 
 import numpy as np
@@ -17,7 +19,7 @@ from filippov.scenes import chunking
 from conftest import ROOT
 
 SCHEMA = ROOT / "config" / "schema" / "scene.schema.json"
-CHUNKED = ("fig04_retmaps", "fig07_pdm_theta_neg", "fig09_pdm_theta_pos")
+CHUNKED = ("fig04_retmaps", "fig07_pdm_theta_neg", "fig09_pdm_theta_pos", "fig10_dfo")
 
 
 def small_scene(sid: str) -> dict:
@@ -26,6 +28,8 @@ def small_scene(sid: str) -> dict:
     p = scene["parameters"]
     if sid == "fig04_retmaps":
         p.update(n_uniform=21, n_geometric=6)
+    elif sid == "fig10_dfo":
+        p.update(n_stick_slip=8, ds=0.2)
     else:
         p.update(n_uniform=9, n_geometric=4)
         p["eps"] = p["eps"][:2]

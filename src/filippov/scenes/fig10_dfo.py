@@ -34,6 +34,7 @@ from ..simulate import Section, simulate
 from .common import require
 
 RTOL, ATOL = 1e-12, 1e-14
+N_MAX = 400  # continuation steps per direction
 
 
 def _law(p: dict) -> dict:
@@ -137,36 +138,58 @@ def start_cycle(v, law, amp=0.2):
     return u
 
 
-def hopf_branch(law, v_start, v_hopf, amp_min, ds, progress=None):
-    """Unstable periodic orbits from the Hopf point to grazing, as rows u = (x1, T, v)
-    ordered by v, with the grazing point refined on the branch."""
+def _branch_amplitude(u, law) -> float:
+    return u[0] - float(df.equilibrium(u[2], **law)[0])
+
+
+def branch_start(law, v_hopf, v_gs):
+    """The cycle both continuation directions start from: at v midway between H and GS."""
+    return start_cycle(0.5 * (v_hopf + v_gs), law)
+
+
+def branch_to_hopf(law, u0, amp_min, ds, progress=None):
+    """From u0 towards H (v decreasing) until the amplitude drops below amp_min.
+    Returns the rows u = (x1, T, v) ordered by increasing v (u0 last) and the
+    number of folds between kept rows."""
     G, J, _ = hopf_problem(law)
-    u0 = start_cycle(v_start, law)
+    to_h = cont.pseudo_arclength(G, u0, [0, 0, -1], J=J, ds=ds, ds_max=2 * ds, n_max=N_MAX,
+                                 stop=lambda u: "amplitude" if _branch_amplitude(u, law) < amp_min
+                                 else "", progress=progress)
+    # past H the shooting solutions continue onto the same small cycles seen from
+    # the other side of the equilibrium (x1 < x1_eq): keep the physical half
+    keep = np.array([_branch_amplitude(u, law) > 0 for u in to_h.u])
+    folds = [i for i in to_h.folds if keep[i] and keep[i + 1]]
+    return to_h.u[keep][::-1], len(folds)
 
-    def amp(u):
-        return u[0] - float(df.equilibrium(u[2], **law)[0])
 
-    to_h = cont.pseudo_arclength(G, u0, [0, 0, -1], J=J, ds=ds, ds_max=2 * ds, n_max=400,
-                                 stop=lambda u: "amplitude" if amp(u) < amp_min else "",
-                                 progress=progress)
-    to_gs = cont.pseudo_arclength(G, u0, [0, 0, 1], J=J, ds=ds, ds_max=4 * ds, n_max=400,
+def branch_to_grazing(law, u0, ds, progress=None):
+    """From u0 towards GS (v increasing) until the cycle touches x2 = v; the grazing
+    cycle is refined on the branch (v - max x2 = 0 with G = 0). Returns the rows
+    after u0 ending with the grazing cycle, the number of folds, and that cycle."""
+    G, J, _ = hopf_problem(law)
+    to_gs = cont.pseudo_arclength(G, u0, [0, 0, 1], J=J, ds=ds, ds_max=4 * ds, n_max=N_MAX,
                                   stop=lambda u: "grazing" if max_x2(u, law) > u[2] else "",
                                   progress=progress)
     if to_gs.stopped != "grazing":
         raise RuntimeError(f"Hopf branch did not reach grazing ({to_gs.stopped})")
-    # grazing on the branch: v - max x2 = 0 with G = 0, by Newton from the last two points
+    # grazing on the branch: Newton from the secant guess of the last two points
     gfun = lambda u: u[2] - max_x2(u, law)
     ua, ub = to_gs.u[-2], to_gs.u[-1]
     ga, gb = gfun(ua), gfun(ub)
     guess = ua + ga / (ga - gb) * (ub - ua)
     u_gs, _ = cont.newton(G, J, guess, extra=lambda u: (gfun(u), cont.fd_jacobian(
         lambda w: np.array([gfun(w)]), u, 1e-6)[0]), tol=1e-12)
-    # past H the shooting solutions continue onto the same small cycles seen from
-    # the other side of the equilibrium (x1 < x1_eq): keep the physical half
-    keep = np.array([amp(u) > 0 for u in to_h.u])
-    branch = np.vstack([to_h.u[keep][::-1], to_gs.u[1:-1], u_gs[None]])
-    folds = [i for i in to_h.folds if keep[i] and keep[i + 1]] + to_gs.folds
-    return branch, u_gs, folds
+    return np.vstack([to_gs.u[1:-1], u_gs[None]]), len(to_gs.folds), u_gs
+
+
+def hopf_branch(law, v_start, v_hopf, amp_min, ds, progress=None):
+    """Unstable periodic orbits from the Hopf point to grazing, as rows u = (x1, T, v)
+    ordered by v, with the grazing point refined on the branch (both directions
+    from the cycle at v_start; the workflow runs them as separate jobs)."""
+    u0 = start_cycle(v_start, law)
+    low, n_low = branch_to_hopf(law, u0, amp_min, ds, progress)
+    high, n_high, u_gs = branch_to_grazing(law, u0, ds, progress)
+    return np.vstack([low, high]), u_gs, n_low + n_high
 
 
 def multipliers_smooth(u, law):
@@ -203,41 +226,126 @@ def stick_slip_orbit(v, law, *, rtol=RTOL, atol=ATOL):
 
 
 # --------------------------------------------------------------------------- scene
-def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+# Chunking (filippov.scenes.chunking). The work is a list of independent tasks:
+# task 0 continues the unstable cycles from the start cycle towards H, the last
+# task continues them towards GS (each direction is sequential in itself), and
+# every task in between is one stick-slip orbit (one belt speed v). `sweep` runs
+# any subset of the tasks; `assemble` builds the dataset from all of them, so a
+# merge of chunks is the unsplit compute bit for bit.
+CHUNK_AXIS = "task"
+TO_HOPF, STICK_SLIP, TO_GRAZING = 0, 1, 2
+
+
+def _checked(scene: dict) -> dict:
     require(scene, "system", {"reduced"})
     require(scene, "flow", {"integrate"})
     if not scene["ingredients"]["sliding"]:
         raise ValueError(f"{scene['id']}: ingredients.sliding must be true: stick-slip "
                          "orbits stick (slide on x2 = v)")
-    p = scene["parameters"]
-    law = _law(p)
-    v_min, v_max = float(p["v_min"]), float(p["v_max"])
-    bar = Progress(scene["id"], int(p["n_stick_slip"]) + 60, progress)
+    return scene["parameters"]
 
+
+def _special_speeds(scene: dict):
+    """(law, v_hopf, v_gs): the friction law, the Hopf point and the GS point."""
+    p = _checked(scene)
+    law = _law(p)
     v_hopf = df.hopf_speed(law["fv"], law["fc"], law["convention"])
     if not np.isfinite(v_hopf):
         raise ValueError(f"{scene['id']}: parameters: this friction law has no Hopf point")
-    v_hopf_num = hopf_numeric(law, (0.5 * v_hopf, 1.5 * v_hopf))
-    v_gs = grazing_speed(law, (v_hopf + 1e-3, v_max))
+    v_gs = grazing_speed(law, (v_hopf + 1e-3, float(p["v_max"])))
+    return law, v_hopf, v_gs
 
-    # unstable cycles born at H
-    v_start = 0.5 * (v_hopf + v_gs)
-    br, u_gs, folds = hopf_branch(law, v_start, v_hopf, float(p["amp_min"]),
-                                  float(p["ds"]), bar)
-    mults = np.array([multipliers_smooth(u, law) for u in br])
-    v_gs_branch = float(u_gs[2])
 
-    # stick-slip orbits up to GS: uniform in v plus points accumulating at GS
-    n = int(p["n_stick_slip"])
+def stick_slip_speeds(p: dict, v_gs: float) -> np.ndarray:
+    """Belt speeds of the stick-slip orbits: uniform up to GS plus points accumulating at GS."""
+    n, v_min = int(p["n_stick_slip"]), float(p["v_min"])
     near = np.geomspace(float(p["gs_closest"]), 0.1 * (v_gs - v_min), n // 4)
-    vs = np.unique(np.concatenate([np.linspace(v_min, v_gs, n - n // 4, endpoint=False),
-                                   v_gs - near]))
-    rows = []
-    for v in vs:
-        rows.append(stick_slip_orbit(v, law))
-        bar.step()
-    ss_mult = np.array([r["multipliers"] for r in rows])
-    ss_stable = np.all(np.abs(ss_mult[:, 1:]) < 1, axis=1)
+    return np.unique(np.concatenate([np.linspace(v_min, v_gs, n - n // 4, endpoint=False),
+                                     v_gs - near]))
+
+
+def chunk_grid(scene: dict) -> np.ndarray:
+    """Task numbers 0 .. n_stick_slip + 1 (see the comment above)."""
+    _, _, v_gs = _special_speeds(scene)
+    return np.arange(stick_slip_speeds(scene["parameters"], v_gs).size + 2, dtype=np.int32)
+
+
+def _task_kind(task: int, n_tasks: int) -> int:
+    return TO_HOPF if task == 0 else TO_GRAZING if task == n_tasks - 1 else STICK_SLIP
+
+
+def sweep(scene: dict, tasks, progress: bool = False) -> xr.Dataset:
+    """Raw results of the given tasks: stick-slip scalars per task, and the branch
+    rows of the two continuation tasks padded with NaN to N_MAX + 1 rows."""
+    p = _checked(scene)
+    law, v_hopf, v_gs = _special_speeds(scene)
+    vs = stick_slip_speeds(p, v_gs)
+    n_tasks = vs.size + 2
+    tasks = np.asarray(tasks, dtype=np.int32)
+    kinds = np.array([_task_kind(int(t), n_tasks) for t in tasks], dtype=np.int8)
+    n_branch = int(np.sum(kinds != STICK_SLIP))
+    bar = Progress(scene["id"], int(np.sum(kinds == STICK_SLIP)) + 30 * n_branch, progress)
+    k, rows = tasks.size, N_MAX + 1
+    nan = lambda *shape: np.full(shape, np.nan)
+    ss = {name: nan(k) for name in ("v", "x1", "period", "stick_time", "stick_length",
+                                    "trivial_multiplier", "multiplier", "closure")}
+    br_u, br_mult = nan(k, rows, 3), nan(k, rows)
+    br_rows, br_folds = np.zeros(k, np.int32), np.zeros(k, np.int32)
+    u_gs = nan(k, 3)
+    u0 = branch_start(law, v_hopf, v_gs) if n_branch else None
+    for j, (task, kind) in enumerate(zip(tasks, kinds)):
+        if kind == STICK_SLIP:
+            v = vs[task - 1]
+            r = stick_slip_orbit(v, law)
+            m = np.abs(r["multipliers"])
+            for name, value in (("v", v), ("x1", r["x1"]), ("period", r["period"]),
+                                ("stick_time", r["stick_time"]),
+                                ("stick_length", r["stick_length"]),
+                                ("trivial_multiplier", m[0]), ("multiplier", m[1]),
+                                ("closure", abs(r["x1_return"] - r["x1"]))):
+                ss[name][j] = value
+            bar.step()
+            continue
+        if kind == TO_HOPF:
+            u, n_folds = branch_to_hopf(law, u0, float(p["amp_min"]), float(p["ds"]), bar)
+        else:
+            u, n_folds, u_gs[j] = branch_to_grazing(law, u0, float(p["ds"]), bar)
+        br_u[j, :len(u)] = u
+        br_mult[j, :len(u)] = [np.abs(multipliers_smooth(row, law)[0]) for row in u]
+        br_rows[j], br_folds[j] = len(u), n_folds
+    raw = {f"ss_{name}": (CHUNK_AXIS, value) for name, value in ss.items()}
+    raw.update(kind=(CHUNK_AXIS, kinds), br_u=((CHUNK_AXIS, "row", "u"), br_u),
+               br_multiplier=((CHUNK_AXIS, "row"), br_mult), br_rows=(CHUNK_AXIS, br_rows),
+               br_folds=(CHUNK_AXIS, br_folds), u_gs=((CHUNK_AXIS, "u"), u_gs))
+    return xr.Dataset(raw, coords={CHUNK_AXIS: tasks})
+
+
+def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    return assemble(scene, sweep(scene, chunk_grid(scene), progress=progress))
+
+
+def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
+    p = _checked(scene)
+    law, v_hopf, v_gs = _special_speeds(scene)
+    v_min, v_max = float(p["v_min"]), float(p["v_max"])
+    v_hopf_num = hopf_numeric(law, (0.5 * v_hopf, 1.5 * v_hopf))
+    kind = raw["kind"].values
+
+    # unstable cycles born at H: towards H (ordered by v), then towards GS
+    def rows(which):
+        j = int(np.flatnonzero(kind == which)[0])
+        n = int(raw["br_rows"].values[j])
+        return raw["br_u"].values[j, :n], raw["br_multiplier"].values[j, :n], j
+    low, m_low, j_low = rows(TO_HOPF)
+    high, m_high, j_high = rows(TO_GRAZING)
+    br, po_mult = np.vstack([low, high]), np.concatenate([m_low, m_high])
+    u_gs = raw["u_gs"].values[j_high]
+    n_folds = int(raw["br_folds"].values[j_low] + raw["br_folds"].values[j_high])
+
+    sel = kind == STICK_SLIP
+    ss = {name[3:]: raw[name].values[sel] for name in raw.data_vars if name.startswith("ss_")}
+    vs = ss["v"]
+    ss_stable = ss["multiplier"] < 1
 
     ve = np.linspace(v_min, v_max, 401)
     veq = np.unique(np.concatenate([ve, [v_hopf]]))
@@ -258,13 +366,13 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
                                              "finite-difference Jacobian", "units": "1"}),
          "v_gs": ((), v_gs, {"long_name": "grazing-sliding point GS (orbit through the sticking "
                              "exit point closes)", "units": "1"}),
-         "v_gs_branch": ((), v_gs_branch, {"long_name": "grazing point of the continued branch "
+         "v_gs_branch": ((), float(u_gs[2]), {"long_name": "grazing point of the continued branch "
                                            "of unstable cycles", "units": "1"}),
          "x1_gs": ((), float(u_gs[0]), {"long_name": "max x1 of the grazing orbit", "units": "1"}),
          "period_gs": ((), float(u_gs[1]), {"long_name": "period of the grazing orbit", "units": "1"}),
          "x1_exit": ((), exit_point(law), {"long_name": "x1 where sticking ends (-F_c(0-))",
                                            "units": "1"}),
-         "n_folds_hopf_branch": ((), len(folds), {"long_name": "folds on the unstable branch",
+         "n_folds_hopf_branch": ((), n_folds, {"long_name": "folds on the unstable branch",
                                                    "units": "1"}),
          # equilibrium
          "eq_v": ("eq", veq, {"long_name": "belt speed v", "units": "1"}),
@@ -275,26 +383,26 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
          "po_v": ("po", br[:, 2], {"long_name": "belt speed v", "units": "1"}),
          "po_x1": ("po", br[:, 0], {"long_name": "max x1 along the cycle", "units": "1"}),
          "po_period": ("po", br[:, 1], {"long_name": "period", "units": "1"}),
-         "po_multiplier": ("po", np.abs(mults[:, 0]),
+         "po_multiplier": ("po", po_mult,
                            {"long_name": "nontrivial Floquet multiplier (modulus)", "units": "1"}),
-         "po_stable": ("po", (np.abs(mults[:, 0]) < 1).astype(np.int8),
+         "po_stable": ("po", (po_mult < 1).astype(np.int8),
                        {"long_name": "1 if the cycle is stable", "units": "1"}),
          # stick-slip orbits
          "ss_v": ("ss", vs, {"long_name": "belt speed v", "units": "1"}),
-         "ss_x1": ("ss", [r["x1"] for r in rows], {"long_name": "max x1 along the orbit",
+         "ss_x1": ("ss", ss["x1"], {"long_name": "max x1 along the orbit",
                                                    "units": "1"}),
-         "ss_period": ("ss", [r["period"] for r in rows], {"long_name": "period", "units": "1"}),
-         "ss_stick_time": ("ss", [r["stick_time"] for r in rows],
+         "ss_period": ("ss", ss["period"], {"long_name": "period", "units": "1"}),
+         "ss_stick_time": ("ss", ss["stick_time"],
                            {"long_name": "time spent sticking (sliding on x2 = v)", "units": "1"}),
-         "ss_stick_length": ("ss", [r["stick_length"] for r in rows],
+         "ss_stick_length": ("ss", ss["stick_length"],
                              {"long_name": "x1 distance travelled while sticking", "units": "1"}),
-         "ss_multiplier": ("ss", np.abs(ss_mult[:, 1]),
+         "ss_multiplier": ("ss", ss["multiplier"],
                            {"long_name": "nontrivial Floquet multiplier (modulus), with saltation",
                             "units": "1"}),
-         "ss_trivial_multiplier": ("ss", np.abs(ss_mult[:, 0]),
+         "ss_trivial_multiplier": ("ss", ss["trivial_multiplier"],
                                    {"long_name": "trivial Floquet multiplier (should be 1)",
                                     "units": "1"}),
-         "ss_closure": ("ss", [abs(r["x1_return"] - r["x1"]) for r in rows],
+         "ss_closure": ("ss", ss["closure"],
                         {"long_name": "|x1 after one period - x1 at start|", "units": "1"}),
          "ss_stable": ("ss", ss_stable.astype(np.int8),
                        {"long_name": "1 if the orbit is stable (multipliers)", "units": "1"}),
