@@ -12,6 +12,7 @@ wildcard_constraints:
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/compute.smk"
+include: "workflow/rules/hard_cases.smk"
 include: "workflow/rules/plot.smk"
 include: "workflow/rules/report.smk"
 
@@ -32,4 +33,5 @@ rule all:
     default_target: True
     input:
         expand("figures/{scene}.{ext}", scene=config["scenes"], ext=["pdf", "png"]),
+        "results/hard_cases.nc",  # the eps sweep of the hard cases (seconds)
         REPORT_PDF,

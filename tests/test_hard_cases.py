@@ -8,7 +8,7 @@ drift cannot pass. Speed is measured in `make bench`, not here.
 import numpy as np
 import pytest
 
-from filippov import SimulationError, ZenoError, fastmap, simulate
+from filippov import SLIDING, SimulationError, ZenoError, fastmap, hard_cases, simulate
 from filippov.analytic import chatter
 from filippov.models import hopf, pseudo_equilibrium
 
@@ -28,63 +28,90 @@ def hopf_map(eps, theta, x2, mu=MU, **opts):
 
 
 # ----------------------------------------------------------------------- eps to 1e-6
+# The eps sweep is a workflow product (results/hard_cases.nc, filippov.hard_cases);
+# these tests assert on the same library code, run here over the same eps values.
 EPS_SWEEP = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6]
 
 
-def test_theta_negative_jump_scales_like_eps_down_to_1e_6():
-    jumps = np.array([1.0 - hopf_map(eps, -0.5, [1.0 + 1e-13])[0][0] for eps in EPS_SWEEP])
-    c = jumps / np.array(EPS_SWEEP)
+@pytest.fixture(scope="module")
+def eps_sweep():
+    """filippov.hard_cases.sweep over EPS_SWEEP: what results/hard_cases.nc holds."""
+    ds = hard_cases.sweep(EPS_SWEEP)
+    np.testing.assert_array_equal(ds.eps.values, EPS_SWEEP)
+    return ds
+
+
+def _statuses(values):
+    return [fastmap.STATUS[int(s)] for s in np.atleast_1d(values)]
+
+
+def test_theta_negative_jump_scales_like_eps_down_to_1e_6(eps_sweep):
+    ds = eps_sweep
+    assert ds.attrs["jump_theta"] == -0.5 and ds.attrs["jump_x2_offset"] == 1e-13
+    assert np.all(ds.jump_status.values == fastmap.OK), _statuses(ds.jump_status.values)
+    assert np.all(ds.jump_finite.values == 1)
+    c = ds.jump_over_eps.values
+    np.testing.assert_array_equal(c, ds.jump.values / np.array(EPS_SWEEP))
     # jump/eps converges (to 0.6008...): the differences shrink like eps
     assert np.all((0.55 < c) & (c < 0.65)), c
     d = np.abs(np.diff(c))
     assert np.all(d[1:] < d[:-1] * 0.5) and d[-1] < 1e-4
 
 
-def test_theta_positive_slope_stays_order_one_down_to_1e_6():
-    slopes = []
+def test_theta_positive_slope_stays_order_one_down_to_1e_6(eps_sweep):
+    ds = eps_sweep
+    assert ds.attrs["slope_theta"] == 0.5
     for eps in EPS_SWEEP:
+        d = ds.sel(eps=eps)
+        assert int(d.slope_status_grazing) == fastmap.OK, _statuses(d.slope_status_grazing)
+        assert int(d.slope_status_probe) == fastmap.OK, _statuses(d.slope_status_probe)
+        assert int(d.slope_finite) == 1
         # the kink's width in x2 is O(eps^2): probe inside it, but not below the
         # spacing of doubles near 1 (the step actually taken is what 1 + dx rounds to)
         x2 = 1.0 + max(1e-3 * eps * eps, 1e-13)
-        P, out = hopf_map(eps, 0.5, [1.0, x2])
-        assert P[0] == 1.0 and out.sliding_time[1] > 0
-        slopes.append((P[1] - P[0]) / (x2 - 1.0))
-    slopes = np.array(slopes)
+        assert float(d.slope_probe) == x2 - 1.0
+        assert float(d.slope_P_grazing) == 1.0 and float(d.slope_sliding_time) > 0
+    slopes = ds.slope.values
     # negative and of order one for every eps, not shrinking as eps -> 0
     assert np.all((-0.7 < slopes) & (slopes < -0.5)), slopes
     assert np.ptp(slopes) < 0.03, slopes
 
 
 @pytest.mark.parametrize("eps", EPS_SWEEP)
-def test_chatter_period_scales_like_eps(eps):
+def test_chatter_period_scales_like_eps(eps_sweep, eps):
     theta = -0.5
+    assert eps_sweep.attrs["chatter_theta"] == theta
+    d = eps_sweep.sel(eps=eps)
     orbit = chatter.orbit(eps, theta)
-    system = pseudo_equilibrium.model(eps, theta).full()
-    traj = simulate(system, [orbit["x_switch"], orbit["y_switch"]], 20.25 * orbit["period"],
-                    dense=False, max_events=100)
-    t = np.array([e.t for e in traj.switches()])
-    assert t.size == 40 and np.all(np.isfinite(t))
-    periods = np.diff(t[::2])
-    np.testing.assert_allclose(periods, orbit["period"], rtol=1e-9)
-    assert orbit["period"] / eps == pytest.approx(chatter.orbit(1.0, theta)["period"], rel=1e-12)
+    assert float(d.chatter_period) == orbit["period"]
+    # 20.25 periods from the switch point: 40 switches, all at finite times
+    assert int(d.chatter_switches) == 40 and int(d.chatter_times_finite) == 1
+    # every simulated period (every second switching time) within 1e-9 of the formula
+    assert float(d.chatter_period_max_rel_dev) <= 1e-9, float(d.chatter_period_max_rel_dev)
+    assert float(d.chatter_period_over_eps) == pytest.approx(chatter.orbit(1.0, theta)["period"],
+                                                             rel=1e-12)
 
 
 @pytest.mark.parametrize("eps", EPS_SWEEP)
-def test_pseudo_equilibrium_theta_positive_slides_in_for_every_eps(eps):
+def test_pseudo_equilibrium_theta_positive_slides_in_for_every_eps(eps_sweep, eps):
     # theta = 0.6: the relaxed + flow meets H_s at x = -(1 - theta) eps, inside the
     # attracting band |x| < theta eps (at theta = 0.5 it would hit the band's edge).
     # Start 30 eps away (the reference driver samples on the eps scale; an O(1)
     # approach is the compiled kernel's job, below) and slide into the origin.
     theta = 0.6
-    system = pseudo_equilibrium.model(eps, theta).full()
-    traj = simulate(system, [30 * eps, 0.0], 100 * eps, dense=False, max_events=100)
-    assert [e.kind for e in traj.events[1:]] == ["slide_start"] and traj.mode == 0
-    assert abs(traj.events[1].state[0] + (1 - theta) * eps) < 1e-12
-    assert abs(traj.z[0]) < 1e-12 and np.all(np.isfinite(traj.z))
+    attrs = eps_sweep.attrs
+    assert attrs["slide_theta"] == theta and attrs["slide_start_over_eps"] == 30
+    d = eps_sweep.sel(eps=eps)
+    # the events after the start are exactly one slide_start, and it ends sliding
+    assert int(d.slide_events) == 1 and int(d.slide_starts) == 1
+    assert int(d.slide_final_mode) == SLIDING
+    assert abs(float(d.slide_start_x) + (1 - theta) * eps) < 1e-12
+    assert float(d.slide_start_offset) == float(d.slide_start_x) + (1 - theta) * eps
+    assert float(d.slide_final_abs_x) < 1e-12 and int(d.slide_finite) == 1
     # from O(1) away: the compiled kernel (exact flows, sliding by DOP853)
-    out = fastmap.compute_returns(pseudo_equilibrium.compiled(eps, theta), [[0.3, 0.0]], 0.5)
-    assert out.status[0] == fastmap.NO_RETURN and out.n_switches[0] == 1
-    assert abs(out.state[0, 0]) < 1e-12 and np.all(np.isfinite(out.state))
+    assert attrs["kernel_start"] == 0.3 and attrs["kernel_t_max"] == 0.5
+    assert int(d.kernel_status) == fastmap.NO_RETURN and int(d.kernel_switches) == 1
+    assert float(d.kernel_final_abs_x) < 1e-12 and int(d.kernel_finite) == 1
 
 
 # ----------------------------------------------------------------------- theta near 0 and 1

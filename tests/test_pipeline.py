@@ -28,6 +28,9 @@ def test_builds_every_figure_then_nothing_to_do(workflow_build):
     for scene in yaml.safe_load((work / "config" / "config.yaml").read_text())["scenes"]:
         for ext in ("pdf", "png"):
             assert (work / "figures" / f"{scene}.{ext}").stat().st_size > 0
+    # the hard-case eps sweep, merged from its chunks (temporary: removed after the merge)
+    assert (work / "results" / "hard_cases.nc").stat().st_size > 0
+    assert not list((work / "results").glob("chunks/hard_cases/*.nc"))
     again = _snakemake(work, "-n")
     assert again.returncode == 0, again.stdout + again.stderr
     out = again.stdout + again.stderr
@@ -97,3 +100,19 @@ def test_editing_a_workflow_script_reruns_its_rule_only(workflow_build, tmp_path
     assert jobs.pop("plot") == scenes
     jobs.pop("all", None)
     assert set(jobs) <= {"paper"}, jobs   # the report includes the redrawn figures
+
+
+def test_build_holds_the_hard_case_sweep_of_the_configured_eps(workflow_build):
+    """results/hard_cases.nc of the build (chunk jobs, merged) is the sweep of
+    filippov.hard_cases over the configured eps in one process."""
+    from filippov import hard_cases
+    from filippov.io import read_dataset
+
+    work, run = workflow_build["work"], workflow_build["run"]
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    block = yaml.safe_load((work / "config" / "config.yaml").read_text())["hard_cases"]
+    built = read_dataset(work / "results" / "hard_cases.nc")
+    whole = hard_cases.sweep(hard_cases.check_config(block)["eps"])
+    # code_version names the commit at the time of writing; everything else is equal
+    built.attrs.pop("code_version"), whole.attrs.pop("code_version")
+    assert built.identical(whole)

@@ -42,9 +42,12 @@ def test_absent_optional_results_say_not_yet_computed():
     m = report.Macros()
     t10, t11 = report.dry_friction(None, None, m)
     tb = report.bench(None, m)
-    for text in (t10, t11, tb):
+    th = report.hard_cases(None, m)
+    for text in (t10, t11, tb, th):
         assert report.NOT_YET in text
-    assert m.flags == {"rpHaveTen": False, "rpHaveEleven": False, "rpHaveBench": False}
+    assert m.flags == {"rpHaveTen": False, "rpHaveEleven": False, "rpHaveBench": False,
+                       "rpHaveHardCases": False}
+    assert m.items == []
 
 
 def test_optional_tables_show_whatever_the_datasets_hold():
@@ -78,8 +81,9 @@ def test_no_number_typed_in_the_figure_prose():
     # equation constants and the paper's own parameters (listed here)
     allowed = {"0", "1", "2", "3", "4", "8", "12", "-12", "-1", "-4", "0.5", "10", "60", "-0.5",
                "0.1", "0.01", "3.32", "3.1", "-2", "0.3", "2.5", "10^{-10}",
-               "10^{-2}", "10^{-3}", "10^{-4}"}  # the last: parameters of named tests
-    for name in ("sec_figures.tex", "sec_pdm.tex"):
+               "10^{-2}", "10^{-3}", "10^{-4}",  # parameters of named tests
+               "-3"}  # exponent of the jump estimate e^{-3 pi mu/omega}
+    for name in ("sec_figures.tex", "sec_pdm.tex", "sec_hardcases.tex"):
         text = (ROOT / "paper" / name).read_text()
         text = re.sub(r"\\(plabel|testref|label|ref|eqref|includegraphics|input)(\[[^]]*\])?\{[^}]*\}",
                       "", text)
@@ -144,8 +148,8 @@ def test_log_has_no_undefined_references_or_missing_files(built):
 
 def _value(ds_dir: Path, source: str):
     """Re-read `dataset:variable[sel]` or `dataset:attrs.name` (None for derived)."""
-    m = re.fullmatch(r"(fig\d\d_[a-z0-9_]+):([A-Za-z0-9_]+)(?:\.([A-Za-z0-9_]+))?(\[(.*)\])?",
-                     source)
+    m = re.fullmatch(r"(fig\d\d_[a-z0-9_]+|hard_cases):([A-Za-z0-9_]+)(?:\.([A-Za-z0-9_]+))?"
+                     r"(\[(.*)\])?", source)
     if not m or source.startswith("derived"):
         return None
     sid, var, attr, _, sel = m.groups()
@@ -205,6 +209,23 @@ def test_derived_macros_match_the_datasets(built):
             assert report.parse_num(cells[0]) == pytest.approx(e, rel=1e-6)
             assert report.parse_num(cells[3]) == pytest.approx(float(ds.error_printed.sel(eps=e)), rel=6e-3)
             assert report.parse_num(cells[5]) == pytest.approx(float(ds.error_first_order.sel(eps=e)), rel=6e-3)
+    with xr.open_dataset(work / "results/hard_cases.nc") as ds:
+        assert val["rpHardSlopeMin"] == pytest.approx(float(ds.slope.min()), rel=6e-3)
+        assert val["rpHardSlopeMax"] == pytest.approx(float(ds.slope.max()), rel=6e-3)
+        assert val["rpHardPeriodDev"] == pytest.approx(
+            float(ds.chatter_period_max_rel_dev.max()), rel=6e-2)
+        assert val["rpHardKernelFinal"] == pytest.approx(float(ds.kernel_final_abs_x.max()),
+                                                         rel=6e-2)
+        tab = (work / "paper/generated/tab_hard_cases.tex").read_text()
+        rows = [r for r in tab.splitlines() if r.startswith("$") and "epsilon" not in r]
+        assert len(rows) == ds.sizes["eps"]
+        for row, e in zip(rows, ds.eps.values):
+            cells = [c.strip().strip("$") for c in row[:-2].split("&")]
+            assert report.parse_num(cells[0]) == pytest.approx(e, rel=1e-6)
+            assert report.parse_num(cells[1]) == pytest.approx(
+                float(ds.jump_over_eps.sel(eps=e)), rel=6e-6)
+            assert report.parse_num(cells[2]) == pytest.approx(float(ds.slope.sel(eps=e)),
+                                                               rel=6e-4)
     with xr.open_dataset(work / "results/fig09_pdm_theta_pos.nc") as ds:
         tab = (work / "paper/generated/tab_fig09.tex").read_text()
         rows = [r for r in tab.splitlines() if r.startswith("$") and "epsilon" not in r]
@@ -218,7 +239,8 @@ def test_optional_sections_follow_the_results(built):
     macros = (work / "paper/generated/macros.tex").read_text()
     for sid, flag, tab in (("fig10_dfo", "rpHaveTen", "tab_fig10.tex"),
                            ("fig11_dfo_retmaps", "rpHaveEleven", "tab_fig11.tex"),
-                           ("bench_work_precision", "rpHaveBench", "tab_bench.tex")):
+                           ("bench_work_precision", "rpHaveBench", "tab_bench.tex"),
+                           ("hard_cases", "rpHaveHardCases", "tab_hard_cases.tex")):
         present = (work / f"results/{sid}.nc").exists()
         assert f"\\{flag}{'true' if present else 'false'}" in macros
         assert (report.NOT_YET in (work / "paper/generated" / tab).read_text()) != present

@@ -146,10 +146,18 @@ def compare_image(png: Path, ref: Path) -> str | None:
 
 
 # ----------------------------------------------------------------------------- manifest
+#: the datasets a build produces: one per scene, and the hard-case eps sweep
+DATA_PATTERNS = ("fig*.nc", "hard_cases.nc")
+
+
+def data_files(results: Path) -> list[Path]:
+    return sorted(p for pattern in DATA_PATTERNS for p in Path(results).glob(pattern))
+
+
 def build_manifest(results: Path, figures: Path, old: dict | None = None) -> dict:
     old = old or {}
     data, figs = {}, {}
-    for nc in sorted(Path(results).glob("fig*.nc")):
+    for nc in data_files(results):
         tol = old.get("data", {}).get(nc.stem, {}).get("tolerance", {"rtol": RTOL, "atol": ATOL})
         data[nc.stem] = {"tolerance": tol, "variables": summarize(nc)}
     for pdf in sorted(Path(figures).glob("fig*.pdf")):
@@ -184,7 +192,7 @@ def check(results: Path, figures: Path, manifest: dict, thumbs: Path = THUMBS) -
             msg = compare_image(png, thumbs.parent / entry["thumbnail"])
             if msg:
                 problems.append(f"figures/{png.name}: {msg}")
-    extra = {p.stem for p in Path(results).glob("fig*.nc")} - set(manifest["data"])
+    extra = {p.stem for p in data_files(results)} - set(manifest["data"])
     problems += [f"results/{s}.nc: not in the manifest (run the manifest update)" for s in sorted(extra)]
     return problems
 

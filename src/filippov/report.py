@@ -11,7 +11,9 @@ ones are ``None``) and returns ``{file name: LaTeX text}`` for
   which optional results (dry friction, work--precision benchmark) exist;
 * ``tab_fig07.tex``, ``tab_fig09.tex`` -- convergence tables over eps;
 * ``tab_fig10.tex``, ``tab_fig11.tex``, ``tab_bench.tex`` -- tables of whatever
-  those datasets hold, or a "not yet computed" sentence when they are absent.
+  those datasets hold, or a "not yet computed" sentence when they are absent;
+* ``tab_hard_cases.tex`` -- the hard-case eps sweep (``results/hard_cases.nc``,
+  :mod:`filippov.hard_cases`), one row per eps, or "not yet computed".
 
 No Snakemake inside; ``workflow/scripts/report_tables.py`` is the thin caller.
 """
@@ -28,7 +30,7 @@ import xarray as xr
 CORE = ("fig01_slidesketch", "fig02_cases", "fig03_grazingsketch", "fig04_retmaps",
         "fig05_thetalt0mfs", "fig06_sgraph", "fig07_pdm_theta_neg", "fig08_s0theta",
         "fig09_pdm_theta_pos")
-OPTIONAL = ("fig10_dfo", "fig11_dfo_retmaps", "bench_work_precision")
+OPTIONAL = ("fig10_dfo", "fig11_dfo_retmaps", "bench_work_precision", "hard_cases")
 NOT_YET = "not yet computed"
 
 
@@ -510,6 +512,65 @@ def bench(ds, m: Macros, effects=None) -> str:
     return "\n".join(lines)
 
 
+def hard_cases(ds, m: Macros) -> str:
+    """Macros and the per-eps table of the hard-case sweep (results/hard_cases.nc):
+    jump/eps (theta < 0), one-sided slope (theta > 0), chatter period, slide-in."""
+    m.flag("rpHaveHardCases", ds is not None)
+    if ds is None:
+        return _not_yet("Hard-case eps sweep", "results/hard_cases.nc")
+    sid = "hard_cases"
+    eps = [float(e) for e in ds.eps.values]
+    kmax, kmin = int(np.argmax(eps)), int(np.argmin(eps))
+    m.add("rpHardN", len(eps), f"{sid}:eps (size)")
+    m.add("rpHardEpsMax", eps[kmax], f"{sid}:eps[{kmax}]")
+    m.add("rpHardEpsMin", eps[kmin], f"{sid}:eps[{kmin}]")
+    for attr, name, sig in (("jump_theta", "JumpTheta", 3), ("jump_x2_offset", "JumpOffset", 3),
+                            ("slope_theta", "SlopeTheta", 3), ("slope_probe_factor", "ProbeFactor", 3),
+                            ("slope_probe_floor", "ProbeFloor", 3),
+                            ("chatter_theta", "ChatterTheta", 3),
+                            ("chatter_periods", "ChatterPeriods", 4),
+                            ("slide_theta", "SlideTheta", 3),
+                            ("slide_start_over_eps", "SlideStart", 3),
+                            ("kernel_start", "KernelStart", 3)):
+        m.add(f"rpHard{name}", float(ds.attrs[attr]), f"{sid}:attrs.{attr}", sig)
+    _var(m, "rpHardJumpFirst", ds, sid, "jump_over_eps", sig=5, eps=eps[kmax])
+    _var(m, "rpHardJumpLast", ds, sid, "jump_over_eps", sig=5, eps=eps[kmin])
+    from .analytic.s0 import s0_lambert
+    mu, omega = float(ds.attrs["mu"]), float(ds.attrs["omega"])
+    pred = float(s0_lambert(np.array([float(ds.attrs["jump_theta"])]))[0]) \
+        * math.exp(-3 * math.pi * mu / omega)
+    m.add("rpHardJumpPred", pred, "derived: s0(jump_theta) exp(-3 pi mu/omega)", 5)
+    if len(eps) > 1:
+        m.add("rpHardJumpDiffLast", abs(_f(ds, "jump_over_eps", eps=eps[kmin])
+                                        - _f(ds, "jump_over_eps", eps=sorted(eps)[1])),
+              "derived: |difference of jump_over_eps| between the two smallest eps", 2)
+    m.add("rpHardSlopeMin", float(ds.slope.min()), "derived: min slope over eps", 3)
+    m.add("rpHardSlopeMax", float(ds.slope.max()), "derived: max slope over eps", 3)
+    _var(m, "rpHardPeriodOverEps", ds, sid, "chatter_period_over_eps", sig=6, eps=eps[kmin])
+    m.add("rpHardPeriodDev", float(ds.chatter_period_max_rel_dev.max()),
+          "derived: max chatter_period_max_rel_dev over eps", 2)
+    m.add("rpHardSlideOffset", float(np.abs(ds.slide_start_offset).max()),
+          "derived: max |slide_start_offset| over eps", 2)
+    m.add("rpHardSlideFinal", float(ds.slide_final_abs_x.max()),
+          "derived: max slide_final_abs_x over eps", 2)
+    m.add("rpHardKernelFinal", float(ds.kernel_final_abs_x.max()),
+          "derived: max kernel_final_abs_x over eps", 2)
+    rows = []
+    for e in eps:
+        d = ds.sel(eps=e)
+        rows.append(" & ".join([
+            f"${_eps_label(e)}$", f"${num(float(d.jump_over_eps), 6)}$",
+            f"${num(float(d.slope), 4)}$", f"${num(float(d.slope_probe), 2)}$",
+            f"${num(float(d.chatter_period_over_eps), 6)}$",
+            f"${num(float(d.chatter_period_max_rel_dev), 2)}$",
+            f"${num(float(d.slide_start_offset), 2)}$", f"${num(float(d.slide_final_abs_x), 2)}$",
+            f"${num(float(d.kernel_final_abs_x), 2)}$"]) + r" \\")
+    return _tabular("rrrrrrrrr", [
+        r"$\epsilon$ & jump$/\epsilon$ & slope & $x_2-1$ & period$/\epsilon$ & "
+        r"period dev. & slide start $+(1-\theta)\epsilon$ & final $|x|$ & "
+        r"final $|x|$, kernel \\"], rows)
+
+
 # ----------------------------------------------------------------------------- entry point
 FIGS = {"fig01_slidesketch": fig01, "fig02_cases": fig02, "fig03_grazingsketch": fig03,
         "fig04_retmaps": fig04, "fig05_thetalt0mfs": fig05, "fig06_sgraph": fig06,
@@ -529,6 +590,10 @@ def generate(datasets: Mapping[str, Optional[xr.Dataset]]) -> dict[str, str]:
             raise KeyError(f"{sid}: the report reads {exc} but the dataset lacks it") from None
     tab10, tab11 = dry_friction(datasets.get("fig10_dfo"), datasets.get("fig11_dfo_retmaps"), m)
     tab_bench = bench(datasets.get("bench_work_precision"), m, datasets.get("bench_effect_cost"))
+    try:
+        tab_hard = hard_cases(datasets.get("hard_cases"), m)
+    except KeyError as exc:
+        raise KeyError(f"hard_cases: the report reads {exc} but the dataset lacks it") from None
     return {
         "macros.tex": m.tex(),
         "tab_fig07.tex": fig07_table(datasets["fig07_pdm_theta_neg"]),
@@ -536,6 +601,7 @@ def generate(datasets: Mapping[str, Optional[xr.Dataset]]) -> dict[str, str]:
         "tab_fig10.tex": tab10,
         "tab_fig11.tex": tab11,
         "tab_bench.tex": tab_bench,
+        "tab_hard_cases.tex": tab_hard,
     }
 
 

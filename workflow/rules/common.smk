@@ -6,7 +6,8 @@ import importlib.util
 from pathlib import Path
 
 # Library parts no scene computation imports: editing them must not recompute data.
-NOT_COMPUTE = ("plotting/", "benchmarks/", "report.py", "manifest.py")
+# (hard_cases.py is the hard-case sweep's own module: rule hard_cases hashes it.)
+NOT_COMPUTE = ("plotting/", "benchmarks/", "report.py", "manifest.py", "hard_cases.py")
 
 
 def library_hash(include="", exclude=()):

@@ -4,7 +4,8 @@
 # used when they are listed in config["scenes"]; the work-precision benchmark
 # when results/bench_work_precision.nc exists. The report says "not yet
 # computed" for whatever is absent. Rule `all` asks for paper/main.pdf only when
-# TeX is installed (see TEX_OK in the Snakefile).
+# TeX is installed (see TEX_OK in the Snakefile). The hard-case eps sweep
+# (results/hard_cases.nc, rule hard_cases) is an input: it takes seconds.
 import shutil
 import subprocess
 import sys
@@ -20,7 +21,7 @@ REPORT_OPTIONAL = ["fig10_dfo", "fig11_dfo_retmaps"]
 report: "../report/workflow.rst"
 
 REPORT_GENERATED = ["macros.tex", "tab_fig07.tex", "tab_fig09.tex", "tab_fig10.tex",
-                    "tab_fig11.tex", "tab_bench.tex"]
+                    "tab_fig11.tex", "tab_bench.tex", "tab_hard_cases.tex"]
 TEX_PACKAGES = ("texlive-publishers texlive-latex-extra texlive-latex-recommended "
                 "texlive-fonts-recommended latexmk")
 
@@ -63,6 +64,7 @@ def report_figures(wildcards):
 rule report_tables:
     input:
         data=report_data,
+        hard_cases="results/hard_cases.nc",  # the eps sweep (rule hard_cases; cheap)
         script="workflow/scripts/report_tables.py",
     output:
         [f"paper/generated/{name}" for name in REPORT_GENERATED],

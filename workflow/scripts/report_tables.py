@@ -6,8 +6,10 @@ import xarray as xr
 import filippov.report
 
 datasets = {}
-# the scenes' datasets (inputs) and the benchmarks' when `make bench` made them
-for path in [*snakemake.input.data, *[p for p in snakemake.params.bench if p.endswith(".nc")]]:  # noqa: F821
+# the scenes' datasets and the hard-case sweep (inputs), and the benchmarks'
+# when `make bench` made them
+for path in [*snakemake.input.data, snakemake.input.hard_cases,  # noqa: F821
+             *[p for p in snakemake.params.bench if p.endswith(".nc")]]:  # noqa: F821
     with xr.open_dataset(path) as ds:
         datasets[Path(path).stem] = ds.load()
 texts = filippov.report.generate(datasets)
