@@ -101,6 +101,98 @@ def test_compiled_hopf_pieces_are_the_model_formulas():
         np.testing.assert_array_equal(out, system.switch_grad(z))
 
 
+# --------------------------------------------------------------------------- integrated modes
+# A model without exact flows (exact=False) has regions + and - integrated with
+# the kernel's DOP853, like sliding: the compiled twin of simulate(method="integrate").
+def _python_integrated(system, z0s, t_max, section, **opts):
+    out = []
+    for z0 in z0s:
+        tr = simulate(system, z0, t_max, method="integrate", sections=[section], dense=False,
+                      **opts)
+        assert tr.status == f"section:{section.name}"
+        sw = tr.switches()
+        slide = sum(b.t - a.t for a, b in zip(tr.events, tr.events[1:]) if a.mode_after == 0)
+        out.append((tr.z.copy(), tr.t, len(sw), sw[0].t if sw else np.nan, slide))
+    return out
+
+
+@pytest.mark.parametrize("eps,v0", [(0.1, 3.32), (0.01, 3.1)])
+def test_dry_friction_compiled_integration_agrees_with_the_python_driver(eps, v0):
+    from filippov.models import dry_friction as df
+    from filippov.scenes.fig11_dfo_retmaps import section_L
+
+    law = dict(gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck")
+    x1 = np.linspace(4.15, 4.6, 10)
+    w, _ = df.slow_manifold_plus(x1, 0.0, eps, v0, **law)
+    z0s = np.stack([x1, np.zeros_like(x1), w], axis=1)
+    cm = df.compiled(eps, v0, **law)
+    assert not cm.exact
+    fast = fastmap.compute_returns(cm, z0s, 200.0, samples_per_step=1, **OPTS)
+    assert np.all(fast.status == fastmap.OK), [fastmap.STATUS[s] for s in fast.status]
+    ref = _python_integrated(df.full_system(eps, v0, **law), z0s, 200.0, section_L(),
+                             samples_per_step=1, **OPTS)
+    np.testing.assert_array_equal(fast.n_switches, [r[2] for r in ref])
+    assert 0 < np.sum(fast.n_switches > 0) < x1.size  # both kinds of orbit are in the test
+    # Not bit for bit (numba's exp is not numpy's in the last bit, and the orbit
+    # amplifies it), but at roundoff level over one orbit at rtol 1e-12 (measured:
+    # P to 8e-14; the fast w, with its 1/eps stiffness, to 2e-11 for eps = 0.01).
+    state = np.array([r[0] for r in ref])
+    np.testing.assert_allclose(fast.state[:, :2], state[:, :2], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(fast.state[:, 2], state[:, 2], rtol=0, atol=1e-10)
+    tol = {"rtol": 0, "atol": 1e-11}
+    np.testing.assert_allclose(fast.time, [r[1] for r in ref], **tol)
+    np.testing.assert_allclose(fast.first_switch, [r[3] for r in ref], **tol)
+    np.testing.assert_allclose(fast.sliding_time, [r[4] for r in ref], **tol)
+    assert np.any(fast.sliding_time > 0)  # sticking is part of it
+
+
+def test_compiled_dry_friction_pieces_are_the_model_formulas():
+    from filippov.models import dry_friction as df
+
+    for convention in ("stribeck", "literal"):
+        system = df.full_system(0.05, 3.2, 2.0, -2.0, 0.3, 2.5, convention)
+        cm = df.compiled(0.05, 3.2, 2.0, -2.0, 0.3, 2.5, convention)
+        out = np.empty(3)
+        for z in np.random.default_rng(2).uniform(-3, 6, size=(20, 3)):
+            cm.field_plus(z, cm.params, out)
+            np.testing.assert_allclose(out, system.field_plus(z), rtol=1e-14, atol=1e-13)
+            cm.field_minus(z, cm.params, out)
+            np.testing.assert_allclose(out, system.field_minus(z), rtol=1e-14, atol=1e-13)
+            assert cm.h(z, cm.params) == float(system.switch(z))
+            cm.grad_h(z, cm.params, out)
+            np.testing.assert_array_equal(out, system.switch_grad(z))
+
+
+@pytest.mark.parametrize("theta", [-0.5, 0.5])
+def test_hopf_with_integrated_regions_agrees_with_the_python_driver(theta):
+    """The Hopf model with its flows switched off: the kernel integrates all modes."""
+    import dataclasses
+
+    from filippov.scenes.fig04_retmaps import section_L1
+
+    x2 = np.array([0.97, 0.999, 1.001, 1.01, 1.03])
+    cm = dataclasses.replace(hopf.compiled(EPS, theta, MU, OMEGA), exact=False)
+    fast = fastmap.compute_returns(cm, starts(x2), T_MAX, **OPTS)
+    assert np.all(fast.status == fastmap.OK)
+    ref = _python_integrated(hopf.model(EPS, theta, MU, OMEGA).full(exact=False), starts(x2),
+                             T_MAX, section_L1(), **OPTS)
+    np.testing.assert_array_equal(fast.n_switches, [r[2] for r in ref])
+    np.testing.assert_allclose(fast.state, [r[0] for r in ref], rtol=0, atol=1e-12)
+    # and both agree with the exact flows to the integration tolerance
+    exact = fastmap.compute_returns(hopf.compiled(EPS, theta, MU, OMEGA), starts(x2), T_MAX,
+                                    **OPTS)
+    np.testing.assert_allclose(fast.state, exact.state, rtol=0, atol=1e-9)
+
+
+def test_integrated_mode_with_a_non_finite_field_is_a_status():
+    from filippov.models import dry_friction as df
+
+    cm = df.compiled(0.1, 3.32)
+    # (1 + gamma) x2 overflows: the field is not finite at the start of the mode
+    out = fastmap.compute_returns(cm, [[4.3, 1e308, 0.0]], 1.0)
+    assert out.status[0] == fastmap.NON_FINITE and out.time[0] == 0.0
+
+
 # --------------------------------------------------------------------------- guards
 # A second model: the kernel is model-agnostic. The pseudo-equilibrium example
 # x' = -sign(h), eps y' = x - y chatters for theta < 0; its default section

@@ -5,9 +5,11 @@
 same algorithm for a whole batch of start points inside one compiled call:
 
 * regions ``+`` (``h >= 0``) and ``-`` are followed with the model's exact
-  flows (both are required), sampled exactly like the reference driver: windows
-  of ``16 sample_step`` from each mode entry, each cut into ``16 samples_per_step``
-  intervals, the flow always taken from the state at the mode entry;
+  flows, sampled exactly like the reference driver: windows of ``16 sample_step``
+  from each mode entry, each cut into ``16 samples_per_step`` intervals, the flow
+  always taken from the state at the mode entry; a model without exact flows
+  (``CompiledModel.exact = False``) has them integrated like sliding, below
+  (the reference driver's ``method="integrate"``);
 * the samples are scanned for the same events: ``h`` leaving the region, a
   hidden grazing crossing (a sign change of ``dh/dt`` whose extremum of ``h``
   goes through zero; ``|h| <= touch_tol`` there is a touch, not a switch), the
@@ -19,6 +21,8 @@ same algorithm for a whole batch of start points inside one compiled call:
 * sliding is integrated with a port of scipy's ``DOP853`` (same coefficients,
   step-size control, initial step and 7th-order dense output) with the Filippov
   field ``(a F_+ - b F_-)/(a - b)``; it ends where ``a`` or ``b`` reaches zero.
+  Each integrated step is sampled at ``samples_per_step + 1`` points of its
+  dense output.
 
 Failures never raise inside the compiled code and never hang: each start point
 gets a status code (:data:`STATUS`) -- event or step bound hit, accumulation of
@@ -212,15 +216,16 @@ def _dense_eval(t, t_old, hs, y_old, F, out):
 
 
 # A segment of the current mode: exact flow from za at time sg[0], or the dense
-# output (F, y_old) of the sliding step [sg[1], sg[1] + sg[2]].
+# output (F, y_old) of the integration step [sg[1], sg[1] + sg[2]] -- always
+# when sliding, and in regions + and - when sg[3] != 0 (a model without flows).
 @_jit
 def _zat(t, mode, sg, za, F, y_old, fns, p, out):
-    if mode == PLUS:
-        fns[0](za, t - sg[0], p, out)
-    elif mode == MINUS:
-        fns[1](za, t - sg[0], p, out)
-    else:
+    if mode == SLIDING or sg[3] != 0.0:
         _dense_eval(t, sg[1], sg[2], y_old, F, out)
+    elif mode == PLUS:
+        fns[0](za, t - sg[0], p, out)
+    else:
+        fns[1](za, t - sg[0], p, out)
 
 
 @_jit
@@ -411,13 +416,20 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, sg, za, F, y_old, fns,
 
 # ============================================================================= DOP853
 @_jit
-def _checked_field(z, first_call, fns, p, wg, wm, wp, out):
-    """The sliding field with simulate._IntegratingStepper's guard: a non-finite
-    value at the first call is an error (False), on a trial stage it is 1e300."""
-    a, b = _speeds(z, fns, p, wg, wm, wp)
+def _checked_field(z, mode, first_call, fns, p, wg, wm, wp, out):
+    """The field of ``mode`` (the Filippov field when sliding) with
+    simulate._IntegratingStepper's guard: a non-finite value at the first call
+    is an error (False), on a trial stage it is 1e300."""
+    if mode == PLUS:
+        fns[2](z, p, out)
+    elif mode == MINUS:
+        fns[3](z, p, out)
+    else:
+        a, b = _speeds(z, fns, p, wg, wm, wp)
+        for k in range(z.size):
+            out[k] = (a * wp[k] - b * wm[k]) / (a - b)
     finite = True
     for k in range(z.size):
-        out[k] = (a * wp[k] - b * wm[k]) / (a - b)
         if not np.isfinite(out[k]):
             finite = False
     if not finite:
@@ -438,7 +450,7 @@ def _rms(x, scale):
 
 
 @_jit
-def _dop_initial_step(t0, y0, f0, t_bound, max_step, rtol, atol, fns, p, wg, wm, wp,
+def _dop_initial_step(mode, t0, y0, f0, t_bound, max_step, rtol, atol, fns, p, wg, wm, wp,
                       y1, f1, scale):
     """scipy.integrate._ivp.common.select_initial_step for DOP853 (order 7)."""
     interval = abs(t_bound - t0)
@@ -456,7 +468,7 @@ def _dop_initial_step(t0, y0, f0, t_bound, max_step, rtol, atol, fns, p, wg, wm,
     h0 = min(h0, interval)
     for k in range(n):
         y1[k] = y0[k] + h0 * f0[k]
-    _checked_field(y1, False, fns, p, wg, wm, wp, f1)
+    _checked_field(y1, mode, False, fns, p, wg, wm, wp, f1)
     s = 0.0
     for k in range(n):
         q = (f1[k] - f0[k]) / scale[k]
@@ -470,7 +482,7 @@ def _dop_initial_step(t0, y0, f0, t_bound, max_step, rtol, atol, fns, p, wg, wm,
 
 
 @_jit
-def _dop_step(t, y, f, h_abs, t_bound, max_step, rtol, atol, fns, p, wg, wm, wp,
+def _dop_step(mode, t, y, f, h_abs, t_bound, max_step, rtol, atol, fns, p, wg, wm, wp,
               K, ynew, ytmp, scale):
     """One accepted step of scipy's DOP853 (RungeKutta._step_impl).
 
@@ -501,13 +513,13 @@ def _dop_step(t, y, f, h_abs, t_bound, max_step, rtol, atol, fns, p, wg, wm, wp,
                 for j in range(s):
                     acc += K[j, k] * _A[s, j]
                 ytmp[k] = y[k] + acc * h
-            _checked_field(ytmp, False, fns, p, wg, wm, wp, K[s])
+            _checked_field(ytmp, mode, False, fns, p, wg, wm, wp, K[s])
         for k in range(n):
             acc = 0.0
             for j in range(_NS):
                 acc += K[j, k] * _B[j]
             ynew[k] = y[k] + h * acc
-        _checked_field(ynew, False, fns, p, wg, wm, wp, K[_NS])
+        _checked_field(ynew, mode, False, fns, p, wg, wm, wp, K[_NS])
         # error norm (DOP853._estimate_error_norm)
         for k in range(n):
             scale[k] = atol + max(abs(y[k]), abs(ynew[k])) * rtol
@@ -541,7 +553,7 @@ def _dop_step(t, y, f, h_abs, t_bound, max_step, rtol, atol, fns, p, wg, wm, wp,
 
 
 @_jit
-def _dop_dense(h, y_old, y, f_old, f, fns, p, wg, wm, wp, K, ytmp, F):
+def _dop_dense(mode, h, y_old, y, f_old, f, fns, p, wg, wm, wp, K, ytmp, F):
     """DOP853._dense_output_impl: extra stages and the interpolant F (7, n)."""
     n = y.size
     for s in range(_NS + 1, _NSE):
@@ -550,7 +562,7 @@ def _dop_dense(h, y_old, y, f_old, f, fns, p, wg, wm, wp, K, ytmp, F):
             for j in range(s):
                 acc += K[j, k] * _A[s, j]
             ytmp[k] = y_old[k] + acc * h
-        _checked_field(ytmp, False, fns, p, wg, wm, wp, K[s])
+        _checked_field(ytmp, mode, False, fns, p, wg, wm, wp, K[s])
     for k in range(n):
         dy = y[k] - y_old[k]
         F[0, k] = dy
@@ -583,7 +595,7 @@ def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
 
 
 @_jit
-def _one(z0, fns, p, t_max, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
+def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
          ts, vals, dvals, svals, recent, sg, za, y, f, y_old, f_old, K, ynew, ytmp, scale,
          F, wz, wg, wf, wp, z, first_sw):
     """First return of z0 (the state at the return, or where the run stopped, in z);
@@ -612,11 +624,12 @@ def _one(z0, fns, p, t_max, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, io
         first = True
         what = _W_NONE
         te = t
-        if mode != SLIDING:
+        if mode != SLIDING and exact:
             # the exact flow from the mode entry, in windows of hwin
             for k in range(n):
                 za[k] = z[k]
             sg[0] = t
+            sg[3] = 0.0
             ns = frac_ex.size
             ta = t
             while True:
@@ -646,12 +659,14 @@ def _one(z0, fns, p, t_max, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, io
                 t = te
                 break
         else:
-            # DOP853 from (t, z) to t_max with the Filippov sliding field
+            # DOP853 from (t, z) to t_max with the mode's field (Filippov's when
+            # sliding; regions + and - of a model without exact flows)
+            sg[3] = 1.0
             for k in range(n):
                 y[k] = z[k]
-            if not _checked_field(y, True, fns, p, wg, wf, wp, f):
+            if not _checked_field(y, mode, True, fns, p, wg, wf, wp, f):
                 return NON_FINITE, t, n_switch, slide_time
-            h_abs = _dop_initial_step(t, y, f, t_max, max_step, rtol, atol, fns, p, wg, wf, wp,
+            h_abs = _dop_initial_step(mode, t, y, f, t_max, max_step, rtol, atol, fns, p, wg, wf, wp,
                                       ynew, ytmp, scale)
             ns = frac_in.size
             tcur = t
@@ -659,7 +674,7 @@ def _one(z0, fns, p, t_max, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, io
                 n_steps += 1
                 if n_steps > max_steps:
                     return STEP_LIMIT, t, n_switch, slide_time
-                ok, t_new, hstep, h_abs = _dop_step(tcur, y, f, h_abs, t_max, max_step, rtol,
+                ok, t_new, hstep, h_abs = _dop_step(mode, tcur, y, f, h_abs, t_max, max_step, rtol,
                                                     atol, fns, p, wg, wf, wp, K, ynew, ytmp,
                                                     scale)
                 if not ok:
@@ -671,7 +686,7 @@ def _one(z0, fns, p, t_max, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, io
                     f[k] = K[_NS, k]
                 ta, tb = tcur, t_new
                 tcur = t_new
-                _dop_dense(hstep, y_old, y, f_old, f, fns, p, wg, wf, wp, K, ytmp, F)
+                _dop_dense(mode, hstep, y_old, y, f_old, f, fns, p, wg, wf, wp, K, ytmp, F)
                 sg[1] = ta
                 sg[2] = tb - ta
                 if not _sample(mode, ta, tb, frac_in, ns, sg, za, F, y_old, fns, p, ts, vals,
@@ -732,6 +747,7 @@ _KERNEL_SIG = types.void(
     _vec,                       # params
     types.float64[:, ::1],      # starts (m, n)
     types.float64,              # t_max
+    types.boolean,              # exact flows in regions + and - (else DOP853)
     types.float64,              # window length of the exact flows
     types.int64,                # section predicate
     types.boolean,              # sliding declared
@@ -743,7 +759,7 @@ _KERNEL_SIG = types.void(
 
 @njit(cache=True)
 def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, p,
-           starts, t_max, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
+           starts, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
            out_state, out_time, out_nsw, out_slide, out_status, out_first):
     fns = (flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where)
     m, n = starts.shape
@@ -753,7 +769,7 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
     dvals = np.empty(nsmax)
     svals = np.empty(nsmax)
     recent = np.empty(max(iopts[2], 1))
-    sg = np.zeros(3)
+    sg = np.zeros(4)
     za, y, f = np.zeros(n), np.zeros(n), np.zeros(n)
     y_old, f_old, ynew, ytmp, scale = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                                        np.zeros(n))
@@ -764,7 +780,7 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
     first = np.zeros(1)
     for i in range(m):
         first[0] = np.nan
-        st, t, nsw, sl = _one(starts[i], fns, p, t_max, hwin, sec_pred, sliding, frac_ex,
+        st, t, nsw, sl = _one(starts[i], fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex,
                               frac_in, fopts, iopts, ts, vals, dvals, svals, recent, sg, za, y,
                               f, y_old, f_old, K, ynew, ytmp, scale, F, wz, wg, wf, wp, z, first)
         out_first[i] = first[0]
@@ -788,17 +804,27 @@ def compile_kernel() -> bool:
     return sum(_batch.stats.cache_hits.values()) > 0
 
 
+@njit(FLOW_SIG, cache=True)
+def no_flow(z0, tau, p, out):
+    """Stands in for the flows of a model without them (never called: exact=False)."""
+    for k in range(out.size):
+        out[k] = np.nan
+
+
 @dataclass(frozen=True)
 class CompiledModel:
-    """A piecewise system (region + is ``h >= 0``) with exact flows in both regions
-    and a section, as numba-compiled functions with the module's signatures.
+    """A piecewise system (region + is ``h >= 0``) and a section, as numba-compiled
+    functions with the module's signatures; with exact flows in both regions
+    (``exact=True``), or integrated there with DOP853 like sliding (``exact=False``,
+    the flows are then :func:`no_flow`).
 
     ``flow_plus``/``flow_minus``: :data:`FLOW_SIG`; ``field_plus``/``field_minus``/
     ``grad_h``: :data:`FIELD_SIG`; ``h``/``section``: :data:`SCALAR_SIG`;
     ``section_where``: :data:`WHERE_SIG`. Every piece receives ``params``.
     ``section_direction`` -1 counts decreasing crossings of ``section(z) = 0``,
     +1 increasing, 0 both. ``sample_step`` is the longest time between samples
-    of an exact flow (it must resolve the fastest time scale).
+    of an exact flow (it must resolve the fastest time scale; unused when
+    ``exact`` is False).
     """
 
     name: str
@@ -816,6 +842,7 @@ class CompiledModel:
     sample_step: float
     sliding: bool = True
     parameters: Mapping[str, float] = field(default_factory=dict)
+    exact: bool = True
 
     @property
     def dim(self) -> int:
@@ -867,10 +894,10 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
         raise ValueError(f"max_step must be > 0, got {max_step!r}")
     if zeno_count < 1:
         raise ValueError("zeno_count must be >= 1")
-    if not (np.isfinite(cmodel.sample_step) and cmodel.sample_step > 0):
+    if cmodel.exact and not (np.isfinite(cmodel.sample_step) and cmodel.sample_step > 0):
         raise ValueError(f"the compiled model needs a finite sample_step > 0, "
                          f"got {cmodel.sample_step!r}")
-    hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max)
+    hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max) if cmodel.exact else np.inf
     frac_ex = np.linspace(0.0, 1.0, EXACT_BLOCK * samples_per_step + 1)
     frac_in = np.linspace(0.0, 1.0, samples_per_step + 1)
     fopts = np.array([rtol, atol, touch_tol, event_xtol, zeno_span, max_step], dtype=float)
@@ -886,7 +913,7 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     compile_kernel()
     _batch(cmodel.flow_plus, cmodel.flow_minus, cmodel.field_plus, cmodel.field_minus,
            cmodel.h, cmodel.grad_h, cmodel.section, cmodel.section_where, params,
-           starts, float(t_max), float(hwin), _section_pred(cmodel.section_direction),
+           starts, float(t_max), bool(cmodel.exact), float(hwin), _section_pred(cmodel.section_direction),
            bool(cmodel.sliding), frac_ex, frac_in, fopts, iopts, state, time, nsw, slide, status,
            first)
     return BatchReturns(state, time, nsw, slide, status, first)

@@ -21,6 +21,11 @@ flows; the exact-flow families are "n/a" there): the project's DOP853 at rtol
 project's driver. The difference of the two references, ``reference_check``,
 is the floor no error below it can be trusted.
 
+The project's methods: its compiled exact flows, the same algorithm in Python,
+its DOP853 driver in Python and the compiled twin of that driver ("project
+compiled DOP853": every mode integrated with DOP853 inside the numba kernel,
+the only compiled mode for the dry-friction model).
+
 A method that raises or runs over ``--time-cap`` seconds is kept in the table
 with its status, never dropped. A table is printed; the dataset goes to
 ``--out`` (``results/bench_work_precision.nc``).
@@ -31,6 +36,7 @@ import argparse
 import statistics
 import sys
 import time
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
@@ -39,6 +45,7 @@ import numpy as np
 import xarray as xr
 import yaml
 
+from .. import fastmap
 from ..io import finalize, write_dataset
 from ..models import dry_friction
 from ..models import hopf
@@ -55,6 +62,7 @@ GRAZING_GAP = 1e-6
 # (family, tolerances): the project's modes first, then solve_ivp as a user would call it
 PROJECT = [("project compiled exact", [1e-6, 1e-8, 1e-10, 1e-12]),
            ("project python exact", [1e-12]),
+           ("project compiled DOP853", [1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-13]),
            ("project DOP853", [1e-4, 1e-6, 1e-8, 1e-10, 1e-12, 1e-13])]
 SCIPY = [("solve_ivp RK45", [1e-3, 1e-4, 1e-6, 1e-8, 1e-10]),
          ("solve_ivp DOP853", [1e-4, 1e-6, 1e-8, 1e-10, 1e-12]),
@@ -69,13 +77,15 @@ class Problem:
     """One return map to benchmark. fig04: ``x2`` is the start coordinate x2 on
     the section x1 = 0 (``model``: the Hopf model). fig11: ``x2`` holds the x1
     of the start points on L = {x2 = 0, x1 > 0} and ``start_states`` the full
-    states (x1, 0, w on M_+), ``model`` the dry-friction PiecewiseSystem."""
+    states (x1, 0, w on M_+), ``model`` the dry-friction PiecewiseSystem and
+    ``compiled`` the same system for the compiled kernel."""
     name: str
     x2: np.ndarray
     model: object
     scored: np.ndarray  # grid points the error is taken over
     kind: str = "fig04"
     start_states: np.ndarray = None
+    compiled: object = None
 
     @property
     def starts(self):
@@ -99,7 +109,8 @@ class Problem:
     def subset(self, idx):
         """The problem on a subset of its start points."""
         return Problem(self.name, self.x2[idx], self.model, self.scored[idx], self.kind,
-                       None if self.start_states is None else self.start_states[idx])
+                       None if self.start_states is None else self.start_states[idx],
+                       self.compiled)
 
 
 class NotApplicable(RuntimeError):
@@ -128,7 +139,8 @@ def fig11_problems(every: int) -> list[Problem]:
         starts = np.stack([x1, np.zeros_like(x1), w], axis=1)
         out.append(Problem(f"fig11 ({'ab'[k]}) eps={eps:g}", x1,
                            dry_friction.full_system(float(eps), float(v0), **ml),
-                           np.ones(x1.size, dtype=bool), "fig11", starts))
+                           np.ones(x1.size, dtype=bool), "fig11", starts,
+                           dry_friction.compiled(float(eps), float(v0), **ml)))
     return out
 
 
@@ -152,10 +164,32 @@ def _fig11_project(problem: Problem, rtol: float, atol: float, time_cap: float):
     return P, first
 
 
+def compiled_model(problem: Problem, exact: bool):
+    """The problem's model for the compiled kernel; ``exact=False``: every mode
+    integrated with DOP853 inside the kernel (the compiled twin of "project DOP853")."""
+    if problem.kind == "fig11":
+        return problem.compiled
+    par = problem.model.parameters
+    return dataclasses.replace(hopf.compiled(par["eps"], par["theta"], par["mu"], par["omega"]),
+                               exact=exact)
+
+
+def _compiled_integrated(problem: Problem, rtol: float, atol: float):
+    t_max = T_MAX11 if problem.kind == "fig11" else 4.0 * 2 * np.pi / abs(
+        problem.model.parameters["omega"])
+    # fig11 as the scene runs it (one sample per step); fig04 as rule `compute` would
+    spp = 1 if problem.kind == "fig11" else 4
+    ret = fastmap.first_returns_compiled(compiled_model(problem, exact=False), problem.starts,
+                                         t_max, rtol=rtol, atol=atol, samples_per_step=spp)
+    return ret.state[:, 0 if problem.kind == "fig11" else 1], ret.first_switch
+
+
 def runner(problem: Problem, family: str, tol: float, time_cap: float) -> Callable:
     """A function returning ``(P, first switch times)`` for one configuration.
     Raises :class:`NotApplicable` for a configuration the problem has no use for."""
     opts = {"rtol": tol, "atol": tol * 1e-2}
+    if family == "project compiled DOP853":
+        return lambda: _compiled_integrated(problem, opts["rtol"], opts["atol"])
     if problem.kind == "fig11":
         if family == "project DOP853":
             return lambda: _fig11_project(problem, opts["rtol"], opts["atol"], time_cap)

@@ -355,3 +355,78 @@ def slow_manifold_plus_on_L(x1_lo, x1_hi, eps, v0, n=33, **kwargs):
         return np.asarray(iw(x1), dtype=float), np.abs(np.asarray(ie(x1), dtype=float))
     start.interval = (x1_lo, x1_hi)
     return start
+
+
+# --------------------------------------------------------------------------- compiled
+def compiled(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck", *,
+             sliding=True):
+    """The slow-fast system eq:dfo-sf, compiled for :mod:`filippov.fastmap`, with
+    the section L of fig:dfo-retmap (x2 = 0 crossed downward, x1 > 0). No region
+    has a closed-form flow, so every mode is integrated (DOP853) inside the
+    kernel. The same formulas as :func:`full_system`, operation for operation."""
+    check_parameters(eps, v0, gamma, f0, fv, fc, convention)
+    if eps <= 0:
+        raise ValueError("eps must be > 0 for the slow-fast system")
+    from ..fastmap import CompiledModel, no_flow
+
+    s0, sc = (-f0, -fc) if convention == "stribeck" else (f0, fc)
+    return CompiledModel(
+        name="dry_friction", names=("x1", "x2", "w"),
+        params=np.array([eps, v0, gamma, s0, sc, fv], dtype=float),
+        flow_plus=no_flow, flow_minus=no_flow, **_compiled_pieces(),
+        section_direction=-1, sample_step=np.inf, sliding=sliding, exact=False,
+        parameters={"eps": eps, "v0": v0, "gamma": gamma, "f0": f0, "fv": fv, "fc": fc})
+
+
+_PIECES = {}
+
+
+def _compiled_pieces() -> dict:
+    """numba versions of the pieces; p = (eps, v0, gamma, s0, sc, fv) with the
+    friction branches F_+(nu) = -s0 - sc (1 - e^nu) + fv nu (region +) and
+    F_-(nu) = s0 + sc (1 - e^-nu) + fv nu (region -), nu = (1 + gamma) x2 - w."""
+    if _PIECES:
+        return _PIECES
+    from numba import njit
+
+    from ..fastmap import FIELD_SIG, SCALAR_SIG, WHERE_SIG
+
+    @njit(FIELD_SIG, cache=True)
+    def field_plus(z, p, out):
+        eps, v0, gamma, s0, sc, fv = p[0], p[1], p[2], p[3], p[4], p[5]
+        x1, x2, w = z[0], z[1], z[2]
+        nu = (1.0 + gamma) * x2 - w
+        out[0] = x2
+        out[1] = -x1 - (-s0 - sc * (1.0 - np.exp(nu)) + fv * nu)
+        out[2] = (v0 + gamma * x2 - w - (eps * gamma) * x1) * (1.0 / eps)
+
+    @njit(FIELD_SIG, cache=True)
+    def field_minus(z, p, out):
+        eps, v0, gamma, s0, sc, fv = p[0], p[1], p[2], p[3], p[4], p[5]
+        x1, x2, w = z[0], z[1], z[2]
+        nu = (1.0 + gamma) * x2 - w
+        out[0] = x2
+        out[1] = -x1 - (s0 + sc * (1.0 - np.exp(-nu)) + fv * nu)
+        out[2] = (v0 + gamma * x2 - w - (eps * gamma) * x1) * (1.0 / eps)
+
+    @njit(SCALAR_SIG, cache=True)
+    def h(z, p):
+        return z[2] - (1.0 + p[2]) * z[1]
+
+    @njit(FIELD_SIG, cache=True)
+    def grad_h(z, p, out):
+        out[0] = 0.0
+        out[1] = -(1.0 + p[2])
+        out[2] = 1.0
+
+    @njit(SCALAR_SIG, cache=True)
+    def section(z, p):
+        return z[1]
+
+    @njit(WHERE_SIG, cache=True)
+    def section_where(z, p):
+        return z[0] > 0
+
+    _PIECES.update(field_plus=field_plus, field_minus=field_minus, h=h, grad_h=grad_h,
+                   section=section, section_where=section_where)
+    return _PIECES

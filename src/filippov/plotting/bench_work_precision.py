@@ -10,6 +10,7 @@ VARS = ["error_map", "wall_time", "status", "reference_check"]
 # the project's modes solid, scipy's dashed; markers tell the families apart
 LOOK = {"project compiled exact": ("o", "-", "black"),
         "project python exact": ("s", "-", "0.45"),
+        "project compiled DOP853": ("d", "-", "#e7298a"),
         "project DOP853": ("D", "-", st.C_PLUS),
         "solve_ivp RK45": ("^", "--", st.C_MINUS),
         "solve_ivp DOP853": ("v", "--", "#7b3294"),
