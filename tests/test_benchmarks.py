@@ -67,7 +67,9 @@ def test_effect_variants_switch_one_ingredient_each():
     assert labels == ["as declared", "system: slow_fast -> reduced", "flow: exact -> integrate",
                       "sliding: True -> False", "engine: compiled -> python"]
     by = dict(effect_cost.variants(scene))
-    assert "engine" not in by["flow: exact -> integrate"]["solver"]  # compiled needs exact
+    # the same engine with the other flow: the cost of the ingredient alone
+    assert by["flow: exact -> integrate"]["solver"]["engine"] == "compiled"
+    assert by["engine: compiled -> python"]["ingredients"]["flow"] == "exact"
     assert scene["ingredients"]["flow"] == "exact"                    # the original untouched
 
 

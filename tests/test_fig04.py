@@ -109,15 +109,33 @@ def test_fixed_points_of_the_map():
         np.testing.assert_array_equal(fixed_points(x2, got), [1.0])
 
 
-def test_compiled_engine_needs_exact_flows():
+def test_engine_is_checked_per_scene():
+    import filippov.scenes
     from filippov.scenes.common import engine
     scene = {"id": "fig04_retmaps", "ingredients": {"flow": "integrate"},
              "solver": {"engine": "compiled"}}
-    with pytest.raises(ValueError, match="solver.engine"):
-        engine(scene)
-    scene["ingredients"]["flow"] = "exact"
-    assert engine(scene) == "compiled"
+    assert engine(scene) == "compiled"   # fig04 runs both flows on both engines
+    assert filippov.scenes._module(scene).ENGINES == ("python", "compiled")
     assert engine({"id": "x", "ingredients": {"flow": "exact"}}) == "python"
+    # a scene without a compiled engine says so, naming the field
+    other = {"id": "fig08_s0theta", "ingredients": {"flow": "exact"},
+             "solver": {"engine": "compiled"}}
+    with pytest.raises(ValueError, match="solver.engine: 'compiled' not available"):
+        filippov.scenes.compute(other)
+
+
+def test_compiled_engine_integrates_when_asked():
+    """flow: integrate on the compiled engine: DOP853 inside the kernel, the same
+    map as the reference driver's integration and, to the tolerance, as the exact flows."""
+    from filippov.scenes.fig04_retmaps import return_map
+    x2 = np.array([0.97, 0.999, 1.001, 1.03])
+    model = hopf.model(0.01, 0.5, 1.0, OMEGA)
+    opts = {"rtol": 1e-12, "atol": 1e-14}
+    fast, _, _ = return_map(model, x2, "integrate", opts, engine="compiled")
+    ref, _, _ = return_map(model, x2, "integrate", opts)
+    exact, _, _ = return_map(model, x2, "exact", opts, engine="compiled")
+    np.testing.assert_allclose(fast, ref, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(fast, exact, rtol=0, atol=1e-9)
 
 
 def test_scene_engines_agree():

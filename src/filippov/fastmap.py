@@ -597,20 +597,25 @@ def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
 @_jit
 def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
          ts, vals, dvals, svals, recent, sg, za, y, f, y_old, f_old, K, ynew, ytmp, scale,
-         F, wz, wg, wf, wp, z, first_sw):
+         F, wz, wg, wf, wp, z, first_sw, slide_dz, slide_z0):
     """First return of z0 (the state at the return, or where the run stopped, in z);
     (status, t, n_switches, sliding_time). first_sw[0]: time of the first change of mode
-    (left untouched if there is none)."""
+    (left untouched if there is none); slide_dz: the change of state summed over the
+    sliding stretches (counted like sliding_time)."""
     rtol, atol, touch_tol, xtol = fopts[0], fopts[1], fopts[2], fopts[3]
     zeno_span, max_step = fopts[4], fopts[5]
     max_events, max_steps, zeno_count = iopts[0], iopts[1], iopts[2]
     n = z0.size
     t = 0.0
     for k in range(n):
+        slide_dz[k] = 0.0
+    for k in range(n):
         z[k] = z0[k]
         if not np.isfinite(z0[k]):
             return BAD_START, t, 0, 0.0
     mode = _initial_mode(z, fns, p, touch_tol, sliding, wg, wf, wp)
+    for k in range(n):
+        slide_z0[k] = z[k]
     n_switch = 0
     n_steps = 0
     slide_time = 0.0
@@ -711,6 +716,8 @@ def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fo
         if what == _W_SECTION:
             if mode == SLIDING:
                 slide_time += t - slide_since
+                for k in range(n):
+                    slide_dz[k] += z[k] - slide_z0[k]
             return OK, t, n_switch, slide_time
         a, b = _speeds(z, fns, p, wg, wf, wp)
         if what == _W_EXIT_MINUS:
@@ -725,8 +732,12 @@ def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fo
             return NO_SLIDING, t, n_switch, slide_time
         if mode == SLIDING:
             slide_time += t - slide_since
+            for k in range(n):
+                slide_dz[k] += z[k] - slide_z0[k]
         if new_mode == SLIDING:
             slide_since = t
+            for k in range(n):
+                slide_z0[k] = z[k]
         if new_mode != mode:
             n_switch += 1
             if n_switch == 1:
@@ -754,13 +765,14 @@ _KERNEL_SIG = types.void(
     _vec, _vec,                 # sample fractions: exact windows, integration steps
     _vec,                       # rtol, atol, touch_tol, event_xtol, zeno_span, max_step
     types.int64[::1],           # max_events, max_steps, zeno_count
-    types.float64[:, ::1], _vec, types.int64[::1], _vec, types.int64[::1], _vec)  # outputs
+    types.float64[:, ::1], _vec, types.int64[::1], _vec, types.int64[::1], _vec,  # outputs
+    types.float64[:, ::1])
 
 
 @njit(cache=True)
 def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, p,
            starts, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
-           out_state, out_time, out_nsw, out_slide, out_status, out_first):
+           out_state, out_time, out_nsw, out_slide, out_status, out_first, out_slide_dz):
     fns = (flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where)
     m, n = starts.shape
     nsmax = max(frac_ex.size, frac_in.size)
@@ -778,14 +790,17 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
     F = np.zeros((_NI, n))
     z = np.zeros(n)
     first = np.zeros(1)
+    slide_dz, slide_z0 = np.zeros(n), np.zeros(n)
     for i in range(m):
         first[0] = np.nan
         st, t, nsw, sl = _one(starts[i], fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex,
                               frac_in, fopts, iopts, ts, vals, dvals, svals, recent, sg, za, y,
-                              f, y_old, f_old, K, ynew, ytmp, scale, F, wz, wg, wf, wp, z, first)
+                              f, y_old, f_old, K, ynew, ytmp, scale, F, wz, wg, wf, wp, z, first,
+                              slide_dz, slide_z0)
         out_first[i] = first[0]
         for c in range(n):
             out_state[i, c] = z[c]
+            out_slide_dz[i, c] = slide_dz[c]
         out_status[i] = st
         out_time[i] = t
         out_nsw[i] = nsw
@@ -860,6 +875,7 @@ class BatchReturns:
     sliding_time: np.ndarray
     status: np.ndarray
     first_switch: np.ndarray  # time of the first change of mode (NaN: none)
+    sliding_displacement: np.ndarray = None  # (m, dim): state change summed over sliding
 
 
 def _section_pred(direction: int) -> int:
@@ -909,14 +925,15 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     slide = np.empty(m)
     status = np.empty(m, dtype=np.int64)
     first = np.empty(m)
+    slide_dz = np.empty_like(starts)
     params = np.ascontiguousarray(cmodel.params, dtype=float)
     compile_kernel()
     _batch(cmodel.flow_plus, cmodel.flow_minus, cmodel.field_plus, cmodel.field_minus,
            cmodel.h, cmodel.grad_h, cmodel.section, cmodel.section_where, params,
            starts, float(t_max), bool(cmodel.exact), float(hwin), _section_pred(cmodel.section_direction),
            bool(cmodel.sliding), frac_ex, frac_in, fopts, iopts, state, time, nsw, slide, status,
-           first)
-    return BatchReturns(state, time, nsw, slide, status, first)
+           first, slide_dz)
+    return BatchReturns(state, time, nsw, slide, status, first, slide_dz)
 
 
 _ERRORS = {EVENT_LIMIT: EventLimitError, STEP_LIMIT: EventLimitError, ZENO: ZenoError}

@@ -52,9 +52,7 @@ def variants(scene: dict) -> list[tuple[str, dict]]:
         value = scene["ingredients"][key]
         if value in flip:
             v = copy.deepcopy(scene)
-            v["ingredients"][key] = flip[value]
-            if key == "flow" and flip[value] != "exact":
-                v.setdefault("solver", {}).pop("engine", None)  # compiled needs exact flows
+            v["ingredients"][key] = flip[value]  # same engine: the ingredient's own cost
             out.append((f"{key}: {value} -> {flip[value]}", v))
     engine = scene.get("solver", {}).get("engine")
     if engine == "compiled":

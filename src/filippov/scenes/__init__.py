@@ -28,7 +28,14 @@ def _module(scene: dict):
     sid = scene.get("id")
     if sid not in SCENES:
         raise ValueError(f"id: unknown scene {sid!r}; known scenes: {', '.join(sorted(SCENES))}")
-    return importlib.import_module(f".{SCENES[sid]}", __name__)
+    module = importlib.import_module(f".{SCENES[sid]}", __name__)
+    # solver.engine: a scene runs on the engines its module lists (default: the reference driver)
+    name = scene.get("solver", {}).get("engine", "python")
+    available = getattr(module, "ENGINES", ("python",))
+    if name not in available:
+        raise ValueError(f"{sid}: solver.engine: {name!r} not available for this scene; "
+                         f"expected one of {list(available)}")
+    return module
 
 
 def compute(scene: dict, *, progress: bool = False):

@@ -12,6 +12,8 @@ rate of change of h along the region-minus field at the grazing point p_g.
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import xarray as xr
 
@@ -40,16 +42,17 @@ def return_map(model, x2, method: str, options: dict, progress=None, sliding=Tru
     """P on L1 for the start values ``x2``: (returned x2, residual |y - x1|, Returns).
 
     ``engine="compiled"`` runs the numba kernel of :mod:`filippov.fastmap` (exact
-    flows only); it follows the reference driver's algorithm step for step.
+    flows, or DOP853 in the kernel for ``method="integrate"``); it follows the
+    reference driver's algorithm step for step.
     """
     starts = np.stack([np.zeros_like(x2), x2, np.zeros_like(x2)], axis=1)
     t_max = 4.0 * 2 * np.pi / abs(model.parameters["omega"])
     if engine == "compiled":
-        if method != "exact":
-            raise ValueError("the compiled engine runs exact flows only")
         par = model.parameters
         cmodel = hopf.compiled(par["eps"], par["theta"], par["mu"], par["omega"],
                                sliding=sliding)
+        if method != "exact":  # integrated with the kernel's DOP853
+            cmodel = dataclasses.replace(cmodel, exact=False)
         ret = first_returns_compiled(cmodel, starts, t_max, progress=progress, **options)
     else:
         system = model.full(sliding=sliding, exact=method == "exact")
@@ -76,6 +79,7 @@ def sigma_minus(model) -> tuple[float, float]:
 # grid -- the fixed points and everything else derived from the whole map are
 # computed there, so compute() and a merge of chunks give identical datasets.
 CHUNK_AXIS = "x2"
+ENGINES = ("python", "compiled")
 
 
 def chunk_grid(scene: dict) -> np.ndarray:

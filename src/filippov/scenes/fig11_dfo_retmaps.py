@@ -35,13 +35,18 @@ import xarray as xr
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 
+from .. import fastmap
 from ..io import finalize
 from ..models import dry_friction as df
 from ..poincare import fixed_points, sliding_time
 from ..progress import Progress
 from ..simulate import Section, simulate
 from ..system import SLIDING
-from .common import require, solver_options
+from .common import engine, require, solver_options
+
+
+T_RETURN = 200.0  # time bound of one return to L
+ENGINES = ("python", "compiled")
 
 
 def section_L() -> Section:
@@ -65,34 +70,61 @@ def _slide_length(events) -> float:
     return total
 
 
+def compiled_returns(z0s, eps, v0, law, rtol, atol):
+    """First returns to L of the states ``z0s`` by the compiled kernel (every mode
+    integrated with DOP853 there, the algorithm of the reference driver), sampled
+    as the scene's reference driver runs it (one sample per step)."""
+    ml = {k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")}
+    z0s = np.atleast_2d(np.asarray(z0s, dtype=float))
+    out = fastmap.compute_returns(df.compiled(eps, v0, **ml), z0s, T_RETURN, rtol=rtol,
+                                  atol=atol, samples_per_step=1)
+    bad = np.flatnonzero(out.status != fastmap.OK)
+    if bad.size:
+        i = int(bad[0])
+        raise RuntimeError(f"start {z0s[i].tolist()} (eps={eps}, v0={v0}) did not return to "
+                           f"L: {fastmap.STATUS[int(out.status[i])]}")
+    return out
+
+
 def return_map(x1, eps, v0, law, *, rtol=1e-12, atol=1e-14, progress=None,
-               with_residual=True, start=None):
+               with_residual=True, start=None, engine="python"):
     """P(x1) on L for start points on M_+. Returns a dict of arrays.
     ``start``: optional ``x1 -> (w, estimate)`` on M_+
     (:func:`filippov.models.dry_friction.slow_manifold_plus_on_L`), else the
-    relaxation is run for these points."""
+    relaxation is run for these points. ``engine``: "python" (the reference
+    driver, one orbit at a time) or "compiled" (:func:`compiled_returns`)."""
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     ml = {k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")}
     if start is None:
         w0, res0 = df.slow_manifold_plus(x1, 0.0, eps, v0, **ml, rtol=rtol, atol=atol)
     else:
         w0, res0 = start(x1)
-    system = df.full_system(eps, v0, **ml)
-    out = {k: np.empty(x1.size) for k in ("P", "w", "time", "slide_time", "slide_length")}
-    out["n_switches"] = np.empty(x1.size, dtype=np.int32)
-    sec = section_L()
-    for i, (a, w) in enumerate(zip(x1, w0)):
-        traj = simulate(system, [a, 0.0, w], 200.0, method="integrate", rtol=rtol, atol=atol,
-                        sections=[sec], dense=False, samples_per_step=1)
-        if traj.status != "section:L":
-            raise RuntimeError(f"start x1={a!r} (eps={eps}, v0={v0}) did not return to L "
-                               f"({traj.status})")
-        out["P"][i], out["w"][i], out["time"][i] = traj.z[0], traj.z[2], traj.t
-        out["slide_time"][i] = sliding_time(traj.events)
-        out["slide_length"][i] = _slide_length(traj.events)
-        out["n_switches"][i] = len(traj.switches())
+    if engine == "compiled":
+        ret = compiled_returns(np.stack([x1, np.zeros_like(x1), w0], axis=1), eps, v0, law,
+                               rtol, atol)
+        out = {"P": ret.state[:, 0].copy(), "w": ret.state[:, 2].copy(), "time": ret.time,
+               "slide_time": ret.sliding_time,
+               "slide_length": ret.sliding_displacement[:, 0].copy(),
+               "n_switches": ret.n_switches.astype(np.int32)}
         if progress is not None:
-            progress.step()
+            progress.step(x1.size)
+    else:
+        out = {k: np.empty(x1.size) for k in ("P", "w", "time", "slide_time", "slide_length")}
+        out["n_switches"] = np.empty(x1.size, dtype=np.int32)
+        system = df.full_system(eps, v0, **ml)
+        sec = section_L()
+        for i, (a, w) in enumerate(zip(x1, w0)):
+            traj = simulate(system, [a, 0.0, w], T_RETURN, method="integrate", rtol=rtol,
+                            atol=atol, sections=[sec], dense=False, samples_per_step=1)
+            if traj.status != "section:L":
+                raise RuntimeError(f"start x1={a!r} (eps={eps}, v0={v0}) did not return to L "
+                                   f"({traj.status})")
+            out["P"][i], out["w"][i], out["time"][i] = traj.z[0], traj.z[2], traj.t
+            out["slide_time"][i] = sliding_time(traj.events)
+            out["slide_length"][i] = _slide_length(traj.events)
+            out["n_switches"][i] = len(traj.switches())
+            if progress is not None:
+                progress.step()
     out["start_residual"] = res0
     if with_residual:
         # distance of the returned point to M_+ (relaxation since the last switch)
@@ -120,13 +152,20 @@ def near_manifold_start(x1, eps, v0, law, t_pull=0.5):
     return np.array([zs[0], zs[1], w2(zs[0], zs[1])])
 
 
-def P_pair(x1, v0, eps, law, rtol, atol):
+def P_pair(x1, v0, eps, law, rtol, atol, engine="python"):
     """(x1 at the first hit of L, x1 at the next): a return of a point that
     reaches L on M_+ (to about exp(-30) for eps = 0.01; for eps = 0.1 the
-    deviation decays by exp(-t/eps) long before the orbit reaches H_s)."""
+    deviation decays by exp(-t/eps) long before the orbit reaches H_s).
+    The compiled engine runs the two returns as two calls (the second from
+    the first hit)."""
+    if engine == "compiled":
+        first = compiled_returns(near_manifold_start(x1, eps, v0, law), eps, v0, law, rtol,
+                                 atol).state
+        second = compiled_returns(first, eps, v0, law, rtol, atol).state
+        return float(first[0, 0]), float(second[0, 0])
     system = df.full_system(eps, v0, **{k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")})
     sec = Section("L", lambda z: z[1], direction=-1, where=lambda z: z[0] > 0, terminal=2)
-    traj = simulate(system, near_manifold_start(x1, eps, v0, law), 200.0, method="integrate",
+    traj = simulate(system, near_manifold_start(x1, eps, v0, law), T_RETURN, method="integrate",
                     rtol=rtol, atol=atol, sections=[sec], dense=False, samples_per_step=1)
     hits = traj.section_hits("L")
     if len(hits) != 2:
@@ -134,10 +173,10 @@ def P_pair(x1, v0, eps, law, rtol, atol):
     return float(hits[0].state[0]), float(hits[1].state[0])
 
 
-def P_scalar(x1, v0, eps, law, rtol, atol):
+def P_scalar(x1, v0, eps, law, rtol, atol, engine="python"):
     """P(x1) - x1 measured on the pair of hits of :func:`P_pair` (so the start
     abscissa is the actual first hit, a hair away from x1)."""
-    a, b = P_pair(x1, v0, eps, law, rtol, atol)
+    a, b = P_pair(x1, v0, eps, law, rtol, atol, engine)
     return b - a + x1
 
 
@@ -152,7 +191,7 @@ def fixed_point_near(x1_guess, v0, eps, law, rtol, atol, width=0.05):
 
 
 def saddle_node(eps, law, x1_lo, x1_hi, v0_guess, *, rtol=1e-12, atol=1e-14,
-                search_rtol=1e-10, window=0.02, progress=None):
+                search_rtol=1e-10, window=0.02, progress=None, engine="python"):
     """The fold of the stick-slip fixed points of P in v0.
 
     M(v0) = max over x1 of P(x1; v0) - x1 is positive while the stable and
@@ -180,7 +219,7 @@ def saddle_node(eps, law, x1_lo, x1_hi, v0_guess, *, rtol=1e-12, atol=1e-14,
         x0 = state["x"]
         bounds = (x1_lo, x1_hi) if x0 is None else (max(x1_lo, x0 - win),
                                                        min(x1_hi, x0 + win))
-        f = lambda x: -(P_scalar(x, v, eps, law, rt, rt * atol / rtol) - x)
+        f = lambda x: -(P_scalar(x, v, eps, law, rt, rt * atol / rtol, engine) - x)
         res = minimize_scalar(f, bounds=bounds, method="bounded", options={"xatol": xatol})
         if x0 is not None and min(res.x - bounds[0], bounds[1] - res.x) < 0.05 * win:
             # the argmax ran to the window's edge: maximise over the full range
@@ -288,7 +327,7 @@ def _merge(maps, new):
 
 
 def refined_return_maps(x_base, panels, law, *, rtol, atol, dP_max, max_rounds, bar=None,
-                        starts=None):
+                        starts=None, engine="python"):
     """P on one x1 grid shared by all panels: the uniform ``x_base``, plus the
     onset of sticking of each panel, plus points subdividing every interval
     where |Delta P| > ``dP_max`` in some panel (:func:`_subdivide`, repeated
@@ -301,7 +340,7 @@ def refined_return_maps(x_base, panels, law, *, rtol, atol, dP_max, max_rounds, 
         outs = []
         for (eps, v0), st in zip(panels, starts):
             r = return_map(x, eps, v0, law, rtol=rtol, atol=atol, progress=bar,
-                           with_residual=False, start=st)
+                           with_residual=False, start=st, engine=engine)
             r["x1"] = np.asarray(x, dtype=float).copy()
             outs.append(r)
         return outs
@@ -376,6 +415,7 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     p = scene["parameters"]
     opts = solver_options(scene)
     rtol, atol = float(opts["rtol"]), float(opts["atol"])
+    kernel = engine(scene)
     law = _law(p)
     eps_list = [float(e) for e in p["eps"]]
     v0_list = [float(v) for v in p["v0"]]
@@ -396,22 +436,24 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
               for eps, v0 in panels]
     maps, onsets = refined_return_maps(np.linspace(lo, hi, n), panels, law, rtol=rtol,
                                        atol=atol, dP_max=dP_max, max_rounds=rounds, bar=bar,
-                                       starts=starts)
+                                       starts=starts, engine=kernel)
     x1 = maps[0]["x1"]
     fps, sns = [], []
     for (eps, v0), r, st in zip(panels, maps, starts):
         # distance of the returned points to M_+ (relaxation since the last switch)
         r["return_residual"] = np.abs(r["w"] - st(r["P"])[0])
         # fixed points of the same map (same start points), Brent in each sign change
-        Pm = lambda x, e=eps, v=v0, s_=st: float(return_map([x], e, v, law, rtol=rtol, atol=atol,
-                                                           with_residual=False, start=s_)["P"][0])
+        Pm = lambda x, e=eps, v=v0, s_=st: float(return_map(
+            [x], e, v, law, rtol=rtol, atol=atol, with_residual=False, start=s_,
+            engine=kernel)["P"][0])
         fps.append(np.asarray(fixed_points(x1, r["P"], refine=Pm, xtol=1e-12)))
         # saddle-node of the stick-slip orbits; first guess: reduced GS + c eps
         xs, vs, br, v_search = saddle_node(eps, law, float(p["sn_x1_range"][0]),
                                            float(p["sn_x1_range"][1]), vgs + cgs * eps,
                                            rtol=rtol, atol=atol, search_rtol=search_rtol,
-                                           progress=bar)
-        at = return_map([xs], eps, vs, law, rtol=rtol, atol=atol, with_residual=False)
+                                           progress=bar, engine=kernel)
+        at = return_map([xs], eps, vs, law, rtol=rtol, atol=atol, with_residual=False,
+                        engine=kernel)
         sns.append({"x1": xs, "v0": vs, "v0_search": v_search,
                     "slide_length": float(at["slide_length"][0]),
                     "slide_time": float(at["slide_time"][0]), "branch": br})
