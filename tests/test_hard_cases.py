@@ -96,8 +96,8 @@ def test_chatter_period_scales_like_eps(eps_sweep, eps):
 def test_pseudo_equilibrium_theta_positive_slides_in_for_every_eps(eps_sweep, eps):
     # theta = 0.6: the relaxed + flow meets H_s at x = -(1 - theta) eps, inside the
     # attracting band |x| < theta eps (at theta = 0.5 it would hit the band's edge).
-    # Start 30 eps away (the reference driver samples on the eps scale; an O(1)
-    # approach is the compiled kernel's job, below) and slide into the origin.
+    # Start 30 eps away (inside the fast transient, sampled on the eps scale; the
+    # O(1) approach is tested below and by the compiled kernel) and slide in.
     theta = 0.6
     attrs = eps_sweep.attrs
     assert attrs["slide_theta"] == theta and attrs["slide_start_over_eps"] == 30
@@ -255,3 +255,41 @@ def test_chatter_formula_rejects_theta_without_a_chatter_orbit():
     for theta in (0.0, 0.5, 1.0, np.nan):
         with pytest.raises(ValueError, match="theta"):
             chatter.half_time(theta)
+
+
+# ----------------------------------------------------------------------- tiny eps, O(1) travel
+@pytest.mark.parametrize("eps", [1e-6, 1e-9, 1e-12])
+def test_reference_driver_travels_order_one_at_tiny_eps_within_a_step_bound(eps):
+    """After the fast relaxation of a mode entry (40 eps) exact flows are scanned
+    at the slow step, so O(1) travel costs O(1) windows, not O(1/eps): a bound of
+    200 windows (the eps-scale step alone would need 0.3 / (4 eps) of them) holds,
+    and the orbit still meets H_s where it must and slides in."""
+    theta = 0.6
+    system = pseudo_equilibrium.model(eps, theta).full()
+    traj = simulate(system, [0.3, 0.0], 0.5, dense=False, max_events=10, max_steps=200)
+    assert [e.kind for e in traj.events[1:]] == ["slide_start"] and traj.mode == SLIDING
+    hit = traj.events[1]
+    assert hit.t == pytest.approx(0.3 + (1 - theta) * eps, rel=0, abs=1e-15)
+    assert abs(hit.state[0] + (1 - theta) * eps) <= 1e-15 + 1e-9 * eps
+    assert abs(traj.z[0]) < 1e-12 and np.all(np.isfinite(traj.z))
+
+
+@pytest.mark.parametrize("theta", [-0.5, 0.5])
+@pytest.mark.parametrize("eps", [1e-2, 1e-4])
+def test_slow_windows_change_the_cost_not_the_result(theta, eps):
+    """The Hopf map with and without the slow windows: same switches, same returns."""
+    import dataclasses
+
+    from filippov.scenes.fig04_retmaps import section_L1
+
+    fast_only = dataclasses.replace(hopf.model(eps, theta, MU, OMEGA).full(),
+                                    slow_sample_step=np.nan)
+    system = hopf.model(eps, theta, MU, OMEGA).full()
+    assert np.isfinite(system.slow_sample_step) and system.transient_time == 40 * eps
+    for x2 in (0.9, 0.99, 1.0 + 10 * eps ** 2, 1.001, 1.02):
+        a = simulate(system, [0.0, x2, 0.0], T_MAX, sections=[section_L1()], dense=False)
+        b = simulate(fast_only, [0.0, x2, 0.0], T_MAX, sections=[section_L1()], dense=False)
+        assert a.status == b.status == "section:L1"
+        assert [e.kind for e in a.events] == [e.kind for e in b.events]
+        np.testing.assert_allclose(a.z, b.z, rtol=0, atol=1e-13)
+        assert a.t == pytest.approx(b.t, abs=1e-13)

@@ -6,8 +6,9 @@ same algorithm for a whole batch of start points inside one compiled call:
 
 * regions ``+`` (``h >= 0``) and ``-`` are followed with the model's exact
   flows, sampled exactly like the reference driver: windows of ``16 sample_step``
-  from each mode entry, each cut into ``16 samples_per_step`` intervals, the flow
-  always taken from the state at the mode entry; a model without exact flows
+  from each mode entry (``16 slow_sample_step`` once ``transient_time`` has
+  passed since the entry), each cut into ``16 samples_per_step`` intervals, the
+  flow always taken from the state at the mode entry; a model without exact flows
   (``CompiledModel.exact = False``) has them integrated like sliding, below
   (the reference driver's ``method="integrate"``);
 * the samples are scanned for the same events: ``h`` leaving the region, a
@@ -54,7 +55,7 @@ from scipy.integrate._ivp import dop853_coefficients as _dop
 
 from .poincare import Returns
 from .progress import Progress
-from .simulate import EXACT_BLOCK, EventLimitError, SimulationError, ZenoError
+from .simulate import EXACT_BLOCK, EventLimitError, SimulationError, ZenoError, slow_window
 from .system import MINUS, PLUS, SLIDING
 
 # ----------------------------------------------------------------------------- signatures
@@ -603,7 +604,7 @@ def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fo
     (left untouched if there is none); slide_dz: the change of state summed over the
     sliding stretches (counted like sliding_time)."""
     rtol, atol, touch_tol, xtol = fopts[0], fopts[1], fopts[2], fopts[3]
-    zeno_span, max_step = fopts[4], fopts[5]
+    zeno_span, max_step, hwin_slow, transient = fopts[4], fopts[5], fopts[6], fopts[7]
     max_events, max_steps, zeno_count = iopts[0], iopts[1], iopts[2]
     n = z0.size
     t = 0.0
@@ -641,7 +642,8 @@ def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fo
                 n_steps += 1
                 if n_steps > max_steps:
                     return STEP_LIMIT, t, n_switch, slide_time
-                tb = min(ta + hwin, t_max)
+                # windows of hwin during the fast transient after the mode entry, then hwin_slow
+                tb = min(ta + (hwin if ta - sg[0] < transient else hwin_slow), t_max)
                 if tb == ta:
                     tb = np.nextafter(ta, np.inf)
                 if not _sample(mode, ta, tb, frac_ex, ns, sg, za, F, y_old, fns, p, ts, vals,
@@ -763,7 +765,8 @@ _KERNEL_SIG = types.void(
     types.int64,                # section predicate
     types.boolean,              # sliding declared
     _vec, _vec,                 # sample fractions: exact windows, integration steps
-    _vec,                       # rtol, atol, touch_tol, event_xtol, zeno_span, max_step
+    _vec,                       # rtol, atol, touch_tol, event_xtol, zeno_span, max_step,
+                                # slow window, transient time
     types.int64[::1],           # max_events, max_steps, zeno_count
     types.float64[:, ::1], _vec, types.int64[::1], _vec, types.int64[::1], _vec,  # outputs
     types.float64[:, ::1])
@@ -839,7 +842,9 @@ class CompiledModel:
     ``section_direction`` -1 counts decreasing crossings of ``section(z) = 0``,
     +1 increasing, 0 both. ``sample_step`` is the longest time between samples
     of an exact flow (it must resolve the fastest time scale; unused when
-    ``exact`` is False).
+    ``exact`` is False); ``slow_sample_step`` and ``transient_time`` as for
+    :class:`filippov.system.PiecewiseSystem` (the slow step once the fast
+    relaxation after a mode entry has decayed).
     """
 
     name: str
@@ -858,6 +863,8 @@ class CompiledModel:
     sliding: bool = True
     parameters: Mapping[str, float] = field(default_factory=dict)
     exact: bool = True
+    slow_sample_step: float = np.nan   # see filippov.system.PiecewiseSystem
+    transient_time: float = np.inf
 
     @property
     def dim(self) -> int:
@@ -914,9 +921,11 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
         raise ValueError(f"the compiled model needs a finite sample_step > 0, "
                          f"got {cmodel.sample_step!r}")
     hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max) if cmodel.exact else np.inf
+    hwin_slow = slow_window(cmodel.slow_sample_step, hwin, max_step, t_max)
     frac_ex = np.linspace(0.0, 1.0, EXACT_BLOCK * samples_per_step + 1)
     frac_in = np.linspace(0.0, 1.0, samples_per_step + 1)
-    fopts = np.array([rtol, atol, touch_tol, event_xtol, zeno_span, max_step], dtype=float)
+    fopts = np.array([rtol, atol, touch_tol, event_xtol, zeno_span, max_step, hwin_slow,
+                      cmodel.transient_time], dtype=float)
     iopts = np.array([max_events, max_steps, zeno_count], dtype=np.int64)
     m = starts.shape[0]
     state = np.empty_like(starts)

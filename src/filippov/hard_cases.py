@@ -180,9 +180,11 @@ def chatter_period(eps: float) -> dict:
 
 def slide_in(eps: float) -> dict:
     """Slide-in to the pseudo-equilibrium at theta = slide_theta (> 0): from
-    slide_start_over_eps * eps with the reference driver (it samples on the eps
-    scale) and from kernel_start with the compiled kernel (exact flows, sliding by
-    DOP853)."""
+    slide_start_over_eps * eps with the reference driver (the approach within
+    the fast transient, sampled on the eps scale) and from kernel_start with the
+    compiled kernel (exact flows, sliding by DOP853); the O(1) approach of the
+    reference driver is tests/test_hard_cases.py's
+    test_reference_driver_travels_order_one_at_tiny_eps_within_a_step_bound."""
     theta = PARAMETERS["slide_theta"]
     system = pseudo_equilibrium.model(eps, theta).full()
     traj = simulate(system, [PARAMETERS["slide_start_over_eps"] * eps, 0.0],

@@ -24,6 +24,11 @@ from .system import PiecewiseSystem
 Fn = Callable[..., np.ndarray]
 
 
+#: fast relaxation times (eps) after which an exp(-t/eps) transient is below
+#: double resolution (exp(-40) = 4e-18): the models' ``transient_time`` in units of eps
+TRANSIENT = 40.0
+
+
 @dataclass(frozen=True)
 class SlowFastModel:
     """Components take ``x`` with shape ``(nx, ...)`` and ``y`` with ``(ny, ...)``.
@@ -48,6 +53,10 @@ class SlowFastModel:
     exact_flows: Mapping[str, Mapping[int, Callable]] = field(default_factory=dict)
     sample_step_full: float = np.inf
     sample_step_reduced: float = np.inf
+    # see PiecewiseSystem: the slow-fast system's slow sample step, used once the
+    # fast relaxation after a mode entry has decayed (after transient_time_full)
+    slow_sample_step_full: float = np.nan
+    transient_time_full: float = np.inf
     units: Mapping[str, str] = field(default_factory=dict)
     parameters: Mapping[str, float] = field(default_factory=dict)
 
@@ -90,7 +99,8 @@ class SlowFastModel:
         return PiecewiseSystem(
             names=self.slow_names + self.fast_names, field_minus=fm, field_plus=fp,
             switch=H, switch_grad=dH, flows=flows, sliding=sliding,
-            sample_step=self.sample_step_full, units=self.units,
+            sample_step=self.sample_step_full, slow_sample_step=self.slow_sample_step_full,
+            transient_time=self.transient_time_full, units=self.units,
             description=f"{self.name}: slow-fast system, eps={eps!r}")
 
     def reduced(self, *, sliding: bool = True, exact: bool = True) -> PiecewiseSystem:

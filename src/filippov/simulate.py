@@ -107,14 +107,17 @@ class Trajectory:
 
 # --------------------------------------------------------------------------- steppers
 class _ExactStepper:
-    """Walks an exact flow in windows of ``h``; the evaluator is the flow itself."""
+    """Walks an exact flow in windows of ``h`` (``h_slow`` once ``transient`` has
+    passed since the mode entry); the evaluator is the flow itself."""
 
-    def __init__(self, flow, z, t, t_end, h):
+    def __init__(self, flow, z, t, t_end, h, h_slow=None, transient=np.inf):
         self.flow, self.za, self.ta, self.t, self.t_end, self.h = flow, z.copy(), t, t, t_end, h
+        self.h_slow, self.transient = (h if h_slow is None else h_slow), transient
 
     def step(self):
         ta = self.t
-        tb = min(ta + self.h, self.t_end)
+        h = self.h if ta - self.ta < self.transient else self.h_slow
+        tb = min(ta + h, self.t_end)
         if tb == ta:  # h below the spacing of floats at t
             tb = np.nextafter(ta, np.inf)
         self.t = tb
@@ -241,6 +244,14 @@ def _quiet_floating_point(fn):
     return wrapper
 
 
+def slow_window(slow_sample_step, h, max_step, span):
+    """The window of an exact flow after the fast transient: EXACT_BLOCK slow
+    sample steps, within the same caps as the fast window and never shorter."""
+    if not np.isfinite(slow_sample_step):
+        return h
+    return max(h, min(EXACT_BLOCK * slow_sample_step, max_step, span))
+
+
 @_quiet_floating_point
 def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
              method: str = "exact", rtol: float = 1e-12, atol: float = 1e-14,
@@ -298,7 +309,9 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
         use_flow = method == "exact" and system.has_flow(mode)
         if use_flow:
             h = min(EXACT_BLOCK * system.sample_step, max_step, t_end - t0)
-            stepper = _ExactStepper(system.flows[mode], z, t, t_end, h)
+            stepper = _ExactStepper(system.flows[mode], z, t, t_end, h,
+                                    slow_window(system.slow_sample_step, h, max_step, t_end - t0),
+                                    system.transient_time)
         else:
             traj.integrated_modes.add(MODE_NAMES[mode])
             stepper = _IntegratingStepper(lambda _t, zz, m=mode: system.field(m, zz),

@@ -34,7 +34,13 @@ class PiecewiseSystem:
     a trajectory reaches an attracting sliding region, the solver stops with an
     error instead of silently computing an effect the scene did not declare.
     ``sample_step`` is the longest time between samples when an exact flow is
-    scanned for events; it must resolve the fastest time scale (eps).
+    scanned for events; it must resolve the fastest time scale (eps). A model
+    whose fast time scale lives only in a relaxation after each mode entry
+    declares how long that lasts (``transient_time``: after it the relaxation
+    is below roundoff) and the sample step of its slow dynamics
+    (``slow_sample_step``): an exact flow that stays longer than
+    ``transient_time`` in one mode is scanned at the slow step from then on,
+    so tiny eps does not cost O(1/eps) samples per unit time.
     """
 
     names: tuple[str, ...]
@@ -45,6 +51,8 @@ class PiecewiseSystem:
     flows: Mapping[int, Flow] = field(default_factory=dict)
     sliding: bool = True
     sample_step: float = np.inf
+    slow_sample_step: float = np.nan   # NaN: none (sample_step throughout)
+    transient_time: float = np.inf
     units: Mapping[str, str] = field(default_factory=dict)
     description: str = ""
 

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import SlowFastModel
+from ..model import TRANSIENT, SlowFastModel
 from ..system import MINUS, PLUS
 
 
@@ -121,6 +121,9 @@ def model(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi) -
         exact_flows=flows,
         sample_step_full=min(eps / 4, period / 64) if eps > 0 else np.inf,
         sample_step_reduced=period / 64,
+        # y - x1 (region +) and y - M_-(x) (region -) decay like exp(-t/eps) exactly:
+        # after 40 eps (exp(-40) = 4e-18) only the slow dynamics is left
+        slow_sample_step_full=period / 64, transient_time_full=TRANSIENT * eps,
         units={"t": "1", "x1": "1", "x2": "1", "y": "1"},
         parameters={"eps": eps, "theta": theta, "mu": mu, "omega": omega})
 
@@ -142,6 +145,7 @@ def compiled(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi
         name="hopf", names=("x1", "x2", "y"),
         params=np.array([eps, theta, mu, omega], dtype=float), **pieces,
         section_direction=-1, sample_step=min(eps / 4, period / 64), sliding=sliding,
+        slow_sample_step=period / 64, transient_time=TRANSIENT * eps,
         parameters={"eps": eps, "theta": theta, "mu": mu, "omega": omega})
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import SlowFastModel
+from ..model import TRANSIENT, SlowFastModel
 from ..system import MINUS, PLUS, SLIDING
 
 
@@ -62,6 +62,8 @@ def model(eps: float, theta: float) -> SlowFastModel:
         eps=eps, y0=lambda x: x.copy(), y0_jac=lambda x: np.ones((1,) + np.shape(x)),
         exact_flows={"full": flows_full, "reduced": flows_reduced},
         sample_step_full=eps / 4 if eps > 0 else np.inf, sample_step_reduced=0.25,
+        # y - x relaxes like exp(-t/eps) after a mode entry; then x, y move at speed 1
+        slow_sample_step_full=0.25, transient_time_full=TRANSIENT * eps,
         units={"t": "1", "x": "1", "y": "1"}, parameters={"eps": eps, "theta": theta})
 
 
@@ -80,7 +82,8 @@ def compiled(eps: float, theta: float, *, section_x: float = 10.0):
     return CompiledModel(
         name="pseudo_equilibrium", names=("x", "y"),
         params=np.array([eps, theta, section_x], dtype=float), **_compiled_pieces(),
-        section_direction=-1, sample_step=eps / 4,
+        section_direction=-1, sample_step=eps / 4, slow_sample_step=0.25,
+        transient_time=TRANSIENT * eps,
         parameters={"eps": eps, "theta": theta})
 
 
