@@ -1,6 +1,5 @@
 """The continuation pieces on problems with known answers."""
 import numpy as np
-import pytest
 
 from filippov import continuation as cont
 

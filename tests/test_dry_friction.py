@@ -3,7 +3,6 @@ stability, slow manifold, reduced vs slow-fast, return-map fixed points and the
 saddle-node, each against an independent check or a refinement."""
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
 from filippov.models import dry_friction as df
 from filippov.scenes import fig10_dfo as f10

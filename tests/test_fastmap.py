@@ -13,7 +13,6 @@ from filippov import fastmap
 from filippov.models import hopf, pseudo_equilibrium
 from filippov.poincare import Returns
 from filippov.scenes.fig04_retmaps import return_map
-from filippov.simulate import Section
 
 EPS, MU, OMEGA = 0.01, 1.0, 8 * np.pi
 OPTS = {"rtol": 1e-12, "atol": 1e-14}

@@ -8,7 +8,7 @@ drift cannot pass. Speed is measured in `make bench`, not here.
 import numpy as np
 import pytest
 
-from filippov import SLIDING, SimulationError, ZenoError, fastmap, hard_cases, simulate
+from filippov import SLIDING, ZenoError, fastmap, hard_cases, simulate
 from filippov.analytic import chatter
 from filippov.models import hopf, pseudo_equilibrium
 

@@ -11,7 +11,7 @@ import yaml
 
 pytest.importorskip("filippov.scenes", reason="compute code (filippov.scenes) not importable yet")
 
-from conftest import ROOT, copy_project, run_snakemake
+from conftest import copy_project, run_snakemake
 
 
 def _project(tmp_path) -> Path:

@@ -10,8 +10,6 @@ import os
 import re
 import shutil
 import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -19,7 +17,7 @@ import pytest
 import xarray as xr
 import yaml
 
-from conftest import copy_project, run_snakemake
+from conftest import run_snakemake
 from filippov import report
 
 ROOT = Path(__file__).resolve().parents[1]

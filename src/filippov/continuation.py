@@ -29,7 +29,6 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
 from .progress import Progress
-from .system import MINUS, PLUS, SLIDING
 
 
 class ContinuationError(RuntimeError):
@@ -156,8 +155,8 @@ def locate_fold(G, u_a, u_b, *, param_index=-1, state_index=None, tol=1e-12):
     cache = {}
 
     def solve(s):
-        # solve for everything but coordinate state_index, from the nearer end point
-        base = u_a if abs(s - u_a[state_index]) < abs(s - u_b[state_index]) else u_b
+        # solve for everything but coordinate state_index, from the interpolated guess
+        # (or the nearest point solved before)
         frac = (s - u_a[state_index]) / (u_b[state_index] - u_a[state_index])
         guess = u_a + frac * (u_b - u_a)
         if cache:

@@ -15,7 +15,7 @@ so that a scene asks for exactly the system it needs.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Mapping, Optional
+from typing import Callable, Mapping
 
 import numpy as np
 

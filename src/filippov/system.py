@@ -13,7 +13,7 @@ state ``(n,)`` and elapsed times ``tau`` (scalar or ``(m,)``).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, Mapping, Optional
+from typing import Callable, Mapping
 
 import numpy as np
 

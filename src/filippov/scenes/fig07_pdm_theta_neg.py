@@ -16,7 +16,7 @@ import xarray as xr
 from ..analytic import pdm as asym
 from ..analytic.s0 import s0_lambert
 from ..io import finalize
-from .pdm_common import (CHUNK_AXIS, base_dataset, checked_theta, chunk_grid,
+from .pdm_common import (CHUNK_AXIS, base_dataset, checked_theta, chunk_grid,  # noqa: F401
                          fields_from_dataset, max_error, rates, sweep_dataset)
 # CHUNK_AXIS, chunk_grid, sweep and assemble make the scene splittable (see .chunking)
 
@@ -38,7 +38,7 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     """The figure's dataset from the fields on the whole xi1 grid (see `sweep`)."""
     theta = _theta(scene)
     p = scene["parameters"]
-    omega, mu = float(p["omega"]), float(p["mu"])
+    omega = float(p["omega"])
     eps, xi, f = fields_from_dataset(scene, raw)
     ds = base_dataset(eps, xi, f, theta)
     x = f["xi1"]

@@ -357,7 +357,6 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     lit = dict(law, convention="literal")
     F_lit = df.friction(nu, **lit)
     Fp, _, Fm, _ = df.friction_branches(**law)
-    one = {"units": "1"}
 
     ds = xr.Dataset(
         {"v_hopf": ((), v_hopf, {"long_name": "Hopf point: belt speed with F_c'(-v) = 0, ln(fc/fv)",
