@@ -130,10 +130,11 @@ def model(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi) -
 
 # --------------------------------------------------------------------------- compiled
 def compiled(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi, *,
-             sliding: bool = True):
+             sliding: bool = True, exact: bool = True):
     """The slow-fast system z = (x1, x2, y) with its exact flows, compiled for
     :mod:`filippov.fastmap`, with the section L1 of fig:retmaps (x1 = 0, x1
-    decreasing, x2 > 0). The same formulas as :func:`model`, in scalar form."""
+    decreasing, x2 > 0). The same formulas as :func:`model`, in scalar form.
+    ``exact=False``: the kernel integrates regions + and - with DOP853 instead."""
     check_parameters(eps, theta, mu, omega)
     if eps <= 0:
         raise ValueError("eps must be > 0 for the slow-fast system")
@@ -145,7 +146,7 @@ def compiled(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi
         name="hopf", names=("x1", "x2", "y"),
         params=np.array([eps, theta, mu, omega], dtype=float), **pieces,
         section_direction=-1, sample_step=min(eps / 4, period / 64), sliding=sliding,
-        slow_sample_step=period / 64, transient_time=TRANSIENT * eps,
+        slow_sample_step=period / 64, transient_time=TRANSIENT * eps, exact=exact,
         parameters={"eps": eps, "theta": theta, "mu": mu, "omega": omega})
 
 

@@ -12,8 +12,6 @@ rate of change of h along the region-minus field at the grazing point p_g.
 """
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import xarray as xr
 
@@ -49,10 +47,9 @@ def return_map(model, x2, method: str, options: dict, progress=None, sliding=Tru
     t_max = 4.0 * 2 * np.pi / abs(model.parameters["omega"])
     if engine == "compiled":
         par = model.parameters
+        # method "integrate": regions + and - integrated with the kernel's DOP853
         cmodel = hopf.compiled(par["eps"], par["theta"], par["mu"], par["omega"],
-                               sliding=sliding)
-        if method != "exact":  # integrated with the kernel's DOP853
-            cmodel = dataclasses.replace(cmodel, exact=False)
+                               sliding=sliding, exact=method == "exact")
         ret = first_returns_compiled(cmodel, starts, t_max, progress=progress, **options)
     else:
         system = model.full(sliding=sliding, exact=method == "exact")
