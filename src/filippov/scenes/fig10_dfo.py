@@ -21,6 +21,8 @@ largest block position x1 along the orbit (x1 where the orbit crosses
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import xarray as xr
 from scipy.integrate import solve_ivp
@@ -252,8 +254,14 @@ def _special_speeds(scene: dict):
     v_hopf = df.hopf_speed(law["fv"], law["fc"], law["convention"])
     if not np.isfinite(v_hopf):
         raise ValueError(f"{scene['id']}: parameters: this friction law has no Hopf point")
-    v_gs = grazing_speed(law, (v_hopf + 1e-3, float(p["v_max"])))
-    return law, v_hopf, v_gs
+    return law, v_hopf, _grazing_speed_cached(tuple(sorted(law.items())), v_hopf,
+                                              float(p["v_max"]))
+
+
+@functools.lru_cache(maxsize=8)
+def _grazing_speed_cached(law_items, v_hopf, v_max):
+    # chunk_grid, sweep and assemble each need GS; one root search per process
+    return grazing_speed(dict(law_items), (v_hopf + 1e-3, v_max))
 
 
 def stick_slip_speeds(p: dict, v_gs: float) -> np.ndarray:
