@@ -5,6 +5,9 @@
 #   make verify    two clean builds in a temporary directory: byte-identical,
 #                  and in agreement with tests/reference/manifest.json
 #   make manifest  rewrite the manifest from results/ and figures/ (prints changes)
+#   make cross-cpu emulate another CPU's last bits (libm, numpy SIMD, numba) and check
+#                  every scene against the manifest; CROSS_CPU_ARGS="--record" stores
+#                  the measured spread next to each tolerance
 #   make report    the reproduction report paper/main.pdf (needs TeX)
 #   make report-html  snakemake's HTML report (report.html): figures, rules, parameters
 #   make lock      re-resolve requirements.lock in a throw-away venv
@@ -40,7 +43,7 @@ export DEBIAN_FRONTEND = noninteractive
 # `python` inside Snakemake shell rules is the venv's interpreter.
 VENV_PATH = PATH="$(abspath $(VENV))/bin:$$PATH" VIRTUAL_ENV="$(abspath $(VENV))"
 
-.PHONY: all venv figures test verify manifest report report-html bench bench-fig04 lock clean distclean check-python
+.PHONY: all venv figures test verify cross-cpu manifest report report-html bench bench-fig04 lock clean distclean check-python
 
 all: figures
 
@@ -84,6 +87,10 @@ test: $(VENV)/.done
 
 verify: $(VENV)/.done
 	$(VENV_PATH) $(PY) workflow/scripts/verify.py
+
+CROSS_CPU_ARGS ?=
+cross-cpu: $(VENV)/.done
+	$(VENV_PATH) $(PY) tests/crosscpu/cross_cpu.py $(CROSS_CPU_ARGS)
 
 manifest: figures
 	$(VENV_PATH) $(PY) -m filippov.manifest update

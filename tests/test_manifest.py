@@ -7,7 +7,7 @@ import shutil
 import numpy as np
 import xarray as xr
 
-from filippov import manifest
+from filippov import manifest, tolerance
 from filippov.io import write_dataset
 
 
@@ -15,7 +15,7 @@ def _dataset(path, scale=1.0):
     x = np.linspace(0.0, 1.0, 500)
     ds = xr.Dataset({"P": ("x", np.sin(7 * x) * scale), "n": ("x", np.arange(500)),
                      "label": ((), "text is not compared")}, coords={"x": x})
-    write_dataset(ds, path)
+    write_dataset(tolerance.annotate(ds, {}), path)
     return path
 
 
@@ -23,9 +23,9 @@ def test_data_within_tolerance_passes_and_beyond_fails(tmp_path):
     ref = manifest.summarize(_dataset(tmp_path / "a.nc"))
     assert set(ref) == {"P", "n", "x"}
     near = manifest.summarize(_dataset(tmp_path / "b.nc", scale=1 + 1e-13))
-    assert manifest.compare_data(near, ref, 1e-9, 1e-12) == []
+    assert manifest.compare_data(near, ref) == []
     far = manifest.summarize(_dataset(tmp_path / "c.nc", scale=1 + 1e-6))
-    problems = manifest.compare_data(far, ref, 1e-9, 1e-12)
+    problems = manifest.compare_data(far, ref)
     assert len(problems) == 1 and problems[0].startswith("P: differs by up to")
 
 
@@ -34,7 +34,7 @@ def test_shape_and_missing_variables_are_reported(tmp_path):
     got = dict(ref)
     del got["n"]
     got["extra"] = ref["P"]
-    problems = manifest.compare_data(got, ref, 1e-9, 1e-12)
+    problems = manifest.compare_data(got, ref)
     assert "n: missing" in problems and "extra: not in the manifest" in problems
 
 
@@ -85,6 +85,34 @@ def test_check_in_another_environment_compares_images(tmp_path):
     assert any("fig98_new.nc: not in the manifest" in p for p in problems)
 
 
+def test_figures_are_hashed_only_for_the_same_environment_and_data(tmp_path):
+    res, figs = tmp_path / "results", tmp_path / "figures"
+    res.mkdir(), figs.mkdir()
+    _dataset(res / "fig99_test.nc")
+    _figure(figs / "fig99_test.png"), _figure(figs / "fig99_test.pdf")
+    man = manifest.build_manifest(res, figs)
+    thumbs = tmp_path / "reference" / "figures"
+    manifest.write_thumbnail(figs / "fig99_test.png", thumbs / "fig99_test.png")
+    (figs / "fig99_test.pdf").write_bytes(b"%PDF other bytes")
+    assert any("hash differs" in p for p in manifest.check(res, figs, man, thumbs))
+    # data within its tolerance but not bit-identical (another CPU): a figure's
+    # bytes may differ too, so it is compared as an image
+    _dataset(res / "fig99_test.nc", scale=1 + 1e-13)
+    assert manifest.check(res, figs, man, thumbs) == []
+
+
+def test_an_unreadable_dataset_is_listed_and_the_check_goes_on(tmp_path):
+    res, figs = tmp_path / "results", tmp_path / "figures"
+    res.mkdir(), figs.mkdir()
+    _dataset(res / "fig98_a.nc"), _dataset(res / "fig99_b.nc")
+    man = manifest.build_manifest(res, figs)
+    (res / "fig98_a.nc").write_bytes(b"CDF\x02 not a dataset")
+    _dataset(res / "fig99_b.nc", scale=2.0)
+    problems = manifest.check(res, figs, man)
+    assert any(p.startswith("results/fig98_a.nc: unreadable") for p in problems)
+    assert any(p.startswith("results/fig99_b.nc: P: differs") for p in problems)
+
+
 def test_update_prints_what_changed(tmp_path, capsys):
     res, figs = tmp_path / "results", tmp_path / "figures"
     res.mkdir(), figs.mkdir()
@@ -100,7 +128,8 @@ def test_update_prints_what_changed(tmp_path, capsys):
     assert "~ results/fig99_test.nc: P: differs" in out
     assert manifest.main(["check", "--results", str(res), "--figures", str(figs),
                           "--manifest", str(path)]) == 0
-    assert json.loads(path.read_text())["data"]["fig99_test"]["tolerance"]["rtol"] == 1e-9
+    saved = json.loads(path.read_text())["data"]["fig99_test"]["variables"]["P"]["tolerance"]
+    assert saved["rtol"] == 1e-9 and saved["why"] == tolerance.DEFAULT.why
 
 
 def test_fresh_build_agrees_with_the_committed_manifest(workflow_build):

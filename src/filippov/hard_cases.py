@@ -39,6 +39,7 @@ import xarray as xr
 from . import fastmap
 from .analytic import chatter
 from .io import finalize
+from .tolerance import ULP, Tolerance, annotate, sqrt_law
 from .models import hopf, pseudo_equilibrium
 from .progress import Progress
 from .scenes.chunking import bounds
@@ -118,6 +119,20 @@ VARIABLES = {
     "kernel_finite": ("i4", "1 if the final state of the compiled kernel is finite, else 0",
                       "1"),
 }
+_OFFSET = PARAMETERS["jump_x2_offset"]
+#: cross-machine tolerances beyond the default (see filippov.tolerance)
+TOLERANCES = {
+    "jump": Tolerance(1e-6, 1e-12, f"return of a start {_OFFSET:g} above grazing: event "
+                                   f"times square-root conditioned (ulp/(2 sqrt(offset)) = "
+                                   f"{sqrt_law(_OFFSET):.1e}) in a jump of O(eps)"),
+    "jump_over_eps": Tolerance(1e-6, 1e-12, "as jump"),
+    "slope": Tolerance(1e-9, 20 * ULP / PARAMETERS["slope_probe_floor"],
+                       "difference quotient over a probe >= slope_probe_floor: one ulp of P "
+                       "moves it by ulp/probe; x20"),
+    "slope_sliding_time": Tolerance(1e-9, sqrt_law(PARAMETERS["slope_probe_floor"], 3.0),
+                                    "slide of a probe just past grazing: square-root law; x3"),
+}
+
 EPS_ATTRS = {"long_name": "singular perturbation parameter eps", "units": "1"}
 
 
@@ -293,7 +308,7 @@ def _raw(eps: list[float], progress: bool = False, label: str = DATASET_ID) -> x
 
 
 def _finish(raw: xr.Dataset, eps: list[float]) -> xr.Dataset:
-    return finalize(raw, _provenance(eps),
+    return finalize(annotate(raw, TOLERANCES), _provenance(eps),
                     title="hard cases: eps sweep of the jump, slope, chatter period and "
                           "slide-in (filippov.hard_cases)")
 

@@ -1,15 +1,19 @@
 """The reproducibility manifest: what every dataset and figure must contain.
 
-Datasets are compared with a declared tolerance against committed reference
-values: for every numeric variable its shape, NaN count, min, max, mean and up
-to ``SAMPLES`` values at fixed, evenly spread positions. Exact hashes of floats
-are not portable (libm's exp/log can differ in the last bit between CPUs), so a
-hash is kept only as a shortcut (equal hash: equal data).
+Datasets are compared against committed reference values: for every numeric
+variable its shape, NaN count, min, max, mean and up to ``SAMPLES`` values at
+fixed, evenly spread positions, each within the tolerance the scene declares
+for that variable (:mod:`filippov.tolerance`; stored in the data's attributes
+and copied into the manifest, where the cross-CPU check records the spread it
+measured next to it). Equal hashes mean equal data; exact hashes of floats are
+not portable (libm's exp/log differ in the last bit between CPUs).
 
-Figures are checked by file hash when the environment matches the one the
-manifest was made in (same lock file, Python, matplotlib and FreeType); in any
-other environment the PNG is compared, with a tolerance, to a small committed
-reference image (grey, downsampled) instead.
+Figures are checked by file hash only where their bytes can be expected to be
+equal: the same environment (lock file, Python, matplotlib, FreeType, numpy's
+SIMD dispatch, numba's target CPU, libc) and the same data (every variable of
+the figure's dataset bit-identical to the manifest). Otherwise the PNG is
+compared, with a tolerance, to a small committed reference image (grey,
+downsampled).
 
 ``python -m filippov.manifest update`` rewrites the manifest from results/ and
 figures/ and prints what changed; ``check`` compares a build with it.
@@ -19,31 +23,56 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
+import os
 import platform
 import sys
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
+
+from .tolerance import DEFAULT, Tolerance, final_values
 
 ROOT = Path(__file__).resolve().parents[2]
 MANIFEST = ROOT / "tests" / "reference" / "manifest.json"
 THUMBS = ROOT / "tests" / "reference" / "figures"
 SAMPLES = 64
-RTOL, ATOL = 1e-9, 1e-12      # default tolerance for data
 IMAGE_RMS = 0.02              # tolerated RMS grey-level difference of thumbnails (0..1)
 THUMB_FACTOR = 4              # thumbnails keep every 4th pixel of the 200-dpi PNG
 
 
 # ----------------------------------------------------------------------------- environment
+def arithmetic() -> dict:
+    """What decides the last bits of the numbers on this machine: numpy's SIMD
+    dispatch (its AVX-512 loops round differently from the baseline ones),
+    numba's target CPU, the C library, and a preloaded library (the cross-CPU
+    emulation's)."""
+    import numpy as np
+    from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+
+    try:
+        from llvmlite import binding
+        host = binding.get_host_cpu_name()
+    except Exception:  # numba absent: nothing compiled
+        host = "none"
+    return {"machine": platform.machine(), "numpy": np.__version__,
+            "numpy_simd": [f for f in __cpu_dispatch__ if __cpu_features__.get(f)],
+            "numba_cpu": os.environ.get("NUMBA_CPU_NAME", host),
+            "libc": "-".join(platform.libc_ver()),
+            "preload": os.environ.get("LD_PRELOAD", "") + ":" + os.environ.get("LASTBIT_SEED", "")}
+
+
 def environment() -> str:
-    """Fingerprint of what decides a figure's bytes."""
+    """Fingerprint of what decides a figure's bytes for given data, and of the
+    arithmetic that decides the data's last bits."""
     import matplotlib
     from matplotlib import ft2font
 
     lock = (ROOT / "requirements.lock")
     parts = [hashlib.sha256(lock.read_bytes()).hexdigest() if lock.exists() else "no-lock",
-             platform.python_version(), platform.machine(), matplotlib.__version__,
-             getattr(ft2font, "__freetype_version__", "?")]
+             platform.python_version(), matplotlib.__version__,
+             getattr(ft2font, "__freetype_version__", "?"),
+             json.dumps(arithmetic(), sort_keys=True)]
     return hashlib.sha256("|".join(parts).encode()).hexdigest()[:16]
 
 
@@ -52,8 +81,13 @@ def sha256(path: Path) -> str:
 
 
 # ----------------------------------------------------------------------------- data
+def _finite_list(values) -> list:
+    return [None if not np.isfinite(v) else float(v) for v in values]
+
+
 def summarize(path: Path) -> dict:
-    """The reference values of one dataset: per numeric variable, statistics and samples."""
+    """The reference values of one dataset: per numeric variable, its tolerance,
+    statistics and samples (for a ``trace``, the converged values)."""
     from .io import read_dataset
 
     ds = read_dataset(path)
@@ -62,29 +96,71 @@ def summarize(path: Path) -> dict:
         values = np.asarray(ds[name].values)
         if values.dtype.kind not in "fiub":
             continue
+        tol = Tolerance.from_attrs(ds[name].attrs)
         flat = values.astype(float).ravel()
         finite = flat[np.isfinite(flat)]
         idx = np.unique(np.linspace(0, flat.size - 1, min(SAMPLES, flat.size)).round().astype(int)) \
             if flat.size else np.array([], dtype=int)
         out[name] = {
+            "tolerance": asdict(tol),
             "shape": list(values.shape), "nan": int(np.count_nonzero(np.isnan(flat))),
             "min": float(finite.min()) if finite.size else None,
             "max": float(finite.max()) if finite.size else None,
             "mean": float(finite.mean()) if finite.size else None,
-            "index": idx.tolist(), "sample": [None if not np.isfinite(v) else float(v)
-                                             for v in flat[idx]],
+            "index": idx.tolist(), "sample": _finite_list(flat[idx]),
             "sha256": hashlib.sha256(np.ascontiguousarray(values).tobytes()).hexdigest()}
+        if tol.rule == "trace":
+            out[name]["final"] = _finite_list(final_values(values)) if values.size else []
     return out
 
 
-def _close(a, b, rtol, atol) -> bool:
+def _close(a, b, tol: Tolerance) -> bool:
     if a is None or b is None:
         return a is None and b is None
-    return abs(a - b) <= atol + rtol * abs(b)
+    return abs(a - b) <= tol.atol + tol.rtol * abs(b)
 
 
-def compare_data(got: dict, want: dict, rtol: float, atol: float) -> list[str]:
-    """Differences between two summaries, one line each (empty: they agree)."""
+def _worst(pairs, tol: Tolerance) -> float:
+    """The largest difference among the pairs that are not within ``tol`` (0: all are)."""
+    worst = 0.0
+    for a, b in pairs:
+        if not _close(a, b, tol):
+            worst = max(worst, np.inf if a is None or b is None else abs(a - b))
+    return worst
+
+
+def _compare_variable(g: dict, w: dict, tol: Tolerance) -> str | None:
+    """One line on how ``g`` differs from the reference ``w`` beyond ``tol`` (None: agrees)."""
+    rule = f"(rule {tol.rule}: {tol.why})"
+    if tol.rule == "trace":
+        # an iteration history: only the converged value of each row is a result
+        if g["shape"][:-1] != w["shape"][:-1] or len(g["final"]) != len(w["final"]):
+            return f"rows {g['shape'][:-1]} != {w['shape'][:-1]} {rule}"
+        worst = _worst(zip(g["final"], w["final"]), tol)
+        return None if worst == 0 else \
+            f"converged value differs by up to {worst:.3e} (tolerance {tol.atol:g} + " \
+            f"{tol.rtol:g}*|value|) {rule}"
+    if g["shape"] != w["shape"] or g["nan"] != w["nan"] or g["index"] != w["index"]:
+        return f"shape/NaN count {g['shape']}/{g['nan']} != {w['shape']}/{w['nan']}"
+    if tol.rule == "tangency":
+        # decided at a tangency: up to `changed` entries may leave the tolerance, by <= jump
+        out = [abs(a - b) for a, b in zip(g["sample"], w["sample"]) if not _close(a, b, tol)]
+        loose = Tolerance(tol.rtol, tol.atol + tol.jump, tol.why)
+        if len(out) <= tol.changed and all(d <= tol.jump for d in out) and \
+                _worst(((g[k], w[k]) for k in ("min", "max")), loose) == 0:
+            return None
+        return f"{len(out)} sampled entries beyond {tol.atol:g} + {tol.rtol:g}*|value| (by " \
+               f"up to {max(out, default=0):.3e}; at most {tol.changed} may, by at most " \
+               f"{tol.jump:g}) {rule}"
+    worst = max(_worst(((g[k], w[k]) for k in ("min", "max", "mean")), tol),
+                _worst(zip(g["sample"], w["sample"]), tol))
+    return None if worst == 0 else \
+        f"differs by up to {worst:.3e} (tolerance {tol.atol:g} + {tol.rtol:g}*|value|) {rule}"
+
+
+def compare_data(got: dict, want: dict) -> list[str]:
+    """Differences between two summaries, one line each (empty: they agree). Each
+    variable is compared with the tolerance recorded in ``want`` (the manifest's)."""
     problems = []
     for name in sorted(set(want) | set(got)):
         if name not in got:
@@ -96,20 +172,13 @@ def compare_data(got: dict, want: dict, rtol: float, atol: float) -> list[str]:
         g, w = got[name], want[name]
         if g["sha256"] == w["sha256"]:
             continue
-        if g["shape"] != w["shape"] or g["nan"] != w["nan"] or g["index"] != w["index"]:
-            problems.append(f"{name}: shape/NaN count {g['shape']}/{g['nan']} "
-                            f"!= {w['shape']}/{w['nan']}")
-            continue
-        worst = 0.0
-        for key in ("min", "max", "mean"):
-            if not _close(g[key], w[key], rtol, atol):
-                worst = max(worst, abs(g[key] - w[key]))
-        for a, b in zip(g["sample"], w["sample"]):
-            if not _close(a, b, rtol, atol):
-                worst = max(worst, np.inf if a is None or b is None else abs(a - b))
-        if worst > 0:
-            problems.append(f"{name}: differs by up to {worst:.3e} "
-                            f"(tolerance {atol:g} + {rtol:g}*|value|)")
+        tol = Tolerance(**w["tolerance"]) if "tolerance" in w else DEFAULT
+        if "tolerance" in w and g["tolerance"] != w["tolerance"]:
+            problems.append(f"{name}: the data declares tolerance {g['tolerance']}, the "
+                            f"manifest {w['tolerance']} (run `make manifest`)")
+        msg = _compare_variable(g, w, tol)
+        if msg:
+            problems.append(f"{name}: {msg}")
     return problems
 
 
@@ -155,11 +224,18 @@ def data_files(results: Path) -> list[Path]:
 
 
 def build_manifest(results: Path, figures: Path, old: dict | None = None) -> dict:
+    """The manifest of a build. The cross-CPU spreads recorded in ``old`` are kept
+    for variables whose tolerance is unchanged (they were measured against it)."""
     old = old or {}
     data, figs = {}, {}
     for nc in data_files(results):
-        tol = old.get("data", {}).get(nc.stem, {}).get("tolerance", {"rtol": RTOL, "atol": ATOL})
-        data[nc.stem] = {"tolerance": tol, "variables": summarize(nc)}
+        variables = summarize(nc)
+        before = old.get("data", {}).get(nc.stem, {}).get("variables", {})
+        for name, entry in variables.items():
+            prev = before.get(name, {})
+            if "spread" in prev and prev.get("tolerance") == entry["tolerance"]:
+                entry["spread"] = prev["spread"]
+        data[nc.stem] = {"variables": variables}
     for pdf in sorted(Path(figures).glob("fig*.pdf")):
         png = pdf.with_suffix(".png")
         figs[pdf.stem] = {"pdf_sha256": sha256(pdf), "png_sha256": sha256(png),
@@ -171,20 +247,27 @@ def check(results: Path, figures: Path, manifest: dict, thumbs: Path = THUMBS) -
     """Everything in which a build differs from the manifest (empty: it agrees)."""
     problems = []
     same_env = manifest["environment"] == environment()
+    identical = set()   # datasets whose every variable is bit-identical to the manifest
     for sid, entry in sorted(manifest["data"].items()):
         path = Path(results) / f"{sid}.nc"
         if not path.exists():
             problems.append(f"results/{sid}.nc: missing")
             continue
-        tol = entry["tolerance"]
-        problems += [f"results/{sid}.nc: {p}" for p in
-                     compare_data(summarize(path), entry["variables"], tol["rtol"], tol["atol"])]
+        try:
+            got = summarize(path)
+        except Exception as exc:  # a damaged file is a mismatch to list, not a crash
+            problems.append(f"results/{sid}.nc: unreadable ({type(exc).__name__}: {exc})")
+            continue
+        want = entry["variables"]
+        problems += [f"results/{sid}.nc: {p}" for p in compare_data(got, want)]
+        if set(got) == set(want) and all(got[n]["sha256"] == want[n]["sha256"] for n in want):
+            identical.add(sid)
     for sid, entry in sorted(manifest["figures"].items()):
         pdf, png = Path(figures) / f"{sid}.pdf", Path(figures) / f"{sid}.png"
         if not (pdf.exists() and png.exists()):
             problems.append(f"figures/{sid}: missing")
             continue
-        if same_env:
+        if same_env and sid in identical:
             for p, key in ((pdf, "pdf_sha256"), (png, "png_sha256")):
                 if sha256(p) != entry[key]:
                     problems.append(f"figures/{p.name}: hash differs in the manifest's environment")
@@ -205,9 +288,7 @@ def describe_changes(old: dict, new: dict) -> list[str]:
         elif sid not in new["data"]:
             lines.append(f"- results/{sid}.nc (removed)")
         else:
-            tol = old["data"][sid]["tolerance"]
-            for p in compare_data(new["data"][sid]["variables"], old["data"][sid]["variables"],
-                                  tol["rtol"], tol["atol"]):
+            for p in compare_data(new["data"][sid]["variables"], old["data"][sid]["variables"]):
                 lines.append(f"~ results/{sid}.nc: {p}")
     for sid in sorted(set(old.get("figures", {})) | set(new["figures"])):
         o, n = old.get("figures", {}).get(sid), new["figures"].get(sid)
@@ -223,9 +304,12 @@ def describe_changes(old: dict, new: dict) -> list[str]:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("command", choices=["update", "check"])
-    ap.add_argument("--results", default=str(ROOT / "results"))
-    ap.add_argument("--figures", default=str(ROOT / "figures"))
-    ap.add_argument("--manifest", default=str(MANIFEST))
+    # a build in the working directory; its own manifest if it has one (a copy
+    # of the project), else the one of this package's checkout
+    local = Path("tests") / "reference" / "manifest.json"
+    ap.add_argument("--results", default="results")
+    ap.add_argument("--figures", default="figures")
+    ap.add_argument("--manifest", default=str(local if local.exists() else MANIFEST))
     args = ap.parse_args(argv)
     path = Path(args.manifest)
     old = json.loads(path.read_text()) if path.exists() else {}

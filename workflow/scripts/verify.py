@@ -39,8 +39,10 @@ def copy_project(dest: Path) -> Path:
     return dest
 
 
-def run_snakemake(work: Path, *args, cores: str = "1", timeout: float = 3000, capture=True):
-    env = dict(os.environ, MPLBACKEND="Agg", SOURCE_DATE_EPOCH="0")
+def run_snakemake(work: Path, *args, cores: str = "1", timeout: float = 3000, capture=True,
+                  env: dict | None = None):
+    """`snakemake` in ``work`` with the project's library; ``env`` adds variables."""
+    env = dict(os.environ, MPLBACKEND="Agg", SOURCE_DATE_EPOCH="0", **(env or {}))
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT / "src"), env.get("PYTHONPATH")]))
     env["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), env.get("PATH", "")])
     cmd = [sys.executable, "-m", "snakemake", "--cores", cores, "--directory", str(work), *args]

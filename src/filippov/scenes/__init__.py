@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import importlib
 
+from .. import tolerance
 from . import chunking
 
 SCENES = {
@@ -38,9 +39,20 @@ def _module(scene: dict):
     return module
 
 
+def _declared(module, scene, ds):
+    """``ds`` with each variable's cross-machine tolerance in its attributes: the
+    module's ``tolerances(scene)`` (when they follow the scene's eps or grid) or
+    ``TOLERANCES`` (see :mod:`filippov.tolerance`)."""
+    declared = module.tolerances(scene) if hasattr(module, "tolerances") else \
+        getattr(module, "TOLERANCES", {})
+    return tolerance.annotate(ds, declared)
+
+
 def compute(scene: dict, *, progress: bool = False):
     # `chunks` (how to split the work, see .chunking) is not part of the result
-    return _module(scene).compute(chunking.without_layout(scene), progress=progress)
+    module = _module(scene)
+    scene = chunking.without_layout(scene)
+    return _declared(module, scene, module.compute(scene, progress=progress))
 
 
 def _chunkable(scene: dict):
@@ -59,4 +71,5 @@ def compute_chunk(scene: dict, i: int, n: int | None = None, *, progress: bool =
 
 def merge(scene: dict, parts):
     """The scene's dataset from all its chunks (identical to :func:`compute`)."""
-    return chunking.merge(_chunkable(scene), scene, parts)
+    module = _chunkable(scene)
+    return _declared(module, scene, chunking.merge(module, scene, parts))

@@ -17,7 +17,11 @@ zero at mu = 1).
 At mu = 1 the orbit is the circle r = 1 and touches x1 = -1 at x_g only. In
 floating point its radius is 1 to an ulp, so the solver may report a degenerate
 slide there (length ~1e-8 in x2, ~1e-9 in time, around x_g): the answer for
-mu = 1 + O(1e-16). Those events are stored as they come (see sliding_time).
+mu = 1 + O(1e-16), present on one machine and absent on another. A period that
+slides for less than ``DEGENERATE_SLIDE`` in time is therefore the grazing
+orbit: x_h and x_l are NaN and its events are not put on the sample grid (so the
+samples of every machine lie at the same times); ``sliding_time`` keeps what
+the solver measured.
 """
 from __future__ import annotations
 
@@ -30,9 +34,31 @@ from ..io import finalize
 from ..models import hopf
 from ..progress import Progress
 from ..simulate import Section
+from ..tolerance import Tolerance
 from .common import require, solver_options
 
 COMPONENTS = ["x1", "x2"]
+#: a slide shorter than this (in time) is the grazing contact at mu = 1 + O(1e-16):
+#: its length is ~sqrt(1e-16) = 1e-8, while the slides of mu >= 1 + 1e-10 last
+#: longer than 1e-6 (length ~ sqrt(mu - 1))
+DEGENERATE_SLIDE = 1e-6
+
+#: cross-machine tolerances (filippov.tolerance): the grazing orbit at mu = 1 opens
+#: or closes a ~1e-9-long slide with the last bit of its radius (square-root law)
+_GRAZING = "mu = 1 grazes: a last-bit change of the radius opens or closes a slide of " \
+           "~sqrt(u) = 1e-8 in x2 and ~1e-9 in time (measured <= 4e-10)"
+TOLERANCES = {
+    "t": Tolerance(1e-9, 1e-8, _GRAZING + "; samples are uniform over the period"),
+    "period": Tolerance(1e-9, 1e-8, _GRAZING),
+    "sliding_time": Tolerance(1e-9, 1e-8, _GRAZING),
+    "x1": Tolerance(1e-9, 1e-6, _GRAZING + "; a sample time moved by 1e-8 moves x by |f| = 25 "
+                                          "times that"),
+    "x2": Tolerance(1e-9, 1e-6, _GRAZING + "; a sample time moved by 1e-8 moves x by |f| = 25 "
+                                          "times that"),
+    "mode": Tolerance(0.0, 0.0, _GRAZING + "; the sample at a quarter period lies on x_g "
+                                           "itself, inside or beside that slide",
+                      rule="tangency", changed=1, jump=1),
+}
 
 
 def section_L1() -> Section:
@@ -64,10 +90,11 @@ def settle(system, x2_start: float, tol: float, max_periods: int, opts: dict):
                        f"(last change {abs(returns[-1] - returns[-2]):.3e})")
 
 
-def one_period(traj, n: int):
-    """n samples of the whole run (one period), uniform in time plus the interior events."""
-    inner = np.array([e.t for e in traj.events
-                      if traj.t0 < e.t < traj.t and e.kind in ("slide_start", "slide_end", "crossing")])
+def one_period(traj, n: int, grazing: bool = False):
+    """n samples of the whole run (one period), uniform in time plus the interior events
+    (without the degenerate slide of a grazing orbit)."""
+    kinds = ("crossing",) if grazing else ("slide_start", "slide_end", "crossing")
+    inner = np.array([e.t for e in traj.events if traj.t0 < e.t < traj.t and e.kind in kinds])
     m = n - inner.size
     while True:
         times = np.union1d(np.linspace(traj.t0, traj.t, m), inner)
@@ -108,10 +135,13 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
         system = hopf.model(0.0, 0.0, mu, omega).reduced(sliding=True, exact=opts["method"] == "exact")
         traj, returns = settle(system, float(p["x2_start"]), float(p["settle_tol"]),
                                int(p["max_periods"]), opts)
-        t, z, mode = one_period(traj, n)
-        ev = {e.kind: e.state.copy() for e in traj.events if traj.t0 < e.t < traj.t}
         starts = [e.t for e in traj.events if e.kind == "slide_start"]
         ends = [e.t for e in traj.events if e.kind == "slide_end"]
+        slid = sum(b - a for a, b in zip(starts, ends))
+        grazing = slid < DEGENERATE_SLIDE
+        t, z, mode = one_period(traj, n, grazing)
+        ev = {} if grazing else \
+            {e.kind: e.state.copy() for e in traj.events if traj.t0 < e.t < traj.t}
         out["t"].append(t), out["x1"].append(z[0]), out["x2"].append(z[1])
         out["mode"].append(mode)
         out["period"].append(traj.t - traj.t0)
@@ -120,7 +150,7 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
         out["n_periods"].append(returns.size - 1)
         out["x_h"].append(ev.get("slide_start", nan2))
         out["x_l"].append(ev.get("slide_end", nan2))
-        out["sliding_time"].append(sum(b - a for a, b in zip(starts, ends)))
+        out["sliding_time"].append(slid)
         out["x_l_formula"].append([-1.0, x_l_tangency(mu, omega)] if mu >= 1 else nan2)
         out["left"].append(left_crossing(traj, t + traj.t0, z))
         bar.step(note=f"mu={mu}")
@@ -146,9 +176,11 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
          "sliding_time": ("mu", np.array(out["sliding_time"]),
                           {"long_name": "time spent sliding per period", "units": "1"}),
          "x_h": (vec, pts["x_h"], {"long_name": "start of sliding x_h (solver event slide_start; "
-                                                "NaN: no sliding)", "units": "1"}),
+                                                "NaN: no sliding, or a degenerate slide "
+                                                "shorter than degenerate_slide)", "units": "1"}),
          "x_l": (vec, pts["x_l"], {"long_name": "end of sliding x_l (solver event slide_end; "
-                                                "NaN: no sliding)", "units": "1"}),
+                                                "NaN: no sliding, or a degenerate slide "
+                                                "shorter than degenerate_slide)", "units": "1"}),
          "x_l_formula": (vec, pts["x_l_formula"], {
              "long_name": "x_l from the tangency dh0/dx f_+ = 0 on x1 = -1 (NaN: mu < 1)",
              "units": "1"}),
@@ -161,5 +193,6 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
                 "component": ("component", COMPONENTS),
                 "sample": ("sample", np.arange(n), {"long_name": "sample index along one period"})})
     return finalize(ds, scene, method=opts["method"], switching_line="x1 = -1",
+                    degenerate_slide=DEGENERATE_SLIDE,
                     section_L1="x1 = 0, x2 > 0",
                     title="grazing-sliding of the reduced Hopf example eq:red (fig:grazingsketch)")

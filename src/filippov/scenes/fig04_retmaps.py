@@ -22,6 +22,17 @@ from ..progress import Progress
 from ..simulate import Section
 from ..fastmap import first_returns_compiled
 from .common import engine, require, solver_options
+from ..tolerance import Tolerance, sqrt_law
+
+
+def tolerances(scene: dict) -> dict:
+    """Cross-machine tolerances (filippov.tolerance): the grid reaches ``closest``
+    above grazing, where times of flight follow a square-root law."""
+    closest = float(scene["parameters"]["closest"])
+    why = (f"start points down to {closest:g} above grazing: times vary as sqrt(x2 - 1), "
+           f"a last-bit change moves them by ulp/(2 sqrt(closest)); x20 (two contacts)")
+    tol = Tolerance(1e-9, sqrt_law(closest, 20.0), why)
+    return {"return_time": tol, "sliding_time": tol}
 
 
 def section_L1() -> Section:

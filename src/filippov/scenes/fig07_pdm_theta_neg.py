@@ -16,6 +16,30 @@ import xarray as xr
 from ..analytic import pdm as asym
 from ..analytic.s0 import s0_lambert
 from ..io import finalize
+from ..tolerance import EVENT_STATE, ULP, Tolerance
+
+
+def tolerances(scene: dict) -> dict:
+    """Cross-machine tolerances (filippov.tolerance). xi = (x1 + 1)/eps: an O(1)
+    state known to EVENT_STATE becomes EVENT_STATE/eps_min in xi; xi2 near
+    xi1 = 0 follows sqrt(-2 xi1), which amplifies the rounding of the start."""
+    p = scene["parameters"]
+    eps_min, closest = min(map(float, p["eps"])), float(p["closest"])
+    xi = EVENT_STATE / eps_min
+    in_xi = Tolerance(1e-9, xi, f"xi = (x1 + 1)/eps: event-located state ({EVENT_STATE:g}) "
+                                f"/ eps_min ({eps_min:g})")
+    xi2 = Tolerance(1e-9, 10 * 2 * ULP / eps_min / np.sqrt(2 * closest),
+                    f"xi2 ~ sqrt(-2 xi1) for xi1 >= -{closest:g}: 2 ulps of x1 / eps_min "
+                    f"amplified by 1/sqrt(2 closest); x10")
+    rate = Tolerance(1e-9, 2 * xi / (1e-3 * np.log(10)),
+                     f"log-log slope of errors >= 1e-3 known to {xi:g}: "
+                     f"2 delta/(e ln 10)")
+    names = ("P_DM", "P_flow", "xi1_exit", "excursion_time", "excursion_time_asym", "pi3_drop",
+             "pi3_drop_asym", "sliding_time", "P_left", "identity_error", "left_limit_error",
+             "error_first_order", "error_zero_order", "error_printed", "error_excursion_time",
+             "error_xi2_entry")
+    return {**{n: in_xi for n in names}, "xi2_entry": xi2, "xi2_exit": xi2,
+            "rate_first_order": rate, "rate_zero_order": rate}
 from .pdm_common import (CHUNK_AXIS, base_dataset, checked_theta, chunk_grid,  # noqa: F401
                          fields_from_dataset, max_error, rates, sweep_dataset)
 # CHUNK_AXIS, chunk_grid, sweep and assemble make the scene splittable (see .chunking)

@@ -7,6 +7,16 @@ import xarray as xr
 from ..analytic import s0
 from ..io import finalize
 from .common import require
+from ..tolerance import U, Tolerance
+
+
+def tolerances(scene: dict) -> dict:
+    """s0 = 1 - theta + W0(-(1 - theta) e^(theta - 1)) cancels near the branch
+    point of W0 (theta -> 0): its absolute spread is ~u/|theta|."""
+    theta_max = abs(float(scene["parameters"]["theta_max"]))
+    return {"s0": Tolerance(1e-9, 50 * U / theta_max,
+                            f"cancellation near W0's branch point: ~u/|theta| at |theta| >= "
+                            f"{theta_max:g}; x50")}
 
 
 def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:

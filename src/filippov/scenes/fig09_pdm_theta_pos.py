@@ -15,6 +15,33 @@ import xarray as xr
 
 from ..analytic import pdm as asym
 from ..io import finalize
+from ..tolerance import Tolerance
+
+#: x1 near -1 after the grazing-sliding passage: the events there move at speed
+#: O(eps), so each leaves x1 reproducible to an ulp or two of 1 (2.2e-16); 450
+#: ulps for the ~10 events and the sliding segment of one passage
+X1_NEAR_GRAZING = 1e-13
+
+
+def tolerances(scene: dict) -> dict:
+    """Cross-machine tolerances (filippov.tolerance). xi = (x1 + 1)/eps^2: x1 known
+    to X1_NEAR_GRAZING becomes X1_NEAR_GRAZING/eps_min^2 in xi; xi2 and the
+    sliding times follow sqrt(-2 xi1) near xi1 = 0; slopes divide by |xi1|."""
+    p = scene["parameters"]
+    eps_min, closest = min(map(float, p["eps"])), float(p["closest"])
+    xi = X1_NEAR_GRAZING / eps_min ** 2
+    in_xi = Tolerance(1e-9, xi, f"xi = (x1 + 1)/eps^2: x1 to {X1_NEAR_GRAZING:g} (450 ulps) / "
+                                f"eps_min^2 ({eps_min ** 2:g})")
+    sqrt = Tolerance(1e-9, xi / np.sqrt(2 * closest),
+                     f"~ sqrt(-2 xi1) for xi1 <= -{closest:g}: {xi:g} / sqrt(2 closest)")
+    slope = Tolerance(1e-9, xi / closest, f"P_DM/xi1 at |xi1| >= {closest:g}: {xi:g} / closest")
+    rate = Tolerance(1e-9, 2 * xi / (3e-3 * np.log(10)),
+                     f"log-log slope of errors >= 3e-3 known to {xi:g}: 2 delta/(e ln 10)")
+    names = ("P_DM", "P_flow", "xi1_exit", "pi3_drop", "pi3_drop_asym", "error", "error_core",
+             "error_printed", "error_xi1_exit", "identity_error", "P_left")
+    return {**{n: in_xi for n in names},
+            **{n: sqrt for n in ("xi2_entry", "xi2_exit", "excursion_time", "sliding_time")},
+            "error_slope": slope, "slope_left": slope, "rate": rate, "rate_core": rate}
 from .pdm_common import (CHUNK_AXIS, base_dataset, checked_theta, chunk_grid,  # noqa: F401
                          fields_from_dataset, max_error, rates, sweep_dataset)
 # CHUNK_AXIS, chunk_grid, sweep and assemble make the scene splittable (see .chunking)

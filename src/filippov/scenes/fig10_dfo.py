@@ -34,6 +34,20 @@ from ..models import dry_friction as df
 from ..progress import Progress
 from ..simulate import Section, simulate
 from .common import require
+from ..tolerance import Tolerance
+
+#: cross-machine tolerances (filippov.tolerance)
+TOLERANCES = {
+    "ss_stick_length": Tolerance(1e-9, 1e-8, "DOP853 at rtol 1e-12 over a period of ~7 with "
+                                             "|f| ~ 10: a last-bit change alters the step "
+                                             "sequence, so the state moves within the global "
+                                             "error ~1e-10; x100 for the stick end"),
+    "ss_stick_time": Tolerance(1e-9, 1e-8, "as ss_stick_length"),
+    "ss_closure": Tolerance(1e-9, 1e-11, "a residual at the shooting's noise floor "
+                                         "(~1e-13): compared absolutely"),
+    "v_hopf_numeric": Tolerance(1e-8, 1e-12, "finite-difference Jacobian, step ~sqrt(u): "
+                                             "rounding enters as u/h ~ 1e-8"),
+}
 
 RTOL, ATOL = 1e-12, 1e-14
 N_MAX = 400  # continuation steps per direction

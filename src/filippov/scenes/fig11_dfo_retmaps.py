@@ -43,6 +43,41 @@ from ..progress import Progress
 from ..simulate import Section, simulate
 from ..system import SLIDING
 from .common import engine, require, solver_options
+from ..tolerance import Tolerance
+
+_ONSET = ("the onset of sticking is a grid point of each panel: whether that orbit "
+          "slides is decided at a tangency (onset known to a few 1e-11, x1_onset_step)")
+_FOLD = "at the fold P(x1) - x1 has a flat maximum: its argmax is square-root conditioned"
+#: cross-machine tolerances (filippov.tolerance)
+TOLERANCES = {
+    "n_switches": Tolerance(0.0, 0.0, _ONSET + ": one crossing pair more or less",
+                            rule="tangency", changed=2, jump=2),
+    "sliding_length": Tolerance(3e-8, 1e-9, _ONSET + ": its whole slide, ~10 sqrt(distance "
+                                "past the onset) <= 3e-4 for an onset off by up to 1e-9; x3. "
+                                "Elsewhere: DOP853 at rtol 1e-12 through a relaxation of "
+                                "stiffness 1/eps <= 100 over a period ~7 with |f| ~ 3: ~3e-9, "
+                                "x10", rule="tangency", changed=2, jump=1e-3),
+    "sliding_time": Tolerance(3e-8, 1e-9, "as sliding_length", rule="tangency", changed=2,
+                              jump=1e-3),
+    "return_residual": Tolerance(1e-9, 2e-10, "distance to M_+ at the noise floor of the "
+                                              "relaxation (rtol 1e-12 / eps): absolute"),
+    "x1_onset_step": Tolerance(1e-9, 1e-9, "last correction of an iteration at its noise "
+                                           "floor (a few 1e-11): absolute"),
+    "x1_sn": Tolerance(1e-9, 1e-6, _FOLD + ": sqrt(2 delta M / |M''|) ~ 1e-6"),
+    "sliding_length_sn": Tolerance(1e-9, 1e-4, _FOLD + "; the slide near the fold grows "
+                                                       "steeply in x1 (~100 per unit)"),
+    "sliding_time_sn": Tolerance(1e-9, 1e-4, "as sliding_length_sn"),
+    "v0_sn_search": Tolerance(1e-7, 1e-12, "secant at sn_search_rtol = 1e-8: converged to "
+                                           "that rtol; x10"),
+    "sn_branch_v0": Tolerance(1e-7, 1e-12, "secant history: only the last iterate is a "
+                                           "result (as v0_sn_search)", rule="trace"),
+    "sn_branch_x1": Tolerance(1e-9, 1e-5, "secant history: only the last iterate is a "
+                                          "result, an argmax at the search's rtol 1e-8 (x1_sn "
+                                          "is then corrected at the full rtol)", rule="trace"),
+    "sn_branch_M": Tolerance(1e-9, 1e-8, "secant history: only the last iterate is a "
+                                         "result, max of P - x1 at the search tolerance 1e-8",
+                             rule="trace"),
+}
 
 
 T_RETURN = 200.0  # time bound of one return to L

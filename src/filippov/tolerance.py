@@ -1,0 +1,157 @@
+"""How closely a variable's values must agree between two machines.
+
+The same code on another CPU rounds exp, log, sin, ... differently in the last
+bit; how far that moves a result depends on the result: a well-conditioned
+output of a solve at rtol 1e-12 moves by a few ulps, a quantity in coordinates
+scaled by 1/eps^2 moves by an ulp of the unscaled state times 1/eps^2, a count
+decided at a tangency can change by one crossing pair. Each scene module
+declares, next to the data it computes, a :class:`Tolerance` with a one-line
+reason for every variable that needs more than :data:`DEFAULT`; the tolerance
+travels with the variable as attributes (``repro_*``) into the netCDF file and
+from there into the manifest (:mod:`filippov.manifest`).
+
+Rules:
+
+* ``close``: same shape and NaN positions count; values within
+  ``atol + rtol * |value|``;
+* ``tangency``: an output decided at a tangency (whether an orbit started on
+  the onset of sticking slides, and so its number of switches and its sliding
+  length): ``close``, except at most ``changed`` entries, which may differ by up
+  to ``jump`` (a count by one crossing pair, a length by its square-root law);
+* ``trace``: an iteration history (secant steps), not a result: only the last
+  finite value along the last axis (the converged value) is compared,
+  ``close``-style; the number of steps may differ.
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import xarray as xr
+
+RULES = ("close", "tangency", "trace")
+PREFIX = "repro_"
+
+
+@dataclass(frozen=True)
+class Tolerance:
+    rtol: float
+    atol: float
+    why: str
+    rule: str = "close"
+    changed: int = 0   # tangency rule: how many entries may leave the close tolerance ...
+    jump: float = 0.0  # ... and by how much at most
+
+    def __post_init__(self):
+        if self.rule not in RULES:
+            raise ValueError(f"tolerance rule {self.rule!r}: expected one of {RULES}")
+        if not (self.rtol >= 0 and self.atol >= 0 and self.jump >= 0
+                and np.isfinite(self.rtol + self.atol + self.jump)):
+            raise ValueError(f"tolerance: rtol, atol and jump must be finite and >= 0, got "
+                             f"{self.rtol}, {self.atol}, {self.jump}")
+        if (self.rule == "tangency") != (self.changed > 0):
+            raise ValueError("tolerance: `changed` > 0 goes with rule 'tangency' (and only there)")
+        if not self.why.strip():
+            raise ValueError("tolerance: a reason (why) is required")
+
+    def attrs(self) -> dict:
+        return {PREFIX + k: v for k, v in asdict(self).items()}
+
+    @classmethod
+    def from_attrs(cls, attrs) -> "Tolerance":
+        if PREFIX + "rule" not in attrs:
+            return DEFAULT
+        return cls(rtol=float(attrs[PREFIX + "rtol"]), atol=float(attrs[PREFIX + "atol"]),
+                   why=str(attrs[PREFIX + "why"]), rule=str(attrs[PREFIX + "rule"]),
+                   changed=int(attrs[PREFIX + "changed"]), jump=float(attrs[PREFIX + "jump"]))
+
+    def allowed(self, reference: np.ndarray) -> np.ndarray:
+        """The admissible difference at each entry of ``reference``."""
+        return self.atol + self.rtol * np.abs(reference)
+
+
+#: exact inputs, grids and well-conditioned outputs of solves at rtol <= 1e-12:
+#: a last-bit change moves them by a few ulps (~1e-15 relative); 1e-9 leaves a
+#: factor 1e6 for accumulation over thousands of events and still catches any
+#: change of model, parameter or method
+DEFAULT = Tolerance(1e-9, 1e-12, "well-conditioned: a few ulps per last-bit change, "
+                                 "1e6 of room for accumulation")
+
+
+#: one ulp of 1 (a last-bit change of an O(1) number), and the unit roundoff
+ULP = float(np.finfo(float).eps)
+U = ULP / 2
+
+#: an O(1) state after located events: two events, each placed to 1e-15 + 4u t
+#: in time at speeds |f| <= 8 pi (the Hopf example), ~1e-13; x10
+EVENT_STATE = 1e-12
+
+
+def sqrt_law(offset: float, factor: float = 1.0) -> float:
+    """Spread of a quantity that varies as sqrt(distance to a tangency) at the
+    smallest distance ``offset``: a last-bit change u of the distance moves it by
+    u / (2 sqrt(offset)), times ``factor``."""
+    return factor * U / (2.0 * np.sqrt(offset))
+
+
+def annotate(ds: xr.Dataset, tolerances: dict[str, Tolerance]) -> xr.Dataset:
+    """``ds`` with the tolerance of every numeric variable in its attributes
+    (:data:`DEFAULT` where ``tolerances`` names none). A name that is not a
+    variable of ``ds`` is an error: a renamed variable must not lose its tolerance."""
+    unknown = sorted(set(tolerances) - set(ds.variables))
+    if unknown:
+        raise ValueError(f"tolerances declared for variables the dataset does not have: "
+                         f"{', '.join(unknown)}")
+    ds = ds.copy()
+    for name in ds.variables:
+        if ds[name].dtype.kind in "fiub":
+            ds[name].attrs.update(tolerances.get(name, DEFAULT).attrs())
+    return ds
+
+
+def final_values(values: np.ndarray) -> np.ndarray:
+    """The last finite value along the last axis (NaN where a row has none)."""
+    values = np.atleast_1d(np.asarray(values, dtype=float))
+    rows = values.reshape(-1, values.shape[-1]) if values.size else values.reshape(0, 1)
+    out = np.full(rows.shape[0], np.nan)
+    for i, row in enumerate(rows):
+        finite = np.flatnonzero(np.isfinite(row))
+        if finite.size:
+            out[i] = row[finite[-1]]
+    return out
+
+
+def spread(reference: xr.DataArray, other: xr.DataArray) -> dict:
+    """How far ``other`` is from ``reference`` (full arrays), against the tolerance
+    declared on ``reference``: max_abs, max_rel, changed (entries that differ at
+    all), margin (smallest tolerance / difference; inf when equal; for the
+    entries the tangency rule exempts, jump / difference) and ok."""
+    tol = Tolerance.from_attrs(reference.attrs)
+    a, b = np.asarray(reference.values, dtype=float), np.asarray(other.values, dtype=float)
+    if tol.rule == "trace":
+        a, b = final_values(a), final_values(b)
+    bad = {"max_abs": np.inf, "max_rel": np.inf, "changed": max(a.size, b.size),
+           "margin": 0.0, "ok": False, "rule": tol.rule}
+    if a.shape != b.shape:
+        return bad
+    nan_a, nan_b = np.isnan(a), np.isnan(b)
+    if np.any(nan_a != nan_b):
+        return dict(bad, changed=int(np.count_nonzero(nan_a != nan_b)))
+    a, b = a[~nan_a], b[~nan_a]
+    diff = np.abs(a - b)
+    ratio = np.where(diff > 0, tol.allowed(a) / np.where(diff > 0, diff, 1.0), np.inf)
+    ok = bool(np.all(ratio >= 1.0))
+    if tol.rule == "tangency":
+        # the `changed` worst entries are exempt from the close tolerance, not from `jump`
+        worst = np.argsort(ratio)[:tol.changed]
+        exempt = worst[ratio[worst] < 1.0]
+        ok = bool(np.all(diff[exempt] <= tol.jump)) and \
+            bool(np.all(np.delete(ratio, exempt) >= 1.0))
+        jumps = tol.jump / diff[exempt] if tol.jump > 0 else np.zeros(exempt.size)
+        ratio = np.concatenate([np.delete(ratio, exempt), jumps])
+    nonzero = (diff > 0) & (a != 0)   # relative spread where the reference is not 0
+    rel = diff[nonzero] / np.abs(a[nonzero])
+    return {"max_abs": float(diff.max()) if diff.size else 0.0,
+            "max_rel": float(rel.max()) if rel.size else 0.0,
+            "changed": int(np.count_nonzero(diff)),
+            "margin": float(ratio.min()) if ratio.size else np.inf, "ok": ok, "rule": tol.rule}

@@ -1,0 +1,208 @@
+"""`make cross-cpu`: emulate another CPU's arithmetic and check every scene against
+the committed manifest.
+
+Other machines round transcendental functions differently in the last bit
+(numpy's AVX-512 loops, another libm). This check makes such a machine out of
+the one it runs on, then builds every figure there:
+
+* ``lastbit.c`` (beside this file), preloaded into every process, moves the last
+  bit of exp, log, sin, atan2, ... results, deterministically per input and
+  per seed (``LASTBIT_SEED``): Python's math module, numba-compiled code and
+  numpy's scalar loops all call those symbols;
+* numpy's SIMD dispatch is switched down to its baseline
+  (``NPY_DISABLE_CPU_FEATURES``), so numpy's own vector loops give way to the
+  perturbed libm wherever the machine had something to switch;
+* ``NUMBA_CPU_NAME=generic`` with an empty numba cache: kernels compiled for
+  no particular CPU.
+
+Each emulated build must pass the manifest check (data within each variable's
+declared tolerance, figures by image). The emulated data are also compared
+with a native build of the same tree, full arrays: every dataset whose numbers
+pass through a transcendental function must change (an emulation that changes
+nothing emulates nothing), and the spread per variable over the seeds is set
+against its tolerance (margin = tolerance / spread; >= 10 is healthy).
+``--record`` writes the measured spreads into the manifest next to each
+tolerance.
+
+    python tests/crosscpu/cross_cpu.py [--seeds 1 2 3] [--record] [--keep]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+sys.path.insert(0, str(ROOT / "src"))
+sys.path.insert(0, str(ROOT / "workflow" / "scripts"))
+
+from verify import copy_project, run_snakemake  # noqa: E402
+
+from filippov import manifest  # noqa: E402
+from filippov.io import read_dataset  # noqa: E402
+from filippov.tolerance import spread  # noqa: E402
+
+#: datasets whose numbers never pass through a transcendental function: the
+#: emulation cannot move them, and they are not required to move
+ALGEBRAIC = {
+    "fig01_slidesketch": "a sketch of linear fields: arrows, straight trajectories and "
+                         "their sliding segment, all polynomial",
+}
+
+
+def build_shim(dest: Path) -> Path:
+    cc = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc")
+    if cc is None:
+        raise SystemExit("cross-cpu: no C compiler (cc/gcc) to build tests/crosscpu/lastbit.c")
+    out = dest / "lastbit.so"
+    subprocess.run([cc, "-O2", "-fno-builtin", "-shared", "-fPIC", "-o", str(out), str(HERE / "lastbit.c"),
+                    "-ldl", "-lm"], check=True)
+    return out
+
+
+def numpy_features_to_disable() -> list[str]:
+    """The SIMD levels numpy dispatches to on this machine above its baseline."""
+    from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+
+    return [f for f in __cpu_dispatch__ if __cpu_features__.get(f)]
+
+
+def emulation_env(shim: Path, seed: int, cache: Path) -> dict:
+    env = {"LD_PRELOAD": str(shim), "LASTBIT_SEED": str(seed), "NUMBA_CPU_NAME": "generic",
+           "NUMBA_CACHE_DIR": str(cache), "PYTHONDONTWRITEBYTECODE": "1"}
+    disable = numpy_features_to_disable()
+    if disable:
+        env["NPY_DISABLE_CPU_FEATURES"] = " ".join(disable)
+    return env
+
+
+def targets() -> list[str]:
+    import yaml
+
+    scenes = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["scenes"]
+    return [f"figures/{s}.{ext}" for s in scenes for ext in ("pdf", "png")] + \
+        ["results/hard_cases.nc"]
+
+
+def build(work: Path, env: dict | None, label: str) -> None:
+    t0 = time.perf_counter()
+    print(f"== {label}: building in {work}", flush=True)
+    run = run_snakemake(work, *targets(), cores="all", env=env)
+    if run.returncode != 0:
+        sys.stdout.write(run.stdout[-4000:] + run.stderr[-4000:])
+        raise SystemExit(f"cross-cpu: {label} build failed (exit {run.returncode})")
+    print(f"== {label}: {time.perf_counter() - t0:.0f} s", flush=True)
+
+
+def compare_builds(native: Path, emulated: Path) -> dict:
+    """{dataset: {variable: spread dict}} over full arrays (see filippov.tolerance.spread)."""
+    out = {}
+    for nc in manifest.data_files(native / "results"):
+        a, b = read_dataset(nc), read_dataset(emulated / "results" / nc.name)
+        out[nc.stem] = {name: spread(a[name], b[name]) for name in sorted(a.variables)
+                        if a[name].dtype.kind in "fiub"}
+    return out
+
+
+def merge_spreads(runs: list[dict]) -> dict:
+    """The worst of the seeds, per variable."""
+    merged: dict = {}
+    for run in runs:
+        for sid, variables in run.items():
+            for name, s in variables.items():
+                m = merged.setdefault(sid, {}).setdefault(name, dict(s, seeds=0))
+                m["seeds"] += 1
+                for key in ("max_abs", "max_rel", "changed"):
+                    m[key] = max(m[key], s[key])
+                m["margin"] = min(m["margin"], s["margin"])
+                m["ok"] = m["ok"] and s["ok"]
+    return merged
+
+
+def report(merged: dict, lowest: int = 15) -> list[str]:
+    """Table lines; and the list of problems (datasets that did not move)."""
+    problems = []
+    print(f"\n{'dataset':24s} {'variables moved':>16s}  smallest margin (variable)")
+    for sid, variables in sorted(merged.items()):
+        moved = sum(1 for s in variables.values() if s["changed"])
+        finite = [(s["margin"], n) for n, s in variables.items() if s["changed"]]
+        worst = min(finite) if finite else None
+        text = f"{worst[0]:.3g} ({worst[1]})" if worst else "-"
+        print(f"{sid:24s} {moved:>7d} of {len(variables):<6d}  {text}")
+        if moved == 0 and sid not in ALGEBRAIC:
+            problems.append(f"results/{sid}.nc: the emulation changed nothing (emulates nothing)")
+        if moved and sid in ALGEBRAIC:
+            problems.append(f"results/{sid}.nc: listed as algebraic but moved: update ALGEBRAIC")
+    rows = sorted((s["margin"], sid, n, s) for sid, v in merged.items() for n, s in v.items()
+                  if s["changed"])
+    print(f"\nsmallest margins (tolerance / spread over {max(s['seeds'] for v in merged.values() for s in v.values())} seeds):")
+    print(f"{'margin':>9s}  {'max abs':>9s}  {'max rel':>9s}  variable")
+    for margin, sid, name, s in rows[:lowest]:
+        print(f"{margin:9.3g}  {s['max_abs']:9.2e}  {s['max_rel']:9.2e}  {sid}:{name}")
+    return problems
+
+
+def record(merged: dict, path: Path = manifest.MANIFEST) -> None:
+    man = json.loads(path.read_text())
+    for sid, variables in merged.items():
+        for name, s in variables.items():
+            entry = man["data"].get(sid, {}).get("variables", {}).get(name)
+            if entry is not None:
+                entry["spread"] = {k: (None if k == "margin" and not np.isfinite(v) else v)
+                                   for k, v in s.items() if k != "ok"}
+    path.write_text(json.dumps(man, indent=1, sort_keys=True) + "\n")
+    print(f"recorded the spreads in {path}")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
+    ap.add_argument("--native", type=Path, help="a finished native build (project copy) to reuse")
+    ap.add_argument("--record", action="store_true", help="write the spreads into the manifest")
+    ap.add_argument("--keep", action="store_true", help="keep the build directories")
+    args = ap.parse_args(argv)
+    man = json.loads(manifest.MANIFEST.read_text())
+    tmp = Path(tempfile.mkdtemp(prefix="filippov-cross-cpu-"))
+    problems, runs = [], []
+    try:
+        shim = build_shim(tmp)
+        native = args.native
+        if native is None:
+            native = copy_project(tmp / "native")
+            build(native, None, "native")
+        problems += [f"native: {p}" for p in manifest.check(native / "results",
+                                                            native / "figures", man)]
+        for seed in args.seeds:
+            work = copy_project(tmp / f"seed{seed}")
+            env = emulation_env(shim, seed, tmp / f"numba-cache-{seed}")
+            build(work, env, f"emulated CPU, seed {seed}")
+            problems += [f"seed {seed}: {p}" for p in
+                         manifest.check(work / "results", work / "figures", man)]
+            runs.append(compare_builds(native, work))
+        merged = merge_spreads(runs)
+        problems += report(merged)
+        if args.record:
+            record(merged)
+    finally:
+        if args.keep:
+            print(f"builds kept in {tmp}")
+        else:
+            shutil.rmtree(tmp, ignore_errors=True)
+    for p in problems:
+        print(f"MISMATCH {p}")
+    print(f"cross-cpu: {len(args.seeds)} emulated builds: "
+          f"{'OK' if not problems else f'{len(problems)} problems'}")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

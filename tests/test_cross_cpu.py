@@ -1,0 +1,207 @@
+"""Cross-machine reproducibility: the tolerance model, the emulation of another
+CPU (tests/crosscpu/lastbit.c), the environment fingerprint, and that the
+manifest still catches a real change of every scene."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from filippov import manifest, scenes, tolerance
+from filippov.config import load_scene
+from filippov.io import write_dataset
+from filippov.tolerance import Tolerance
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests" / "crosscpu"))
+import cross_cpu  # noqa: E402
+
+
+# ----------------------------------------------------------------------------- tolerance model
+def _ds(values, tol=None, name="v"):
+    ds = xr.Dataset({name: ("i", np.asarray(values, dtype=float))})
+    return tolerance.annotate(ds, {name: tol} if tol else {})
+
+
+def test_declared_tolerance_travels_with_the_data(tmp_path):
+    tol = Tolerance(1e-7, 1e-5, "scaled by 1/eps^2")
+    path = write_dataset(_ds(np.linspace(0, 1, 10), tol), tmp_path / "a.nc")
+    entry = manifest.summarize(path)["v"]
+    assert entry["tolerance"]["atol"] == 1e-5 and entry["tolerance"]["why"] == "scaled by 1/eps^2"
+    undeclared = manifest.summarize(write_dataset(_ds([1.0, 2.0]), tmp_path / "b.nc"))["v"]
+    assert Tolerance(**undeclared["tolerance"]) == tolerance.DEFAULT
+
+
+def test_annotate_refuses_a_tolerance_for_a_missing_variable():
+    with pytest.raises(ValueError, match="does not have: w"):
+        tolerance.annotate(xr.Dataset({"v": ("i", [1.0])}),
+                           {"w": Tolerance(1e-9, 1e-12, "a renamed variable")})
+
+
+@pytest.mark.parametrize("bad", [dict(rtol=-1.0), dict(atol=np.nan), dict(why=" "),
+                                 dict(rule="count"), dict(rule="tangency"),
+                                 dict(changed=2)])
+def test_a_malformed_tolerance_is_refused(bad):
+    args = dict(rtol=1e-9, atol=1e-12, why="reason") | bad
+    with pytest.raises(ValueError):
+        Tolerance(**args)
+
+
+def _compare(ref, got, tol, tmp_path):
+    want = manifest.summarize(write_dataset(_ds(ref, tol), tmp_path / "ref.nc"))
+    have = manifest.summarize(write_dataset(_ds(got, tol), tmp_path / "got.nc"))
+    return manifest.compare_data(have, want)
+
+
+def test_close_rule_uses_the_variables_own_tolerance(tmp_path):
+    x = np.linspace(1.0, 2.0, 50)
+    loose = Tolerance(1e-9, 1e-5, "scaled")
+    assert _compare(x, x + 5e-6, loose, tmp_path) == []
+    problems = _compare(x, x + 5e-6, tolerance.DEFAULT, tmp_path)
+    assert len(problems) == 1 and problems[0].startswith("v: differs by up to 5.000e-06")
+
+
+def test_tangency_rule_allows_few_entries_to_jump(tmp_path):
+    n = np.full(40, 4.0)
+    tol = Tolerance(0.0, 0.0, "onset point", rule="tangency", changed=2, jump=2)
+    one = n.copy()
+    one[7] = 6.0
+    assert _compare(n, one, tol, tmp_path) == []
+    three = n.copy()
+    three[[1, 7, 20]] = 6.0
+    assert "3 sampled entries" in _compare(n, three, tol, tmp_path)[0]
+    far = n.copy()
+    far[7] = 10.0
+    assert "by up to 6.000e+00" in _compare(n, far, tol, tmp_path)[0]
+
+
+def test_trace_rule_compares_converged_values_only(tmp_path):
+    tol = Tolerance(1e-7, 1e-12, "secant history", rule="trace")
+    ref = xr.Dataset({"b": (("p", "k"), [[1.0, 2.0, 3.0, np.nan], [5.0, 6.0, np.nan, np.nan]])})
+    longer = xr.Dataset({"b": (("p", "k"), [[1.5, 2.5, 2.9, 3.0, np.nan],
+                                            [4.0, 5.5, 5.9, 6.0, np.nan]])})
+    want = manifest.summarize(write_dataset(tolerance.annotate(ref, {"b": tol}), tmp_path / "r.nc"))
+    got = manifest.summarize(write_dataset(tolerance.annotate(longer, {"b": tol}),
+                                           tmp_path / "g.nc"))
+    assert manifest.compare_data(got, want) == []
+    moved = longer.copy(deep=True)
+    moved["b"][0, 3] = 3.001
+    got = manifest.summarize(write_dataset(tolerance.annotate(moved, {"b": tol}), tmp_path / "m.nc"))
+    assert "converged value differs" in manifest.compare_data(got, want)[0]
+
+
+def test_spread_margin_and_nan_changes():
+    tol = Tolerance(0.0, 1e-6, "abs")
+    a = _ds([1.0, 2.0, 3.0], tol)["v"]
+    s = tolerance.spread(a, _ds([1.0, 2.0 + 1e-8, 3.0])["v"])
+    assert s["ok"] and s["changed"] == 1 and s["margin"] == pytest.approx(100, rel=1e-6)
+    assert not tolerance.spread(a, _ds([1.0, np.nan, 3.0])["v"])["ok"]
+
+
+# ----------------------------------------------------------------------------- emulation
+PROBE = r"""
+import math, sys
+import numpy as np, numba
+x = np.linspace(0.05, 3.0, 4001)
+@numba.njit(cache=False)
+def kernel(v):
+    out = np.empty_like(v)
+    for i in range(v.size):
+        out[i] = math.exp(v[i])
+    return out
+res = {"math": [math.exp(v) for v in x], "numpy": np.exp(x).tolist(),
+       "numpy_sin": np.sin(x).tolist(), "numba": kernel(x).tolist(),
+       "exact": [math.exp(0.0), math.cos(0.0), math.pow(2.0, 3.0), float(np.log(1.0))]}
+print(__import__("json").dumps(res))
+"""
+
+
+@pytest.fixture(scope="module")
+def shim(tmp_path_factory):
+    if shutil.which("cc") is None and shutil.which("gcc") is None:
+        pytest.fail("no C compiler: the cross-CPU emulation needs cc or gcc")
+    return cross_cpu.build_shim(tmp_path_factory.mktemp("shim"))
+
+
+def _probe(env, tmp_path):
+    full = dict(os.environ, **{"NUMBA_CACHE_DIR": str(tmp_path / "numba"), **env})
+    out = subprocess.run([sys.executable, "-c", PROBE], env=full, capture_output=True,
+                         text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    return {k: np.array(v) for k, v in json.loads(out.stdout).items()}
+
+
+def test_emulation_moves_last_bits_of_math_numpy_and_numba(shim, tmp_path):
+    native = _probe({}, tmp_path)
+    seed1 = _probe(cross_cpu.emulation_env(shim, 1, tmp_path / "c1"), tmp_path)
+    again = _probe(cross_cpu.emulation_env(shim, 1, tmp_path / "c2"), tmp_path)
+    seed2 = _probe(cross_cpu.emulation_env(shim, 2, tmp_path / "c3"), tmp_path)
+    for key in ("math", "numpy", "numpy_sin", "numba"):
+        moved = native[key] != seed1[key]
+        # a good share of results move, each by one ulp of libm's result (numpy's
+        # native SIMD loops may already be an ulp away from libm: two from native)
+        assert 0.2 < moved.mean() < 0.8, (key, moved.mean())
+        ulps = np.abs(native[key] - seed1[key]) / np.spacing(np.abs(native[key]))
+        assert ulps.max() <= (2.0 if key.startswith("numpy") else 1.0) + 1e-12, key
+        # deterministic per input and seed, as another machine is
+        np.testing.assert_array_equal(seed1[key], again[key])
+        assert np.any(seed1[key] != seed2[key]), key
+    # exact cases stay exact: every libm gets these right
+    np.testing.assert_array_equal(seed1["exact"], [1.0, 1.0, 8.0, 0.0])
+
+
+def test_environment_fingerprint_tracks_the_arithmetic(shim):
+    code = "from filippov import manifest; print(manifest.environment())"
+
+    def fingerprint(extra):
+        env = dict(os.environ, **extra)
+        return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                              text=True, check=True, timeout=120).stdout.strip()
+
+    native = fingerprint({})
+    assert fingerprint({}) == native
+    assert fingerprint({"NUMBA_CPU_NAME": "generic"}) != native
+    assert fingerprint({"LD_PRELOAD": str(shim), "LASTBIT_SEED": "1"}) != native
+    switched = cross_cpu.numpy_features_to_disable()
+    if switched:  # a machine with SIMD levels above numpy's baseline
+        assert fingerprint({"NPY_DISABLE_CPU_FEATURES": " ".join(switched)}) != native
+
+
+# ----------------------------------------------------------------------------- real changes
+#: one physical parameter per scene, changed by one percent
+PARAMETER = {"fig01_slidesketch": "t_end", "fig02_cases": "eps", "fig03_grazingsketch": "omega",
+             "fig04_retmaps": "eps", "fig05_thetalt0mfs": "eps", "fig06_sgraph": "omega",
+             "fig07_pdm_theta_neg": "theta", "fig08_s0theta": "theta_min",
+             "fig09_pdm_theta_pos": "theta", "fig10_dfo": "fv", "fig11_dfo_retmaps": "fv"}
+
+
+def test_every_scene_has_a_parameter_to_change():
+    listed = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["scenes"]
+    assert sorted(PARAMETER) == sorted(listed)
+
+
+@pytest.mark.parametrize("sid", sorted(PARAMETER))
+def test_manifest_catches_a_one_percent_parameter_change(sid, tmp_path):
+    scene = load_scene(ROOT / "config" / "scenes" / f"{sid}.yaml",
+                       ROOT / "config" / "schema" / "scene.schema.json")
+    name = PARAMETER[sid]
+    value = scene["parameters"][name]
+    scene["parameters"][name] = [v * 1.01 for v in value] if isinstance(value, list) \
+        else value * 1.01
+    results = tmp_path / "results"
+    write_dataset(scenes.compute(scene), results / f"{sid}.nc")
+    man = json.loads(manifest.MANIFEST.read_text())
+    man = dict(man, data={sid: man["data"][sid]}, figures={})
+    problems = manifest.check(results, tmp_path / "figures", man)
+    assert problems, f"{sid}: a 1% change of {name} went unnoticed"
+    # each line names the dataset and a variable of it
+    variables = set(man["data"][sid]["variables"])
+    for line in problems:
+        where, var = line.split(": ")[:2]
+        assert where == f"results/{sid}.nc" and var in variables, line
