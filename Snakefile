@@ -2,7 +2,20 @@
 # -> figures/<id>.{pdf,png}. The workflow knows files only; numerics live in
 # src/filippov and are reached through the thin scripts in workflow/scripts.
 
-configfile: "config/config.yaml"
+import sys
+
+from filippov.config import SceneError, load_workflow_config
+
+# config/config.yaml, validated against its schema (one line naming the file and
+# line/column or field when it is malformed); --config values on the command
+# line take precedence. Loaded here rather than with `configfile:` so that the
+# error is ours, not a traceback.
+try:
+    config.update(load_workflow_config("config/config.yaml", "config/schema/config.schema.json",
+                                       overrides=config))
+except SceneError as exc:
+    print(f"error: {exc}", file=sys.stderr)
+    sys.exit(1)
 
 # Scene ids look like fig02_cases; constraining the wildcard keeps stray
 # targets (e.g. results/foo.nc) from matching the rules.

@@ -51,9 +51,13 @@ def test_a_flipped_byte_is_refused(tmp_path):
 
 def test_an_unreadable_header_and_a_foreign_file_are_refused(tmp_path):
     bad = tmp_path / "bad.nc"
-    bad.write_bytes(b"CDF\x02 garbage")
+    bad.write_bytes(b"this is no netCDF file")
     with pytest.raises(DatasetError, match="bad.nc: not a readable netCDF"):
         read_dataset(bad)
+    header = tmp_path / "header.nc"   # netCDF opens this as an empty dataset
+    header.write_bytes(b"CDF\x02 garbage")
+    with pytest.raises(DatasetError, match="header.nc: no checksum"):
+        read_dataset(header)
     foreign = tmp_path / "foreign.nc"
     xr.Dataset({"v": ("i", [1.0, 2.0])}).to_netcdf(foreign, format="NETCDF3_64BIT")
     with pytest.raises(DatasetError, match="foreign.nc: no checksum"):

@@ -17,7 +17,79 @@ from jsonschema.exceptions import best_match, by_relevance
 
 
 class SceneError(ValueError):
-    """A scene file is unreadable or violates the schema."""
+    """A scene file is unreadable, violates the schema or exceeds a limit."""
+
+
+#: what one scene may ask for unless the run raises the limit explicitly
+#: (snakemake --config max_points=1000000): the sweep's size (start points,
+#: grid points), the samples stored, the jobs it is split into, the simulated time
+LIMITS = {"max_points": 200_000, "max_samples": 20_000_000, "max_chunks": 512,
+          "max_t_end": 1.0e4}
+
+
+def limits(overrides=None) -> dict:
+    """:data:`LIMITS` with the run's overrides (any mapping holding some of its keys,
+    e.g. Snakemake's ``config``); a malformed override is a :class:`SceneError`."""
+    out = dict(LIMITS)
+    for key in LIMITS:
+        if overrides is None or key not in overrides:
+            continue
+        value = overrides[key]
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            value = math.nan
+        if not (math.isfinite(value) and value > 0):
+            raise SceneError(f"--config {key}: must be a positive number, got {overrides[key]!r}")
+        out[key] = value
+    return out
+
+
+def sweep_size(scene: dict) -> dict:
+    """A cheap upper estimate of what a scene computes, from its parameters alone:
+    ``points`` = (sum of the counts ``n_*``) x (product of the lengths of its lists),
+    ``samples`` likewise with ``n_samples`` alone, and the longest simulated time."""
+    params = scene.get("parameters", {})
+    counts = [v for k, v in params.items() if k.startswith("n_") and isinstance(v, int)]
+    lists = [len(v) for v in params.values() if isinstance(v, list)]
+    factor = math.prod(lists) if lists else 1
+    t_end = [float(v) for k, v in params.items()
+             if (k == "t_end" or k.endswith("_t_end") or k == "t_max")
+             and isinstance(v, (int, float)) and not isinstance(v, bool)]
+    return {"points": max(sum(counts), 1) * factor,
+            "samples": int(params.get("n_samples", 0) or 0) * factor,
+            "t_end": max(t_end, default=0.0)}
+
+
+def check_limits(scene: dict, lim: dict | None = None, path="scene") -> None:
+    """Refuse a scene that asks for more than the limits allow, naming the field and
+    the limit (and how to raise it). Cheap: runs while Snakemake plans the jobs."""
+    lim = limits() if lim is None else lim
+    size = sweep_size(scene)
+    params = scene.get("parameters", {})
+    raise_it = "raise it with snakemake --config {key}=<value> for a real large run"
+    if size["points"] > lim["max_points"]:
+        biggest = max((k for k in params if k.startswith("n_") and isinstance(params[k], int)),
+                      key=lambda k: params[k], default="n_*")
+        raise SceneError(f"{path}: parameters.{biggest}: the sweep has ~{size['points']:.3g} "
+                         f"points, over the limit max_points = {lim['max_points']:.6g}; "
+                         + raise_it.format(key="max_points"))
+    if size["samples"] > lim["max_samples"]:
+        raise SceneError(f"{path}: parameters.n_samples: ~{size['samples']:.3g} samples, over "
+                         f"the limit max_samples = {lim['max_samples']:.6g}; "
+                         + raise_it.format(key="max_samples"))
+    if size["t_end"] > lim["max_t_end"]:
+        key = next(k for k in params if k == "t_end" or k.endswith("_t_end") or k == "t_max")
+        raise SceneError(f"{path}: parameters.{key}: {size['t_end']:g} over the limit "
+                         f"max_t_end = {lim['max_t_end']:g}; " + raise_it.format(key="max_t_end"))
+    chunks = scene.get("chunks")
+    if isinstance(chunks, int) and not isinstance(chunks, bool):
+        if chunks > lim["max_chunks"]:
+            raise SceneError(f"{path}: chunks: {chunks} jobs, over the limit max_chunks = "
+                             f"{lim['max_chunks']:.6g}; " + raise_it.format(key="max_chunks"))
+        if chunks > size["points"]:
+            raise SceneError(f"{path}: chunks: {chunks} chunks for a sweep of at most "
+                             f"{size['points']} points; need chunks <= the grid size")
 
 
 class _Loader(yaml.SafeLoader):
@@ -62,8 +134,34 @@ def _non_finite(node, path=()):
     return None
 
 
-def load_scene(path, schema_path) -> dict:
-    """Read a scene, validate it against the JSON schema and return it as a dict."""
+def load_workflow_config(path, schema_path, overrides=None) -> dict:
+    """config/config.yaml, validated against its schema, with the command line's
+    ``--config`` values (``overrides``) taking precedence. A malformed file or
+    value is a :class:`SceneError` naming the file and line/column or field."""
+    path = Path(path)
+    try:
+        with path.open(encoding="utf-8") as stream:
+            data = yaml.load(stream, Loader=_Loader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise SceneError(f"{path}: {where}{problem}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SceneError(f"{path}: cannot read: {exc}") from None
+    if not isinstance(data, dict):
+        raise SceneError(f"{path}: must be a YAML mapping")
+    merged = {**data, **dict(overrides or {})}
+    schema = json.loads(Path(schema_path).read_text(encoding="utf-8"))
+    error = best_match(Draft202012Validator(schema).iter_errors(merged), key=_RELEVANCE)
+    if error is not None:
+        raise SceneError(f"{path}: {_field(error.absolute_path)}: {error.message}")
+    return merged
+
+
+def load_scene(path, schema_path, lim: dict | None = None) -> dict:
+    """Read a scene, validate it against the JSON schema and the limits (``lim``,
+    default :data:`LIMITS`) and return it as a dict."""
     path = Path(path)
     try:
         with path.open(encoding="utf-8") as stream:  # a stream: YAML errors then cite the file
@@ -89,4 +187,5 @@ def load_scene(path, schema_path) -> dict:
     if scene["model"] == "s0_closed_form" and not params["theta_min"] < params["theta_max"]:
         raise SceneError(f"{path}: parameters.theta_min: must be less than theta_max "
                          f"({params['theta_min']} >= {params['theta_max']})")
+    check_limits(scene, lim, path)
     return scene

@@ -4,9 +4,16 @@ Files are written as NETCDF3_64BIT: unlike the HDF5-based formats it stores no
 library versions or timestamps, so the same data gives the same bytes. Writes go
 to a temporary file in the target folder and are renamed into place, so a failed
 run never leaves a half-written dataset behind.
+
+Every file carries a checksum of its contents (``checksum_sha256``: every
+variable's name, dimensions, type and values, and every attribute), computed
+from what a reader sees and checked by :func:`read_dataset`. netCDF-3 reads a
+truncated file without complaint (the missing part as zeros); the checksum
+refuses it, and any other damage, with one line naming the file.
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import subprocess
@@ -21,6 +28,12 @@ import xarray as xr
 from . import __version__
 
 NETCDF_FORMAT = "NETCDF3_64BIT"
+CHECKSUM_ATTR = "checksum_sha256"
+
+
+class DatasetError(ValueError):
+    """A file that is not a sound dataset of this project (unreadable, damaged,
+    truncated, written by something else, or of another scene)."""
 
 
 @lru_cache(maxsize=1)
@@ -101,12 +114,68 @@ def atomic_output(path):
             os.unlink(tmp)
 
 
+def _plain(value):
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _attrs_bytes(attrs) -> bytes:
+    return json.dumps({k: _plain(v) for k, v in attrs.items()}, sort_keys=True,
+                      default=str).encode()
+
+
+def checksum(ds: xr.Dataset) -> str:
+    """sha256 of a dataset as read from disk (its own checksum attribute excluded)."""
+    h = hashlib.sha256()
+    for name in sorted(ds.variables):
+        var = ds[name]
+        h.update(json.dumps([name, list(var.dims), str(var.dtype), list(var.shape)]).encode())
+        values = np.asarray(var.values)
+        h.update(json.dumps(values.tolist()).encode() if values.dtype.kind == "O"
+                 else np.ascontiguousarray(values).tobytes())
+        h.update(_attrs_bytes(var.attrs))
+    h.update(_attrs_bytes({k: v for k, v in ds.attrs.items() if k != CHECKSUM_ATTR}))
+    return h.hexdigest()
+
+
+def _load(path) -> xr.Dataset:
+    with xr.open_dataset(path, engine="netcdf4") as ds:
+        return ds.load()
+
+
 def write_dataset(ds: xr.Dataset, path) -> Path:
+    """Write ``ds`` atomically, with the checksum of what a reader will see."""
+    import netCDF4
+
     with atomic_output(path) as tmp:
         ds.to_netcdf(tmp, format=NETCDF_FORMAT, engine="netcdf4")
+        digest = checksum(_load(tmp))
+        with netCDF4.Dataset(tmp, "a") as nc:
+            nc.setncattr(CHECKSUM_ATTR, digest)
+        if checksum(_load(tmp)) != digest:  # the attribute must not change the contents
+            raise RuntimeError(f"{path}: checksum changed on writing it; not written")
     return Path(path)
 
 
-def read_dataset(path) -> xr.Dataset:
-    with xr.open_dataset(path, engine="netcdf4") as ds:
-        return ds.load()
+def read_dataset(path, scene_id: str | None = None) -> xr.Dataset:
+    """The dataset in ``path``, checked against its checksum (and, with
+    ``scene_id``, that it holds that scene); :class:`DatasetError` otherwise."""
+    try:
+        ds = _load(path)
+    except Exception as exc:  # netCDF's own errors are many and terse
+        raise DatasetError(f"{path}: not a readable netCDF dataset ({type(exc).__name__}: "
+                           f"{exc}); recompute it") from None
+    stored = ds.attrs.pop(CHECKSUM_ATTR, None)
+    if stored is None:
+        raise DatasetError(f"{path}: no checksum ({CHECKSUM_ATTR}): not written by "
+                           f"filippov.io, or its header is damaged; recompute it")
+    if checksum(ds) != stored:
+        raise DatasetError(f"{path}: checksum mismatch: the file is damaged or truncated; "
+                           f"recompute it")
+    if scene_id is not None and ds.attrs.get("scene_id") != scene_id:
+        raise DatasetError(f"{path}: holds scene {ds.attrs.get('scene_id')!r}, expected "
+                           f"{scene_id!r}")
+    return ds

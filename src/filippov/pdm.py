@@ -45,7 +45,7 @@ from .model import SlowFastModel
 from .models.hopf import hopf_rhs, polar_flow
 from .poincare import sliding_time
 from .progress import Progress
-from .simulate import Section, simulate
+from .simulate import SimulationError, Section, simulate
 from .system import MINUS, PLUS, SLIDING, PiecewiseSystem
 
 
@@ -150,7 +150,10 @@ def discontinuity_map(model: SlowFastModel, xi1, *, scale: float | None = None,
         s1, s2 = polar_flow(x10, x20, np.asarray(-tau), mu, omega)
         z0 = np.array([float(s1), float(s2), float(s1)])  # on M_+, inside region +
         if not float(system.switch(z0)) > 0:
-            raise RuntimeError(f"start point for xi1={xi!r} is not inside region +: increase back")
+            raise SimulationError(
+                f"start point for xi1={xi!r} (eps={eps!r}) is not inside region +: x1 = -1 + "
+                f"{scale * abs(xi):.3g} is below the resolution of x1 near -1, or the start "
+                f"is too close to the crossing (argument back={back!r})")
         traj = simulate(system, z0, t_max, sections=[section], **opts)
         if traj.status != "section:L2" or traj.events[-1].mode_after != PLUS:
             raise RuntimeError(f"xi1={xi!r}: the trajectory did not return to L2 in mode + "

@@ -54,6 +54,18 @@ class Section:
     where: Optional[Callable[[np.ndarray], bool]] = None
     terminal: Optional[int] = None
 
+    def __post_init__(self):
+        if self.direction not in (-1, 0, 1):
+            raise ValueError(f"Section {self.name!r}: direction must be -1, 0 or +1, got "
+                             f"{self.direction!r}")
+        if not callable(self.func):
+            raise TypeError(f"Section {self.name!r}: func must be callable")
+        if self.terminal is not None and (isinstance(self.terminal, bool)
+                                          or not isinstance(self.terminal, (int, np.integer))
+                                          or self.terminal < 1):
+            raise ValueError(f"Section {self.name!r}: terminal must be None or an integer "
+                             f">= 1, got {self.terminal!r}")
+
 
 @dataclass(frozen=True)
 class Event:
@@ -160,6 +172,7 @@ class _IntegratingStepper:
 # --------------------------------------------------------------------------- crossings
 _TINY = np.finfo(float).tiny
 EXACT_BLOCK = 16
+PROJECT_AFTER = 1000  # steps before the step budget is projected from the mean step
 
 
 @dataclass(frozen=True)
@@ -203,7 +216,16 @@ def _refine(fun, pred, ta, tb, va, vb, xtol):
     if va == 0.0:
         r = ta
     else:
-        r = brentq(fun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=200)
+        try:
+            r = brentq(fun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=200)
+        except ValueError:
+            # no sign change between fun(ta) and fun(tb): the start sample of a
+            # just-entered mode is clamped inside, while rounding put the true
+            # value a hair past the crossing already: the event is at once
+            if isinstance(pred, _Crossing) and pred.after(fun(ta)):
+                r = ta
+            else:
+                raise
     # Brent may stop a hair before the sign flips (rounding in fun near a shallow
     # crossing): step forward by doubling increments until it has flipped.
     step = 2 * np.spacing(max(abs(r), _TINY))
@@ -252,6 +274,35 @@ def slow_window(slow_sample_step, h, max_step, span):
     return max(h, min(EXACT_BLOCK * slow_sample_step, max_step, span))
 
 
+def _check_options(**opts) -> None:
+    """Every option of :func:`simulate` where it enters: a bad value is named."""
+    def number(name, low, strict, allow_inf=False):
+        v = opts[name]
+        ok = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool) \
+            and not np.isnan(v) and (allow_inf or np.isfinite(v)) \
+            and (v > low if strict else v >= low)
+        if not ok:
+            bound = f"> {low}" if strict else f">= {low}"
+            raise ValueError(f"{name} must be a {'' if allow_inf else 'finite '}number "
+                             f"{bound}, got {v!r}")
+
+    def integer(name, low):
+        v = opts[name]
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < low:
+            raise ValueError(f"{name} must be an integer >= {low}, got {v!r}")
+
+    number("rtol", 0.0, True)
+    number("atol", 0.0, True)
+    number("max_step", 0.0, True, allow_inf=True)
+    number("touch_tol", 0.0, False)
+    number("event_xtol", 0.0, True)
+    number("zeno_span", 0.0, False)
+    integer("max_events", 1)
+    integer("max_steps", 1)
+    integer("samples_per_step", 1)
+    integer("zeno_count", 2)
+
+
 @_quiet_floating_point
 def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
              method: str = "exact", rtol: float = 1e-12, atol: float = 1e-14,
@@ -278,8 +329,14 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
         raise ValueError(f"initial state must be finite, got {z.tolist()}")
     if not (np.isfinite(t0) and np.isfinite(t_end) and t_end >= t0):
         raise ValueError(f"need finite t0 <= t_end, got t0={t0!r}, t_end={t_end!r}")
-    if samples_per_step < 1:
-        raise ValueError("samples_per_step must be >= 1")
+    _check_options(rtol=rtol, atol=atol, max_step=max_step, max_events=max_events,
+                   max_steps=max_steps, samples_per_step=samples_per_step,
+                   touch_tol=touch_tol, event_xtol=event_xtol, zeno_count=zeno_count,
+                   zeno_span=zeno_span)
+    for k, sec in enumerate(sections):
+        if not isinstance(sec, Section):
+            raise TypeError(f"sections[{k}]: expected a filippov.simulate.Section, got "
+                            f"{type(sec).__name__}")
 
     traj = Trajectory(system=system, t0=t0, z0=z.copy(), t=t0, z=z.copy())
     mode, kind = initial_mode(system, z, touch_tol)
@@ -333,6 +390,19 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
                     f"step limit {max_steps} hit at t={t!r}, state {z.tolist()}, mode "
                     f"{MODE_NAMES[mode]}: the run is too long or the step size collapsed")
             ta, tb, Z = stepper.step()
+            # a run that cannot reach t_end within the step budget stops now, not
+            # after minutes: project the steps left from the mean step so far
+            if traj.n_steps > PROJECT_AFTER and tb > t0:
+                left = (t_end - tb) * traj.n_steps / (tb - t0)
+            else:
+                left = 0.0
+            if traj.n_steps + left > max_steps:
+                raise EventLimitError(
+                    f"steps of {tb - ta:.3g} (mean {(tb - t0) / traj.n_steps:.3g}) at t={ta!r} in mode "
+                    f"{MODE_NAMES[mode]} (state {z.tolist()}): ~{left:.3g} more steps to "
+                    f"t_end={t_end!r} exceed max_steps={max_steps}"
+                    + ("; the integrated field is stiff here (a fast time scale, e.g. a "
+                       "small eps): use exact flows or a shorter t_end" if not use_flow else ""))
             frac = frac_exact if use_flow else frac_integrated
             ts = ta + frac * (tb - ta)
             ts[-1] = tb
@@ -341,8 +411,15 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
                 raise SimulationError(
                     f"non-finite state in mode {MODE_NAMES[mode]} between t={ta!r} and "
                     f"t={tb!r}, last finite state {z.tolist()}")
-            found = _scan(system, mode, Z, ts, zs, leave, sections, preds, first,
-                          touch_tol, event_xtol, traj)
+            try:
+                found = _scan(system, mode, Z, ts, zs, leave, sections, preds, first,
+                              touch_tol, event_xtol, traj)
+            except ValueError as exc:  # scipy's root finders: no context of their own
+                raise SimulationError(
+                    f"event location failed in mode {MODE_NAMES[mode]} between t={ta!r} and "
+                    f"t={tb!r} (state at ta {z.tolist()}): {exc}; the sampled sign change "
+                    f"did not survive refinement (time scale of the system: sample_step "
+                    f"{system.sample_step!r})") from exc
             first = False
             if dense:
                 traj.segments.append((ta, tb, mode, Z))
@@ -376,6 +453,16 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
                     f"accumulation of switches: {recent.maxlen} switches within "
                     f"{recent[-1] - recent[0]:.3e} time units near t={te!r}, state "
                     f"{ze.tolist()} (Zeno point or chattering below the time resolution)")
+            if len(recent) == recent.maxlen and recent[-1] > recent[0]:
+                # switching at this rate to t_end would exceed the event budget: stop now
+                ahead = (t_end - te) * (recent.maxlen - 1) / (recent[-1] - recent[0])
+                if n_switch + ahead > max_events:
+                    raise EventLimitError(
+                        f"switching every {(recent[-1] - recent[0]) / (recent.maxlen - 1):.3g} "
+                        f"time units near t={te!r} (state {ze.tolist()}, mode "
+                        f"{MODE_NAMES[new_mode]}): ~{ahead:.3g} more switches to "
+                        f"t_end={t_end!r} exceed max_events={max_events} (raise max_events "
+                        f"if this rate does not last)")
             mode = new_mode
             traj.mode = mode
 

@@ -2,6 +2,7 @@
 # when the library code the script imports changes; passing a hash of that code
 # as a param makes it do so (params are a default rerun trigger in Snakemake 8+).
 import hashlib
+import sys
 import importlib.util
 from pathlib import Path
 
@@ -27,3 +28,10 @@ def library_hash(include="", exclude=()):
             continue
         digest.update(rel.encode() + b"\0" + path.read_bytes() + b"\0")
     return digest.hexdigest()[:16]
+
+
+def fail(message):
+    """Stop while the workflow is being read: one line naming the file and field,
+    no traceback and no plan."""
+    print(f"error: {message}", file=sys.stderr)
+    sys.exit(1)

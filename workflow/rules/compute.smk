@@ -6,20 +6,36 @@ import re
 
 import yaml
 
+from filippov.config import SceneError, check_limits, limits
+
 
 def scene_chunks():
     """{id: N} for the scene files with a top-level `chunks: N` (N >= 1).
 
     Read when the DAG is built, so the chunk jobs are known statically (no
-    checkpoint). A malformed file or `chunks` value is left to rule `compute`,
-    whose job reports it (schema validation names the field).
+    checkpoint). Each scene is checked against the size limits first (cheap,
+    from its parameters), so that no oversized plan is ever built: a scene over
+    a limit stops the run here with one line. A malformed file or `chunks`
+    value is left to rule `compute`, whose job reports it (schema validation
+    names the field).
     """
     found = {}
+    try:
+        lim = limits(config)
+    except SceneError as exc:
+        fail(exc)
     for path in sorted(Path("config/scenes").glob("*.yaml")):
         try:
             data = yaml.safe_load(path.read_text(encoding="utf-8"))
         except (OSError, UnicodeDecodeError, yaml.YAMLError):
             continue
+        try:
+            if isinstance(data, dict) and isinstance(data.get("parameters", {}), dict):
+                check_limits(data, lim, path)
+        except SceneError as exc:
+            fail(exc)
+        except (TypeError, ValueError, AttributeError):
+            pass  # malformed: the schema check of the job names the field
         n = data.get("chunks") if isinstance(data, dict) else None
         if isinstance(n, int) and not isinstance(n, bool) and n >= 1:
             found[path.stem] = n

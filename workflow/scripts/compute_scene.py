@@ -3,10 +3,12 @@ import sys
 
 import filippov.io
 import filippov.scenes
-from filippov.config import SceneError, load_scene
+from filippov.config import SceneError, limits, load_scene
 
 try:
-    scene = load_scene(snakemake.input.scene, snakemake.input.schema)  # noqa: F821
+    scene = load_scene(snakemake.input.scene, snakemake.input.schema,  # noqa: F821
+                       limits(snakemake.config))  # noqa: F821
+    filippov.scenes.check(scene)  # the engine it asks for, the size of its grid
 except SceneError as exc:
     sys.exit(f"error: {exc}")  # a config mistake: one clear line, no traceback
 ds = filippov.scenes.compute(scene, progress=True)

@@ -10,5 +10,8 @@ try:
     settings = hard_cases.check_config(json.loads(snakemake.params.settings))  # noqa: F821
 except hard_cases.ConfigError as exc:
     sys.exit(f"error: config/config.yaml: {exc}")
-parts = [filippov.io.read_dataset(path) for path in snakemake.input.parts]  # noqa: F821
+try:
+    parts = [filippov.io.read_dataset(path) for path in snakemake.input.parts]  # noqa: F821
+except filippov.io.DatasetError as exc:
+    sys.exit(f"error: {exc}")
 filippov.io.write_dataset(hard_cases.merge(parts, settings), snakemake.output[0])  # noqa: F821

@@ -2,14 +2,19 @@
 
 filippov.plotting builds pyplot-free Figures, so no GUI backend is involved.
 """
+import sys
 from pathlib import Path
 
-import xarray as xr
-
+import filippov.io
 import filippov.plotting
 
-with xr.open_dataset(snakemake.input.data) as ds:  # noqa: F821
-    ds = ds.load()
 # the figure's id is its file name: figures/<id>.pdf (scenes and benchmarks alike)
-fig = filippov.plotting.draw(Path(snakemake.output.pdf).stem, ds)  # noqa: F821
+fid = Path(snakemake.output.pdf).stem  # noqa: F821
+try:
+    # a damaged, truncated or foreign file is refused before anything is drawn
+    ds = filippov.io.read_dataset(snakemake.input.data,  # noqa: F821
+                                  scene_id=fid if fid.startswith("fig") else None)
+except filippov.io.DatasetError as exc:
+    sys.exit(f"error: {exc}")
+fig = filippov.plotting.draw(fid, ds)
 filippov.plotting.save(fig, snakemake.output.pdf, snakemake.output.png)  # noqa: F821

@@ -8,6 +8,7 @@ from __future__ import annotations
 import importlib
 
 from .. import tolerance
+from ..config import SceneError
 from . import chunking
 
 SCENES = {
@@ -28,15 +29,33 @@ SCENES = {
 def _module(scene: dict):
     sid = scene.get("id")
     if sid not in SCENES:
-        raise ValueError(f"id: unknown scene {sid!r}; known scenes: {', '.join(sorted(SCENES))}")
+        raise SceneError(f"id: unknown scene {sid!r}; known scenes: {', '.join(sorted(SCENES))}")
     module = importlib.import_module(f".{SCENES[sid]}", __name__)
     # solver.engine: a scene runs on the engines its module lists (default: the reference driver)
     name = scene.get("solver", {}).get("engine", "python")
     available = getattr(module, "ENGINES", ("python",))
     if name not in available:
-        raise ValueError(f"{sid}: solver.engine: {name!r} not available for this scene; "
+        raise SceneError(f"{sid}: solver.engine: {name!r} not available for this scene; "
                          f"expected one of {list(available)}")
     return module
+
+
+def check(scene: dict) -> None:
+    """What only the scene's module can tell, before anything is computed: that it
+    offers the engine the scene asks for, and that ``chunks`` does not exceed its
+    grid. Raises :class:`~filippov.config.SceneError` naming the field."""
+    module = _module(scene)
+    if hasattr(module, "validate"):
+        module.validate(chunking.without_layout(scene))
+    n = scene.get("chunks")
+    if n is None:
+        return
+    if not chunking.supports_chunks(module):
+        raise SceneError(f"{scene.get('id')}: chunks: this scene cannot be split into chunks")
+    size = len(module.chunk_grid(chunking.without_layout(scene)))
+    if not 1 <= chunking.n_chunks(scene) <= size:
+        raise SceneError(f"{scene.get('id')}: chunks: {n} chunks for a grid of {size} points; "
+                         f"need 1 <= chunks <= {size}")
 
 
 def _declared(module, scene, ds):

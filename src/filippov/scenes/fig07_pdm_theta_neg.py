@@ -45,6 +45,11 @@ from .pdm_common import (CHUNK_AXIS, base_dataset, checked_theta, chunk_grid,  #
 # CHUNK_AXIS, chunk_grid, sweep and assemble make the scene splittable (see .chunking)
 
 
+def validate(scene: dict) -> None:
+    """The checks a schema cannot make (filippov.scenes.check runs them first)."""
+    _theta(scene)
+
+
 def _theta(scene: dict) -> float:
     return checked_theta(scene, lambda t: t < 0, "be < 0")
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from ..config import SceneError
 from ..models import hopf
 from ..pdm import discontinuity_map, scale_for
 from ..progress import Progress
@@ -66,6 +67,10 @@ FIELDS = ("xi1", "P", "P_flow", "n_switches", "xi2_entry", "excursion_time", "xi
 _RAW_NAME = {"xi1": "xi1_start"}  # the field xi1 would clash with the coordinate
 
 
+#: the smallest distance of a start point from x1 = -1: 16 ulps of 1
+RESOLUTION = 16 * float(np.finfo(float).eps)
+
+
 def chunk_grid(scene: dict) -> np.ndarray:
     return xi1_grid(scene["parameters"])
 
@@ -76,9 +81,20 @@ def checked_theta(scene: dict, ok, requirement: str) -> float:
     p = scene["parameters"]
     theta, mu = float(p["theta"]), float(p["mu"])
     if not ok(theta):
-        raise ValueError(f"{scene['id']}: parameters.theta must {requirement}, got {theta!r}")
+        raise SceneError(f"{scene['id']}: parameters.theta must {requirement}, got {theta!r}")
     if mu != 1.0:
-        raise ValueError(f"{scene['id']}: the stored asymptotics are for q = 0 (mu = 1)")
+        raise SceneError(f"{scene['id']}: parameters.mu: the stored asymptotics are for "
+                         f"q = 0 (mu = 1), got {mu!r}")
+    # the grid point nearest grazing, x1 = -1 + scale * closest, must be resolved in
+    # floating point near x1 = -1 (16 ulps), or its start point cannot be placed
+    closest = float(p["closest"])
+    for e in p["eps"]:
+        offset = scale_for(float(e), theta) * closest
+        if offset < RESOLUTION:
+            raise SceneError(
+                f"{scene['id']}: parameters.eps: {e!r} puts the grid point xi1 = -closest at "
+                f"x1 = -1 + {offset:.3g}, below the resolution of x1 near -1 (need "
+                f"{'eps' if theta < 0 else 'eps^2'} * closest >= {RESOLUTION:.2g})")
     return theta
 
 

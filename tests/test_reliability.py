@@ -1,0 +1,185 @@
+"""A harsh user: oversized configs, extreme eps, unchecked options and malformed
+settings each stop at once with one line naming the field (or t, state and mode),
+in the library and in the workflow."""
+
+import shutil
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from filippov import EventLimitError, SimulationError, scenes, simulate
+from filippov.config import SceneError, check_limits, limits, load_scene
+from filippov.models import hopf, pseudo_equilibrium
+from filippov.simulate import Section
+
+ROOT = Path(__file__).resolve().parents[1]
+SCHEMA = ROOT / "config" / "schema" / "scene.schema.json"
+sys.path.insert(0, str(ROOT / "workflow" / "scripts"))
+from verify import copy_project, run_snakemake  # noqa: E402
+
+
+def _scene(sid):
+    return load_scene(ROOT / "config" / "scenes" / f"{sid}.yaml", SCHEMA)
+
+
+# ----------------------------------------------------------------------------- size limits
+@pytest.mark.parametrize("sid,field,value,named", [
+    ("fig04_retmaps", "n_uniform", 100_000_000, "parameters.n_uniform"),
+    ("fig08_s0theta", "n_theta", 2_000_000_000, "parameters.n_theta"),
+    ("fig02_cases", "t_end", 1.0e9, "parameters.t_end"),
+    ("fig02_cases", "n_samples", 100_000_000, "parameters.n_samples"),
+])
+def test_oversized_scene_is_refused_naming_field_and_limit(sid, field, value, named):
+    scene = _scene(sid)
+    scene["parameters"][field] = value
+    with pytest.raises(SceneError, match=rf"{named}: .*max_\w+ = .*--config max_\w+="):
+        check_limits(scene)
+    # an explicit, larger limit lets a real large run through
+    check_limits(scene, limits({"max_points": 1e10, "max_samples": 1e10, "max_t_end": 1e10}))
+
+
+def test_chunks_beyond_limit_or_grid_are_refused():
+    scene = _scene("fig04_retmaps")
+    scene["chunks"] = 100_000
+    with pytest.raises(SceneError, match="chunks: 100000 jobs, over the limit max_chunks"):
+        check_limits(scene)
+    scene = _scene("fig09_pdm_theta_pos")
+    scene["chunks"] = 500   # under max_chunks and the cheap estimate, over the real grid
+    with pytest.raises(SceneError, match=r"chunks: 500 chunks for a grid of \d+ points"):
+        scenes.check(scene)
+
+
+def test_malformed_limit_override_is_named():
+    with pytest.raises(SceneError, match="--config max_points: must be a positive number"):
+        limits({"max_points": "lots"})
+
+
+def test_engine_a_scene_does_not_offer_is_one_line():
+    scene = _scene("fig02_cases")
+    scene["solver"]["engine"] = "compiled"
+    with pytest.raises(SceneError, match=r"solver.engine: 'compiled' not available"):
+        scenes.check(scene)
+
+
+def test_pdm_eps_below_the_resolution_of_x1_is_refused_before_computing():
+    scene = _scene("fig07_pdm_theta_neg")
+    scene["parameters"]["eps"] = [1.0e-2, 1.0e-12]
+    with pytest.raises(SceneError, match=r"parameters.eps: 1e-12 .* below the resolution"):
+        scenes.check(scene)
+
+
+# ----------------------------------------------------------------------------- extreme eps
+@pytest.mark.parametrize("eps", [1e-12, 1e6, 1e-300])
+def test_extreme_eps_stops_at_once_with_context(eps):
+    t0 = time.perf_counter()
+    with pytest.raises(SimulationError) as info:
+        simulate(hopf.model(eps, 0.5).full(), [0.0, 1.2, 0.0], 1.0)
+    assert "t=" in str(info.value) and "state" in str(info.value)
+    assert "f(a) and f(b)" not in str(info.value)
+    assert time.perf_counter() - t0 < 20
+
+
+def test_chatter_faster_than_the_budget_allows_stops_at_once():
+    t0 = time.perf_counter()
+    with pytest.raises(EventLimitError, match=r"switching every .* exceed max_events"):
+        simulate(pseudo_equilibrium.model(1e-12, -0.5).full(), [1e-11, 0.0], 1.0)
+    assert time.perf_counter() - t0 < 20
+
+
+def test_integrating_a_stiff_field_stops_at_once_with_the_reason():
+    t0 = time.perf_counter()
+    with pytest.raises(EventLimitError, match=r"exceed max_steps.*stiff"):
+        simulate(hopf.model(1e-12, -0.5).full(), [0.0, 1.2, 0.0], 1.0, method="integrate")
+    assert time.perf_counter() - t0 < 20
+
+
+# ----------------------------------------------------------------------------- options
+@pytest.mark.parametrize("option,value", [
+    ("max_step", 0.0), ("max_step", np.nan), ("rtol", -1.0), ("atol", 0.0), ("rtol", np.inf),
+    ("zeno_count", 0), ("zeno_count", 1), ("max_events", 0), ("max_steps", 2.5),
+    ("event_xtol", -1e-15), ("touch_tol", np.nan), ("samples_per_step", 0)])
+def test_every_option_is_checked_where_it_enters(option, value):
+    system = pseudo_equilibrium.model(0.1, -0.5).full()
+    with pytest.raises(ValueError, match=rf"^{option} must be"):
+        simulate(system, [0.3, 0.0], 1.0, **{option: value})
+
+
+def test_sections_are_checked():
+    with pytest.raises(ValueError, match="direction must be -1, 0 or"):
+        Section("L", lambda z: z[0], direction=5)
+    with pytest.raises(ValueError, match="terminal must be None or an integer"):
+        Section("L", lambda z: z[0], terminal=0)
+    with pytest.raises(TypeError, match=r"sections\[0\]"):
+        simulate(pseudo_equilibrium.model(0.1, -0.5).full(), [0.3, 0.0], 1.0,
+                 sections=[lambda z: z[0]])
+
+
+# ----------------------------------------------------------------------------- workflow
+@pytest.fixture
+def project(tmp_path):
+    work = copy_project(tmp_path / "p")
+    yield work
+    shutil.rmtree(work, ignore_errors=True)
+
+
+def _edit(path: Path, fn):
+    data = yaml.safe_load(path.read_text())
+    fn(data)
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+
+
+def _lines(run):
+    return [line for line in (run.stdout + run.stderr).splitlines() if line.strip()]
+
+
+def test_planning_an_oversized_scene_stops_in_seconds(project):
+    _edit(project / "config/scenes/fig04_retmaps.yaml", lambda d: d.update(chunks=100_000))
+    t0 = time.perf_counter()
+    run = run_snakemake(project, "-n")
+    assert run.returncode != 0 and time.perf_counter() - t0 < 30
+    assert any(line.startswith("error: config/scenes/fig04_retmaps.yaml: chunks: 100000")
+               for line in _lines(run)), run.stderr[-2000:]
+    assert "Traceback" not in run.stdout + run.stderr
+    # the limit is raised explicitly for a real large run (then the grid bound applies)
+    run = run_snakemake(project, "-n", "--config", "max_chunks=1000000")
+    assert "chunks for a sweep of at most 2202 points" in run.stdout + run.stderr
+
+
+def test_malformed_config_names_file_line_and_column(project):
+    cfg = project / "config/config.yaml"
+    cfg.write_text(cfg.read_text().replace("scenes: [", "scenes: [[", 1))
+    run = run_snakemake(project, "-n")
+    assert run.returncode != 0
+    assert any(line.startswith("error: config/config.yaml: line ") and "column" in line
+               for line in _lines(run)), run.stderr[-2000:]
+
+
+def test_unknown_top_level_setting_is_named(project):
+    run = run_snakemake(project, "-n", "--config", "max_pionts=5")
+    assert run.returncode != 0
+    assert "'max_pionts' was unexpected" in run.stdout + run.stderr
+
+
+def test_engine_error_from_the_compute_job_is_one_line(project):
+    _edit(project / "config/scenes/fig02_cases.yaml",
+          lambda d: d["solver"].update(engine="compiled"))
+    run = run_snakemake(project, "results/fig02_cases.nc")
+    assert run.returncode != 0
+    assert "error: fig02_cases: solver.engine: 'compiled' not available" in run.stdout + run.stderr
+    assert "Traceback" not in run.stdout + run.stderr
+    assert not (project / "results/fig02_cases.nc").exists()
+
+
+def test_manifest_check_defaults_to_the_working_directory(tmp_path, monkeypatch):
+    from filippov import manifest
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "results").mkdir()
+    (tmp_path / "figures").mkdir()
+    # no build here: every dataset and figure of the manifest is missing *here*
+    assert manifest.main(["check"]) == 1
+
