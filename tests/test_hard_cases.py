@@ -92,6 +92,37 @@ def test_chatter_period_scales_like_eps(eps_sweep, eps):
                                                              rel=1e-12)
 
 
+def test_theta_positive_sliding_return_converges_like_eps_squared_at_bounded_cost(eps_sweep):
+    # one return of the Hopf example at theta = 0.5 through sliding, reference driver
+    d = eps_sweep
+    assert np.all(d.return_finite.values == 1)
+    np.testing.assert_array_equal(d.return_P_reduced.values, 1.0)   # the reduced orbit
+    gap = 1.0 - d.return_P.values
+    assert np.all(gap > 0)
+    scaled = gap / d.eps.values ** 2                 # O(eps^2), as the theta > 0 scaling says
+    assert np.all((scaled[1:] > 100) & (scaled[1:] < 200)), scaled
+    assert np.ptp(scaled[2:]) < 0.05 * scaled[-1]    # converged for eps <= 1e-4
+    # sliding lasts O(1) at every eps; the stiff sliding field is handed to Radau at
+    # small eps, so the cost stays bounded instead of growing like 1/eps
+    assert np.all((d.return_sliding_time.values > 0.1) & (d.return_sliding_time.values < 0.3))
+    assert list(d.return_stiff.values) == [0, 0, 0, 1, 1]
+    assert d.return_steps.values.max() < 4000
+
+
+def test_radau_takes_over_stiff_sliding_and_agrees_with_dop853(monkeypatch):
+    """Where both run (eps = 1e-4), the implicit finish agrees with DOP853."""
+    import sys
+
+    model = hopf.model(1e-4, 0.5)
+    start, opts = [0.0, 1.2, 0.0], dict(dense=False, max_steps=20_000)
+    explicit = simulate(model.full(), start, 0.3, stiff=False, **opts)
+    # check for stiffness early, so that Radau takes over for most of the slide
+    monkeypatch.setattr(sys.modules["filippov.simulate"], "STIFF_AFTER", 200)
+    implicit = simulate(model.full(), start, 0.3, **opts)
+    assert "sliding" in implicit.stiff_modes and not explicit.stiff_modes
+    np.testing.assert_allclose(implicit.z, explicit.z, rtol=0, atol=1e-11)
+
+
 @pytest.mark.parametrize("eps", EPS_SWEEP)
 def test_pseudo_equilibrium_theta_positive_slides_in_for_every_eps(eps_sweep, eps):
     # theta = 0.6: the relaxed + flow meets H_s at x = -(1 - theta) eps, inside the

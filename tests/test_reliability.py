@@ -90,10 +90,23 @@ def test_chatter_faster_than_the_budget_allows_stops_at_once():
     assert time.perf_counter() - t0 < 20
 
 
-def test_integrating_a_stiff_field_stops_at_once_with_the_reason():
+def test_integrating_a_stiff_field_switches_to_radau_with_a_note():
+    # method="integrate" at eps = 1e-12: the fast relaxation makes DOP853 crawl; the
+    # driver notes the stiffness and finishes with Radau, agreeing with the exact flow
+    system = hopf.model(1e-12, -0.5).full()
+    t0 = time.perf_counter()
+    traj = simulate(system, [0.0, 1.2, 0.3], 0.02, method="integrate")
+    assert time.perf_counter() - t0 < 20
+    assert traj.status == "t_end" and traj.stiff_modes == {"plus"}
+    exact = simulate(system, [0.0, 1.2, 0.3], 0.02)
+    np.testing.assert_allclose(traj.z, exact.z, rtol=0, atol=1e-10)
+
+
+def test_without_the_stiff_switch_it_refuses_at_once_with_the_reason():
     t0 = time.perf_counter()
     with pytest.raises(EventLimitError, match=r"exceed max_steps.*stiff"):
-        simulate(hopf.model(1e-12, -0.5).full(), [0.0, 1.2, 0.0], 1.0, method="integrate")
+        simulate(hopf.model(1e-12, -0.5).full(), [0.0, 1.2, 0.0], 1.0, method="integrate",
+                 stiff=False)
     assert time.perf_counter() - t0 < 20
 
 
@@ -101,7 +114,8 @@ def test_integrating_a_stiff_field_stops_at_once_with_the_reason():
 @pytest.mark.parametrize("option,value", [
     ("max_step", 0.0), ("max_step", np.nan), ("rtol", -1.0), ("atol", 0.0), ("rtol", np.inf),
     ("zeno_count", 0), ("zeno_count", 1), ("max_events", 0), ("max_steps", 2.5),
-    ("event_xtol", -1e-15), ("touch_tol", np.nan), ("samples_per_step", 0)])
+    ("event_xtol", -1e-15), ("touch_tol", np.nan), ("samples_per_step", 0),
+    ("stiff", "yes")])
 def test_every_option_is_checked_where_it_enters(option, value):
     system = pseudo_equilibrium.model(0.1, -0.5).full()
     with pytest.raises(ValueError, match=rf"^{option} must be"):

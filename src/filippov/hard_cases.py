@@ -43,7 +43,8 @@ from .tolerance import ULP, Tolerance, annotate, sqrt_law
 from .models import hopf, pseudo_equilibrium
 from .progress import Progress
 from .scenes.chunking import bounds
-from .simulate import simulate
+from .poincare import sliding_time
+from .simulate import Section, simulate
 
 DATASET_ID = "hard_cases"
 CONFIG_KEYS = ("eps", "chunks")
@@ -69,6 +70,8 @@ PARAMETERS = {
     "slide_max_events": 100,
     "kernel_start": 0.3,                   # compiled kernel: start at x = 0.3 ...
     "kernel_t_max": 0.5,                   # ... for a time 0.5
+    "return_theta": 0.5,                   # Hopf example, theta > 0: one return to L1 ...
+    "return_x2": 1.2,                      # ... from (0, return_x2, 0), sliding on the way
 }
 
 _STATUS_NOTE = "filippov.fastmap status: " + "; ".join(
@@ -118,6 +121,14 @@ VARIABLES = {
     "kernel_final_abs_x": ("f8", "|x| at the end of the compiled kernel's run", "1"),
     "kernel_finite": ("i4", "1 if the final state of the compiled kernel is finite, else 0",
                       "1"),
+    "return_P": ("f8", "x2 at the first return to L1 of the Hopf orbit from (0, return_x2, 0), "
+                       "theta = return_theta, reference driver (sliding integrated)", "1"),
+    "return_P_reduced": ("f8", "the same return of the reduced system (eps = 0)", "1"),
+    "return_sliding_time": ("f8", "time the orbit slides on the way", "1"),
+    "return_steps": ("i4", "driver steps of the return (its cost, deterministic)", "1"),
+    "return_stiff": ("i4", "1 if the sliding was finished by the implicit Radau method "
+                           "(DOP853 bounded by stability), else 0", "1"),
+    "return_finite": ("i4", "1 if the returned state is finite, else 0", "1"),
 }
 _OFFSET = PARAMETERS["jump_x2_offset"]
 #: cross-machine tolerances beyond the default (see filippov.tolerance)
@@ -131,6 +142,10 @@ TOLERANCES = {
                        "moves it by ulp/probe; x20"),
     "slope_sliding_time": Tolerance(1e-9, sqrt_law(PARAMETERS["slope_probe_floor"], 3.0),
                                     "slide of a probe just past grazing: square-root law; x3"),
+    "return_steps": Tolerance(0.5, 10, "a cost counter, not a result: step acceptance and "
+                                       "Radau's Newton and Jacobian-reuse decisions flip with "
+                                       "last bits (a few percent measured); it shows the cost "
+                                       "stays bounded"),
 }
 
 EPS_ATTRS = {"long_name": "singular perturbation parameter eps", "units": "1"}
@@ -220,7 +235,32 @@ def slide_in(eps: float) -> dict:
             "kernel_finite": int(np.all(np.isfinite(out.state)))}
 
 
-MEASUREMENTS = (theta_negative_jump, theta_positive_slope, chatter_period, slide_in)
+def _section_L1() -> Section:
+    return Section("L1", lambda z: z[0], direction=-1, where=lambda z: z[1] > 0, terminal=1)
+
+
+def sliding_return(eps: float) -> dict:
+    """One return to L1 of the Hopf example at theta = return_theta (> 0) with the
+    reference driver: the orbit grazes into sliding, whose fast direction
+    (x1 + 1 relaxing at rate 1/(theta eps)) makes the sliding field stiff; the
+    driver detects it and finishes with Radau. Its steps are the cost."""
+    p = PARAMETERS
+    model = hopf.model(eps, p["return_theta"], p["mu"], p["omega"])
+    start = [0.0, p["return_x2"], 0.0]
+    traj = simulate(model.full(), start, p["hopf_t_max"], sections=[_section_L1()],
+                    dense=False)
+    reduced = simulate(model.reduced(), start[:2], p["hopf_t_max"], sections=[_section_L1()],
+                       dense=False)
+    ok = traj.status == "section:L1" and reduced.status == "section:L1"
+    return {"return_P": float(traj.z[1]) if ok else math.nan,
+            "return_P_reduced": float(reduced.z[1]) if ok else math.nan,
+            "return_sliding_time": float(sliding_time(traj.events)),
+            "return_steps": int(traj.n_steps), "return_stiff": int("sliding" in traj.stiff_modes),
+            "return_finite": int(ok and np.all(np.isfinite(traj.z)))}
+
+
+MEASUREMENTS = (theta_negative_jump, theta_positive_slope, chatter_period, slide_in,
+                sliding_return)
 
 
 def measure(eps: float) -> dict:

@@ -517,7 +517,8 @@ def hard_cases(ds, m: Macros) -> str:
     jump/eps (theta < 0), one-sided slope (theta > 0), chatter period, slide-in."""
     m.flag("rpHaveHardCases", ds is not None)
     if ds is None:
-        return _not_yet("Hard-case eps sweep", "results/hard_cases.nc")
+        return (_not_yet("Hard-case eps sweep", "results/hard_cases.nc"),
+                _not_yet("Sliding return sweep", "results/hard_cases.nc"))
     sid = "hard_cases"
     eps = [float(e) for e in ds.eps.values]
     kmax, kmin = int(np.argmax(eps)), int(np.argmin(eps))
@@ -565,10 +566,40 @@ def hard_cases(ds, m: Macros) -> str:
             f"${num(float(d.chatter_period_max_rel_dev), 2)}$",
             f"${num(float(d.slide_start_offset), 2)}$", f"${num(float(d.slide_final_abs_x), 2)}$",
             f"${num(float(d.kernel_final_abs_x), 2)}$"]) + r" \\")
-    return _tabular("rrrrrrrrr", [
+    table = _tabular("rrrrrrrrr", [
         r"$\epsilon$ & jump$/\epsilon$ & slope & $x_2-1$ & period$/\epsilon$ & "
         r"period dev. & slide start $+(1-\theta)\epsilon$ & final $|x|$ & "
         r"final $|x|$, kernel \\"], rows)
+    return table, _hard_return(ds, m, eps)
+
+
+def _hard_return(ds, m: Macros, eps: list) -> str:
+    """The theta > 0 sliding return per eps: 1 - P against eps^2, sliding time, cost."""
+    sid = "hard_cases"
+    m.add("rpHardReturnTheta", float(ds.attrs["return_theta"]), f"{sid}:attrs.return_theta", 3)
+    m.add("rpHardReturnXtwo", float(ds.attrs["return_x2"]), f"{sid}:attrs.return_x2", 3)
+    gap = np.abs(ds.return_P_reduced.values - ds.return_P.values)
+    scaled = gap / ds.eps.values ** 2
+    small = [k for k, e in enumerate(eps) if e <= 1e-3] or list(range(len(eps)))
+    m.add("rpHardReturnScaledMin", float(scaled[small].min()),
+          "derived: min |P_reduced - P|/eps^2 over eps <= 1e-3", 3)
+    m.add("rpHardReturnScaledMax", float(scaled[small].max()),
+          "derived: max |P_reduced - P|/eps^2 over eps <= 1e-3", 3)
+    steps = ds.return_steps.values
+    m.add("rpHardReturnStepsMin", int(steps.min()), "derived: min return_steps over eps")
+    m.add("rpHardReturnStepsMax", int(steps.max()), "derived: max return_steps over eps")
+    m.add("rpHardReturnStiffN", int(ds.return_stiff.values.sum()),
+          "derived: eps values whose sliding was finished by Radau")
+    rows = []
+    for k, e in enumerate(eps):
+        d = ds.sel(eps=e)
+        rows.append(" & ".join([
+            f"${_eps_label(e)}$", f"${num(float(gap[k]), 3)}$", f"${num(float(scaled[k]), 4)}$",
+            f"${num(float(d.return_sliding_time), 5)}$", f"${int(d.return_steps)}$",
+            "Radau" if int(d.return_stiff) else "DOP853"]) + r" \\")
+    return _tabular("rrrrrl", [
+        r"$\epsilon$ & $|P_0-P|$ & $|P_0-P|/\epsilon^2$ & sliding time & steps & "
+        r"sliding by \\"], rows)
 
 
 # ----------------------------------------------------------------------------- entry point
@@ -591,7 +622,7 @@ def generate(datasets: Mapping[str, Optional[xr.Dataset]]) -> dict[str, str]:
     tab10, tab11 = dry_friction(datasets.get("fig10_dfo"), datasets.get("fig11_dfo_retmaps"), m)
     tab_bench = bench(datasets.get("bench_work_precision"), m, datasets.get("bench_effect_cost"))
     try:
-        tab_hard = hard_cases(datasets.get("hard_cases"), m)
+        tab_hard, tab_return = hard_cases(datasets.get("hard_cases"), m)
     except KeyError as exc:
         raise KeyError(f"hard_cases: the report reads {exc} but the dataset lacks it") from None
     return {
@@ -602,6 +633,7 @@ def generate(datasets: Mapping[str, Optional[xr.Dataset]]) -> dict[str, str]:
         "tab_fig11.tex": tab11,
         "tab_bench.tex": tab_bench,
         "tab_hard_cases.tex": tab_hard,
+        "tab_hard_return.tex": tab_return,
     }
 
 

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 from typing import Callable, Optional, Sequence
 
 import numpy as np
-from scipy.integrate import DOP853
+from scipy.integrate import DOP853, Radau
 from scipy.optimize import brentq
 
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
@@ -90,6 +90,9 @@ class Trajectory:
     status: str = "running"
     n_steps: int = 0
     integrated_modes: set = field(default_factory=set)
+    # modes whose integration switched from DOP853 to the implicit Radau method
+    # because the field proved stiff there (see STIFF_AFTER)
+    stiff_modes: set = field(default_factory=set)
 
     def section_hits(self, name: str) -> list:
         return [e for e in self.events if e.kind == "section" and e.name == name]
@@ -138,7 +141,9 @@ class _ExactStepper:
 
 
 class _IntegratingStepper:
-    def __init__(self, fun, z, t, t_end, rtol, atol, max_step):
+    """DOP853 (explicit), or Radau (implicit, for a stiff field), with dense output."""
+
+    def __init__(self, fun, z, t, t_end, rtol, atol, max_step, method=DOP853):
         calls = [0]
 
         def checked(tt, zz):
@@ -157,7 +162,8 @@ class _IntegratingStepper:
                 v = np.full(np.shape(v), 1e300)
             return v
 
-        self.solver = DOP853(checked, t, z, t_end, rtol=rtol, atol=atol,
+        self.method = method
+        self.solver = method(checked, t, z, t_end, rtol=rtol, atol=atol,
                              max_step=max_step if np.isfinite(max_step) else np.inf)
 
     def step(self):
@@ -165,7 +171,7 @@ class _IntegratingStepper:
         ta = s.t
         msg = s.step()
         if s.status == "failed":
-            raise SimulationError(f"DOP853 failed at t={ta!r}: {msg}")
+            raise SimulationError(f"{self.method.__name__} failed at t={ta!r}: {msg}")
         return ta, s.t, s.dense_output()
 
 
@@ -173,6 +179,29 @@ class _IntegratingStepper:
 _TINY = np.finfo(float).tiny
 EXACT_BLOCK = 16
 PROJECT_AFTER = 1000  # steps before the step budget is projected from the mean step
+#: every STIFF_AFTER DOP853 steps in one stay in a mode, the step is compared with
+#: the field's stiffness: when h * rho(J) > 1 the step is bounded by stability, not
+#: accuracy (a fast variable slaved to a slow manifold, e.g. sliding of a slow-fast
+#: system at small eps), and the rest of the stay is integrated by Radau
+#: (listed in Trajectory.stiff_modes)
+STIFF_AFTER = 1000
+
+
+def spectral_radius(fun, t, z, iterations: int = 6) -> float:
+    """Largest |eigenvalue| of the field's Jacobian at ``z``, by power iteration on
+    finite differences (iterations + 1 field evaluations)."""
+    z = np.asarray(z, dtype=float)
+    f0 = np.asarray(fun(t, z), dtype=float)
+    v = np.ones_like(z) / np.sqrt(z.size)
+    delta = 1e-7 * (1.0 + np.linalg.norm(z))
+    rho = 0.0
+    for _ in range(iterations):
+        w = (np.asarray(fun(t, z + delta * v), dtype=float) - f0) / delta
+        rho = float(np.linalg.norm(w))
+        if not (np.isfinite(rho) and rho > 0):
+            return 0.0
+        v = w / rho
+    return rho
 
 
 @dataclass(frozen=True)
@@ -301,6 +330,8 @@ def _check_options(**opts) -> None:
     integer("max_steps", 1)
     integer("samples_per_step", 1)
     integer("zeno_count", 2)
+    if not isinstance(opts["stiff"], (bool, np.bool_)):
+        raise ValueError(f"stiff must be True or False, got {opts['stiff']!r}")
 
 
 @_quiet_floating_point
@@ -310,14 +341,17 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
              max_events: int = 100_000, max_steps: int = 5_000_000,
              dense: bool = True, samples_per_step: int = 4, touch_tol: float = 1e-15,
              event_xtol: float = 1e-15, zeno_count: int = 64,
-             zeno_span: float = 1e-10) -> Trajectory:
+             zeno_span: float = 1e-10, stiff: bool = True) -> Trajectory:
     """Integrate ``system`` from ``z0`` at ``t0`` to ``t_end`` (or a terminal section).
 
     ``method="exact"`` uses the system's exact flows where it has them (modes
     without one are integrated, listed in ``Trajectory.integrated_modes``);
     ``method="integrate"`` integrates every mode with DOP853 at ``rtol``/``atol``.
     Contacts with ``|H| <= touch_tol`` at a tangency count as touching, not
-    crossing (region + is ``H >= 0``).
+    crossing (region + is ``H >= 0``). With ``stiff`` (default), an integrated
+    mode whose DOP853 steps turn out bounded by stability (step x spectral radius
+    of the Jacobian > 1, checked every ``STIFF_AFTER`` steps) continues with the
+    implicit Radau method (listed in ``Trajectory.stiff_modes``).
     """
     if method not in ("exact", "integrate"):
         raise ValueError(f"method must be 'exact' or 'integrate', got {method!r}")
@@ -332,7 +366,7 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
     _check_options(rtol=rtol, atol=atol, max_step=max_step, max_events=max_events,
                    max_steps=max_steps, samples_per_step=samples_per_step,
                    touch_tol=touch_tol, event_xtol=event_xtol, zeno_count=zeno_count,
-                   zeno_span=zeno_span)
+                   zeno_span=zeno_span, stiff=stiff)
     for k, sec in enumerate(sections):
         if not isinstance(sec, Section):
             raise TypeError(f"sections[{k}]: expected a filippov.simulate.Section, got "
@@ -371,8 +405,9 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
                                     system.transient_time)
         else:
             traj.integrated_modes.add(MODE_NAMES[mode])
-            stepper = _IntegratingStepper(lambda _t, zz, m=mode: system.field(m, zz),
-                                          z, t, t_end, rtol, atol, max_step)
+            field_of_mode = lambda _t, zz, m=mode: system.field(m, zz)
+            stepper = _IntegratingStepper(field_of_mode, z, t, t_end, rtol, atol, max_step)
+        steps_in_mode, stepper_steps, stepper_t = 0, 0, t
         # Functions whose crossing ends this mode, with the mode they lead to.
         if mode == PLUS:
             leave = [(system.switch, TO_NEG, "switch")]
@@ -391,14 +426,13 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
                     f"{MODE_NAMES[mode]}: the run is too long or the step size collapsed")
             ta, tb, Z = stepper.step()
             # a run that cannot reach t_end within the step budget stops now, not
-            # after minutes: project the steps left from the mean step so far
-            if traj.n_steps > PROJECT_AFTER and tb > t0:
-                left = (t_end - tb) * traj.n_steps / (tb - t0)
-            else:
-                left = 0.0
+            # after minutes: project the steps left from this stepper's mean step
+            stepper_steps += 1
+            mean = (tb - stepper_t) / stepper_steps
+            left = (t_end - tb) / mean if stepper_steps > PROJECT_AFTER and mean > 0 else 0.0
             if traj.n_steps + left > max_steps:
                 raise EventLimitError(
-                    f"steps of {tb - ta:.3g} (mean {(tb - t0) / traj.n_steps:.3g}) at t={ta!r} in mode "
+                    f"steps of {tb - ta:.3g} (mean {mean:.3g}) at t={ta!r} in mode "
                     f"{MODE_NAMES[mode]} (state {z.tolist()}): ~{left:.3g} more steps to "
                     f"t_end={t_end!r} exceed max_steps={max_steps}"
                     + ("; the integrated field is stiff here (a fast time scale, e.g. a "
@@ -427,6 +461,14 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
                 t, z = tb, zs[:, -1].copy()
                 if tb >= t_end:
                     return stop("t_end")
+                steps_in_mode += 1
+                if (stiff and not use_flow and stepper.method is DOP853
+                        and steps_in_mode % STIFF_AFTER == 0
+                        and (tb - ta) * spectral_radius(field_of_mode, t, z) > 1.0):
+                    traj.stiff_modes.add(MODE_NAMES[mode])
+                    stepper = _IntegratingStepper(field_of_mode, z, t, t_end, rtol, atol,
+                                                  max_step, method=Radau)
+                    stepper_steps, stepper_t = 0, t
                 continue
             te, ze, what, idx = found
             if dense:  # the segment ends at the event

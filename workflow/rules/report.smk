@@ -21,7 +21,8 @@ REPORT_OPTIONAL = ["fig10_dfo", "fig11_dfo_retmaps"]
 report: "../report/workflow.rst"
 
 REPORT_GENERATED = ["macros.tex", "tab_fig07.tex", "tab_fig09.tex", "tab_fig10.tex",
-                    "tab_fig11.tex", "tab_bench.tex", "tab_hard_cases.tex"]
+                    "tab_fig11.tex", "tab_bench.tex", "tab_hard_cases.tex",
+                    "tab_hard_return.tex"]
 TEX_PACKAGES = ("texlive-publishers texlive-latex-extra texlive-latex-recommended "
                 "texlive-fonts-recommended latexmk")
 
