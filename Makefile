@@ -10,6 +10,8 @@
 #                  the measured spread next to each tolerance
 #   make report    the reproduction report paper/main.pdf (needs TeX)
 #   make report-html  snakemake's HTML report (report.html): figures, rules, parameters
+#   make archive   one tarball of code, results, figures and report, with its sha256
+#   make help      this list
 #   make lock      re-resolve requirements.lock in a throw-away venv
 #   make clean     remove workflow outputs (keeps .venv)
 #   make bench        work-precision sweep and cost of each model ingredient
@@ -43,9 +45,24 @@ export DEBIAN_FRONTEND = noninteractive
 # `python` inside Snakemake shell rules is the venv's interpreter.
 VENV_PATH = PATH="$(abspath $(VENV))/bin:$$PATH" VIRTUAL_ENV="$(abspath $(VENV))"
 
-.PHONY: all venv figures test verify cross-cpu manifest report report-html bench bench-fig04 lock clean distclean check-python
+.PHONY: all help archive venv figures test verify cross-cpu manifest report report-html bench bench-fig04 lock clean distclean check-python
 
 all: figures
+
+# The target list: the comment block at the top of this file.
+help:
+	@sed -n '/^#   make /,/^# *$$/p' $(firstword $(MAKEFILE_LIST)) | sed 's/^# \{0,3\}//' | sed '/^$$/d'
+
+# One tarball of what a reader needs: the code, the results, the figures and the
+# report, with its sha256 beside it (a tracked file list: no venv, no caches).
+ARCHIVE ?= filippov-$(shell git describe --always --dirty 2>/dev/null || echo snapshot).tar.gz
+archive: figures
+	@test -d results && test -n "$$(ls figures/*.pdf 2>/dev/null)" || { echo "error: no build to archive" >&2; exit 1; }
+	tmp=$$(mktemp); trap 'rm -f "$$tmp"' EXIT; \
+	{ git ls-files; ls results/*.nc figures/*.pdf figures/*.png; ls paper/main.pdf 2>/dev/null || true; } | sort -u > "$$tmp"; \
+	tar --sort=name --mtime='@0' --owner=0 --group=0 --numeric-owner -czf $(ARCHIVE).tmp -T "$$tmp"; \
+	mv $(ARCHIVE).tmp $(ARCHIVE); sha256sum $(ARCHIVE) > $(ARCHIVE).sha256; \
+	echo "wrote $(ARCHIVE) ($$(wc -l < "$$tmp") files) and $(ARCHIVE).sha256"
 
 check-python:
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else 1)' || \
@@ -95,7 +112,10 @@ cross-cpu: $(VENV)/.done
 manifest: figures
 	$(VENV_PATH) $(PY) -m filippov.manifest update
 
+TEX_INSTALL = apt-get install -y --no-install-recommends texlive-publishers texlive-latex-extra texlive-latex-recommended texlive-fonts-recommended latexmk
 report: $(VENV)/.done
+	@command -v latexmk >/dev/null && command -v pdflatex >/dev/null && kpsewhich elsarticle.cls >/dev/null || \
+	  { echo "error: the report needs TeX (latexmk, pdflatex, elsarticle.cls); install it with: sudo $(TEX_INSTALL)" >&2; exit 1; }
 	$(VENV_PATH) $(VENV)/bin/snakemake --cores all $(SNAKEFLAGS) paper/main.pdf
 
 report-html: $(VENV)/.done

@@ -46,7 +46,9 @@ def code_version() -> str:
         dirty = subprocess.run(["git", "-C", str(here), "status", "--porcelain", "--", "."],
                                check=True, capture_output=True, text=True, timeout=10).stdout.strip()
     except (OSError, subprocess.SubprocessError):
-        return "unknown"
+        commit = ""
+    if not commit:  # an installed copy, not a git checkout: its released version
+        return f"filippov-{__version__} (installed)"
     return commit + ("-dirty" if dirty else "")
 
 
