@@ -38,3 +38,15 @@ def test_licence_and_citation_are_there():
     assert "MIT License" in (ROOT / "LICENSE").read_text()
     cff = (ROOT / "CITATION.cff").read_text()
     assert "preferred-citation" in cff and "Sieber" in cff and "doi:" in cff
+
+
+def test_progress_lines_name_the_chunk_and_the_time_left(capsys):
+    from filippov.progress import Progress, context
+
+    with context("chunk 2/4"):
+        bar = Progress("fig99_test", 4, enabled=True, every=0.0)
+    for _ in range(4):
+        bar.step(note="x")
+    lines = capsys.readouterr().err.splitlines()
+    assert lines[0].startswith("[fig99_test chunk 2/4] 1/4 ( 25.0%)") and " eta " in lines[0]
+    assert lines[-1].split()[6] == "done"   # [label chunk k/n] 4/4 (100.0%) t done x

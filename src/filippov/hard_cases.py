@@ -365,7 +365,7 @@ def compute_part(config, i: int, progress: bool = False) -> xr.Dataset:
     cfg = check_config(config)
     eps, n = cfg["eps"], cfg["chunks"]
     start, stop = bounds(len(eps), i, n)
-    raw = _raw(eps[start:stop], progress, label=f"{DATASET_ID} {i + 1}/{n}")
+    raw = _raw(eps[start:stop], progress, label=f"{DATASET_ID} chunk {i + 1}/{n}")
     return finalize(raw, _provenance(eps), chunk_index=i, chunk_count=n, chunk_axis="eps",
                     chunk_start=start, chunk_stop=stop, grid_size=len(eps),
                     title=f"chunk {i + 1} of {n} of the hard-case sweep (see "

@@ -29,6 +29,7 @@ import numpy as np
 import xarray as xr
 
 from ..io import finalize
+from ..progress import context as progress_context
 
 LAYOUT_KEYS = ("chunks",)
 
@@ -69,7 +70,8 @@ def compute_chunk(module, scene: dict, i: int, n: int, *, progress: bool = False
     scene = without_layout(scene)
     grid = np.asarray(module.chunk_grid(scene))
     start, stop = bounds(grid.size, i, n)
-    raw = module.sweep(scene, grid[start:stop], progress=progress)
+    with progress_context(f"chunk {i + 1}/{n}"):
+        raw = module.sweep(scene, grid[start:stop], progress=progress)
     return finalize(raw, scene, chunk_index=i, chunk_count=n, chunk_axis=module.CHUNK_AXIS,
                     chunk_start=start, chunk_stop=stop, grid_size=grid.size,
                     title=f"chunk {i + 1} of {n} of {scene.get('id')} (raw; see results/"
