@@ -59,12 +59,32 @@ def check(scene: dict) -> None:
 
 
 def _declared(module, scene, ds):
-    """``ds`` with each variable's cross-machine tolerance in its attributes: the
-    module's ``tolerances(scene)`` (when they follow the scene's eps or grid) or
-    ``TOLERANCES`` (see :mod:`filippov.tolerance`)."""
+    """``ds`` with what the module declares about its variables: names and units
+    (``VARIABLE_ATTRS``, {name: (long_name, units or None)}: every variable must
+    end up with a long_name, every numeric one with units) and cross-machine
+    tolerances (``tolerances(scene)`` when they follow the scene's eps or grid,
+    else ``TOLERANCES``; see :mod:`filippov.tolerance`)."""
+    ds = describe(ds, getattr(module, "VARIABLE_ATTRS", {}))
     declared = module.tolerances(scene) if hasattr(module, "tolerances") else \
         getattr(module, "TOLERANCES", {})
     return tolerance.annotate(ds, declared)
+
+
+def describe(ds, attrs: dict):
+    """``ds`` with long_name/units from ``attrs``; every variable must have a long_name
+    and every numeric variable units afterwards (CF-1.8), or this is an error."""
+    ds = ds.copy()
+    for name, (long_name, units) in attrs.items():
+        if name not in ds.variables:
+            raise ValueError(f"VARIABLE_ATTRS names {name!r}, which the dataset lacks")
+        ds[name].attrs["long_name"] = long_name
+        if units is not None:
+            ds[name].attrs["units"] = units
+    lacking = sorted(n for n in ds.variables if "long_name" not in ds[n].attrs
+                     or (ds[n].dtype.kind in "fiub" and "units" not in ds[n].attrs))
+    if lacking:
+        raise ValueError(f"variables without long_name or units: {', '.join(lacking)}")
+    return ds
 
 
 def compute(scene: dict, *, progress: bool = False):

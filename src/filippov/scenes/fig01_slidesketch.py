@@ -12,6 +12,18 @@ from .common import require, solver_options
 
 CASES = ("crossing", "sliding")
 
+#: names and units of the variables built below (checked complete by filippov.scenes)
+VARIABLE_ATTRS = {
+    "x1": ("x1 along the trajectory", "1"), "x2": ("x2 along the trajectory", "1"),
+    "mode": ("field followed: -1 region -, 0 sliding, 1 region +", "1"),
+    "hit_x1": ("x1 where the trajectory first meets H_s", "1"),
+    "hit_x2": ("x2 where the trajectory first meets H_s", "1"),
+    "arrow_x1": ("x1 of a field arrow", "1"), "arrow_x2": ("x2 of a field arrow", "1"),
+    "arrow_u": ("x1 component of the field at the arrow", "1"),
+    "arrow_v": ("x2 component of the field at the arrow", "1"),
+    "case": ("trajectory shown: crossing or sliding", None), "t": ("time", "1"),
+}
+
 
 def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     require(scene, "system", {"reduced"})

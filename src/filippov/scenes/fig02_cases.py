@@ -13,6 +13,16 @@ from ..sliding import attracting_intervals
 from ..system import PLUS
 from .common import require, solver_options
 
+#: names and units of the variables without them below (checked by filippov.scenes)
+VARIABLE_ATTRS = {
+    "mode": ("field followed: -1 region -, 0 sliding, 1 region +", "1"),
+    "x_cycle": ("x along one period of the chatter orbit (solver)", "1"),
+    "y_cycle": ("y along one period of the chatter orbit (solver)", "1"),
+    "t_cycle": ("time along one period of the chatter orbit, from a switch to +", "1"),
+    "theta": ("theta, weight of the fast variable in the switching function", "1"),
+    "t": ("time", "1"),
+}
+
 SETTLE_PERIODS = 40  # the orbit contracts by ~0.03 a period (theta=-0.5): ample
 
 

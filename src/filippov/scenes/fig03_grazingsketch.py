@@ -38,6 +38,8 @@ from ..tolerance import Tolerance
 from .common import require, solver_options
 
 COMPONENTS = ["x1", "x2"]
+VARIABLE_ATTRS = {"component": ("state component", None),
+                  "sample": ("sample index along one period", "1")}
 #: a slide shorter than this (in time) is the grazing contact at mu = 1 + O(1e-16):
 #: its length is ~sqrt(1e-16) = 1e-8, while the slides of mu >= 1 + 1e-10 last
 #: longer than 1e-6 (length ~ sqrt(mu - 1))

@@ -88,6 +88,8 @@ def sigma_minus(model) -> tuple[float, float]:
 # computed there, so compute() and a merge of chunks give identical datasets.
 CHUNK_AXIS = "x2"
 ENGINES = ("python", "compiled")
+VARIABLE_ATTRS = {"theta": ("theta, weight of the fast variable in the switching function",
+                            "1")}
 
 
 def chunk_grid(scene: dict) -> np.ndarray:

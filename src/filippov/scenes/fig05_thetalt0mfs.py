@@ -30,6 +30,14 @@ from ..simulate import Section
 from ..system import MINUS, PLUS
 from .common import require, solver_options
 
+#: names and units of the variables without them below (checked by filippov.scenes)
+VARIABLE_ATTRS = {
+    "mode": ("field followed: -1 region -, 0 sliding, 1 region +", "1"),
+    "switch_from": ("mode before the switch: -1 region -, 0 sliding, 1 region +", "1"),
+    "switch_to": ("mode after the switch: -1 region -, 0 sliding, 1 region +", "1"),
+    "switch": ("switch index along the switching trajectory", "1"),
+}
+
 P_G = np.array([-1.0, 0.0, -1.0])  # grazing point at mu = 1
 
 

@@ -7,6 +7,8 @@ import xarray as xr
 from ..analytic import s0
 from ..io import finalize
 from .common import require
+
+VARIABLE_ATTRS = {"residual": ("left side of eq:s0def at the closed-form s0", "1")}
 from ..tolerance import U, Tolerance
 
 
