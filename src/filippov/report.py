@@ -390,8 +390,9 @@ def scalar_table(ds: xr.Dataset, max_rows: int = 40) -> str:
     for name, var in ds.data_vars.items():
         if var.ndim != 0:
             continue
-        meaning = var.attrs.get("long_name", "")
-        rows.append(rf"\texttt{{{tex_escape(name)}}} & {tex_escape(meaning)} & {_cell(var.values)} \\")
+        # a typeset meaning where the scene gives one, else the plain long_name
+        meaning = var.attrs.get("long_name_tex") or tex_escape(var.attrs.get("long_name", ""))
+        rows.append(rf"\texttt{{{tex_escape(name)}}} & {meaning} & {_cell(var.values)} \\")
         if len(rows) >= max_rows:
             break
     if not rows:

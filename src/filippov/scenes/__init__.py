@@ -64,16 +64,21 @@ def _declared(module, scene, ds):
     end up with a long_name, every numeric one with units) and cross-machine
     tolerances (``tolerances(scene)`` when they follow the scene's eps or grid,
     else ``TOLERANCES``; see :mod:`filippov.tolerance`)."""
-    ds = describe(ds, getattr(module, "VARIABLE_ATTRS", {}))
+    ds = describe(ds, getattr(module, "VARIABLE_ATTRS", {}), getattr(module, "LATEX_NAMES", {}))
     declared = module.tolerances(scene) if hasattr(module, "tolerances") else \
         getattr(module, "TOLERANCES", {})
     return tolerance.annotate(ds, declared)
 
 
-def describe(ds, attrs: dict):
-    """``ds`` with long_name/units from ``attrs``; every variable must have a long_name
-    and every numeric variable units afterwards (CF-1.8), or this is an error."""
+def describe(ds, attrs: dict, latex: dict | None = None):
+    """``ds`` with long_name/units from ``attrs`` and typeset meanings from ``latex``
+    (``long_name_tex``, for the report); every variable must have a long_name and
+    every numeric variable units afterwards (CF-1.8), or this is an error."""
     ds = ds.copy()
+    for name, tex in (latex or {}).items():
+        if name not in ds.variables:
+            raise ValueError(f"LATEX_NAMES names {name!r}, which the dataset lacks")
+        ds[name].attrs["long_name_tex"] = tex
     for name, (long_name, units) in attrs.items():
         if name not in ds.variables:
             raise ValueError(f"VARIABLE_ATTRS names {name!r}, which the dataset lacks")

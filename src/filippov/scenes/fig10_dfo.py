@@ -49,6 +49,19 @@ TOLERANCES = {
                                              "rounding enters as u/h ~ 1e-8"),
 }
 
+#: the scalars' meanings typeset for the report (attribute long_name_tex)
+LATEX_NAMES = {
+    "v_hopf": r"Hopf point: belt speed $v$ with $F_c'(-v)=0$, i.e.\ $v=\ln(f_c/f_v)$",
+    "v_hopf_numeric": r"Hopf point from the eigenvalues of a finite-difference Jacobian",
+    "v_gs": r"grazing-sliding point GS (the orbit through the sticking exit point closes)",
+    "v_gs_branch": r"grazing point of the continued branch of unstable cycles",
+    "x1_gs": r"largest $x_1$ of the grazing orbit",
+    "period_gs": r"period of the grazing orbit",
+    "x1_exit": r"$x_1$ where sticking ends, $-F_c(0^-)$",
+    "n_folds_hopf_branch": r"folds on the unstable branch",
+    "F_c_static": r"$F_c(0^+)$, the static friction level",
+}
+
 RTOL, ATOL = 1e-12, 1e-14
 N_MAX = 400  # continuation steps per direction
 

@@ -45,6 +45,17 @@ from ..system import SLIDING
 from .common import engine, require, solver_options
 from ..tolerance import Tolerance
 
+#: the scalars' meanings typeset for the report (attribute long_name_tex)
+LATEX_NAMES = {
+    "chi_minus": r"$\nabla h\cdot f_- - \nabla h\cdot f_+$ at the grazing point; $>0$: case 1 "
+                 r"of the lemma",
+    "chi_minus_literal": r"the same for the printed friction law read literally",
+    "sticking_a": r"$\mathrm{d}h/\mathrm{d}t$ along $f_-$ at $(0, v_0)$, reduced system",
+    "sticking_b": r"$\mathrm{d}h/\mathrm{d}t$ along $f_+$ at $(0, v_0)$, reduced system",
+    "sticking_a_literal": r"as \texttt{sticking\_a}, printed law read literally",
+    "sticking_b_literal": r"as \texttt{sticking\_b}, printed law read literally",
+}
+
 _ONSET = ("the onset of sticking is a grid point of each panel: whether that orbit "
           "slides is decided at a tangency (onset known to a few 1e-11, x1_onset_step)")
 _FOLD = "at the fold P(x1) - x1 has a flat maximum: its argmax is square-root conditioned"
