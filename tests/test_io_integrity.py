@@ -1,7 +1,6 @@
 """Damaged, truncated or foreign datasets are refused with one line naming the
 file, by the library and by every workflow step that reads one."""
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
