@@ -45,6 +45,10 @@ def limits(overrides=None) -> dict:
     return out
 
 
+def _is_time(key: str) -> bool:
+    return key == "t_end" or key.endswith("_t_end") or key == "t_max"
+
+
 def sweep_size(scene: dict) -> dict:
     """A cheap upper estimate of what a scene computes, from its parameters alone:
     ``points`` = (sum of the counts ``n_*``) x (product of the lengths of its lists),
@@ -54,8 +58,7 @@ def sweep_size(scene: dict) -> dict:
     lists = [len(v) for v in params.values() if isinstance(v, list)]
     factor = math.prod(lists) if lists else 1
     t_end = [float(v) for k, v in params.items()
-             if (k == "t_end" or k.endswith("_t_end") or k == "t_max")
-             and isinstance(v, (int, float)) and not isinstance(v, bool)]
+             if _is_time(k) and isinstance(v, (int, float)) and not isinstance(v, bool)]
     return {"points": max(sum(counts), 1) * factor,
             "samples": int(params.get("n_samples", 0) or 0) * factor,
             "t_end": max(t_end, default=0.0)}
@@ -79,7 +82,7 @@ def check_limits(scene: dict, lim: dict | None = None, path="scene") -> None:
                          f"the limit max_samples = {lim['max_samples']:.6g}; "
                          + raise_it.format(key="max_samples"))
     if size["t_end"] > lim["max_t_end"]:
-        key = next(k for k in params if k == "t_end" or k.endswith("_t_end") or k == "t_max")
+        key = next(k for k in params if _is_time(k) and params[k] == size["t_end"])
         raise SceneError(f"{path}: parameters.{key}: {size['t_end']:g} over the limit "
                          f"max_t_end = {lim['max_t_end']:g}; " + raise_it.format(key="max_t_end"))
     chunks = scene.get("chunks")

@@ -40,13 +40,14 @@ class DatasetError(ValueError):
 def code_version() -> str:
     """Git commit of the source tree (suffix '-dirty' for uncommitted changes)."""
     here = Path(__file__).resolve().parent
+    commit = dirty = ""
     try:
         commit = subprocess.run(["git", "-C", str(here), "rev-parse", "HEAD"], check=True,
                                 capture_output=True, text=True, timeout=10).stdout.strip()
         dirty = subprocess.run(["git", "-C", str(here), "status", "--porcelain", "--", "."],
                                check=True, capture_output=True, text=True, timeout=10).stdout.strip()
     except (OSError, subprocess.SubprocessError):
-        commit = ""
+        commit = ""  # not a (readable) git checkout
     if not commit:  # an installed copy, not a git checkout: its released version
         return f"filippov-{__version__} (installed)"
     return commit + ("-dirty" if dirty else "")
@@ -168,11 +169,10 @@ def write_dataset(ds: xr.Dataset, path) -> Path:
                 if ds[name].dtype.kind == "f"}
     with atomic_output(path) as tmp:
         ds.to_netcdf(tmp, format=NETCDF_FORMAT, engine="netcdf4", encoding=encoding)
-        digest = checksum(_load(tmp))
+        # the checksum of what a reader sees, added as a global attribute (which
+        # the checksum leaves out, so adding it changes nothing it covers)
         with netCDF4.Dataset(tmp, "a") as nc:
-            nc.setncattr(CHECKSUM_ATTR, digest)
-        if checksum(_load(tmp)) != digest:  # the attribute must not change the contents
-            raise RuntimeError(f"{path}: checksum changed on writing it; not written")
+            nc.setncattr(CHECKSUM_ATTR, checksum(_load(tmp)))
     return Path(path)
 
 

@@ -47,15 +47,14 @@ def check(scene: dict) -> None:
     module = _module(scene)
     if hasattr(module, "validate"):
         module.validate(chunking.without_layout(scene))
-    n = scene.get("chunks")
-    if n is None:
+    if scene.get("chunks") is None:
         return
-    if not chunking.supports_chunks(module):
-        raise SceneError(f"{scene.get('id')}: chunks: this scene cannot be split into chunks")
+    module = _chunkable(scene)
     size = len(module.chunk_grid(chunking.without_layout(scene)))
-    if not 1 <= chunking.n_chunks(scene) <= size:
-        raise SceneError(f"{scene.get('id')}: chunks: {n} chunks for a grid of {size} points; "
-                         f"need 1 <= chunks <= {size}")
+    try:
+        chunking.bounds(size, 0, chunking.n_chunks(scene))
+    except ValueError as exc:
+        raise SceneError(f"{scene.get('id')}: {exc}") from None
 
 
 def _declared(module, scene, ds):
@@ -102,7 +101,7 @@ def compute(scene: dict, *, progress: bool = False):
 def _chunkable(scene: dict):
     module = _module(scene)
     if not chunking.supports_chunks(module):
-        raise ValueError(f"{scene.get('id')}: chunks: this scene cannot be split into chunks")
+        raise SceneError(f"{scene.get('id')}: chunks: this scene cannot be split into chunks")
     return module
 
 
