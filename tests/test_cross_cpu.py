@@ -168,7 +168,7 @@ def test_environment_fingerprint_tracks_the_arithmetic(shim):
     assert fingerprint({}) == native
     assert fingerprint({"NUMBA_CPU_NAME": "generic"}) != native
     assert fingerprint({"LD_PRELOAD": str(shim), "LASTBIT_SEED": "1"}) != native
-    switched = cross_cpu.numpy_features_to_disable()
+    switched = manifest.numpy_simd()
     if switched:  # a machine with SIMD levels above numpy's baseline
         assert fingerprint({"NPY_DISABLE_CPU_FEATURES": " ".join(switched)}) != native
 

@@ -44,7 +44,8 @@ from .models import hopf, pseudo_equilibrium
 from .progress import Progress
 from .scenes.chunking import bounds
 from .poincare import sliding_time
-from .simulate import Section, simulate
+from .scenes.fig04_retmaps import section_L1  # the section of the return map P (fig04)
+from .simulate import simulate
 
 DATASET_ID = "hard_cases"
 CONFIG_KEYS = ("eps", "chunks")
@@ -235,10 +236,6 @@ def slide_in(eps: float) -> dict:
             "kernel_finite": int(np.all(np.isfinite(out.state)))}
 
 
-def _section_L1() -> Section:
-    return Section("L1", lambda z: z[0], direction=-1, where=lambda z: z[1] > 0, terminal=1)
-
-
 def sliding_return(eps: float) -> dict:
     """One return to L1 of the Hopf example at theta = return_theta (> 0) with the
     reference driver: the orbit grazes into sliding, whose fast direction
@@ -247,9 +244,9 @@ def sliding_return(eps: float) -> dict:
     p = PARAMETERS
     model = hopf.model(eps, p["return_theta"], p["mu"], p["omega"])
     start = [0.0, p["return_x2"], 0.0]
-    traj = simulate(model.full(), start, p["hopf_t_max"], sections=[_section_L1()],
+    traj = simulate(model.full(), start, p["hopf_t_max"], sections=[section_L1()],
                     dense=False)
-    reduced = simulate(model.reduced(), start[:2], p["hopf_t_max"], sections=[_section_L1()],
+    reduced = simulate(model.reduced(), start[:2], p["hopf_t_max"], sections=[section_L1()],
                        dense=False)
     ok = traj.status == "section:L1" and reduced.status == "section:L1"
     return {"return_P": float(traj.z[1]) if ok else math.nan,

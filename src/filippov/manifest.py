@@ -42,13 +42,20 @@ THUMB_FACTOR = 4              # thumbnails keep every 4th pixel of the 200-dpi P
 
 
 # ----------------------------------------------------------------------------- environment
+def numpy_simd() -> list[str]:
+    """The SIMD levels numpy dispatches to on this machine above its baseline (those
+    that NPY_DISABLE_CPU_FEATURES has not switched off)."""
+    from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+
+    return [f for f in __cpu_dispatch__ if __cpu_features__.get(f)]
+
+
 def arithmetic() -> dict:
     """What decides the last bits of the numbers on this machine: numpy's SIMD
     dispatch (its AVX-512 loops round differently from the baseline ones),
     numba's target CPU, the C library, and a preloaded library (the cross-CPU
     emulation's)."""
     import numpy as np
-    from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
 
     try:
         from llvmlite import binding
@@ -56,7 +63,7 @@ def arithmetic() -> dict:
     except Exception:  # numba absent: nothing compiled
         host = "none"
     return {"machine": platform.machine(), "numpy": np.__version__,
-            "numpy_simd": [f for f in __cpu_dispatch__ if __cpu_features__.get(f)],
+            "numpy_simd": numpy_simd(),
             "numba_cpu": os.environ.get("NUMBA_CPU_NAME", host),
             "libc": "-".join(platform.libc_ver()),
             "preload": os.environ.get("LD_PRELOAD", "") + ":" + os.environ.get("LASTBIT_SEED", "")}

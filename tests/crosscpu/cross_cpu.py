@@ -69,17 +69,10 @@ def build_shim(dest: Path) -> Path:
     return out
 
 
-def numpy_features_to_disable() -> list[str]:
-    """The SIMD levels numpy dispatches to on this machine above its baseline."""
-    from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
-
-    return [f for f in __cpu_dispatch__ if __cpu_features__.get(f)]
-
-
 def emulation_env(shim: Path, seed: int, cache: Path) -> dict:
     env = {"LD_PRELOAD": str(shim), "LASTBIT_SEED": str(seed), "NUMBA_CPU_NAME": "generic",
            "NUMBA_CACHE_DIR": str(cache), "PYTHONDONTWRITEBYTECODE": "1"}
-    disable = numpy_features_to_disable()
+    disable = manifest.numpy_simd()   # switched down to numpy's baseline
     if disable:
         env["NPY_DISABLE_CPU_FEATURES"] = " ".join(disable)
     return env
