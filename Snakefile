@@ -46,5 +46,7 @@ rule all:
     default_target: True
     input:
         expand("figures/{scene}.{ext}", scene=config["scenes"], ext=["pdf", "png"]),
+        expand("results/scenes/{scene}.yaml", scene=config["scenes"]),  # for the HTML report
         "results/hard_cases.nc",  # the eps sweep of the hard cases (seconds)
+        "figures/work_precision.pdf",  # what accuracy costs: errors and times (seconds)
         REPORT_PDF,

@@ -83,11 +83,34 @@ def test_no_number_typed_in_the_figure_prose():
                "-3"}  # exponent of the jump estimate e^{-3 pi mu/omega}
     for name in ("sec_figures.tex", "sec_pdm.tex", "sec_hardcases.tex"):
         text = (ROOT / "paper" / name).read_text()
-        text = re.sub(r"\\(plabel|testref|label|ref|eqref|includegraphics|input)(\[[^]]*\])?\{[^}]*\}",
+        text = re.sub(r"\\paperfig\{[^}]*\}\{[^}]*\}", "", text)
+        text = re.sub(r"\\(pref|pnum|testref|label|ref|eqref|includegraphics|input)(\[[^]]*\])?\{[^}]*\}",
                       "", text)
         text = re.sub(r"\\[A-Za-z]+", "", text)   # macro names (rpTwoPeriod, ...)
         found = set(re.findall(r"(?<![A-Za-z_0-9.])-?\d+(?:\.\d+)?(?:\^\{-?\d+\})?", text))
         assert not found - allowed, f"{name}: numbers typed by hand: {sorted(found - allowed)}"
+
+
+def test_the_paper_is_cited_by_its_printed_numbers():
+    # every citation of the paper goes through paper/paper_labels.tex (derived from the
+    # paper's source by filippov.paper_labels): no raw label text, no unknown label
+    from filippov.paper_labels import read_tex
+
+    known = read_tex((ROOT / "paper" / "paper_labels.tex").read_text())
+    cited = set()
+    for tex in sorted((ROOT / "paper").glob("sec_*.tex")) + [ROOT / "paper" / "main.tex"]:
+        text = tex.read_text()
+        assert "\\plabel" not in text, f"{tex.name}: cites a raw label"
+        cited |= set(re.findall(r"\\(?:pref|pnum)\{([^}]*)\}", text))
+        cited |= set(re.findall(r"\\paperfig\{([^}]*)\}", text))
+    cited.discard("#1")  # main.tex's definitions of \paperfig and the bookmark text
+    assert len(cited) > 30
+    assert not cited - set(known), f"labels the paper does not have: {sorted(cited - set(known))}"
+    # each of the eleven figures is captioned with the paper figure it reproduces
+    captions = "".join((ROOT / "paper" / n).read_text()
+                       for n in ("sec_figures.tex", "sec_pdm.tex", "sec_dryfriction.tex"))
+    ids = re.findall(r"\\paperfig\{fig:[^}]*\}\{(fig\d\d)", captions)
+    assert sorted(ids) == [f"fig{k:02d}" for k in range(1, 12)]
 
 
 # ----------------------------------------------------------------------------- the build
@@ -136,6 +159,12 @@ def test_pdf_is_built_with_every_figure(built):
     assert pages >= 10, pages
 
 
+def test_log_has_no_overfull_box_over_five_points(built):
+    log = (built["work"] / "paper" / "main.log").read_text(errors="replace")
+    widths = [float(w) for w in re.findall(r"Overfull \\hbox \(([\d.]+)pt too wide\)", log)]
+    assert all(w <= 5.0 for w in widths), f"overfull boxes: {sorted(widths)[::-1][:5]} pt"
+
+
 def test_log_has_no_undefined_references_or_missing_files(built):
     log = (built["work"] / "paper" / "main.log").read_text(errors="replace")
     for bad in ("undefined references", "There were undefined", "Reference `",
@@ -146,7 +175,7 @@ def test_log_has_no_undefined_references_or_missing_files(built):
 
 def _value(ds_dir: Path, source: str):
     """Re-read `dataset:variable[sel]` or `dataset:attrs.name` (None for derived)."""
-    m = re.fullmatch(r"(fig\d\d_[a-z0-9_]+|hard_cases):([A-Za-z0-9_]+)(?:\.([A-Za-z0-9_]+))?"
+    m = re.fullmatch(r"(fig\d\d_[a-z0-9_]+|hard_cases|work_precision):([A-Za-z0-9_]+)(?:\.([A-Za-z0-9_]+))?"
                      r"(\[(.*)\])?", source)
     if not m or source.startswith("derived"):
         return None
@@ -216,8 +245,8 @@ def test_derived_macros_match_the_datasets(built):
                                                          rel=6e-2)
         tab = (work / "paper/generated/tab_hard_cases.tex").read_text()
         rows = [r for r in tab.splitlines() if r.startswith("$") and "epsilon" not in r]
-        assert len(rows) == ds.sizes["eps"]
-        for row, e in zip(rows, ds.eps.values):
+        assert len(rows) == 2 * ds.sizes["eps"]  # return maps, then pseudo-equilibrium
+        for row, e in zip(rows[:ds.sizes["eps"]], ds.eps.values):
             cells = [c.strip().strip("$") for c in row[:-2].split("&")]
             assert report.parse_num(cells[0]) == pytest.approx(e, rel=1e-6)
             assert report.parse_num(cells[1]) == pytest.approx(
@@ -237,7 +266,7 @@ def test_optional_sections_follow_the_results(built):
     macros = (work / "paper/generated/macros.tex").read_text()
     for sid, flag, tab in (("fig10_dfo", "rpHaveTen", "tab_fig10.tex"),
                            ("fig11_dfo_retmaps", "rpHaveEleven", "tab_fig11.tex"),
-                           ("bench_work_precision", "rpHaveBench", "tab_bench.tex"),
+                           ("work_precision", "rpHaveBench", "tab_bench.tex"),
                            ("hard_cases", "rpHaveHardCases", "tab_hard_cases.tex")):
         present = (work / f"results/{sid}.nc").exists()
         assert f"\\{flag}{'true' if present else 'false'}" in macros
@@ -273,5 +302,23 @@ def test_html_report_links_every_figure_to_its_rule(workflow_build, tmp_path):
     scenes = yaml.safe_load((work / "config" / "config.yaml").read_text())["scenes"]
     for scene in scenes:
         assert f"{scene}.pdf" in html and f"{scene}.png" in html, scene
+        # the dataset and the scene file are attached too
+        assert f"{scene}.nc" in html and f"{scene}.yaml" in html, scene
     for rule in ("compute", "plot"):
         assert rule in html
+    # captions from the scene: the paper's printed figure number, the description,
+    # the physical parameters (not only a code hash)
+    from html import escape as html_escape
+
+    from filippov.paper_labels import read_tex
+
+    printed = read_tex((ROOT / "paper" / "paper_labels.tex").read_text())
+    for scene in scenes:
+        data = yaml.safe_load((work / "config" / "scenes" / f"{scene}.yaml").read_text())
+        number = printed[data["paper_figure"]].replace("~", " ")
+        assert f"<strong>{number}</strong>" in html, (scene, number)
+        first = " ".join(str(data["description"]).split())[:40]
+        assert html_escape(first) in html, (scene, first)
+        for key, value in data["parameters"].items():
+            if isinstance(value, (int, float)):
+                assert f"{key} = {value}" in html, (scene, key)

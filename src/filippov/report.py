@@ -8,7 +8,7 @@ ones are ``None``) and returns ``{file name: LaTeX text}`` for
 * ``macros.tex`` -- one ``\\newcommand`` per quoted number, each preceded by a
   ``%% source:`` comment naming the dataset and variable it comes from (the
   tests re-read that variable and compare), plus ``\\newif`` switches saying
-  which optional results (dry friction, work--precision benchmark) exist;
+  which optional results (dry friction, work--precision sweep) exist;
 * ``tab_fig07.tex``, ``tab_fig09.tex`` -- convergence tables over eps;
 * ``tab_fig10.tex``, ``tab_fig11.tex``, ``tab_bench.tex`` -- tables of whatever
   those datasets hold, or a "not yet computed" sentence when they are absent;
@@ -30,7 +30,7 @@ import xarray as xr
 CORE = ("fig01_slidesketch", "fig02_cases", "fig03_grazingsketch", "fig04_retmaps",
         "fig05_thetalt0mfs", "fig06_sgraph", "fig07_pdm_theta_neg", "fig08_s0theta",
         "fig09_pdm_theta_pos")
-OPTIONAL = ("fig10_dfo", "fig11_dfo_retmaps", "bench_work_precision", "hard_cases")
+OPTIONAL = ("fig10_dfo", "fig11_dfo_retmaps", "work_precision", "hard_cases")
 NOT_YET = "not yet computed"
 
 
@@ -310,9 +310,9 @@ def fig07_table(ds) -> str:
             f"${num(float(d.error_printed))}$", f"${num(float(d.error_zero_order))}$",
             f"${num(float(d.error_first_order))}$",
             "--" if math.isnan(rate) else f"${num(rate, 2)}$"]) + r" \\")
-    return _tabular("rrrrrrr", [
-        r"$\epsilon$ & $P_\mathrm{DM}(0^-)$ & $|P_\mathrm{DM}(0^-)-s_0|$ & printed & "
-        r"$\xi_1+s_0$ & corrected 1st & rate \\"], rows)
+    return _tabular("rrrrrrr", [_head(
+        r"$\epsilon$", r"$P_\mathrm{DM}(0^-)$", r"$|P_\mathrm{DM}(0^-)$//$-s_0|$", "printed",
+        r"$\xi_1+s_0$", "corrected//1st order", "rate")], rows)
 
 
 def fig08(ds, m: Macros):
@@ -357,15 +357,25 @@ def fig09_table(ds) -> str:
             f"${num(float(d.error_printed))}$", f"${num(float(d.error))}$",
             f"${num(float(d.error_core))}$", "--" if math.isnan(rate) else f"${num(rate, 3)}$",
             f"${num(float(d.sliding_limit_xi2))}$"]) + r" \\")
-    return _tabular("rrrrrrr", [
-        r"$\epsilon$ & $P_\mathrm{DM}(\xi_1^-)/\xi_1^-$ & printed & corrected & "
-        r"corrected, core & rate (core) & $\xi_2$ sliding limit \\"], rows)
+    return _tabular("rrrrrrr", [_head(
+        r"$\epsilon$", r"$P_\mathrm{DM}(\xi_1^-)$//$/\xi_1^-$", "printed", "corrected",
+        "corrected,//core", "rate//(core)", r"$\xi_2$, sliding//limit")], rows)
 
 
 # ----------------------------------------------------------------------------- optional data
 def _tabular(cols, head, rows) -> str:
-    return "\n".join([rf"\begin{{tabular}}{{{cols}}}", r"\toprule", *head, r"\midrule",
-                      *rows, r"\bottomrule", r"\end{tabular}"]) + "\n"
+    return "\n".join([rf"\begin{{tabular}}{{@{{}}{cols}@{{}}}}", r"\toprule", *head,
+                      r"\midrule", *rows, r"\bottomrule", r"\end{tabular}"]) + "\n"
+
+
+def _head(*cells: str) -> str:
+    """A header row; a cell with a line break ``//`` is set on two lines (the tables
+    keep to the text width at the body font size instead of being shrunk)."""
+    def stack(cell):
+        if "//" not in cell:
+            return cell
+        return r"\begin{tabular}[b]{@{}c@{}}" + cell.replace("//", r"\\") + r"\end{tabular}"
+    return " & ".join(stack(c) for c in cells) + r" \\"
 
 
 def _not_yet(what: str, path: str) -> str:
@@ -397,7 +407,7 @@ def scalar_table(ds: xr.Dataset, max_rows: int = 40) -> str:
             break
     if not rows:
         return r"\emph{(the dataset holds no scalar variables)}" + "\n"
-    return _tabular("lp{0.55\\textwidth}r", [r"variable & meaning & value \\"], rows)
+    return _tabular("lp{0.5\\textwidth}r", [r"variable & meaning & value \\"], rows)
 
 
 def table_frame(ds: xr.Dataset, max_rows: int = 30) -> str:
@@ -461,40 +471,92 @@ def dry_friction(ds10, ds11, m: Macros) -> tuple[str, str]:
     return tab10, tab11
 
 
-def bench(ds, m: Macros, effects=None) -> str:
-    """The work-precision table (one row per method and tolerance, error / time /
-    missed switches per problem), the speed-up at the target error, and the cost
-    of each model ingredient when results/bench_effect_cost.nc is there."""
-    m.flag("rpHaveBench", ds is not None)
-    if ds is None:
-        return _not_yet("Work--precision benchmark", "results/bench_work_precision.nc")
-    if "method" not in ds.coords or "problem" not in ds.dims:
-        return table_frame(ds)
-    probs = [str(p) for p in ds.problem.values]
-    head = " & ".join(rf"\multicolumn{{3}}{{c}}{{\texttt{{{tex_escape(p)}}}}}" for p in probs)
-    sub = " & ".join(["error & time [s] & missed"] * len(probs))
-    lines = [r"\begin{tabular}{ll" + "rrr" * len(probs) + "}", r"\toprule",
-             rf"method & rtol & {head} \\", rf" & & {sub} \\", r"\midrule"]
-    for j in range(ds.sizes["config"]):
-        cells = [tex_escape(str(ds.method.values[j])), f"${num(float(ds.tolerance.values[j]), 2)}$"]
-        for i in range(len(probs)):
+#: the methods as the work-precision table names them (short: the table fits the page)
+METHOD_TEX = {"project compiled exact": "compiled, exact flows",
+              "project python exact": "Python, exact flows",
+              "project compiled DOP853": "compiled DOP853",
+              "project DOP853": "Python DOP853",
+              "solve_ivp RK45": "scipy RK45",
+              "solve_ivp DOP853": "scipy DOP853",
+              "solve_ivp Radau": "scipy Radau",
+              "solve_ivp LSODA": "scipy LSODA"}
+
+
+def _bench_tabular(ds, probs: list[int]) -> list[str]:
+    """One tabular: a row per method and tolerance, error / time / missed switches
+    for each problem in ``probs``; a configuration that failed says so in its cells."""
+    head = " & ".join(rf"\multicolumn{{3}}{{c}}{{{_problem_tex(str(ds.problem.values[i]))}}}"
+                      for i in probs)
+    rules = "".join(rf"\cmidrule(lr){{{3 + 3 * k}-{5 + 3 * k}}}" for k in range(len(probs)))
+    sub = " & ".join(["error & ms & missed"] * len(probs))
+    lines = [r"\begin{tabular}{@{}ll" + "rrr" * len(probs) + "@{}}", r"\toprule",
+             rf"method & rtol & {head} \\", rules, rf" & & {sub} \\", r"\midrule"]
+    rows = [j for j in range(ds.sizes["config"])
+            if any(str(ds.status.values[i, j]) != "n/a" for i in probs)]
+    for j in rows:
+        fam = str(ds.method.values[j])
+        cells = [METHOD_TEX.get(fam, tex_escape(fam)), f"${num(float(ds.tolerance.values[j]), 2)}$"]
+        for i in probs:
             status = str(ds.status.values[i, j])
             if status != "ok":
-                cells.append(r"\multicolumn{3}{l}{\emph{" + tex_escape(status.split(":")[0]) + "}}")
+                cells.append(r"\multicolumn{3}{c}{\emph{" + tex_escape(status.split(":")[0]) + "}}")
                 continue
             cells += [f"${num(float(ds.error_map.values[i, j]), 2)}$",
-                      f"${num(float(ds.wall_time.values[i, j]), 2)}$",
+                      f"${num(1e3 * float(ds.wall_time.values[i, j]), 2)}$",
                       str(int(ds.missed_switches.values[i, j]))]
         lines.append(" & ".join(cells) + r" \\")
-    lines += [r"\bottomrule", r"\end{tabular}", ""]
-    for i, p in enumerate(probs[:4]):
+    return lines + [r"\bottomrule", r"\end{tabular}", ""]
+
+
+def _problem_tex(name: str) -> str:
+    """'fig04 theta=-0.5' -> the paper's symbols ('$\theta=-0.5$')."""
+    parts = name.split()
+    rest = " ".join(parts[1:])
+    for key, sym in (("theta", r"\theta"), ("eps", r"\epsilon")):
+        rest = re.sub(rf"{key}=(\S+)", lambda mm: f"${sym}={mm.group(1)}$", rest)
+    return rest
+
+
+def bench(ds, m: Macros, effects=None) -> str:
+    """The work-precision tables of the default build's sweep (results/work_precision.nc):
+    per problem set (fig04, fig11), one row per method and tolerance, error / time /
+    missed switches per problem; the speed-up at the target error and what the
+    scipy solvers a user reaches for first get wrong; the cost of each model
+    ingredient when results/bench_effect_cost.nc is there (`make bench`)."""
+    sid = "work_precision"
+    m.flag("rpHaveBench", ds is not None)
+    if ds is None:
+        return _not_yet("Work--precision sweep", "results/work_precision.nc")
+    if "method" not in ds.coords or "problem" not in ds.dims:
+        return table_frame(ds)
+    names = [str(p) for p in ds.problem.values]
+    lines = []
+    for prefix in ("fig04", "fig11"):
+        probs = [i for i, p in enumerate(names) if p.startswith(prefix)]
+        if probs:
+            lines += ([r"\medskip", ""] if lines else []) + _bench_tabular(ds, probs)
+    fam = np.array([str(f) for f in ds.method.values])
+    for i, p in enumerate(names[:4]):
         key = "ABCD"[i]
         m.add(f"rpBenchSpeedup{key}", float(ds.speedup_vs_rk45.values[i]),
-              _src("bench_work_precision", f"speedup_vs_rk45[{i}]"), 3)
+              _src(sid, f"speedup_vs_rk45[{i}]"), 2)
         m.add(f"rpBenchFloor{key}", float(ds.reference_check.values[i]),
-              _src("bench_work_precision", f"reference_check[{i}]"), 2)
+              _src(sid, f"reference_check[{i}]"), 2)
         m.add(f"rpBenchPoints{key}", float(ds.n_points.values[i]),
-              _src("bench_work_precision", f"n_points[{i}]"), 4)
+              _src(sid, f"n_points[{i}]"), 4)
+        ok = ds.status.values[i] == "ok"
+        for tag, family in (("RK", "solve_ivp RK45"), ("DOP", "solve_ivp DOP853")):
+            sel = (fam == family) & ok
+            m.add(f"rpBenchMissed{tag}{key}",
+                  float(ds.missed_switches.values[i, sel].max()) if sel.any() else 0.0,
+                  f"derived: max of work_precision:missed_switches[{i}] over {family}", 4)
+            m.add(f"rpBenchBest{tag}{key}",
+                  float(np.nanmin(ds.error_map.values[i, sel])) if sel.any() else math.nan,
+                  f"derived: min of work_precision:error_map[{i}] over {family}", 2)
+    m.add("rpBenchFailed", float(np.count_nonzero(
+        np.char.startswith(ds.status.values.astype(str), "failed"))),
+        "derived: configurations of work_precision:status that failed", 4)
+    m.add("rpBenchConfigs", float(ds.sizes["config"]), "work_precision:config (size)", 4)
     m.flag("rpHaveEffects", effects is not None)
     if effects is not None:
         lines += [r"\medskip", "", r"\begin{tabular}{llrrl}", r"\toprule",
@@ -557,20 +619,23 @@ def hard_cases(ds, m: Macros) -> str:
           "derived: max slide_final_abs_x over eps", 2)
     m.add("rpHardKernelFinal", float(ds.kernel_final_abs_x.max()),
           "derived: max kernel_final_abs_x over eps", 2)
-    rows = []
+    maps, chatter = [], []
     for e in eps:
         d = ds.sel(eps=e)
-        rows.append(" & ".join([
+        maps.append(" & ".join([
             f"${_eps_label(e)}$", f"${num(float(d.jump_over_eps), 6)}$",
-            f"${num(float(d.slope), 4)}$", f"${num(float(d.slope_probe), 2)}$",
-            f"${num(float(d.chatter_period_over_eps), 6)}$",
+            f"${num(float(d.slope), 4)}$", f"${num(float(d.slope_probe), 2)}$"]) + r" \\")
+        chatter.append(" & ".join([
+            f"${_eps_label(e)}$", f"${num(float(d.chatter_period_over_eps), 6)}$",
             f"${num(float(d.chatter_period_max_rel_dev), 2)}$",
             f"${num(float(d.slide_start_offset), 2)}$", f"${num(float(d.slide_final_abs_x), 2)}$",
             f"${num(float(d.kernel_final_abs_x), 2)}$"]) + r" \\")
-    table = _tabular("rrrrrrrrr", [
-        r"$\epsilon$ & jump$/\epsilon$ & slope & $x_2-1$ & period$/\epsilon$ & "
-        r"period dev. & slide start $+(1-\theta)\epsilon$ & final $|x|$ & "
-        r"final $|x|$, kernel \\"], rows)
+    # the return maps, then the pseudo-equilibrium (two tabulars: one would not fit)
+    table = _tabular("rrrr", [_head(r"$\epsilon$", r"jump$/\epsilon$", "slope", "$x_2-1$")],
+                     maps) + "\n\\medskip\n\n" + _tabular("rrrrrr", [_head(
+                         r"$\epsilon$", r"period//$/\epsilon$", "period//dev.",
+                         r"slide start//$+(1-\theta)\epsilon$", "final//$|x|$",
+                         "final $|x|$,//kernel")], chatter)
     return table, _hard_return(ds, m, eps)
 
 
@@ -621,7 +686,7 @@ def generate(datasets: Mapping[str, Optional[xr.Dataset]]) -> dict[str, str]:
         except KeyError as exc:
             raise KeyError(f"{sid}: the report reads {exc} but the dataset lacks it") from None
     tab10, tab11 = dry_friction(datasets.get("fig10_dfo"), datasets.get("fig11_dfo_retmaps"), m)
-    tab_bench = bench(datasets.get("bench_work_precision"), m, datasets.get("bench_effect_cost"))
+    tab_bench = bench(datasets.get("work_precision"), m, datasets.get("bench_effect_cost"))
     try:
         tab_hard, tab_return = hard_cases(datasets.get("hard_cases"), m)
     except KeyError as exc:

@@ -20,7 +20,9 @@ Rules:
   to ``jump`` (a count by one crossing pair, a length by its square-root law);
 * ``trace``: an iteration history (secant steps), not a result: only the last
   finite value along the last axis (the converged value) is compared,
-  ``close``-style; the number of steps may differ.
+  ``close``-style; the number of steps may differ;
+* ``measured``: a wall-clock measurement (a time, a repeat count decided by
+  time): it differs between any two runs, so only its shape is compared.
 """
 from __future__ import annotations
 
@@ -29,7 +31,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import xarray as xr
 
-RULES = ("close", "tangency", "trace")
+RULES = ("close", "tangency", "trace", "measured")
 PREFIX = "repro_"
 
 
@@ -76,6 +78,11 @@ class Tolerance:
 #: change of model, parameter or method
 DEFAULT = Tolerance(1e-9, 1e-12, "well-conditioned: a few ulps per last-bit change, "
                                  "1e6 of room for accumulation")
+
+
+#: a wall-clock time, or a count decided by one (repeats until a time budget)
+MEASURED = Tolerance(0.0, 0.0, "wall-clock measurement: differs between any two runs; "
+                               "only its shape is compared", rule="measured")
 
 
 #: one ulp of 1 (a last-bit change of an O(1) number), and the unit roundoff
@@ -134,6 +141,9 @@ def spread(reference: xr.DataArray, other: xr.DataArray) -> dict:
            "margin": 0.0, "ok": False, "rule": tol.rule}
     if a.shape != b.shape:
         return bad
+    if tol.rule == "measured":  # a timing: no two runs agree, only the shape is a result
+        return {"max_abs": 0.0, "max_rel": 0.0, "changed": 0, "margin": np.inf, "ok": True,
+                "rule": tol.rule}
     nan_a, nan_b = np.isnan(a), np.isnan(b)
     if np.any(nan_a != nan_b):
         return dict(bad, changed=int(np.count_nonzero(nan_a != nan_b)))

@@ -1,3 +1,30 @@
+# The default build's work-precision sweep (part of `all`, a few seconds): the
+# fig04 and fig11 maps on subgrids, the project's modes against solve_ivp RK45 and
+# DOP853 (preset "build" of filippov.benchmarks.work_precision). Its wall times
+# differ between any two runs (tolerance rule "measured"); its errors are
+# reproducible.
+rule work_precision:
+    output:
+        "results/work_precision.nc",
+    params:
+        code=library_hash(exclude=("plotting", "report.py", "manifest.py")),
+    script:
+        "../scripts/bench_work_precision.py"
+
+
+rule plot_work_precision:
+    input:
+        data="results/work_precision.nc",
+        script="workflow/scripts/plot_scene.py",
+    output:
+        pdf="figures/work_precision.pdf",
+        png="figures/work_precision.png",
+    params:
+        code=library_hash("plotting"),
+    script:
+        "../scripts/plot_scene.py"
+
+
 # Benchmarks: not part of `all` (they time things and take minutes). Run with
 # `snakemake bench` or `make bench`. Timings vary between runs; the dataset
 # records the machine-independent part (errors) next to the wall times.

@@ -8,7 +8,8 @@ from pathlib import Path
 
 # Library parts no scene computation imports: editing them must not recompute data.
 # (hard_cases.py is the hard-case sweep's own module: rule hard_cases hashes it.)
-NOT_COMPUTE = ("plotting/", "benchmarks/", "report.py", "manifest.py", "hard_cases.py")
+NOT_COMPUTE = ("plotting/", "benchmarks/", "report.py", "manifest.py", "hard_cases.py",
+               "paper_labels.py")
 
 
 def library_hash(include="", exclude=()):
@@ -35,3 +36,26 @@ def fail(message):
     no traceback and no plan."""
     print(f"error: {message}", file=sys.stderr)
     sys.exit(1)
+
+
+def scene_summary(scene):
+    """What the HTML report shows with a scene's figure, dataset and scene file: its
+    description, the paper figure it reproduces (the printed number, from
+    paper/paper_labels.tex), its model, ingredients and physical parameters."""
+    import yaml
+
+    path = Path(f"config/scenes/{scene}.yaml")
+    if not path.exists():
+        return {}
+    data = yaml.safe_load(path.read_text()) or {}
+    label = str(data.get("paper_figure", ""))
+    printed = label
+    labels = Path("paper/paper_labels.tex")
+    if label and labels.exists():
+        from filippov.paper_labels import read_tex
+
+        printed = read_tex(labels.read_text()).get(label, label).replace("~", " ")
+    return {"description": " ".join(str(data.get("description", "")).split()),
+            "paper_figure": printed, "paper_label": label, "model": str(data.get("model", "")),
+            "ingredients": ", ".join(f"{k}: {v}" for k, v in data.get("ingredients", {}).items()),
+            "parameters": [f"{k} = {v}" for k, v in data.get("parameters", {}).items()]}

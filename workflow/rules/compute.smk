@@ -52,9 +52,11 @@ rule compute:
         schema=config["schema"],
         script="workflow/scripts/compute_scene.py",
     output:
-        "results/{scene}.nc",
+        report("results/{scene}.nc", caption="../report/dataset.rst", category="Datasets",
+               labels={"scene": "{scene}", "format": "netCDF"}),
     params:
         code=library_hash(exclude=NOT_COMPUTE),  # see common.smk
+        scene=lambda wc: scene_summary(wc.scene),  # for the HTML report's caption
     script:
         "../scripts/compute_scene.py"
 
@@ -87,11 +89,13 @@ rule merge_chunks:
         script="workflow/scripts/merge_chunks.py",
         chunks=lambda wc: [f"results/chunks/{wc.scene}/{i}.nc" for i in range(CHUNKS[wc.scene])],
     output:
-        "results/{scene}.nc",
+        report("results/{scene}.nc", caption="../report/dataset.rst", category="Datasets",
+               labels={"scene": "{scene}", "format": "netCDF"}),
     wildcard_constraints:
         scene=CHUNKED_SCENES,
     params:
         code=library_hash(exclude=NOT_COMPUTE),  # see common.smk
+        scene=lambda wc: scene_summary(wc.scene),  # for the HTML report's caption
     script:
         "../scripts/merge_chunks.py"
 
@@ -101,3 +105,18 @@ rule merge_chunks:
 # submitting host instead of waiting in the queue.
 ruleorder: merge_chunks > compute
 localrules: merge_chunks
+
+
+# The scene file next to its dataset and figure in the HTML report (a copy:
+# Snakemake's report attaches outputs only).
+rule publish_scene:
+    input:
+        "config/scenes/{scene}.yaml",
+    output:
+        report("results/scenes/{scene}.yaml", caption="../report/scene.rst",
+               category="Scene files", labels={"scene": "{scene}", "format": "YAML"}),
+    params:
+        scene=lambda wc: scene_summary(wc.scene),
+    localrule: True
+    shell:
+        "cp {input:q} {output:q}"

@@ -11,5 +11,6 @@ rule plot:
                    subcategory="{scene}", labels={"figure": "{scene}", "format": "PNG"}),
     params:
         code=library_hash("plotting"),  # restyle -> redraw, without recomputing
+        scene=lambda wc: scene_summary(wc.scene),  # for the HTML report's caption
     script:
         "../scripts/plot_scene.py"

@@ -1,7 +1,10 @@
-"""Thin: one problem set of the work-precision benchmark (a chunk job), or the merge."""
+"""Thin: the default build's work-precision sweep, one problem set of the full
+benchmark (a chunk job), or the merge."""
 import filippov.benchmarks.work_precision as wp
 
-if snakemake.rule == "bench_work_precision":  # noqa: F821
+if snakemake.rule == "work_precision":  # noqa: F821
+    wp.main(["--preset", "build", "--out", snakemake.output[0]])  # noqa: F821
+elif snakemake.rule == "bench_work_precision":  # noqa: F821
     wp.main(["--merge", *snakemake.input.parts, "--out", snakemake.output[0]])  # noqa: F821
 else:
     wp.main(["--problems", snakemake.wildcards.problems, "--every",  # noqa: F821

@@ -69,6 +69,35 @@ SCIPY = [("solve_ivp RK45", [1e-3, 1e-4, 1e-6, 1e-8, 1e-10]),
          ("solve_ivp LSODA", [1e-4, 1e-6, 1e-8, 1e-10])]
 QUICK = [("project compiled exact", [1e-10]), ("project DOP853", [1e-8]),
          ("solve_ivp RK45", [1e-6])]
+#: the default build's sweep (rule work_precision, results/work_precision.nc): a
+#: few seconds on subgrids of both scenes, with what a user reaches for first
+#: (solve_ivp RK45 and DOP853) next to the project's modes; `make bench` runs the
+#: full sweep
+BUILD = {"families": [("project compiled exact", [1e-8, 1e-10, 1e-12]),
+                      ("project compiled DOP853", [1e-6, 1e-8, 1e-10, 1e-12]),
+                      ("project DOP853", [1e-8, 1e-12]),
+                      ("solve_ivp RK45", [1e-4, 1e-6, 1e-8, 1e-10]),
+                      ("solve_ivp DOP853", [1e-6, 1e-8, 1e-10, 1e-12])],
+         "every": 20, "every11": 3, "repeat": 3, "time_cap": 10.0, "budget": 0.25}
+PRESETS = {"full": {"families": PROJECT + SCIPY, "every": 10, "every11": 5, "repeat": 3,
+                    "time_cap": 120.0, "budget": 10.0},
+           "build": BUILD,
+           "quick": {"families": QUICK, "every": 10, "every11": 5, "repeat": 3,
+                     "time_cap": 120.0, "budget": 10.0}}
+
+#: how closely two runs agree (filippov.tolerance): times never do; an error is
+#: |P - P_ref| of two solves at rtol <= 1e-12 (reference) and the method's own, each
+#: O(1) and moved by a few hundred ulps by a last-bit change (hundreds of steps and
+#: event refinements): 1e-13 absolute. A last-bit change could flip one accept/reject
+#: decision of a step-size controller only with probability ~1e-13, so no room for it.
+def tolerances() -> dict:
+    from ..tolerance import MEASURED, Tolerance
+
+    err = Tolerance(1e-6, 1e-13, "difference of two O(1) solves, each moved by a few hundred "
+                                 "ulps by a last-bit change")
+    return {"wall_time": MEASURED, "runs": MEASURED, "time_ours_at_target": MEASURED,
+            "time_rk45_at_target": MEASURED, "speedup_vs_rk45": MEASURED,
+            "error_map": err, "error_switch": err, "reference_check": err}
 
 
 @dataclass(frozen=True)
@@ -209,14 +238,14 @@ def runner(problem: Problem, family: str, tol: float, time_cap: float) -> Callab
     return run
 
 
-def timed(fn, repeat: int, time_cap: float):
-    """Median wall time of up to ``repeat`` runs (one run if it is slow)."""
+def timed(fn, repeat: int, time_cap: float, budget: float = 10.0):
+    """Median wall time of up to ``repeat`` runs (fewer once they took ``budget`` s)."""
     times, out = [], None
     for _ in range(repeat):
         t0 = time.perf_counter()
         out = fn()
         times.append(time.perf_counter() - t0)
-        if sum(times) > min(10.0, time_cap):
+        if sum(times) > min(budget, time_cap):
             break
     return statistics.median(times), len(times), out
 
@@ -248,7 +277,10 @@ def time_at_error(errors, times, target):
     return float(np.exp(t[i] + w * (t[j] - t[i])))
 
 
-def run(problems, families, repeat: int, time_cap: float, log=print) -> xr.Dataset:
+def run(problems, families, repeat: int, time_cap: float, log=print, budget: float = 10.0,
+        **settings) -> xr.Dataset:
+    """Every configuration on every problem; ``settings`` (preset, grid strides) are
+    stored as attributes."""
     configs = [(fam, tol) for fam, tols in families for tol in tols]
     shape = (len(problems), len(configs))
     err_map, err_sw, wall = np.full(shape, np.nan), np.full(shape, np.nan), np.full(shape, np.nan)
@@ -269,7 +301,7 @@ def run(problems, families, repeat: int, time_cap: float, log=print) -> xr.Datas
             want_p, want_sw = (chk_p, chk_sw) if prob.scored_by_check(fam) else (ref_p, ref_sw)
             try:
                 wall[i, j], runs[i, j], (got_p, got_sw) = timed(
-                    runner(prob, fam, tol, time_cap), repeat, time_cap)
+                    runner(prob, fam, tol, time_cap), repeat, time_cap, budget)
             except NotApplicable:
                 status[i, j] = "n/a"
             except baseline.TimeCapExceeded as exc:
@@ -318,8 +350,11 @@ def run(problems, families, repeat: int, time_cap: float, log=print) -> xr.Datas
              "long_name": "RK45 time / project time at equal error (the target)", "units": "1"})},
         coords={"problem": [p.name for p in problems],
                 "method": ("config", fam_of), "tolerance": ("config", [c[1] for c in configs])})
+    from ..tolerance import annotate
+
+    ds = annotate(ds, tolerances())
     return finalize(ds, None, target_error=TARGET_ERROR, time_cap=time_cap, repeat=repeat,
-                    grazing_gap=GRAZING_GAP,
+                    grazing_gap=GRAZING_GAP, budget=budget, **settings,
                     title="work-precision of the fig04 and fig11 return maps: project vs solve_ivp")
 
 
@@ -334,7 +369,7 @@ def merge(parts: list[xr.Dataset]) -> xr.Dataset:
         if not (np.array_equal(ds.method.values, first.method.values)
                 and np.array_equal(ds.tolerance.values, first.tolerance.values)):
             raise ValueError("benchmark parts were run with different method/tolerance lists")
-        for key in ("target_error", "time_cap", "repeat", "grazing_gap"):
+        for key in ("target_error", "time_cap", "repeat", "grazing_gap", "preset", "budget"):
             if ds.attrs.get(key) != first.attrs.get(key):
                 raise ValueError(f"benchmark parts differ in their setting {key!r}")
     names = np.concatenate([ds.problem.values for ds in parts])
@@ -364,14 +399,16 @@ def table(ds: xr.Dataset) -> str:
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--every", type=int, default=10, help="use every k-th fig04 grid point")
-    ap.add_argument("--every11", type=int, default=5,
-                    help="use every k-th point of the fig11 base grid")
+    ap.add_argument("--preset", choices=sorted(PRESETS), default="full",
+                    help="methods, tolerances, grids and repeats: full (make bench), build "
+                         "(the default build's seconds-long sweep) or quick (smoke test)")
+    ap.add_argument("--every", type=int, help="use every k-th fig04 grid point")
+    ap.add_argument("--every11", type=int, help="use every k-th point of the fig11 base grid")
     ap.add_argument("--problems", default="fig04,fig11",
                     help="comma-separated problem sets: fig04, fig11")
-    ap.add_argument("--repeat", type=int, default=3, help="runs per configuration (median)")
-    ap.add_argument("--time-cap", type=float, default=120.0, help="seconds per configuration")
-    ap.add_argument("--quick", action="store_true", help="three configurations only (smoke test)")
+    ap.add_argument("--repeat", type=int, help="runs per configuration (median)")
+    ap.add_argument("--time-cap", type=float, help="seconds per configuration")
+    ap.add_argument("--quick", action="store_true", help="same as --preset quick")
     ap.add_argument("--out", default=str(ROOT / "results" / "bench_work_precision.nc"))
     ap.add_argument("--merge", nargs="+", metavar="PART",
                     help="merge datasets of earlier runs (chunk jobs) into --out instead")
@@ -384,16 +421,22 @@ def main(argv=None) -> None:
         print(table(ds))
         print(f"\nwrote {args.out}")
         return
-    if args.every < 1 or args.every11 < 1 or args.repeat < 1 or not args.time_cap > 0:
+    preset = dict(PRESETS["quick" if args.quick else args.preset])
+    for key in ("every", "every11", "repeat", "time_cap"):
+        if getattr(args, key) is not None:
+            preset[key] = getattr(args, key)
+    if preset["every"] < 1 or preset["every11"] < 1 or preset["repeat"] < 1 \
+            or not preset["time_cap"] > 0:
         ap.error("--every, --every11 and --repeat must be >= 1 and --time-cap > 0")
     sets = [s.strip() for s in args.problems.split(",") if s.strip()]
     if not sets or set(sets) - {"fig04", "fig11"}:
         ap.error(f"--problems: choose from fig04, fig11, got {args.problems!r}")
-    problems = ((fig04_problems(args.every) if "fig04" in sets else [])
-                + (fig11_problems(args.every11) if "fig11" in sets else []))
-    families = QUICK if args.quick else PROJECT + SCIPY
-    ds = run(problems, families, args.repeat, args.time_cap,
-             log=lambda s: print(s, file=sys.stderr, flush=True))
+    problems = ((fig04_problems(preset["every"]) if "fig04" in sets else [])
+                + (fig11_problems(preset["every11"]) if "fig11" in sets else []))
+    ds = run(problems, preset["families"], preset["repeat"], preset["time_cap"],
+             log=lambda s: print(s, file=sys.stderr, flush=True), budget=preset["budget"],
+             preset="quick" if args.quick else args.preset, every=preset["every"],
+             every11=preset["every11"])
     write_dataset(ds, args.out)
     print(table(ds))
     print(f"\nwrote {args.out}")

@@ -21,6 +21,7 @@ DRAW = {
     "fig08_s0theta": "fig08_s0theta",
     "fig09_pdm_theta_pos": "fig09_pdm_theta_pos",
     "bench_work_precision": "bench_work_precision",
+    "work_precision": "bench_work_precision",
     "fig10_dfo": "fig10_dfo",
     "fig11_dfo_retmaps": "fig11_dfo_retmaps",
 }
