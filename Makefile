@@ -9,7 +9,8 @@
 #                  every scene against the manifest; CROSS_CPU_ARGS="--record" stores
 #                  the measured spread next to each tolerance
 #   make report    the reproduction report paper/main.pdf (needs TeX)
-#   make report-html  snakemake's HTML report (report.html): figures, rules, parameters
+#   make report-html  snakemake's HTML report (report.html): figures captioned with the
+#                  paper's number, description and parameters; datasets, scene files
 #   make archive   one tarball of code, results, figures and report, with its sha256
 #   make help      this list
 #   make lock      re-resolve requirements.lock in a throw-away venv

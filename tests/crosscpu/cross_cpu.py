@@ -83,7 +83,7 @@ def targets() -> list[str]:
 
     scenes = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["scenes"]
     return [f"figures/{s}.{ext}" for s in scenes for ext in ("pdf", "png")] + \
-        ["results/hard_cases.nc"]
+        ["results/hard_cases.nc", "results/work_precision.nc"]
 
 
 def build(work: Path, env: dict | None, label: str) -> None:
