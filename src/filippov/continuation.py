@@ -17,7 +17,9 @@ needed, each tested in tests/test_continuation.py:
   start coordinates, the period and the parameter);
 * :func:`monodromy` -- the monodromy matrix of a (nonsmooth) periodic orbit from
   an event-driven trajectory of :mod:`filippov.simulate`: variational equations on
-  each smooth or sliding segment and saltation matrices at the switches.
+  each smooth or sliding segment and saltation matrices at the switches;
+* :func:`floquet_multipliers` -- its eigenvalues, checked for the multiplier 1
+  every periodic orbit of an autonomous system has.
 """
 from __future__ import annotations
 
@@ -25,10 +27,12 @@ from dataclasses import dataclass, field
 from typing import Callable, Optional
 
 import numpy as np
+import scipy.linalg
 from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
 from .progress import Progress
+from .system import SLIDING
 
 
 class ContinuationError(RuntimeError):
@@ -256,6 +260,16 @@ def saltation(f_before, f_after, grad):
     return np.eye(n) + np.outer(f_after - f_before, grad) / (grad @ f_before)
 
 
+def _switch_matrix(system, before, after, z):
+    """Saltation matrix of a switch from mode ``before`` to ``after`` at ``z``; None
+    when there is none: no switch, or the end of sliding, where the field is
+    continuous (a or b is zero there, so the sliding field equals the field it
+    leaves into) and the saltation matrix is the identity."""
+    if before == after or before == SLIDING:
+        return None
+    return saltation(system.field(before, z), system.field(after, z), system.switch_grad(z))
+
+
 def monodromy(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None):
     """Monodromy matrix of the periodic orbit traced by ``traj`` (one period,
     from a start point back to it), built from its events:
@@ -266,7 +280,10 @@ def monodromy(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None):
     * at a crossing or the start of sliding the saltation matrix with the
       normal grad H applies; it projects onto T H_s when sliding starts;
     * at the end of sliding the field is continuous (a or b is zero there, so
-      the sliding field equals the field it leaves into): identity.
+      the sliding field equals the field it leaves into): identity;
+    * a period that starts on the switching surface ends in another mode than
+      it started in: that switch is applied once, at the end, so the result
+      does not depend on where on the orbit the period starts.
 
     Returns (M, multipliers sorted by modulus, descending)."""
     n = system.dim
@@ -274,10 +291,9 @@ def monodromy(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None):
     M = np.eye(n)
     ev = traj.events
     for k, e in enumerate(ev):
-        if e.kind in ("crossing", "slide_start"):
-            fb = system.field(e.mode_before, e.state)
-            fa = system.field(e.mode_after, e.state)
-            M = saltation(fb, fa, system.switch_grad(e.state)) @ M
+        S = _switch_matrix(system, e.mode_before, e.mode_after, e.state)
+        if S is not None:
+            M = S @ M
         t_next = ev[k + 1].t if k + 1 < len(ev) else traj.t
         dt = t_next - e.t
         if dt <= 0:
@@ -293,5 +309,60 @@ def monodromy(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None):
         if not sol.success:
             raise ContinuationError(f"variational integration failed: {sol.message}")
         M = sol.y[n:, -1].reshape(n, n) @ M
+    # simulate logs a start on H = 0 as 'start' in the mode it leaves in, and the
+    # return to it is logged as a switch only if rounding puts the end state past
+    # the surface: close the period with the switch from the end mode to the start
+    # mode. Saltations of crossings at one point compose (S_bc S_ab = S_ac,
+    # S_ba S_ab = I), so a switch logged at t0 or at the end too is not counted twice.
+    S = _switch_matrix(system, traj.mode, ev[0].mode_after, traj.z)
+    if S is not None:
+        M = S @ M
     mult = np.linalg.eigvals(M)
     return M, mult[np.argsort(-np.abs(mult))]
+
+
+def floquet_multipliers(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None,
+                        check=True):
+    """Floquet multipliers of the periodic orbit traced by ``traj`` (see
+    :func:`monodromy`), sorted by modulus, descending. With ``check``, a
+    ContinuationError is raised when none of them is 1 within the accuracy of the
+    computation: the system is autonomous, so the flow direction f(z0) of a
+    periodic orbit is an eigenvector with multiplier 1, and its absence means the
+    monodromy matrix (or the orbit) is wrong.
+
+    Tolerance, by first-order perturbation theory: an error E in M moves a simple
+    eigenvalue lambda_i by at most kappa_i |E| (kappa_i = 1 / |w_i^H v_i|, unit left
+    and right eigenvectors; large near a defective eigenvalue, e.g. a second
+    multiplier near 1 at a fold, where the check cannot decide and passes).
+    |E| / max(1, |M|) is estimated as the sum of
+    * 100 (rtol + atol): the DOP853 global error of the variational equations, seen
+      at <= 3 rtol over a period on the orbits of tests/test_continuation.py and the
+      stick-slip orbits (rtol 1e-6 .. 1e-12), with a x30 margin;
+    * 1e-8 when no ``jacobian`` is given: central differences at step 1e-6 carry a
+      rounding error eps/1e-6 ~ 2e-10 relative to the field, seen at <= 3e-9 in M;
+    * |f(z_T) - f(z0)| / |f(z0)|: ``traj`` ends at z_T, not exactly at z0, and M
+      maps f(z0) to f(z_T), so the trivial multiplier is off by that much.
+    A missing saltation matrix shifts it by O(1)."""
+    M, _ = monodromy(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
+    lam, wl, vr = scipy.linalg.eig(M, left=True, right=True)
+    order = np.argsort(-np.abs(lam))
+    if check:
+        mode = traj.events[0].mode_after
+        f0 = system.field(mode, traj.z0)
+        scale = np.linalg.norm(f0)
+        if not scale > 0:
+            raise ContinuationError(f"the start point {traj.z0.tolist()} is an equilibrium: "
+                                    "no periodic orbit through it")
+        err = (100 * (rtol + atol) + (1e-8 if jacobian is None else 0.0)
+               + np.linalg.norm(system.field(mode, traj.z) - f0) / scale)
+        err *= max(1.0, np.linalg.norm(M, 2))
+        with np.errstate(divide="ignore"):
+            kappa = 1.0 / np.abs(np.sum(wl.conj() * vr, axis=0))
+        if not np.any(np.abs(lam - 1) <= kappa * err):
+            i = int(np.argmin(np.abs(lam - 1)))
+            raise ContinuationError(
+                f"no Floquet multiplier is 1: the nearest is {lam[i]:.6g} (|m - 1| = "
+                f"{abs(lam[i] - 1):.2e} > {kappa[i] * err:.2e}, the accuracy of M): the "
+                f"monodromy matrix or the orbit is wrong; multipliers {lam[order].tolist()}")
+    lam = lam[order]
+    return lam.real if np.all(lam.imag == 0) else lam   # as np.linalg.eigvals
