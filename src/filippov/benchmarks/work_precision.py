@@ -85,19 +85,25 @@ PRESETS = {"full": {"families": PROJECT + SCIPY, "every": 10, "every11": 5, "rep
            "quick": {"families": QUICK, "every": 10, "every11": 5, "repeat": 3,
                      "time_cap": 120.0, "budget": 10.0}}
 
-#: how closely two runs agree (filippov.tolerance): times never do; an error is
-#: |P - P_ref| of two solves at rtol <= 1e-12 (reference) and the method's own, each
-#: O(1) and moved by a few hundred ulps by a last-bit change (hundreds of steps and
-#: event refinements): 1e-13 absolute. A last-bit change could flip one accept/reject
-#: decision of a step-size controller only with probability ~1e-13, so no room for it.
+#: how closely two runs agree (filippov.tolerance): times never do. An error
+#: |P - P_ref| of an approximate method is decided partly by the method's discrete
+#: choices (a step accepted or rejected at an error norm near 1, a sign change of h
+#: seen or missed at a step end): a last-bit change that flips one moves the error by
+#: up to its own size (the emulated CPU of tests/crosscpu moved error_map by up to
+#: 6.6e-10 and error_switch by up to 9e-7 absolute). So errors agree within a factor of
+#: two, which still tells methods and tolerances apart (they differ by decades);
+#: the reference check is two solves at rtol 1e-13, a few hundred ulps each.
 def tolerances() -> dict:
     from ..tolerance import MEASURED, Tolerance
 
-    err = Tolerance(1e-6, 1e-13, "difference of two O(1) solves, each moved by a few hundred "
-                                 "ulps by a last-bit change")
+    err = Tolerance(1.0, 1e-12, "error of an approximate method: a last-bit change can flip "
+                                "one of its discrete step or event decisions, moving the "
+                                "error by up to its own size")
+    check = Tolerance(1e-6, 1e-12, "difference of two solves at rtol 1e-13, each moved by a "
+                                   "few hundred ulps by a last-bit change")
     return {"wall_time": MEASURED, "runs": MEASURED, "time_ours_at_target": MEASURED,
             "time_rk45_at_target": MEASURED, "speedup_vs_rk45": MEASURED,
-            "error_map": err, "error_switch": err, "reference_check": err}
+            "error_map": err, "error_switch": err, "reference_check": check}
 
 
 @dataclass(frozen=True)
