@@ -86,21 +86,23 @@ PRESETS = {"full": {"families": PROJECT + SCIPY, "every": 10, "every11": 5, "rep
                      "time_cap": 120.0, "budget": 10.0}}
 
 #: how closely two runs agree (filippov.tolerance): times never do. An error
-#: |P - P_ref| of an approximate method is decided partly by the method's discrete
-#: choices (a step accepted or rejected at an error norm near 1, a sign change of h
-#: seen or missed at a step end): a last-bit change that flips one moves the error by
-#: up to its own size (the emulated CPU of tests/crosscpu moved error_map by up to
-#: 6.6e-10 and error_switch by up to 9e-7 absolute). So errors agree within a factor of
-#: two, which still tells methods and tolerances apart (they differ by decades);
-#: the reference check is two solves at rtol 1e-13, a few hundred ulps each.
+#: |P - P_ref| of an approximate method is not a well-conditioned result: it is decided
+#: by the method's discrete choices (a step accepted or rejected at an error norm near
+#: 1, a sign change of h seen or missed at a step end) and, for the dry-friction maps,
+#: by orbits that slide and leave H near a tangency, whose reference map itself moves
+#: by ~3e-13 under a last-bit change. Measured with the emulated CPU of tests/crosscpu:
+#: errors move by up to a factor ~5 (5.2e-11 -> 2.2e-10 at rtol 1e-10, 5.7e-12 ->
+#: 3.0e-11 for a switching time at rtol 1e-12). So errors are compared to within a
+#: decade (rtol 10) above a floor of 1e-10: enough to tell methods and tolerances apart,
+#: which differ by decades.
 def tolerances() -> dict:
     from ..tolerance import MEASURED, Tolerance
 
-    err = Tolerance(1.0, 1e-12, "error of an approximate method: a last-bit change can flip "
-                                "one of its discrete step or event decisions, moving the "
-                                "error by up to its own size")
-    check = Tolerance(1e-6, 1e-12, "difference of two solves at rtol 1e-13, each moved by a "
-                                   "few hundred ulps by a last-bit change")
+    err = Tolerance(10.0, 1e-10, "error of an approximate method: decided by discrete step "
+                                 "and event choices near tangencies; moves by up to ~5x "
+                                 "under a last-bit change (measured)")
+    check = Tolerance(1e-6, 1e-12, "difference of two solves at rtol 1e-13 of maps that move "
+                                   "by ~3e-13 under a last-bit change (measured)")
     return {"wall_time": MEASURED, "runs": MEASURED, "time_ours_at_target": MEASURED,
             "time_rk45_at_target": MEASURED, "speedup_vs_rk45": MEASURED,
             "error_map": err, "error_switch": err, "reference_check": check}
