@@ -93,10 +93,10 @@ def test_sliding_segment_of_pseudo_equilibrium():
     assert abs(traj.z[0]) < 1e-20
 
 
-def test_no_sliding_ingredient_means_an_error_not_a_silent_slide():
+def test_a_system_built_without_sliding_errs_instead_of_sliding():
     system = pseudo_equilibrium.model(0.02, 0.4).full(sliding=False)
     from filippov import SimulationError
-    with pytest.raises(SimulationError, match="sliding"):
+    with pytest.raises(SimulationError, match="sliding reached .* built with sliding=False"):
         simulate(system, [0.2, 0.1], 2.0)
 
 

@@ -14,9 +14,10 @@ except PackageNotFoundError:  # running from a source tree without install
 from .system import PiecewiseSystem, MINUS, PLUS, SLIDING
 from .model import SlowFastModel
 from .simulate import simulate, Section, SimulationError, ZenoError, EventLimitError
+from .checks import SystemContractError
 
 __all__ = [
     "PiecewiseSystem", "SlowFastModel", "simulate", "Section",
-    "SimulationError", "ZenoError", "EventLimitError",
+    "SimulationError", "ZenoError", "EventLimitError", "SystemContractError",
     "MINUS", "PLUS", "SLIDING", "__version__",
 ]

@@ -27,6 +27,7 @@ import numpy as np
 from scipy.integrate import DOP853, Radau
 from scipy.optimize import brentq
 
+from . import checks
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 
 
@@ -143,13 +144,16 @@ class _ExactStepper:
 class _IntegratingStepper:
     """DOP853 (explicit), or Radau (implicit, for a stiff field), with dense output."""
 
-    def __init__(self, fun, z, t, t_end, rtol, atol, max_step, method=DOP853):
+    def __init__(self, fun, z, t, t_end, rtol, atol, max_step, method=DOP853,
+                 piece=lambda zz: "the field"):
         calls = [0]
+        self.piece, self.non_finite = piece, None
 
         def checked(tt, zz):
             # scipy's step control loops forever on a NaN error norm. A non-finite
             # field at the start state is an error; on a trial stage (an overlong
-            # step into overflow) a huge finite value makes DOP853 reject the step.
+            # step into overflow) a huge finite value makes DOP853 reject the step,
+            # and if the step size collapses on it, step() names the piece.
             # This runs once per stage, so it is kept cheap: the sum is finite when
             # every component is (the full test runs only when it is not), and the
             # floating-point warnings are silenced once, by simulate().
@@ -157,8 +161,9 @@ class _IntegratingStepper:
             calls[0] += 1
             if not math.isfinite(v.sum()) and not np.all(np.isfinite(v)):
                 if calls[0] == 1:
-                    raise SimulationError(
-                        f"non-finite field value at t={tt!r}, state {np.asarray(zz).tolist()}")
+                    raise SimulationError(self._non_finite_message(tt, zz))
+                if self.non_finite is None:  # the first in this step: near the orbit
+                    self.non_finite = (tt, np.array(zz, dtype=float))
                 v = np.full(np.shape(v), 1e300)
             return v
 
@@ -166,11 +171,21 @@ class _IntegratingStepper:
         self.solver = method(checked, t, z, t_end, rtol=rtol, atol=atol,
                              max_step=max_step if np.isfinite(max_step) else np.inf)
 
+    def _non_finite_message(self, tt, zz):
+        zz = np.asarray(zz, dtype=float)
+        return (f"{self.piece(zz)} returned a non-finite value at t={float(tt)!r}, "
+                f"z={zz.tolist()}")
+
     def step(self):
         s = self.solver
         ta = s.t
+        self.non_finite = None
         msg = s.step()
         if s.status == "failed":
+            if self.non_finite is not None:  # the step size collapsed on a NaN or inf
+                raise SimulationError(
+                    self._non_finite_message(*self.non_finite)
+                    + f" ({self.method.__name__} could not step past it from t={float(ta)!r})")
             raise SimulationError(f"{self.method.__name__} failed at t={ta!r}: {msg}")
         return ta, s.t, s.dense_output()
 
@@ -374,6 +389,7 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
         if not isinstance(sec, Section):
             raise TypeError(f"sections[{k}]: expected a filippov.simulate.Section, got "
                             f"{type(sec).__name__}")
+    checks.check_system(system, z, method=method)  # the pieces keep the class's contract
 
     traj = Trajectory(system=system, t0=t0, z0=z.copy(), t=t0, z=z.copy())
     mode, kind = initial_mode(system, z, touch_tol)
@@ -397,9 +413,8 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
         if t >= t_end:
             return stop("t_end")
         if mode == SLIDING and not system.sliding:
-            raise SimulationError(
-                f"attracting sliding reached at t={t!r}, state {z.tolist()}, but the scene "
-                "does not declare the sliding ingredient")
+            raise SimulationError(f"attracting sliding reached at t={t!r}, state "
+                                  f"{z.tolist()}, {_NO_SLIDING}")
         use_flow = method == "exact" and system.has_flow(mode)
         if use_flow:
             h = min(EXACT_BLOCK * system.sample_step, max_step, t_end - t0)
@@ -409,7 +424,9 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
         else:
             traj.integrated_modes.add(MODE_NAMES[mode])
             field_of_mode = lambda _t, zz, m=mode: system.field(m, zz)
-            stepper = _IntegratingStepper(field_of_mode, z, t, t_end, rtol, atol, max_step)
+            piece = lambda zz, m=mode: checks.non_finite_piece(system, m, zz)
+            stepper = _IntegratingStepper(field_of_mode, z, t, t_end, rtol, atol, max_step,
+                                          piece=piece)
         steps_in_mode, stepper_steps, stepper_t = 0, 0, t
         # Functions whose crossing ends this mode, with the mode they lead to.
         if mode == PLUS:
@@ -470,7 +487,7 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
                         and (tb - ta) * spectral_radius(field_of_mode, t, z) > 1.0):
                     traj.stiff_modes.add(MODE_NAMES[mode])
                     stepper = _IntegratingStepper(field_of_mode, z, t, t_end, rtol, atol,
-                                                  max_step, method=Radau)
+                                                  max_step, method=Radau, piece=piece)
                     stepper_steps, stepper_t = 0, t
                 continue
             te, ze, what, idx = found
@@ -512,6 +529,10 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
             traj.mode = mode
 
 
+_NO_SLIDING = ("but the system was built with sliding=False; build it with sliding=True "
+               "to follow sliding")
+
+
 def _decide(system, mode, what, z):
     """The Filippov decision at a point of H = 0 (eq:atSl)."""
     a, b = (float(v) for v in system.normal_speeds(z))
@@ -523,17 +544,15 @@ def _decide(system, mode, what, z):
         if a > 0 and system.sliding:
             return SLIDING, "slide_start"
         if a > 0:
-            raise SimulationError(
-                f"attracting sliding reached at state {z.tolist()}, but the scene does not "
-                "declare the sliding ingredient")
+            raise SimulationError(f"attracting sliding reached at state {z.tolist()}, "
+                                  f"{_NO_SLIDING}")
         return MINUS, "crossing"
     # arrived from H < 0
     if b < 0 and system.sliding:
         return SLIDING, "slide_start"
     if b < 0:
-        raise SimulationError(
-            f"attracting sliding reached at state {z.tolist()}, but the scene does not "
-            "declare the sliding ingredient")
+        raise SimulationError(f"attracting sliding reached at state {z.tolist()}, "
+                              f"{_NO_SLIDING}")
     return PLUS, "crossing"
 
 

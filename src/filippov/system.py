@@ -8,7 +8,9 @@ never knows which physics it runs.
 Conventions (the paper's eq:filip): region ``+`` is ``H(z) >= 0``, region ``-`` is
 ``H(z) < 0``. All callables take a state with the components along axis 0, so
 ``z`` may be a vector ``(n,)`` or a batch ``(n, m)``; exact flows take a start
-state ``(n,)`` and elapsed times ``tau`` (scalar or ``(m,)``).
+state ``(n,)`` and elapsed times ``tau`` (scalar or ``(m,)``). The full contract
+is in :class:`PiecewiseSystem`; :func:`filippov.checks.check_system` tests it at
+the start of every simulation.
 """
 from __future__ import annotations
 
@@ -28,13 +30,39 @@ Flow = Callable[[np.ndarray, np.ndarray], np.ndarray]
 class PiecewiseSystem:
     """A Filippov system ``dz/dt = F_-(z)`` if ``H(z) < 0`` else ``F_+(z)``.
 
+    The pieces, for a system of ``n = len(names)`` components:
+
+    * ``field_minus(z)``, ``field_plus(z)``: ``F_-``, ``F_+``;
+    * ``switch(z)``: ``H``, smooth across ``H = 0``;
+    * ``switch_grad(z)``: its gradient ``dH/dz`` (not a multiple, not of another
+      function: its sign decides between crossing and sliding);
+    * ``flows[mode](z0, tau)``: the exact flow of a mode from ``z0`` over the
+      elapsed times ``tau``.
+
+    Batch contract: the solver evaluates the pieces both on one state ``z`` of
+    shape ``(n,)`` and on a batch ``z`` of shape ``(n, m)`` (m samples along a
+    segment, any m >= 1, also m == n), components along axis 0. A piece must
+    treat the samples independently and return the same trailing shape: fields
+    and ``switch_grad`` ``(n,)`` or ``(n, m)``, ``switch`` a scalar or ``(m,)``.
+    An exact flow takes ``z0`` of shape ``(n,)`` and ``tau`` a scalar or
+    ``(m,)``, and returns ``(n,)`` or ``(n, m)``. Write pieces with ``z[i]`` for
+    component i, reductions over ``axis=0``, and constant vectors that
+    broadcast along the samples: ``A @ z - B`` with ``B`` of shape ``(n,)`` is
+    wrong for a batch (``(n, m) - (n,)`` fails, or for m == n silently subtracts
+    ``B[j]`` from sample j); write ``A @ z - B.reshape((-1,) + (1,) * (z.ndim - 1))``
+    (``B[:, None]`` when z is a batch). :func:`filippov.simulate.simulate`
+    checks this contract at its start (:mod:`filippov.checks`) and names the
+    piece that breaks it.
+
     ``flows`` maps a mode (MINUS, PLUS, SLIDING) to an exact flow
     ``flow(z0, tau)``; a missing entry means that mode is integrated.
     ``sliding`` says whether the model includes Filippov sliding: when False and
     a trajectory reaches an attracting sliding region, the solver stops with an
-    error instead of silently computing an effect the scene did not declare.
+    error instead of silently computing an effect the system was not built for.
     ``sample_step`` is the longest time between samples when an exact flow is
-    scanned for events; it must resolve the fastest time scale (eps). A model
+    scanned for events; it must resolve the fastest time scale (eps), and a
+    system with exact flows needs one (finite, > 0) to be simulated with
+    ``method="exact"``; the default (inf) suits a system without flows. A model
     whose fast time scale lives only in a relaxation after each mode entry
     declares how long that lasts (``transient_time``: after it the relaxation
     is below roundoff) and the sample step of its slow dynamics

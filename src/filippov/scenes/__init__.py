@@ -5,10 +5,12 @@ system kind, exact or integrated flows, sliding) and builds nothing else.
 """
 from __future__ import annotations
 
+import contextlib
 import importlib
 
 from .. import tolerance
 from ..config import SceneError
+from ..simulate import SimulationError
 from . import chunking
 
 SCENES = {
@@ -91,11 +93,30 @@ def describe(ds, attrs: dict, latex: dict | None = None):
     return ds
 
 
+#: how the solver says that a system built without sliding reached it
+#: (filippov.simulate, and the compiled kernel's status text)
+_NO_SLIDING_MARKS = ("built with sliding=False", "declares no sliding")
+
+
+@contextlib.contextmanager
+def _in_scene_terms(scene: dict):
+    """Solver errors that name what the system lacks, told also in the scene's words."""
+    try:
+        yield
+    except SimulationError as exc:
+        if (scene.get("ingredients", {}).get("sliding") is False
+                and any(mark in str(exc) for mark in _NO_SLIDING_MARKS)):
+            raise type(exc)(f"{scene.get('id')}: {exc} (the scene sets ingredients.sliding: "
+                            "false; set it to true to follow sliding)") from exc
+        raise
+
+
 def compute(scene: dict, *, progress: bool = False):
     # `chunks` (how to split the work, see .chunking) is not part of the result
     module = _module(scene)
     scene = chunking.without_layout(scene)
-    return _declared(module, scene, module.compute(scene, progress=progress))
+    with _in_scene_terms(scene):
+        return _declared(module, scene, module.compute(scene, progress=progress))
 
 
 def _chunkable(scene: dict):
@@ -109,7 +130,8 @@ def compute_chunk(scene: dict, i: int, n: int | None = None, *, progress: bool =
     """Chunk ``i`` (0-based) of ``n`` (default: the scene's ``chunks``): raw results
     on part of the scene's grid; :func:`merge` of all chunks equals :func:`compute`."""
     n = chunking.n_chunks(scene) if n is None else n
-    return chunking.compute_chunk(_chunkable(scene), scene, i, n, progress=progress)
+    with _in_scene_terms(scene):
+        return chunking.compute_chunk(_chunkable(scene), scene, i, n, progress=progress)
 
 
 def merge(scene: dict, parts):

@@ -1,0 +1,263 @@
+"""Checks of a :class:`~filippov.system.PiecewiseSystem` against its contract.
+
+A system is built by whoever writes the model, and a piece that breaks the
+contract of the class (see its docstring) otherwise fails far from the cause:
+a numpy broadcast error deep in the event scan, a wrong answer when the number
+of samples happens to equal the dimension, a Zeno error for a gradient of the
+wrong sign. :func:`check_system` runs once at the start of
+:func:`filippov.simulate.simulate` and names the piece instead.
+
+The checks only evaluate the pieces (a few dozen calls on states next to the
+start state); they compute nothing the solver uses, so a valid system gives
+the same trajectory bit for bit. They cost about as much as a short run of an
+exact flow (~0.3 ms), so a system object that passed is not checked again: a
+return map calls simulate once per start point on the same system.
+"""
+from __future__ import annotations
+
+import weakref
+
+import numpy as np
+
+from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
+
+FLOW_NAMES = {MINUS: "flows[MINUS]", PLUS: "flows[PLUS]", SLIDING: "flows[SLIDING]"}
+FIELD_NAMES = {MINUS: "field_minus", PLUS: "field_plus"}
+
+#: batch probe: relative spread of the probe states around the start state, and
+#: the agreement asked of a batch evaluation with the column-by-column one. Both
+#: evaluate the same elementwise arithmetic (bit-identical); only a library
+#: routine that picks another kernel for a batch (matmul: gemv vs gemm, SIMD
+#: transcendental functions) may differ, by a few ulps of the terms, far below
+#: 1e-8 of a row's size; a piece that mixes samples is off by the spread, 1e-3.
+PROBE_SPREAD = 1e-3
+PROBE_RTOL = 1e-8
+
+#: switch_grad check: relative tolerance of the directional derivative. The
+#: central difference (H(z + h d) - H(z - h d)) / 2h has truncation error
+#: h^2/6 |D^3 H| and rounding error ~ eps |H| / h; with h = eps^(1/3) s (s the
+#: size of the state) both are ~1e-11 relative when H varies on the scale s, so
+#: 1e-3 leaves eight orders of margin, while a gradient of the wrong sign is off
+#: by 2 along d = grad/|grad| (and one of another function by O(1)). A switch
+#: that varies on a scale far below s is met by the smaller steps
+#: GRAD_STEPS: the check fails only if no step agrees.
+GRAD_RTOL = 1e-3
+GRAD_STEPS = (1.0, 1e-2, 1e-4)
+
+
+class SystemContractError(ValueError):
+    """A piece of a :class:`~filippov.system.PiecewiseSystem` breaks its contract."""
+
+
+# (id(system), exact flows checked) -> weak reference to a system that passed; the
+# entry goes with the system, so a new object at a recycled id is checked afresh
+_PASSED: dict = {}
+
+
+# what each kind of piece must do (the batch contract of PiecewiseSystem), and how
+_CONTRACT = {
+    "vector": "must map a state z of shape (n,) to (n,) and a batch (n, m) of m "
+              "samples to (n, m), sample by sample",
+    "scalar": "must map a state z of shape (n,) to a scalar and a batch (n, m) of m "
+              "samples to (m,), sample by sample",
+    "flow": "(an exact flow) must map z0 of shape (n,) and a scalar time tau to (n,), "
+            "and times tau of shape (m,) to (n, m), time by time",
+}
+_HINT = {
+    "vector": "components are z[i] (not z[..., i]), sums run over axis=0, and a constant "
+              "vector B of shape (n,) must broadcast along the samples: B[:, None] for a "
+              "batch, B.reshape((-1,) + (1,) * (z.ndim - 1)) for both shapes",
+    "flow": "a constant vector v of shape (n,) times tau: np.multiply.outer(v, tau) "
+            "serves both shapes; components of z0 are z0[i]",
+}
+_HINT["scalar"] = _HINT["vector"]
+
+
+def _how(name, kind):
+    return f"{name} {_CONTRACT[kind]} (see PiecewiseSystem); {_HINT[kind]}"
+
+
+def check_system(system: PiecewiseSystem, z0: np.ndarray, *, method: str) -> None:
+    """Raise :class:`SystemContractError` if ``system`` breaks its contract near ``z0``.
+
+    Checked: a finite positive ``sample_step`` when exact flows will be used
+    (``method="exact"``); that every piece (and every exact flow that will be
+    used) evaluates a batch of states as it does each state alone, with the
+    right shape; that ``switch_grad`` is the gradient of ``switch`` at ``z0``.
+    A system object that passed is not checked again (for the same use of its
+    flows), whatever ``z0``.
+    """
+    exact = method == "exact" and len(system.flows) > 0
+    key = (id(system), exact)
+    ref = _PASSED.get(key)
+    if ref is not None and ref() is system:
+        return
+    _check(system, z0, exact)
+    try:
+        _PASSED[key] = weakref.ref(system, lambda _, key=key: _PASSED.pop(key, None))
+    except TypeError:  # an object without weak references is checked every time
+        pass
+
+
+def _check(system, z0, exact):
+    if exact:
+        check_sample_step(system)
+    n = system.dim
+    m = n + 2  # neither 1 nor n: a broadcast along the wrong axis cannot pass unseen
+    Z = probe_states(z0, m)
+    for name, fn, kind in (("field_minus", system.field_minus, "vector"),
+                           ("field_plus", system.field_plus, "vector"),
+                           ("switch", system.switch, "scalar"),
+                           ("switch_grad", system.switch_grad, "vector")):
+        _probe_piece(name, fn, Z, [Z[:, j] for j in range(m)], n, kind)
+    if exact:
+        taus = system.sample_step * np.arange(m) / (m - 1)
+        for mode, flow in system.flows.items():
+            name = FLOW_NAMES.get(mode, f"flows[{mode!r}]")
+            _probe_piece(name, lambda tau, f=flow: f(z0, tau), taus,
+                         [np.float64(t) for t in taus], n, "flow")
+    check_switch_grad(system, z0)
+
+
+def check_sample_step(system: PiecewiseSystem) -> None:
+    """Exact flows are scanned for events every ``sample_step``: it must be finite > 0."""
+    step = system.sample_step
+    modes = ", ".join(MODE_NAMES.get(k, repr(k)) for k in system.flows)
+    if not _positive(step):
+        raise SystemContractError(
+            f"the system has exact flows (modes {modes}) but sample_step={step!r}: an exact "
+            "flow is scanned for events every sample_step, so sample_step must be a finite "
+            "number > 0 that resolves the fastest time scale of the system (build the "
+            "PiecewiseSystem with, e.g., sample_step=period/64 or eps/4; or simulate "
+            "with method='integrate')")
+    slow = system.slow_sample_step
+    if not (np.isnan(slow) or _positive(slow)):
+        raise SystemContractError(
+            f"slow_sample_step must be NaN (none) or a finite number > 0, got {slow!r}")
+
+
+def _positive(v) -> bool:
+    try:
+        return bool(np.isfinite(v) and v > 0)
+    except TypeError:
+        return False
+
+
+def probe_states(z0: np.ndarray, m: int) -> np.ndarray:
+    """``m`` distinct states next to ``z0`` (the first is ``z0`` itself), shape (n, m)."""
+    n = z0.size
+    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
+    pattern = np.where(j == 0, 0.0, np.cos(1.0 + 1.7 * i + 2.3 * j))
+    scale = PROBE_SPREAD * np.maximum(np.abs(z0), 1.0)
+    return z0[:, None] + scale[:, None] * pattern
+
+
+def _probe_piece(name, fn, batch, columns, n, kind):
+    """Evaluate ``fn`` on ``batch`` and on each of ``columns``; compare."""
+    m = len(columns)
+    try:
+        singles = [np.asarray(fn(c), dtype=float) for c in columns]
+    except Exception:
+        # the piece fails on a single state: not a matter of batches; the solver
+        # meets (and reports) that itself where it happens
+        return
+    single_shape = () if kind == "scalar" else (n,)
+    what = "time" if kind == "flow" else "state"
+    for s in singles:
+        if s.shape != single_shape and not (kind == "scalar" and s.size == 1):
+            raise SystemContractError(
+                f"{name} returned shape {s.shape} for a single {what} "
+                f"({'a scalar tau' if kind == 'flow' else f'z of shape ({n},)'}); expected "
+                f"{single_shape}: {_how(name, kind)}")
+    want = (m,) if kind == "scalar" else (n, m)
+    arg = f"tau of shape ({m},)" if kind == "flow" else f"z of shape ({n}, {m})"
+    try:
+        out = np.asarray(fn(batch), dtype=float)
+    except Exception as exc:
+        raise SystemContractError(
+            f"{name} fails on a batch ({arg}) but not on each sample alone "
+            f"({type(exc).__name__}: {str(exc).strip()}); expected shape {want}: "
+            f"{_how(name, kind)}") from exc
+    if out.shape != want:
+        raise SystemContractError(
+            f"{name} returned shape {out.shape} for {arg}; expected {want}: "
+            f"{_how(name, kind)}")
+    cols = np.stack([s.reshape(()) if kind == "scalar" else s for s in singles], axis=-1)
+    rows = np.atleast_2d(cols)
+    outs = np.atleast_2d(out)
+    with np.errstate(invalid="ignore", over="ignore"):
+        finite = np.where(np.isfinite(rows), np.abs(rows), 0.0)
+        tol = PROBE_RTOL * (finite.max(axis=1, keepdims=True) + 1e-6 * finite.max(initial=0.0))
+        same = (np.abs(outs - rows) <= tol) | (outs == rows) | (np.isnan(outs) & np.isnan(rows))
+    if not np.all(same):
+        r, c = (int(k[0]) for k in np.nonzero(~same))
+        raise SystemContractError(
+            f"{name} on a batch ({arg}) differs from its evaluation {what} by {what}: "
+            f"{what} {c} gives {float(outs[r, c])!r} in the batch but "
+            f"{float(rows[r, c])!r} alone (component {r}), so the piece mixes samples: "
+            f"{_how(name, kind)}")
+
+
+def check_switch_grad(system: PiecewiseSystem, z0: np.ndarray) -> None:
+    """``switch_grad(z0)`` against central differences of ``switch`` along two
+    directions: the gradient's own and a fixed one (see :data:`GRAD_RTOL`)."""
+    g = np.asarray(system.switch_grad(z0), dtype=float).reshape(-1)
+    if not np.all(np.isfinite(g)):
+        return
+    n = z0.size
+    fixed = np.cos(0.7 + 2.1 * np.arange(n))
+    dirs = [fixed / np.linalg.norm(fixed)]
+    gnorm = float(np.linalg.norm(g))
+    if gnorm > 0:
+        dirs.insert(0, g / gnorm)
+    size = max(1.0, float(np.max(np.abs(z0))))
+    h0 = np.cbrt(np.finfo(float).eps) * size
+    steps = [h0 * f for f in GRAD_STEPS]
+    pts = [z0 + sign * h * d for h in steps for d in dirs for sign in (1.0, -1.0)]
+    try:
+        H = np.asarray(system.switch(np.stack(pts, axis=1)), dtype=float)
+        H = H.reshape(len(steps), len(dirs), 2)
+        H0 = abs(float(np.asarray(system.switch(z0), dtype=float).reshape(())))
+    except Exception:  # switch fails next to z0: no verdict here, the solver meets it
+        return
+    # rounding of H at the sample points: eps times the size of H's terms
+    terms = H0 + gnorm * float(np.linalg.norm(z0))
+    worst = None
+    for k, h in enumerate(steps):
+        agree = True
+        with np.errstate(invalid="ignore", over="ignore"):
+            for i, d in enumerate(dirs):
+                fd = (H[k, i, 0] - H[k, i, 1]) / (2 * h)
+                gd = float(g @ d)
+                noise = 8 * np.finfo(float).eps * (terms + np.max(np.abs(H[k, i]))) / h
+                scale = max(abs(gd), abs(fd), gnorm)
+                if abs(fd - gd) > GRAD_RTOL * scale + noise:  # False for NaN: no verdict
+                    agree = False
+                    if worst is None:
+                        worst = (d, gd, fd, h)
+        if agree:
+            return
+    d, gd, fd, h = worst
+    raise SystemContractError(
+        f"switch_grad does not match a finite difference of switch at the start state "
+        f"z={z0.tolist()}: along d={d.tolist()}, switch_grad(z).d = {gd!r} but "
+        f"(switch(z + h d) - switch(z - h d)) / 2h = {float(fd)!r} (h = {h:.3g}; smaller steps "
+        f"disagree too). switch_grad must return the gradient dH/dz of switch; one of "
+        f"the wrong sign makes attracting sliding look repelling (and crossings look "
+        f"like sliding)")
+
+
+def non_finite_piece(system: PiecewiseSystem, mode: int, z: np.ndarray) -> str:
+    """The piece to blame for a non-finite field value of ``mode`` at ``z``."""
+    if mode in FIELD_NAMES:
+        return FIELD_NAMES[mode]
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        for name, fn in (("field_minus", system.field_minus), ("field_plus", system.field_plus),
+                         ("switch_grad", system.switch_grad)):
+            try:
+                if not np.all(np.isfinite(np.asarray(fn(z), dtype=float))):
+                    return name
+            except Exception:
+                return name
+    return ("the sliding field (a F_+ - b F_-)/(a - b), a = dH.F_-, b = dH.F_+ "
+            "(built from field_minus, field_plus and switch_grad)")
