@@ -15,9 +15,12 @@ from .system import PiecewiseSystem, MINUS, PLUS, SLIDING
 from .model import SlowFastModel
 from .simulate import simulate, Section, SimulationError, ZenoError, EventLimitError
 from .checks import SystemContractError
+from .poincare import first_returns, fixed_points
+from .continuation import monodromy, floquet_multipliers, ContinuationError
 
 __all__ = [
     "PiecewiseSystem", "SlowFastModel", "simulate", "Section",
     "SimulationError", "ZenoError", "EventLimitError", "SystemContractError",
+    "first_returns", "fixed_points", "monodromy", "floquet_multipliers", "ContinuationError",
     "MINUS", "PLUS", "SLIDING", "__version__",
 ]
