@@ -32,26 +32,14 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import minimize_scalar
 
 from .progress import Progress
-from .system import SLIDING
+# the derivatives live in filippov.variational; fd_jacobian and saltation stay
+# importable from here, where the continuation code and its users reach for them
+from .variational import (VariationalError, fd_jacobian, saltation,  # noqa: F401
+                          switch_matrix, transition_matrix)
 
 
 class ContinuationError(RuntimeError):
     """Newton failed to converge or the step size collapsed."""
-
-
-# --------------------------------------------------------------------------- derivatives
-def fd_jacobian(fun: Callable[[np.ndarray], np.ndarray], u: np.ndarray,
-                step: float = 1e-7) -> np.ndarray:
-    """Central differences; ``step`` is relative to max(1, |u_i|)."""
-    u = np.asarray(u, dtype=float)
-    cols = []
-    for i in range(u.size):
-        d = step * max(1.0, abs(u[i]))
-        up, um = u.copy(), u.copy()
-        up[i] += d
-        um[i] -= d
-        cols.append((np.asarray(fun(up)) - np.asarray(fun(um))) / (2 * d))
-    return np.stack(cols, axis=-1)
 
 
 def _null_vector(J: np.ndarray) -> np.ndarray:
@@ -247,29 +235,6 @@ def shooting_residual(make_field, fixed_index: int, fixed_value: float, n: int, 
 
 
 # --------------------------------------------------------------------------- Floquet
-def _jac(field, z, step=1e-6):
-    # a step well above the noise level: the variational equation must see a
-    # smooth matrix, or DOP853's step control chases rounding noise
-    return fd_jacobian(field, z, step)
-
-
-def saltation(f_before, f_after, grad):
-    """I + (f_after - f_before) grad^T / (grad . f_before): maps perturbations
-    across a switching surface with normal ``grad`` reached along f_before."""
-    n = f_before.size
-    return np.eye(n) + np.outer(f_after - f_before, grad) / (grad @ f_before)
-
-
-def _switch_matrix(system, before, after, z):
-    """Saltation matrix of a switch from mode ``before`` to ``after`` at ``z``; None
-    when there is none: no switch, or the end of sliding, where the field is
-    continuous (a or b is zero there, so the sliding field equals the field it
-    leaves into) and the saltation matrix is the identity."""
-    if before == after or before == SLIDING:
-        return None
-    return saltation(system.field(before, z), system.field(after, z), system.switch_grad(z))
-
-
 def monodromy(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None):
     """Monodromy matrix of the periodic orbit traced by ``traj`` (one period,
     from a start point back to it), built from its events:
@@ -286,35 +251,16 @@ def monodromy(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None):
       does not depend on where on the orbit the period starts.
 
     Returns (M, multipliers sorted by modulus, descending)."""
-    n = system.dim
-    jac = jacobian or (lambda mode, z: _jac(lambda zz: system.field(mode, zz), z))
-    M = np.eye(n)
-    ev = traj.events
-    for k, e in enumerate(ev):
-        S = _switch_matrix(system, e.mode_before, e.mode_after, e.state)
-        if S is not None:
-            M = S @ M
-        t_next = ev[k + 1].t if k + 1 < len(ev) else traj.t
-        dt = t_next - e.t
-        if dt <= 0:
-            continue
-        mode = e.mode_after
-
-        def rhs(t, z, mode=mode):
-            x, Phi = z[:n], z[n:].reshape(n, n)
-            return np.concatenate([system.field(mode, x), (jac(mode, x) @ Phi).ravel()])
-
-        sol = solve_ivp(rhs, (0.0, dt), np.concatenate([e.state, np.eye(n).ravel()]),
-                        method="DOP853", rtol=rtol, atol=atol)
-        if not sol.success:
-            raise ContinuationError(f"variational integration failed: {sol.message}")
-        M = sol.y[n:, -1].reshape(n, n) @ M
-    # simulate logs a start on H = 0 as 'start' in the mode it leaves in, and the
-    # return to it is logged as a switch only if rounding puts the end state past
-    # the surface: close the period with the switch from the end mode to the start
-    # mode. Saltations of crossings at one point compose (S_bc S_ab = S_ac,
-    # S_ba S_ab = I), so a switch logged at t0 or at the end too is not counted twice.
-    S = _switch_matrix(system, traj.mode, ev[0].mode_after, traj.z)
+    try:
+        M = transition_matrix(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
+        # simulate logs a start on H = 0 as 'start' in the mode it leaves in, and the
+        # return to it is logged as a switch only if rounding puts the end state past
+        # the surface: close the period with the switch from the end mode to the start
+        # mode. Saltations of crossings at one point compose (S_bc S_ab = S_ac,
+        # S_ba S_ab = I), so a switch logged at t0 or at the end too is not counted twice.
+        S = switch_matrix(system, traj.mode, traj.events[0].mode_after, traj.z)
+    except VariationalError as exc:
+        raise ContinuationError(str(exc)) from exc
     if S is not None:
         M = S @ M
     mult = np.linalg.eigvals(M)

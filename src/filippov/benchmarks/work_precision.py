@@ -356,8 +356,12 @@ def run(problems, families, repeat: int, time_cap: float, log=print, budget: flo
                           "NaN: not reached)", "units": "s"}),
          "speedup_vs_rk45": ("problem", ratio, {
              "long_name": "RK45 time / project time at equal error (the target)", "units": "1"})},
-        coords={"problem": [p.name for p in problems],
-                "method": ("config", fam_of), "tolerance": ("config", [c[1] for c in configs])})
+        coords={"problem": ("problem", [p.name for p in problems],
+                            {"long_name": "return map measured (scene and panel)"}),
+                "method": ("config", fam_of, {"long_name": "method (project mode or solve_ivp)"}),
+                "tolerance": ("config", [c[1] for c in configs],
+                              {"long_name": "relative tolerance rtol (atol = rtol/100)",
+                               "units": "1"})})
     from ..tolerance import annotate
 
     ds = annotate(ds, tolerances())

@@ -1,0 +1,165 @@
+"""Derivatives of a nonsmooth flow with respect to its start state.
+
+An event-driven trajectory of :mod:`filippov.simulate` is smooth between its
+events, so its derivative dz(t)/dz0 is a product: on every segment the
+variational equation of that mode's field (the Filippov field while sliding),
+and at every event the saltation matrix that carries perturbations across the
+switching surface (Filippov's correction for the change of arrival time):
+
+* a crossing from mode a to b, or the start of sliding, at a point with normal
+  n = grad H: S = I + (f_b - f_a) n^T / (n . f_a); entering sliding it projects
+  onto the tangent space of H_s;
+* the end of sliding: identity (one normal speed is zero there, so the sliding
+  field equals the field it leaves into).
+
+:func:`transition_matrix` is that product over a whole trajectory;
+:func:`return_jacobian` adds the correction for the arrival time at a Poincare
+section, giving the derivative dP/dz0 of a return map (tested against finite
+differences of P, tests/test_variational.py); :func:`filippov.continuation.monodromy`
+closes a period with it.
+"""
+from __future__ import annotations
+
+from typing import Callable, Optional
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .system import SLIDING
+
+
+class VariationalError(RuntimeError):
+    """The variational equations could not be integrated, or a switch or section
+    is met tangentially (the derivative does not exist there)."""
+
+
+def fd_jacobian(fun: Callable[[np.ndarray], np.ndarray], u: np.ndarray,
+                step: float = 1e-7) -> np.ndarray:
+    """Central differences; ``step`` is relative to max(1, |u_i|)."""
+    u = np.asarray(u, dtype=float)
+    cols = []
+    for i in range(u.size):
+        d = step * max(1.0, abs(u[i]))
+        up, um = u.copy(), u.copy()
+        up[i] += d
+        um[i] -= d
+        cols.append((np.asarray(fun(up)) - np.asarray(fun(um))) / (2 * d))
+    return np.stack(cols, axis=-1)
+
+
+def field_jacobian(system, mode: int, z: np.ndarray, step: float = 1e-6) -> np.ndarray:
+    """Jacobian of the field of ``mode`` by central differences. The step is well
+    above the noise level: the variational equation must see a smooth matrix, or
+    DOP853's step control chases rounding noise."""
+    return fd_jacobian(lambda zz: system.field(mode, zz), z, step)
+
+
+def saltation(f_before, f_after, grad):
+    """I + (f_after - f_before) grad^T / (grad . f_before): maps perturbations
+    across a switching surface with normal ``grad`` reached along f_before."""
+    speed = grad @ f_before
+    if speed == 0:
+        raise VariationalError("the switching surface is reached tangentially (grad H . f = 0): "
+                               "the flow is not differentiable there")
+    return np.eye(f_before.size) + np.outer(f_after - f_before, grad) / speed
+
+
+def switch_matrix(system, before: int, after: int, z: np.ndarray):
+    """Saltation matrix of a switch from mode ``before`` to ``after`` at ``z``; None
+    when there is none: no switch, or the end of sliding (identity)."""
+    if before == after or before == SLIDING:
+        return None
+    return saltation(system.field(before, z), system.field(after, z), system.switch_grad(z))
+
+
+def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
+                      jacobian: Optional[Callable] = None) -> np.ndarray:
+    """dz(t_end)/dz0 along ``traj`` (a Trajectory of :func:`filippov.simulate`):
+    the variational equations of every segment between its events, from the event
+    states, composed with the saltation matrix of every switch.
+
+    Parameters
+    ----------
+    system : PiecewiseSystem
+        The system ``traj`` was computed with.
+    traj : Trajectory
+        Its events (``traj.events``) and end (``traj.t``, ``traj.z``) are used.
+    rtol, atol : float
+        Tolerances of the variational integration (DOP853). With the default
+        finite-difference Jacobians keep rtol >= ~1e-10: tighter, DOP853 chases
+        their rounding noise (a stiff sliding segment of the Hopf example took 94 s
+        at rtol 1e-12 and 0.2 s at 1e-10).
+    jacobian : callable, optional
+        ``jacobian(mode, z)`` -> (n, n) Jacobian of the field of ``mode``;
+        default: central differences (:func:`field_jacobian`).
+
+    Returns
+    -------
+    ndarray, shape (n, n)
+    """
+    n = system.dim
+    jac = jacobian or (lambda mode, z: field_jacobian(system, mode, z))
+    M = np.eye(n)
+    ev = traj.events
+    for k, e in enumerate(ev):
+        S = switch_matrix(system, e.mode_before, e.mode_after, e.state)
+        if S is not None:
+            M = S @ M
+        t_next = ev[k + 1].t if k + 1 < len(ev) else traj.t
+        dt = t_next - e.t
+        if dt <= 0:
+            continue
+        mode = e.mode_after
+
+        def rhs(t, z, mode=mode):
+            x, Phi = z[:n], z[n:].reshape(n, n)
+            return np.concatenate([system.field(mode, x), (jac(mode, x) @ Phi).ravel()])
+
+        sol = solve_ivp(rhs, (0.0, dt), np.concatenate([e.state, np.eye(n).ravel()]),
+                        method="DOP853", rtol=rtol, atol=atol)
+        if not sol.success:
+            raise VariationalError(f"variational integration failed: {sol.message}")
+        M = sol.y[n:, -1].reshape(n, n) @ M
+    return M
+
+
+def return_jacobian(system, traj, section, *, rtol: float = 1e-10, atol: float = 1e-12,
+                    jacobian: Optional[Callable] = None,
+                    section_grad: Optional[Callable] = None) -> np.ndarray:
+    """dP/dz0 of the return map to ``section`` at the start of ``traj``, a run of
+    :func:`filippov.simulate` that stopped at a hit of that (terminal) section.
+
+    P(z0) lies on the section, so dP/dz0 = (I - f n^T / (n . f)) dz(T)/dz0 with
+    f the field and n the section's gradient at the hit: a perturbation moves the
+    arrival time, along f, until the orbit is back on the section. Columns along
+    the flow direction at z0 give zero when z0 itself lies on the section.
+
+    Parameters
+    ----------
+    system, traj, rtol, atol, jacobian
+        As for :func:`transition_matrix`.
+    section : Section
+        The section ``traj`` stopped at (``traj.status == "section:<name>"``).
+    section_grad : callable, optional
+        ``section_grad(z)`` -> (n,) gradient of ``section.func``; default: central
+        differences.
+
+    Returns
+    -------
+    ndarray, shape (n, n)
+        Maps perturbations of z0 to perturbations of P(z0) (within the section's
+        tangent space).
+    """
+    if traj.status != f"section:{section.name}":
+        raise VariationalError(f"the trajectory ended with status {traj.status!r}, not at a "
+                               f"hit of section {section.name!r}")
+    Phi = transition_matrix(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
+    z = np.asarray(traj.z, dtype=float)
+    grad = (np.asarray(section_grad(z), dtype=float) if section_grad is not None else
+            fd_jacobian(lambda zz: np.atleast_1d(section.func(zz)), z)[0])
+    f = np.asarray(system.field(traj.mode, z), dtype=float)
+    speed = grad @ f
+    if speed == 0:
+        raise VariationalError(f"section {section.name!r} is hit tangentially at t={traj.t!r}: "
+                               "the return map is not differentiable there")
+    return (np.eye(z.size) - np.outer(f, grad) / speed) @ Phi
