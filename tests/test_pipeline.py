@@ -87,6 +87,8 @@ def test_changing_one_scene_reruns_only_its_chain(workflow_build, tmp_path):
     assert jobs.pop("plot") == {"fig08_s0theta"}
     jobs.pop("all", None)
     # the report (if built) quotes every dataset: it follows; nothing else does
+    # the report, and the copy of the changed scene file the HTML report attaches
+    assert jobs.pop("publish_scene", {"fig08_s0theta"}) == {"fig08_s0theta"}
     assert set(jobs) <= {"report_tables", "paper"}, jobs
 
 
@@ -99,7 +101,9 @@ def test_editing_a_workflow_script_reruns_its_rule_only(workflow_build, tmp_path
     assert "compute" not in jobs
     assert jobs.pop("plot") == scenes
     jobs.pop("all", None)
-    assert set(jobs) <= {"paper"}, jobs   # the report includes the redrawn figures
+    # the report includes the redrawn figures; the work-precision figure is drawn by
+    # the same script
+    assert set(jobs) <= {"paper", "plot_work_precision"}, jobs
 
 
 def test_build_holds_the_hard_case_sweep_of_the_configured_eps(workflow_build):

@@ -317,7 +317,7 @@ def test_html_report_links_every_figure_to_its_rule(workflow_build, tmp_path):
         data = yaml.safe_load((work / "config" / "scenes" / f"{scene}.yaml").read_text())
         number = printed[data["paper_figure"]].replace("~", " ")
         assert f"<strong>{number}</strong>" in html, (scene, number)
-        first = " ".join(str(data["description"]).split())[:40]
+        first = " ".join(str(data.get("description", "")).split())[:40]
         assert html_escape(first) in html, (scene, first)
         for key, value in data["parameters"].items():
             if isinstance(value, (int, float)):
