@@ -197,3 +197,25 @@ def test_manifest_check_defaults_to_the_working_directory(tmp_path, monkeypatch)
     # no build here: every dataset and figure of the manifest is missing *here*
     assert manifest.main(["check"]) == 1
 
+
+
+def test_a_slide_ends_on_the_switching_surface():
+    # the integrated sliding flow drifts off H by its local errors; at small eps the
+    # fast part of H turns a drift of 1e-14 into an O(1) normal speed, and a slide
+    # that ends that far off H was re-entered at once (a Zeno error at eps = 1e-8).
+    # The end of a slide is put back on H: |H| at rounding level there.
+    sim = sys.modules["filippov.simulate"]
+    from filippov.models import hopf
+    from filippov.scenes.fig04_retmaps import section_L1
+
+    system = hopf.model(1e-4, 0.5).full()
+    traj = sim.simulate(system, [0.0, 1.2, 0.0], 1.0, sections=[section_L1()], dense=False)
+    ends = [e for e in traj.events if e.kind == "slide_end"]
+    assert len(ends) == 1
+    assert abs(float(system.switch(ends[0].state))) <= np.finfo(float).eps  # 6.7e-16 before
+    # the projection itself: exact for a linear H, never moves a point away from H
+    z = np.array([-1.0, 0.3, -1.0 - 3e-14])
+    moved = sim._onto_switch(system, z)
+    assert abs(float(system.switch(moved))) <= 2 * np.finfo(float).eps < abs(float(system.switch(z)))
+    on = np.array([-1.0, 0.3, -1.0])
+    assert sim._onto_switch(system, on) is on
