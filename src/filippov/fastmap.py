@@ -14,9 +14,10 @@ same algorithm for a whole batch of start points inside one compiled call:
 * the samples are scanned for the same events: ``h`` leaving the region, a
   hidden grazing crossing (a sign change of ``dh/dt`` whose extremum of ``h``
   goes through zero; ``|h| <= touch_tol`` there is a touch, not a switch), the
-  section (direction and ``where`` condition); roots are refined with a port of
-  scipy's ``brentq`` (same tolerances) and then stepped to the far side of the
-  crossing;
+  section (direction and ``where`` condition; a section root at the instant of
+  a switch is the return, a start on the section up to rounding is not, as for
+  :class:`filippov.simulate.Section`); roots are refined with a port of scipy's
+  ``brentq`` (same tolerances) and then stepped to the far side of the crossing;
 * at ``h = 0`` the Filippov decision uses ``a = grad h . F_-`` and
   ``b = grad h . F_+`` exactly as :func:`filippov.simulate._decide`;
 * sliding is integrated with a port of scipy's ``DOP853`` (same coefficients,
@@ -55,7 +56,8 @@ from scipy.integrate._ivp import dop853_coefficients as _dop
 
 from .poincare import Returns
 from .progress import Progress
-from .simulate import EXACT_BLOCK, EventLimitError, SimulationError, ZenoError, slow_window
+from .simulate import (EXACT_BLOCK, SLIDE_TANGENT, START_ULPS, EventLimitError,
+                       SimulationError, ZenoError, slow_window)
 from .system import MINUS, PLUS, SLIDING
 
 # ----------------------------------------------------------------------------- signatures
@@ -85,6 +87,7 @@ NO_SLIDING = 6     # attracting sliding reached, but the model declares no slidi
 STEP_FAILED = 7    # the sliding integrator's step size collapsed
 ROOT_FAILED = 8    # an event could not be bracketed / refined
 BAD_START = 9      # non-finite start point
+SECTION_SLIDING = 10  # the orbit slides inside the section (a section on H)
 
 STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event limit",
           STEP_LIMIT: "step limit", ZENO: "accumulation of switches (Zeno)",
@@ -92,7 +95,9 @@ STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event lim
           NO_SLIDING: "attracting sliding reached, but the model declares no sliding",
           STEP_FAILED: "sliding integrator: step size too small",
           ROOT_FAILED: "event refinement failed (no bracket or no convergence)",
-          BAD_START: "non-finite start point"}
+          BAD_START: "non-finite start point",
+          SECTION_SLIDING: "the orbit slides along H inside the section (a section on the "
+                           "switching surface): its crossings there would be rounding noise"}
 
 # crossing predicates (simulate.TO_NEG, TO_NONNEG, TO_NONPOS, _EitherWay)
 _TO_NEG, _TO_NONNEG, _TO_NONPOS, _EITHER = 0, 1, 2, 3
@@ -103,6 +108,7 @@ _W_NONE, _W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_SECTION = -1, 0, 1, 2, 3
 
 _TINY = np.finfo(float).tiny
 _EPS = np.finfo(float).eps
+_FD_STEP = np.cbrt(_EPS)  # simulate._slides_in
 
 # ----------------------------------------------------------------------------- DOP853 tableau
 # The coefficients of scipy's DOP853, which the reference driver integrates sliding
@@ -144,7 +150,7 @@ def _after(pred, v):
         return v >= 0.0
     if pred == _TO_NONPOS:
         return v <= 0.0
-    return True  # _EITHER: both refinements end at a root
+    return True  # _EITHER (not reached: _refine resolves it to the crossing's side)
 
 
 @_jit
@@ -298,6 +304,8 @@ def _brentq(sel, xa, xb, xtol, rtol, maxiter, mode, sg, za, F, y_old, fns, p, wz
 @_jit
 def _refine(sel, pred, ta, tb, va, xtol, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
     """simulate._refine: root in [ta, tb] on the far side of the crossing; (t, ok)."""
+    if pred == _EITHER:  # the far side of this crossing
+        pred = _TO_NONPOS if va > 0.0 else _TO_NONNEG
     if va == 0.0:
         r = ta
     else:
@@ -347,8 +355,19 @@ def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, s
 
 
 @_jit
-def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, sg, za, F, y_old, fns, p,
-          vals, dvals, svals, wz, wg, wf):
+def _starts_on_section(s0, z0, sr, zr):
+    """simulate._starts_on_section."""
+    frac = min(1.0, abs(s0) / abs(s0 - sr)) if s0 != sr else 1.0
+    size, moved = 0.0, 0.0
+    for k in range(z0.size):
+        size = max(size, abs(z0[k]), abs(zr[k]))
+        moved = max(moved, abs(zr[k] - z0[k]))
+    return frac * moved <= START_ULPS * _EPS * size
+
+
+@_jit
+def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y_old, fns,
+          p, vals, dvals, svals, wz, wg, wf):
     """simulate._scan on the samples: the earliest event; (status, t, what)."""
     if mode == PLUS:
         nleave, sel0, pred0, what0, sel_d = 1, _S_H, _TO_NEG, _W_SWITCH, _S_B
@@ -406,10 +425,18 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, sg, za, F, y_old, fns,
                             fns, p, wz, wg, wf)
             if not ok:
                 return ROOT_FAILED, r, _W_NONE
-            if best_w == _W_NONE or r < best_t:
+            # simulate._scan: min_time; a tie with a switch (simulate._same_instant)
+            # goes to the section; a start on the section up to rounding is no hit
+            if r >= min_time and (best_w == _W_NONE
+                                  or r <= best_t + 4.0 * (xtol + 4.0 * _EPS * abs(best_t))):
                 _zat(r, mode, sg, za, F, y_old, fns, p, wz)
                 if fns[7](wz, p):
-                    best_t, best_w = r, _W_SECTION
+                    at_start = False
+                    if ts[i] == 0.0:
+                        _zat(ts[i], mode, sg, za, F, y_old, fns, p, wg)
+                        at_start = _starts_on_section(svals[i], wg, fns[6](wz, p), wz)
+                    if not at_start:
+                        best_t, best_w = r, _W_SECTION
         if best_w != _W_NONE:
             return OK, best_t, best_w
     return OK, np.inf, _W_NONE
@@ -578,6 +605,34 @@ def _dop_dense(mode, h, y_old, y, f_old, f, fns, p, wg, wm, wp, K, ytmp, F):
 
 # ============================================================================= one start point
 @_jit
+def _section_rate(z, wm, wp, cm, cp, d, fns, p, wz):
+    """Central difference of the section along the field cm F_- + cp F_+."""
+    for k in range(z.size):
+        wz[k] = z[k] + d * (cm * wm[k] + cp * wp[k])
+    s1 = fns[6](wz, p)
+    for k in range(z.size):
+        wz[k] = z[k] - d * (cm * wm[k] + cp * wp[k])
+    return (s1 - fns[6](wz, p)) / (2.0 * d)
+
+
+@_jit
+def _slides_in(z, fns, p, wg, wm, wp, wz):
+    """simulate._slides_in: the sliding flow at z stays in the section (on H)."""
+    a, b = _speeds(z, fns, p, wg, wm, wp)
+    speed, size = 0.0, 1.0
+    for k in range(z.size):
+        speed = max(speed, abs(wm[k]), abs(wp[k]))
+        size = max(size, abs(z[k]))
+    if not (np.isfinite(speed) and speed > 0.0):
+        return False
+    d = _FD_STEP * size / speed
+    scale = max(abs(_section_rate(z, wm, wp, 1.0, 0.0, d, fns, p, wz)),
+                abs(_section_rate(z, wm, wp, 0.0, 1.0, d, fns, p, wz)))
+    rate = _section_rate(z, wm, wp, -b / (a - b), a / (a - b), d, fns, p, wz)
+    return abs(fns[6](z, p)) <= SLIDE_TANGENT * d * scale and abs(rate) <= SLIDE_TANGENT * scale
+
+
+@_jit
 def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
     """simulate.initial_mode."""
     H = fns[4](z, p)
@@ -605,6 +660,7 @@ def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fo
     sliding stretches (counted like sliding_time)."""
     rtol, atol, touch_tol, xtol = fopts[0], fopts[1], fopts[2], fopts[3]
     zeno_span, max_step, hwin_slow, transient = fopts[4], fopts[5], fopts[6], fopts[7]
+    min_time = fopts[8]
     max_events, max_steps, zeno_count = iopts[0], iopts[1], iopts[2]
     n = z0.size
     t = 0.0
@@ -615,6 +671,8 @@ def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fo
         if not np.isfinite(z0[k]):
             return BAD_START, t, 0, 0.0
     mode = _initial_mode(z, fns, p, touch_tol, sliding, wg, wf, wp)
+    if mode == SLIDING and _slides_in(z, fns, p, wg, wf, wp, wz):
+        return SECTION_SLIDING, t, 0, 0.0
     for k in range(n):
         slide_z0[k] = z[k]
     n_switch = 0
@@ -649,8 +707,8 @@ def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fo
                 if not _sample(mode, ta, tb, frac_ex, ns, sg, za, F, y_old, fns, p, ts, vals,
                                dvals, svals, wz, wg, wf, wp, ynew):
                     return NON_FINITE, ta, n_switch, slide_time
-                st, te, what = _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, sg, za,
-                                     F, y_old, fns, p, vals, dvals, svals, wz, wg, wf)
+                st, te, what = _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time,
+                                     sg, za, F, y_old, fns, p, vals, dvals, svals, wz, wg, wf)
                 if st != OK:
                     return st, ta, n_switch, slide_time
                 first = False
@@ -699,8 +757,8 @@ def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fo
                 if not _sample(mode, ta, tb, frac_in, ns, sg, za, F, y_old, fns, p, ts, vals,
                                dvals, svals, wz, wg, wf, wp, ynew):
                     return NON_FINITE, ta, n_switch, slide_time
-                st, te, what = _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, sg, za,
-                                     F, y_old, fns, p, vals, dvals, svals, wz, wg, wf)
+                st, te, what = _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time,
+                                     sg, za, F, y_old, fns, p, vals, dvals, svals, wz, wg, wf)
                 if st != OK:
                     return st, ta, n_switch, slide_time
                 first = False
@@ -732,6 +790,8 @@ def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fo
             new_mode = SLIDING if b < 0 else PLUS
         if new_mode == SLIDING and not sliding:
             return NO_SLIDING, t, n_switch, slide_time
+        if new_mode == SLIDING and mode != SLIDING and _slides_in(z, fns, p, wg, wf, wp, wz):
+            return SECTION_SLIDING, t, n_switch, slide_time
         if mode == SLIDING:
             slide_time += t - slide_since
             for k in range(n):
@@ -766,7 +826,7 @@ _KERNEL_SIG = types.void(
     types.boolean,              # sliding declared
     _vec, _vec,                 # sample fractions: exact windows, integration steps
     _vec,                       # rtol, atol, touch_tol, event_xtol, zeno_span, max_step,
-                                # slow window, transient time
+                                # slow window, transient time, min_time
     types.int64[::1],           # max_events, max_steps, zeno_count
     types.float64[:, ::1], _vec, types.int64[::1], _vec, types.int64[::1], _vec,  # outputs
     types.float64[:, ::1])
@@ -897,11 +957,13 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
                     atol: float = 1e-14, max_step: float = np.inf, max_events: int = 100_000,
                     max_steps: int = 5_000_000, samples_per_step: int = 4,
                     touch_tol: float = 1e-15, event_xtol: float = 1e-15, zeno_count: int = 64,
-                    zeno_span: float = 1e-10) -> BatchReturns:
+                    zeno_span: float = 1e-10, min_time: float = 0.0) -> BatchReturns:
     """First returns of ``starts`` (``(m, dim)``) to the model's section, one compiled call.
 
-    Options mean what they mean for :func:`filippov.simulate.simulate`. Nothing is
-    raised for a start point that fails: see ``status``.
+    Options mean what they mean for :func:`filippov.simulate.simulate`; ``min_time``
+    that of :class:`filippov.simulate.Section` (hits before it are ignored; a start
+    on the section up to rounding is not a hit either way). Nothing is raised for a
+    start point that fails: see ``status``.
     """
     starts = np.ascontiguousarray(np.atleast_2d(np.asarray(starts, dtype=float)))
     if starts.ndim != 2 or starts.shape[1] != cmodel.dim:
@@ -917,6 +979,8 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
         raise ValueError(f"max_step must be > 0, got {max_step!r}")
     if zeno_count < 1:
         raise ValueError("zeno_count must be >= 1")
+    if not (np.isfinite(min_time) and min_time >= 0):
+        raise ValueError(f"min_time must be a finite number >= 0, got {min_time!r}")
     if cmodel.exact and not (np.isfinite(cmodel.sample_step) and cmodel.sample_step > 0):
         raise ValueError(f"the compiled model needs a finite sample_step > 0, "
                          f"got {cmodel.sample_step!r}")
@@ -925,7 +989,7 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     frac_ex = np.linspace(0.0, 1.0, EXACT_BLOCK * samples_per_step + 1)
     frac_in = np.linspace(0.0, 1.0, samples_per_step + 1)
     fopts = np.array([rtol, atol, touch_tol, event_xtol, zeno_span, max_step, hwin_slow,
-                      cmodel.transient_time], dtype=float)
+                      cmodel.transient_time, min_time], dtype=float)
     iopts = np.array([max_events, max_steps, zeno_count], dtype=np.int64)
     m = starts.shape[0]
     state = np.empty_like(starts)

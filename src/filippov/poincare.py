@@ -7,6 +7,7 @@ the time spent sliding, so a figure can show where the map changes character.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,10 +34,12 @@ def first_returns(system: PiecewiseSystem, starts, section: Section, t_max: floa
 
     ``options`` go to :func:`simulate`. A start point that does not return within
     ``t_max`` is an error naming it: a return map with holes is not a return map.
+    A start on the section (up to rounding) returns at its next crossing;
+    ``section.min_time`` skips crossings closer to the start than that.
     """
     starts = np.atleast_2d(np.asarray(starts, dtype=float))
     if section.terminal != 1:
-        section = Section(section.name, section.func, section.direction, section.where, 1)
+        section = dataclasses.replace(section, terminal=1)
     m = starts.shape[0]
     state = np.empty_like(starts)
     time = np.empty(m)

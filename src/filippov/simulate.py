@@ -47,13 +47,28 @@ class ZenoError(SimulationError):
 class Section:
     """A user event ``func(z) = 0``; ``direction`` -1 counts decreasing crossings
     only, +1 increasing, 0 both; ``where(z)`` must hold at the hit;
-    ``terminal`` stops the run after that many hits (None: never)."""
+    ``terminal`` stops the run after that many hits (None: never); hits earlier
+    than ``t0 + min_time`` are ignored.
+
+    A start point on the section is not a hit, also when rounding puts it a hair
+    before the section (a crossing in the run's first sample interval within
+    ``START_ULPS`` rounding errors of the start): a return map started on its
+    section gives the next return, never ``P(z) = z`` at t ~ 1e-17. ``min_time``
+    skips crossings that are genuinely close to the start.
+
+    A section may lie on the switching surface H: where the orbit crosses H, or
+    arrives on it to slide, the hit is logged there, before the switch. Sliding
+    along H inside the section (whatever ``where`` says) is an error, since its
+    crossings there would be rounding noise: a terminal hit at the arrival ends
+    the run first; else use a section transverse to the sliding flow.
+    """
 
     name: str
     func: Callable[[np.ndarray], np.ndarray]
     direction: int = 0
     where: Optional[Callable[[np.ndarray], bool]] = None
     terminal: Optional[int] = None
+    min_time: float = 0.0
 
     def __post_init__(self):
         if self.direction not in (-1, 0, 1):
@@ -66,6 +81,11 @@ class Section:
                                           or self.terminal < 1):
             raise ValueError(f"Section {self.name!r}: terminal must be None or an integer "
                              f">= 1, got {self.terminal!r}")
+        m = self.min_time
+        if (isinstance(m, bool) or not isinstance(m, (int, float, np.integer, np.floating))
+                or not (np.isfinite(m) and m >= 0)):
+            raise ValueError(f"Section {self.name!r}: min_time must be a finite number >= 0, "
+                             f"got {self.min_time!r}")
 
 
 @dataclass(frozen=True)
@@ -247,9 +267,7 @@ TO_NONPOS = _Crossing(lambda v: v > 0, lambda v: v <= 0, _TINY)
 class _EitherWay:
     def __call__(self, v0, v1):
         return np.logical_or(TO_NONNEG(v0, v1), TO_NONPOS(v0, v1))
-
-    def after(self, v):  # the far side is wherever the sign flipped to; both refinements end at a root
-        return True
+    # no far side of its own: _refine takes that of the crossing at hand
 
 
 def _section_pred(direction):
@@ -262,6 +280,10 @@ def _section_pred(direction):
 
 def _refine(fun, pred, ta, tb, va, vb, xtol):
     """Root of ``fun`` in [ta, tb], returned on the far side of the crossing."""
+    if isinstance(pred, _EitherWay):
+        # the far side of this crossing: else a non-terminal hit left on the near
+        # side is found again after each restart, and the run never gets past it
+        pred = TO_NONPOS if va > 0 else TO_NONNEG
     if va == 0.0:
         r = ta
     else:
@@ -284,6 +306,74 @@ def _refine(fun, pred, ta, tb, va, vb, xtol):
         r = min(r + step, tb)
         step *= 2
     return r
+
+
+def _same_instant(xtol, t):
+    """Events closer than this are one instant to the solver: each root is located
+    to xtol + 4 eps |t| (brentq's tolerance) and then stepped to its far side."""
+    return 4.0 * (xtol + 4.0 * np.finfo(float).eps * abs(t))
+
+
+#: A section crossing in the first sample interval of a run that lies within
+#: START_ULPS rounding errors (eps times the largest component of the state) of
+#: the start point is the start itself, put a hair before the section by rounding:
+#: not a hit. Ignored rather than an error, because a start exactly on the section
+#: is no hit either (no sign change), and one rounding error must not change the
+#: return. The test is in state, not in time: the time to cross is rounding over
+#: speed, far above event_xtol for a slow field and far below it for a fast one.
+#: The crossing point is interpolated between the start and the refined root,
+#: since brentq places that up to event_xtol past the crossing, which a fast field
+#: turns into a movement far above rounding. Within one sample interval nothing
+#: the sampling resolves returns to the start, so a periodic orbit's genuine
+#: return P(z) = z is never taken for this.
+START_ULPS = 64
+
+
+def _starts_on_section(s0, z0, sr, zr) -> bool:
+    """The start ``z0`` (section value ``s0``) lies on the section up to rounding,
+    given the refined root ``zr`` (section value ``sr``)."""
+    z0, zr = np.asarray(z0, dtype=float), np.asarray(zr, dtype=float)
+    # linear interpolation to the crossing; sr is on the far side, so the fraction is <= 1
+    frac = min(1.0, abs(s0) / abs(s0 - sr)) if s0 != sr else 1.0
+    size = max(np.abs(z0).max(), np.abs(zr).max())
+    return frac * np.abs(zr - z0).max() <= START_ULPS * np.finfo(float).eps * size
+
+
+#: central-difference step (relative to the state's size) and the tolerance of
+#: _slides_in: truncation and rounding of the differences are ~1e-10 relative
+_FD_STEP = np.cbrt(np.finfo(float).eps)
+SLIDE_TANGENT = 1e-6
+
+
+def _slides_in(system: PiecewiseSystem, func, z) -> bool:
+    """True if the sliding flow at ``z`` (on H) stays in the section ``func = 0``:
+    ``z`` lies on it and the section changes along F_- or F_+ but not along the
+    Filippov field -- a section on H, whose crossings while sliding are noise."""
+    z = np.asarray(z, dtype=float)
+    fm, fp = np.asarray(system.field_minus(z), float), np.asarray(system.field_plus(z), float)
+    speed = max(np.abs(fm).max(), np.abs(fp).max())
+    if not (np.isfinite(speed) and speed > 0):
+        return False
+    d = _FD_STEP * max(1.0, np.abs(z).max()) / speed
+
+    def rate(f):
+        return (float(func(z + d * f)) - float(func(z - d * f))) / (2 * d)
+
+    scale = max(abs(rate(fm)), abs(rate(fp)))
+    fs = np.asarray(system.sliding_field(z), float)
+    return (abs(float(func(z))) <= SLIDE_TANGENT * d * scale
+            and abs(rate(fs)) <= SLIDE_TANGENT * scale)
+
+
+def _refuse_sliding_in_sections(system, sections, z, t) -> None:
+    for sec in sections:
+        if _slides_in(system, sec.func, z):
+            raise SimulationError(
+                f"the orbit slides along the switching surface from t={t!r}, state "
+                f"{z.tolist()}, inside section {sec.name!r} (the section lies on H there): "
+                "its crossings while sliding would be rounding noise. Stop at the arrival "
+                "on H (a terminal hit there ends the run first) or use a section "
+                "transverse to the sliding flow")
 
 
 # --------------------------------------------------------------------------- driver
@@ -397,6 +487,8 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
     mode, kind = initial_mode(system, z, touch_tol)
     traj.mode = mode
     traj.events.append(Event(t0, kind, z.copy(), mode, mode))
+    if mode == SLIDING:
+        _refuse_sliding_in_sections(system, sections, z, t0)
     preds = [_section_pred(s.direction) for s in sections]
     hits = [0] * len(sections)
     recent = deque(maxlen=zeno_count)
@@ -507,6 +599,8 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
             new_mode, kind = _decide(system, mode, what, ze)
             if kind == "slide_end":
                 ze = z = _onto_switch(system, ze)
+            if new_mode == SLIDING and mode != SLIDING:
+                _refuse_sliding_in_sections(system, sections, ze, te)
             traj.events.append(Event(te, kind, ze.copy(), mode, new_mode))
             n_switch += new_mode != mode
             if n_switch > max_events:
@@ -625,8 +719,20 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
         for k, (sec, pred, sv) in enumerate(zip(sections, preds, svals)):
             if pred(sv[i], sv[i + 1]):
                 r = _refine(scalar(sec.func), pred, ta, tb, sv[i], sv[i + 1], xtol)
-                if (best is None or r < best[0]) and (sec.where is None or sec.where(Z(r))):
-                    best = (r, "section", k)
+                if r < traj.t0 + sec.min_time:
+                    continue
+                # a section root at the instant of a switch (a section on H) is hit
+                # there, before the switch: the switch then follows at once on restart
+                if not (best is None or r < best[0]
+                        or (best[1] != "section" and r <= best[0] + _same_instant(xtol, best[0]))):
+                    continue
+                zr = Z(r)
+                if sec.where is not None and not sec.where(zr):
+                    continue
+                if (i == 0 and ta == traj.t0
+                        and _starts_on_section(sv[0], zs[:, 0], float(sec.func(zr)), zr)):
+                    continue
+                best = (r, "section", k)
         if best is not None:
             r, what, k = best
             return r, np.asarray(Z(r), dtype=float).reshape(-1).copy(), what, k

@@ -116,7 +116,7 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     ds["rate_core"] = ("eps", loc_c, {"long_name": "local slope of log error_core against "
                                                    "log eps", **u})
     ds["error_xi1_exit"] = ("eps", max_error(f["xi1_exit"], ds["xi1_exit_asym"].values, in_core),
-                            {"long_name": f"max over the core |xi1(p2) - eq:p:xi12|", **u})
+                            {"long_name": "max over the core |xi1(p2) - eq:p:xi12|", **u})
     k = int(np.flatnonzero(neg)[-1])  # grid point closest to 0 from below
     slope = f["P"][:, k] / xi[k]
     ds["xi1_left"] = ((), float(xi[k]), {"long_name": "grid point closest to 0 from below", **u})

@@ -1,0 +1,258 @@
+"""Sections on the switching surface, and start points on a section, on both engines.
+
+Two ways a return map could come out silently wrong:
+
+* a section on H (the same zero set as the switch function): the switch event at
+  the same root used to win, the mode restarted past the root, and the section
+  was never hit;
+* a start point on its section up to rounding: the run used to "return" at
+  t ~ 1e-17 with P(z) = z.
+"""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from filippov import MINUS, PLUS, PiecewiseSystem, Section, SimulationError, fastmap, simulate
+from filippov.models import hopf
+from filippov.poincare import first_returns
+from filippov.scenes.fig04_retmaps import section_L1
+
+# --------------------------------------------------------------------------- a planar crossing
+# Region + (x1 >= 0) turns about the origin, region - about (-C, 0); both fields
+# have x1' = -x2 on H = {x1 = 0}, so every orbit crosses H transversally. From
+# (0.5, 0) the orbit reaches H at (0, 0.5) at t = pi/2 (x1 decreasing), turns
+# 3 pi/2 about (-C, 0) to (0, -0.5) at t = 2 pi (x1 increasing), and is back at
+# (0.5, 0) after the period 5 pi/2.
+C = 0.5
+PERIOD = 2.5 * np.pi
+
+
+def _rotation(c):
+    def field(z):
+        return np.stack([-z[1], z[0] + c])
+
+    def flow(z0, tau):
+        tau = np.asarray(tau, dtype=float)
+        u, v = z0[0] + c, z0[1]
+        return np.stack([np.cos(tau) * u - np.sin(tau) * v - c, np.sin(tau) * u + np.cos(tau) * v])
+
+    return field, flow
+
+
+def two_centres():
+    fp, flow_p = _rotation(0.0)
+    fm, flow_m = _rotation(C)
+    return PiecewiseSystem(
+        names=("x1", "x2"), field_minus=fm, field_plus=fp, switch=lambda z: z[0],
+        switch_grad=lambda z: np.stack([np.ones_like(z[0]), np.zeros_like(z[1])]),
+        flows={PLUS: flow_p, MINUS: flow_m}, sample_step=0.05)
+
+
+# the same zero set as H: H itself, and a function that is not a multiple of it
+ON_H = {"H": lambda z: z[0], "2H+H^3": lambda z: 2 * z[0] + z[0] ** 3}
+
+
+@pytest.mark.parametrize("func", ON_H.values(), ids=ON_H.keys())
+@pytest.mark.parametrize("direction,t_hit,x2_hit", [(-1, np.pi / 2, 0.5), (0, np.pi / 2, 0.5),
+                                                    (+1, 2 * np.pi, -0.5)])
+def test_section_on_the_switching_surface_is_hit_at_the_crossing(func, direction, t_hit,
+                                                                  x2_hit):
+    system = two_centres()
+    sec = Section("H", func, direction=direction, terminal=1)
+    traj = simulate(system, [0.5, 0.0], 10.0, sections=[sec])
+    assert traj.status == "section:H"
+    hit = traj.events[-1]
+    assert hit.kind == "section" and hit.t == pytest.approx(t_hit, abs=1e-12)
+    np.testing.assert_allclose(hit.state, [0.0, x2_hit], rtol=0, atol=1e-12)
+    ret = first_returns(system, [[0.5, 0.0]], sec, 10.0)
+    assert ret.time[0] == pytest.approx(t_hit, abs=1e-12)
+    np.testing.assert_allclose(ret.state[0], [0.0, x2_hit], rtol=0, atol=1e-12)
+
+
+def test_section_on_the_switching_surface_logs_every_crossing_and_still_switches():
+    system = two_centres()
+    sec = Section("H", lambda z: z[0])
+    traj = simulate(system, [0.5, 0.0], 2 * PERIOD - 0.1, sections=[sec], max_steps=20_000)
+    hits = traj.section_hits("H")
+    expected = np.array([np.pi / 2, 2 * np.pi, np.pi / 2 + PERIOD, 2 * np.pi + PERIOD])
+    np.testing.assert_allclose([e.t for e in hits], expected, rtol=0, atol=1e-11)
+    switches = traj.switches()
+    assert [e.kind for e in switches] == ["crossing"] * 4
+    np.testing.assert_allclose([e.t for e in switches], expected, rtol=0, atol=1e-11)
+    # each hit is logged at its crossing, before it
+    kinds = [e.kind for e in traj.events[1:]]
+    assert kinds == ["section", "crossing"] * 4
+    # and the orbit is the same as without the section
+    plain = simulate(system, [0.5, 0.0], 2 * PERIOD - 0.1)
+    np.testing.assert_allclose(traj.z, plain.z, rtol=0, atol=1e-12)
+
+
+def test_a_two_way_section_is_left_behind_after_each_hit():
+    """direction 0, not terminal: each hit is stepped to the far side of its crossing,
+    so the restart does not find it again (the run used to stick at the first hit
+    that rounding left on the near side, until the step limit)."""
+    sec = Section("x2=0.1", lambda z: z[1] - 0.1)
+    traj = simulate(two_centres(), [0.5, 0.0], 20.0, sections=[sec], max_steps=20_000)
+    assert traj.status == "t_end"
+    t = np.array([e.t for e in traj.section_hits("x2=0.1")])
+    assert t.size == 6 and np.all(np.diff(t) > 0.1)
+    np.testing.assert_allclose([e.state[1] for e in traj.section_hits("x2=0.1")], 0.1,
+                               rtol=0, atol=1e-14)
+
+
+# --------------------------------------------------------------------------- sliding on H
+# F_+ = (-1, 1/2), F_- = (1, 1/2): all of H = {x1 = 0} is attracting sliding, with
+# the Filippov field (0, 1/2). From (0.3, 0) the orbit reaches H at t = 0.3.
+def sliding_system():
+    const = lambda v: (lambda z: np.stack([np.full_like(z[0], v[0]), np.full_like(z[1], v[1])]))
+    return PiecewiseSystem(
+        names=("x1", "x2"), field_minus=const((1.0, 0.5)), field_plus=const((-1.0, 0.5)),
+        switch=lambda z: z[0],
+        switch_grad=lambda z: np.stack([np.ones_like(z[0]), np.zeros_like(z[1])]))
+
+
+def test_section_on_H_is_hit_where_the_orbit_arrives_to_slide():
+    sec = Section("H", lambda z: z[0], direction=-1, terminal=1)
+    traj = simulate(sliding_system(), [0.3, 0.0], 5.0, sections=[sec])
+    assert traj.status == "section:H"
+    assert traj.t == pytest.approx(0.3, abs=1e-14)
+    np.testing.assert_allclose(traj.z, [0.0, 0.15], rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("z0,terminal", [([0.3, 0.0], None), ([0.3, 0.0], 2),
+                                         ([0.0, 0.0], 1)])
+def test_sliding_inside_a_section_on_H_is_refused(z0, terminal):
+    """While the orbit slides along H, a section on H has no crossings, only
+    rounding noise: continuing into sliding (or starting there) is an error."""
+    sec = Section("onH", lambda z: 2 * z[0] + z[0] ** 3, terminal=terminal)
+    with pytest.raises(SimulationError, match=r"slides.*section 'onH'"):
+        simulate(sliding_system(), z0, 5.0, sections=[sec])
+
+
+def test_a_section_transverse_to_the_sliding_flow_is_still_hit():
+    sec = Section("x2=1", lambda z: z[1] - 1.0, direction=1, terminal=1)
+    traj = simulate(sliding_system(), [0.3, 0.0], 5.0, sections=[sec])
+    assert traj.status == "section:x2=1" and traj.mode == 0
+    assert traj.t == pytest.approx(2.0, abs=1e-12)
+
+
+# --------------------------------------------------------------------------- start on a section
+SEC_X2 = Section("x2=0", lambda z: z[1], direction=1, where=lambda z: z[0] > 0, terminal=1)
+
+
+@pytest.mark.parametrize("x2", [0.0, -5e-324, -0.5 * np.cos(np.pi / 2), -1e-16])
+def test_start_on_the_section_up_to_rounding_is_not_a_return(x2):
+    """(0.5, x2) with x2 one rounding error below the section: the first return is a
+    full period later, as from the point exactly on it -- not P(z) = z at t ~ 1e-17."""
+    ret = first_returns(two_centres(), [[0.5, x2]], SEC_X2, 10.0)
+    assert ret.time[0] == pytest.approx(PERIOD, abs=1e-11)
+    np.testing.assert_allclose(ret.state[0], [0.5, 0.0], rtol=0, atol=1e-11)
+
+
+def test_start_on_a_section_on_H_up_to_rounding():
+    """Both fixes at once: the start is a rounding error past H = x1 = 0, on the
+    section; the crossing at once is no return, the next arrival is."""
+    sec = Section("H", lambda z: z[0], direction=-1, terminal=1)
+    # |x1| <= touch_tol starts in region - (both fields point there); 5e-15 in +,
+    # where it switches at once
+    for x1, n_switches in ((5e-15, 2), (1e-17, 1), (0.0, 1), (-1e-17, 1)):
+        ret = first_returns(two_centres(), [[x1, 0.5]], sec, 10.0)
+        assert ret.time[0] == pytest.approx(PERIOD, abs=1e-11)
+        np.testing.assert_allclose(ret.state[0], [0.0, 0.5], rtol=0, atol=1e-11)
+        assert ret.n_switches[0] == n_switches
+
+
+def test_start_genuinely_before_the_section_still_hits_at_once():
+    ret = first_returns(two_centres(), [[0.5, -1e-9]], SEC_X2, 10.0)
+    assert ret.time[0] == pytest.approx(2e-9, rel=1e-6)
+    np.testing.assert_allclose(ret.state[0], [0.5, 0.0], rtol=0, atol=1e-15)
+
+
+def test_min_time_ignores_early_hits():
+    sec = dataclasses.replace(SEC_X2, min_time=1.0, terminal=None)
+    ret = first_returns(two_centres(), [[0.5, -1e-9]], sec, 10.0)
+    assert ret.time[0] == pytest.approx(PERIOD, abs=1e-8)
+    # the option survives first_returns' rebuilding of the section, and is checked
+    for bad in (-1.0, np.nan, np.inf):
+        with pytest.raises(ValueError, match="min_time"):
+            Section("s", lambda z: z[0], min_time=bad)
+
+
+# --------------------------------------------------------------------------- compiled engine
+EPS, MU, OMEGA = 0.01, 1.0, 8 * np.pi
+OPTS = {"rtol": 1e-12, "atol": 1e-14}
+T_MAX = 4.0 * 2 * np.pi / OMEGA
+
+
+@pytest.mark.parametrize("x1", [5e-324, 1e-17, 0.5 * np.cos(np.pi / 2)])
+def test_compiled_start_on_the_section_up_to_rounding_is_not_a_return(x1):
+    """L1 is x1 = 0 with x1 decreasing: a start at x1 = +rounding used to "return"
+    at once; now it returns as the start exactly on L1 does, on both engines."""
+    cm = hopf.compiled(EPS, -0.5, MU, OMEGA)
+    z0 = [[x1, 1.02, 0.0]]
+    exact = fastmap.compute_returns(cm, [[0.0, 1.02, 0.0]], T_MAX, **OPTS)
+    out = fastmap.compute_returns(cm, z0, T_MAX, **OPTS)
+    assert out.status[0] == fastmap.OK
+    assert out.time[0] == pytest.approx(exact.time[0], abs=1e-13)
+    np.testing.assert_allclose(out.state, exact.state, rtol=0, atol=1e-13)
+    ref = first_returns(hopf.model(EPS, -0.5, MU, OMEGA).full(), z0, section_L1(), T_MAX,
+                        **OPTS)
+    np.testing.assert_allclose(ref.state, exact.state, rtol=0, atol=1e-11)
+
+
+def test_compiled_min_time():
+    cm = hopf.compiled(EPS, -0.5, MU, OMEGA)
+    z0 = [[1e-9, 1.02, 1e-9]]  # genuinely before L1: the hit at once is a return
+    at_once = fastmap.compute_returns(cm, z0, T_MAX, **OPTS)
+    assert at_once.status[0] == fastmap.OK and 0 < at_once.time[0] < 1e-10
+    later = fastmap.compute_returns(cm, z0, T_MAX, min_time=0.1, **OPTS)
+    full = fastmap.compute_returns(cm, [[0.0, 1.02, 0.0]], T_MAX, **OPTS)
+    assert later.status[0] == fastmap.OK
+    assert later.time[0] == pytest.approx(full.time[0], abs=1e-8)
+    with pytest.raises(ValueError, match="min_time"):
+        fastmap.compute_returns(cm, z0, T_MAX, min_time=-1.0)
+
+
+def _on_h(theta, direction):
+    """The compiled Hopf model with its section moved onto the switching surface."""
+    cm = hopf.compiled(EPS, theta, MU, OMEGA)
+    return dataclasses.replace(cm, section=cm.h, section_direction=direction)
+
+
+X2 = np.array([1.005, 1.01, 1.0125, 1.0175, 1.02])
+
+
+@pytest.mark.parametrize("theta,direction,n_switches", [(-0.5, -1, 0), (0.5, +1, 1)])
+def test_compiled_section_on_the_switching_surface(theta, direction, n_switches):
+    """From L1 the orbit first crosses H into region - (h decreasing); for theta > 0
+    it comes back to slide (h increasing). The first arrival at H in the section's
+    direction is the return, on both engines."""
+    z0 = np.stack([0 * X2, X2, 0 * X2], axis=1)
+    out = fastmap.first_returns_compiled(_on_h(theta, direction), z0, T_MAX, **OPTS)
+    system = hopf.model(EPS, theta, MU, OMEGA).full()
+    sec = Section("H", system.switch, direction=direction, where=lambda z: z[1] > 0,
+                  terminal=1)
+    ref = first_returns(system, z0, sec, T_MAX, **OPTS)
+    assert np.all(out.n_switches == n_switches) and np.all(ref.n_switches == n_switches)
+    assert np.all(np.abs(system.switch(out.state.T)) < 1e-13)
+    assert np.all(out.time < 2 * np.pi / OMEGA)
+    np.testing.assert_allclose(out.state, ref.state, rtol=0, atol=1e-11)
+    np.testing.assert_allclose(out.time, ref.time, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("direction", [-1, 0, 1])
+def test_compiled_start_sliding_inside_a_section_on_H_is_a_status(direction):
+    system = hopf.model(EPS, 0.5, MU, OMEGA).full()
+    events = simulate(system, [0.0, 1.02, 0.0], T_MAX, dense=False).events
+    z0 = [next(e.state for e in events if e.kind == "slide_start")]  # on H, sliding
+    out = fastmap.compute_returns(_on_h(0.5, direction), z0, T_MAX, **OPTS)
+    assert out.status[0] == fastmap.SECTION_SLIDING
+    with pytest.raises(SimulationError, match="slides"):
+        fastmap.first_returns_compiled(_on_h(0.5, direction), z0, T_MAX, **OPTS)
+    sec = Section("H", system.switch, direction=direction, terminal=1)
+    with pytest.raises(SimulationError, match="slides"):
+        first_returns(system, z0, sec, T_MAX, **OPTS)
+    # a section across the sliding stretch is still fine from there
+    assert fastmap.compute_returns(hopf.compiled(EPS, 0.5, MU, OMEGA), z0, T_MAX,
+                                   **OPTS).status[0] == fastmap.OK
