@@ -8,7 +8,7 @@ built without it (said in the system's words; the scene layer adds its own).
 import numpy as np
 import pytest
 
-from filippov import MINUS, PLUS, SLIDING, PiecewiseSystem, SimulationError, simulate
+from filippov import MINUS, PLUS, PiecewiseSystem, SimulationError, simulate
 from filippov.models import planar_sketch, pseudo_equilibrium
 
 ONES = lambda z: np.ones_like(z[0])
