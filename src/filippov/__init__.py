@@ -17,10 +17,12 @@ from .simulate import simulate, Section, SimulationError, ZenoError, EventLimitE
 from .checks import SystemContractError
 from .poincare import first_returns, fixed_points
 from .continuation import monodromy, floquet_multipliers, ContinuationError
+from .variational import transition_matrix, return_jacobian, VariationalError
 
 __all__ = [
     "PiecewiseSystem", "SlowFastModel", "simulate", "Section",
     "SimulationError", "ZenoError", "EventLimitError", "SystemContractError",
     "first_returns", "fixed_points", "monodromy", "floquet_multipliers", "ContinuationError",
+    "transition_matrix", "return_jacobian", "VariationalError",
     "MINUS", "PLUS", "SLIDING", "__version__",
 ]

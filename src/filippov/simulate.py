@@ -597,8 +597,6 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
                     return stop(f"section:{sec.name}")
                 continue
             new_mode, kind = _decide(system, mode, what, ze)
-            if kind == "slide_end":
-                ze = z = _onto_switch(system, ze)
             if new_mode == SLIDING and mode != SLIDING:
                 _refuse_sliding_in_sections(system, sections, ze, te)
             traj.events.append(Event(te, kind, ze.copy(), mode, new_mode))
@@ -629,20 +627,6 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
 
 _NO_SLIDING = ("but the system was built with sliding=False; build it with sliding=True "
                "to follow sliding")
-
-
-def _onto_switch(system, z):
-    """``z`` moved onto H = 0 along grad H (one Newton step; kept only if it brings
-    H closer to 0). The integrated sliding flow drifts off H by its local errors;
-    at small eps, where H's fast component amplifies a drift of 1e-14 into an O(1)
-    normal speed, a slide that ends that far off H is re-entered at once and
-    chatters at the exit (a Zeno error at eps = 1e-8 before this)."""
-    h = float(system.switch(z))
-    if h == 0.0:
-        return z
-    g = np.asarray(system.switch_grad(z), dtype=float)
-    moved = z - h * g / float(g @ g)
-    return moved if abs(float(system.switch(moved))) < abs(h) else z
 
 
 def _decide(system, mode, what, z):

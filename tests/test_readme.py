@@ -1,0 +1,34 @@
+"""The README's user example runs as written and computes what it says."""
+import contextlib
+import io
+import re
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_the_readme_user_example_runs_and_finds_the_relay_orbit():
+    text = (ROOT / "README.md").read_text()
+    section = text[text.index("## Your own system"):text.index("## Examples")]
+    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    assert len(code.strip().splitlines()) <= 30
+    out = io.StringIO()
+    scope = {}
+    with contextlib.redirect_stdout(out):
+        exec(compile(code, "README.md", "exec"), scope)
+    # the closed form of examples/relay_feedback.py: period and multipliers
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("relay", ROOT / "examples" / "relay_feedback.py")
+    relay = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(relay)
+    want = relay.closed_form()
+    assert abs(scope["orbit"].t - want["period"]) < 1e-10
+    got = np.sort(np.abs(np.linalg.eigvals(
+        scope["return_jacobian"](scope["relay"], scope["orbit"], scope["up"],
+                                 jacobian=lambda mode, z: relay.A))))[::-1]
+    # dP/dz has the nontrivial multipliers and a 0 (the section direction)
+    np.testing.assert_allclose(got[:2], want["multipliers"][1:], rtol=1e-6)
+    assert "Floquet multipliers" in out.getvalue()
