@@ -246,3 +246,18 @@ def test_bad_input_is_rejected():
         fastmap.compute_returns(cm, [[0.0, np.nan, 0.0]], T_MAX)
     with pytest.raises(ValueError, match="shape"):
         fastmap.compute_returns(cm, [[0.0, 1.0]], T_MAX)
+
+
+def test_the_vendored_dop853_tableau_is_scipys_bit_for_bit():
+    # the compiled kernel's DOP853 uses filippov.dop853_tableau (numbers transcribed,
+    # source cited); scipy's solve_ivp(method="DOP853") is the reference driver's
+    from scipy.integrate._ivp import dop853_coefficients as scipy_table
+
+    from filippov import dop853_tableau as ours
+
+    for name in ("A", "B", "C", "D", "E3", "E5"):
+        want = np.asarray(getattr(scipy_table, name), dtype=float)
+        got = getattr(ours, name)
+        assert got.shape == want.shape and np.array_equal(got, want), name
+    for name in ("N_STAGES", "N_STAGES_EXTENDED", "INTERPOLATOR_POWER"):
+        assert getattr(ours, name) == getattr(scipy_table, name), name

@@ -52,8 +52,8 @@ from typing import Any, Mapping
 import numpy as np
 from numba import njit, types
 from numba.core.errors import NumbaExperimentalFeatureWarning
-from scipy.integrate._ivp import dop853_coefficients as _dop
 
+from . import dop853_tableau as _dop
 from .poincare import Returns
 from .progress import Progress
 from .simulate import (EXACT_BLOCK, SLIDE_TANGENT, START_ULPS, EventLimitError,
