@@ -32,3 +32,17 @@ def test_the_readme_user_example_runs_and_finds_the_relay_orbit():
     # dP/dz has the nontrivial multipliers and a 0 (the section direction)
     np.testing.assert_allclose(got[:2], want["multipliers"][1:], rtol=1e-6)
     assert "Floquet multipliers" in out.getvalue()
+
+
+def test_the_readme_compiled_engine_block_runs():
+    text = (ROOT / "README.md").read_text()
+    section = text[text.index("## Your own system"):text.index("## Examples")]
+    blocks = re.findall(r"```python\n(.*?)```", section, re.S)
+    assert len(blocks) == 2
+    scope = {}
+    with contextlib.redirect_stdout(io.StringIO()):
+        for code in blocks:                       # the second uses the first's imports
+            exec(compile(code, "README.md", "exec"), scope)
+    ret = scope["returns"]
+    assert ret.state.shape == (2, 3) and np.all(ret.time > 0)
+    np.testing.assert_allclose(ret.state[:, 0], 0.0, atol=1e-14)   # on the section x1 = 0

@@ -19,10 +19,25 @@ from .poincare import first_returns, fixed_points
 from .continuation import monodromy, floquet_multipliers, ContinuationError
 from .variational import transition_matrix, return_jacobian, VariationalError
 
+# the compiled engine (numba) is imported on first use, not by `import filippov`
+_COMPILED = {"compile_system": "compiled_system", "with_section": "compiled_system",
+             "CompiledModel": "fastmap", "compute_returns": "fastmap",
+             "first_returns_compiled": "fastmap"}
+
+
+def __getattr__(name):
+    if name in _COMPILED:
+        import importlib
+
+        return getattr(importlib.import_module(f".{_COMPILED[name]}", __name__), name)
+    raise AttributeError(f"module 'filippov' has no attribute {name!r}")
+
+
 __all__ = [
     "PiecewiseSystem", "SlowFastModel", "simulate", "Section",
     "SimulationError", "ZenoError", "EventLimitError", "SystemContractError",
     "first_returns", "fixed_points", "monodromy", "floquet_multipliers", "ContinuationError",
     "transition_matrix", "return_jacobian", "VariationalError",
-    "MINUS", "PLUS", "SLIDING", "__version__",
+    "compile_system", "with_section", "CompiledModel", "compute_returns",
+    "first_returns_compiled", "MINUS", "PLUS", "SLIDING", "__version__",
 ]

@@ -1,0 +1,204 @@
+"""A user's Filippov system on the compiled engine, from plain scalar functions.
+
+The compiled kernel (:mod:`filippov.fastmap`) calls its pieces through numba
+first-class functions with out-parameters (``field(z, p, out)``). A researcher
+should not have to write that ABI: :func:`compile_system` takes functions of one
+state ``z`` (a 1-D float array) and the parameter array ``p`` that *return* their
+values, compiles each with numba and wraps it in the kernel's signature. The
+section is the caller's, not the model's: :func:`with_section` puts another one on
+the same compiled system.
+"""
+from __future__ import annotations
+
+import dataclasses
+import warnings
+from typing import Callable, Optional
+
+import numpy as np
+from numba import njit
+from numba.core.errors import NumbaError
+
+from .fastmap import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, no_flow
+
+_DOC_PIECE = ("write it for one state z (1-D float array) and the parameter array p, "
+              "with numpy and math only (no Python objects, no closures over lists)")
+
+
+def _jit(fn: Callable, piece: str):
+    if not callable(fn):
+        raise TypeError(f"{piece}: expected a function, got {type(fn).__name__}")
+    return fn if hasattr(fn, "py_func") else njit(fn)
+
+
+def _compile(adapter_src: Callable, sig, piece: str):
+    """``adapter_src`` compiled with ``sig``; a numba failure becomes one readable line."""
+    try:
+        with warnings.catch_warnings():  # numba's casts of a broken piece: the error says it
+            warnings.simplefilter("ignore")
+            return njit(sig)(adapter_src)
+    except NumbaError as exc:
+        lines = [ln.strip() for ln in str(exc).splitlines() if ln.strip()]
+        # numba's first line names the compiler stage; the next one names the problem
+        detail = next((ln for ln in lines if not ln.startswith(("Failed in", "During:"))),
+                      lines[0] if lines else type(exc).__name__)
+        raise ValueError(f"{piece}: numba cannot compile it ({detail}); {_DOC_PIECE}") from None
+
+
+def _vector_piece(fn, piece: str, n: int):
+    user = _jit(fn, piece)
+
+    def adapter(z, p, out):
+        v = user(z, p)
+        if len(v) != n:
+            raise ValueError("a vector piece returned the wrong number of values")
+        for i in range(n):
+            out[i] = v[i]
+
+    return _compile(adapter, FIELD_SIG, piece)
+
+
+def _flow_piece(fn, piece: str, n: int):
+    user = _jit(fn, piece)
+
+    def adapter(z0, tau, p, out):
+        v = user(z0, tau, p)
+        if len(v) != n:
+            raise ValueError("a flow returned the wrong number of values")
+        for i in range(n):
+            out[i] = v[i]
+
+    return _compile(adapter, FLOW_SIG, piece)
+
+
+def _scalar_piece(fn, piece: str):
+    user = _jit(fn, piece)
+
+    def adapter(z, p):
+        return float(user(z, p))
+
+    return _compile(adapter, SCALAR_SIG, piece)
+
+
+def _where_piece(fn, piece: str):
+    if fn is None:
+        def always(z, p):
+            return True
+        return njit(WHERE_SIG)(always)
+    user = _jit(fn, piece)
+
+    def adapter(z, p):
+        return bool(user(z, p))
+
+    return _compile(adapter, WHERE_SIG, piece)
+
+
+def _check_shapes(cm: CompiledModel, probe: np.ndarray) -> None:
+    """Run every piece once at ``probe``: wrong output sizes and non-finite values
+    are named here, not deep in the kernel."""
+    n, p = cm.dim, cm.params
+    for piece in ("field_minus", "field_plus", "grad_h"):
+        out = np.full(n, np.nan)
+        try:
+            getattr(cm, piece)(probe, p, out)
+        except Exception as exc:  # the wrong number of values, ...
+            raise ValueError(f"{_USER_NAME[piece]} failed at z={probe.tolist()}: {exc} "
+                             f"(expected {n} values, one per component of "
+                             f"{', '.join(cm.names)})") from None
+        if not np.all(np.isfinite(out)):
+            raise ValueError(f"{_USER_NAME[piece]} must return {n} finite values at "
+                             f"z={probe.tolist()}, got {out.tolist()}")
+    for piece in ("h", "section"):
+        v = getattr(cm, piece)(probe, p)
+        if not np.isfinite(v):
+            raise ValueError(f"{_USER_NAME[piece]} returned {v!r} at z={probe.tolist()}")
+
+
+_USER_NAME = {"field_minus": "field_minus", "field_plus": "field_plus", "grad_h": "switch_grad",
+              "h": "switch", "section": "section"}
+
+
+def compile_system(names, field_minus, field_plus, switch, switch_grad, *, section,
+                   section_direction: int = 0, section_where: Optional[Callable] = None,
+                   params=(), flow_minus: Optional[Callable] = None,
+                   flow_plus: Optional[Callable] = None, sample_step: float = np.inf,
+                   sliding: bool = True, name: str = "user", probe=None) -> CompiledModel:
+    """A piecewise system (region + is ``switch(z, p) >= 0``) for the compiled engine.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The state components; their number n is the dimension.
+    field_minus, field_plus : callable
+        ``f(z, p) -> array (n,)``: the fields of the regions ``switch < 0`` and ``>= 0``.
+    switch : callable
+        ``h(z, p) -> float``, the switching function.
+    switch_grad : callable
+        ``grad_h(z, p) -> array (n,)``.
+    section : callable
+        ``s(z, p) -> float``: returns are hits of ``s = 0``.
+    section_direction : int
+        -1 decreasing crossings of ``s`` only, +1 increasing, 0 both.
+    section_where : callable, optional
+        ``w(z, p) -> bool`` that must hold at a hit (default: always).
+    params : sequence of float
+        The array ``p`` every piece receives.
+    flow_minus, flow_plus : callable, optional
+        Exact flows ``phi(z0, tau, p) -> array (n,)`` of the two regions (both or
+        neither); without them both regions are integrated with DOP853 inside the
+        kernel, like sliding.
+    sample_step : float
+        With exact flows: the longest time between samples (it must resolve the
+        fastest time scale of the flows).
+    sliding : bool
+        Follow attracting sliding (Filippov's convex combination) where it occurs.
+    probe : array (n,), optional
+        A state at which every piece is run once to check its output (default: 0.5).
+
+    Returns
+    -------
+    CompiledModel
+        For :func:`filippov.fastmap.compute_returns` / ``first_returns_compiled``.
+
+    Each piece is a plain function of one state, compiled with numba (``njit``); it
+    must use numpy and math only. The first call compiles the pieces (a second or
+    two each) and, once per machine, the kernel (about 16 s on 2 cores, cached).
+    """
+    names = tuple(str(x) for x in names)
+    n = len(names)
+    if n < 1:
+        raise ValueError("names: at least one state component")
+    if section_direction not in (-1, 0, 1):
+        raise ValueError(f"section_direction must be -1, 0 or +1, got {section_direction!r}")
+    if (flow_minus is None) != (flow_plus is None):
+        raise ValueError("flow_minus and flow_plus: give both exact flows or neither")
+    exact = flow_plus is not None
+    if exact and not (np.isfinite(sample_step) and sample_step > 0):
+        raise ValueError(f"sample_step: exact flows need a finite sample_step > 0 (the "
+                         f"longest time between samples), got {sample_step!r}")
+    p = np.ascontiguousarray(np.asarray(params, dtype=float).reshape(-1))
+    cm = CompiledModel(
+        name=name, names=names, params=p,
+        flow_plus=_flow_piece(flow_plus, "flow_plus", n) if exact else no_flow,
+        flow_minus=_flow_piece(flow_minus, "flow_minus", n) if exact else no_flow,
+        field_plus=_vector_piece(field_plus, "field_plus", n),
+        field_minus=_vector_piece(field_minus, "field_minus", n),
+        h=_scalar_piece(switch, "switch"), grad_h=_vector_piece(switch_grad, "switch_grad", n),
+        section=_scalar_piece(section, "section"),
+        section_where=_where_piece(section_where, "section_where"),
+        section_direction=int(section_direction), sample_step=float(sample_step),
+        sliding=bool(sliding), exact=exact, parameters={})
+    probe = np.full(n, 0.5) if probe is None else np.ascontiguousarray(probe, dtype=float)
+    if probe.shape != (n,):
+        raise ValueError(f"probe: expected shape ({n},), got {probe.shape}")
+    _check_shapes(cm, probe)
+    return cm
+
+
+def with_section(cm: CompiledModel, section: Callable, *, direction: int = 0,
+                 where: Optional[Callable] = None) -> CompiledModel:
+    """The same compiled system with another section (``section(z, p) -> float``)."""
+    if direction not in (-1, 0, 1):
+        raise ValueError(f"direction must be -1, 0 or +1, got {direction!r}")
+    return dataclasses.replace(cm, section=_scalar_piece(section, "section"),
+                               section_where=_where_piece(where, "section_where"),
+                               section_direction=int(direction))

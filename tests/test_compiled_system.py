@@ -1,0 +1,101 @@
+"""A user's system on the compiled engine from plain scalar functions
+(filippov.compiled_system): same answers as the Python driver, errors that name
+the piece."""
+import numpy as np
+import pytest
+
+from filippov import PiecewiseSystem, Section, first_returns, fastmap
+from filippov.compiled_system import compile_system, with_section
+
+A = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, -3.0, -3.0]])   # lag 1/(s+1)^3
+B, C = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+STARTS = np.array([[0.0, 0.1, 0.0], [0.0, 0.29, 0.14], [0.0, 0.5, -0.2]])
+
+
+def _relay_python():
+    col = lambda v, z: v.reshape((-1,) + (1,) * (np.ndim(z) - 1))
+    return PiecewiseSystem(("x1", "x2", "x3"), lambda z: A @ z + col(B, z),
+                           lambda z: A @ z - col(B, z), lambda z: C @ z,
+                           lambda z: np.broadcast_to(col(C, z), np.shape(z)).copy())
+
+
+def _relay_compiled(**kw):
+    return compile_system(
+        ("x1", "x2", "x3"),
+        field_minus=lambda z, p: np.array([z[1], z[2], -z[0] - 3 * z[1] - 3 * z[2] + p[0]]),
+        field_plus=lambda z, p: np.array([z[1], z[2], -z[0] - 3 * z[1] - 3 * z[2] - p[0]]),
+        switch=lambda z, p: z[0], switch_grad=lambda z, p: np.array([1.0, 0.0, 0.0]),
+        params=[1.0], **kw)
+
+
+def test_a_users_relay_system_returns_as_on_the_python_driver():
+    # a section on the switching surface itself, crossed upwards: both engines run the
+    # same DOP853 and event rules; they agree to the last few bits
+    cm = _relay_compiled(section=lambda z, p: z[0], section_direction=1)
+    fast = fastmap.first_returns_compiled(cm, STARTS, 20.0)
+    up = Section("up", lambda z: C @ z, direction=1)
+    ref = first_returns(_relay_python(), STARTS, up, 20.0, method="integrate")
+    np.testing.assert_allclose(fast.state, ref.state, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(fast.time, ref.time, rtol=0, atol=1e-13)
+    np.testing.assert_array_equal(fast.n_switches, ref.n_switches)
+
+
+def test_another_section_on_the_same_compiled_system():
+    cm = with_section(_relay_compiled(section=lambda z, p: z[0]),
+                      lambda z, p: z[1], direction=-1, where=lambda z, p: z[0] > 0)
+    fast = fastmap.first_returns_compiled(cm, STARTS, 20.0)
+    sec = Section("x2down", lambda z: np.asarray(z)[1], direction=-1,
+                  where=lambda z: np.asarray(z)[0] > 0)
+    ref = first_returns(_relay_python(), STARTS, sec, 20.0, method="integrate")
+    np.testing.assert_allclose(fast.state, ref.state, rtol=0, atol=1e-14)
+
+
+def test_exact_flows_and_sliding_of_a_users_system():
+    # examples/sliding_segment.py's system: F_+ = (2, -1), F_- = (1, 1 - x), H = y;
+    # slides on y = 0 from x = -1 to the fold x = 1; returns to x = 3
+    cm = compile_system(
+        ("x", "y"), field_minus=lambda z, p: np.array([1.0, 1.0 - z[0]]),
+        field_plus=lambda z, p: np.array([2.0, -1.0]), switch=lambda z, p: z[1],
+        switch_grad=lambda z, p: np.array([0.0, 1.0]),
+        flow_plus=lambda z0, s, p: np.array([z0[0] + 2.0 * s, z0[1] - s]),
+        flow_minus=lambda z0, s, p: np.array([z0[0] + s, z0[1] + (1.0 - z0[0]) * s - s * s / 2]),
+        sample_step=0.05, section=lambda z, p: z[0] - 3.0, section_direction=1)
+    start = np.array([[-2.0, 0.5]])
+    out = fastmap.compute_returns(cm, start, 10.0)
+    assert out.status[0] == fastmap.OK and out.sliding_time[0] > 0
+    ref = first_returns(_python_sliding(), start, Section("x3", lambda z: np.asarray(z)[0] - 3.0,
+                                                          direction=1), 10.0)
+    np.testing.assert_allclose(out.state, ref.state, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(out.sliding_time, ref.sliding_time, rtol=0, atol=1e-12)
+
+
+def _python_sliding():
+    from filippov import MINUS, PLUS
+
+    return PiecewiseSystem(
+        names=("x", "y"),
+        field_minus=lambda z: np.stack([np.ones_like(z[0]), 1.0 - z[0]]),
+        field_plus=lambda z: np.stack([np.full_like(z[0], 2.0), np.full_like(z[0], -1.0)]),
+        switch=lambda z: z[1],
+        switch_grad=lambda z: np.stack([np.zeros_like(z[1]), np.ones_like(z[1])]),
+        flows={PLUS: lambda z0, s: np.stack([z0[0] + 2.0 * s, z0[1] - s]),
+               MINUS: lambda z0, s: np.stack([z0[0] + s, z0[1] + (1.0 - z0[0]) * s - s * s / 2])},
+        sample_step=0.05)
+
+
+@pytest.mark.parametrize("kw,match", [
+    (dict(field_minus=lambda z, p: np.array([1.0])), r"field_minus failed .*expected 2 values"),
+    (dict(field_plus=lambda z, p: {"a": 1.0}), r"field_plus: numba cannot compile it"),
+    (dict(switch_grad=lambda z, p: np.array([np.nan, 1.0])), r"switch_grad must return 2 finite"),
+    (dict(flow_plus=lambda z0, s, p: z0), r"give both exact flows or neither"),
+    (dict(flow_plus=lambda z0, s, p: z0, flow_minus=lambda z0, s, p: z0),
+     r"sample_step: exact flows need a finite sample_step"),
+    (dict(section_direction=2), r"section_direction must be -1, 0 or \+1"),
+])
+def test_a_broken_piece_is_named(kw, match):
+    args = dict(field_minus=lambda z, p: np.array([1.0, -z[0]]),
+                field_plus=lambda z, p: np.array([-1.0, -z[0]]), switch=lambda z, p: z[0],
+                switch_grad=lambda z, p: np.array([1.0, 0.0]), section=lambda z, p: z[1])
+    args.update(kw)
+    with pytest.raises(ValueError, match=match):
+        compile_system(("x", "y"), **args)
