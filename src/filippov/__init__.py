@@ -21,6 +21,7 @@ from .variational import transition_matrix, return_jacobian, VariationalError
 
 # the compiled engine (numba) is imported on first use, not by `import filippov`
 _COMPILED = {"compile_system": "compiled_system", "with_section": "compiled_system",
+             "FilippovSystem": "compiled_system",
              "CompiledModel": "fastmap", "compute_returns": "fastmap",
              "first_returns_compiled": "fastmap"}
 
@@ -38,6 +39,6 @@ __all__ = [
     "SimulationError", "ZenoError", "EventLimitError", "SystemContractError",
     "first_returns", "fixed_points", "monodromy", "floquet_multipliers", "ContinuationError",
     "transition_matrix", "return_jacobian", "VariationalError",
-    "compile_system", "with_section", "CompiledModel", "compute_returns",
+    "FilippovSystem", "compile_system", "with_section", "CompiledModel", "compute_returns",
     "first_returns_compiled", "MINUS", "PLUS", "SLIDING", "__version__",
 ]

@@ -202,3 +202,125 @@ def with_section(cm: CompiledModel, section: Callable, *, direction: int = 0,
     return dataclasses.replace(cm, section=_scalar_piece(section, "section"),
                                section_where=_where_piece(where, "section_where"),
                                section_direction=int(direction))
+
+
+# ----------------------------------------------------------------------------- one definition
+def _batch_vector(user, n: int):
+    """A vector piece f(z, p) -> (n,) evaluated on (n,) or (n, m) states, compiled."""
+    @njit
+    def batch(zs, p):
+        m = zs.shape[1]
+        out = np.empty((n, m))
+        z = np.empty(n)
+        for j in range(m):
+            for i in range(n):
+                z[i] = zs[i, j]
+            v = user(z, p)
+            for i in range(n):
+                out[i, j] = v[i]
+        return out
+    return batch
+
+
+def _batch_scalar(user, n: int):
+    @njit
+    def batch(zs, p):
+        m = zs.shape[1]
+        out = np.empty(m)
+        z = np.empty(n)
+        for j in range(m):
+            for i in range(n):
+                z[i] = zs[i, j]
+            out[j] = user(z, p)
+        return out
+    return batch
+
+
+def _batch_flow(user, n: int):
+    @njit
+    def batch(z0, taus, p):
+        out = np.empty((n, taus.size))
+        for j in range(taus.size):
+            v = user(z0, taus[j], p)
+            for i in range(n):
+                out[i, j] = v[i]
+        return out
+    return batch
+
+
+def _states(z, n):
+    z = np.asarray(z, dtype=float)
+    return np.ascontiguousarray(z.reshape(n, -1)), z.shape[1:]
+
+
+class FilippovSystem:
+    """One definition of a Filippov system, run by both engines.
+
+    Written once as plain scalar functions of one state ``z`` (1-D float array)
+    and the parameter array ``p`` (see :func:`compile_system` for the pieces);
+    :meth:`python` gives the :class:`~filippov.system.PiecewiseSystem` the
+    reference driver (:func:`filippov.simulate`) runs, its pieces evaluated by
+    numba-compiled loops over the samples; :meth:`compiled` gives the compiled
+    engine's :class:`~filippov.fastmap.CompiledModel` with a section of the
+    caller's choosing. Sections belong to the caller, not to the system.
+    """
+
+    def __init__(self, names, field_minus, field_plus, switch, switch_grad, *, params=(),
+                 flow_minus=None, flow_plus=None, sample_step: float = np.inf,
+                 sliding: bool = True, name: str = "user"):
+        self.names = tuple(str(x) for x in names)
+        self.params = np.ascontiguousarray(np.asarray(params, dtype=float).reshape(-1))
+        self.name, self.sliding, self.sample_step = name, bool(sliding), float(sample_step)
+        self._pieces = dict(field_minus=field_minus, field_plus=field_plus, switch=switch,
+                            switch_grad=switch_grad, flow_minus=flow_minus, flow_plus=flow_plus)
+        self._python = None
+
+    def compiled(self, section, *, direction: int = 0, where=None, probe=None) -> CompiledModel:
+        """The compiled engine's model with the section ``section(z, p) = 0``."""
+        return compile_system(self.names, section=section, section_direction=direction,
+                              section_where=where, params=self.params,
+                              sample_step=self.sample_step, sliding=self.sliding,
+                              name=self.name, probe=probe, **self._pieces)
+
+    def python(self):
+        """The reference driver's PiecewiseSystem (built once, then reused)."""
+        if self._python is None:
+            self._python = self._build_python()
+        return self._python
+
+    def _build_python(self):
+        from .system import MINUS, PLUS, PiecewiseSystem
+
+        n, p = len(self.names), self.params
+        pc = self._pieces
+        fm = _batch_vector(_jit(pc["field_minus"], "field_minus"), n)
+        fp = _batch_vector(_jit(pc["field_plus"], "field_plus"), n)
+        gr = _batch_vector(_jit(pc["switch_grad"], "switch_grad"), n)
+        sw = _batch_scalar(_jit(pc["switch"], "switch"), n)
+
+        def vector(batch):
+            def piece(z):
+                zs, tail = _states(z, n)
+                return batch(zs, p).reshape((n,) + tail)
+            return piece
+
+        def scalar(z):
+            zs, tail = _states(z, n)
+            out = sw(zs, p)
+            return out.reshape(tail) if tail else float(out[0])
+
+        flows = {}
+        if pc["flow_plus"] is not None and pc["flow_minus"] is not None:
+            for mode, key in ((PLUS, "flow_plus"), (MINUS, "flow_minus")):
+                batch = _batch_flow(_jit(pc[key], key), n)
+
+                def flow(z0, tau, batch=batch):
+                    tau = np.asarray(tau, dtype=float)
+                    out = batch(np.ascontiguousarray(z0, dtype=float),
+                                np.ascontiguousarray(tau.reshape(-1)), p)
+                    return out.reshape((n,) + tau.shape)
+                flows[mode] = flow
+        return PiecewiseSystem(names=self.names, field_minus=vector(fm), field_plus=vector(fp),
+                               switch=scalar, switch_grad=vector(gr), flows=flows,
+                               sliding=self.sliding, sample_step=self.sample_step,
+                               description=f"{self.name} (one definition, compiled pieces)")
