@@ -5,26 +5,27 @@ Plotting reads results only (never calls the solver), one module per figure.
 from __future__ import annotations
 
 import importlib
+import pkgutil
+import re
 
 from ..io import atomic_output
 from . import style
 
-# scene id -> module in this package whose draw(ds) makes the figure
-DRAW = {
-    "fig01_slidesketch": "fig01_slidesketch",
-    "fig02_cases": "fig02_cases",
-    "fig03_grazingsketch": "fig03_grazingsketch",
-    "fig04_retmaps": "fig04_retmaps",
-    "fig05_thetalt0mfs": "fig05_thetalt0mfs",
-    "fig06_sgraph": "fig06_sgraph",
-    "fig07_pdm_theta_neg": "fig07_pdm_theta_neg",
-    "fig08_s0theta": "fig08_s0theta",
-    "fig09_pdm_theta_pos": "fig09_pdm_theta_pos",
-    "bench_work_precision": "bench_work_precision",
-    "work_precision": "bench_work_precision",
-    "fig10_dfo": "fig10_dfo",
-    "fig11_dfo_retmaps": "fig11_dfo_retmaps",
-}
+# a figure's module is named like its dataset (figNN_name.py draws results/figNN_name.nc);
+# only figures whose module has another name are listed
+ALIASES = {"work_precision": "bench_work_precision"}
+
+
+def _module_name(scene_id: str) -> str:
+    name = ALIASES.get(scene_id, scene_id)
+    # figure modules: figNN_name (a scene) or bench_name (a benchmark); the rest are helpers
+    known = {m.name for m in pkgutil.iter_modules(__path__)
+             if re.fullmatch(r"fig[0-9]{2}_[a-z0-9_]+|bench_[a-z0-9_]+", m.name)}
+    if name not in known:
+        raise ValueError(f"no figure module for scene {scene_id!r}; known: "
+                         f"{', '.join(sorted(known | set(ALIASES)))}")
+    return name
+
 
 # No timestamps or tool versions in the files: same data -> same bytes.
 PDF_METADATA = {"CreationDate": None, "ModDate": None, "Producer": None, "Creator": None}
@@ -33,10 +34,7 @@ PNG_DPI = 200
 
 
 def draw(scene_id: str, ds):
-    try:
-        module = importlib.import_module(f".{DRAW[scene_id]}", __name__)
-    except KeyError:
-        raise ValueError(f"no figure module for scene {scene_id!r}; known: {', '.join(sorted(DRAW))}") from None
+    module = importlib.import_module(f".{_module_name(scene_id)}", __name__)
     with style.context():
         return module.draw(ds)
 

@@ -7,32 +7,29 @@ from __future__ import annotations
 
 import contextlib
 import importlib
+import pkgutil
+import re
 
 from .. import tolerance
 from ..config import SceneError
 from ..simulate import SimulationError
 from . import chunking
 
-SCENES = {
-    "fig01_slidesketch": "fig01_slidesketch",
-    "fig02_cases": "fig02_cases",
-    "fig03_grazingsketch": "fig03_grazingsketch",
-    "fig04_retmaps": "fig04_retmaps",
-    "fig05_thetalt0mfs": "fig05_thetalt0mfs",
-    "fig06_sgraph": "fig06_sgraph",
-    "fig07_pdm_theta_neg": "fig07_pdm_theta_neg",
-    "fig08_s0theta": "fig08_s0theta",
-    "fig09_pdm_theta_pos": "fig09_pdm_theta_pos",
-    "fig10_dfo": "fig10_dfo",
-    "fig11_dfo_retmaps": "fig11_dfo_retmaps",
-}
+SCENE_ID = re.compile(r"fig[0-9]{2}_[a-z0-9_]+")
+
+
+def known_scenes() -> list[str]:
+    """The scene ids: every module of this package named like one (``figNN_name``).
+    A new figure is a new module here; there is no registry to update."""
+    return sorted(m.name for m in pkgutil.iter_modules(__path__) if SCENE_ID.fullmatch(m.name))
 
 
 def _module(scene: dict):
     sid = scene.get("id")
-    if sid not in SCENES:
-        raise SceneError(f"id: unknown scene {sid!r}; known scenes: {', '.join(sorted(SCENES))}")
-    module = importlib.import_module(f".{SCENES[sid]}", __name__)
+    known = known_scenes()
+    if sid not in known:
+        raise SceneError(f"id: unknown scene {sid!r}; known scenes: {', '.join(known)}")
+    module = importlib.import_module(f".{sid}", __name__)
     # solver.engine: a scene runs on the engines its module lists (default: the reference driver)
     name = scene.get("solver", {}).get("engine", "python")
     available = getattr(module, "ENGINES", ("python",))
