@@ -19,13 +19,36 @@ def _relay_python():
                            lambda z: np.broadcast_to(col(C, z), np.shape(z)).copy())
 
 
+# the relay as scalar pieces (one state z, parameters p = (relay amplitude,))
+RELAY = dict(
+    field_minus=lambda z, p: np.array([z[1], z[2], -z[0] - 3 * z[1] - 3 * z[2] + p[0]]),
+    field_plus=lambda z, p: np.array([z[1], z[2], -z[0] - 3 * z[1] - 3 * z[2] - p[0]]),
+    switch=lambda z, p: z[0], switch_grad=lambda z, p: np.array([1.0, 0.0, 0.0]),
+    params=[1.0])
+
+
 def _relay_compiled(**kw):
-    return compile_system(
-        ("x1", "x2", "x3"),
-        field_minus=lambda z, p: np.array([z[1], z[2], -z[0] - 3 * z[1] - 3 * z[2] + p[0]]),
-        field_plus=lambda z, p: np.array([z[1], z[2], -z[0] - 3 * z[1] - 3 * z[2] - p[0]]),
-        switch=lambda z, p: z[0], switch_grad=lambda z, p: np.array([1.0, 0.0, 0.0]),
-        params=[1.0], **kw)
+    return compile_system(("x1", "x2", "x3"), **RELAY, **kw)
+
+
+def _sliding_example():
+    """examples/sliding_segment.py: its PiecewiseSystem, and the same system as
+    scalar pieces with exact flows."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "sliding_segment.py"
+    spec = importlib.util.spec_from_file_location("sliding_segment", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    pieces = dict(
+        field_minus=lambda z, p: np.array([1.0, 1.0 - z[0]]),
+        field_plus=lambda z, p: np.array([2.0, -1.0]), switch=lambda z, p: z[1],
+        switch_grad=lambda z, p: np.array([0.0, 1.0]),
+        flow_plus=lambda z0, s, p: np.array([z0[0] + 2.0 * s, z0[1] - s]),
+        flow_minus=lambda z0, s, p: np.array([z0[0] + s, z0[1] + (1.0 - z0[0]) * s - s * s / 2]),
+        sample_step=module.SYSTEM.sample_step)
+    return module.SYSTEM, pieces
 
 
 def test_a_users_relay_system_returns_as_on_the_python_driver():
@@ -53,34 +76,16 @@ def test_another_section_on_the_same_compiled_system():
 def test_exact_flows_and_sliding_of_a_users_system():
     # examples/sliding_segment.py's system: F_+ = (2, -1), F_- = (1, 1 - x), H = y;
     # slides on y = 0 from x = -1 to the fold x = 1; returns to x = 3
-    cm = compile_system(
-        ("x", "y"), field_minus=lambda z, p: np.array([1.0, 1.0 - z[0]]),
-        field_plus=lambda z, p: np.array([2.0, -1.0]), switch=lambda z, p: z[1],
-        switch_grad=lambda z, p: np.array([0.0, 1.0]),
-        flow_plus=lambda z0, s, p: np.array([z0[0] + 2.0 * s, z0[1] - s]),
-        flow_minus=lambda z0, s, p: np.array([z0[0] + s, z0[1] + (1.0 - z0[0]) * s - s * s / 2]),
-        sample_step=0.05, section=lambda z, p: z[0] - 3.0, section_direction=1)
+    system, pieces = _sliding_example()
+    cm = compile_system(("x", "y"), **pieces, section=lambda z, p: z[0] - 3.0,
+                        section_direction=1)
     start = np.array([[-2.0, 0.5]])
     out = fastmap.compute_returns(cm, start, 10.0)
     assert out.status[0] == fastmap.OK and out.sliding_time[0] > 0
-    ref = first_returns(_python_sliding(), start, Section("x3", lambda z: np.asarray(z)[0] - 3.0,
-                                                          direction=1), 10.0)
+    ref = first_returns(system, start, Section("x3", lambda z: np.asarray(z)[0] - 3.0,
+                                               direction=1), 10.0)
     np.testing.assert_allclose(out.state, ref.state, rtol=0, atol=1e-12)
     np.testing.assert_allclose(out.sliding_time, ref.sliding_time, rtol=0, atol=1e-12)
-
-
-def _python_sliding():
-    from filippov import MINUS, PLUS
-
-    return PiecewiseSystem(
-        names=("x", "y"),
-        field_minus=lambda z: np.stack([np.ones_like(z[0]), 1.0 - z[0]]),
-        field_plus=lambda z: np.stack([np.full_like(z[0], 2.0), np.full_like(z[0], -1.0)]),
-        switch=lambda z: z[1],
-        switch_grad=lambda z: np.stack([np.zeros_like(z[1]), np.ones_like(z[1])]),
-        flows={PLUS: lambda z0, s: np.stack([z0[0] + 2.0 * s, z0[1] - s]),
-               MINUS: lambda z0, s: np.stack([z0[0] + s, z0[1] + (1.0 - z0[0]) * s - s * s / 2])},
-        sample_step=0.05)
 
 
 @pytest.mark.parametrize("kw,match", [
@@ -107,12 +112,7 @@ def test_one_definition_runs_on_both_engines():
     # for the kernel
     from filippov import FilippovSystem
 
-    relay = FilippovSystem(
-        ("x1", "x2", "x3"),
-        field_minus=lambda z, p: np.array([z[1], z[2], -z[0] - 3 * z[1] - 3 * z[2] + p[0]]),
-        field_plus=lambda z, p: np.array([z[1], z[2], -z[0] - 3 * z[1] - 3 * z[2] - p[0]]),
-        switch=lambda z, p: z[0], switch_grad=lambda z, p: np.array([1.0, 0.0, 0.0]),
-        params=[1.0])
+    relay = FilippovSystem(("x1", "x2", "x3"), **RELAY)
     up = Section("up", lambda z: np.asarray(z)[0], direction=1)
     ref = first_returns(relay.python(), STARTS, up, 20.0, method="integrate")
     fast = fastmap.first_returns_compiled(relay.compiled(lambda z, p: z[0], direction=1),
@@ -127,15 +127,10 @@ def test_one_definition_runs_on_both_engines():
 def test_one_definition_with_exact_flows_and_sliding():
     from filippov import FilippovSystem, simulate
 
-    seg = FilippovSystem(
-        ("x", "y"), field_minus=lambda z, p: np.array([1.0, 1.0 - z[0]]),
-        field_plus=lambda z, p: np.array([2.0, -1.0]), switch=lambda z, p: z[1],
-        switch_grad=lambda z, p: np.array([0.0, 1.0]),
-        flow_plus=lambda z0, s, p: np.array([z0[0] + 2.0 * s, z0[1] - s]),
-        flow_minus=lambda z0, s, p: np.array([z0[0] + s, z0[1] + (1.0 - z0[0]) * s - s * s / 2]),
-        sample_step=0.05)
+    system, pieces = _sliding_example()
+    seg = FilippovSystem(("x", "y"), **pieces)
     got = simulate(seg.python(), [-2.0, 0.5], 4.0, dense=False)
-    want = simulate(_python_sliding(), [-2.0, 0.5], 4.0, dense=False)
+    want = simulate(system, [-2.0, 0.5], 4.0, dense=False)
     assert [e.kind for e in got.events] == [e.kind for e in want.events]
     np.testing.assert_allclose([e.t for e in got.events], [e.t for e in want.events], atol=1e-14)
     np.testing.assert_allclose(got.z, want.z, atol=1e-14)

@@ -274,13 +274,23 @@ class FilippovSystem:
         self._pieces = dict(field_minus=field_minus, field_plus=field_plus, switch=switch,
                             switch_grad=switch_grad, flow_minus=flow_minus, flow_plus=flow_plus)
         self._python = None
+        self._compiled = None   # the fields compiled once; each call only adds a section
+        self._user = None       # the pieces as numba dispatchers, shared by both engines
+
+    def _user_pieces(self) -> dict:
+        if self._user is None:
+            self._user = {k: (None if f is None else _jit(f, k)) for k, f in self._pieces.items()}
+        return self._user
 
     def compiled(self, section, *, direction: int = 0, where=None, probe=None) -> CompiledModel:
         """The compiled engine's model with the section ``section(z, p) = 0``."""
-        return compile_system(self.names, section=section, section_direction=direction,
-                              section_where=where, params=self.params,
-                              sample_step=self.sample_step, sliding=self.sliding,
-                              name=self.name, probe=probe, **self._pieces)
+        if self._compiled is None:
+            self._compiled = compile_system(
+                self.names, section=section, section_direction=direction, section_where=where,
+                params=self.params, sample_step=self.sample_step, sliding=self.sliding,
+                name=self.name, probe=probe, **self._user_pieces())
+            return self._compiled
+        return with_section(self._compiled, section, direction=direction, where=where)
 
     def python(self):
         """The reference driver's PiecewiseSystem (built once, then reused)."""
@@ -292,11 +302,11 @@ class FilippovSystem:
         from .system import MINUS, PLUS, PiecewiseSystem
 
         n, p = len(self.names), self.params
-        pc = self._pieces
-        fm = _batch_vector(_jit(pc["field_minus"], "field_minus"), n)
-        fp = _batch_vector(_jit(pc["field_plus"], "field_plus"), n)
-        gr = _batch_vector(_jit(pc["switch_grad"], "switch_grad"), n)
-        sw = _batch_scalar(_jit(pc["switch"], "switch"), n)
+        pc = self._user_pieces()
+        fm = _batch_vector(pc["field_minus"], n)
+        fp = _batch_vector(pc["field_plus"], n)
+        gr = _batch_vector(pc["switch_grad"], n)
+        sw = _batch_scalar(pc["switch"], n)
 
         def vector(batch):
             def piece(z):
@@ -312,7 +322,7 @@ class FilippovSystem:
         flows = {}
         if pc["flow_plus"] is not None and pc["flow_minus"] is not None:
             for mode, key in ((PLUS, "flow_plus"), (MINUS, "flow_minus")):
-                batch = _batch_flow(_jit(pc[key], key), n)
+                batch = _batch_flow(pc[key], n)
 
                 def flow(z0, tau, batch=batch):
                     tau = np.asarray(tau, dtype=float)

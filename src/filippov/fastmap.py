@@ -56,8 +56,10 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 from . import dop853_tableau as _dop
 from .poincare import Returns
 from .progress import Progress
-from .simulate import (EXACT_BLOCK, SLIDE_TANGENT, START_ULPS, EventLimitError,
-                       SimulationError, ZenoError, slow_window)
+from .simulate import (_FD_STEP, EXACT_BLOCK, SLIDE_TANGENT, EventLimitError, SimulationError,
+                       SlidingNotBuiltError, ZenoError, slow_window)
+from .simulate import _same_instant as _py_same_instant
+from .simulate import _starts_on_section as _py_starts_on_section
 from .system import MINUS, PLUS, SLIDING
 
 # ----------------------------------------------------------------------------- signatures
@@ -108,7 +110,6 @@ _W_NONE, _W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_SECTION = -1, 0, 1, 2, 3
 
 _TINY = np.finfo(float).tiny
 _EPS = np.finfo(float).eps
-_FD_STEP = np.cbrt(_EPS)  # simulate._slides_in
 
 # ----------------------------------------------------------------------------- DOP853 tableau
 # The coefficients of scipy's DOP853, which the reference driver integrates sliding
@@ -354,15 +355,9 @@ def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, s
     return True
 
 
-@_jit
-def _starts_on_section(s0, z0, sr, zr):
-    """simulate._starts_on_section."""
-    frac = min(1.0, abs(s0) / abs(s0 - sr)) if s0 != sr else 1.0
-    size, moved = 0.0, 0.0
-    for k in range(z0.size):
-        size = max(size, abs(z0[k]), abs(zr[k]))
-        moved = max(moved, abs(zr[k] - z0[k]))
-    return frac * moved <= START_ULPS * _EPS * size
+# the reference driver's rules, compiled from their one source
+_starts_on_section = _jit(_py_starts_on_section)
+_same_instant = _jit(_py_same_instant)
 
 
 @_jit
@@ -428,7 +423,7 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
             # simulate._scan: min_time; a tie with a switch (simulate._same_instant)
             # goes to the section; a start on the section up to rounding is no hit
             if r >= min_time and (best_w == _W_NONE
-                                  or r <= best_t + 4.0 * (xtol + 4.0 * _EPS * abs(best_t))):
+                                  or r <= best_t + _same_instant(xtol, best_t)):
                 _zat(r, mode, sg, za, F, y_old, fns, p, wz)
                 if fns[7](wz, p):
                     at_start = False
@@ -1009,7 +1004,8 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     return BatchReturns(state, time, nsw, slide, status, first, slide_dz)
 
 
-_ERRORS = {EVENT_LIMIT: EventLimitError, STEP_LIMIT: EventLimitError, ZENO: ZenoError}
+_ERRORS = {EVENT_LIMIT: EventLimitError, STEP_LIMIT: EventLimitError, ZENO: ZenoError,
+           NO_SLIDING: SlidingNotBuiltError}
 
 
 def first_returns_compiled(cmodel: CompiledModel, starts, t_max: float, *,

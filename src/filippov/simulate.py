@@ -43,6 +43,10 @@ class ZenoError(SimulationError):
     """Switching times accumulate: infinitely many switches in finite time."""
 
 
+class SlidingNotBuiltError(SimulationError):
+    """Attracting sliding reached by a system built with ``sliding=False``."""
+
+
 @dataclass(frozen=True)
 class Section:
     """A user event ``func(z) = 0``; ``direction`` -1 counts decreasing crossings
@@ -308,10 +312,15 @@ def _refine(fun, pred, ta, tb, va, vb, xtol):
     return r
 
 
+_EPS = float(np.finfo(float).eps)
+
+
+# The next two functions are the rule for both engines: plain scalar code that
+# fastmap compiles with numba as it stands (no second copy to keep equal).
 def _same_instant(xtol, t):
     """Events closer than this are one instant to the solver: each root is located
     to xtol + 4 eps |t| (brentq's tolerance) and then stepped to its far side."""
-    return 4.0 * (xtol + 4.0 * np.finfo(float).eps * abs(t))
+    return 4.0 * (xtol + 4.0 * _EPS * abs(t))
 
 
 #: A section crossing in the first sample interval of a run that lies within
@@ -329,14 +338,16 @@ def _same_instant(xtol, t):
 START_ULPS = 64
 
 
-def _starts_on_section(s0, z0, sr, zr) -> bool:
+def _starts_on_section(s0, z0, sr, zr):
     """The start ``z0`` (section value ``s0``) lies on the section up to rounding,
-    given the refined root ``zr`` (section value ``sr``)."""
-    z0, zr = np.asarray(z0, dtype=float), np.asarray(zr, dtype=float)
+    given the refined root ``zr`` (section value ``sr``); 1-D float arrays."""
     # linear interpolation to the crossing; sr is on the far side, so the fraction is <= 1
     frac = min(1.0, abs(s0) / abs(s0 - sr)) if s0 != sr else 1.0
-    size = max(np.abs(z0).max(), np.abs(zr).max())
-    return frac * np.abs(zr - z0).max() <= START_ULPS * np.finfo(float).eps * size
+    size, moved = 0.0, 0.0
+    for k in range(z0.size):
+        size = max(size, abs(z0[k]), abs(zr[k]))
+        moved = max(moved, abs(zr[k] - z0[k]))
+    return frac * moved <= START_ULPS * _EPS * size
 
 
 #: central-difference step (relative to the state's size) and the tolerance of
@@ -507,8 +518,7 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
         if t >= t_end:
             return stop("t_end")
         if mode == SLIDING and not system.sliding:
-            raise SimulationError(f"attracting sliding reached at t={t!r}, state "
-                                  f"{z.tolist()}, {_NO_SLIDING}")
+            raise _no_sliding(t, z)
         use_flow = method == "exact" and system.has_flow(mode)
         if use_flow:
             h = min(EXACT_BLOCK * system.sample_step, max_step, t_end - t0)
@@ -625,8 +635,11 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
             traj.mode = mode
 
 
-_NO_SLIDING = ("but the system was built with sliding=False; build it with sliding=True "
-               "to follow sliding")
+def _no_sliding(t, z) -> SlidingNotBuiltError:
+    at = f"t={t!r}, " if t is not None else ""
+    return SlidingNotBuiltError(
+        f"attracting sliding reached at {at}state {z.tolist()}, but the system was built "
+        "with sliding=False; build it with sliding=True to follow sliding")
 
 
 def _decide(system, mode, what, z):
@@ -636,20 +649,14 @@ def _decide(system, mode, what, z):
         return MINUS, "slide_end"
     if what == "exit_plus":
         return PLUS, "slide_end"
-    if mode == PLUS:  # arrived from H > 0, F_+ points down
-        if a > 0 and system.sliding:
-            return SLIDING, "slide_start"
-        if a > 0:
-            raise SimulationError(f"attracting sliding reached at state {z.tolist()}, "
-                                  f"{_NO_SLIDING}")
-        return MINUS, "crossing"
-    # arrived from H < 0
-    if b < 0 and system.sliding:
-        return SLIDING, "slide_start"
-    if b < 0:
-        raise SimulationError(f"attracting sliding reached at state {z.tolist()}, "
-                              f"{_NO_SLIDING}")
-    return PLUS, "crossing"
+    # arrived from H > 0 (F_+ points down) or from H < 0: sliding attracts when the
+    # field on the other side points back (a > 0, resp. b < 0)
+    attracts, across = (a > 0, MINUS) if mode == PLUS else (b < 0, PLUS)
+    if not attracts:
+        return across, "crossing"
+    if not system.sliding:
+        raise _no_sliding(None, z)
+    return SLIDING, "slide_start"
 
 
 def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xtol, traj):
@@ -714,7 +721,8 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
                 if sec.where is not None and not sec.where(zr):
                     continue
                 if (i == 0 and ta == traj.t0
-                        and _starts_on_section(sv[0], zs[:, 0], float(sec.func(zr)), zr)):
+                        and _starts_on_section(float(sv[0]), np.asarray(zs[:, 0], dtype=float),
+                                               float(sec.func(zr)), np.asarray(zr, dtype=float))):
                     continue
                 best = (r, "section", k)
         if best is not None:

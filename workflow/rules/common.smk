@@ -1,6 +1,7 @@
 # Library fingerprints. Snakemake reruns a job when its script changes, but not
 # when the library code the script imports changes; passing a hash of that code
 # as a param makes it do so (params are a default rerun trigger in Snakemake 8+).
+import functools
 import hashlib
 import sys
 import importlib.util
@@ -38,6 +39,18 @@ def fail(message):
     sys.exit(1)
 
 
+@functools.lru_cache(maxsize=None)
+def _paper_labels():
+    """paper/paper_labels.tex read once per workflow run (every scene's jobs ask)."""
+    path = Path("paper/paper_labels.tex")
+    if not path.exists():
+        return {}
+    from filippov.paper_labels import read_tex
+
+    return read_tex(path.read_text())
+
+
+@functools.lru_cache(maxsize=None)
 def scene_summary(scene):
     """What the HTML report shows with a scene's figure, dataset and scene file: its
     description, the paper figure it reproduces (the printed number, from
@@ -49,12 +62,7 @@ def scene_summary(scene):
         return {}
     data = yaml.safe_load(path.read_text()) or {}
     label = str(data.get("paper_figure", ""))
-    printed = label
-    labels = Path("paper/paper_labels.tex")
-    if label and labels.exists():
-        from filippov.paper_labels import read_tex
-
-        printed = read_tex(labels.read_text()).get(label, label).replace("~", " ")
+    printed = _paper_labels().get(label, label).replace("~", " ")
     return {"description": " ".join(str(data.get("description", "")).split()),
             "paper_figure": printed, "paper_label": label, "model": str(data.get("model", "")),
             "ingredients": ", ".join(f"{k}: {v}" for k, v in data.get("ingredients", {}).items()),

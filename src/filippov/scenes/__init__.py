@@ -12,7 +12,7 @@ import re
 
 from .. import tolerance
 from ..config import SceneError
-from ..simulate import SimulationError
+from ..simulate import SlidingNotBuiltError
 from . import chunking
 
 SCENE_ID = re.compile(r"fig[0-9]{2}_[a-z0-9_]+")
@@ -90,19 +90,13 @@ def describe(ds, attrs: dict, latex: dict | None = None):
     return ds
 
 
-#: how the solver says that a system built without sliding reached it
-#: (filippov.simulate, and the compiled kernel's status text)
-_NO_SLIDING_MARKS = ("built with sliding=False", "declares no sliding")
-
-
 @contextlib.contextmanager
 def _in_scene_terms(scene: dict):
-    """Solver errors that name what the system lacks, told also in the scene's words."""
+    """A system built without sliding that reached it, told also in the scene's words."""
     try:
         yield
-    except SimulationError as exc:
-        if (scene.get("ingredients", {}).get("sliding") is False
-                and any(mark in str(exc) for mark in _NO_SLIDING_MARKS)):
+    except SlidingNotBuiltError as exc:
+        if scene.get("ingredients", {}).get("sliding") is False:
             raise type(exc)(f"{scene.get('id')}: {exc} (the scene sets ingredients.sliding: "
                             "false; set it to true to follow sliding)") from exc
         raise
