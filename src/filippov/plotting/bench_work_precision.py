@@ -46,8 +46,9 @@ def draw(ds):
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("wall time of one map [s]")
-        st.panel_label(ax, f"({'abcd'[i]}) {ds.problem.values[i]}, "
-                           f"{int(ds.n_points.values[i])} points")
+        name = str(ds.problem.values[i]).replace("theta=", r"$\theta=$").replace(
+            "eps=", r"$\varepsilon=$")   # the paper's symbols
+        st.panel_label(ax, f"({'abcd'[i]}) {name}, {int(ds.n_points.values[i])} points")
     for ax in axes[::ncols]:
         ax.set_ylabel(r"max $|P - P_{\mathrm{ref}}|$")
     # one legend for all panels, below them
