@@ -105,8 +105,12 @@ def test_theta_positive_sliding_return_converges_like_eps_squared_at_bounded_cos
     # sliding lasts O(1) at every eps; the stiff sliding field is handed to Radau at
     # small eps, so the cost stays bounded instead of growing like 1/eps
     assert np.all((d.return_sliding_time.values > 0.1) & (d.return_sliding_time.values < 0.3))
-    assert list(d.return_stiff.values) == [0, 0, 0, 1, 1]
-    assert d.return_steps.values.max() < 4000
+    # (eps = 1e-4 sits near the rent-or-buy point of simulate.STIFF_AFTER)
+    stiff = list(d.return_stiff.values)
+    assert stiff[:2] == [0, 0] and stiff[3:] == [1, 1]
+    # before the noise floor of Radau's tolerance (simulate.NOISE_STEPS): 3007 steps
+    # at eps = 1e-6, and 11072 at 1e-7
+    assert d.return_steps.values.max() < 2000
 
 
 def test_radau_takes_over_stiff_sliding_and_agrees_with_dop853(monkeypatch):

@@ -113,6 +113,51 @@ def test_integrating_a_stiff_field_switches_to_radau_with_a_note():
     np.testing.assert_allclose(traj.z, exact.z, rtol=0, atol=1e-10)
 
 
+@pytest.mark.parametrize("eps", [1e-7, 1e-9])
+def test_stiff_sliding_at_tiny_eps_is_cheap_and_leaves_at_its_tangential_exit(eps):
+    # theta > 0: the orbit slides, x1 + 1 relaxing at rate 1/(theta eps) inside the
+    # slide. Before: at eps = 1e-7 Radau chased the field's rounding noise (11072
+    # steps, 11 s); at eps = 1e-9 the exit point, one rounding below H, read as a
+    # crossing back and the driver cycled slide_end/slide_start into a ZenoError.
+    from filippov.scenes.fig04_retmaps import section_L1
+    model = hopf.model(eps, 0.5)
+    traj = simulate(model.full(), [0.0, 1.2, 0.0], 1.0, sections=[section_L1()], dense=False)
+    reduced = simulate(model.reduced(), [0.0, 1.2], 1.0, sections=[section_L1()], dense=False)
+    assert traj.status == "section:L1"
+    # into region -, a fast approach to H, one slide, the tangential exit (a touch of
+    # H right after it is recorded as such), the return
+    assert [e.kind for e in traj.events if e.kind != "touch"] == [
+        "start", "crossing", "slide_start", "slide_end", "section"]
+    assert traj.n_steps < 1500
+    # the tolerance the noise allowed is reported, and it grows like 1/eps^2 at most
+    # (noise ~ u/eps, steps of the slow scale): 1e-14 * (1e-4/eps)^2 bounds it
+    assert atol_floor_bound(traj, eps)
+    # the return differs from the reduced one (P = 1) by 163 eps^2 (the hard-case
+    # sweep measures 1 - P = 1.63e-10 at eps = 1e-6): the raised tolerance does not
+    # reach P, since the sliding flow contracts every error across the flow
+    assert 0 <= reduced.z[1] - traj.z[1] < 200 * eps ** 2 + 4 * np.finfo(float).eps
+    if eps >= 1e-7:  # the compiled engine (explicit DOP853 in sliding) agrees
+        from filippov import fastmap
+        ref = fastmap.compute_returns(hopf.compiled(eps, 0.5), [[0.0, 1.2, 0.0]], 1.0)
+        assert ref.status[0] == 0
+        assert abs(ref.state[0, 1] - traj.z[1]) < 1e-13
+
+
+def atol_floor_bound(traj, eps):
+    raised = traj.atol_raised.get("sliding", 0.0)
+    return 1e-14 < raised < 1e-14 * (1e-4 / eps) ** 2
+
+
+def test_field_noise_is_the_rounding_of_state_and_field():
+    from filippov.simulate import field_noise
+    jac = np.array([[-1e6, 2.0], [0.0, -3.0]])
+    z = np.array([-1.0, 0.5])
+    noise = field_noise(lambda t, zz: jac @ zz, 0.0, z)
+    u = np.finfo(float).eps
+    expected = np.abs(jac) @ (u * np.abs(z)) + u * np.abs(jac @ z)
+    np.testing.assert_allclose(noise, expected, rtol=1e-6)
+
+
 def test_without_the_stiff_switch_it_refuses_at_once_with_the_reason():
     t0 = time.perf_counter()
     with pytest.raises(EventLimitError, match=r"exceed max_steps.*stiff"):

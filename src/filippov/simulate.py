@@ -27,7 +27,7 @@ import numpy as np
 from scipy.integrate import DOP853, Radau
 from scipy.optimize import brentq
 
-from . import checks
+from . import checks, variational
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 
 
@@ -118,6 +118,10 @@ class Trajectory:
     # modes whose integration switched from DOP853 to the implicit Radau method
     # because the field proved stiff there (see STIFF_AFTER)
     stiff_modes: set = field(default_factory=set)
+    # mode name -> largest absolute tolerance Radau was given there, where the field's
+    # rounding noise (see NOISE_STEPS) lifted it above atol: the local accuracy the
+    # field's conditioning allowed
+    atol_raised: dict = field(default_factory=dict)
 
     def section_hits(self, name: str) -> list:
         return [e for e in self.events if e.kind == "section" and e.name == name]
@@ -169,8 +173,9 @@ class _IntegratingStepper:
     """DOP853 (explicit), or Radau (implicit, for a stiff field), with dense output."""
 
     def __init__(self, fun, z, t, t_end, rtol, atol, max_step, method=DOP853,
-                 piece=lambda zz: "the field"):
+                 piece=lambda zz: "the field", noise=None):
         calls = [0]
+        self.atol, self.noise, self.atol_used = atol, noise, atol
         self.piece, self.non_finite = piece, None
 
         def checked(tt, zz):
@@ -204,6 +209,10 @@ class _IntegratingStepper:
         s = self.solver
         ta = s.t
         self.non_finite = None
+        if self.noise is not None and s.step_size is not None:
+            # scipy's Radau reads its atol afresh in every step
+            s.atol = np.maximum(self.atol, NOISE_STEPS * s.step_size * self.noise)
+            self.atol_used = max(self.atol_used, float(np.max(s.atol)))
         msg = s.step()
         if s.status == "failed":
             if self.non_finite is not None:  # the step size collapsed on a NaN or inf
@@ -223,12 +232,31 @@ PROJECT_AFTER = 1000  # steps before the step budget is projected from the mean 
 #: accuracy (a fast variable slaved to a slow manifold, e.g. sliding of a slow-fast
 #: system at small eps), and the rest of the stay is integrated by Radau (listed in
 #: Trajectory.stiff_modes). When to switch is a rent-or-buy choice, since the length
-#: of the stay is unknown: Radau at rtol 1e-12 costs about as much as ~1000 DOP853
-#: steps on the Hopf example's sliding (1534 Radau steps in 2.3 s against 876 DOP853
-#: steps in 2.1 s at eps = 1e-4), so switching after that many explicit steps costs
-#: at most twice the better of the two. Switching after 16 steps made eps = 1e-3
-#: five times dearer (1475 Radau steps where DOP853 finishes in 261).
-STIFF_AFTER = 1000
+#: of the stay is unknown. Measured on one sliding return of the Hopf example
+#: (theta = 0.5, rtol 1e-12; seconds at eps = 1e-3, 1e-4, 1e-5, 1e-6, 1e-7):
+#: 1000 -> 0.15, 0.61, 1.25, 1.19, 0.88; 250 -> 0.15, 0.80, 0.79, 0.77, 0.40;
+#: 100 -> 0.67, 0.74, 0.76, 0.62, 0.33. 250 is never more than 1.3x the best of
+#: the three (eps = 1e-3 finishes in 261 DOP853 steps; 100 sends it to Radau).
+STIFF_AFTER = 250
+
+#: A stiff field amplifies the rounding of the state: at eps = 1e-6 the Hopf
+#: example's sliding field moves by ~1e-8 when x1 moves by one ulp (its Jacobian
+#: has entries ~1/eps). Radau's Newton iteration cannot settle an increment below
+#: h times that noise, so its absolute tolerance is kept at least NOISE_STEPS * h *
+#: field_noise (per component, h the last step); below it Radau shrank its step to
+#: 1e-7 and re-factorised on every step (eps = 1e-7: 11072 steps, 10.8 s; with the
+#: floor 785 steps, 0.4 s; the return P moved by < 3e-15 in both).
+NOISE_STEPS = 10.0
+
+
+def field_noise(fun, t, z) -> np.ndarray:
+    """Per component, how far the field moves when the state is rounded: |J| (u |z|)
+    plus the rounding of the field itself (u = unit roundoff)."""
+    z = np.asarray(z, dtype=float)
+    f = np.asarray(fun(t, z), dtype=float)
+    jac = variational.fd_jacobian(lambda zz: fun(t, zz), z)
+    u = np.finfo(float).eps
+    return np.abs(jac) @ (u * np.abs(z)) + u * np.abs(f)
 
 
 def spectral_radius(fun, t, z, iterations: int = 6) -> float:
@@ -472,7 +500,9 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
     crossing (region + is ``H >= 0``). With ``stiff`` (default), an integrated
     mode whose DOP853 steps turn out bounded by stability (step x spectral radius
     of the Jacobian > 1, checked every ``STIFF_AFTER`` steps) continues with the
-    implicit Radau method (listed in ``Trajectory.stiff_modes``).
+    implicit Radau method (listed in ``Trajectory.stiff_modes``), whose absolute
+    tolerance is kept above the field's rounding noise (``NOISE_STEPS``; where that
+    lifted it above ``atol``, ``Trajectory.atol_raised`` says by how much).
     """
     if method not in ("exact", "integrate"):
         raise ValueError(f"method must be 'exact' or 'integrate', got {method!r}")
@@ -533,10 +563,9 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
                                           piece=piece)
         steps_in_mode, stepper_steps, stepper_t = 0, 0, t
         # Functions whose crossing ends this mode, with the mode they lead to.
-        if mode == PLUS:
-            leave = [(system.switch, TO_NEG, "switch")]
-        elif mode == MINUS:
-            leave = [(system.switch, TO_NONNEG, "switch")]
+        if mode != SLIDING:
+            switch = _switch_after_exit(system, mode, z, traj.events[-1].kind, touch_tol)
+            leave = [(switch, TO_NEG if mode == PLUS else TO_NONNEG, "switch")]
         else:
             leave = [(lambda zz: system.normal_speeds(zz)[0], TO_NONPOS, "exit_minus"),
                      (lambda zz: system.normal_speeds(zz)[1], TO_NONNEG, "exit_plus")]
@@ -581,6 +610,9 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
             first = False
             if dense:
                 traj.segments.append((ta, tb, mode, Z))
+            if getattr(stepper, "method", None) is Radau and stepper.atol_used > atol:
+                name = MODE_NAMES[mode]
+                traj.atol_raised[name] = max(traj.atol_raised.get(name, 0.0), stepper.atol_used)
             if found is None:
                 t, z = tb, zs[:, -1].copy()
                 if tb >= t_end:
@@ -591,7 +623,8 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
                         and (tb - ta) * spectral_radius(field_of_mode, t, z) > 1.0):
                     traj.stiff_modes.add(MODE_NAMES[mode])
                     stepper = _IntegratingStepper(field_of_mode, z, t, t_end, rtol, atol,
-                                                  max_step, method=Radau, piece=piece)
+                                                  max_step, method=Radau, piece=piece,
+                                                  noise=field_noise(field_of_mode, t, z))
                     stepper_steps, stepper_t = 0, t
                 continue
             te, ze, what, idx = found
@@ -640,6 +673,23 @@ def _no_sliding(t, z) -> SlidingNotBuiltError:
     return SlidingNotBuiltError(
         f"attracting sliding reached at {at}state {z.tolist()}, but the system was built "
         "with sliding=False; build it with sliding=True to follow sliding")
+
+
+def _switch_after_exit(system, mode, z, entered_by, touch_tol):
+    """The switching function a stay in region ``mode`` watches. After a sliding exit
+    it is measured from the exit point when that lies within touch_tol on the wrong
+    side: the exit is tangential, and a state one rounding below H would otherwise
+    read as an immediate crossing back (at eps = 1e-9 the Hopf example's exit point
+    has H = -2.2e-16 while dH/dt = 3e-14, below the 1e-7 noise of that speed, and
+    the driver cycled slide_end -> slide_start at one instant into a ZenoError).
+    A real return across H from there is still a sign change of the shifted function."""
+    if entered_by != "slide_end":
+        return system.switch
+    h0 = float(system.switch(z))
+    wrong_side = h0 < 0 if mode == PLUS else h0 >= 0
+    if not (wrong_side and abs(h0) <= touch_tol):
+        return system.switch
+    return lambda zz: system.switch(zz) - h0
 
 
 def _decide(system, mode, what, z):
@@ -700,10 +750,10 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
             if hidden:
                 dfun = scalar(lambda zz: system.speed_of_switch(mode, zz))
                 tm = brentq(dfun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps)
-                Hm = float(system.switch(Z(tm)))
+                Hm = float(leave[0][0](Z(tm)))
                 pred = leave[0][1]
                 if (mode == PLUS and Hm < -touch_tol) or (mode == MINUS and Hm > touch_tol):
-                    r = _refine(scalar(system.switch), pred, ta, tm, H[i], Hm, xtol)
+                    r = _refine(scalar(leave[0][0]), pred, ta, tm, H[i], Hm, xtol)
                     best = (r, "switch", -1)
                 elif abs(Hm) <= touch_tol:
                     traj.events.append(Event(tm, "touch", Z(tm).copy(), mode, mode))
