@@ -75,3 +75,20 @@ def test_s0_range_must_be_ordered(tmp_path):
     path = _write(tmp_path, text.replace("theta_min: -5.0", "theta_min: -0.0005"), "fig08_s0theta")
     with pytest.raises(SceneError, match="parameters.theta_min"):
         load_scene(path, SCHEMA)
+
+
+def test_a_scene_brings_its_own_parameter_block(tmp_path):
+    # fig04's parameters are closed by config/schema/scenes/fig04_retmaps.schema.json,
+    # not by a block in the shared schema: a typo there is named, and a broken block
+    # file is named as such
+    import shutil
+    text = (ROOT / "config" / "scenes" / "fig04_retmaps.yaml").read_text()
+    assert "closest:" in text
+    path = _write(tmp_path, text.replace("closest:", "closets:"), "fig04_retmaps")
+    with pytest.raises(SceneError, match=r"fig04_retmaps.yaml: parameters: .*closets"):
+        load_scene(path, SCHEMA)
+    schema_dir = tmp_path / "schema"
+    shutil.copytree(SCHEMA.parent, schema_dir)
+    (schema_dir / "scenes" / "fig04_retmaps.schema.json").write_text("{not json")
+    with pytest.raises(SceneError, match=r"fig04_retmaps.schema.json: cannot read"):
+        load_scene(_write(tmp_path, text, "fig04_retmaps"), schema_dir / "scene.schema.json")

@@ -328,3 +328,21 @@ def test_slow_windows_change_the_cost_not_the_result(theta, eps):
         assert [e.kind for e in a.events] == [e.kind for e in b.events]
         np.testing.assert_allclose(a.z, b.z, rtol=0, atol=1e-13)
         assert a.t == pytest.approx(b.t, abs=1e-13)
+
+
+def test_stiff_sliding_does_not_depend_on_the_blas_thread_count():
+    # Radau's LU goes through OpenBLAS, whose multi-threaded path rounds differently:
+    # the eps = 1e-4 return moved by 1.4e-15 between a Snakemake job (one thread)
+    # and a plain process. The driver now runs Radau's steps on one BLAS thread.
+    import os
+    import subprocess
+    import sys
+    code = ("from filippov import hard_cases; r = hard_cases.sliding_return(1e-4); "
+            "print(repr(r['return_P']), r['return_steps'], r['return_stiff'])")
+    out = set()
+    for threads in ("1", "2"):
+        env = dict(os.environ, OPENBLAS_NUM_THREADS=threads)
+        run = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                             text=True, check=True)
+        out.add(run.stdout)
+    assert len(out) == 1 and out.pop().split()[2] == "1", out

@@ -162,6 +162,13 @@ def load_workflow_config(path, schema_path, overrides=None) -> dict:
     return merged
 
 
+def scene_schema_file(schema_path, scene_id: str) -> Path:
+    """Where a scene keeps the schema of its own parameters: ``scenes/<id>.schema.json``
+    beside the scene schema (optional; a scene whose model block says it all has none).
+    It is one more ``allOf`` entry of the scene schema, so ``#/$defs/...`` refer there."""
+    return Path(schema_path).parent / "scenes" / f"{scene_id}.schema.json"
+
+
 def load_scene(path, schema_path, lim: dict | None = None) -> dict:
     """Read a scene, validate it against the JSON schema and the limits (``lim``,
     default :data:`LIMITS`) and return it as a dict."""
@@ -177,6 +184,15 @@ def load_scene(path, schema_path, lim: dict | None = None) -> dict:
 
     schema = json.loads(Path(schema_path).read_text(encoding="utf-8"))
     error = best_match(Draft202012Validator(schema).iter_errors(scene), key=_RELEVANCE)
+    if error is None:  # the id is valid now: the scene's own block, if it has one
+        own = scene_schema_file(schema_path, scene["id"])
+        if own.exists():
+            try:
+                block = json.loads(own.read_text(encoding="utf-8"))
+            except (OSError, UnicodeDecodeError, ValueError) as exc:
+                raise SceneError(f"{own}: cannot read the scene's schema block: {exc}") from exc
+            schema["allOf"] = [*schema.get("allOf", []), block]
+            error = best_match(Draft202012Validator(schema).iter_errors(scene), key=_RELEVANCE)
     if error is not None:
         raise SceneError(f"{path}: {_field(error.absolute_path)}: {error.message}")
 

@@ -58,8 +58,7 @@ from .poincare import Returns
 from .progress import Progress
 from .simulate import (_FD_STEP, EXACT_BLOCK, SLIDE_TANGENT, EventLimitError, SimulationError,
                        SlidingNotBuiltError, ZenoError, slow_window)
-from .simulate import _same_instant as _py_same_instant
-from .simulate import _starts_on_section as _py_starts_on_section
+from . import rules
 from .system import MINUS, PLUS, SLIDING
 
 # ----------------------------------------------------------------------------- signatures
@@ -356,8 +355,14 @@ def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, s
 
 
 # the reference driver's rules, compiled from their one source
-_starts_on_section = _jit(_py_starts_on_section)
-_same_instant = _jit(_py_same_instant)
+# the decisions, compiled from their one source (filippov.rules)
+_starts_on_section = _jit(rules.starts_on_section)
+_same_instant = _jit(rules.same_instant)
+_start_side = _jit(rules.start_side)
+_start_on_switch = _jit(rules.start_on_switch)
+_next_mode = _jit(rules.next_mode)
+_accumulates = _jit(rules.accumulates)
+assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 
 
 @_jit
@@ -629,20 +634,14 @@ def _slides_in(z, fns, p, wg, wm, wp, wz):
 
 @_jit
 def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
-    """simulate.initial_mode."""
+    """simulate.initial_mode (rules.start_side, rules.start_on_switch)."""
     H = fns[4](z, p)
-    if abs(H) > touch_tol:
-        return PLUS if H > 0 else MINUS
+    side = _start_side(H, touch_tol)
+    if side != SLIDING:
+        return side
     a, b = _speeds(z, fns, p, wg, wm, wp)
-    if a > 0 and b < 0:
-        return SLIDING if sliding else PLUS
-    if a < 0 and b < 0:
-        return MINUS
-    if a > 0 and b > 0:
-        return PLUS
-    if a < 0 < b:
-        return PLUS
-    return PLUS if H >= 0 else MINUS
+    mode, _ = _start_on_switch(H, a, b, sliding)
+    return mode
 
 
 @_jit
@@ -775,14 +774,7 @@ def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fo
                     slide_dz[k] += z[k] - slide_z0[k]
             return OK, t, n_switch, slide_time
         a, b = _speeds(z, fns, p, wg, wf, wp)
-        if what == _W_EXIT_MINUS:
-            new_mode = MINUS
-        elif what == _W_EXIT_PLUS:
-            new_mode = PLUS
-        elif mode == PLUS:
-            new_mode = SLIDING if a > 0 else MINUS
-        else:
-            new_mode = SLIDING if b < 0 else PLUS
+        new_mode = _next_mode(mode, what, a, b)  # what: rules.SWITCH/EXIT_MINUS/EXIT_PLUS
         if new_mode == SLIDING and not sliding:
             return NO_SLIDING, t, n_switch, slide_time
         if new_mode == SLIDING and mode != SLIDING and _slides_in(z, fns, p, wg, wf, wp, wz):
@@ -805,7 +797,7 @@ def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fo
         n_recent += 1
         if n_recent >= zeno_count:
             oldest = recent[n_recent % zeno_count]
-            if t - oldest <= zeno_span * max(1.0, abs(t)):
+            if _accumulates(oldest, t, zeno_span):
                 return ZENO, t, n_switch, slide_time
         mode = new_mode
 

@@ -9,11 +9,19 @@ ones are ``None``) and returns ``{file name: LaTeX text}`` for
   ``%% source:`` comment naming the dataset and variable it comes from (the
   tests re-read that variable and compare), plus ``\\newif`` switches saying
   which optional results (dry friction, work--precision sweep) exist;
-* ``tab_fig07.tex``, ``tab_fig09.tex`` -- convergence tables over eps;
-* ``tab_fig10.tex``, ``tab_fig11.tex``, ``tab_bench.tex`` -- tables of whatever
-  those datasets hold, or a "not yet computed" sentence when they are absent;
-* ``tab_hard_cases.tex`` -- the hard-case eps sweep (``results/hard_cases.nc``,
-  :mod:`filippov.hard_cases`), one row per eps, or "not yet computed".
+* ``<scene id>.tex`` for every scene -- the table its scene module's ``report``
+  returns (e.g. convergence over eps), a "not yet computed" sentence for an
+  optional scene without data, or a comment when the scene has no table;
+* ``tab_bench.tex`` -- the work--precision sweep, or "not yet computed";
+* ``tab_hard_cases.tex``, ``tab_hard_return.tex`` -- the hard-case eps sweep
+  (``results/hard_cases.nc``, :mod:`filippov.hard_cases`), one row per eps.
+
+The scenes declare their own part: each figure module ``filippov.plotting.<id>``
+(which draws the figure from the same dataset) defines ``report(ds, macros)`` (adds
+its macros, returns its table or None) and, when the report can do without its
+data, ``REPORT_OPTIONAL = True`` (then ``ds`` may be None). There is no list of
+scenes here. Being presentation, these parts are outside the code the compute jobs
+depend on: editing one rebuilds the report, not the data.
 
 No Snakemake inside; ``workflow/scripts/report_tables.py`` is the thin caller.
 """
@@ -27,10 +35,6 @@ from typing import Mapping, Optional
 import numpy as np
 import xarray as xr
 
-CORE = ("fig01_slidesketch", "fig02_cases", "fig03_grazingsketch", "fig04_retmaps",
-        "fig05_thetalt0mfs", "fig06_sgraph", "fig07_pdm_theta_neg", "fig08_s0theta",
-        "fig09_pdm_theta_pos")
-OPTIONAL = ("fig10_dfo", "fig11_dfo_retmaps", "work_precision", "hard_cases")
 NOT_YET = "not yet computed"
 
 
@@ -114,261 +118,33 @@ class Macros:
         return {name: (value, source) for name, value, source, _ in self.items}
 
 
-def _f(ds, var, **sel) -> float:
+def value(ds, var, **sel) -> float:
     v = ds[var]
     if sel:
         v = v.sel(**sel)
     return float(v.values)
 
 
-def _src(sid, var, **sel) -> str:
+def source(sid, var, **sel) -> str:
     s = ",".join(f"{k}={v!r}" for k, v in sel.items())
     return f"{sid}:{var}" + (f"[{s}]" if s else "")
 
 
-def _var(m: Macros, name, ds, sid, var, sig=3, **sel):
-    m.add(name, _f(ds, var, **sel), _src(sid, var, **sel), sig)
+def var(m: Macros, name, ds, sid, var, sig=3, **sel):
+    m.add(name, value(ds, var, **sel), source(sid, var, **sel), sig)
 
 
-# ----------------------------------------------------------------------------- per figure
-def fig01(ds, m: Macros):
-    sid = "fig01_slidesketch"
-    for case, word in (("crossing", "Cross"), ("sliding", "Slide")):
-        _var(m, f"rpOneHit{word}A", ds, sid, "hit_x1", case=case)
-        _var(m, f"rpOneHit{word}B", ds, sid, "hit_x2", case=case)
-    m.add("rpOneFieldsCross", None, f"{sid}:attrs.crossing_fields",
-          text=r"\texttt{" + tex_escape(ds.attrs["crossing_fields"]) + "}")
-    m.add("rpOneFieldsSlide", None, f"{sid}:attrs.sliding_fields",
-          text=r"\texttt{" + tex_escape(ds.attrs["sliding_fields"]) + "}")
-
-
-def fig02(ds, m: Macros):
-    sid = "fig02_cases"
-    eps, th_slide = float(ds.attrs["eps"]), float(ds.attrs["theta_sliding"])
-    m.add("rpTwoEps", eps, f"{sid}:attrs.eps")
-    m.add("rpTwoThetaSlide", th_slide, f"{sid}:attrs.theta_sliding")
-    m.add("rpTwoThetaChatter", float(ds.attrs["theta"]), f"{sid}:attrs.theta")
-    m.add("rpTwoEpsTheta", eps * th_slide, "derived: eps*theta_sliding")
-    start = [float(v) for v in np.atleast_1d(ds.attrs["start"])]
-    m.add("rpTwoStartX", start[0], "fig02_cases:attrs.start[0]")
-    m.add("rpTwoStartY", start[1], "fig02_cases:attrs.start[1]")
-    _var(m, "rpTwoSlideMin", ds, sid, "sliding_x_min", sig=6)
-    _var(m, "rpTwoSlideMax", ds, sid, "sliding_x_max", sig=6)
-    m.add("rpTwoSlideErr", max(abs(_f(ds, "sliding_x_min") + eps * th_slide),
-                               abs(_f(ds, "sliding_x_max") - eps * th_slide)),
-          "derived: max |sliding_x_min + eps theta|, |sliding_x_max - eps theta|", 2)
-    _var(m, "rpTwoXFinal", ds, sid, "x_final", sig=2)
-    for var, name in (("period", "Period"), ("x_switch", "XSwitch"), ("y_switch", "YSwitch"),
-                      ("period_formula", "PeriodFormula"), ("T_half", "THalf"),
-                      ("y_switch_printed", "YSwitchPrinted"), ("theta_printed", "ThetaPrinted")):
-        _var(m, f"rpTwo{name}", ds, sid, var, sig=6 if var != "theta_printed" else 4)
-    m.add("rpTwoPeriodOverEps", _f(ds, "period") / eps, "derived: period/eps")
-    m.add("rpTwoPeriodErr", abs(_f(ds, "period") - _f(ds, "period_formula")),
-          "derived: |period - period_formula|", 2)
-    m.add("rpTwoYSwitchErr", abs(_f(ds, "y_switch") - _f(ds, "y_switch_printed")),
-          "derived: |y_switch - y_switch_printed|", 2)
-    T = _f(ds, "T_half")
-    m.add("rpTwoMinusThetaTanh", -float(ds.attrs["theta"]) * math.tanh(T / 2),
-          "derived: -theta tanh(T_half/2)", 4)
-
-
-def fig03(ds, m: Macros):
-    sid = "fig03_grazingsketch"
-    mus = [float(v) for v in ds.mu.values]
-    m.add("rpThreeOmega", float(ds.attrs["omega"]), f"{sid}:attrs.omega", 6)
-    m.add("rpThreeStart", float(ds.attrs["x2_start"]), f"{sid}:attrs.x2_start")
-    m.add("rpThreeSettle", float(ds.attrs["settle_tol"]), f"{sid}:attrs.settle_tol")
-    for mu, word in zip(mus, ("Below", "At", "Above")):
-        m.add(f"rpThreeMu{word}", mu, _src(sid, "mu", mu=mu))
-        _var(m, f"rpThreeFixed{word}", ds, sid, "fixed_x2", sig=6, mu=mu)
-        _var(m, f"rpThreePeriod{word}", ds, sid, "period", sig=6, mu=mu)
-        _var(m, f"rpThreeSlideTime{word}", ds, sid, "sliding_time", sig=3, mu=mu)
-    mu = mus[2]
-    _var(m, "rpThreeXhTwo", ds, sid, "x_h", sig=4, mu=mu, component="x2")
-    _var(m, "rpThreeXlTwo", ds, sid, "x_l", sig=6, mu=mu, component="x2")
-    _var(m, "rpThreeXlFormulaTwo", ds, sid, "x_l_formula", sig=6, mu=mu, component="x2")
-    m.add("rpThreeXlErr", abs(_f(ds, "x_l", mu=mu, component="x2")
-                              - _f(ds, "x_l_formula", mu=mu, component="x2")),
-          "derived: |x_l - x_l_formula| at mu above 1", 2)
-    m.add("rpThreeSqrtMuBelow", math.sqrt(mus[0]), "derived: sqrt(mu below 1)", 6)
-
-
-def _first_above(x, d0):
-    d = x - 1.0
-    idx = np.where(d >= d0)[0]
-    return int(idx[0])
-
-
-def fig04(ds, m: Macros):
-    sid = "fig04_retmaps"
-    eps, mu, omega = (float(ds.attrs[k]) for k in ("eps", "mu", "omega"))
-    m.add("rpFourEps", eps, f"{sid}:attrs.eps")
-    m.add("rpFourMu", mu, f"{sid}:attrs.mu")
-    m.add("rpFourOmegaOverPi", omega / math.pi, "derived: omega/pi", 4)
-    m.add("rpFourNPoints", ds.sizes["x2"], f"{sid}:x2 (size)")
-    m.add("rpFourXMin", float(ds.attrs["x2_min"]), f"{sid}:attrs.x2_min")
-    m.add("rpFourXMax", float(ds.attrs["x2_max"]), f"{sid}:attrs.x2_max")
-    _var(m, "rpFourSlopeSmooth", ds, sid, "slope_smooth", sig=4)
-    x2 = ds.x2.values
-    below = np.where((x2 < 1) & (1 - x2 >= 1e-6))[0][-1]
-    Pm, Pp = ds.P.sel(theta=-0.5).values, ds.P.sel(theta=0.5).values
-    m.add("rpFourSlopeBelow", (1 - Pm[below]) / (1 - x2[below]),
-          "derived: (1 - P(x2))/(1 - x2) at theta=-0.5, 1 - x2 ~ 1e-6", 4)
-    m.add("rpFourFixed", _f(ds, "fixed_point", theta=-0.5, fixed=0),
-          _src(sid, "fixed_point", theta=-0.5, fixed=0), 6)
-    j = _first_above(x2, 0.0 + 1e-300)
-    jump = 1.0 - Pm[j]
-    m.add("rpFourJump", jump, "derived: 1 - P(theta=-0.5, smallest x2 > 1)", 4)
-    m.add("rpFourJumpOverEps", jump / eps, "derived: jump/eps", 3)
-    m.add("rpFourClosest", x2[j] - 1.0, "derived: smallest x2 - 1 > 0 on the grid", 2)
-    from .analytic.s0 import s0_lambert
-    pred = float(s0_lambert(np.array([-0.5]))[0]) * math.exp(-3 * math.pi * mu / omega)
-    m.add("rpFourJumpPredOverEps", pred, "derived: s0(-0.5) exp(-3 pi mu/omega)", 3)
-    k = _first_above(x2, 1e-8)
-    m.add("rpFourSlopeAbovePos", (Pp[k] - 1.0) / (x2[k] - 1.0),
-          "derived: (P - 1)/(x2 - 1) at theta=0.5, first x2 - 1 >= 1e-8", 3)
-    m.add("rpFourSlopeAboveProbe", x2[k] - 1.0, "derived: x2 - 1 used for the slope", 2)
-    m.add("rpFourSlopeCarried", -1.0 * _f(ds, "slope_smooth"),
-          "derived: (theta-1)/theta * slope_smooth at theta=0.5", 3)
-    # one-sided slope next to the jump (theta < 0): difference quotients near 1+
-    d = x2 - 1.0
-    i1, i2 = _first_above(x2, 1e-10), _first_above(x2, 1e-6)
-    s1 = abs((Pm[i1 + 1] - Pm[i1]) / (x2[i1 + 1] - x2[i1]))
-    s2 = abs((Pm[i2 + 1] - Pm[i2]) / (x2[i2 + 1] - x2[i2]))
-    m.add("rpFourNegSlopeNear", s1, "derived: |dP/dx2| at theta=-0.5, x2 - 1 ~ 1e-10", 2)
-    m.add("rpFourNegSlopeFar", s2, "derived: |dP/dx2| at theta=-0.5, x2 - 1 ~ 1e-6", 2)
-    m.add("rpFourNegProbeNear", d[i1], "derived: x2 - 1 for rpFourNegSlopeNear", 2)
-    m.add("rpFourNegProbeFar", d[i2], "derived: x2 - 1 for rpFourNegSlopeFar", 2)
-    res = ds.residual.sel(theta=-0.5).values[(x2 - 1) > 1e-3]
-    m.add("rpFourResMin", float(res.min()), "derived: min residual, theta=-0.5, x2 > 1.001", 2)
-    m.add("rpFourResMax", float(res.max()), "derived: max residual, theta=-0.5, x2 > 1.001", 2)
-    for th, word in ((-0.5, "Neg"), (0.5, "Pos")):
-        _var(m, f"rpFourSigma{word}", ds, sid, "sigma_minus", sig=3, theta=th)
-
-
-def fig05(ds, m: Macros):
-    sid = "fig05_thetalt0mfs"
-    m.add("rpFiveEps", float(ds.attrs["eps"]), f"{sid}:attrs.eps")
-    m.add("rpFiveTheta", float(ds.attrs["theta"]), f"{sid}:attrs.theta")
-    m.add("rpFiveStart", float(ds.attrs["start_x2"]), f"{sid}:attrs.start_x2", 6)
-    m.add("rpFiveSettle", float(ds.attrs["settle"]), f"{sid}:attrs.settle")
-    m.add("rpFiveReturn", float(ds.attrs["x2_return"]), f"{sid}:attrs.x2_return", 6)
-    _var(m, "rpFiveGap", ds, sid, "gap_pg", sig=6)
-    _var(m, "rpFiveDecay", ds, sid, "decay_rate", sig=8)
-    _var(m, "rpFiveDecayErr", ds, sid, "decay_rate_rel_error", sig=2)
-    _var(m, "rpFiveMminusErr", ds, sid, "M_minus_max_error", sig=2)
-    _var(m, "rpFiveExpansionErr", ds, sid, "M_minus_max_expansion_error", sig=3)
-    _var(m, "rpFiveSwitchTwoXone", ds, sid, "switch_x1", sig=5, switch=1)
-    _var(m, "rpFiveSwitchTwoY", ds, sid, "switch_y", sig=5, switch=1)
-    _var(m, "rpFiveSwitchXtwo", ds, sid, "switch_x2", sig=4, switch=0)
-
-
-def fig06(ds, m: Macros):
-    sid = "fig06_sgraph"
-    m.add("rpSixTheta", float(ds.attrs["theta"]), f"{sid}:attrs.theta")
-    _var(m, "rpSixSlopeZero", ds, sid, "slope_at_zero")
-    _var(m, "rpSixImageLimit", ds, sid, "image_limit", sig=5)
-    m.add("rpSixSFirst", float(ds.s.values[0]), _src(sid, "s") + "[0]", 6)
-    m.add("rpSixTsMin", float(ds.t_s.values[0]), "fig06_sgraph:t_s[0]", 2)
-    m.add("rpSixTsMax", float(ds.t_s.values[-1]), "fig06_sgraph:t_s[-1]", 2)
-    m.add("rpSixXiMin", float(ds.xi1.values[-1]), "fig06_sgraph:xi1[-1]", 4)
-
-
-def _eps_label(e):
+def eps_tex(e):
     return num(e, 2)
 
 
-def fig07(ds, m: Macros):
-    sid = "fig07_pdm_theta_neg"
-    eps = [float(e) for e in ds.eps.values]
-    m.add("rpSevenTheta", _f(ds, "theta"), _src(sid, "theta"))
-    _var(m, "rpSevenSzero", ds, sid, "s0", sig=6)
-    m.add("rpSevenXiMin", float(ds.attrs["xi1_min"]), f"{sid}:attrs.xi1_min")
-    m.add("rpSevenXiMinAbs", abs(float(ds.attrs["xi1_min"])), "derived: |xi1_min|")
-    m.add("rpSevenEpsMax", eps[0], f"{sid}:eps[0]")
-    m.add("rpSevenEpsMin", eps[-1], f"{sid}:eps[-1]")
-    m.add("rpSevenRateFirst", float(ds.attrs["rate_first_order_fit"]),
-          f"{sid}:attrs.rate_first_order_fit", 2)
-    m.add("rpSevenRateZero", float(ds.attrs["rate_zero_order_fit"]),
-          f"{sid}:attrs.rate_zero_order_fit", 2)
-    for var, name in (("error_printed", "ErrPrinted"), ("error_first_order", "ErrFirst"),
-                      ("error_zero_order", "ErrZero"), ("left_limit_error", "LeftErr"),
-                      ("jump_x1", "Jump")):
-        _var(m, f"rpSeven{name}Max", ds, sid, var, eps=eps[0])
-        _var(m, f"rpSeven{name}Min", ds, sid, var, eps=eps[-1])
-    m.add("rpSevenIdentityErr", float(ds.identity_error_x1.max()),
-          "derived: max identity_error_x1 over eps", 2)
-
-
-def fig07_table(ds) -> str:
-    rows = []
-    for e in ds.eps.values:
-        d = ds.sel(eps=e)
-        rate = float(d.rate_first_order)
-        rows.append(" & ".join([
-            f"${_eps_label(e)}$", f"${num(float(d.P_left), 5)}$", f"${num(float(d.left_limit_error), 2)}$",
-            f"${num(float(d.error_printed))}$", f"${num(float(d.error_zero_order))}$",
-            f"${num(float(d.error_first_order))}$",
-            "--" if math.isnan(rate) else f"${num(rate, 2)}$"]) + r" \\")
-    return _tabular("rrrrrrr", [_head(
-        r"$\epsilon$", r"$P_\mathrm{DM}(0^-)$", r"$|P_\mathrm{DM}(0^-)$//$-s_0|$", "printed",
-        r"$\xi_1+s_0$", "corrected//1st order", "rate")], rows)
-
-
-def fig08(ds, m: Macros):
-    sid = "fig08_s0theta"
-    th = ds.theta.values
-    m.add("rpEightThetaMin", float(th[0]), f"{sid}:theta[0]")
-    m.add("rpEightThetaMax", float(th[-1]), f"{sid}:theta[-1]")
-    m.add("rpEightN", th.size, f"{sid}:theta (size)")
-    m.add("rpEightLambertRoot", float(np.max(np.abs(ds.s0.values - ds.s0_root.values))),
-          "derived: max |s0 - s0_root|", 2)
-    m.add("rpEightResidual", float(np.max(np.abs(ds.residual.values))), "derived: max |residual|", 2)
-    m.add("rpEightMargin", float(np.min(ds.s0.values + th)), "derived: min (s0 + theta) > 0", 3)
-    m.add("rpEightSmallRatio", float(ds.s0.values[-1] / (-2 * th[-1] / (1 - th[-1]))),
-          "derived: s0 / (-2 theta/(1-theta)) at theta[-1]", 5)
-
-
-def fig09(ds, m: Macros):
-    sid = "fig09_pdm_theta_pos"
-    eps = [float(e) for e in ds.eps.values]
-    m.add("rpNineTheta", _f(ds, "theta"), _src(sid, "theta"))
-    _var(m, "rpNineSlopeTheory", ds, sid, "slope_theory")
-    m.add("rpNineEpsMax", eps[0], f"{sid}:eps[0]")
-    m.add("rpNineEpsMin", eps[-1], f"{sid}:eps[-1]")
-    _var(m, "rpNineXiLeft", ds, sid, "xi1_left")
-    m.add("rpNineCore", float(ds.attrs["core"]), f"{sid}:attrs.core")
-    m.add("rpNineXiMin", float(ds.attrs["xi1_min"]), f"{sid}:attrs.xi1_min")
-    m.add("rpNineRateCore", float(ds.attrs["rate_core_fit"]), f"{sid}:attrs.rate_core_fit", 3)
-    for var, name in (("error_printed", "ErrPrinted"), ("error", "Err"),
-                      ("error_core", "ErrCore"), ("slope_left", "SlopeLeft")):
-        _var(m, f"rpNine{name}Max", ds, sid, var, sig=4 if var == "slope_left" else 3, eps=eps[0])
-        _var(m, f"rpNine{name}Min", ds, sid, var, sig=4 if var == "slope_left" else 3, eps=eps[-1])
-    _var(m, "rpNineSlideLimitMax", ds, sid, "sliding_limit_xi2", eps=eps[0])
-
-
-def fig09_table(ds) -> str:
-    rows = []
-    for e in ds.eps.values:
-        d = ds.sel(eps=e)
-        rate = float(d.rate_core)
-        rows.append(" & ".join([
-            f"${_eps_label(e)}$", f"${num(float(d.slope_left), 4)}$",
-            f"${num(float(d.error_printed))}$", f"${num(float(d.error))}$",
-            f"${num(float(d.error_core))}$", "--" if math.isnan(rate) else f"${num(rate, 3)}$",
-            f"${num(float(d.sliding_limit_xi2))}$"]) + r" \\")
-    return _tabular("rrrrrrr", [_head(
-        r"$\epsilon$", r"$P_\mathrm{DM}(\xi_1^-)$//$/\xi_1^-$", "printed", "corrected",
-        "corrected,//core", "rate//(core)", r"$\xi_2$, sliding//limit")], rows)
-
-
 # ----------------------------------------------------------------------------- optional data
-def _tabular(cols, head, rows) -> str:
+def tabular(cols, head, rows) -> str:
     return "\n".join([rf"\begin{{tabular}}{{@{{}}{cols}@{{}}}}", r"\toprule", *head,
                       r"\midrule", *rows, r"\bottomrule", r"\end{tabular}"]) + "\n"
 
 
-def _head(*cells: str) -> str:
+def head(*cells: str) -> str:
     """A header row; a cell with a line break ``//`` is set on two lines (the tables
     keep to the text width at the body font size instead of being shrunk)."""
     def stack(cell):
@@ -378,7 +154,7 @@ def _head(*cells: str) -> str:
     return " & ".join(stack(c) for c in cells) + r" \\"
 
 
-def _not_yet(what: str, path: str) -> str:
+def not_yet(what: str, path: str) -> str:
     return (rf"\emph{{{what}: {NOT_YET}}} (\texttt{{{tex_escape(path)}}} is absent; the table "
             r"fills in when the workflow is rerun after it has been produced).") + "\n"
 
@@ -407,7 +183,7 @@ def scalar_table(ds: xr.Dataset, max_rows: int = 40) -> str:
             break
     if not rows:
         return r"\emph{(the dataset holds no scalar variables)}" + "\n"
-    return _tabular("lp{0.5\\textwidth}r", [r"variable & meaning & value \\"], rows)
+    return tabular("lp{0.5\\textwidth}r", [r"variable & meaning & value \\"], rows)
 
 
 def table_frame(ds: xr.Dataset, max_rows: int = 30) -> str:
@@ -427,48 +203,7 @@ def table_frame(ds: xr.Dataset, max_rows: int = 30) -> str:
     rows = [" & ".join(_cell(r[c]) for c in cols) + r" \\" for _, r in df.head(max_rows).iterrows()]
     if len(df) > max_rows:
         rows.append(rf"\multicolumn{{{len(cols)}}}{{l}}{{\emph{{\dots\ {len(df) - max_rows} more rows in the dataset}}}} \\")
-    return _tabular("l" * len(dims) + "r" * len(names), [head], rows)
-
-
-def dry_friction(ds10, ds11, m: Macros) -> tuple[str, str]:
-    """Macros for the findings of the dry-friction scenes (each read from the
-    variable that holds it, when present) and a table of their scalars."""
-    m.flag("rpHaveTen", ds10 is not None)
-    m.flag("rpHaveEleven", ds11 is not None)
-    if ds10 is not None:
-        for var, name, sig in (("v_hopf", "rpTenVHopf", 10), ("v_hopf_numeric", "rpTenVHopfNum", 10),
-                               ("v_gs", "rpTenVGS", 9), ("v_gs_branch", "rpTenVGSBranch", 9),
-                               ("x1_gs", "rpTenXGS", 5), ("period_gs", "rpTenPeriodGS", 5),
-                               ("F_c_static", "rpTenStatic", 3)):
-            if var in ds10:
-                _var(m, name, ds10, "fig10_dfo", var, sig)
-            else:
-                m.add(name, None, f"fig10_dfo:{var} (missing)", text=r"\emph{(" + var + " missing)}")
-        if "ss_multiplier" in ds10:
-            m.add("rpTenSSMultMax", float(np.nanmax(ds10.ss_multiplier.values)),
-                  "derived:max(fig10_dfo:ss_multiplier)", 2)
-        if "po_multiplier" in ds10:
-            m.add("rpTenPOMultMin", float(np.nanmin(ds10.po_multiplier.values)),
-                  "derived:min(fig10_dfo:po_multiplier)", 5)
-    if ds11 is not None:
-        for var, name in (("chi_minus", "rpElevenChi"), ("chi_minus_literal", "rpElevenChiLit"),
-                          ("sticking_a", "rpElevenA"), ("sticking_b", "rpElevenB"),
-                          ("sticking_a_literal", "rpElevenALit"),
-                          ("sticking_b_literal", "rpElevenBLit")):
-            if var in ds11:
-                _var(m, name, ds11, "fig11_dfo_retmaps", var, 3)
-        for k, key in ((0, "A"), (1, "B")):
-            if "panel" not in ds11.dims or ds11.sizes["panel"] <= k:
-                continue
-            for var, name, sig in (("eps", "Eps", 3), ("v0_sn", "VSN", 8), ("x1_sn", "XSN", 6),
-                                   ("sliding_length_sn", "SlideSN", 3),
-                                   ("sliding_time_sn", "SlideTimeSN", 3)):
-                if var in ds11:
-                    _var(m, f"rpEleven{name}{key}", ds11, "fig11_dfo_retmaps", var, sig, panel=k)
-    tab10 = scalar_table(ds10) if ds10 is not None else _not_yet("fig10", "results/fig10_dfo.nc")
-    tab11 = scalar_table(ds11) if ds11 is not None else _not_yet("fig11",
-                                                                 "results/fig11_dfo_retmaps.nc")
-    return tab10, tab11
+    return tabular("l" * len(dims) + "r" * len(names), [head], rows)
 
 
 #: the methods as the work-precision table names them (short: the table fits the page)
@@ -526,7 +261,7 @@ def bench(ds, m: Macros, effects=None) -> str:
     sid = "work_precision"
     m.flag("rpHaveBench", ds is not None)
     if ds is None:
-        return _not_yet("Work--precision sweep", "results/work_precision.nc")
+        return not_yet("Work--precision sweep", "results/work_precision.nc")
     if "method" not in ds.coords or "problem" not in ds.dims:
         return table_frame(ds)
     names = [str(p) for p in ds.problem.values]
@@ -539,11 +274,11 @@ def bench(ds, m: Macros, effects=None) -> str:
     for i, p in enumerate(names[:4]):
         key = "ABCD"[i]
         m.add(f"rpBenchSpeedup{key}", float(ds.speedup_vs_rk45.values[i]),
-              _src(sid, f"speedup_vs_rk45[{i}]"), 2)
+              source(sid, f"speedup_vs_rk45[{i}]"), 2)
         m.add(f"rpBenchFloor{key}", float(ds.reference_check.values[i]),
-              _src(sid, f"reference_check[{i}]"), 2)
+              source(sid, f"reference_check[{i}]"), 2)
         m.add(f"rpBenchPoints{key}", float(ds.n_points.values[i]),
-              _src(sid, f"n_points[{i}]"), 4)
+              source(sid, f"n_points[{i}]"), 4)
         ok = ds.status.values[i] == "ok"
         for tag, family in (("RK", "solve_ivp RK45"), ("DOP", "solve_ivp DOP853")):
             sel = (fam == family) & ok
@@ -580,8 +315,8 @@ def hard_cases(ds, m: Macros) -> str:
     jump/eps (theta < 0), one-sided slope (theta > 0), chatter period, slide-in."""
     m.flag("rpHaveHardCases", ds is not None)
     if ds is None:
-        return (_not_yet("Hard-case eps sweep", "results/hard_cases.nc"),
-                _not_yet("Sliding return sweep", "results/hard_cases.nc"))
+        return (not_yet("Hard-case eps sweep", "results/hard_cases.nc"),
+                not_yet("Sliding return sweep", "results/hard_cases.nc"))
     sid = "hard_cases"
     eps = [float(e) for e in ds.eps.values]
     kmax, kmin = int(np.argmax(eps)), int(np.argmin(eps))
@@ -597,20 +332,20 @@ def hard_cases(ds, m: Macros) -> str:
                             ("slide_start_over_eps", "SlideStart", 3),
                             ("kernel_start", "KernelStart", 3)):
         m.add(f"rpHard{name}", float(ds.attrs[attr]), f"{sid}:attrs.{attr}", sig)
-    _var(m, "rpHardJumpFirst", ds, sid, "jump_over_eps", sig=5, eps=eps[kmax])
-    _var(m, "rpHardJumpLast", ds, sid, "jump_over_eps", sig=5, eps=eps[kmin])
+    var(m, "rpHardJumpFirst", ds, sid, "jump_over_eps", sig=5, eps=eps[kmax])
+    var(m, "rpHardJumpLast", ds, sid, "jump_over_eps", sig=5, eps=eps[kmin])
     from .analytic.s0 import s0_lambert
     mu, omega = float(ds.attrs["mu"]), float(ds.attrs["omega"])
     pred = float(s0_lambert(np.array([float(ds.attrs["jump_theta"])]))[0]) \
         * math.exp(-3 * math.pi * mu / omega)
     m.add("rpHardJumpPred", pred, "derived: s0(jump_theta) exp(-3 pi mu/omega)", 5)
     if len(eps) > 1:
-        m.add("rpHardJumpDiffLast", abs(_f(ds, "jump_over_eps", eps=eps[kmin])
-                                        - _f(ds, "jump_over_eps", eps=sorted(eps)[1])),
+        m.add("rpHardJumpDiffLast", abs(value(ds, "jump_over_eps", eps=eps[kmin])
+                                        - value(ds, "jump_over_eps", eps=sorted(eps)[1])),
               "derived: |difference of jump_over_eps| between the two smallest eps", 2)
     m.add("rpHardSlopeMin", float(ds.slope.min()), "derived: min slope over eps", 3)
     m.add("rpHardSlopeMax", float(ds.slope.max()), "derived: max slope over eps", 3)
-    _var(m, "rpHardPeriodOverEps", ds, sid, "chatter_period_over_eps", sig=6, eps=eps[kmin])
+    var(m, "rpHardPeriodOverEps", ds, sid, "chatter_period_over_eps", sig=6, eps=eps[kmin])
     m.add("rpHardPeriodDev", float(ds.chatter_period_max_rel_dev.max()),
           "derived: max chatter_period_max_rel_dev over eps", 2)
     m.add("rpHardSlideOffset", float(np.abs(ds.slide_start_offset).max()),
@@ -623,16 +358,16 @@ def hard_cases(ds, m: Macros) -> str:
     for e in eps:
         d = ds.sel(eps=e)
         maps.append(" & ".join([
-            f"${_eps_label(e)}$", f"${num(float(d.jump_over_eps), 6)}$",
+            f"${eps_tex(e)}$", f"${num(float(d.jump_over_eps), 6)}$",
             f"${num(float(d.slope), 4)}$", f"${num(float(d.slope_probe), 2)}$"]) + r" \\")
         chatter.append(" & ".join([
-            f"${_eps_label(e)}$", f"${num(float(d.chatter_period_over_eps), 6)}$",
+            f"${eps_tex(e)}$", f"${num(float(d.chatter_period_over_eps), 6)}$",
             f"${num(float(d.chatter_period_max_rel_dev), 2)}$",
             f"${num(float(d.slide_start_offset), 2)}$", f"${num(float(d.slide_final_abs_x), 2)}$",
             f"${num(float(d.kernel_final_abs_x), 2)}$"]) + r" \\")
     # the return maps, then the pseudo-equilibrium (two tabulars: one would not fit)
-    table = _tabular("rrrr", [_head(r"$\epsilon$", r"jump$/\epsilon$", "slope", "$x_2-1$")],
-                     maps) + "\n\\medskip\n\n" + _tabular("rrrrrr", [_head(
+    table = tabular("rrrr", [head(r"$\epsilon$", r"jump$/\epsilon$", "slope", "$x_2-1$")],
+                     maps) + "\n\\medskip\n\n" + tabular("rrrrrr", [head(
                          r"$\epsilon$", r"period//$/\epsilon$", "period//dev.",
                          r"slide start//$+(1-\theta)\epsilon$", "final//$|x|$",
                          "final $|x|$,//kernel")], chatter)
@@ -660,47 +395,47 @@ def _hard_return(ds, m: Macros, eps: list) -> str:
     for k, e in enumerate(eps):
         d = ds.sel(eps=e)
         rows.append(" & ".join([
-            f"${_eps_label(e)}$", f"${num(float(gap[k]), 3)}$", f"${num(float(scaled[k]), 4)}$",
+            f"${eps_tex(e)}$", f"${num(float(gap[k]), 3)}$", f"${num(float(scaled[k]), 4)}$",
             f"${num(float(d.return_sliding_time), 5)}$", f"${int(d.return_steps)}$",
             "Radau" if int(d.return_stiff) else "DOP853"]) + r" \\")
-    return _tabular("rrrrrl", [
+    return tabular("rrrrrl", [
         r"$\epsilon$ & $|P_0-P|$ & $|P_0-P|/\epsilon^2$ & sliding time & steps & "
         r"sliding by \\"], rows)
 
 
 # ----------------------------------------------------------------------------- entry point
-FIGS = {"fig01_slidesketch": fig01, "fig02_cases": fig02, "fig03_grazingsketch": fig03,
-        "fig04_retmaps": fig04, "fig05_thetalt0mfs": fig05, "fig06_sgraph": fig06,
-        "fig07_pdm_theta_neg": fig07, "fig08_s0theta": fig08, "fig09_pdm_theta_pos": fig09}
+def _scene_modules() -> list:
+    """(id, figure module) of every scene, in id order (the order of the macros)."""
+    import importlib
+
+    from .scenes import known_scenes
+    return [(sid, importlib.import_module(f".plotting.{sid}", __package__))
+            for sid in known_scenes()]
 
 
 def generate(datasets: Mapping[str, Optional[xr.Dataset]]) -> dict[str, str]:
-    """All generated LaTeX files, keyed by file name. Core datasets are required."""
-    missing = [sid for sid in CORE if datasets.get(sid) is None]
+    """All generated LaTeX files, keyed by file name. The datasets of scenes that do
+    not declare ``REPORT_OPTIONAL`` are required."""
+    modules = _scene_modules()
+    missing = [sid for sid, mod in modules
+               if datasets.get(sid) is None and not getattr(mod, "REPORT_OPTIONAL", False)]
     if missing:
         raise ValueError(f"report needs the datasets of {', '.join(missing)}")
     m = Macros()
-    for sid, fn in FIGS.items():
+    texts = {}
+    for sid, mod in modules:
         try:
-            fn(datasets[sid], m)
+            table = mod.report(datasets.get(sid), m)
         except KeyError as exc:
             raise KeyError(f"{sid}: the report reads {exc} but the dataset lacks it") from None
-    tab10, tab11 = dry_friction(datasets.get("fig10_dfo"), datasets.get("fig11_dfo_retmaps"), m)
+        texts[f"{sid}.tex"] = table if table is not None else f"% {sid}: no table\n"
     tab_bench = bench(datasets.get("work_precision"), m, datasets.get("bench_effect_cost"))
     try:
         tab_hard, tab_return = hard_cases(datasets.get("hard_cases"), m)
     except KeyError as exc:
         raise KeyError(f"hard_cases: the report reads {exc} but the dataset lacks it") from None
-    return {
-        "macros.tex": m.tex(),
-        "tab_fig07.tex": fig07_table(datasets["fig07_pdm_theta_neg"]),
-        "tab_fig09.tex": fig09_table(datasets["fig09_pdm_theta_pos"]),
-        "tab_fig10.tex": tab10,
-        "tab_fig11.tex": tab11,
-        "tab_bench.tex": tab_bench,
-        "tab_hard_cases.tex": tab_hard,
-        "tab_hard_return.tex": tab_return,
-    }
+    return {"macros.tex": m.tex(), **texts, "tab_bench.tex": tab_bench,
+            "tab_hard_cases.tex": tab_hard, "tab_hard_return.tex": tab_return}
 
 
 def read_macros(text: str) -> dict:

@@ -27,7 +27,7 @@ import numpy as np
 from scipy.integrate import DOP853, Radau
 from scipy.optimize import brentq
 
-from . import checks, variational
+from . import checks, rules, variational
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 
 
@@ -56,7 +56,7 @@ class Section:
 
     A start point on the section is not a hit, also when rounding puts it a hair
     before the section (a crossing in the run's first sample interval within
-    ``START_ULPS`` rounding errors of the start): a return map started on its
+    ``rules.START_ULPS`` rounding errors of the start): a return map started on its
     section gives the next return, never ``P(z) = z`` at t ~ 1e-17. ``min_time``
     skips crossings that are genuinely close to the start.
 
@@ -169,6 +169,20 @@ class _ExactStepper:
         return ta, tb, lambda tt: flow(za, np.asarray(tt, dtype=float) - t0)
 
 
+@functools.lru_cache(maxsize=1)
+def _blas_controller():
+    from threadpoolctl import ThreadpoolController
+    return ThreadpoolController()
+
+
+def _one_blas_thread():
+    """Radau factorises its Newton matrices with LAPACK. OpenBLAS takes another code
+    path with more than one thread, and the result moves in the last bits (the
+    eps = 1e-4 sliding return differed between OPENBLAS_NUM_THREADS=1, as in a
+    Snakemake job, and the default): one thread makes it the same everywhere."""
+    return _blas_controller().limit(limits=1, user_api="blas")
+
+
 class _IntegratingStepper:
     """DOP853 (explicit), or Radau (implicit, for a stiff field), with dense output."""
 
@@ -213,7 +227,11 @@ class _IntegratingStepper:
             # scipy's Radau reads its atol afresh in every step
             s.atol = np.maximum(self.atol, NOISE_STEPS * s.step_size * self.noise)
             self.atol_used = max(self.atol_used, float(np.max(s.atol)))
-        msg = s.step()
+        if self.method is Radau:
+            with _one_blas_thread():
+                msg = s.step()
+        else:
+            msg = s.step()
         if s.status == "failed":
             if self.non_finite is not None:  # the step size collapsed on a NaN or inf
                 raise SimulationError(
@@ -340,44 +358,6 @@ def _refine(fun, pred, ta, tb, va, vb, xtol):
     return r
 
 
-_EPS = float(np.finfo(float).eps)
-
-
-# The next two functions are the rule for both engines: plain scalar code that
-# fastmap compiles with numba as it stands (no second copy to keep equal).
-def _same_instant(xtol, t):
-    """Events closer than this are one instant to the solver: each root is located
-    to xtol + 4 eps |t| (brentq's tolerance) and then stepped to its far side."""
-    return 4.0 * (xtol + 4.0 * _EPS * abs(t))
-
-
-#: A section crossing in the first sample interval of a run that lies within
-#: START_ULPS rounding errors (eps times the largest component of the state) of
-#: the start point is the start itself, put a hair before the section by rounding:
-#: not a hit. Ignored rather than an error, because a start exactly on the section
-#: is no hit either (no sign change), and one rounding error must not change the
-#: return. The test is in state, not in time: the time to cross is rounding over
-#: speed, far above event_xtol for a slow field and far below it for a fast one.
-#: The crossing point is interpolated between the start and the refined root,
-#: since brentq places that up to event_xtol past the crossing, which a fast field
-#: turns into a movement far above rounding. Within one sample interval nothing
-#: the sampling resolves returns to the start, so a periodic orbit's genuine
-#: return P(z) = z is never taken for this.
-START_ULPS = 64
-
-
-def _starts_on_section(s0, z0, sr, zr):
-    """The start ``z0`` (section value ``s0``) lies on the section up to rounding,
-    given the refined root ``zr`` (section value ``sr``); 1-D float arrays."""
-    # linear interpolation to the crossing; sr is on the far side, so the fraction is <= 1
-    frac = min(1.0, abs(s0) / abs(s0 - sr)) if s0 != sr else 1.0
-    size, moved = 0.0, 0.0
-    for k in range(z0.size):
-        size = max(size, abs(z0[k]), abs(zr[k]))
-        moved = max(moved, abs(zr[k] - z0[k]))
-    return frac * moved <= START_ULPS * _EPS * size
-
-
 #: central-difference step (relative to the state's size) and the tolerance of
 #: _slides_in: truncation and rounding of the differences are ~1e-10 relative
 _FD_STEP = np.cbrt(np.finfo(float).eps)
@@ -417,21 +397,16 @@ def _refuse_sliding_in_sections(system, sections, z, t) -> None:
 
 # --------------------------------------------------------------------------- driver
 def initial_mode(system: PiecewiseSystem, z: np.ndarray, touch_tol: float) -> tuple[int, str]:
-    """Region to start in; on H = 0 (to ``touch_tol``) the field directions decide,
-    so a start point that rounding puts a hair on the wrong side is not a switch."""
+    """Region to start in; on H = 0 (to ``touch_tol``) the field directions decide
+    (:func:`filippov.rules.start_on_switch`), so a start point that rounding puts a
+    hair on the wrong side is not a switch."""
     H = float(system.switch(z))
-    if abs(H) > touch_tol:
-        return (PLUS if H > 0 else MINUS), "start"
+    side = rules.start_side(H, touch_tol)
+    if side != SLIDING:
+        return side, "start"
     a, b = (float(v) for v in system.normal_speeds(z))
-    if a > 0 and b < 0:
-        return (SLIDING if system.sliding else PLUS), "start"
-    if a < 0 and b < 0:
-        return MINUS, "start"
-    if a > 0 and b > 0:
-        return PLUS, "start"
-    if a < 0 < b:  # repelling sliding: either side is a solution; h >= 0 picks +
-        return PLUS, "repelling_start"
-    return (PLUS if H >= 0 else MINUS), "start"  # a tangency: the sign of H decides
+    mode, repelling = rules.start_on_switch(H, a, b, system.sliding)
+    return mode, ("repelling_start" if repelling else "start")
 
 
 def _quiet_floating_point(fn):
@@ -649,7 +624,7 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
                     f"event limit {max_events} hit: rapid switching near t={te!r}, "
                     f"state {ze.tolist()}")
             recent.append(te)
-            if len(recent) == recent.maxlen and recent[-1] - recent[0] <= zeno_span * max(1.0, abs(te)):
+            if len(recent) == recent.maxlen and rules.accumulates(recent[0], te, zeno_span):
                 raise ZenoError(
                     f"accumulation of switches: {recent.maxlen} switches within "
                     f"{recent[-1] - recent[0]:.3e} time units near t={te!r}, state "
@@ -692,18 +667,19 @@ def _switch_after_exit(system, mode, z, entered_by, touch_tol):
     return lambda zz: system.switch(zz) - h0
 
 
+_ENDED_BY = {"switch": rules.SWITCH, "exit_minus": rules.EXIT_MINUS, "exit_plus": rules.EXIT_PLUS}
+
+
 def _decide(system, mode, what, z):
-    """The Filippov decision at a point of H = 0 (eq:atSl)."""
+    """The Filippov decision at a point of H = 0 (:func:`filippov.rules.next_mode`),
+    with the kind of event it makes."""
     a, b = (float(v) for v in system.normal_speeds(z))
-    if what == "exit_minus":
-        return MINUS, "slide_end"
-    if what == "exit_plus":
-        return PLUS, "slide_end"
-    # arrived from H > 0 (F_+ points down) or from H < 0: sliding attracts when the
-    # field on the other side points back (a > 0, resp. b < 0)
-    attracts, across = (a > 0, MINUS) if mode == PLUS else (b < 0, PLUS)
-    if not attracts:
-        return across, "crossing"
+    ended_by = _ENDED_BY[what]
+    new_mode = rules.next_mode(mode, ended_by, a, b)
+    if ended_by != rules.SWITCH:
+        return new_mode, "slide_end"
+    if new_mode != SLIDING:
+        return new_mode, "crossing"
     if not system.sliding:
         raise _no_sliding(None, z)
     return SLIDING, "slide_start"
@@ -765,13 +741,13 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
                 # a section root at the instant of a switch (a section on H) is hit
                 # there, before the switch: the switch then follows at once on restart
                 if not (best is None or r < best[0]
-                        or (best[1] != "section" and r <= best[0] + _same_instant(xtol, best[0]))):
+                        or (best[1] != "section" and r <= best[0] + rules.same_instant(xtol, best[0]))):
                     continue
                 zr = Z(r)
                 if sec.where is not None and not sec.where(zr):
                     continue
                 if (i == 0 and ta == traj.t0
-                        and _starts_on_section(float(sv[0]), np.asarray(zs[:, 0], dtype=float),
+                        and rules.starts_on_section(float(sv[0]), np.asarray(zs[:, 0], dtype=float),
                                                float(sec.func(zr)), np.asarray(zr, dtype=float))):
                     continue
                 best = (r, "section", k)

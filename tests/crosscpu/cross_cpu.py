@@ -13,7 +13,11 @@ the one it runs on, then builds every figure there:
   (``NPY_DISABLE_CPU_FEATURES``), so numpy's own vector loops give way to the
   perturbed libm wherever the machine had something to switch;
 * ``NUMBA_CPU_NAME=generic`` with an empty numba cache: kernels compiled for
-  no particular CPU.
+  no particular CPU;
+* ``OPENBLAS_CORETYPE=Prescott``: OpenBLAS (numpy's and scipy's, built for every
+  x86 CPU and picking its kernels at load) runs its SSE3 kernels, as on a CPU
+  without AVX and FMA; LAPACK's LU in Radau's Newton steps then rounds differently
+  (the eps = 1e-4 sliding return of the hard-case sweep moves by 4e-16).
 
 Each emulated build must pass the manifest check (data within each variable's
 declared tolerance, figures by image). The emulated data are also compared
@@ -71,7 +75,8 @@ def build_shim(dest: Path) -> Path:
 
 def emulation_env(shim: Path, seed: int, cache: Path) -> dict:
     env = {"LD_PRELOAD": str(shim), "LASTBIT_SEED": str(seed), "NUMBA_CPU_NAME": "generic",
-           "NUMBA_CACHE_DIR": str(cache), "PYTHONDONTWRITEBYTECODE": "1"}
+           "NUMBA_CACHE_DIR": str(cache), "PYTHONDONTWRITEBYTECODE": "1",
+           "OPENBLAS_CORETYPE": "Prescott"}
     disable = manifest.numpy_simd()   # switched down to numpy's baseline
     if disable:
         env["NPY_DISABLE_CPU_FEATURES"] = " ".join(disable)

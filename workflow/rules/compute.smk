@@ -1,4 +1,4 @@
-# Compute one scene's dataset. The schema and the script are inputs and the
+# Compute one scene's dataset. The schema (and the scene's own block of it) and the script are inputs and the
 # library's hash is a param, so editing any of them reruns the scene. A failed
 # job leaves no results/<id>.nc: the library writes atomically and Snakemake
 # removes outputs of failed jobs.
@@ -6,7 +6,7 @@ import re
 
 import yaml
 
-from filippov.config import SceneError, check_limits, limits
+from filippov.config import SceneError, check_limits, limits, scene_schema_file
 
 
 def scene_chunks():
@@ -42,6 +42,13 @@ def scene_chunks():
     return found
 
 
+def own_schema(scene):
+    """The scene's own schema block, when it has one (an input: editing it reruns
+    that scene alone)."""
+    path = scene_schema_file(config["schema"], scene)
+    return [str(path)] if path.exists() else []
+
+
 CHUNKS = scene_chunks()
 CHUNKED_SCENES = "|".join(re.escape(s) for s in CHUNKS) or "(?!)"  # (?!): matches nothing
 
@@ -50,6 +57,7 @@ rule compute:
     input:
         scene="config/scenes/{scene}.yaml",
         schema=config["schema"],
+        own_schema=lambda wc: own_schema(wc.scene),
         script="workflow/scripts/compute_scene.py",
     output:
         report("results/{scene}.nc", caption="../report/dataset.rst", category="Datasets",
@@ -70,6 +78,7 @@ rule compute_chunk:
     input:
         scene="config/scenes/{scene}.yaml",
         schema=config["schema"],
+        own_schema=lambda wc: own_schema(wc.scene),
         script="workflow/scripts/compute_chunk.py",
     output:
         temp("results/chunks/{scene}/{chunk}.nc"),
@@ -86,6 +95,7 @@ rule merge_chunks:
     input:
         scene="config/scenes/{scene}.yaml",
         schema=config["schema"],
+        own_schema=lambda wc: own_schema(wc.scene),
         script="workflow/scripts/merge_chunks.py",
         chunks=lambda wc: [f"results/chunks/{wc.scene}/{i}.nc" for i in range(CHUNKS[wc.scene])],
     output:

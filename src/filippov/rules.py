@@ -1,0 +1,96 @@
+"""The decisions of the event-driven method, each written once.
+
+Plain scalar Python: :mod:`filippov.simulate` calls these functions as they are,
+and :mod:`filippov.fastmap` compiles the same functions with numba, so the two
+engines cannot drift apart on a decision (the engines differ only in how they
+step, sample and store). Modes are the integers of :mod:`filippov.system`;
+``a = grad H . F_-`` and ``b = grad H . F_+`` are the normal speeds (eq:atSl).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .system import MINUS, PLUS, SLIDING
+
+_EPS = float(np.finfo(float).eps)
+
+#: what ended a stay in a mode: a crossing of H (from region + or -), or, while
+#: sliding, a normal speed reaching zero (F_- or F_+ turning tangent to H)
+SWITCH, EXIT_MINUS, EXIT_PLUS = 0, 1, 2
+
+
+def start_side(H: float, touch_tol: float) -> int:
+    """PLUS or MINUS for a start off H (beyond ``touch_tol``); SLIDING (0) for a
+    start on H, where the field directions decide (:func:`start_on_switch`)."""
+    if abs(H) > touch_tol:
+        return PLUS if H > 0 else MINUS
+    return SLIDING
+
+
+def start_on_switch(H: float, a: float, b: float, sliding: bool) -> tuple[int, bool]:
+    """The mode a start on H begins in, and whether H repels there (either side
+    is a solution; region + is taken). A start that rounding puts a hair on the
+    wrong side is thereby no switch."""
+    if a > 0 and b < 0:
+        return (SLIDING if sliding else PLUS), False
+    if a < 0 and b < 0:
+        return MINUS, False
+    if a > 0 and b > 0:
+        return PLUS, False
+    if a < 0 < b:
+        return PLUS, True
+    return (PLUS if H >= 0 else MINUS), False  # a tangency: the sign of H decides
+
+
+def next_mode(mode: int, ended_by: int, a: float, b: float) -> int:
+    """The Filippov decision at a point of H = 0 (eq:atSl). A slide ends into the
+    region whose field turned tangent; a crossing from H > 0 (F_+ points down)
+    slides when F_- points back up (a > 0), one from H < 0 when F_+ points back
+    down (b < 0), and crosses otherwise."""
+    if ended_by == EXIT_MINUS:
+        return MINUS
+    if ended_by == EXIT_PLUS:
+        return PLUS
+    if mode == PLUS:
+        return SLIDING if a > 0 else MINUS
+    return SLIDING if b < 0 else PLUS
+
+
+def accumulates(oldest: float, newest: float, zeno_span: float) -> bool:
+    """The last zeno_count switches, from ``oldest`` to ``newest``, fall within
+    zeno_span (relative to |t| beyond 1): a Zeno point or chatter below the time
+    resolution."""
+    return newest - oldest <= zeno_span * max(1.0, abs(newest))
+
+
+def same_instant(xtol: float, t: float) -> float:
+    """Events closer than this are one instant to the solver: each root is located
+    to xtol + 4 eps |t| (brentq's tolerance) and then stepped to its far side."""
+    return 4.0 * (xtol + 4.0 * _EPS * abs(t))
+
+
+#: A section crossing in the first sample interval of a run that lies within
+#: START_ULPS rounding errors (eps times the largest component of the state) of
+#: the start point is the start itself, put a hair before the section by rounding:
+#: not a hit. Ignored rather than an error, because a start exactly on the section
+#: is no hit either (no sign change), and one rounding error must not change the
+#: return. The test is in state, not in time: the time to cross is rounding over
+#: speed, far above event_xtol for a slow field and far below it for a fast one.
+#: The crossing point is interpolated between the start and the refined root,
+#: since brentq places that up to event_xtol past the crossing, which a fast field
+#: turns into a movement far above rounding. Within one sample interval nothing
+#: the sampling resolves returns to the start, so a periodic orbit's genuine
+#: return P(z) = z is never taken for this.
+START_ULPS = 64
+
+
+def starts_on_section(s0, z0, sr, zr) -> bool:
+    """The start ``z0`` (section value ``s0``) lies on the section up to rounding,
+    given the refined root ``zr`` (section value ``sr``); 1-D float arrays."""
+    # linear interpolation to the crossing; sr is on the far side, so the fraction is <= 1
+    frac = min(1.0, abs(s0) / abs(s0 - sr)) if s0 != sr else 1.0
+    size, moved = 0.0, 0.0
+    for k in range(z0.size):
+        size = max(size, abs(z0[k]), abs(zr[k]))
+        moved = max(moved, abs(zr[k] - z0[k]))
+    return frac * moved <= START_ULPS * _EPS * size
