@@ -225,6 +225,7 @@ def _dense_eval(t, t_old, hs, y_old, F, out):
 # A segment of the current mode: exact flow from za at time sg[0], or the dense
 # output (F, y_old) of the integration step [sg[1], sg[1] + sg[2]] -- always
 # when sliding, and in regions + and - when sg[3] != 0 (a model without flows).
+# sg[4]: what the stay subtracts from H (rules.exit_shift; 0 but after a slide).
 @_jit
 def _zat(t, mode, sg, za, F, y_old, fns, p, out):
     if mode == SLIDING or sg[3] != 0.0:
@@ -238,7 +239,8 @@ def _zat(t, mode, sg, za, F, y_old, fns, p, out):
 @_jit
 def _fval(sel, t, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
     _zat(t, mode, sg, za, F, y_old, fns, p, wz)
-    return _scalar(sel, wz, fns, p, wg, wf)
+    v = _scalar(sel, wz, fns, p, wg, wf)
+    return v - sg[4] if sel == _S_H else v  # sg[4]: the stay's rules.exit_shift
 
 
 # ============================================================================= root finding
@@ -341,7 +343,7 @@ def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, s
             vals[0, k] = a
             vals[1, k] = b
         else:
-            vals[0, k] = fns[4](wz, p)
+            vals[0, k] = fns[4](wz, p) - sg[4]
             fns[5](wz, p, wg)
             if mode == PLUS:
                 fns[2](wz, p, wf)
@@ -354,7 +356,6 @@ def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, s
     return True
 
 
-# the reference driver's rules, compiled from their one source
 # the decisions, compiled from their one source (filippov.rules)
 _starts_on_section = _jit(rules.starts_on_section)
 _same_instant = _jit(rules.same_instant)
@@ -362,6 +363,7 @@ _start_side = _jit(rules.start_side)
 _start_on_switch = _jit(rules.start_on_switch)
 _next_mode = _jit(rules.next_mode)
 _accumulates = _jit(rules.accumulates)
+_exit_shift = _jit(rules.exit_shift)
 assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 
 
@@ -674,6 +676,7 @@ def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fo
     slide_time = 0.0
     slide_since = t
     n_recent = 0
+    sg[4] = 0.0
     while True:
         if t >= t_max:
             return NO_RETURN, t, n_switch, slide_time
@@ -799,6 +802,9 @@ def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fo
             oldest = recent[n_recent % zeno_count]
             if _accumulates(oldest, t, zeno_span):
                 return ZENO, t, n_switch, slide_time
+        sg[4] = 0.0
+        if mode == SLIDING and new_mode != SLIDING:
+            sg[4] = _exit_shift(new_mode, fns[4](z, p), touch_tol)
         mode = new_mode
 
 
@@ -831,7 +837,7 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
     dvals = np.empty(nsmax)
     svals = np.empty(nsmax)
     recent = np.empty(max(iopts[2], 1))
-    sg = np.zeros(4)
+    sg = np.zeros(5)
     za, y, f = np.zeros(n), np.zeros(n), np.zeros(n)
     y_old, f_old, ynew, ytmp, scale = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                                        np.zeros(n))

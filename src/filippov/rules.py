@@ -56,6 +56,20 @@ def next_mode(mode: int, ended_by: int, a: float, b: float) -> int:
     return SLIDING if b < 0 else PLUS
 
 
+def exit_shift(mode: int, h0: float, touch_tol: float) -> float:
+    """What a stay in region ``mode`` entered at a sliding exit subtracts from H:
+    the exit point's own H when it lies within touch_tol on the wrong side, else 0.
+    The exit is tangential, and a state one rounding below H would otherwise read
+    as an immediate crossing back (at eps = 1e-9 the Hopf example's exit point has
+    H = -2.2e-16 while dH/dt = 3e-14, below the 1e-7 noise of that speed: the driver
+    cycled slide_end -> slide_start at one instant into a ZenoError). A real return
+    across H from there is still a sign change of the shifted function."""
+    wrong_side = h0 < 0 if mode == PLUS else h0 >= 0
+    if wrong_side and abs(h0) <= touch_tol:
+        return h0
+    return 0.0
+
+
 def accumulates(oldest: float, newest: float, zeno_span: float) -> bool:
     """The last zeno_count switches, from ``oldest`` to ``newest``, fall within
     zeno_span (relative to |t| beyond 1): a Zeno point or chatter below the time

@@ -509,6 +509,7 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
     hits = [0] * len(sections)
     recent = deque(maxlen=zeno_count)
     n_switch = 0
+    shift = 0.0  # subtracted from H in this stay (rules.exit_shift)
     t = t0
     frac_integrated = np.linspace(0.0, 1.0, samples_per_step + 1)
     # An exact flow is evaluated EXACT_BLOCK windows at a time: the same sample
@@ -539,7 +540,7 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
         steps_in_mode, stepper_steps, stepper_t = 0, 0, t
         # Functions whose crossing ends this mode, with the mode they lead to.
         if mode != SLIDING:
-            switch = _switch_after_exit(system, mode, z, traj.events[-1].kind, touch_tol)
+            switch = system.switch if shift == 0.0 else (lambda zz, c=shift: system.switch(zz) - c)
             leave = [(switch, TO_NEG if mode == PLUS else TO_NONNEG, "switch")]
         else:
             leave = [(lambda zz: system.normal_speeds(zz)[0], TO_NONPOS, "exit_minus"),
@@ -639,6 +640,9 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
                         f"{MODE_NAMES[new_mode]}): ~{ahead:.3g} more switches to "
                         f"t_end={t_end!r} exceed max_events={max_events} (raise max_events "
                         f"if this rate does not last)")
+            # after a sliding exit the stay measures H from the exit point's rounding
+            shift = (rules.exit_shift(new_mode, float(system.switch(ze)), touch_tol)
+                     if kind == "slide_end" else 0.0)
             mode = new_mode
             traj.mode = mode
 
@@ -648,23 +652,6 @@ def _no_sliding(t, z) -> SlidingNotBuiltError:
     return SlidingNotBuiltError(
         f"attracting sliding reached at {at}state {z.tolist()}, but the system was built "
         "with sliding=False; build it with sliding=True to follow sliding")
-
-
-def _switch_after_exit(system, mode, z, entered_by, touch_tol):
-    """The switching function a stay in region ``mode`` watches. After a sliding exit
-    it is measured from the exit point when that lies within touch_tol on the wrong
-    side: the exit is tangential, and a state one rounding below H would otherwise
-    read as an immediate crossing back (at eps = 1e-9 the Hopf example's exit point
-    has H = -2.2e-16 while dH/dt = 3e-14, below the 1e-7 noise of that speed, and
-    the driver cycled slide_end -> slide_start at one instant into a ZenoError).
-    A real return across H from there is still a sign change of the shifted function."""
-    if entered_by != "slide_end":
-        return system.switch
-    h0 = float(system.switch(z))
-    wrong_side = h0 < 0 if mode == PLUS else h0 >= 0
-    if not (wrong_side and abs(h0) <= touch_tol):
-        return system.switch
-    return lambda zz: system.switch(zz) - h0
 
 
 _ENDED_BY = {"switch": rules.SWITCH, "exit_minus": rules.EXIT_MINUS, "exit_plus": rules.EXIT_PLUS}

@@ -1,0 +1,68 @@
+"""The decisions of the event-driven method are written once (filippov.rules):
+the reference driver calls them, the compiled engine compiles the same functions."""
+import itertools
+
+import numpy as np
+import pytest
+
+from filippov import fastmap, rules
+from filippov.system import MINUS, PLUS, SLIDING
+
+SPEEDS = (-1.0, -0.0, 0.0, 1e-300, 2.0)
+
+
+def test_the_compiled_engine_compiles_the_rules_themselves():
+    for compiled, source in ((fastmap._next_mode, rules.next_mode),
+                             (fastmap._start_side, rules.start_side),
+                             (fastmap._start_on_switch, rules.start_on_switch),
+                             (fastmap._accumulates, rules.accumulates),
+                             (fastmap._exit_shift, rules.exit_shift),
+                             (fastmap._same_instant, rules.same_instant),
+                             (fastmap._starts_on_section, rules.starts_on_section)):
+        assert compiled.py_func is source
+
+
+@pytest.mark.parametrize("mode", [PLUS, MINUS, SLIDING])
+def test_compiled_and_python_decide_alike(mode):
+    for ended, a, b in itertools.product((rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS),
+                                         SPEEDS, SPEEDS):
+        if mode == SLIDING and ended == rules.SWITCH:
+            continue
+        assert fastmap._next_mode(mode, ended, a, b) == rules.next_mode(mode, ended, a, b)
+    for H, a, b in itertools.product((-1e-17, 0.0, 1e-17), SPEEDS, SPEEDS):
+        for sliding in (True, False):
+            assert fastmap._start_on_switch(H, a, b, sliding) == rules.start_on_switch(H, a, b, sliding)
+
+
+def test_filippov_decision_table():
+    # from region +: F_- points back up (a > 0) -> slide, else cross into -
+    assert rules.next_mode(PLUS, rules.SWITCH, 1.0, -1.0) == SLIDING
+    assert rules.next_mode(PLUS, rules.SWITCH, -1.0, -1.0) == MINUS
+    # from region -: F_+ points back down (b < 0) -> slide, else cross into +
+    assert rules.next_mode(MINUS, rules.SWITCH, 1.0, -1.0) == SLIDING
+    assert rules.next_mode(MINUS, rules.SWITCH, 1.0, 1.0) == PLUS
+    assert rules.next_mode(SLIDING, rules.EXIT_PLUS, 1.0, 0.0) == PLUS
+    assert rules.next_mode(SLIDING, rules.EXIT_MINUS, 0.0, -1.0) == MINUS
+    # a start on H: sliding attracts, repels (either side; + is taken), or one side
+    assert rules.start_on_switch(0.0, 1.0, -1.0, True) == (SLIDING, False)
+    assert rules.start_on_switch(0.0, 1.0, -1.0, False) == (PLUS, False)
+    assert rules.start_on_switch(0.0, -1.0, 1.0, True) == (PLUS, True)
+    assert rules.start_on_switch(-1e-17, 0.0, 0.0, True) == (MINUS, False)
+    assert rules.start_side(2e-15, 1e-15) == PLUS and rules.start_side(-5e-16, 1e-15) == SLIDING
+
+
+def test_exit_shift_only_takes_up_rounding_on_the_wrong_side():
+    tol = 1e-15
+    assert rules.exit_shift(PLUS, -2.2e-16, tol) == -2.2e-16     # wrong side, rounding
+    assert rules.exit_shift(PLUS, 3e-16, tol) == 0.0             # right side
+    assert rules.exit_shift(PLUS, -1e-12, tol) == 0.0            # beyond rounding: a crossing
+    assert rules.exit_shift(MINUS, 2.2e-16, tol) == 2.2e-16
+    assert rules.exit_shift(MINUS, -1e-16, tol) == 0.0
+    assert fastmap._exit_shift(PLUS, -2.2e-16, tol) == -2.2e-16
+
+
+def test_zeno_span_is_relative_beyond_t_of_one():
+    assert rules.accumulates(0.0, 1e-10, 1e-10)
+    assert not rules.accumulates(0.0, 2e-10, 1e-10)
+    assert rules.accumulates(1e6 - 1e-5, 1e6, 1e-10)     # 1e-5 <= 1e-10 * 1e6
+    assert not np.isnan(rules.same_instant(1e-15, 1.0))
