@@ -154,6 +154,27 @@ def head(*cells: str) -> str:
     return " & ".join(stack(c) for c in cells) + r" \\"
 
 
+def per_eps_rows(ds, cells) -> list[str]:
+    """One table row per eps of ``ds``: ``cells(d)`` gives the cells after the eps
+    column for the selection ``d`` at that eps."""
+    rows = []
+    for e in ds.eps.values:
+        rows.append(" & ".join([f"${eps_tex(e)}$", *cells(ds.sel(eps=e))]) + r" \\")
+    return rows
+
+
+def rate_cell(rate: float, sig: int) -> str:
+    """A convergence rate, or a dash where there is none (the first eps)."""
+    return "--" if math.isnan(rate) else f"${num(rate, sig)}$"
+
+
+def absent(m: "Macros", flag: str, ds, what: str, path: str) -> Optional[str]:
+    """For an optional scene: sets the report's switch ``flag``; the "not yet
+    computed" text when ``ds`` is None, else None."""
+    m.flag(flag, ds is not None)
+    return not_yet(what, path) if ds is None else None
+
+
 def not_yet(what: str, path: str) -> str:
     return (rf"\emph{{{what}: {NOT_YET}}} (\texttt{{{tex_escape(path)}}} is absent; the table "
             r"fills in when the workflow is rerun after it has been produced).") + "\n"

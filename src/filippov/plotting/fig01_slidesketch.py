@@ -65,6 +65,7 @@ def draw(ds):
         st.panel_label(ax, f"({tag}) {case}")
     return fig
 
+
 # ----------------------------------------------------------------------------- report
 def report(ds, m: Macros) -> str | None:
     """The report's macros from this scene's dataset; returns its table (None: none)."""

@@ -106,6 +106,7 @@ def draw(ds):
     st.panel_label(ax_b, rf"(b) $\theta={neg:g}$, period $={float(ds.period) / eps:.3g}\,\varepsilon$")
     return fig
 
+
 # ----------------------------------------------------------------------------- report
 def report(ds, m: Macros) -> str | None:
     """The report's macros from this scene's dataset; returns its table (None: none)."""

@@ -82,6 +82,7 @@ def draw(ds):
     axes[0].set_ylabel(st.X2)
     return fig
 
+
 # ----------------------------------------------------------------------------- report
 def report(ds, m: Macros) -> str | None:
     """The report's macros from this scene's dataset; returns its table (None: none)."""

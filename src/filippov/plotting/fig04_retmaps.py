@@ -41,6 +41,7 @@ def draw(ds):
         ax.legend(loc="upper left")
     return fig
 
+
 # ----------------------------------------------------------------------------- report
 def _first_above(x, d0):
     d = x - 1.0

@@ -144,6 +144,7 @@ def _omega(ds) -> str:
     k = omega / np.pi
     return rf"{k:g}\pi" if np.isfinite(k) and abs(k - round(k)) < 1e-9 else f"{omega:g}"
 
+
 # ----------------------------------------------------------------------------- report
 def report(ds, m: Macros) -> str | None:
     """The report's macros from this scene's dataset; returns its table (None: none)."""

@@ -75,6 +75,7 @@ def draw(ds):
                            fill=False, ec="k", lw=st.LW_THIN, zorder=6))
     return fig
 
+
 # ----------------------------------------------------------------------------- report
 def report(ds, m: Macros) -> str | None:
     """The report's macros from this scene's dataset; returns its table (None: none)."""

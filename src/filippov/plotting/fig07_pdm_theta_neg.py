@@ -3,13 +3,11 @@ the first-order expansion for each eps (dashed) and its limit xi1 + s0 (black);
 (b) the largest deviation over xi1 < 0 against eps, log-log."""
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from matplotlib import colormaps
 
 from . import style as st
-from ..report import Macros, eps_tex, head, num, source, tabular, value, var
+from ..report import Macros, head, num, per_eps_rows, rate_cell, source, tabular, value, var
 
 VARS = ["P_DM", "P_first_order", "P_zero_order", "P_printed", "P_flow", "s0",
         "error_first_order", "error_zero_order", "error_printed", "left_limit_error"]
@@ -114,21 +112,17 @@ def draw(ds):
     bx.legend(loc="lower left", fontsize=6.5)
     return fig
 
+
 # ----------------------------------------------------------------------------- report
 def table(ds) -> str:
     """Convergence over eps, one row per eps."""
-    rows = []
-    for e in ds.eps.values:
-        d = ds.sel(eps=e)
-        rate = float(d.rate_first_order)
-        rows.append(" & ".join([
-            f"${eps_tex(e)}$", f"${num(float(d.P_left), 5)}$", f"${num(float(d.left_limit_error), 2)}$",
-            f"${num(float(d.error_printed))}$", f"${num(float(d.error_zero_order))}$",
-            f"${num(float(d.error_first_order))}$",
-            "--" if math.isnan(rate) else f"${num(rate, 2)}$"]) + r" \\")
+    def cells(d):
+        return [f"${num(float(d.P_left), 5)}$", f"${num(float(d.left_limit_error), 2)}$",
+                f"${num(float(d.error_printed))}$", f"${num(float(d.error_zero_order))}$",
+                f"${num(float(d.error_first_order))}$", rate_cell(float(d.rate_first_order), 2)]
     return tabular("rrrrrrr", [head(
         r"$\epsilon$", r"$P_\mathrm{DM}(0^-)$", r"$|P_\mathrm{DM}(0^-)$//$-s_0|$", "printed",
-        r"$\xi_1+s_0$", "corrected//1st order", "rate")], rows)
+        r"$\xi_1+s_0$", "corrected//1st order", "rate")], per_eps_rows(ds, cells))
 
 
 def report(ds, m: Macros) -> str | None:

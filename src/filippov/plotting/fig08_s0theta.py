@@ -29,6 +29,7 @@ def draw(ds):
     ax.legend(loc="upper right")
     return fig
 
+
 # ----------------------------------------------------------------------------- report
 def report(ds, m: Macros) -> str | None:
     """The report's macros from this scene's dataset; returns its table (None: none)."""

@@ -4,13 +4,11 @@ the grazing point with the linear map eq:p:pdm of slope (theta-1)/theta;
 (c) the largest deviation from the zero-order curve against eps, log-log."""
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from . import style as st
 from .fig07_pdm_theta_neg import eps_colours, eps_label, reference_slope
-from ..report import Macros, eps_tex, head, num, source, tabular, value, var
+from ..report import Macros, head, num, per_eps_rows, rate_cell, source, tabular, value, var
 
 VARS = ["P_DM", "P_zero_order", "P_printed", "P_linear", "P_reduced", "slope_theory",
         "error", "error_core", "error_printed"]
@@ -82,21 +80,17 @@ def draw(ds):
     bx.legend(loc="lower left", fontsize=6.5)
     return fig
 
+
 # ----------------------------------------------------------------------------- report
 def table(ds) -> str:
-    """Convergence over eps, one row per eps."""
-    rows = []
-    for e in ds.eps.values:
-        d = ds.sel(eps=e)
-        rate = float(d.rate_core)
-        rows.append(" & ".join([
-            f"${eps_tex(e)}$", f"${num(float(d.slope_left), 4)}$",
-            f"${num(float(d.error_printed))}$", f"${num(float(d.error))}$",
-            f"${num(float(d.error_core))}$", "--" if math.isnan(rate) else f"${num(rate, 3)}$",
-            f"${num(float(d.sliding_limit_xi2))}$"]) + r" \\")
+    """Convergence over eps with the core correction, one row per eps."""
+    def cells(d):
+        return [f"${num(float(d.slope_left), 4)}$", f"${num(float(d.error_printed))}$",
+                f"${num(float(d.error))}$", f"${num(float(d.error_core))}$",
+                rate_cell(float(d.rate_core), 3), f"${num(float(d.sliding_limit_xi2))}$"]
     return tabular("rrrrrrr", [head(
         r"$\epsilon$", r"$P_\mathrm{DM}(\xi_1^-)$//$/\xi_1^-$", "printed", "corrected",
-        "corrected,//core", "rate//(core)", r"$\xi_2$, sliding//limit")], rows)
+        "corrected,//core", "rate//(core)", r"$\xi_2$, sliding//limit")], per_eps_rows(ds, cells))
 
 
 def report(ds, m: Macros) -> str | None:

@@ -6,7 +6,7 @@ import numpy as np
 from matplotlib.patches import Circle, FancyArrowPatch, Rectangle
 
 from . import style as st
-from ..report import Macros, not_yet, scalar_table, var
+from ..report import Macros, absent, scalar_table, var
 
 VARS = ["v_hopf", "v_gs", "eq_v", "eq_x1", "eq_stable", "po_v", "po_x1", "po_stable",
         "ss_v", "ss_x1", "ss_stable", "nu", "F_c", "x1_gs"]
@@ -94,17 +94,18 @@ def draw(ds):
     st.panel_label(ax_c, "(c) bifurcation diagram")
     return fig
 
+
 # ----------------------------------------------------------------------------- report
 #: the report does without this scene (its section says "not yet computed")
 REPORT_OPTIONAL = True
 
 
 def report(ds, m: Macros) -> str:
-    """Macros for the findings (each read from the variable that holds it, when
-    present) and a table of the dataset's scalars; ``ds`` None: not computed."""
-    m.flag("rpHaveTen", ds is not None)
-    if ds is None:
-        return not_yet("fig10", "results/fig10_dfo.nc")
+    """Macros for the bifurcation diagram's findings (Hopf and grazing-sliding points,
+    multipliers), each when its variable is present, and a table of the scalars."""
+    missing = absent(m, "rpHaveTen", ds, "fig10", "results/fig10_dfo.nc")
+    if missing:
+        return missing
     for name_var, name, sig in (("v_hopf", "rpTenVHopf", 10), ("v_hopf_numeric", "rpTenVHopfNum", 10),
                                 ("v_gs", "rpTenVGS", 9), ("v_gs_branch", "rpTenVGSBranch", 9),
                                 ("x1_gs", "rpTenXGS", 5), ("period_gs", "rpTenPeriodGS", 5),

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import style as st
-from ..report import Macros, not_yet, scalar_table, var
+from ..report import Macros, absent, scalar_table, var
 
 VARS = ["P", "fixed_point", "sliding_length", "eps", "v0"]
 
@@ -80,17 +80,18 @@ def draw(ds):
                fontsize=7, frameon=False)
     return fig
 
+
 # ----------------------------------------------------------------------------- report
 #: the report does without this scene (its section says "not yet computed")
 REPORT_OPTIONAL = True
 
 
 def report(ds, m: Macros) -> str:
-    """Macros for the findings (each read from the variable that holds it, when
-    present) and a table of the dataset's scalars; ``ds`` None: not computed."""
-    m.flag("rpHaveEleven", ds is not None)
-    if ds is None:
-        return not_yet("fig11", "results/fig11_dfo_retmaps.nc")
+    """Macros for the return maps' findings (chi_-, the sticking interval, the
+    saddle-node of each panel), each when present, and a table of the scalars."""
+    missing = absent(m, "rpHaveEleven", ds, "fig11", "results/fig11_dfo_retmaps.nc")
+    if missing:
+        return missing
     for name_var, name in (("chi_minus", "rpElevenChi"), ("chi_minus_literal", "rpElevenChiLit"),
                            ("sticking_a", "rpElevenA"), ("sticking_b", "rpElevenB"),
                            ("sticking_a_literal", "rpElevenALit"),
