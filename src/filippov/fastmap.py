@@ -46,6 +46,7 @@ recorded (they change nothing in a return).
 from __future__ import annotations
 
 import warnings
+from collections import namedtuple
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
@@ -130,6 +131,10 @@ _ERR_EXP = -1.0 / (7 + 1)  # error estimator order 7
 # of a helper pays an atomic incref/decref per array argument, which was half the
 # run time. Only the kernel _batch allocates (its work arrays, once per call).
 _jit = njit(cache=True, _nrt=False)
+# the driver's pieces below (_window, _stay_*, _event) are inlined into _one at the
+# IR level: as separate calls they were 4-13% slower on the fig04/fig11 maps, each
+# call passing the named work arrays by value
+_jit_inline = njit(cache=True, _nrt=False, inline="always")
 
 
 # ============================================================================= predicates
@@ -646,166 +651,187 @@ def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
     return mode
 
 
-@_jit
-def _one(z0, fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
-         ts, vals, dvals, svals, recent, sg, za, y, f, y_old, f_old, K, ynew, ytmp, scale,
-         F, wz, wg, wf, wp, z, first_sw, slide_dz, slide_z0):
-    """First return of z0 (the state at the return, or where the run stopped, in z);
-    (status, t, n_switches, sliding_time). first_sw[0]: time of the first change of mode
-    (left untouched if there is none); slide_dz: the change of state summed over the
-    sliding stretches (counted like sliding_time)."""
-    rtol, atol, touch_tol, xtol = fopts[0], fopts[1], fopts[2], fopts[3]
-    zeno_span, max_step, hwin_slow, transient = fopts[4], fopts[5], fopts[6], fopts[7]
-    min_time = fopts[8]
-    max_events, max_steps, zeno_count = iopts[0], iopts[1], iopts[2]
-    n = z0.size
-    t = 0.0
-    for k in range(n):
-        slide_dz[k] = 0.0
-    for k in range(n):
-        z[k] = z0[k]
-        if not np.isfinite(z0[k]):
-            return BAD_START, t, 0, 0.0
-    mode = _initial_mode(z, fns, p, touch_tol, sliding, wg, wf, wp)
-    if mode == SLIDING and _slides_in(z, fns, p, wg, wf, wp, wz):
-        return SECTION_SLIDING, t, 0, 0.0
-    for k in range(n):
-        slide_z0[k] = z[k]
-    n_switch = 0
-    n_steps = 0
-    slide_time = 0.0
-    slide_since = t
-    n_recent = 0
-    sg[4] = 0.0
+#: what a batch runs with (compute_returns fills it; _batch builds it once per call)
+Settings = namedtuple("Settings", [
+    "t_max", "exact", "hwin", "hwin_slow", "transient", "sec_pred", "sliding",
+    "frac_ex", "frac_in", "rtol", "atol", "touch_tol", "xtol", "zeno_span", "max_step",
+    "min_time", "max_events", "max_steps", "zeno_count"])
+
+#: the kernel's named work arrays, allocated once per batch by _batch. count: switches,
+#: steps, entries in the Zeno ring; tally: time slid, start of the current slide
+Work = namedtuple("Work", [
+    "ts", "vals", "dvals", "svals", "recent", "sg", "za", "y", "f", "y_old", "f_old", "K",
+    "ynew", "ytmp", "scale", "F", "wz", "wg", "wf", "wp", "z", "first_sw", "slide_dz",
+    "slide_z0", "count", "tally"])
+
+_GO_ON = -1  # no event yet / the orbit goes on (never a returned status)
+
+
+@_jit_inline
+def _window(mode, ta, tb, frac, first, fns, p, s, w):
+    """Samples the segment [ta, tb] of the current mode and finds its earliest event:
+    (_GO_ON, tb, _W_NONE) if there is none (the state at tb in w.z), (OK, te, what)
+    at an event (its state in w.z), NO_RETURN at t_max, or an error (status, ta)."""
+    ns = frac.size
+    if not _sample(mode, ta, tb, frac, ns, w.sg, w.za, w.F, w.y_old, fns, p, w.ts, w.vals,
+                   w.dvals, w.svals, w.wz, w.wg, w.wf, w.wp, w.ynew):
+        return NON_FINITE, ta, _W_NONE
+    st, te, what = _find(mode, w.ts, ns, first, s.sec_pred, s.touch_tol, s.xtol, s.min_time,
+                         w.sg, w.za, w.F, w.y_old, fns, p, w.vals, w.dvals, w.svals, w.wz,
+                         w.wg, w.wf)
+    if st != OK:
+        return st, ta, _W_NONE
+    if what == _W_NONE:
+        for c in range(w.z.size):
+            w.z[c] = w.ynew[c]
+        return (NO_RETURN if tb >= s.t_max else _GO_ON), tb, _W_NONE
+    _zat(te, mode, w.sg, w.za, w.F, w.y_old, fns, p, w.z)
+    return OK, te, what
+
+
+@_jit_inline
+def _stay_exact(mode, t, fns, p, s, w):
+    """A stay in region + or - on the exact flow from the mode entry, in windows of
+    hwin during the fast transient after the entry, then hwin_slow; (status, t, what)."""
+    for k in range(w.z.size):
+        w.za[k] = w.z[k]
+    w.sg[0] = t
+    w.sg[3] = 0.0
+    ta, first = t, True
     while True:
-        if t >= t_max:
-            return NO_RETURN, t, n_switch, slide_time
-        if mode == SLIDING and not sliding:
-            return NO_SLIDING, t, n_switch, slide_time
-        first = True
-        what = _W_NONE
-        te = t
-        if mode != SLIDING and exact:
-            # the exact flow from the mode entry, in windows of hwin
-            for k in range(n):
-                za[k] = z[k]
-            sg[0] = t
-            sg[3] = 0.0
-            ns = frac_ex.size
-            ta = t
-            while True:
-                n_steps += 1
-                if n_steps > max_steps:
-                    return STEP_LIMIT, t, n_switch, slide_time
-                # windows of hwin during the fast transient after the mode entry, then hwin_slow
-                tb = min(ta + (hwin if ta - sg[0] < transient else hwin_slow), t_max)
-                if tb == ta:
-                    tb = np.nextafter(ta, np.inf)
-                if not _sample(mode, ta, tb, frac_ex, ns, sg, za, F, y_old, fns, p, ts, vals,
-                               dvals, svals, wz, wg, wf, wp, ynew):
-                    return NON_FINITE, ta, n_switch, slide_time
-                st, te, what = _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time,
-                                     sg, za, F, y_old, fns, p, vals, dvals, svals, wz, wg, wf)
-                if st != OK:
-                    return st, ta, n_switch, slide_time
-                first = False
-                if what == _W_NONE:
-                    t = tb
-                    for c in range(n):
-                        z[c] = ynew[c]
-                    if tb >= t_max:
-                        return NO_RETURN, t, n_switch, slide_time
-                    ta = tb
-                    continue
-                _zat(te, mode, sg, za, F, y_old, fns, p, z)
-                t = te
-                break
-        else:
-            # DOP853 from (t, z) to t_max with the mode's field (Filippov's when
-            # sliding; regions + and - of a model without exact flows)
-            sg[3] = 1.0
-            for k in range(n):
-                y[k] = z[k]
-            if not _checked_field(y, mode, True, fns, p, wg, wf, wp, f):
-                return NON_FINITE, t, n_switch, slide_time
-            h_abs = _dop_initial_step(mode, t, y, f, t_max, max_step, rtol, atol, fns, p, wg, wf, wp,
-                                      ynew, ytmp, scale)
-            ns = frac_in.size
-            tcur = t
-            while True:
-                n_steps += 1
-                if n_steps > max_steps:
-                    return STEP_LIMIT, t, n_switch, slide_time
-                ok, t_new, hstep, h_abs = _dop_step(mode, tcur, y, f, h_abs, t_max, max_step, rtol,
-                                                    atol, fns, p, wg, wf, wp, K, ynew, ytmp,
-                                                    scale)
-                if not ok:
-                    return STEP_FAILED, tcur, n_switch, slide_time
-                for k in range(n):
-                    y_old[k] = y[k]
-                    f_old[k] = f[k]
-                    y[k] = ynew[k]
-                    f[k] = K[_NS, k]
-                ta, tb = tcur, t_new
-                tcur = t_new
-                _dop_dense(mode, hstep, y_old, y, f_old, f, fns, p, wg, wf, wp, K, ytmp, F)
-                sg[1] = ta
-                sg[2] = tb - ta
-                if not _sample(mode, ta, tb, frac_in, ns, sg, za, F, y_old, fns, p, ts, vals,
-                               dvals, svals, wz, wg, wf, wp, ynew):
-                    return NON_FINITE, ta, n_switch, slide_time
-                st, te, what = _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time,
-                                     sg, za, F, y_old, fns, p, vals, dvals, svals, wz, wg, wf)
-                if st != OK:
-                    return st, ta, n_switch, slide_time
-                first = False
-                if what == _W_NONE:
-                    t = tb
-                    for c in range(n):
-                        z[c] = ynew[c]
-                    if tb >= t_max:
-                        return NO_RETURN, t, n_switch, slide_time
-                    continue
-                _zat(te, mode, sg, za, F, y_old, fns, p, z)
-                t = te
-                break
-        # ---- an event at (t, z)
-        if what == _W_SECTION:
-            if mode == SLIDING:
-                slide_time += t - slide_since
-                for k in range(n):
-                    slide_dz[k] += z[k] - slide_z0[k]
-            return OK, t, n_switch, slide_time
-        a, b = _speeds(z, fns, p, wg, wf, wp)
-        new_mode = _next_mode(mode, what, a, b)  # what: rules.SWITCH/EXIT_MINUS/EXIT_PLUS
-        if new_mode == SLIDING and not sliding:
-            return NO_SLIDING, t, n_switch, slide_time
-        if new_mode == SLIDING and mode != SLIDING and _slides_in(z, fns, p, wg, wf, wp, wz):
-            return SECTION_SLIDING, t, n_switch, slide_time
+        w.count[1] += 1
+        if w.count[1] > s.max_steps:
+            return STEP_LIMIT, ta, _W_NONE
+        tb = min(ta + (s.hwin if ta - w.sg[0] < s.transient else s.hwin_slow), s.t_max)
+        if tb == ta:
+            tb = np.nextafter(ta, np.inf)
+        st, t, what = _window(mode, ta, tb, s.frac_ex, first, fns, p, s, w)
+        if st != _GO_ON:
+            return st, t, what
+        ta, first = tb, False
+
+
+@_jit_inline
+def _stay_integrated(mode, t, fns, p, s, w):
+    """A stay integrated by DOP853 with the mode's field (Filippov's when sliding;
+    regions + and - of a model without exact flows); (status, t, what)."""
+    n = w.z.size
+    w.sg[3] = 1.0
+    for k in range(n):
+        w.y[k] = w.z[k]
+    if not _checked_field(w.y, mode, True, fns, p, w.wg, w.wf, w.wp, w.f):
+        return NON_FINITE, t, _W_NONE
+    h_abs = _dop_initial_step(mode, t, w.y, w.f, s.t_max, s.max_step, s.rtol, s.atol, fns, p,
+                              w.wg, w.wf, w.wp, w.ynew, w.ytmp, w.scale)
+    ta, first = t, True
+    while True:
+        w.count[1] += 1
+        if w.count[1] > s.max_steps:
+            return STEP_LIMIT, ta, _W_NONE
+        ok, tb, hstep, h_abs = _dop_step(mode, ta, w.y, w.f, h_abs, s.t_max, s.max_step, s.rtol,
+                                         s.atol, fns, p, w.wg, w.wf, w.wp, w.K, w.ynew, w.ytmp,
+                                         w.scale)
+        if not ok:
+            return STEP_FAILED, ta, _W_NONE
+        for k in range(n):
+            w.y_old[k] = w.y[k]
+            w.f_old[k] = w.f[k]
+            w.y[k] = w.ynew[k]
+            w.f[k] = w.K[_NS, k]
+        _dop_dense(mode, hstep, w.y_old, w.y, w.f_old, w.f, fns, p, w.wg, w.wf, w.wp, w.K,
+                   w.ytmp, w.F)
+        w.sg[1] = ta
+        w.sg[2] = tb - ta
+        st, t, what = _window(mode, ta, tb, s.frac_in, first, fns, p, s, w)
+        if st != _GO_ON:
+            return st, t, what
+        ta, first = tb, False
+
+
+@_jit_inline
+def _end_slide(t, w):
+    """Counts the slide that ends at t (time, and change of state)."""
+    w.tally[0] += t - w.tally[1]
+    for k in range(w.z.size):
+        w.slide_dz[k] += w.z[k] - w.slide_z0[k]
+
+
+@_jit_inline
+def _event(mode, t, what, fns, p, s, w):
+    """The event ``what`` at (t, w.z): a section hit ends the run (OK); a switch is
+    decided (rules.next_mode) and counted against the limits and the Zeno ring.
+    (status, mode to go on in); status _GO_ON unless the run ends here."""
+    if what == _W_SECTION:
         if mode == SLIDING:
-            slide_time += t - slide_since
-            for k in range(n):
-                slide_dz[k] += z[k] - slide_z0[k]
-        if new_mode == SLIDING:
-            slide_since = t
-            for k in range(n):
-                slide_z0[k] = z[k]
-        if new_mode != mode:
-            n_switch += 1
-            if n_switch == 1:
-                first_sw[0] = t
-        if n_switch > max_events:
-            return EVENT_LIMIT, t, n_switch, slide_time
-        recent[n_recent % zeno_count] = t
-        n_recent += 1
-        if n_recent >= zeno_count:
-            oldest = recent[n_recent % zeno_count]
-            if _accumulates(oldest, t, zeno_span):
-                return ZENO, t, n_switch, slide_time
-        sg[4] = 0.0
-        if mode == SLIDING and new_mode != SLIDING:
-            sg[4] = _exit_shift(new_mode, fns[4](z, p), touch_tol)
-        mode = new_mode
+            _end_slide(t, w)
+        return OK, mode
+    a, b = _speeds(w.z, fns, p, w.wg, w.wf, w.wp)
+    new_mode = _next_mode(mode, what, a, b)  # what: rules.SWITCH/EXIT_MINUS/EXIT_PLUS
+    if new_mode == SLIDING and not s.sliding:
+        return NO_SLIDING, mode
+    if new_mode == SLIDING and mode != SLIDING and _slides_in(w.z, fns, p, w.wg, w.wf, w.wp,
+                                                             w.wz):
+        return SECTION_SLIDING, mode
+    if mode == SLIDING:
+        _end_slide(t, w)
+    if new_mode == SLIDING:
+        w.tally[1] = t
+        for k in range(w.z.size):
+            w.slide_z0[k] = w.z[k]
+    if new_mode != mode:
+        w.count[0] += 1
+        if w.count[0] == 1:
+            w.first_sw[0] = t
+    if w.count[0] > s.max_events:
+        return EVENT_LIMIT, mode
+    w.recent[w.count[2] % s.zeno_count] = t
+    w.count[2] += 1
+    if w.count[2] >= s.zeno_count and _accumulates(w.recent[w.count[2] % s.zeno_count], t,
+                                                   s.zeno_span):
+        return ZENO, mode
+    w.sg[4] = 0.0
+    if mode == SLIDING and new_mode != SLIDING:
+        w.sg[4] = _exit_shift(new_mode, fns[4](w.z, p), s.touch_tol)
+    return _GO_ON, new_mode
+
+
+@_jit
+def _one(z0, fns, p, s, w):
+    """First return of z0 (the state at the return, or where the run stopped, in w.z);
+    (status, t, n_switches, sliding_time). w.first_sw[0]: time of the first change of
+    mode (left untouched if there is none); w.slide_dz: the change of state summed
+    over the sliding stretches (counted like sliding_time)."""
+    n = z0.size
+    for k in range(n):
+        w.slide_dz[k] = 0.0
+    for k in range(n):
+        w.z[k] = z0[k]
+        if not np.isfinite(z0[k]):
+            return BAD_START, 0.0, 0, 0.0
+    mode = _initial_mode(w.z, fns, p, s.touch_tol, s.sliding, w.wg, w.wf, w.wp)
+    if mode == SLIDING and _slides_in(w.z, fns, p, w.wg, w.wf, w.wp, w.wz):
+        return SECTION_SLIDING, 0.0, 0, 0.0
+    for k in range(n):
+        w.slide_z0[k] = w.z[k]
+    for k in range(3):
+        w.count[k] = 0
+    w.tally[0] = 0.0
+    w.tally[1] = 0.0
+    w.sg[4] = 0.0
+    t = 0.0
+    while True:
+        if t >= s.t_max:
+            return NO_RETURN, t, w.count[0], w.tally[0]
+        if mode == SLIDING and not s.sliding:
+            return NO_SLIDING, t, w.count[0], w.tally[0]
+        if mode != SLIDING and s.exact:
+            st, t, what = _stay_exact(mode, t, fns, p, s, w)
+        else:
+            st, t, what = _stay_integrated(mode, t, fns, p, s, w)
+        if st == OK:
+            st, mode = _event(mode, t, what, fns, p, s, w)
+        if st != _GO_ON:
+            return st, t, w.count[0], w.tally[0]
 
 
 _KERNEL_SIG = types.void(
@@ -844,19 +870,20 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
     wz, wg, wf, wp = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
     K = np.zeros((_NSE, n))
     F = np.zeros((_NI, n))
-    z = np.zeros(n)
     first = np.zeros(1)
-    slide_dz, slide_z0 = np.zeros(n), np.zeros(n)
+    w = Work(ts, vals, dvals, svals, recent, sg, za, y, f, y_old, f_old, K, ynew, ytmp, scale,
+             F, wz, wg, wf, wp, np.zeros(n), first, np.zeros(n), np.zeros(n),
+             np.zeros(3, dtype=np.int64), np.zeros(2))
+    s = Settings(t_max, exact, hwin, fopts[6], fopts[7], sec_pred, sliding, frac_ex, frac_in,
+                 fopts[0], fopts[1], fopts[2], fopts[3], fopts[4], fopts[5], fopts[8],
+                 iopts[0], iopts[1], iopts[2])
     for i in range(m):
         first[0] = np.nan
-        st, t, nsw, sl = _one(starts[i], fns, p, t_max, exact, hwin, sec_pred, sliding, frac_ex,
-                              frac_in, fopts, iopts, ts, vals, dvals, svals, recent, sg, za, y,
-                              f, y_old, f_old, K, ynew, ytmp, scale, F, wz, wg, wf, wp, z, first,
-                              slide_dz, slide_z0)
+        st, t, nsw, sl = _one(starts[i], fns, p, s, w)
         out_first[i] = first[0]
         for c in range(n):
-            out_state[i, c] = z[c]
-            out_slide_dz[i, c] = slide_dz[c]
+            out_state[i, c] = w.z[c]
+            out_slide_dz[i, c] = w.slide_dz[c]
         out_status[i] = st
         out_time[i] = t
         out_nsw[i] = nsw

@@ -154,9 +154,13 @@ class _ExactStepper:
     """Walks an exact flow in windows of ``h`` (``h_slow`` once ``transient`` has
     passed since the mode entry); the evaluator is the flow itself."""
 
+    method = None  # not integrated
+    piece = None
+
     def __init__(self, flow, z, t, t_end, h, h_slow=None, transient=np.inf):
         self.flow, self.za, self.ta, self.t, self.t_end, self.h = flow, z.copy(), t, t, t_end, h
         self.h_slow, self.transient = (h if h_slow is None else h_slow), transient
+        self.n_taken, self.t_start = 0, t  # steps taken by this stepper, since t_start
 
     def step(self):
         ta = self.t
@@ -190,7 +194,8 @@ class _IntegratingStepper:
                  piece=lambda zz: "the field", noise=None):
         calls = [0]
         self.atol, self.noise, self.atol_used = atol, noise, atol
-        self.piece, self.non_finite = piece, None
+        self.fun, self.piece, self.non_finite = fun, piece, None
+        self.n_taken, self.t_start = 0, t  # steps taken by this stepper, since t_start
 
         def checked(tt, zz):
             # scipy's step control loops forever on a NaN error norm. A non-finite
@@ -499,152 +504,216 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
                             f"{type(sec).__name__}")
     checks.check_system(system, z, method=method)  # the pieces keep the class's contract
 
-    traj = Trajectory(system=system, t0=t0, z0=z.copy(), t=t0, z=z.copy())
-    mode, kind = initial_mode(system, z, touch_tol)
-    traj.mode = mode
-    traj.events.append(Event(t0, kind, z.copy(), mode, mode))
-    if mode == SLIDING:
-        _refuse_sliding_in_sections(system, sections, z, t0)
-    preds = [_section_pred(s.direction) for s in sections]
-    hits = [0] * len(sections)
-    recent = deque(maxlen=zeno_count)
-    n_switch = 0
-    shift = 0.0  # subtracted from H in this stay (rules.exit_shift)
-    t = t0
-    frac_integrated = np.linspace(0.0, 1.0, samples_per_step + 1)
-    # An exact flow is evaluated EXACT_BLOCK windows at a time: the same sample
-    # spacing, a sixteenth of the Python overhead.
-    frac_exact = np.linspace(0.0, 1.0, EXACT_BLOCK * samples_per_step + 1)
+    opts = dict(t0=t0, t_end=t_end, method=method, rtol=rtol, atol=atol, max_step=max_step,
+                max_events=max_events, max_steps=max_steps, dense=dense,
+                samples_per_step=samples_per_step, touch_tol=touch_tol, event_xtol=event_xtol,
+                zeno_count=zeno_count, zeno_span=zeno_span, stiff=stiff)
+    return _Run(system, z, list(sections), opts).go()
 
-    def stop(status):
-        traj.status, traj.t, traj.z, traj.mode = status, t, z.copy(), mode
+
+class _Run:
+    """One call of :func:`simulate`: its options, the trajectory and the counters.
+    :meth:`go` is the driver loop, :meth:`stay` follows one mode until its next
+    event, :meth:`event` records that event and decides how to go on."""
+
+    def __init__(self, system, z, sections, opts):
+        self.system, self.sections = system, sections
+        self.__dict__.update(opts)
+        self.traj = Trajectory(system=system, t0=self.t0, z0=z.copy(), t=self.t0, z=z.copy())
+        self.mode, kind = initial_mode(system, z, self.touch_tol)
+        self.traj.mode = self.mode
+        self.traj.events.append(Event(self.t0, kind, z.copy(), self.mode, self.mode))
+        if self.mode == SLIDING:
+            _refuse_sliding_in_sections(system, sections, z, self.t0)
+        self.t, self.z = self.t0, z
+        self.preds = [_section_pred(sec.direction) for sec in sections]
+        self.hits = [0] * len(sections)
+        self.recent = deque(maxlen=self.zeno_count)
+        self.n_switch = 0
+        self.shift = 0.0  # subtracted from H in this stay (rules.exit_shift)
+        self.frac_integrated = np.linspace(0.0, 1.0, self.samples_per_step + 1)
+        # An exact flow is evaluated EXACT_BLOCK windows at a time: the same sample
+        # spacing, a sixteenth of the Python overhead.
+        self.frac_exact = np.linspace(0.0, 1.0, EXACT_BLOCK * self.samples_per_step + 1)
+
+    def stop(self, status):
+        traj = self.traj
+        traj.status, traj.t, traj.z, traj.mode = status, self.t, self.z.copy(), self.mode
         return traj
 
-    while True:
-        if t >= t_end:
-            return stop("t_end")
-        if mode == SLIDING and not system.sliding:
-            raise _no_sliding(t, z)
-        use_flow = method == "exact" and system.has_flow(mode)
-        if use_flow:
-            h = min(EXACT_BLOCK * system.sample_step, max_step, t_end - t0)
-            stepper = _ExactStepper(system.flows[mode], z, t, t_end, h,
-                                    slow_window(system.slow_sample_step, h, max_step, t_end - t0),
-                                    system.transient_time)
-        else:
-            traj.integrated_modes.add(MODE_NAMES[mode])
-            field_of_mode = lambda _t, zz, m=mode: system.field(m, zz)
-            piece = lambda zz, m=mode: checks.non_finite_piece(system, m, zz)
-            stepper = _IntegratingStepper(field_of_mode, z, t, t_end, rtol, atol, max_step,
-                                          piece=piece)
-        steps_in_mode, stepper_steps, stepper_t = 0, 0, t
-        # Functions whose crossing ends this mode, with the mode they lead to.
+    def go(self) -> Trajectory:
+        while True:
+            if self.t >= self.t_end:
+                return self.stop("t_end")
+            if self.mode == SLIDING and not self.system.sliding:
+                raise _no_sliding(self.t, self.z)
+            done = self.stay()
+            if done is not None:
+                return done
+
+    # ------------------------------------------------------------------ one stay
+    def _stepper(self, mode):
+        system, t, z = self.system, self.t, self.z
+        if self.method == "exact" and system.has_flow(mode):
+            h = min(EXACT_BLOCK * system.sample_step, self.max_step, self.t_end - self.t0)
+            return _ExactStepper(system.flows[mode], z, t, self.t_end, h,
+                                 slow_window(system.slow_sample_step, h, self.max_step,
+                                             self.t_end - self.t0),
+                                 system.transient_time)
+        self.traj.integrated_modes.add(MODE_NAMES[mode])
+        return _IntegratingStepper(lambda _t, zz: system.field(mode, zz), z, t, self.t_end,
+                                   self.rtol, self.atol, self.max_step,
+                                   piece=lambda zz: checks.non_finite_piece(system, mode, zz))
+
+    def _leave(self, mode):
+        """Functions whose crossing ends this mode, with what that crossing is."""
+        system = self.system
         if mode != SLIDING:
-            switch = system.switch if shift == 0.0 else (lambda zz, c=shift: system.switch(zz) - c)
-            leave = [(switch, TO_NEG if mode == PLUS else TO_NONNEG, "switch")]
-        else:
-            leave = [(lambda zz: system.normal_speeds(zz)[0], TO_NONPOS, "exit_minus"),
-                     (lambda zz: system.normal_speeds(zz)[1], TO_NONNEG, "exit_plus")]
-        first = True
-        restart = False
-        while not restart:
-            traj.n_steps += 1
-            if traj.n_steps > max_steps:
-                raise EventLimitError(
-                    f"step limit {max_steps} hit at t={t!r}, state {z.tolist()}, mode "
-                    f"{MODE_NAMES[mode]}: the run is too long or the step size collapsed")
-            ta, tb, Z = stepper.step()
-            # a run that cannot reach t_end within the step budget stops now, not
-            # after minutes: project the steps left from this stepper's mean step
-            stepper_steps += 1
-            mean = (tb - stepper_t) / stepper_steps
-            left = (t_end - tb) / mean if stepper_steps > PROJECT_AFTER and mean > 0 else 0.0
-            if traj.n_steps + left > max_steps:
-                raise EventLimitError(
-                    f"steps of {tb - ta:.3g} (mean {mean:.3g}) at t={ta!r} in mode "
-                    f"{MODE_NAMES[mode]} (state {z.tolist()}): ~{left:.3g} more steps to "
-                    f"t_end={t_end!r} exceed max_steps={max_steps}"
-                    + ("; the integrated field is stiff here (a fast time scale, e.g. a "
-                       "small eps): use exact flows or a shorter t_end" if not use_flow else ""))
-            frac = frac_exact if use_flow else frac_integrated
-            ts = ta + frac * (tb - ta)
-            ts[-1] = tb
-            zs = Z(ts)
-            if not np.all(np.isfinite(zs)):
-                raise SimulationError(
-                    f"non-finite state in mode {MODE_NAMES[mode]} between t={ta!r} and "
-                    f"t={tb!r}, last finite state {z.tolist()}")
-            try:
-                found = _scan(system, mode, Z, ts, zs, leave, sections, preds, first,
-                              touch_tol, event_xtol, traj)
-            except ValueError as exc:  # scipy's root finders: no context of their own
-                raise SimulationError(
-                    f"event location failed in mode {MODE_NAMES[mode]} between t={ta!r} and "
-                    f"t={tb!r} (state at ta {z.tolist()}): {exc}; the sampled sign change "
-                    f"did not survive refinement (time scale of the system: sample_step "
-                    f"{system.sample_step!r})") from exc
+            switch = (system.switch if self.shift == 0.0
+                      else (lambda zz, c=self.shift: system.switch(zz) - c))
+            return [(switch, TO_NEG if mode == PLUS else TO_NONNEG, "switch")]
+        return [(lambda zz: system.normal_speeds(zz)[0], TO_NONPOS, "exit_minus"),
+                (lambda zz: system.normal_speeds(zz)[1], TO_NONNEG, "exit_plus")]
+
+    def stay(self):
+        """Follows the current mode to its next event; the stopped trajectory, or None
+        to go on (in the mode the event decided)."""
+        mode = self.mode
+        stepper = self._stepper(mode)
+        leave = self._leave(mode)
+        first, steps_in_mode = True, 0
+        while True:
+            ta, tb, Z = self._step(stepper)
+            ts, zs = self._samples(stepper, Z, ta, tb)
+            found = self._scan(Z, ts, zs, leave, first, ta, tb)
             first = False
-            if dense:
-                traj.segments.append((ta, tb, mode, Z))
-            if getattr(stepper, "method", None) is Radau and stepper.atol_used > atol:
-                name = MODE_NAMES[mode]
-                traj.atol_raised[name] = max(traj.atol_raised.get(name, 0.0), stepper.atol_used)
+            if self.dense:
+                self.traj.segments.append((ta, tb, mode, Z))
+            if stepper.method is Radau and stepper.atol_used > self.atol:
+                raised = self.traj.atol_raised
+                raised[MODE_NAMES[mode]] = max(raised.get(MODE_NAMES[mode], 0.0),
+                                               stepper.atol_used)
             if found is None:
-                t, z = tb, zs[:, -1].copy()
-                if tb >= t_end:
-                    return stop("t_end")
+                self.t, self.z = tb, zs[:, -1].copy()
+                if tb >= self.t_end:
+                    return self.stop("t_end")
                 steps_in_mode += 1
-                if (stiff and not use_flow and stepper.method is DOP853
-                        and steps_in_mode % STIFF_AFTER == 0
-                        and (tb - ta) * spectral_radius(field_of_mode, t, z) > 1.0):
-                    traj.stiff_modes.add(MODE_NAMES[mode])
-                    stepper = _IntegratingStepper(field_of_mode, z, t, t_end, rtol, atol,
-                                                  max_step, method=Radau, piece=piece,
-                                                  noise=field_noise(field_of_mode, t, z))
-                    stepper_steps, stepper_t = 0, t
+                stepper = self._stiff_switch(stepper, steps_in_mode, tb - ta)
                 continue
             te, ze, what, idx = found
-            if dense:  # the segment ends at the event
-                traj.segments[-1] = (ta, te, mode, Z)
-            t, z = te, ze
-            restart = True
-            if what == "section":
-                sec = sections[idx]
-                hits[idx] += 1
-                traj.events.append(Event(te, "section", ze.copy(), mode, mode, sec.name))
-                if sec.terminal is not None and hits[idx] >= sec.terminal:
-                    return stop(f"section:{sec.name}")
-                continue
-            new_mode, kind = _decide(system, mode, what, ze)
-            if new_mode == SLIDING and mode != SLIDING:
-                _refuse_sliding_in_sections(system, sections, ze, te)
-            traj.events.append(Event(te, kind, ze.copy(), mode, new_mode))
-            n_switch += new_mode != mode
-            if n_switch > max_events:
+            if self.dense:  # the segment ends at the event
+                self.traj.segments[-1] = (ta, te, mode, Z)
+            self.t, self.z = te, ze
+            return self.event(what, idx)
+
+    def _step(self, stepper):
+        """One step, within the step budget: a run that cannot reach t_end within it
+        stops now, not after minutes (the steps left projected from the mean step)."""
+        traj, mode = self.traj, self.mode
+        traj.n_steps += 1
+        if traj.n_steps > self.max_steps:
+            raise EventLimitError(
+                f"step limit {self.max_steps} hit at t={self.t!r}, state {self.z.tolist()}, "
+                f"mode {MODE_NAMES[mode]}: the run is too long or the step size collapsed")
+        ta, tb, Z = stepper.step()
+        stepper.n_taken += 1
+        mean = (tb - stepper.t_start) / stepper.n_taken
+        left = ((self.t_end - tb) / mean if stepper.n_taken > PROJECT_AFTER and mean > 0
+                else 0.0)
+        if traj.n_steps + left > self.max_steps:
+            raise EventLimitError(
+                f"steps of {tb - ta:.3g} (mean {mean:.3g}) at t={ta!r} in mode "
+                f"{MODE_NAMES[mode]} (state {self.z.tolist()}): ~{left:.3g} more steps to "
+                f"t_end={self.t_end!r} exceed max_steps={self.max_steps}"
+                + ("; the integrated field is stiff here (a fast time scale, e.g. a "
+                   "small eps): use exact flows or a shorter t_end"
+                   if stepper.method is not None else ""))
+        return ta, tb, Z
+
+    def _samples(self, stepper, Z, ta, tb):
+        frac = self.frac_exact if stepper.method is None else self.frac_integrated
+        ts = ta + frac * (tb - ta)
+        ts[-1] = tb
+        zs = Z(ts)
+        if not np.all(np.isfinite(zs)):
+            raise SimulationError(
+                f"non-finite state in mode {MODE_NAMES[self.mode]} between t={ta!r} and "
+                f"t={tb!r}, last finite state {self.z.tolist()}")
+        return ts, zs
+
+    def _scan(self, Z, ts, zs, leave, first, ta, tb):
+        try:
+            return _scan(self.system, self.mode, Z, ts, zs, leave, self.sections, self.preds,
+                         first, self.touch_tol, self.event_xtol, self.traj)
+        except ValueError as exc:  # scipy's root finders: no context of their own
+            raise SimulationError(
+                f"event location failed in mode {MODE_NAMES[self.mode]} between t={ta!r} and "
+                f"t={tb!r} (state at ta {self.z.tolist()}): {exc}; the sampled sign change "
+                f"did not survive refinement (time scale of the system: sample_step "
+                f"{self.system.sample_step!r})") from exc
+
+    def _stiff_switch(self, stepper, steps_in_mode, h):
+        """Radau for the rest of the stay when DOP853's steps are bounded by stability
+        (checked every STIFF_AFTER steps; see there)."""
+        if not (self.stiff and stepper.method is DOP853 and steps_in_mode % STIFF_AFTER == 0):
+            return stepper
+        field = stepper.fun
+        if h * spectral_radius(field, self.t, self.z) <= 1.0:
+            return stepper
+        self.traj.stiff_modes.add(MODE_NAMES[self.mode])
+        return _IntegratingStepper(field, self.z, self.t, self.t_end, self.rtol, self.atol,
+                                   self.max_step, method=Radau, piece=stepper.piece,
+                                   noise=field_noise(field, self.t, self.z))
+
+    # ------------------------------------------------------------------ one event
+    def event(self, what, idx):
+        """Records the event at (t, z): a section hit (which may end the run) or a
+        switch, decided by the rules and counted against the limits."""
+        te, ze, mode, traj = self.t, self.z, self.mode, self.traj
+        if what == "section":
+            sec = self.sections[idx]
+            self.hits[idx] += 1
+            traj.events.append(Event(te, "section", ze.copy(), mode, mode, sec.name))
+            if sec.terminal is not None and self.hits[idx] >= sec.terminal:
+                return self.stop(f"section:{sec.name}")
+            return None
+        new_mode, kind = _decide(self.system, mode, what, ze)
+        if new_mode == SLIDING and mode != SLIDING:
+            _refuse_sliding_in_sections(self.system, self.sections, ze, te)
+        traj.events.append(Event(te, kind, ze.copy(), mode, new_mode))
+        self.n_switch += new_mode != mode
+        if self.n_switch > self.max_events:
+            raise EventLimitError(
+                f"event limit {self.max_events} hit: rapid switching near t={te!r}, "
+                f"state {ze.tolist()}")
+        self._check_rate(te, ze, new_mode)
+        # after a sliding exit the stay measures H from the exit point's rounding
+        self.shift = (rules.exit_shift(new_mode, float(self.system.switch(ze)), self.touch_tol)
+                      if kind == "slide_end" else 0.0)
+        self.mode = traj.mode = new_mode
+        return None
+
+    def _check_rate(self, te, ze, new_mode):
+        """The Zeno ring: zeno_count switches in no time is an accumulation; at the
+        rate of the last ones, the event budget must last to t_end."""
+        recent = self.recent
+        recent.append(te)
+        if len(recent) < recent.maxlen:
+            return
+        if rules.accumulates(recent[0], te, self.zeno_span):
+            raise ZenoError(
+                f"accumulation of switches: {recent.maxlen} switches within "
+                f"{recent[-1] - recent[0]:.3e} time units near t={te!r}, state "
+                f"{ze.tolist()} (Zeno point or chattering below the time resolution)")
+        if recent[-1] > recent[0]:
+            ahead = (self.t_end - te) * (recent.maxlen - 1) / (recent[-1] - recent[0])
+            if self.n_switch + ahead > self.max_events:
                 raise EventLimitError(
-                    f"event limit {max_events} hit: rapid switching near t={te!r}, "
-                    f"state {ze.tolist()}")
-            recent.append(te)
-            if len(recent) == recent.maxlen and rules.accumulates(recent[0], te, zeno_span):
-                raise ZenoError(
-                    f"accumulation of switches: {recent.maxlen} switches within "
-                    f"{recent[-1] - recent[0]:.3e} time units near t={te!r}, state "
-                    f"{ze.tolist()} (Zeno point or chattering below the time resolution)")
-            if len(recent) == recent.maxlen and recent[-1] > recent[0]:
-                # switching at this rate to t_end would exceed the event budget: stop now
-                ahead = (t_end - te) * (recent.maxlen - 1) / (recent[-1] - recent[0])
-                if n_switch + ahead > max_events:
-                    raise EventLimitError(
-                        f"switching every {(recent[-1] - recent[0]) / (recent.maxlen - 1):.3g} "
-                        f"time units near t={te!r} (state {ze.tolist()}, mode "
-                        f"{MODE_NAMES[new_mode]}): ~{ahead:.3g} more switches to "
-                        f"t_end={t_end!r} exceed max_events={max_events} (raise max_events "
-                        f"if this rate does not last)")
-            # after a sliding exit the stay measures H from the exit point's rounding
-            shift = (rules.exit_shift(new_mode, float(system.switch(ze)), touch_tol)
-                     if kind == "slide_end" else 0.0)
-            mode = new_mode
-            traj.mode = mode
+                    f"switching every {(recent[-1] - recent[0]) / (recent.maxlen - 1):.3g} "
+                    f"time units near t={te!r} (state {ze.tolist()}, mode "
+                    f"{MODE_NAMES[new_mode]}): ~{ahead:.3g} more switches to "
+                    f"t_end={self.t_end!r} exceed max_events={self.max_events} (raise "
+                    f"max_events if this rate does not last)")
 
 
 def _no_sliding(t, z) -> SlidingNotBuiltError:
