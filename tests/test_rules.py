@@ -18,7 +18,9 @@ def test_the_compiled_engine_compiles_the_rules_themselves():
                              (fastmap._accumulates, rules.accumulates),
                              (fastmap._exit_shift, rules.exit_shift),
                              (fastmap._same_instant, rules.same_instant),
-                             (fastmap._starts_on_section, rules.starts_on_section)):
+                             (fastmap._starts_on_section, rules.starts_on_section),
+                             (fastmap._after, rules.after), (fastmap._crosses, rules.crosses),
+                             (fastmap._clamp, rules.clamp), (fastmap._far_side, rules.far_side)):
         assert compiled.py_func is source
 
 
@@ -66,3 +68,22 @@ def test_zeno_span_is_relative_beyond_t_of_one():
     assert not rules.accumulates(0.0, 2e-10, 1e-10)
     assert rules.accumulates(1e6 - 1e-5, 1e6, 1e-10)     # 1e-5 <= 1e-10 * 1e6
     assert not np.isnan(rules.same_instant(1e-15, 1.0))
+
+
+def test_crossing_predicates_are_the_same_on_scalars_arrays_and_compiled():
+    values = np.array([-1.0, -_TINY, -0.0, 0.0, _TINY, 1.0])
+    v0, v1 = np.meshgrid(values, values, indexing="ij")
+    for pred in (rules.TO_NEG, rules.TO_NONNEG, rules.TO_NONPOS, rules.EITHER):
+        table = rules.crosses(pred, v0, v1)  # numpy, elementwise (the Python driver)
+        for i, j in np.ndindex(table.shape):
+            assert bool(rules.crosses(pred, v0[i, j], v1[i, j])) == table[i, j]
+            assert fastmap._crosses(pred, v0[i, j], v1[i, j]) == table[i, j]
+    # leaving region +: from H >= 0 to H < 0; region -: from H < 0 to H >= 0
+    assert rules.crosses(rules.TO_NEG, 0.0, -1e-300) and not rules.crosses(rules.TO_NEG, -1.0, -2.0)
+    assert rules.crosses(rules.TO_NONNEG, -1e-300, 0.0)
+    assert rules.clamp(rules.TO_NEG, -1e-17) == 0.0 and rules.clamp(rules.TO_NONNEG, 0.0) < 0.0
+    assert rules.far_side(rules.EITHER, 0.5) == rules.TO_NONPOS
+    assert rules.section_pred(-1) == rules.TO_NONPOS and rules.section_pred(0) == rules.EITHER
+
+
+_TINY = np.finfo(float).tiny

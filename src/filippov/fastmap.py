@@ -101,8 +101,8 @@ STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event lim
           SECTION_SLIDING: "the orbit slides along H inside the section (a section on the "
                            "switching surface): its crossings there would be rounding noise"}
 
-# crossing predicates (simulate.TO_NEG, TO_NONNEG, TO_NONPOS, _EitherWay)
-_TO_NEG, _TO_NONNEG, _TO_NONPOS, _EITHER = 0, 1, 2, 3
+# crossing predicates (filippov.rules)
+_TO_NEG, _TO_NONNEG, _TO_NONPOS, _EITHER = rules.TO_NEG, rules.TO_NONNEG, rules.TO_NONPOS, rules.EITHER
 # scalar functions of the state whose zeros are events
 _S_H, _S_A, _S_B, _S_SEC = 0, 1, 2, 3
 # what an event is
@@ -138,42 +138,11 @@ _jit_inline = njit(cache=True, _nrt=False, inline="always")
 
 
 # ============================================================================= predicates
-@_jit
-def _before(pred, v):
-    if pred == _TO_NEG:
-        return v >= 0.0
-    if pred == _TO_NONNEG:
-        return v < 0.0
-    return v > 0.0  # _TO_NONPOS
-
-
-@_jit
-def _after(pred, v):
-    if pred == _TO_NEG:
-        return v < 0.0
-    if pred == _TO_NONNEG:
-        return v >= 0.0
-    if pred == _TO_NONPOS:
-        return v <= 0.0
-    return True  # _EITHER (not reached: _refine resolves it to the crossing's side)
-
-
-@_jit
-def _crosses(pred, v0, v1):
-    if pred == _EITHER:
-        return (v0 < 0.0 and v1 >= 0.0) or (v0 > 0.0 and v1 <= 0.0)
-    return _before(pred, v0) and _after(pred, v1)
-
-
-@_jit
-def _clamp(pred, v0):
-    if _before(pred, v0):
-        return v0
-    if pred == _TO_NEG:
-        return 0.0
-    if pred == _TO_NONNEG:
-        return -_TINY
-    return _TINY
+# the crossing predicates, compiled from their one source (filippov.rules)
+_after = _jit(rules.after)
+_crosses = _jit(rules.crosses)
+_clamp = _jit(rules.clamp)
+_far_side = _jit(rules.far_side)
 
 
 # ============================================================================= model pieces
@@ -311,8 +280,7 @@ def _brentq(sel, xa, xb, xtol, rtol, maxiter, mode, sg, za, F, y_old, fns, p, wz
 @_jit
 def _refine(sel, pred, ta, tb, va, xtol, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
     """simulate._refine: root in [ta, tb] on the far side of the crossing; (t, ok)."""
-    if pred == _EITHER:  # the far side of this crossing
-        pred = _TO_NONPOS if va > 0.0 else _TO_NONNEG
+    pred = _far_side(pred, va)
     if va == 0.0:
         r = ta
     else:
@@ -966,11 +934,7 @@ class BatchReturns:
 
 
 def _section_pred(direction: int) -> int:
-    if direction < 0:
-        return _TO_NONPOS
-    if direction > 0:
-        return _TO_NONNEG
-    return _EITHER
+    return rules.section_pred(direction)
 
 
 def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float = 1e-12,

@@ -14,6 +14,66 @@ from .system import MINUS, PLUS, SLIDING
 
 _EPS = float(np.finfo(float).eps)
 
+_TINY = float(np.finfo(float).tiny)
+
+#: the sign changes events are made of: leaving region + (H >= 0 -> H < 0), leaving
+#: region - (H < 0 -> H >= 0), a positive quantity reaching zero (a normal speed while
+#: sliding, a decreasing section), and either way (a section without direction)
+TO_NEG, TO_NONNEG, TO_NONPOS, EITHER = 0, 1, 2, 3
+
+
+def after(pred: int, v):
+    """v is on the far side of the sign change ``pred`` (elementwise on arrays).
+    EITHER has no far side of its own: a refinement takes that of the crossing at
+    hand (:func:`far_side`). The near side is the complement."""
+    if pred == TO_NEG:
+        return v < 0.0
+    if pred == TO_NONNEG:
+        return v >= 0.0
+    return v <= 0.0  # TO_NONPOS
+
+
+def crosses(pred: int, v0, v1):
+    """The samples v0 -> v1 hold the sign change ``pred``: v0 on the near side, v1 on
+    the far side (elementwise on arrays). Self-contained, so that numba compiles it
+    as it stands."""
+    if pred == TO_NEG:
+        return (v0 >= 0.0) & (v1 < 0.0)
+    if pred == TO_NONNEG:
+        return (v0 < 0.0) & (v1 >= 0.0)
+    if pred == TO_NONPOS:
+        return (v0 > 0.0) & (v1 <= 0.0)
+    return ((v0 < 0.0) & (v1 >= 0.0)) | ((v0 > 0.0) & (v1 <= 0.0))  # EITHER
+
+
+def far_side(pred: int, v0: float) -> int:
+    """The crossing a refinement must end beyond: for EITHER, the one leaving v0's
+    side (else a non-terminal hit left on the near side is found again after each
+    restart, and the run never gets past it)."""
+    if pred == EITHER:
+        return TO_NONPOS if v0 > 0.0 else TO_NONNEG
+    return pred
+
+
+def clamp(pred: int, v0: float) -> float:
+    """The start sample of a just-entered mode, inside by construction: a value that
+    rounding put on the far side is moved to the near side's edge."""
+    if pred == TO_NEG:
+        return v0 if v0 >= 0.0 else 0.0
+    if pred == TO_NONNEG:
+        return v0 if v0 < 0.0 else -_TINY
+    return v0 if v0 > 0.0 else _TINY  # TO_NONPOS
+
+
+def section_pred(direction: int) -> int:
+    """The sign change a section with this direction counts (-1, +1, 0: either)."""
+    if direction < 0:
+        return TO_NONPOS
+    if direction > 0:
+        return TO_NONNEG
+    return EITHER
+
+
 #: what ended a stay in a mode: a crossing of H (from region + or -), or, while
 #: sliding, a normal speed reaching zero (F_- or F_+ turning tangent to H)
 SWITCH, EXIT_MINUS, EXIT_PLUS = 0, 1, 2

@@ -299,46 +299,14 @@ def spectral_radius(fun, t, z, iterations: int = 6) -> float:
     return rho
 
 
-@dataclass(frozen=True)
-class _Crossing:
-    """A sign change to detect between two samples, and how to tell its far side."""
-
-    before: Callable[[float], bool]
-    after: Callable[[float], bool]
-    inside: float  # value a just-entered mode's start sample is clamped towards
-
-    def __call__(self, v0, v1):  # works on scalars and, elementwise, on arrays
-        return np.logical_and(self.before(v0), self.after(v1))
-
-    def clamp(self, v0):
-        return v0 if self.before(v0) else self.inside
-
-
-TO_NEG = _Crossing(lambda v: v >= 0, lambda v: v < 0, 0.0)        # leaves region +
-TO_NONNEG = _Crossing(lambda v: v < 0, lambda v: v >= 0, -_TINY)  # leaves region -
-TO_NONPOS = _Crossing(lambda v: v > 0, lambda v: v <= 0, _TINY)
-
-
-class _EitherWay:
-    def __call__(self, v0, v1):
-        return np.logical_or(TO_NONNEG(v0, v1), TO_NONPOS(v0, v1))
-    # no far side of its own: _refine takes that of the crossing at hand
-
-
-def _section_pred(direction):
-    if direction < 0:
-        return TO_NONPOS
-    if direction > 0:
-        return TO_NONNEG
-    return _EitherWay()
+# the crossing predicates (codes and functions: filippov.rules)
+TO_NEG, TO_NONNEG, TO_NONPOS = rules.TO_NEG, rules.TO_NONNEG, rules.TO_NONPOS
+_section_pred = rules.section_pred
 
 
 def _refine(fun, pred, ta, tb, va, vb, xtol):
     """Root of ``fun`` in [ta, tb], returned on the far side of the crossing."""
-    if isinstance(pred, _EitherWay):
-        # the far side of this crossing: else a non-terminal hit left on the near
-        # side is found again after each restart, and the run never gets past it
-        pred = TO_NONPOS if va > 0 else TO_NONNEG
+    pred = rules.far_side(pred, va)
     if va == 0.0:
         r = ta
     else:
@@ -348,14 +316,14 @@ def _refine(fun, pred, ta, tb, va, vb, xtol):
             # no sign change between fun(ta) and fun(tb): the start sample of a
             # just-entered mode is clamped inside, while rounding put the true
             # value a hair past the crossing already: the event is at once
-            if isinstance(pred, _Crossing) and pred.after(fun(ta)):
+            if rules.after(pred, fun(ta)):
                 r = ta
             else:
                 raise
     # Brent may stop a hair before the sign flips (rounding in fun near a shallow
     # crossing): step forward by doubling increments until it has flipped.
     step = 2 * np.spacing(max(abs(r), _TINY))
-    while not pred.after(fun(r)):
+    while not rules.after(pred, fun(r)):
         if r >= tb:
             return tb
         r = min(r + step, tb)
@@ -748,7 +716,7 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
         v = np.asarray(func(zs), dtype=float)
         if first:  # just entered this mode: its start is inside by construction
             v = v.copy()
-            v[0] = pred.clamp(v[0])
+            v[0] = rules.clamp(pred, v[0])
         vals.append(v)
     if mode != SLIDING:
         D = np.asarray(system.speed_of_switch(mode, zs), dtype=float)
@@ -761,17 +729,17 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
     # those are examined one by one (a scan of many samples costs a few numpy calls).
     cand = np.zeros(ts.size - 1, dtype=bool)
     for (_, pred, _), v in zip(leave, vals):
-        cand |= pred(v[:-1], v[1:])
+        cand |= rules.crosses(pred, v[:-1], v[1:])
     if mode != SLIDING:
         cand |= ((D[:-1] < 0) & (D[1:] >= 0)) if mode == PLUS else ((D[:-1] > 0) & (D[1:] <= 0))
     for pred, sv in zip(preds, svals):
-        cand |= pred(sv[:-1], sv[1:])
+        cand |= rules.crosses(pred, sv[:-1], sv[1:])
 
     for i in np.flatnonzero(cand):
         best = None  # (t, z, what, idx)
         ta, tb = ts[i], ts[i + 1]
         for (func, pred, what), v in zip(leave, vals):
-            if pred(v[i], v[i + 1]):
+            if rules.crosses(pred, v[i], v[i + 1]):
                 r = _refine(scalar(func), pred, ta, tb, v[i], v[i + 1], xtol)
                 if best is None or r < best[0]:
                     best = (r, what, -1)
@@ -790,7 +758,7 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
                 elif abs(Hm) <= touch_tol:
                     traj.events.append(Event(tm, "touch", Z(tm).copy(), mode, mode))
         for k, (sec, pred, sv) in enumerate(zip(sections, preds, svals)):
-            if pred(sv[i], sv[i + 1]):
+            if rules.crosses(pred, sv[i], sv[i + 1]):
                 r = _refine(scalar(sec.func), pred, ta, tb, sv[i], sv[i + 1], xtol)
                 if r < traj.t0 + sec.min_time:
                     continue
