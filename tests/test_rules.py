@@ -20,7 +20,11 @@ def test_the_compiled_engine_compiles_the_rules_themselves():
                              (fastmap._same_instant, rules.same_instant),
                              (fastmap._starts_on_section, rules.starts_on_section),
                              (fastmap._after, rules.after), (fastmap._crosses, rules.crosses),
-                             (fastmap._clamp, rules.clamp), (fastmap._far_side, rules.far_side)):
+                             (fastmap._clamp, rules.clamp), (fastmap._far_side, rules.far_side),
+                             (fastmap._extremum_between, rules.extremum_between),
+                             (fastmap._graze, rules.graze),
+                             (fastmap._section_fd_step, rules.section_fd_step),
+                             (fastmap._slides_in_section, rules.slides_in_section)):
         assert compiled.py_func is source
 
 
@@ -87,3 +91,19 @@ def test_crossing_predicates_are_the_same_on_scalars_arrays_and_compiled():
 
 
 _TINY = np.finfo(float).tiny
+
+
+def test_hidden_extremum_and_graze():
+    # region +: dH/dt from < 0 to >= 0 is a minimum of H; beyond touch_tol below 0 it
+    # is a crossing, within it a touch
+    assert rules.extremum_between(PLUS, -1.0, 0.0) and not rules.extremum_between(PLUS, 1.0, -1.0)
+    assert rules.extremum_between(MINUS, 1.0, 0.0)
+    assert rules.graze(PLUS, -2e-15, 1e-15) == rules.GRAZE_CROSSES
+    assert rules.graze(PLUS, -5e-16, 1e-15) == rules.GRAZE_TOUCHES
+    assert rules.graze(PLUS, 1e-3, 1e-15) == rules.GRAZE_NONE
+    assert rules.graze(MINUS, 2e-15, 1e-15) == rules.GRAZE_CROSSES
+    assert fastmap._graze(MINUS, 2e-15, 1e-15) == rules.GRAZE_CROSSES
+    assert rules.section_fd_step(1.0, 0.0) == 0.0 and rules.section_fd_step(1.0, np.nan) == 0.0
+    assert not rules.slides_in_section(0.0, 0.0, 1.0, 1.0, 0.0)
+    assert rules.slides_in_section(0.0, 1e-5, 1.0, -1.0, 0.0)
+    assert not rules.slides_in_section(0.0, 1e-5, 1.0, -1.0, 0.5)

@@ -57,7 +57,7 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 from . import dop853_tableau as _dop
 from .poincare import Returns
 from .progress import Progress
-from .simulate import (_FD_STEP, EXACT_BLOCK, SLIDE_TANGENT, EventLimitError, SimulationError,
+from .simulate import (EXACT_BLOCK, EventLimitError, SimulationError,
                        SlidingNotBuiltError, ZenoError, slow_window)
 from . import rules
 from .system import MINUS, PLUS, SLIDING
@@ -143,6 +143,10 @@ _after = _jit(rules.after)
 _crosses = _jit(rules.crosses)
 _clamp = _jit(rules.clamp)
 _far_side = _jit(rules.far_side)
+_extremum_between = _jit(rules.extremum_between)
+_graze = _jit(rules.graze)
+_section_fd_step = _jit(rules.section_fd_step)
+_slides_in_section = _jit(rules.slides_in_section)
 
 
 # ============================================================================= model pieces
@@ -357,12 +361,7 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
     for i in range(ns - 1):
         c0 = _crosses(pred0, vals[0, i], vals[0, i + 1])
         c1 = nleave == 2 and _crosses(_TO_NONNEG, vals[1, i], vals[1, i + 1])
-        if mode == PLUS:
-            cd = dvals[i] < 0.0 and dvals[i + 1] >= 0.0
-        elif mode == MINUS:
-            cd = dvals[i] > 0.0 and dvals[i + 1] <= 0.0
-        else:
-            cd = False
+        cd = mode != SLIDING and _extremum_between(mode, dvals[i], dvals[i + 1])
         cs = _crosses(sec_pred, svals[i], svals[i + 1])
         if not (c0 or c1 or cd or cs):
             continue
@@ -388,7 +387,7 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
             if not ok:
                 return ROOT_FAILED, tm, _W_NONE
             hm = _fval(_S_H, tm, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
-            if (mode == PLUS and hm < -touch_tol) or (mode == MINUS and hm > touch_tol):
+            if _graze(mode, hm, touch_tol) == rules.GRAZE_CROSSES:
                 r, ok = _refine(_S_H, pred0, ta, tm, vals[0, i], xtol, mode, sg, za, F,
                                 y_old, fns, p, wz, wg, wf)
                 if not ok:
@@ -598,13 +597,12 @@ def _slides_in(z, fns, p, wg, wm, wp, wz):
     for k in range(z.size):
         speed = max(speed, abs(wm[k]), abs(wp[k]))
         size = max(size, abs(z[k]))
-    if not (np.isfinite(speed) and speed > 0.0):
+    d = _section_fd_step(size, speed)
+    if d == 0.0:
         return False
-    d = _FD_STEP * size / speed
-    scale = max(abs(_section_rate(z, wm, wp, 1.0, 0.0, d, fns, p, wz)),
-                abs(_section_rate(z, wm, wp, 0.0, 1.0, d, fns, p, wz)))
-    rate = _section_rate(z, wm, wp, -b / (a - b), a / (a - b), d, fns, p, wz)
-    return abs(fns[6](z, p)) <= SLIDE_TANGENT * d * scale and abs(rate) <= SLIDE_TANGENT * scale
+    return _slides_in_section(fns[6](z, p), d, _section_rate(z, wm, wp, 1.0, 0.0, d, fns, p, wz),
+                              _section_rate(z, wm, wp, 0.0, 1.0, d, fns, p, wz),
+                              _section_rate(z, wm, wp, -b / (a - b), a / (a - b), d, fns, p, wz))
 
 
 @_jit

@@ -74,6 +74,55 @@ def section_pred(direction: int) -> int:
     return EITHER
 
 
+def extremum_between(mode: int, d0, d1):
+    """dH/dt changes sign between two samples so that H has a minimum (region +) or a
+    maximum (region -) there, which may hide a crossing of H between samples where H
+    has the same sign (elementwise on arrays)."""
+    if mode == PLUS:
+        return (d0 < 0.0) & (d1 >= 0.0)
+    return (d0 > 0.0) & (d1 <= 0.0)
+
+
+#: what a hidden extremum hm of H is: nothing, a crossing (the extremum lies beyond
+#: touch_tol on the other side), or a touch (|hm| <= touch_tol: no switch)
+GRAZE_NONE, GRAZE_CROSSES, GRAZE_TOUCHES = 0, 1, 2
+
+
+def graze(mode: int, hm: float, touch_tol: float) -> int:
+    if (mode == PLUS and hm < -touch_tol) or (mode == MINUS and hm > touch_tol):
+        return GRAZE_CROSSES
+    if abs(hm) <= touch_tol:
+        return GRAZE_TOUCHES
+    return GRAZE_NONE
+
+
+#: central-difference step (relative to the state's size) and the tolerance of the
+#: test whether sliding stays in a section: truncation and rounding of the
+#: differences are ~1e-10 relative
+FD_STEP = float(np.cbrt(np.finfo(float).eps))
+SLIDE_TANGENT = 1e-6
+
+
+def section_fd_step(size: float, speed: float) -> float:
+    """The central-difference step along the fields (largest component ``speed``) at a
+    state of size ``size`` (>= 1); 0 where the fields give no direction."""
+    if not (np.isfinite(speed) and speed > 0.0):
+        return 0.0
+    return FD_STEP * size / speed
+
+
+def slides_in_section(s_at_z: float, d: float, rate_minus: float, rate_plus: float,
+                      rate_sliding: float) -> bool:
+    """The sliding flow stays in the section (a section on H): the state lies on it
+    and the section changes along F_- or F_+ but not along the Filippov field (rates
+    of the section along each field by central differences of step d); its crossings
+    while sliding would be rounding noise."""
+    if d == 0.0:
+        return False
+    scale = max(abs(rate_minus), abs(rate_plus))
+    return abs(s_at_z) <= SLIDE_TANGENT * d * scale and abs(rate_sliding) <= SLIDE_TANGENT * scale
+
+
 #: what ended a stay in a mode: a crossing of H (from region + or -), or, while
 #: sliding, a normal speed reaching zero (F_- or F_+ turning tangent to H)
 SWITCH, EXIT_MINUS, EXIT_PLUS = 0, 1, 2

@@ -28,7 +28,7 @@ from scipy.integrate import DOP853, Radau
 from scipy.optimize import brentq
 
 from . import checks, rules, variational
-from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
+from .system import MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 
 
 class SimulationError(RuntimeError):
@@ -331,30 +331,20 @@ def _refine(fun, pred, ta, tb, va, vb, xtol):
     return r
 
 
-#: central-difference step (relative to the state's size) and the tolerance of
-#: _slides_in: truncation and rounding of the differences are ~1e-10 relative
-_FD_STEP = np.cbrt(np.finfo(float).eps)
-SLIDE_TANGENT = 1e-6
-
-
 def _slides_in(system: PiecewiseSystem, func, z) -> bool:
-    """True if the sliding flow at ``z`` (on H) stays in the section ``func = 0``:
-    ``z`` lies on it and the section changes along F_- or F_+ but not along the
-    Filippov field -- a section on H, whose crossings while sliding are noise."""
+    """True if the sliding flow at ``z`` (on H) stays in the section ``func = 0``
+    (:func:`filippov.rules.slides_in_section`)."""
     z = np.asarray(z, dtype=float)
     fm, fp = np.asarray(system.field_minus(z), float), np.asarray(system.field_plus(z), float)
-    speed = max(np.abs(fm).max(), np.abs(fp).max())
-    if not (np.isfinite(speed) and speed > 0):
+    d = rules.section_fd_step(max(1.0, np.abs(z).max()), max(np.abs(fm).max(), np.abs(fp).max()))
+    if d == 0.0:
         return False
-    d = _FD_STEP * max(1.0, np.abs(z).max()) / speed
 
     def rate(f):
         return (float(func(z + d * f)) - float(func(z - d * f))) / (2 * d)
 
-    scale = max(abs(rate(fm)), abs(rate(fp)))
     fs = np.asarray(system.sliding_field(z), float)
-    return (abs(float(func(z))) <= SLIDE_TANGENT * d * scale
-            and abs(rate(fs)) <= SLIDE_TANGENT * scale)
+    return rules.slides_in_section(float(func(z)), d, rate(fm), rate(fp), rate(fs))
 
 
 def _refuse_sliding_in_sections(system, sections, z, t) -> None:
@@ -731,7 +721,7 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
     for (_, pred, _), v in zip(leave, vals):
         cand |= rules.crosses(pred, v[:-1], v[1:])
     if mode != SLIDING:
-        cand |= ((D[:-1] < 0) & (D[1:] >= 0)) if mode == PLUS else ((D[:-1] > 0) & (D[1:] <= 0))
+        cand |= rules.extremum_between(mode, D[:-1], D[1:])
     for pred, sv in zip(preds, svals):
         cand |= rules.crosses(pred, sv[:-1], sv[1:])
 
@@ -746,16 +736,16 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
         if mode != SLIDING and best is None:
             # a minimum (in +) or maximum (in -) of H hidden between samples
             H = vals[0]
-            hidden = (D[i] < 0 <= D[i + 1]) if mode == PLUS else (D[i] > 0 >= D[i + 1])
-            if hidden:
+            if rules.extremum_between(mode, D[i], D[i + 1]):
                 dfun = scalar(lambda zz: system.speed_of_switch(mode, zz))
                 tm = brentq(dfun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps)
                 Hm = float(leave[0][0](Z(tm)))
                 pred = leave[0][1]
-                if (mode == PLUS and Hm < -touch_tol) or (mode == MINUS and Hm > touch_tol):
+                kind = rules.graze(mode, Hm, touch_tol)
+                if kind == rules.GRAZE_CROSSES:
                     r = _refine(scalar(leave[0][0]), pred, ta, tm, H[i], Hm, xtol)
                     best = (r, "switch", -1)
-                elif abs(Hm) <= touch_tol:
+                elif kind == rules.GRAZE_TOUCHES:
                     traj.events.append(Event(tm, "touch", Z(tm).copy(), mode, mode))
         for k, (sec, pred, sv) in enumerate(zip(sections, preds, svals)):
             if rules.crosses(pred, sv[i], sv[i + 1]):
