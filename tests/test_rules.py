@@ -107,3 +107,15 @@ def test_hidden_extremum_and_graze():
     assert not rules.slides_in_section(0.0, 0.0, 1.0, 1.0, 0.0)
     assert rules.slides_in_section(0.0, 1e-5, 1.0, -1.0, 0.0)
     assert not rules.slides_in_section(0.0, 1e-5, 1.0, -1.0, 0.5)
+
+
+def test_no_model_imports_the_engine():
+    # models hand the compiled engine a CompiledModel with filippov.abi's signatures;
+    # the engine (fastmap) may change its insides without a model noticing
+    import ast
+    from pathlib import Path
+    models = Path(rules.__file__).parent / "models"
+    for path in models.glob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom):
+                assert node.module not in ("fastmap", "simulate"), (path.name, node.module)

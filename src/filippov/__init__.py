@@ -22,7 +22,7 @@ from .variational import transition_matrix, return_jacobian, VariationalError
 # the compiled engine (numba) is imported on first use, not by `import filippov`
 _COMPILED = {"compile_system": "compiled_system", "with_section": "compiled_system",
              "FilippovSystem": "compiled_system",
-             "CompiledModel": "fastmap", "compute_returns": "fastmap",
+             "CompiledModel": "abi", "compute_returns": "fastmap",
              "first_returns_compiled": "fastmap"}
 
 

@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 from numba.core.errors import NumbaError
 
-from .fastmap import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, no_flow
+from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, no_flow
 
 _DOC_PIECE = ("write it for one state z (1-D float array) and the parameter array p, "
               "with numpy and math only (no Python objects, no closures over lists)")
@@ -261,7 +261,7 @@ class FilippovSystem:
     :meth:`python` gives the :class:`~filippov.system.PiecewiseSystem` the
     reference driver (:func:`filippov.simulate`) runs, its pieces evaluated by
     numba-compiled loops over the samples; :meth:`compiled` gives the compiled
-    engine's :class:`~filippov.fastmap.CompiledModel` with a section of the
+    engine's :class:`~filippov.abi.CompiledModel` with a section of the
     caller's choosing. Sections belong to the caller, not to the system.
     """
 

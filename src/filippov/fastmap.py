@@ -47,14 +47,15 @@ from __future__ import annotations
 
 import warnings
 from collections import namedtuple
-from dataclasses import dataclass, field
-from typing import Any, Mapping
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit, types
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from . import dop853_tableau as _dop
+# what a model hands the engine (its pieces' signatures, CompiledModel), re-exported here
+from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, no_flow  # noqa: F401
 from .poincare import Returns
 from .progress import Progress
 from .simulate import (EXACT_BLOCK, EventLimitError, SimulationError,
@@ -64,15 +65,6 @@ from .system import MINUS, PLUS, SLIDING
 
 # ----------------------------------------------------------------------------- signatures
 _vec = types.float64[::1]
-#: ``flow(z0, tau, params, out)``: the exact flow of a region from ``z0`` over ``tau``.
-FLOW_SIG = types.void(_vec, types.float64, _vec, _vec)
-#: ``field(z, params, out)`` (also ``grad_h``).
-FIELD_SIG = types.void(_vec, _vec, _vec)
-#: ``h(z, params)`` and ``section(z, params)``.
-SCALAR_SIG = types.float64(_vec, _vec)
-#: ``where(z, params)``: the condition a section hit must satisfy.
-WHERE_SIG = types.boolean(_vec, _vec)
-
 _FLOW = types.FunctionType(FLOW_SIG)
 _FIELD = types.FunctionType(FIELD_SIG)
 _SCALAR = types.FunctionType(SCALAR_SIG)
@@ -866,55 +858,6 @@ def compile_kernel() -> bool:
             _batch.compile(_KERNEL_SIG)
         _batch.disable_compile()  # any other argument types are an error, not a recompile
     return sum(_batch.stats.cache_hits.values()) > 0
-
-
-@njit(FLOW_SIG, cache=True)
-def no_flow(z0, tau, p, out):
-    """Stands in for the flows of a model without them (never called: exact=False)."""
-    for k in range(out.size):
-        out[k] = np.nan
-
-
-@dataclass(frozen=True)
-class CompiledModel:
-    """A piecewise system (region + is ``h >= 0``) and a section, as numba-compiled
-    functions with the module's signatures; with exact flows in both regions
-    (``exact=True``), or integrated there with DOP853 like sliding (``exact=False``,
-    the flows are then :func:`no_flow`).
-
-    ``flow_plus``/``flow_minus``: :data:`FLOW_SIG`; ``field_plus``/``field_minus``/
-    ``grad_h``: :data:`FIELD_SIG`; ``h``/``section``: :data:`SCALAR_SIG`;
-    ``section_where``: :data:`WHERE_SIG`. Every piece receives ``params``.
-    ``section_direction`` -1 counts decreasing crossings of ``section(z) = 0``,
-    +1 increasing, 0 both. ``sample_step`` is the longest time between samples
-    of an exact flow (it must resolve the fastest time scale; unused when
-    ``exact`` is False); ``slow_sample_step`` and ``transient_time`` as for
-    :class:`filippov.system.PiecewiseSystem` (the slow step once the fast
-    relaxation after a mode entry has decayed).
-    """
-
-    name: str
-    names: tuple
-    params: np.ndarray
-    flow_plus: Any
-    flow_minus: Any
-    field_plus: Any
-    field_minus: Any
-    h: Any
-    grad_h: Any
-    section: Any
-    section_where: Any
-    section_direction: int
-    sample_step: float
-    sliding: bool = True
-    parameters: Mapping[str, float] = field(default_factory=dict)
-    exact: bool = True
-    slow_sample_step: float = np.nan   # see filippov.system.PiecewiseSystem
-    transient_time: float = np.inf
-
-    @property
-    def dim(self) -> int:
-        return len(self.names)
 
 
 @dataclass(frozen=True)

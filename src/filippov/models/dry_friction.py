@@ -360,14 +360,14 @@ def slow_manifold_plus_on_L(x1_lo, x1_hi, eps, v0, n=33, **kwargs):
 # --------------------------------------------------------------------------- compiled
 def compiled(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck", *,
              sliding=True):
-    """The slow-fast system eq:dfo-sf, compiled for :mod:`filippov.fastmap`, with
+    """The slow-fast system eq:dfo-sf, compiled for the compiled engine (:mod:`filippov.abi`), with
     the section L of fig:dfo-retmap (x2 = 0 crossed downward, x1 > 0). No region
     has a closed-form flow, so every mode is integrated (DOP853) inside the
     kernel. The same formulas as :func:`full_system`, operation for operation."""
     check_parameters(eps, v0, gamma, f0, fv, fc, convention)
     if eps <= 0:
         raise ValueError("eps must be > 0 for the slow-fast system")
-    from ..fastmap import CompiledModel, no_flow
+    from ..abi import CompiledModel, no_flow
 
     s0, sc = (-f0, -fc) if convention == "stribeck" else (f0, fc)
     return CompiledModel(
@@ -389,7 +389,7 @@ def _compiled_pieces() -> dict:
         return _PIECES
     from numba import njit
 
-    from ..fastmap import FIELD_SIG, SCALAR_SIG, WHERE_SIG
+    from ..abi import FIELD_SIG, SCALAR_SIG, WHERE_SIG
 
     @njit(FIELD_SIG, cache=True)
     def field_plus(z, p, out):

@@ -132,13 +132,13 @@ def model(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi) -
 def compiled(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi, *,
              sliding: bool = True, exact: bool = True):
     """The slow-fast system z = (x1, x2, y) with its exact flows, compiled for
-    :mod:`filippov.fastmap`, with the section L1 of fig:retmaps (x1 = 0, x1
+    the compiled engine (:mod:`filippov.abi`), with the section L1 of fig:retmaps (x1 = 0, x1
     decreasing, x2 > 0). The same formulas as :func:`model`, in scalar form.
     ``exact=False``: the kernel integrates regions + and - with DOP853 instead."""
     check_parameters(eps, theta, mu, omega)
     if eps <= 0:
         raise ValueError("eps must be > 0 for the slow-fast system")
-    from ..fastmap import CompiledModel
+    from ..abi import CompiledModel
 
     pieces = _compiled_pieces()
     period = 2 * np.pi / abs(omega)
@@ -160,7 +160,7 @@ def _compiled_pieces() -> dict:
         return _PIECES
     from numba import njit
 
-    from ..fastmap import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG
+    from ..abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG
 
     @njit(FLOW_SIG, cache=True)
     def flow_plus(z0, tau, p, out):

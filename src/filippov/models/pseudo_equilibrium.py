@@ -70,14 +70,14 @@ def model(eps: float, theta: float) -> SlowFastModel:
 # --------------------------------------------------------------------------- compiled
 def compiled(eps: float, theta: float, *, section_x: float = 10.0):
     """The slow-fast system z = (x, y) with its exact flows, compiled for
-    :mod:`filippov.fastmap`; the section is ``x = section_x`` crossed with x
+    the compiled engine (:mod:`filippov.abi`); the section is ``x = section_x`` crossed with x
     decreasing (the default is never reached near the origin, so a run counts
     switches until ``t_max``). Sliding is not compiled: the kernel integrates
     it with DOP853, as the reference driver does without ``method="exact"``."""
     _check(eps, theta)
     if eps <= 0:
         raise ValueError("eps must be > 0 for the slow-fast system")
-    from ..fastmap import CompiledModel
+    from ..abi import CompiledModel
 
     return CompiledModel(
         name="pseudo_equilibrium", names=("x", "y"),
@@ -96,7 +96,7 @@ def _compiled_pieces() -> dict:
         return _PIECES
     from numba import njit
 
-    from ..fastmap import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG
+    from ..abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG
 
     @njit(FLOW_SIG, cache=True)
     def flow_plus(z0, tau, p, out):  # x' = -1: y relaxes to x + eps
