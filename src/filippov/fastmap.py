@@ -129,16 +129,15 @@ _jit = njit(cache=True, _nrt=False)
 _jit_inline = njit(cache=True, _nrt=False, inline="always")
 
 
-# ============================================================================= predicates
-# the crossing predicates, compiled from their one source (filippov.rules)
-_after = _jit(rules.after)
-_crosses = _jit(rules.crosses)
-_clamp = _jit(rules.clamp)
-_far_side = _jit(rules.far_side)
-_extremum_between = _jit(rules.extremum_between)
-_graze = _jit(rules.graze)
-_section_fd_step = _jit(rules.section_fd_step)
-_slides_in_section = _jit(rules.slides_in_section)
+# ============================================================================= rules
+# every decision and crossing predicate, compiled from its one source (filippov.rules)
+(_after, _crosses, _clamp, _far_side, _extremum_between, _graze, _section_fd_step,
+ _slides_in_section, _starts_on_section, _same_instant, _start_side, _start_on_switch,
+ _next_mode, _accumulates, _exit_shift) = (_jit(getattr(rules, name)) for name in (
+    "after", "crosses", "clamp", "far_side", "extremum_between", "graze", "section_fd_step",
+    "slides_in_section", "starts_on_section", "same_instant", "start_side", "start_on_switch",
+    "next_mode", "accumulates", "exit_shift"))
+assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 
 
 # ============================================================================= model pieces
@@ -323,17 +322,6 @@ def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, s
     for c in range(wz.size):
         zlast[c] = wz[c]
     return True
-
-
-# the decisions, compiled from their one source (filippov.rules)
-_starts_on_section = _jit(rules.starts_on_section)
-_same_instant = _jit(rules.same_instant)
-_start_side = _jit(rules.start_side)
-_start_on_switch = _jit(rules.start_on_switch)
-_next_mode = _jit(rules.next_mode)
-_accumulates = _jit(rules.accumulates)
-_exit_shift = _jit(rules.exit_shift)
-assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 
 
 @_jit
