@@ -17,6 +17,7 @@ bound on events and steps, and an accumulation (Zeno) detector.
 """
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
 from collections import deque
@@ -155,7 +156,6 @@ class _ExactStepper:
     passed since the mode entry); the evaluator is the flow itself."""
 
     method = None  # not integrated
-    piece = None
 
     def __init__(self, flow, z, t, t_end, h, h_slow=None, transient=np.inf):
         self.flow, self.za, self.ta, self.t, self.t_end, self.h = flow, z.copy(), t, t, t_end, h
@@ -232,10 +232,7 @@ class _IntegratingStepper:
             # scipy's Radau reads its atol afresh in every step
             s.atol = np.maximum(self.atol, NOISE_STEPS * s.step_size * self.noise)
             self.atol_used = max(self.atol_used, float(np.max(s.atol)))
-        if self.method is Radau:
-            with _one_blas_thread():
-                msg = s.step()
-        else:
+        with _one_blas_thread() if self.method is Radau else contextlib.nullcontext():
             msg = s.step()
         if s.status == "failed":
             if self.non_finite is not None:  # the step size collapsed on a NaN or inf
@@ -297,11 +294,6 @@ def spectral_radius(fun, t, z, iterations: int = 6) -> float:
             return 0.0
         v = w / rho
     return rho
-
-
-# the crossing predicates (codes and functions: filippov.rules)
-TO_NEG, TO_NONNEG, TO_NONPOS = rules.TO_NEG, rules.TO_NONNEG, rules.TO_NONPOS
-_section_pred = rules.section_pred
 
 
 def _refine(fun, pred, ta, tb, va, vb, xtol):
@@ -484,7 +476,7 @@ class _Run:
         if self.mode == SLIDING:
             _refuse_sliding_in_sections(system, sections, z, self.t0)
         self.t, self.z = self.t0, z
-        self.preds = [_section_pred(sec.direction) for sec in sections]
+        self.preds = [rules.section_pred(sec.direction) for sec in sections]
         self.hits = [0] * len(sections)
         self.recent = deque(maxlen=self.zeno_count)
         self.n_switch = 0
@@ -529,9 +521,9 @@ class _Run:
         if mode != SLIDING:
             switch = (system.switch if self.shift == 0.0
                       else (lambda zz, c=self.shift: system.switch(zz) - c))
-            return [(switch, TO_NEG if mode == PLUS else TO_NONNEG, "switch")]
-        return [(lambda zz: system.normal_speeds(zz)[0], TO_NONPOS, "exit_minus"),
-                (lambda zz: system.normal_speeds(zz)[1], TO_NONNEG, "exit_plus")]
+            return [(switch, rules.TO_NEG if mode == PLUS else rules.TO_NONNEG, "switch")]
+        return [(lambda zz: system.normal_speeds(zz)[0], rules.TO_NONPOS, "exit_minus"),
+                (lambda zz: system.normal_speeds(zz)[1], rules.TO_NONNEG, "exit_plus")]
 
     def stay(self):
         """Follows the current mode to its next event; the stopped trajectory, or None
@@ -547,13 +539,10 @@ class _Run:
             first = False
             if self.dense:
                 self.traj.segments.append((ta, tb, mode, Z))
-            if stepper.method is Radau and stepper.atol_used > self.atol:
-                raised = self.traj.atol_raised
-                raised[MODE_NAMES[mode]] = max(raised.get(MODE_NAMES[mode], 0.0),
-                                               stepper.atol_used)
             if found is None:
                 self.t, self.z = tb, zs[:, -1].copy()
                 if tb >= self.t_end:
+                    self._note_tolerance(stepper)
                     return self.stop("t_end")
                 steps_in_mode += 1
                 stepper = self._stiff_switch(stepper, steps_in_mode, tb - ta)
@@ -562,7 +551,15 @@ class _Run:
             if self.dense:  # the segment ends at the event
                 self.traj.segments[-1] = (ta, te, mode, Z)
             self.t, self.z = te, ze
+            self._note_tolerance(stepper)
             return self.event(what, idx)
+
+    def _note_tolerance(self, stepper):
+        """At the end of a stay: how far the noise floor lifted Radau's atol (the
+        stepper keeps the largest; a stay ends with the stepper that lifted it)."""
+        if stepper.method is Radau and stepper.atol_used > self.atol:
+            raised, name = self.traj.atol_raised, MODE_NAMES[self.mode]
+            raised[name] = max(raised.get(name, 0.0), stepper.atol_used)
 
     def _step(self, stepper):
         """One step, within the step budget: a run that cannot reach t_end within it
