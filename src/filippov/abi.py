@@ -31,6 +31,12 @@ def no_flow(z0, tau, p, out):
         out[k] = np.nan
 
 
+@njit(WHERE_SIG, cache=True)
+def always(z, p):
+    """The ``section_where`` of a section without a condition: every hit counts."""
+    return True
+
+
 @dataclass(frozen=True)
 class CompiledModel:
     """A piecewise system (region + is ``h >= 0``) and a section, as numba-compiled

@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 from numba.core.errors import NumbaError
 
-from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, no_flow
+from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, always, no_flow
 
 _DOC_PIECE = ("write it for one state z (1-D float array) and the parameter array p, "
               "with numpy and math only (no Python objects, no closures over lists)")
@@ -81,9 +81,7 @@ def _scalar_piece(fn, piece: str):
 
 def _where_piece(fn, piece: str):
     if fn is None:
-        def always(z, p):
-            return True
-        return njit(WHERE_SIG)(always)
+        return always  # compiled once (and cached), not per call
     user = _jit(fn, piece)
 
     def adapter(z, p):

@@ -96,7 +96,7 @@ def _compiled_pieces() -> dict:
         return _PIECES
     from numba import njit
 
-    from ..abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG
+    from ..abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, always
 
     @njit(FLOW_SIG, cache=True)
     def flow_plus(z0, tau, p, out):  # x' = -1: y relaxes to x + eps
@@ -133,11 +133,7 @@ def _compiled_pieces() -> dict:
     def section(z, p):
         return z[0] - p[2]
 
-    @njit(WHERE_SIG, cache=True)
-    def section_where(z, p):
-        return True
-
     _PIECES.update(flow_plus=flow_plus, flow_minus=flow_minus, field_plus=field_plus,
                    field_minus=field_minus, h=h, grad_h=grad_h, section=section,
-                   section_where=section_where)
+                   section_where=always)
     return _PIECES
