@@ -37,7 +37,7 @@ def test_number_formatting_round_trips():
 
 
 def test_absent_optional_results_say_not_yet_computed():
-    from filippov.plotting import fig10_dfo, fig11_dfo_retmaps
+    from filippov.reports import fig10_dfo, fig11_dfo_retmaps
     m = report.Macros()
     t10, t11 = fig10_dfo.report(None, m), fig11_dfo_retmaps.report(None, m)
     tb = report.bench(None, m)
@@ -52,7 +52,7 @@ def test_absent_optional_results_say_not_yet_computed():
 def test_optional_tables_show_whatever_the_datasets_hold():
     ds = xr.Dataset({"v_hopf": ((), 2.5, {"long_name": "Hopf point"}),
                      "v_gs": ((), 3.25, {"long_name": "grazing-sliding point"})})
-    from filippov.plotting import fig10_dfo
+    from filippov.reports import fig10_dfo
     m = report.Macros()
     t10 = fig10_dfo.report(ds, m)
     assert "v\\_hopf" in t10 and "2.5" in t10 and report.NOT_YET not in t10
@@ -327,11 +327,11 @@ def test_html_report_links_every_figure_to_its_rule(workflow_build, tmp_path):
 
 
 def test_every_scene_declares_its_report_part():
-    # no list of scenes in filippov.report: each figure module brings its part, and
+    # no list of scenes in filippov.report: each report part brings its own, and
     # the report refuses to go on without a scene that does not declare itself optional
     import importlib
     for sid in scenes.known_scenes():
-        module = importlib.import_module(f"filippov.plotting.{sid}")
+        module = importlib.import_module(f"filippov.reports.{sid}")
         assert callable(module.report), sid
     with pytest.raises(ValueError, match="report needs the datasets of fig01_slidesketch"):
         report.generate({})

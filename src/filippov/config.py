@@ -162,6 +162,10 @@ def load_workflow_config(path, schema_path, overrides=None) -> dict:
     return merged
 
 
+#: a scene id (the schema's pattern for ``id``): figNN_name
+SCENE_ID = re.compile(r"fig[0-9]{2}_[a-z0-9_]+")
+
+
 def scene_schema_file(schema_path, scene_id: str) -> Path:
     """Where a scene keeps the schema of its own parameters: ``scenes/<id>.schema.json``
     beside the scene schema (optional; a scene whose model block says it all has none).
@@ -183,16 +187,16 @@ def load_scene(path, schema_path, lim: dict | None = None) -> dict:
         raise SceneError(f"{path}: a scene must be a YAML mapping, got {got}")
 
     schema = json.loads(Path(schema_path).read_text(encoding="utf-8"))
-    error = best_match(Draft202012Validator(schema).iter_errors(scene), key=_RELEVANCE)
-    if error is None:  # the id is valid now: the scene's own block, if it has one
-        own = scene_schema_file(schema_path, scene["id"])
+    sid = scene.get("id")
+    if isinstance(sid, str) and SCENE_ID.fullmatch(sid):  # the scene's own block, if any
+        own = scene_schema_file(schema_path, sid)
         if own.exists():
             try:
                 block = json.loads(own.read_text(encoding="utf-8"))
             except (OSError, UnicodeDecodeError, ValueError) as exc:
                 raise SceneError(f"{own}: cannot read the scene's schema block: {exc}") from exc
             schema["allOf"] = [*schema.get("allOf", []), block]
-            error = best_match(Draft202012Validator(schema).iter_errors(scene), key=_RELEVANCE)
+    error = best_match(Draft202012Validator(schema).iter_errors(scene), key=_RELEVANCE)
     if error is not None:
         raise SceneError(f"{path}: {_field(error.absolute_path)}: {error.message}")
 

@@ -16,12 +16,12 @@ ones are ``None``) and returns ``{file name: LaTeX text}`` for
 * ``tab_hard_cases.tex``, ``tab_hard_return.tex`` -- the hard-case eps sweep
   (``results/hard_cases.nc``, :mod:`filippov.hard_cases`), one row per eps.
 
-The scenes declare their own part: each figure module ``filippov.plotting.<id>``
-(which draws the figure from the same dataset) defines ``report(ds, macros)`` (adds
-its macros, returns its table or None) and, when the report can do without its
-data, ``REPORT_OPTIONAL = True`` (then ``ds`` may be None). There is no list of
-scenes here. Being presentation, these parts are outside the code the compute jobs
-depend on: editing one rebuilds the report, not the data.
+The scenes declare their own part: each module ``filippov.reports.<id>`` defines
+``report(ds, macros)`` (adds its macros, returns its table or None) and, when the
+report can do without its data, ``REPORT_OPTIONAL = True`` (then ``ds`` may be
+None). There is no list of scenes here. These parts are neither in the code the
+compute jobs depend on nor in the plotting code: editing one rebuilds the report
+tables only.
 
 No Snakemake inside; ``workflow/scripts/report_tables.py`` is the thin caller.
 """
@@ -280,9 +280,9 @@ def bench(ds, m: Macros, effects=None) -> str:
     scipy solvers a user reaches for first get wrong; the cost of each model
     ingredient when results/bench_effect_cost.nc is there (`make bench`)."""
     sid = "work_precision"
-    m.flag("rpHaveBench", ds is not None)
-    if ds is None:
-        return not_yet("Work--precision sweep", "results/work_precision.nc")
+    missing = absent(m, "rpHaveBench", ds, "Work--precision sweep", "results/work_precision.nc")
+    if missing:
+        return missing
     if "method" not in ds.coords or "problem" not in ds.dims:
         return table_frame(ds)
     names = [str(p) for p in ds.problem.values]
@@ -375,17 +375,14 @@ def hard_cases(ds, m: Macros) -> str:
           "derived: max slide_final_abs_x over eps", 2)
     m.add("rpHardKernelFinal", float(ds.kernel_final_abs_x.max()),
           "derived: max kernel_final_abs_x over eps", 2)
-    maps, chatter = [], []
-    for e in eps:
-        d = ds.sel(eps=e)
-        maps.append(" & ".join([
-            f"${eps_tex(e)}$", f"${num(float(d.jump_over_eps), 6)}$",
-            f"${num(float(d.slope), 4)}$", f"${num(float(d.slope_probe), 2)}$"]) + r" \\")
-        chatter.append(" & ".join([
-            f"${eps_tex(e)}$", f"${num(float(d.chatter_period_over_eps), 6)}$",
-            f"${num(float(d.chatter_period_max_rel_dev), 2)}$",
-            f"${num(float(d.slide_start_offset), 2)}$", f"${num(float(d.slide_final_abs_x), 2)}$",
-            f"${num(float(d.kernel_final_abs_x), 2)}$"]) + r" \\")
+    maps = per_eps_rows(ds, lambda d: [
+        f"${num(float(d.jump_over_eps), 6)}$", f"${num(float(d.slope), 4)}$",
+        f"${num(float(d.slope_probe), 2)}$"])
+    chatter = per_eps_rows(ds, lambda d: [
+        f"${num(float(d.chatter_period_over_eps), 6)}$",
+        f"${num(float(d.chatter_period_max_rel_dev), 2)}$",
+        f"${num(float(d.slide_start_offset), 2)}$", f"${num(float(d.slide_final_abs_x), 2)}$",
+        f"${num(float(d.kernel_final_abs_x), 2)}$"])
     # the return maps, then the pseudo-equilibrium (two tabulars: one would not fit)
     table = tabular("rrrr", [head(r"$\epsilon$", r"jump$/\epsilon$", "slope", "$x_2-1$")],
                      maps) + "\n\\medskip\n\n" + tabular("rrrrrr", [head(
@@ -412,13 +409,10 @@ def _hard_return(ds, m: Macros, eps: list) -> str:
     m.add("rpHardReturnStepsMax", int(steps.max()), "derived: max return_steps over eps")
     m.add("rpHardReturnStiffN", int(ds.return_stiff.values.sum()),
           "derived: eps values whose sliding was finished by Radau")
-    rows = []
-    for k, e in enumerate(eps):
-        d = ds.sel(eps=e)
-        rows.append(" & ".join([
-            f"${eps_tex(e)}$", f"${num(float(gap[k]), 3)}$", f"${num(float(scaled[k]), 4)}$",
-            f"${num(float(d.return_sliding_time), 5)}$", f"${int(d.return_steps)}$",
-            "Radau" if int(d.return_stiff) else "DOP853"]) + r" \\")
+    rows = per_eps_rows(ds.assign(gap=("eps", gap), scaled=("eps", scaled)), lambda d: [
+        f"${num(float(d.gap), 3)}$", f"${num(float(d.scaled), 4)}$",
+        f"${num(float(d.return_sliding_time), 5)}$", f"${int(d.return_steps)}$",
+        "Radau" if int(d.return_stiff) else "DOP853"])
     return tabular("rrrrrl", [
         r"$\epsilon$ & $|P_0-P|$ & $|P_0-P|/\epsilon^2$ & sliding time & steps & "
         r"sliding by \\"], rows)
@@ -426,11 +420,11 @@ def _hard_return(ds, m: Macros, eps: list) -> str:
 
 # ----------------------------------------------------------------------------- entry point
 def _scene_modules() -> list:
-    """(id, figure module) of every scene, in id order (the order of the macros)."""
+    """(id, report part) of every scene, in id order (the order of the macros)."""
     import importlib
 
     from .scenes import known_scenes
-    return [(sid, importlib.import_module(f".plotting.{sid}", __package__))
+    return [(sid, importlib.import_module(f".reports.{sid}", __package__))
             for sid in known_scenes()]
 
 

@@ -9,8 +9,8 @@ from pathlib import Path
 
 # Library parts no scene computation imports: editing them must not recompute data.
 # (hard_cases.py is the hard-case sweep's own module: rule hard_cases hashes it.)
-NOT_COMPUTE = ("plotting/", "benchmarks/", "report.py", "manifest.py", "hard_cases.py",
-               "paper_labels.py")
+NOT_COMPUTE = ("plotting/", "reports/", "benchmarks/", "report.py", "manifest.py",
+               "hard_cases.py", "paper_labels.py")
 
 
 def library_hash(include="", exclude=()):

@@ -6,7 +6,6 @@ import numpy as np
 
 from . import style as st
 from .lines import arrowhead, runs, unit_arrows
-from ..report import Macros, tex_escape, var
 
 VARS = ["x1", "x2", "mode", "hit_x1", "hit_x2", "arrow_x1", "arrow_x2", "arrow_u", "arrow_v"]
 COLOUR = {1: st.C_PLUS, -1: st.C_MINUS, 0: st.C_SLIDE}
@@ -64,17 +63,3 @@ def draw(ds):
         _panel(ax, ds.sel(case=case))
         st.panel_label(ax, f"({tag}) {case}")
     return fig
-
-
-# ----------------------------------------------------------------------------- report
-def report(ds, m: Macros) -> str | None:
-    """The report's macros from this scene's dataset; returns its table (None: none)."""
-    sid = "fig01_slidesketch"
-    for case, word in (("crossing", "Cross"), ("sliding", "Slide")):
-        var(m, f"rpOneHit{word}A", ds, sid, "hit_x1", case=case)
-        var(m, f"rpOneHit{word}B", ds, sid, "hit_x2", case=case)
-    m.add("rpOneFieldsCross", None, f"{sid}:attrs.crossing_fields",
-          text=r"\texttt{" + tex_escape(ds.attrs["crossing_fields"]) + "}")
-    m.add("rpOneFieldsSlide", None, f"{sid}:attrs.sliding_fields",
-          text=r"\texttt{" + tex_escape(ds.attrs["sliding_fields"]) + "}")
-    return None

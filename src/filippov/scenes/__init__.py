@@ -8,14 +8,12 @@ from __future__ import annotations
 import contextlib
 import importlib
 import pkgutil
-import re
 
 from .. import tolerance
-from ..config import SceneError
+from ..config import SCENE_ID, SceneError
 from ..simulate import SlidingNotBuiltError
 from . import chunking
 
-SCENE_ID = re.compile(r"fig[0-9]{2}_[a-z0-9_]+")
 
 
 def known_scenes() -> list[str]:
