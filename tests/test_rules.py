@@ -119,3 +119,13 @@ def test_no_model_imports_the_engine():
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.ImportFrom):
                 assert node.module not in ("fastmap", "simulate"), (path.name, node.module)
+
+
+def test_a_dip_after_the_entry_moves_the_bracket_beyond_it():
+    # leaving H into the region (dH/dt away from H) and heading back by the interval's
+    # end: only then is the crossing back refined from the extremum
+    for f in (rules.dips_and_returns, fastmap._dips_and_returns):
+        assert f(MINUS, -3.5e-3, 1e-2) and f(PLUS, 3.5e-3, -1e-2)
+        assert not f(MINUS, 3.5e-3, 1e-2) and not f(MINUS, -1.0, -0.5)
+        assert not f(PLUS, -3.5e-3, -1e-2) and not f(PLUS, 1.0, 0.5)
+    assert fastmap._dips_and_returns.py_func is rules.dips_and_returns

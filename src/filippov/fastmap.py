@@ -133,10 +133,10 @@ _jit_inline = njit(cache=True, _nrt=False, inline="always")
 # every decision and crossing predicate, compiled from its one source (filippov.rules)
 (_after, _crosses, _clamp, _far_side, _extremum_between, _graze, _section_fd_step,
  _slides_in_section, _starts_on_section, _same_instant, _start_side, _start_on_switch,
- _next_mode, _accumulates, _exit_shift) = (_jit(getattr(rules, name)) for name in (
+ _next_mode, _accumulates, _exit_shift, _dips_and_returns) = (_jit(getattr(rules, name)) for name in (
     "after", "crosses", "clamp", "far_side", "extremum_between", "graze", "section_fd_step",
     "slides_in_section", "starts_on_section", "same_instant", "start_side", "start_on_switch",
-    "next_mode", "accumulates", "exit_shift"))
+    "next_mode", "accumulates", "exit_shift", "dips_and_returns"))
 assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 
 
@@ -348,7 +348,14 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
         ta, tb = ts[i], ts[i + 1]
         best_t, best_w = np.inf, _W_NONE
         if c0:
-            r, ok = _refine(sel0, pred0, ta, tb, vals[0, i], xtol, mode, sg, za, F, y_old,
+            lo, vlo = ta, vals[0, i]
+            if first and i == 0 and mode != SLIDING and _dips_and_returns(mode, dvals[0], dvals[1]):
+                tm, ok = _brentq(sel_d, ta, tb, xtol, 4.0 * _EPS, 100, mode, sg, za, F, y_old,
+                                 fns, p, wz, wg, wf)
+                hm = _fval(_S_H, tm, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+                if ok and not _after(pred0, hm):  # refine beyond the dip (rules)
+                    lo, vlo = tm, hm
+            r, ok = _refine(sel0, pred0, lo, tb, vlo, xtol, mode, sg, za, F, y_old,
                             fns, p, wz, wg, wf)
             if not ok:
                 return ROOT_FAILED, r, _W_NONE

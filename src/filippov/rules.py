@@ -83,6 +83,19 @@ def extremum_between(mode: int, d0, d1):
     return (d0 > 0.0) & (d1 <= 0.0)
 
 
+def dips_and_returns(mode: int, d0: float, d1: float) -> bool:
+    """On the first sample interval of a stay entered at H = 0: the orbit leaves H
+    (dH/dt = d0 points into the region) and heads back by the interval's end (d1).
+    A crossing back then lies beyond the extremum of H between them, and is refined
+    from there: next to the entry H is rounding noise (at a crossing with normal speed
+    3.5e-3 on the Hopf example's chaotic attractor, theta = 0.2, H read >= 0 again
+    1.7e-14 after the entry), and a bracket starting at the entry converged to that
+    noise instead of the real return 7e-5 later (a ZenoError, a failed root)."""
+    if mode == PLUS:
+        return d0 > 0.0 and d1 <= 0.0
+    return d0 < 0.0 and d1 >= 0.0
+
+
 #: what a hidden extremum hm of H is: nothing, a crossing (the extremum lies beyond
 #: touch_tol on the other side), or a touch (|hm| <= touch_tol: no switch)
 GRAZE_NONE, GRAZE_CROSSES, GRAZE_TOUCHES = 0, 1, 2

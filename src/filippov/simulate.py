@@ -727,7 +727,16 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
         ta, tb = ts[i], ts[i + 1]
         for (func, pred, what), v in zip(leave, vals):
             if rules.crosses(pred, v[i], v[i + 1]):
-                r = _refine(scalar(func), pred, ta, tb, v[i], v[i + 1], xtol)
+                lo, vlo = ta, v[i]
+                if (mode != SLIDING and first and i == 0
+                        and rules.dips_and_returns(mode, D[0], D[1])):
+                    # refine beyond the dip: next to the entry H is noise (rules)
+                    dfun = scalar(lambda zz: system.speed_of_switch(mode, zz))
+                    tm = brentq(dfun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps)
+                    hm = float(func(Z(tm)))
+                    if not rules.after(pred, hm):
+                        lo, vlo = tm, hm
+                r = _refine(scalar(func), pred, lo, tb, vlo, v[i + 1], xtol)
                 if best is None or r < best[0]:
                     best = (r, what, -1)
         if mode != SLIDING and best is None:
