@@ -799,15 +799,21 @@ _KERNEL_SIG = types.void(
     _vec, _vec,                 # sample fractions: exact windows, integration steps
     _vec,                       # rtol, atol, touch_tol, event_xtol, zeno_span, max_step,
                                 # slow window, transient time, min_time
-    types.int64[::1],           # max_events, max_steps, zeno_count
+    types.int64[::1],           # max_events, max_steps, zeno_count, returns per start
     types.float64[:, ::1], _vec, types.int64[::1], _vec, types.int64[::1], _vec,  # outputs
-    types.float64[:, ::1])
+    types.float64[:, ::1],
+    types.float64[:, :, ::1],   # the last returns of each start (m, keep, n)
+    types.int64[::1])           # returns completed per start
 
 
 @njit(cache=True)
 def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, p,
            starts, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
-           out_state, out_time, out_nsw, out_slide, out_status, out_first, out_slide_dz):
+           out_state, out_time, out_nsw, out_slide, out_status, out_first, out_slide_dz,
+           out_orbit, out_done):
+    """Each start is mapped iopts[3] times by the first-return map, each return
+    starting from the last one's state; the outputs describe the last return made
+    (or where it stopped) and out_orbit[i] holds the last keep returns."""
     fns = (flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where)
     m, n = starts.shape
     nsmax = max(frac_ex.size, frac_in.size)
@@ -830,9 +836,27 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
     s = Settings(t_max, exact, hwin, fopts[6], fopts[7], sec_pred, sliding, frac_ex, frac_in,
                  fopts[0], fopts[1], fopts[2], fopts[3], fopts[4], fopts[5], fopts[8],
                  iopts[0], iopts[1], iopts[2])
+    n_iter, keep = iopts[3], out_orbit.shape[1]
+    zin = np.empty(n)
     for i in range(m):
-        first[0] = np.nan
-        st, t, nsw, sl = _one(starts[i], fns, p, s, w)
+        for c in range(n):
+            zin[c] = starts[i, c]
+        done = 0
+        while True:
+            first[0] = np.nan
+            st, t, nsw, sl = _one(zin, fns, p, s, w)
+            if st != OK:
+                break
+            done += 1
+            j = done - 1 - (n_iter - keep)
+            if j >= 0:
+                for c in range(n):
+                    out_orbit[i, j, c] = w.z[c]
+            if done >= n_iter:
+                break
+            for c in range(n):
+                zin[c] = w.z[c]
+        out_done[i] = done
         out_first[i] = first[0]
         for c in range(n):
             out_state[i, c] = w.z[c]
@@ -867,6 +891,8 @@ class BatchReturns:
     status: np.ndarray
     first_switch: np.ndarray  # time of the first change of mode (NaN: none)
     sliding_displacement: np.ndarray = None  # (m, dim): state change summed over sliding
+    orbit: np.ndarray = None  # (m, keep, dim): the last ``keep`` of ``iterations`` returns
+    returns_done: np.ndarray = None  # (m,): returns completed (== iterations: all made)
 
 
 def _section_pred(direction: int) -> int:
@@ -877,13 +903,20 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
                     atol: float = 1e-14, max_step: float = np.inf, max_events: int = 100_000,
                     max_steps: int = 5_000_000, samples_per_step: int = 4,
                     touch_tol: float = 1e-15, event_xtol: float = 1e-15, zeno_count: int = 64,
-                    zeno_span: float = 1e-10, min_time: float = 0.0) -> BatchReturns:
+                    zeno_span: float = 1e-10, min_time: float = 0.0, iterations: int = 1,
+                    keep: int = 0) -> BatchReturns:
     """First returns of ``starts`` (``(m, dim)``) to the model's section, one compiled call.
 
     Options mean what they mean for :func:`filippov.simulate.simulate`; ``min_time``
     that of :class:`filippov.simulate.Section` (hits before it are ignored; a start
     on the section up to rounding is not a hit either way). Nothing is raised for a
     start point that fails: see ``status``.
+
+    ``iterations`` > 1 iterates the return map: each return starts from the state
+    of the one before (``t_max`` and the limits hold per return); the outputs then
+    describe the last return made, or the one that failed, ``returns_done[i]``
+    counts the returns completed and ``orbit[i]`` holds the last ``keep`` of them
+    (rows of a start that stopped early stay NaN).
     """
     starts = np.ascontiguousarray(np.atleast_2d(np.asarray(starts, dtype=float)))
     if starts.ndim != 2 or starts.shape[1] != cmodel.dim:
@@ -899,6 +932,10 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
         raise ValueError(f"max_step must be > 0, got {max_step!r}")
     if zeno_count < 1:
         raise ValueError("zeno_count must be >= 1")
+    if not (isinstance(iterations, (int, np.integer)) and iterations >= 1):
+        raise ValueError(f"iterations must be an integer >= 1, got {iterations!r}")
+    if not (isinstance(keep, (int, np.integer)) and 0 <= keep <= iterations):
+        raise ValueError(f"keep must be an integer in [0, iterations={iterations}], got {keep!r}")
     if not (np.isfinite(min_time) and min_time >= 0):
         raise ValueError(f"min_time must be a finite number >= 0, got {min_time!r}")
     if cmodel.exact and not (np.isfinite(cmodel.sample_step) and cmodel.sample_step > 0):
@@ -910,7 +947,7 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     frac_in = np.linspace(0.0, 1.0, samples_per_step + 1)
     fopts = np.array([rtol, atol, touch_tol, event_xtol, zeno_span, max_step, hwin_slow,
                       cmodel.transient_time, min_time], dtype=float)
-    iopts = np.array([max_events, max_steps, zeno_count], dtype=np.int64)
+    iopts = np.array([max_events, max_steps, zeno_count, iterations], dtype=np.int64)
     m = starts.shape[0]
     state = np.empty_like(starts)
     time = np.empty(m)
@@ -919,14 +956,16 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     status = np.empty(m, dtype=np.int64)
     first = np.empty(m)
     slide_dz = np.empty_like(starts)
+    orbit = np.full((m, keep, starts.shape[1]), np.nan)
+    done = np.empty(m, dtype=np.int64)
     params = np.ascontiguousarray(cmodel.params, dtype=float)
     compile_kernel()
     _batch(cmodel.flow_plus, cmodel.flow_minus, cmodel.field_plus, cmodel.field_minus,
            cmodel.h, cmodel.grad_h, cmodel.section, cmodel.section_where, params,
            starts, float(t_max), bool(cmodel.exact), float(hwin), _section_pred(cmodel.section_direction),
            bool(cmodel.sliding), frac_ex, frac_in, fopts, iopts, state, time, nsw, slide, status,
-           first, slide_dz)
-    return BatchReturns(state, time, nsw, slide, status, first, slide_dz)
+           first, slide_dz, orbit, done)
+    return BatchReturns(state, time, nsw, slide, status, first, slide_dz, orbit, done)
 
 
 _ERRORS = {EVENT_LIMIT: EventLimitError, STEP_LIMIT: EventLimitError, ZENO: ZenoError,

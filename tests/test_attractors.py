@@ -1,0 +1,83 @@
+"""Attractors of the return map (filippov.attractors): iteration on the compiled engine,
+period, escape, and the slope of P whose mean log is the Lyapunov exponent."""
+import numpy as np
+import pytest
+
+from filippov import attractors
+from filippov.fastmap import OK, compute_returns
+from filippov.models import hopf
+from filippov.scenes.fig04_retmaps import section_L1
+from filippov.simulate import simulate
+from filippov.variational import return_jacobian
+
+EPS = 1e-2
+T_MAX = 1.0  # four rotations: one return to L1 takes one
+
+
+def test_iterating_in_one_call_is_chaining_first_returns():
+    cm = hopf.compiled(EPS, -0.5, 1 + EPS)
+    z = np.array([[0.0, 1.0, 0.0]])
+    run = compute_returns(cm, z, T_MAX, iterations=7, keep=4)
+    chain = []
+    for _ in range(7):
+        out = compute_returns(cm, z, T_MAX)
+        assert out.status[0] == OK
+        z = out.state
+        chain.append(z[0])
+    assert run.status[0] == OK and run.returns_done[0] == 7
+    np.testing.assert_array_equal(run.orbit[0], np.array(chain[3:]))
+    np.testing.assert_array_equal(run.state[0], chain[-1])
+
+
+def test_a_return_that_fails_stops_the_iteration_and_is_an_escape():
+    cm = hopf.compiled(EPS, -0.5, 1 + EPS)
+    # t_max below one rotation: no return at all
+    at = attractors.settle(cm, [0.0, 1.0, 0.0], coordinate=1, transient=3, keep=4, t_max=0.1,
+                           scale=EPS, max_period=2, window=(0.5, 1.5))
+    assert at.escaped and "no return within t_max after 0 returns" in at.reason
+    assert np.isnan(at.width) and np.all(np.isnan(at.values))
+    # a window that the attractor leaves
+    at = attractors.settle(cm, [0.0, 1.0, 0.0], coordinate=1, transient=50, keep=20,
+                           t_max=T_MAX, scale=EPS, max_period=10, window=(0.999, 1.5))
+    assert at.escaped and "left the window" in at.reason
+
+
+def test_period_of_finds_the_smallest_period_and_none_for_a_random_sequence():
+    cycle = np.tile([0.1, 0.5, 0.2], 10)
+    assert attractors.period_of(cycle, 1e-12, 10) == 3
+    assert attractors.period_of(np.full(8, 2.0), 0.0, 4) == 1
+    rng = np.random.default_rng(0)
+    assert attractors.period_of(rng.random(60), 1e-6, 30) == 0
+    with pytest.raises(ValueError, match="at least 2 max_period"):
+        attractors.period_of(cycle[:5], 1e-12, 3)
+
+
+def test_finite_difference_slopes_are_the_variational_derivative_of_the_return():
+    # On the chaotic attractor at theta = 0.2 (mu = 1 + 2 eps^2): the compiled engine's
+    # central differences of P_x2 in x2 against dP/dz from the variational equations
+    # with saltation matrices on the reference driver (filippov.variational), and the
+    # fast row of dP/dz, which is what makes the x2 slope the whole story
+    mu = 1 + 2 * EPS ** 2
+    cm = hopf.compiled(EPS, 0.2, mu)
+    run = attractors.iterate(cm, [0.0, np.sqrt(mu), 0.0], transient=400, keep=6, t_max=T_MAX)
+    system = hopf.model(EPS, 0.2, mu).full()
+    fd = attractors.slopes(cm, run.orbit[0], 1, 1e-4 * EPS ** 2, T_MAX)
+    for z, s in zip(run.orbit[0], fd):
+        traj = simulate(system, z, T_MAX, sections=[section_L1()], dense=False)
+        J = return_jacobian(system, traj, section_L1(), rtol=1e-11, atol=1e-13)
+        assert s == pytest.approx(J[1, 1], rel=1e-6)
+        assert np.abs(J[2, 1:]).max() < 1e-6  # y forgets: rank one up to exp(-T/eps)
+    assert np.ptp(fd) > 1.0  # the kept points see both branches of the map
+
+
+def test_the_attractor_at_theta_0_2_is_chaotic_and_at_theta_minus_0_5_periodic():
+    chaotic = attractors.settle(hopf.compiled(EPS, 0.2, 1 + 2 * EPS ** 2), [0.0, 1.0, 0.0],
+                                coordinate=1, transient=400, keep=200, t_max=T_MAX,
+                                scale=EPS ** 2, max_period=50, window=(0.99, 1.01),
+                                lyapunov_step=1e-4 * EPS ** 2)
+    assert chaotic.period == 0 and chaotic.lyapunov > 0.2
+    periodic = attractors.settle(hopf.compiled(EPS, -0.5, 1 + EPS), [0.0, 1.0, 0.0],
+                                 coordinate=1, transient=400, keep=100, t_max=T_MAX,
+                                 scale=EPS, max_period=50, window=(0.9, 1.1),
+                                 lyapunov_step=1e-4 * EPS)
+    assert periodic.period == 5 and periodic.lyapunov < 0
