@@ -60,6 +60,27 @@ def period_of(values: np.ndarray, tol: float, max_period: int) -> int:
     return 0
 
 
+#: the smallest central-difference step for slopes of a return map whose states are
+#: of order one: one return carries rounding of ~1e-14 (event times to ~1e-15, summed
+#: over the switches), which a step of 1e-11 turns into 1e-3 of an O(1) slope
+MIN_FD_STEP = 1e-11
+
+
+def check_resolvable(scale: float, lyapunov_step: float | None = None) -> None:
+    """Refuse an attractor scale that double precision cannot resolve on states of
+    order one: the period test needs 1000 ulp <= 1e-2 scale, the slopes a step of at
+    least MIN_FD_STEP and at most 1e-1 scale (truncation ~1e-2 of the slope there; e.g.
+    theta > 0 at eps = 1e-6: scale eps^2 = 1e-12, below both)."""
+    if period_tolerance(scale) > 1e-2 * scale:
+        raise ValueError(f"attractor scale {scale:.3g} is below what double precision "
+                         f"resolves on states of order one (1000 ulp = {1e3 * _UNIT:.3g} "
+                         f"must be <= 1e-2 of it): periods cannot be told apart")
+    if lyapunov_step is not None and not MIN_FD_STEP <= lyapunov_step <= 1e-1 * scale:
+        raise ValueError(f"lyapunov_step {lyapunov_step:.3g} must lie in [{MIN_FD_STEP:g}, "
+                         f"1e-1 scale = {1e-1 * scale:.3g}]: below, the rounding of one "
+                         f"return dominates the slope; above, the attractor's own scale")
+
+
 def period_tolerance(scale: float) -> float:
     """Two returns are one point of a periodic orbit when they agree to 1e-4 of the
     attractor's scale (eps or eps^2 here), but never closer than 1000 ulp of 1: the
@@ -100,7 +121,9 @@ def slopes(cmodel: CompiledModel, states: np.ndarray, coordinate: int, step: flo
 def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, keep: int,
            t_max: float, scale: float, max_period: int, window: tuple[float, float],
            lyapunov_step: float | None = None, **options) -> Attractor:
-    """Iterate, classify, and (``lyapunov_step`` given) the Lyapunov exponent."""
+    """Iterate, classify, and (``lyapunov_step`` given) the Lyapunov exponent.
+    A scale too small to resolve is refused first (:func:`check_resolvable`)."""
+    check_resolvable(scale, lyapunov_step)
     run = iterate(cmodel, start, transient=transient, keep=keep, t_max=t_max, **options)
     states = run.orbit[0]
     values = states[:, coordinate]
@@ -118,5 +141,52 @@ def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, kee
     lyap = np.nan
     if lyapunov_step is not None:
         s = slopes(cmodel, states, coordinate, lyapunov_step, t_max, **options)
-        lyap = float(np.mean(np.log(np.abs(s)))) if np.all(np.isfinite(s)) else np.nan
+        with np.errstate(divide="ignore"):  # a flat return (sliding throughout): -inf
+            lyap = float(np.mean(np.log(np.abs(s)))) if np.all(np.isfinite(s)) else np.nan
     return Attractor(values, period, width, lyap, False, "", states)
+
+
+def first_window(periods: np.ndarray, n: int) -> tuple[int, int] | None:
+    """[i0, i1] (inclusive) of the first run of ``periods == n`` of at least two grid
+    points, scanning the grid upwards; None if there is none."""
+    hit = np.asarray(periods) == n
+    i = 0
+    while i < hit.size:
+        if hit[i]:
+            j = i
+            while j + 1 < hit.size and hit[j + 1]:
+                j += 1
+            if j > i:
+                return i, j
+            i = j + 1
+        else:
+            i += 1
+    return None
+
+
+def edge(classify, inside: float, outside: float, n: int, tol: float) -> float:
+    """Bisection for where the period ``n`` at ``inside`` stops (``classify(s)`` gives
+    the period at s, ``outside`` has another one): the midpoint of the last bracket,
+    no wider than ``tol``."""
+    a, b = float(inside), float(outside)
+    while abs(b - a) > tol:
+        m = 0.5 * (a + b)
+        if classify(m) == n:
+            a = m
+        else:
+            b = m
+    return 0.5 * (a + b)
+
+
+def window_edges(grid: np.ndarray, periods: np.ndarray, n: int, classify,
+                 tol: float) -> tuple[float, float]:
+    """(left, right) edges of the first window of period n on ``grid`` (see
+    :func:`first_window`), located by bisection to ``tol``; NaN where the window
+    is not there or reaches the end of the grid (the edge lies outside)."""
+    w = first_window(periods, n)
+    if w is None:
+        return np.nan, np.nan
+    i0, i1 = w
+    left = edge(classify, grid[i0], grid[i0 - 1], n, tol) if i0 > 0 else np.nan
+    right = edge(classify, grid[i1], grid[i1 + 1], n, tol) if i1 + 1 < grid.size else np.nan
+    return left, right

@@ -1,0 +1,78 @@
+"""Period-adding cascade (theta < 0): orbit diagrams of the slow-fast return map with
+the limit map beside them, the period against s, and how the window edges converge."""
+from __future__ import annotations
+
+import numpy as np
+
+from . import style as st
+from .fig13_small_scale_chaos import eps_tex
+
+VARS = ["u", "u_limit", "u_limit0", "period", "period_limit0", "edge", "edge_limit0",
+        "edge_gap"]
+S_LABEL = r"$s=(\mu-1)/\varepsilon$"
+U_LABEL = r"$(x_2-1)/\varepsilon$ on $\mathcal{L}_1$"
+
+
+def _diagram(ax, s, u, **kw):
+    ss = np.repeat(s, u.shape[-1])
+    ax.plot(ss, u.reshape(-1), ",", **kw)
+
+
+def draw(ds):
+    st.require(ds, "fig12_period_adding", VARS)
+    s, eps = ds.s.values, ds.eps.values
+    theta = float(ds.theta.values[0])
+    fig = st.new_figure(st.WIDTH_DOUBLE, 5.2)
+    axes = fig.subplots(2, 3)
+    shown = [0, len(eps) // 2, len(eps) - 1]
+    for k, (ax, j) in enumerate(zip(axes[0], shown)):
+        _diagram(ax, s, ds.u.values[0, j], color="black", rasterized=False)
+        _diagram(ax, s + 0.35 * (s[1] - s[0]), ds.u_limit.values[0, j], color=st.C_MINUS)
+        ax.set_xlabel(S_LABEL)
+        ax.set_ylabel(U_LABEL)
+        ax.set_xlim(s.min(), s.max())
+        st.panel_label(ax, f"({'abc'[k]}) $\\varepsilon={eps_tex(eps[j])}$, $\\theta={theta:g}$")
+        if k == 0:
+            ax.plot([], [], "s", ms=3, color="black", label="slow-fast")
+            ax.plot([], [], "s", ms=3, color=st.C_MINUS, label="limit map")
+            ax.legend(loc="lower left")
+    ax = axes[1, 0]
+    _diagram(ax, s, ds.u_limit0.values[0], color=st.C_PLUS)
+    ax.set_xlabel(S_LABEL)
+    ax.set_ylabel(U_LABEL)
+    ax.set_xlim(s.min(), s.max())
+    st.panel_label(ax, r"(d) limit map, $\varepsilon\to 0$")
+    ax = axes[1, 1]
+    colors = ["0.75", "0.6", "0.45", "0.3", "black"]
+    for j, e in enumerate(eps):
+        per = np.where(ds.period.values[0, j] > 0, ds.period.values[0, j], np.nan)
+        ax.step(s, per, where="mid", color=colors[j % len(colors)], lw=st.LW_THIN,
+                label=f"$\\varepsilon={eps_tex(e)}$")
+    per0 = np.where(ds.period_limit0.values[0] > 0, ds.period_limit0.values[0], np.nan)
+    ax.step(s, per0, where="mid", color=st.C_PLUS, lw=st.LW, ls="--",
+            label=r"$\varepsilon\to 0$")
+    ax.set_yscale("log")
+    ax.set_yticks([1, 2, 3, 4, 5, 6, 8, 10])
+    ax.set_yticklabels(["1", "2", "3", "4", "5", "6", "8", "10"])
+    ax.set_xlabel(S_LABEL)
+    ax.set_ylabel("period of the attractor")
+    ax.set_xlim(s.min(), s.max())
+    ax.legend(loc="upper right", fontsize=6)
+    st.panel_label(ax, "(e) period (gaps: none found)")
+    ax = axes[1, 2]
+    edge, edge0 = ds.edge.values, ds.edge_limit0.values
+    for m, n in enumerate(ds.n.values):
+        for side, marker in ((0, "o"), (1, "s")):
+            d = np.abs(edge[:, m, side] - edge0[m, side])
+            ok = np.isfinite(d) & (d > 0)
+            ax.loglog(eps[ok], d[ok], marker=marker, ms=3, lw=st.LW_THIN,
+                      mfc="none" if side else None,
+                      color=[st.C_PLUS, st.C_MINUS, st.C_SLIDE, "black"][m % 4],
+                      label=f"$n={n}$" if side == 0 else None)
+    ax.loglog(eps, ds.edge_gap.values, color=st.C_AUX, lw=st.LW, ls="--",
+              label="slow-fast vs limit map")
+    ax.set_xlabel(st.EPS)
+    ax.set_ylabel(r"$|$edge $-$ edge$_{\varepsilon\to0}|$ in $s$")
+    ax.legend(loc="lower right", fontsize=6)
+    st.panel_label(ax, "(f) window edges: left o, right \u25a1")
+    return fig

@@ -1,0 +1,84 @@
+"""Small-scale chaos (theta > 0): orbit diagrams with the limit map, the Lyapunov
+exponent against s for every theta, and the eps^2 scaling of the attractor's width."""
+from __future__ import annotations
+
+import numpy as np
+
+from . import style as st
+
+VARS = ["u", "u_limit", "lyapunov", "lyapunov_limit", "width_x2", "width_exponent",
+        "slope_pdm", "period"]
+S_LABEL = r"$s=(\mu-1)/\varepsilon^2$"
+U_LABEL = r"$(x_2-1)/\varepsilon^2$ on $\mathcal{L}_1$"
+COLORS = ["0.6", st.C_PLUS, st.C_SLIDE, st.C_MINUS, "black"]
+
+
+def eps_tex(e: float) -> str:
+    p = np.log10(e)
+    return f"10^{{{int(round(p))}}}" if abs(p - round(p)) < 1e-9 else f"{e:g}"
+
+
+def _diagram(ax, s, u, **kw):
+    ax.plot(np.repeat(s, u.shape[-1]), u.reshape(-1), ",", **kw)
+
+
+def draw(ds):
+    st.require(ds, "fig13_small_scale_chaos", VARS)
+    s, eps, th = ds.s.values, ds.eps.values, ds.theta.values
+    lin = s <= float(ds.attrs["s_max"]) + 1e-12
+    j = len(eps) - 1
+    fig = st.new_figure(st.WIDTH_DOUBLE, 5.2)
+    axes = fig.subplots(2, 3)
+    picks = [i for i in np.argsort(-th) if th[i] in (0.5, 0.2, 0.1)][:3] or [0, 1, 2][:th.size]
+    for k, (ax, i) in enumerate(zip(axes[0], picks)):
+        _diagram(ax, s[lin], ds.u.values[i, j][lin], color="black")
+        _diagram(ax, s[lin] + 0.3 * (s[1] - s[0]), ds.u_limit.values[i, j][lin],
+                 color=st.C_MINUS)
+        ax.set_xlabel(S_LABEL)
+        ax.set_ylabel(U_LABEL)
+        ax.set_xlim(s[lin].min(), s[lin].max())
+        st.panel_label(ax, f"({'abc'[k]}) $\\theta={th[i]:g}$, "
+                           f"$\\varepsilon={eps_tex(eps[j])}$, "
+                           f"$s(\\theta,0,0)={float(ds.slope_pdm.values[i]):.3g}$")
+        if k == 0:
+            ax.plot([], [], "s", ms=3, color="black", label="slow-fast")
+            ax.plot([], [], "s", ms=3, color=st.C_MINUS, label="limit map")
+            ax.legend(loc="upper left")
+    ax = axes[1, 0]
+    for i, t in enumerate(th):
+        c = COLORS[i % len(COLORS)]
+        ax.plot(s[lin], ds.lyapunov.values[i, j][lin], color=c, lw=st.LW,
+                label=f"$\\theta={t:g}$")
+        ax.plot(s[lin], ds.lyapunov_limit.values[i, j][lin], color=c, lw=st.LW_THIN, ls="--")
+    ax.axhline(0.0, color=st.C_AUX, lw=st.LW_THIN)
+    ax.set_ylim(-2.0, 1.0)
+    ax.set_xlim(s[lin].min(), s[lin].max())
+    ax.set_xlabel(S_LABEL)
+    ax.set_ylabel("largest Lyapunov exponent")
+    ax.legend(loc="lower right", fontsize=6, ncol=2)
+    st.panel_label(ax, f"(d) $\\varepsilon={eps_tex(eps[j])}$; dashed: limit map")
+    ax = axes[1, 1]
+    i = int(np.argmin(np.abs(th - 0.2)))
+    pos = s > 0
+    for jj, e in enumerate(eps):
+        w = ds.width_x2.values[i, jj][pos]
+        ok = ds.period.values[i, jj][pos] != 1  # a point: width zero up to rounding
+        ax.loglog((s[pos] * e * e)[ok], w[ok], "o-", ms=2, lw=st.LW_THIN,
+                  color=COLORS[(jj + 2) % len(COLORS)], label=f"$\\varepsilon={eps_tex(e)}$")
+    ax.set_xlabel(r"$\mu-1$")
+    ax.set_ylabel(r"width of the attractor in $x_2$")
+    ax.legend(loc="upper left", fontsize=6)
+    st.panel_label(ax, f"(e) $\\theta={th[i]:g}$: chaos on the scale $\\varepsilon^2$")
+    ax = axes[1, 2]
+    for i, t in enumerate(th):
+        k = ds.width_exponent.values[i]
+        if np.isfinite(k).any():
+            ax.semilogx(s[pos], k[pos], "o-", ms=2, lw=st.LW_THIN, color=COLORS[i % len(COLORS)],
+                        label=f"$\\theta={t:g}$")
+    ax.axhline(2.0, color=st.C_AUX, lw=st.LW_THIN, ls="--", label="$k=2$")
+    ax.set_ylim(0.0, 4.0)
+    ax.set_xlabel(S_LABEL)
+    ax.set_ylabel(r"$k$ in width $\propto\varepsilon^k$")
+    ax.legend(loc="lower left", fontsize=6)
+    st.panel_label(ax, "(f) scaling exponent of the width")
+    return fig

@@ -1,0 +1,196 @@
+"""Shared part of the small-scale instability scenes (orbit diagrams of the Hopf
+example's return map to L1 across mu = 1, on the compiled engine with exact flows).
+
+Coordinates are the paper's scales: sigma = eps (theta < 0), eps^2 (theta > 0);
+s = (mu - 1)/sigma along the parameter, u = (x2 - 1)/sigma on L1. Every (theta, eps, s)
+is computed on its own (one compiled call iterating the return map from the cycle's
+point (0, sqrt(mu), 0)), so the s grid splits into chunks bit for bit. Beside each
+slow-fast diagram the limit map of :mod:`filippov.analytic.limit_map` is iterated
+on the same grid, at order 1 for each eps and at order 0 (eps -> 0).
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from .. import attractors
+from ..analytic import limit_map
+from ..config import SceneError
+from ..fastmap import OK
+from ..models import hopf
+from ..progress import Progress
+from .common import require, solver_options
+
+CHUNK_AXIS = "s"
+ENGINES = ("compiled",)
+#: status of a run that left the watched window (beyond the engine's status codes)
+LEFT_WINDOW = 100
+T_RETURN = 1.0  # t_max of one return: four rotations (one return takes one)
+
+
+def s_grid(p: dict) -> np.ndarray:
+    """n_mu points on [s_min, s_max], and with ``n_geo`` the points of a geometric grid
+    from s_max to s_geo_max beyond it (how the attractor ends away from grazing)."""
+    lo, hi, n = float(p["s_min"]), float(p["s_max"]), int(p["n_mu"])
+    if not lo < hi:
+        raise SceneError(f"parameters.s_min < s_max required, got {lo!r}, {hi!r}")
+    grid = np.linspace(lo, hi, n)
+    if int(p.get("n_geo", 0)) > 0:
+        top = float(p["s_geo_max"])
+        if not (hi > 0 and top > hi):
+            raise SceneError(f"parameters.s_geo_max: need s_geo_max > s_max > 0, got "
+                             f"{top!r} and {hi!r}")
+        grid = np.concatenate([grid, np.geomspace(hi, top, int(p["n_geo"]) + 1)[1:]])
+    return grid
+
+
+def thetas(p: dict) -> list[float]:
+    return [float(t) for t in np.atleast_1d(p["theta"])]
+
+
+def eps_list(p: dict) -> list[float]:
+    return sorted((float(e) for e in np.atleast_1d(p["eps"])), reverse=True)
+
+
+def validate(scene: dict) -> None:
+    p = scene["parameters"]
+    for t in thetas(p):
+        for e in eps_list(p):
+            try:
+                attractors.check_resolvable(limit_map.scale(e, t), fd_step(
+                    limit_map.scale(e, t)) if p.get("lyapunov") else None)
+            except ValueError as exc:
+                raise SceneError(f"{scene['id']}: parameters.eps: {e:g} at theta = {t:g}: "
+                                 f"{exc}") from None
+    if int(p["n_keep"]) < 2 * int(p["max_period"]):
+        raise SceneError(f"{scene['id']}: parameters.n_keep: need at least 2 max_period = "
+                         f"{2 * int(p['max_period'])} kept returns to tell periods up to "
+                         f"max_period, got {p['n_keep']}")
+    if any(t == 0 for t in thetas(p)):
+        raise SceneError(f"{scene['id']}: parameters.theta: theta = 0 is the boundary "
+                         "between the two cases (no scale)")
+
+
+def _settle(p, theta, eps, s, options, lyapunov):
+    sigma = limit_map.scale(eps, theta)
+    mu = 1.0 + s * sigma
+    cm = hopf.compiled(eps, theta, mu, float(p["omega"]), sliding=theta > 0)
+    w = float(p["window"])
+    return attractors.settle(
+        cm, [0.0, np.sqrt(mu), 0.0], coordinate=1, transient=int(p["n_transient"]),
+        keep=int(p["n_keep"]), t_max=T_RETURN, scale=sigma, max_period=int(p["max_period"]),
+        window=(1.0 - w, 1.0 + w), lyapunov_step=fd_step(sigma) if lyapunov else None,
+        **options)
+
+
+def fd_step(sigma: float) -> float:
+    """Central-difference step of the Lyapunov slopes: 1e-4 of the attractor's scale,
+    never below attractors.MIN_FD_STEP (the rounding of one return)."""
+    return max(1e-4 * sigma, attractors.MIN_FD_STEP)
+
+
+def sweep(scene: dict, s: np.ndarray, *, progress: bool = False) -> xr.Dataset:
+    """Raw attractors on the points ``s`` (any part of the grid), per theta and eps."""
+    require(scene, "system", {"slow_fast"})
+    require(scene, "flow", {"exact"})
+    p = scene["parameters"]
+    opts = solver_options(scene)
+    opts.pop("method")
+    lyapunov = bool(p.get("lyapunov", False))
+    th, ep, s = thetas(p), eps_list(p), np.asarray(s, dtype=float)
+    keep = int(p["n_keep"])
+    shape = (len(th), len(ep), s.size)
+    u = np.full(shape + (keep,), np.nan)
+    period, status = np.zeros(shape, dtype=np.int32), np.zeros(shape, dtype=np.int32)
+    width, lyap = np.full(shape, np.nan), np.full(shape, np.nan)
+    bar = Progress(scene["id"], int(np.prod(shape)), progress)
+    for i, theta in enumerate(th):
+        for j, eps in enumerate(ep):
+            sigma = limit_map.scale(eps, theta)
+            for k, sk in enumerate(s):
+                at = _settle(p, theta, eps, float(sk), opts, lyapunov)
+                u[i, j, k] = (at.values - 1.0) / sigma
+                period[i, j, k] = at.period
+                width[i, j, k] = at.width / sigma
+                lyap[i, j, k] = at.lyapunov
+                status[i, j, k] = (OK if not at.escaped else
+                                   LEFT_WINDOW if at.reason.startswith("left") else
+                                   _status_code(at.reason))
+                bar.step()
+    dims = ("theta", "eps", "s")
+    return xr.Dataset(
+        {"u": (dims + ("k",), u), "period": (dims, period), "width": (dims, width),
+         "lyapunov": (dims, lyap), "status": (dims, status)},
+        coords={"theta": ("theta", th), "eps": ("eps", ep), "s": ("s", s),
+                "k": ("k", np.arange(keep, dtype=np.int32))})
+
+
+def _status_code(reason: str) -> int:
+    from ..fastmap import STATUS
+    for code, text in STATUS.items():
+        if reason.startswith(text):
+            return int(code)
+    return -1
+
+
+def limit_diagrams(scene: dict, s: np.ndarray) -> dict:
+    """The limit map on the same grid: order 1 per (theta, eps) and order 0 per theta
+    (for theta > 0 the two coincide: no eps is left at leading order)."""
+    p = scene["parameters"]
+    th, ep = thetas(p), eps_list(p)
+    n_tr, keep, omega = int(p["n_transient"]), int(p["n_keep"]), float(p["omega"])
+    u1 = np.stack([np.stack([limit_map.orbit(s, eps=e, theta=t, omega=omega, transient=n_tr,
+                                             keep=keep, order=1) for e in ep]) for t in th])
+    u0 = np.stack([limit_map.orbit(s, eps=ep[-1], theta=t, omega=omega, transient=n_tr,
+                                   keep=keep, order=0) for t in th])
+    return {"u_limit": u1, "u_limit0": u0}
+
+
+def periods_of(u: np.ndarray, scale_tol: float, max_period: int) -> np.ndarray:
+    """Period of each row of kept scaled values (last axis), as attractors.period_of."""
+    flat = u.reshape(-1, u.shape[-1])
+    out = np.array([attractors.period_of(r, scale_tol, max_period) if np.all(np.isfinite(r))
+                    else 0 for r in flat], dtype=np.int32)
+    return out.reshape(u.shape[:-1])
+
+
+#: scaled-unit tolerance of a period (attractors.period_tolerance with scale 1)
+PERIOD_TOL = 1e-4
+
+VARIABLE_ATTRS = {
+    "u": ("(x2 - 1)/sigma at the kept returns to L1 (sigma = eps for theta < 0, eps^2 for "
+          "theta > 0)", "1"),
+    "period": ("period of the attractor (0: none up to max_period)", "1"),
+    "width": ("width of the attractor in u (max - min of the kept returns)", "1"),
+    "lyapunov": ("largest Lyapunov exponent of the return map along the attractor (mean "
+                 "log |dP/dx2|; NaN: not computed or escaped)", "1"),
+    "status": ("0: settled; 100: left the window; else the engine's status code of the "
+               "failed return", "1"),
+    "u_limit": ("u of the limit map (paper's asymptotics, order 1 in sqrt(eps))", "1"),
+    "u_limit0": ("u of the limit map at order 0 (eps -> 0)", "1"),
+    "period_limit": ("period of the limit map's attractor (order 1)", "1"),
+    "period_limit0": ("period of the limit map's attractor (order 0)", "1"),
+    "theta": ("theta, weight of the fast variable in the switching function", "1"),
+    "eps": ("eps, time-scale ratio", "1"),
+    "s": ("s = (mu - 1)/sigma, the scaled parameter", "1"),
+    "k": ("index of the kept return", "1"),
+}
+
+
+def common_dataset(scene: dict, raw: xr.Dataset) -> xr.Dataset:
+    """Raw sweep plus the limit maps and their periods."""
+    p = scene["parameters"]
+    s = s_grid(p)
+    if not np.array_equal(raw["s"].values, s):
+        raise ValueError(f"{scene['id']}: the raw attractors are not on the scene's s grid")
+    lim = limit_diagrams(scene, s)
+    mp = int(p["max_period"])
+    ds = raw.copy()
+    ds["u_limit"] = (("theta", "eps", "s", "k"), lim["u_limit"])
+    ds["u_limit0"] = (("theta", "s", "k"), lim["u_limit0"])
+    ds["period_limit"] = (("theta", "eps", "s"), periods_of(lim["u_limit"], PERIOD_TOL, mp))
+    ds["period_limit0"] = (("theta", "s"), periods_of(lim["u_limit0"], PERIOD_TOL, mp))
+    ds["multiplier"] = ((), limit_map.multiplier(1.0, float(p["omega"])), {
+        "long_name": "lambda = exp(-4 pi/omega), the Hopf cycle's multiplier per turn at mu = 1",
+        "units": "1"})
+    return ds

@@ -1,0 +1,114 @@
+"""Period-adding cascade (theta < 0): the attractor of the return map to L1 of the
+slow-fast Hopf example across mu = 1, for several eps, beside the limit map.
+
+Orbit diagram in s = (mu - 1)/eps, u = (x2 - 1)/eps (attractor_common). On top of
+the shared sweep this scene locates the windows of the cascade: for each period n of
+``window_periods`` the first window of period n (scanning s upwards), its edges found by
+bisection on the slow-fast system (to ``edge_tol`` in s), on the order-1 limit map
+for the same eps and on the order-0 limit map (eps -> 0). The edges at eps <=
+``fit_eps_max`` are then fitted by edge = A + B eps^(1/2) (the order-1 term of P_DM
+is of order sqrt(eps) relative to the order-0 jump) and by edge = A + B eps; the
+intercept A of the first is compared with the order-0 edge.
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from .. import attractors
+from ..analytic import limit_map
+from ..io import finalize
+from .attractor_common import (CHUNK_AXIS, ENGINES, PERIOD_TOL, T_RETURN,  # noqa: F401
+                               VARIABLE_ATTRS as _COMMON_ATTRS, _settle, common_dataset,
+                               eps_list, s_grid, sweep, thetas, validate)
+from .common import solver_options
+
+VARIABLE_ATTRS = dict(_COMMON_ATTRS)
+VARIABLE_ATTRS.update({
+    "n": ("period of the window", "1"),
+    "side": ("0: left edge (smaller s), 1: right edge", "1"),
+    "edge": ("edge in s of the first window of period n, slow-fast system (NaN: not on "
+             "the grid)", "1"),
+    "edge_limit": ("edge in s of the first window of period n, limit map order 1", "1"),
+    "edge_limit0": ("edge in s of the first window of period n, limit map order 0 "
+                    "(eps -> 0)", "1"),
+    "fit_sqrt_A": ("intercept A of edge = A + B eps^(1/2) over eps <= fit_eps_max", "1"),
+    "fit_sqrt_B": ("slope B of edge = A + B eps^(1/2)", "1"),
+    "fit_sqrt_rms": ("rms residual of edge = A + B eps^(1/2)", "1"),
+    "fit_lin_A": ("intercept A of edge = A + B eps", "1"),
+    "fit_lin_B": ("slope B of edge = A + B eps", "1"),
+    "fit_lin_rms": ("rms residual of edge = A + B eps", "1"),
+    "edge_gap": ("largest |edge - edge_limit| over the windows: slow-fast against the "
+                 "order-1 limit map", "1"),
+})
+
+
+def chunk_grid(scene: dict) -> np.ndarray:
+    return s_grid(scene["parameters"])
+
+
+def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    return assemble(scene, sweep(scene, chunk_grid(scene), progress=progress))
+
+
+def _fit(x: np.ndarray, y: np.ndarray):
+    """Least squares y = A + B x over the finite points: (A, B, rms); NaN with < 3."""
+    ok = np.isfinite(y)
+    if ok.sum() < 3:
+        return np.nan, np.nan, np.nan
+    M = np.stack([np.ones(ok.sum()), x[ok]], axis=1)
+    (a, b), *_ = np.linalg.lstsq(M, y[ok], rcond=None)
+    return float(a), float(b), float(np.sqrt(np.mean((M @ [a, b] - y[ok]) ** 2)))
+
+
+def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
+    p = scene["parameters"]
+    ds = common_dataset(scene, raw)
+    (theta,) = thetas(p)
+    eps, s = eps_list(p), s_grid(p)
+    ns = [int(n) for n in p["window_periods"]]
+    tol, mp = float(p["edge_tol"]), int(p["max_period"])
+    omega, n_tr, keep = float(p["omega"]), int(p["n_transient"]), int(p["n_keep"])
+    opts = solver_options(scene)
+    opts.pop("method")
+
+    def limit_period(order, e):
+        return lambda x: attractors.period_of(
+            limit_map.orbit([x], eps=e, theta=theta, omega=omega, transient=n_tr, keep=keep,
+                            order=order)[0], PERIOD_TOL, mp)
+
+    edge = np.full((len(eps), len(ns), 2), np.nan)
+    edge_lim = np.full_like(edge, np.nan)
+    for j, e in enumerate(eps):
+        sf = lambda x, e=e: _settle(p, theta, e, x, opts, False).period  # noqa: E731
+        for m, n in enumerate(ns):
+            edge[j, m] = attractors.window_edges(s, ds.period.values[0, j], n, sf, tol)
+            edge_lim[j, m] = attractors.window_edges(s, ds.period_limit.values[0, j], n,
+                                                     limit_period(1, e), tol)
+    edge0 = np.full((len(ns), 2), np.nan)
+    for m, n in enumerate(ns):
+        edge0[m] = attractors.window_edges(s, ds.period_limit0.values[0], n,
+                                           limit_period(0, eps[-1]), tol)
+    fits = {k: np.full((len(ns), 2), np.nan) for k in (
+        "fit_sqrt_A", "fit_sqrt_B", "fit_sqrt_rms", "fit_lin_A", "fit_lin_B", "fit_lin_rms")}
+    ea = np.array(eps)
+    fitted = ea <= float(p["fit_eps_max"])
+    for m in range(len(ns)):
+        for side in (0, 1):
+            y = np.where(fitted, edge[:, m, side], np.nan)
+            fits["fit_sqrt_A"][m, side], fits["fit_sqrt_B"][m, side], \
+                fits["fit_sqrt_rms"][m, side] = _fit(np.sqrt(ea), y)
+            fits["fit_lin_A"][m, side], fits["fit_lin_B"][m, side], \
+                fits["fit_lin_rms"][m, side] = _fit(ea, y)
+    ds = ds.assign_coords(n=("n", np.array(ns, dtype=np.int32)),
+                          side=("side", np.array([0, 1], dtype=np.int32)))
+    ds["edge"] = (("eps", "n", "side"), edge)
+    ds["edge_limit"] = (("eps", "n", "side"), edge_lim)
+    ds["edge_limit0"] = (("n", "side"), edge0)
+    for k, v in fits.items():
+        ds[k] = (("n", "side"), v)
+    gap = np.abs(edge - edge_lim).reshape(len(eps), -1)
+    ds["edge_gap"] = ("eps", np.array([np.nanmax(g) if np.isfinite(g).any() else np.nan
+                                       for g in gap]))
+    return finalize(ds, scene, engine="compiled", method="exact",
+                    title="period-adding cascade of the slow-fast Hopf example, theta < 0")
