@@ -81,3 +81,18 @@ def test_the_attractor_at_theta_0_2_is_chaotic_and_at_theta_minus_0_5_periodic()
                                  scale=EPS, max_period=50, window=(0.9, 1.1),
                                  lyapunov_step=1e-4 * EPS)
     assert periodic.period == 5 and periodic.lyapunov < 0
+
+
+def test_a_slope_on_the_kink_of_p_is_refused_not_averaged():
+    # at mu = 1 the attractor is the grazing point itself, where P has a kink (slope
+    # lambda on one side, lambda s(theta,0,0) on the other): central differences would
+    # average the two (at theta = 0.5 to ~0, log -> -9); the exponent is NaN instead
+    at = attractors.settle(hopf.compiled(1e-3, 0.5, 1.0), [0.0, 1.0, 0.0], coordinate=1,
+                           transient=100, keep=20, t_max=T_MAX, scale=1e-6, max_period=10,
+                           window=(0.9, 1.1), lyapunov_step=1e-10)
+    assert at.period == 1 and np.isnan(at.lyapunov)
+    # one step away from it the slopes are those of the smooth branch
+    mu = 1 - 1e-6
+    s = attractors.slopes(hopf.compiled(1e-3, 0.5, mu), [[0.0, np.sqrt(mu), 0.0]], 1, 1e-10,
+                          T_MAX)
+    assert s[0] == pytest.approx(np.exp(-4 * np.pi * mu / (8 * np.pi)), rel=1e-3)

@@ -9,7 +9,8 @@ recorded, all in one compiled call: :func:`filippov.fastmap.compute_returns` wit
   (0: none up to ``max_period`` -- chaotic, quasi-periodic or not yet settled);
 * ``width``: max - min of the kept values;
 * ``lyapunov``: the mean of log |dP/du| along the kept returns, the slope of the
-  map in the coordinate u by central differences (:func:`slopes`);
+  map in the coordinate u by central differences (:func:`slopes`), leaving out points
+  that lie on a kink of P (NaN when all do: the attractor sits on the grazing point);
 * ``escaped``: a return failed (no return within t_max: the orbit left for another
   attractor or infinity) or a kept value left the window the caller watches; such an
   attractor is reported as escaped with the reason, never as numbers.
@@ -98,24 +99,38 @@ def iterate(cmodel: CompiledModel, start, *, transient: int, keep: int, t_max: f
                            keep=keep, **options)
 
 
+#: one-sided slopes of P that differ by more than this (relative) put the point on a
+#: kink of P (the grazing point): central differences straddling it average two
+#: branches, so the slope there is refused (NaN). Smooth parts stay far below: the
+#: curvature term is ~step/scale = 1e-4, the rounding ~1e-14/step <= 1e-2 for the
+#: steps :func:`check_resolvable` admits.
+KINK = 0.05
+
+
 def slopes(cmodel: CompiledModel, states: np.ndarray, coordinate: int, step: float,
            t_max: float, **options) -> np.ndarray:
     """dP_u/du at each state by central differences of step ``step`` in coordinate u
     (the other coordinates held), P_u the u-component of the first return. NaN where a
-    perturbed start fails to return. Truncation ~ step^2 P'''/6, rounding ~ e/step
-    with e the error of one return (~1e-14 here): a step of 1e-4 of the attractor's
-    scale keeps both below 1e-3 of a slope of order one for scales >= 1e-8."""
+    start fails to return or where the point lies on a kink of P (one-sided slopes
+    differ by more than :data:`KINK`). Truncation ~ step^2 times the third derivative
+    of P, rounding ~ e/step with e the error of one return (~1e-14 here): a step of
+    1e-4 of the attractor's scale keeps both below 1e-3 of a slope of order one for
+    scales >= 1e-8."""
     states = np.atleast_2d(np.asarray(states, dtype=float))
     plus, minus = states.copy(), states.copy()
     plus[:, coordinate] += step
     minus[:, coordinate] -= step
-    out = compute_returns(cmodel, np.concatenate([plus, minus]), t_max, **options)
+    out = compute_returns(cmodel, np.concatenate([plus, minus, states]), t_max, **options)
     m = states.shape[0]
-    fp, fm = out.state[:m, coordinate], out.state[m:, coordinate]
-    ok = (out.status[:m] == OK) & (out.status[m:] == OK)
-    # the step actually taken (u +- step rounded), not the nominal one
-    du = plus[:, coordinate] - minus[:, coordinate]
-    return np.where(ok, (fp - fm) / du, np.nan)
+    fp, fm, f0 = (out.state[k * m:(k + 1) * m, coordinate] for k in range(3))
+    ok = np.all(out.status.reshape(3, m) == OK, axis=0)
+    # the steps actually taken (u +- step rounded), not the nominal one
+    up = plus[:, coordinate] - states[:, coordinate]
+    down = states[:, coordinate] - minus[:, coordinate]
+    right, left = (fp - f0) / up, (f0 - fm) / down
+    big = np.maximum(1.0, np.maximum(np.abs(right), np.abs(left)))
+    kink = np.abs(right - left) > KINK * big
+    return np.where(ok & ~kink, (fp - fm) / (up + down), np.nan)
 
 
 def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, keep: int,
@@ -140,9 +155,11 @@ def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, kee
     width = float(values.max() - values.min())
     lyap = np.nan
     if lyapunov_step is not None:
+        # points on a kink of P (NaN slopes) are left out; none left: no exponent
         s = slopes(cmodel, states, coordinate, lyapunov_step, t_max, **options)
+        s = s[np.isfinite(s)]
         with np.errstate(divide="ignore"):  # a flat return (sliding throughout): -inf
-            lyap = float(np.mean(np.log(np.abs(s)))) if np.all(np.isfinite(s)) else np.nan
+            lyap = float(np.mean(np.log(np.abs(s)))) if s.size else np.nan
     return Attractor(values, period, width, lyap, False, "", states)
 
 

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .tolerance import DEFAULT, Tolerance, final_values
+from .tolerance import DEFAULT, Tolerance, attractor_allowed, extents, final_values
 
 ROOT = Path(__file__).resolve().parents[2]
 MANIFEST = ROOT / "tests" / "reference" / "manifest.json"
@@ -121,6 +121,9 @@ def summarize(path: Path) -> dict:
             "sha256": hashlib.sha256(np.ascontiguousarray(values).tobytes()).hexdigest()}
         if tol.rule == "trace":
             out[name]["final"] = _finite_list(final_values(values)) if values.size else []
+        if tol.rule == "attractor":  # only each row's extent is a result
+            lo, hi = extents(values) if values.size else (np.array([]), np.array([]))
+            out[name]["extent_min"], out[name]["extent_max"] = _finite_list(lo), _finite_list(hi)
     return out
 
 
@@ -154,6 +157,20 @@ def _compare_variable(g: dict, w: dict, tol: Tolerance) -> str | None:
         return None if g["shape"] == w["shape"] else f"shape {g['shape']} != {w['shape']} {rule}"
     if g["shape"] != w["shape"] or g["nan"] != w["nan"] or g["index"] != w["index"]:
         return f"shape/NaN count {g['shape']}/{g['nan']} != {w['shape']}/{w['nan']}"
+    if tol.rule == "attractor":
+        # points of an attractor: each row's extent, within tolerance + jump x its width
+        lo_w, hi_w = (np.array([np.nan if v is None else v for v in w[k]], dtype=float)
+                      for k in ("extent_min", "extent_max"))
+        lo_g, hi_g = (np.array([np.nan if v is None else v for v in g[k]], dtype=float)
+                      for k in ("extent_min", "extent_max"))
+        ref, got = np.concatenate([lo_w, hi_w]), np.concatenate([lo_g, hi_g])
+        if np.any(np.isnan(ref) != np.isnan(got)):
+            return f"rows without finite values differ {rule}"
+        diff = np.abs(np.nan_to_num(got - ref))
+        excess = diff - np.nan_to_num(attractor_allowed(tol, lo_w, hi_w))
+        return None if np.all(excess <= 0) else \
+            f"a row's extent moved by up to {diff.max():.3e} (tolerance {tol.atol:g} + " \
+            f"{tol.rtol:g}*|value| + {tol.jump:g}*width) {rule}"
     if tol.rule == "tangency":
         # decided at a tangency: up to `changed` entries may leave the tolerance, by <= jump
         out = [abs(a - b) for a, b in zip(g["sample"], w["sample"]) if not _close(a, b, tol)]

@@ -22,7 +22,14 @@ Rules:
   finite value along the last axis (the converged value) is compared,
   ``close``-style; the number of steps may differ;
 * ``measured``: a wall-clock measurement (a time, a repeat count decided by
-  time): it differs between any two runs, so only its shape is compared.
+  time): it differs between any two runs, so only its shape is compared;
+* ``attractor``: the last axis holds points of an attractor (returns kept after a
+  transient). On a chaotic attractor a last-bit change is amplified by e^(lambda n)
+  over n returns, so the points themselves are not a result, only where they lie:
+  each row is compared by its extent (min and max over the last axis), within
+  ``atol + rtol |value|`` plus ``jump`` times the row's reference width (0 for a
+  periodic row, which must agree closely; a fraction of the width for a chaotic one,
+  whose extent is sampled by a different orbit).
 """
 from __future__ import annotations
 
@@ -31,7 +38,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import xarray as xr
 
-RULES = ("close", "tangency", "trace", "measured")
+RULES = ("close", "tangency", "trace", "measured", "attractor")
 PREFIX = "repro_"
 
 
@@ -128,6 +135,24 @@ def final_values(values: np.ndarray) -> np.ndarray:
     return out
 
 
+def extents(values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per row (all axes but the last) the min and max of its finite values (NaN where
+    a row has none)."""
+    values = np.atleast_1d(np.asarray(values, dtype=float))
+    rows = values.reshape(-1, values.shape[-1])
+    lo, hi = np.full(rows.shape[0], np.nan), np.full(rows.shape[0], np.nan)
+    some = np.isfinite(rows).any(axis=1)
+    lo[some], hi[some] = np.nanmin(rows[some], axis=1), np.nanmax(rows[some], axis=1)
+    return lo, hi
+
+
+def attractor_allowed(tol: "Tolerance", lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Admissible change of each row's min and max: close-style plus jump x width."""
+    width = np.abs(hi - lo)
+    return np.concatenate([tol.allowed(lo), tol.allowed(hi)]) + tol.jump * np.concatenate(
+        [width, width])
+
+
 def spread(reference: xr.DataArray, other: xr.DataArray) -> dict:
     """How far ``other`` is from ``reference`` (full arrays), against the tolerance
     declared on ``reference``: max_abs, max_rel, changed (entries that differ at
@@ -135,8 +160,15 @@ def spread(reference: xr.DataArray, other: xr.DataArray) -> dict:
     entries the tangency rule exempts, jump / difference) and ok."""
     tol = Tolerance.from_attrs(reference.attrs)
     a, b = np.asarray(reference.values, dtype=float), np.asarray(other.values, dtype=float)
+    allowed = tol.allowed
     if tol.rule == "trace":
         a, b = final_values(a), final_values(b)
+    if tol.rule == "attractor" and a.shape == b.shape:
+        (lo_a, hi_a), (lo_b, hi_b) = extents(a), extents(b)
+        limit = attractor_allowed(tol, lo_a, hi_a)
+        a, b = np.concatenate([lo_a, hi_a]), np.concatenate([lo_b, hi_b])
+        limit = limit[~np.isnan(a)]  # the entries compared below (NaN rows dropped)
+        allowed = lambda ref: limit  # noqa: E731
     bad = {"max_abs": np.inf, "max_rel": np.inf, "changed": max(a.size, b.size),
            "margin": 0.0, "ok": False, "rule": tol.rule}
     if a.shape != b.shape:
@@ -149,7 +181,7 @@ def spread(reference: xr.DataArray, other: xr.DataArray) -> dict:
         return dict(bad, changed=int(np.count_nonzero(nan_a != nan_b)))
     a, b = a[~nan_a], b[~nan_a]
     diff = np.abs(a - b)
-    ratio = np.where(diff > 0, tol.allowed(a) / np.where(diff > 0, diff, 1.0), np.inf)
+    ratio = np.where(diff > 0, allowed(a) / np.where(diff > 0, diff, 1.0), np.inf)
     ok = bool(np.all(ratio >= 1.0))
     if tol.rule == "tangency":
         # the `changed` worst entries are exempt from the close tolerance, not from `jump`

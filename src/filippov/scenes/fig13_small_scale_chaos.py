@@ -21,8 +21,10 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from .. import tolerance
 from ..analytic import limit_map
 from ..io import finalize
+from ..tolerance import Tolerance
 from .attractor_common import (CHUNK_AXIS, ENGINES, T_RETURN,  # noqa: F401
                                VARIABLE_ATTRS as _COMMON_ATTRS, common_dataset, eps_list,
                                s_grid, sweep, thetas)
@@ -38,6 +40,33 @@ VARIABLE_ATTRS.update({
     "width_exponent": ("k of width_x2 ~ eps^k: least-squares slope over eps <= fit_eps_max "
                        "(NaN: the attractor is a point at one of them)", "1"),
 })
+
+
+def tolerances(scene: dict) -> dict:
+    """Cross-machine tolerances (filippov.tolerance). Where the attractor is chaotic
+    (lambda s(theta,0,0) < -1), a last-bit change is amplified by e^(lambda n) over the
+    n returns of the run (lambda up to ~0.6: e^180 after 300): the kept points belong to
+    another orbit on the same attractor. Its points are therefore compared by the
+    extent of each row (rule attractor: half the width, the sampling error of 100
+    points' extent); the exponent, a mean of log-slopes over the kept returns, whose
+    logs spread by about one (slopes lambda and lambda s), moves by ~0.1 for another
+    orbit: 0.3; the width by its sampling error: 50%; the width exponent, a log ratio
+    of two widths over a decade, by log10(1.5/0.5) ~ 0.5. Periodic rows (width 0)
+    keep the close tolerance of their points: 10 x EVENT_STATE/eps_min^2 in u."""
+    eps = np.array(eps_list(scene["parameters"]))
+    u_atol = 10 * tolerance.EVENT_STATE / eps.min() ** 2
+    pts = Tolerance(0.0, u_atol, "a chaotic orbit's points are not reproducible, only "
+                                 "where they lie: each row's extent, to half its width",
+                    rule="attractor", jump=0.5)
+    lim = Tolerance(0.0, 1e-9, "limit map (numpy): chaotic where lambda s < -1; each row's "
+                               "extent, to half its width", rule="attractor", jump=0.5)
+    stat = "a sampled statistic of a chaotic orbit (another orbit on another machine)"
+    return {"u": pts, "u_limit": lim, "u_limit0": lim,
+            "lyapunov": Tolerance(0.0, 0.3, f"{stat}: mean log-slope, per-return spread ~1"),
+            "lyapunov_limit": Tolerance(0.0, 0.3, f"{stat}: mean log-slope"),
+            "width": Tolerance(0.5, u_atol, f"{stat}: extent of 100 points"),
+            "width_x2": Tolerance(0.5, tolerance.EVENT_STATE, f"{stat}: extent of 100 points"),
+            "width_exponent": Tolerance(0.0, 0.5, f"{stat}: log10 of a width ratio")}
 
 
 def validate(scene: dict) -> None:
