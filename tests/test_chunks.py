@@ -1,8 +1,9 @@
 """Chunked sweeps (filippov.scenes.chunking): chunks computed apart and merged give
 exactly the dataset of one unsplit compute -- xarray-identical and the same bytes
 on disk -- for the return maps (fig04, split over x2), the discontinuity maps
-(fig07, fig09, split over xi1) and the dry-friction bifurcation diagram (fig10,
-split over tasks: the two continuation directions and the stick-slip orbits).
+(fig07, fig09, split over xi1), the dry-friction bifurcation diagram (fig10,
+split over tasks: the two continuation directions and the stick-slip orbits) and the
+orbit diagrams of the instabilities (fig12, fig13, split over the scaled mu).
 Small grids keep it quick."""
 import random
 
@@ -19,7 +20,8 @@ from filippov.scenes import chunking
 from conftest import ROOT
 
 SCHEMA = ROOT / "config" / "schema" / "scene.schema.json"
-CHUNKED = ("fig04_retmaps", "fig07_pdm_theta_neg", "fig09_pdm_theta_pos", "fig10_dfo")
+CHUNKED = ("fig04_retmaps", "fig07_pdm_theta_neg", "fig09_pdm_theta_pos", "fig10_dfo",
+           "fig12_period_adding", "fig13_small_scale_chaos")
 
 
 def small_scene(sid: str) -> dict:
@@ -30,6 +32,13 @@ def small_scene(sid: str) -> dict:
         p.update(n_uniform=21, n_geometric=6)
     elif sid == "fig10_dfo":
         p.update(n_stick_slip=8, ds=0.2)
+    elif sid in ("fig12_period_adding", "fig13_small_scale_chaos"):
+        p.update(n_mu=7, n_transient=40, n_keep=20, max_period=10)
+        p["eps"] = p["eps"][:2]
+        if "theta" in p and isinstance(p["theta"], list):
+            p["theta"] = p["theta"][-2:]
+        if "n_geo" in p:
+            p["n_geo"] = 2
     else:
         p.update(n_uniform=9, n_geometric=4)
         p["eps"] = p["eps"][:2]

@@ -92,3 +92,28 @@ def test_a_scene_brings_its_own_parameter_block(tmp_path):
     (schema_dir / "scenes" / "fig04_retmaps.schema.json").write_text("{not json")
     with pytest.raises(SceneError, match=r"fig04_retmaps.schema.json: cannot read"):
         load_scene(_write(tmp_path, text, "fig04_retmaps"), schema_dir / "scene.schema.json")
+
+
+def test_a_named_resolution_overrides_parameters_and_chunks(tmp_path):
+    # --config resolution=full: the scene's resolutions.full block applied (and checked);
+    # a scene without that block builds its default; the default drops the blocks
+    path = ROOT / "config" / "scenes" / "fig12_period_adding.yaml"
+    default = load_scene(path, SCHEMA)
+    full = load_scene(path, SCHEMA, resolution="full")
+    assert "resolutions" not in default and "resolution" not in default
+    assert full["resolution"] == "full" and full["chunks"] > default["chunks"]
+    assert full["parameters"]["n_mu"] > default["parameters"]["n_mu"]
+    assert full["parameters"]["eps"] == default["parameters"]["eps"]
+    plain = ROOT / "config" / "scenes" / "fig08_s0theta.yaml"
+    assert load_scene(plain, SCHEMA, resolution="full") == load_scene(plain, SCHEMA)
+    bad = tmp_path / "fig12_period_adding.yaml"
+    bad.write_text(path.read_text().replace("n_mu: 1801", "n_mu: 1"))
+    (tmp_path / "scenes").mkdir()
+    own = ROOT / "config" / "schema" / "scenes" / "fig12_period_adding.schema.json"
+    schema_dir = tmp_path / "schema"
+    (schema_dir / "scenes").mkdir(parents=True)
+    (schema_dir / "scene.schema.json").write_text(SCHEMA.read_text())
+    (schema_dir / "scenes" / own.name).write_text(own.read_text())
+    load_scene(bad, schema_dir / "scene.schema.json")  # the default is untouched
+    with pytest.raises(SceneError, match=r"resolutions\.full: parameters\.n_mu"):
+        load_scene(bad, schema_dir / "scene.schema.json", resolution="full")

@@ -173,9 +173,36 @@ def scene_schema_file(schema_path, scene_id: str) -> Path:
     return Path(schema_path).parent / "scenes" / f"{scene_id}.schema.json"
 
 
-def load_scene(path, schema_path, lim: dict | None = None) -> dict:
+#: the resolution a run asks for when it names none (snakemake --config resolution=full)
+DEFAULT_RESOLUTION = "default"
+
+
+def apply_resolution(scene: dict, resolution: str | None) -> dict:
+    """The scene at ``resolution``: its ``resolutions.<name>`` block (``parameters``
+    overrides, ``chunks``) applied, the ``resolutions`` key removed, and the name kept as
+    ``resolution`` when it is not the default. A scene without a block for that name
+    runs at its default (most figures have one resolution). Works on the raw mapping:
+    no validation here (see :func:`load_scene`)."""
+    out = {k: v for k, v in scene.items() if k != "resolutions"}
+    name = resolution or DEFAULT_RESOLUTION
+    blocks = scene.get("resolutions") if isinstance(scene.get("resolutions"), dict) else {}
+    block = blocks.get(name) if name != DEFAULT_RESOLUTION else None
+    if isinstance(block, dict):
+        params = dict(out.get("parameters") or {})
+        params.update(block.get("parameters") or {})
+        out["parameters"] = params
+        if "chunks" in block:
+            out["chunks"] = block["chunks"]
+        out["resolution"] = name
+    return out
+
+
+def load_scene(path, schema_path, lim: dict | None = None,
+               resolution: str | None = None) -> dict:
     """Read a scene, validate it against the JSON schema and the limits (``lim``,
-    default :data:`LIMITS`) and return it as a dict."""
+    default :data:`LIMITS`) and return it as a dict, at ``resolution`` (its
+    ``resolutions`` block of that name applied and validated again; see
+    :func:`apply_resolution`)."""
     path = Path(path)
     try:
         with path.open(encoding="utf-8") as stream:  # a stream: YAML errors then cite the file
@@ -199,6 +226,12 @@ def load_scene(path, schema_path, lim: dict | None = None) -> dict:
     error = best_match(Draft202012Validator(schema).iter_errors(scene), key=_RELEVANCE)
     if error is not None:
         raise SceneError(f"{path}: {_field(error.absolute_path)}: {error.message}")
+    scene = apply_resolution(scene, resolution)
+    if "resolution" in scene:  # the overrides must make a valid scene too
+        error = best_match(Draft202012Validator(schema).iter_errors(scene), key=_RELEVANCE)
+        if error is not None:
+            raise SceneError(f"{path}: resolutions.{scene['resolution']}: "
+                             f"{_field(error.absolute_path)}: {error.message}")
 
     bad = _non_finite(scene)
     if bad is not None:

@@ -77,7 +77,19 @@ rule bench_effect_cost:
         "../scripts/bench_effect_cost.py"
 
 
+# The cost of one return of the iterated Hopf map (the instability scenes' kernel):
+# median wall time per return, printed as a table.
+rule bench_attractor_cost:
+    output:
+        "results/bench_attractor_cost.nc",
+    params:
+        code=library_hash(exclude="plotting"),
+    script:
+        "../scripts/bench_attractor_cost.py"
+
+
 rule bench:
     input:
         rules.plot_bench.output,
         rules.bench_effect_cost.output,
+        rules.bench_attractor_cost.output,

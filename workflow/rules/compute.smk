@@ -2,11 +2,28 @@
 # library's hash is a param, so editing any of them reruns the scene. A failed
 # job leaves no results/<id>.nc: the library writes atomically and Snakemake
 # removes outputs of failed jobs.
+import functools
 import re
 
 import yaml
 
-from filippov.config import SceneError, check_limits, limits, scene_schema_file
+from filippov.config import (DEFAULT_RESOLUTION, SceneError, apply_resolution, check_limits,
+                             limits, scene_schema_file)
+
+RESOLUTION = config.get("resolution", DEFAULT_RESOLUTION)
+
+
+@functools.lru_cache(maxsize=None)
+def scene_resolution(scene):
+    """The resolution scene `scene` is built at: the run's, if the scene file has a
+    block of that name under `resolutions`, else the default -- so that asking for
+    another resolution reruns only the scenes that have one."""
+    try:
+        data = yaml.safe_load(Path(f"config/scenes/{scene}.yaml").read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return DEFAULT_RESOLUTION
+    blocks = data.get("resolutions") if isinstance(data, dict) else None
+    return RESOLUTION if isinstance(blocks, dict) and RESOLUTION in blocks else DEFAULT_RESOLUTION
 
 
 def scene_chunks():
@@ -31,6 +48,7 @@ def scene_chunks():
             continue
         try:
             if isinstance(data, dict) and isinstance(data.get("parameters", {}), dict):
+                data = apply_resolution(data, RESOLUTION)
                 check_limits(data, lim, path)
         except SceneError as exc:
             fail(exc)
@@ -64,6 +82,7 @@ rule compute:
                labels={"scene": "{scene}", "format": "netCDF"}),
     params:
         code=library_hash(exclude=NOT_COMPUTE),  # see common.smk
+        resolution=lambda wc: scene_resolution(wc.scene),  # --config resolution=full
         scene=lambda wc: scene_summary(wc.scene),  # for the HTML report's caption
     script:
         "../scripts/compute_scene.py"
@@ -87,6 +106,7 @@ rule compute_chunk:
         chunk="[0-9]+",
     params:
         code=library_hash(exclude=NOT_COMPUTE),  # see common.smk
+        resolution=lambda wc: scene_resolution(wc.scene),  # --config resolution=full
     script:
         "../scripts/compute_chunk.py"
 
@@ -105,6 +125,7 @@ rule merge_chunks:
         scene=CHUNKED_SCENES,
     params:
         code=library_hash(exclude=NOT_COMPUTE),  # see common.smk
+        resolution=lambda wc: scene_resolution(wc.scene),  # --config resolution=full
         scene=lambda wc: scene_summary(wc.scene),  # for the HTML report's caption
     script:
         "../scripts/merge_chunks.py"

@@ -7,7 +7,8 @@ from filippov.config import SceneError, limits, load_scene
 
 try:
     scene = load_scene(snakemake.input.scene, snakemake.input.schema,  # noqa: F821
-                       limits(snakemake.config))  # noqa: F821
+                       limits(snakemake.config),
+                       resolution=snakemake.params.resolution)  # noqa: F821
     filippov.scenes.check(scene)  # the engine it asks for, the size of its grid
 except SceneError as exc:
     sys.exit(f"error: {exc}")  # a config mistake: one clear line, no traceback

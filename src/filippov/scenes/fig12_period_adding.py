@@ -62,8 +62,8 @@ def tolerances(scene: dict) -> dict:
     eps = np.array(eps_list(p))
     tol_e = float(p["edge_tol"])
     u_atol = 10 * tolerance.EVENT_STATE / eps.min()
-    pts = Tolerance(0.0, u_atol, f"points of a periodic attractor in u = (x2 - 1)/eps: "
-                                 f"10 x EVENT_STATE / eps_min", rule="attractor")
+    pts = Tolerance(0.0, u_atol, "points of a periodic attractor in u = (x2 - 1)/eps: "
+                                 "10 x EVENT_STATE / eps_min", rule="attractor")
     lim = Tolerance(0.0, 1e-9, "limit map (numpy, O(1) values): a contraction; last-bit "
                                "changes stay at the ulp level, 1e6 of room", rule="attractor")
     edge = Tolerance(0.0, tol_e, "bisection to edge_tol: one flipped classification")

@@ -1,0 +1,83 @@
+"""What one return of the iterated Hopf return map costs on the compiled engine.
+
+Run ``python -m filippov.benchmarks.attractor_cost`` (part of ``make bench``). For each
+case (theta, eps, s) the map is iterated ``--returns`` times from the cycle's point in
+one compiled call (:func:`filippov.fastmap.compute_returns` with ``iterations``), the
+call repeated ``--repeat`` times; the table gives the median wall time per return and
+the mean number of switches per return (what a return does). The first call of a
+process compiles or loads the kernel and is not timed.
+"""
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import numpy as np
+import xarray as xr
+
+from ..analytic import limit_map
+from ..fastmap import OK, compute_returns
+from ..io import finalize, write_dataset
+from ..models import hopf
+
+#: (theta, eps, s): the cascade (theta < 0) and the chaos (theta > 0) at the scenes' eps
+CASES = [(-0.5, 1e-2, 1.0), (-0.5, 1e-4, 1.0), (-0.5, 1e-6, 1.0),
+         (0.2, 1e-2, 2.0), (0.2, 1e-3, 2.0), (0.2, 1e-4, 2.0), (0.7, 1e-4, 2.0)]
+OMEGA = 8 * np.pi
+
+
+def measure(theta: float, eps: float, s: float, returns: int, repeat: int) -> dict:
+    mu = 1.0 + s * limit_map.scale(eps, theta)
+    cm = hopf.compiled(eps, theta, mu, OMEGA, sliding=theta > 0)
+    start = np.array([[0.0, np.sqrt(mu), 0.0]])
+    compute_returns(cm, start, 1.0)  # compile or load the kernel
+    times, switches = [], 0.0
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = compute_returns(cm, start, 1.0, iterations=returns, keep=1)
+        times.append(time.perf_counter() - t0)
+        if out.status[0] != OK:
+            raise RuntimeError(f"theta={theta}, eps={eps}, s={s}: a return failed")
+    # switches per return: one more call, returns counted one by one
+    z = start
+    for _ in range(min(returns, 200)):
+        r = compute_returns(cm, z, 1.0)
+        switches += r.n_switches[0]
+        z = r.state
+    return {"per_return": statistics.median(times) / returns,
+            "switches": switches / min(returns, 200)}
+
+
+def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
+    rows = [measure(t, e, s, returns, repeat) for t, e, s in CASES]
+    ds = xr.Dataset(
+        {"time_per_return": ("case", [r["per_return"] for r in rows],
+                             {"long_name": "median wall time per return", "units": "s"}),
+         "switches_per_return": ("case", [r["switches"] for r in rows],
+                                 {"long_name": "mean mode changes per return", "units": "1"})},
+        coords={"theta": ("case", [c[0] for c in CASES], {"units": "1"}),
+                "eps": ("case", [c[1] for c in CASES], {"units": "1"}),
+                "s": ("case", [c[2] for c in CASES],
+                      {"long_name": "(mu - 1)/eps (theta < 0), /eps^2 (theta > 0)",
+                       "units": "1"})})
+    log(f"{'theta':>6} {'eps':>7} {'s':>4} {'us/return':>10} {'switches':>9}")
+    for (t, e, s), r in zip(CASES, rows):
+        log(f"{t:6.2f} {e:7.0e} {s:4.1f} {1e6 * r['per_return']:10.1f} {r['switches']:9.2f}")
+    return finalize(ds, None, returns=returns, repeat=repeat,
+                    title="cost per return of the iterated Hopf return map (compiled engine)")
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--returns", type=int, default=2000)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--out", default=None, help="netCDF file for the table")
+    args = ap.parse_args(argv)
+    ds = run(args.returns, args.repeat)
+    if args.out:
+        write_dataset(ds, args.out)
+
+
+if __name__ == "__main__":
+    main()
