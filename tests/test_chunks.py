@@ -21,7 +21,7 @@ from conftest import ROOT
 
 SCHEMA = ROOT / "config" / "schema" / "scene.schema.json"
 CHUNKED = ("fig04_retmaps", "fig07_pdm_theta_neg", "fig09_pdm_theta_pos", "fig10_dfo",
-           "fig12_period_adding", "fig13_small_scale_chaos")
+           "fig12_period_adding", "fig13_small_scale_chaos", "fig14_atlas")
 
 
 def small_scene(sid: str) -> dict:
@@ -32,11 +32,11 @@ def small_scene(sid: str) -> dict:
         p.update(n_uniform=21, n_geometric=6)
     elif sid == "fig10_dfo":
         p.update(n_stick_slip=8, ds=0.2)
-    elif sid in ("fig12_period_adding", "fig13_small_scale_chaos"):
+    elif sid in ("fig12_period_adding", "fig13_small_scale_chaos", "fig14_atlas"):
         p.update(n_mu=7, n_transient=40, n_keep=20, max_period=10)
         p["eps"] = p["eps"][:2]
         if "theta" in p and isinstance(p["theta"], list):
-            p["theta"] = p["theta"][-2:]
+            p["theta"] = p["theta"][:1] + p["theta"][-2:]
         if "n_geo" in p:
             p["n_geo"] = 2
     else:
