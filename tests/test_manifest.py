@@ -141,3 +141,15 @@ def test_fresh_build_agrees_with_the_committed_manifest(workflow_build):
     man = json.loads(manifest.MANIFEST.read_text())
     problems = manifest.check(work / "results", work / "figures", man)
     assert problems == [], "\n".join(problems)
+
+
+def test_a_figure_of_chaotic_orbits_declares_a_wider_image_tolerance(tmp_path):
+    # fig13 scatters chaotic orbits (another machine: another orbit on the attractor);
+    # every other figure keeps the default, and the declared limit is the one applied
+    assert manifest.image_tolerance("fig13_small_scale_chaos") > manifest.IMAGE_RMS
+    assert manifest.image_tolerance("fig04_retmaps") == manifest.IMAGE_RMS
+    png = _figure(tmp_path / "f.png")
+    manifest.write_thumbnail(png, tmp_path / "ref" / "f.png")
+    changed = _figure(tmp_path / "g.png", box=True)
+    assert "image differs" in manifest.compare_image(changed, tmp_path / "ref" / "f.png")
+    assert manifest.compare_image(changed, tmp_path / "ref" / "f.png", limit=1.0) is None

@@ -13,12 +13,13 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .. import attractors
+from .. import attractors, tolerance
 from ..analytic import limit_map
 from ..config import SceneError
 from ..fastmap import OK
 from ..models import hopf
 from ..progress import Progress
+from ..tolerance import Tolerance
 from .common import require, solver_options
 
 CHUNK_AXIS = "s"
@@ -194,3 +195,51 @@ def common_dataset(scene: dict, raw: xr.Dataset) -> xr.Dataset:
         "long_name": "lambda = exp(-4 pi/omega), the Hopf cycle's multiplier per turn at mu = 1",
         "units": "1"})
     return ds
+
+
+def lyapunov_limit(ds: xr.Dataset, omega: float) -> np.ndarray:
+    """Lyapunov exponent of the limit map along its kept points, per (theta, eps, s): the
+    mean log-slope by central differences of the map."""
+    out = np.full(ds.period_limit.shape, np.nan)
+    s = ds.s.values
+    for i, theta in enumerate(ds.theta.values):
+        for j, eps in enumerate(ds.eps.values):
+            sl = limit_map.slopes(ds.u_limit.values[i, j], s[:, None], eps=float(eps),
+                                  theta=float(theta), omega=omega)
+            with np.errstate(divide="ignore"):
+                out[i, j] = np.mean(np.log(np.abs(sl)), axis=1)
+    return out
+
+
+def chaos_tolerances(scene: dict) -> dict:
+    """Cross-machine tolerances where the attractor may be chaotic (filippov.tolerance).
+    There a last-bit change is amplified by e^(lambda n) over the n returns of the run
+    (lambda up to ~0.6: e^180 after 300): the kept points belong to another orbit on the
+    same attractor. Points are therefore compared by each row's extent (rule attractor,
+    to half the width: the sampling error of the extent of ~100 points); the exponent,
+    a mean of log-slopes whose logs spread by about one (slopes lambda and lambda s), by
+    three standard errors of that mean; the width to 50%. Periodic rows (width 0) keep
+    the close tolerance of their points, 10 x EVENT_STATE / sigma_min in u. The
+    classifications (period) may change at a few points near a boundary between types
+    (at most one in fifty)."""
+    p = scene["parameters"]
+    sigma = min(limit_map.scale(e, t) for e in eps_list(p) for t in thetas(p))
+    u_atol = 10 * tolerance.EVENT_STATE / sigma
+    stat = "a sampled statistic of a chaotic orbit (another orbit on another machine)"
+    pts = Tolerance(0.0, u_atol, "a chaotic orbit's points are not reproducible, only "
+                                 "where they lie: each row's extent, to half its width",
+                    rule="attractor", jump=0.5)
+    lim = Tolerance(0.0, 1e-9, "limit map (numpy): chaotic where lambda s < -1; each row's "
+                               "extent, to half its width", rule="attractor", jump=0.5)
+    mean = Tolerance(0.0, 6.0 / np.sqrt(int(p["n_keep"])),
+                     f"{stat}: mean of n_keep correlated log-slopes, standard error "
+                     f"~2/sqrt(n_keep) (per-return spread ~1, correlated over a few "
+                     f"returns), three of them: 6/sqrt(n_keep)")
+    n_pts = len(thetas(p)) * len(eps_list(p)) * len(s_grid(p))
+    kind = Tolerance(0.0, 0.0, "a classification: points at a boundary of types (or with "
+                               "an exponent within sampling error of 0) may change",
+                     rule="tangency", changed=max(1, n_pts // 50), jump=100.0)
+    return {"period": kind, "period_limit": kind, "period_limit0": kind,
+            "u": pts, "u_limit": lim, "u_limit0": lim, "lyapunov": mean,
+            "lyapunov_limit": mean,
+            "width": Tolerance(0.5, u_atol, f"{stat}: extent of the kept points")}

@@ -26,8 +26,8 @@ from ..analytic import limit_map
 from ..io import finalize
 from ..tolerance import Tolerance
 from .attractor_common import (CHUNK_AXIS, ENGINES, T_RETURN,  # noqa: F401
-                               VARIABLE_ATTRS as _COMMON_ATTRS, common_dataset, eps_list,
-                               s_grid, sweep, thetas)
+                               VARIABLE_ATTRS as _COMMON_ATTRS, chaos_tolerances,
+                               common_dataset, eps_list, lyapunov_limit, s_grid, sweep, thetas)
 from .attractor_common import validate as _validate_common
 from ..config import SceneError
 
@@ -43,30 +43,14 @@ VARIABLE_ATTRS.update({
 
 
 def tolerances(scene: dict) -> dict:
-    """Cross-machine tolerances (filippov.tolerance). Where the attractor is chaotic
-    (lambda s(theta,0,0) < -1), a last-bit change is amplified by e^(lambda n) over the
-    n returns of the run (lambda up to ~0.6: e^180 after 300): the kept points belong to
-    another orbit on the same attractor. Its points are therefore compared by the
-    extent of each row (rule attractor: half the width, the sampling error of 100
-    points' extent); the exponent, a mean of log-slopes over the kept returns, whose
-    logs spread by about one (slopes lambda and lambda s), moves by ~0.1 for another
-    orbit: 0.3; the width by its sampling error: 50%; the width exponent, a log ratio
-    of two widths over a decade, by log10(1.5/0.5) ~ 0.5. Periodic rows (width 0)
-    keep the close tolerance of their points: 10 x EVENT_STATE/eps_min^2 in u."""
-    eps = np.array(eps_list(scene["parameters"]))
-    u_atol = 10 * tolerance.EVENT_STATE / eps.min() ** 2
-    pts = Tolerance(0.0, u_atol, "a chaotic orbit's points are not reproducible, only "
-                                 "where they lie: each row's extent, to half its width",
-                    rule="attractor", jump=0.5)
-    lim = Tolerance(0.0, 1e-9, "limit map (numpy): chaotic where lambda s < -1; each row's "
-                               "extent, to half its width", rule="attractor", jump=0.5)
+    """attractor_common.chaos_tolerances, and for the derived widths: width_x2 to its
+    sampling error (50%), the width exponent, a log10 ratio of two widths a decade of
+    eps apart, to log10(1.5/0.5) ~ 0.5."""
+    out = chaos_tolerances(scene)
     stat = "a sampled statistic of a chaotic orbit (another orbit on another machine)"
-    return {"u": pts, "u_limit": lim, "u_limit0": lim,
-            "lyapunov": Tolerance(0.0, 0.3, f"{stat}: mean log-slope, per-return spread ~1"),
-            "lyapunov_limit": Tolerance(0.0, 0.3, f"{stat}: mean log-slope"),
-            "width": Tolerance(0.5, u_atol, f"{stat}: extent of 100 points"),
-            "width_x2": Tolerance(0.5, tolerance.EVENT_STATE, f"{stat}: extent of 100 points"),
-            "width_exponent": Tolerance(0.0, 0.5, f"{stat}: log10 of a width ratio")}
+    out["width_x2"] = Tolerance(0.5, tolerance.EVENT_STATE, f"{stat}: extent of the points")
+    out["width_exponent"] = Tolerance(0.0, 0.5, f"{stat}: log10 of a width ratio")
+    return out
 
 
 def validate(scene: dict) -> None:
@@ -84,20 +68,6 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     return assemble(scene, sweep(scene, chunk_grid(scene), progress=progress))
 
 
-def _lyapunov_limit(ds, p) -> np.ndarray:
-    omega = float(p["omega"])
-    out = np.full(ds.period_limit.shape, np.nan)
-    s = ds.s.values
-    for i, theta in enumerate(ds.theta.values):
-        for j, eps in enumerate(ds.eps.values):
-            u = ds.u_limit.values[i, j]
-            sl = limit_map.slopes(u, s[:, None], eps=float(eps), theta=float(theta),
-                                  omega=omega)
-            with np.errstate(divide="ignore"):
-                out[i, j] = np.mean(np.log(np.abs(sl)), axis=1)
-    return out
-
-
 def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     p = scene["parameters"]
     ds = common_dataset(scene, raw)
@@ -105,7 +75,7 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     lam = limit_map.multiplier(1.0, float(p["omega"]))
     ds["slope_pdm"] = ("theta", (th - 1.0) / th)
     ds["slope_return"] = ("theta", lam * (th - 1.0) / th)
-    ds["lyapunov_limit"] = (("theta", "eps", "s"), _lyapunov_limit(ds, p))
+    ds["lyapunov_limit"] = (("theta", "eps", "s"), lyapunov_limit(ds, float(p["omega"])))
     wx = ds.width.values * (eps ** 2)[None, :, None]
     ds["width_x2"] = (("theta", "eps", "s"), wx)
     k = np.full((th.size, ds.sizes["s"]), np.nan)
