@@ -178,7 +178,9 @@ def test_environment_fingerprint_tracks_the_arithmetic(shim):
 PARAMETER = {"fig01_slidesketch": "t_end", "fig02_cases": "eps", "fig03_grazingsketch": "omega",
              "fig04_retmaps": "eps", "fig05_thetalt0mfs": "eps", "fig06_sgraph": "omega",
              "fig07_pdm_theta_neg": "theta", "fig08_s0theta": "theta_min",
-             "fig09_pdm_theta_pos": "theta", "fig10_dfo": "fv", "fig11_dfo_retmaps": "fv"}
+             "fig09_pdm_theta_pos": "theta", "fig10_dfo": "fv", "fig11_dfo_retmaps": "fv",
+             "fig12_period_adding": "theta", "fig13_small_scale_chaos": "theta",
+             "fig14_atlas": "theta"}
 
 
 def test_every_scene_has_a_parameter_to_change():

@@ -63,7 +63,10 @@ def scene_summary(scene):
     data = yaml.safe_load(path.read_text()) or {}
     label = str(data.get("paper_figure", ""))
     printed = _paper_labels().get(label, label).replace("~", " ")
+    # a scene beyond the paper's figures (the instabilities) has no paper figure
+    ref = f"{printed} of the paper" if printed else "beyond the paper's figures"
     return {"description": " ".join(str(data.get("description", "")).split()),
-            "paper_figure": printed, "paper_label": label, "model": str(data.get("model", "")),
+            "paper_figure": printed, "paper_ref": ref, "paper_label": label,
+            "model": str(data.get("model", "")),
             "ingredients": ", ".join(f"{k}: {v}" for k, v in data.get("ingredients", {}).items()),
             "parameters": [f"{k} = {v}" for k, v in data.get("parameters", {}).items()]}

@@ -35,7 +35,7 @@ def report(ds, m: Macros) -> str | None:
     sid = "fig12_period_adding"
     eps = [float(e) for e in ds.eps.values]
     theta = float(ds.theta.values[0])
-    m.add("rpTwelveTheta", theta, source(sid, "theta"))
+    m.add("rpTwelveTheta", theta, source(sid, "theta", theta=theta))
     m.add("rpTwelveEpsMax", eps[0], f"{sid}:eps[0]")
     m.add("rpTwelveEpsMin", eps[-1], f"{sid}:eps[-1]")
     m.add("rpTwelveNEps", len(eps), f"{sid}:eps (size)")
@@ -52,7 +52,7 @@ def report(ds, m: Macros) -> str | None:
     below = s < 0
     per = ds.period.values[0]
     m.add("rpTwelveBelowEvery", None, "derived: period == 1 for every s < 0 and eps",
-          text="every" if np.all(per[:, below] == 1) else r"\emph{not} every")
+          text=r"\text{every}" if np.all(per[:, below] == 1) else r"\text{\emph{not} every}")
     onset = [float(s[np.flatnonzero((s > 0) & (per[j] != 1))[0]]) for j in range(len(eps))]
     m.add("rpTwelveOnsetMax", max(onset), "derived: largest first s > 0 with period != 1", 2)
     lin_l = float(np.nanmax(ds.fit_lin_rms.values[:, 0]))

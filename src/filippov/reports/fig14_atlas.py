@@ -23,7 +23,7 @@ def report(ds, m: Macros) -> str | None:
     m.add("rpFourteenPeriodOneThetaMin", float(th[pos & one].min()),
           "derived: smallest theta > 0 with period one everywhere above grazing", 3)
     m.add("rpFourteenBelowAllOne", None, "derived: period one at every s < 0",
-          text="every" if np.all(kind[:, s < 0] == 1) else r"\emph{not} every")
+          text=r"\text{every}" if np.all(kind[:, s < 0] == 1) else r"\text{\emph{not} every}")
     m.add("rpFourteenAgree", 100.0 * float(np.mean(kind == lim)),
           "derived: percent of points where slow-fast and limit-map types agree", 3)
     neg = th < 0
