@@ -33,6 +33,9 @@ from .abi import CompiledModel
 from .fastmap import OK, STATUS, compute_returns
 
 _UNIT = float(np.spacing(1.0))
+#: status of a run whose kept returns left the watched window (beyond the engine's
+#: status codes, :data:`filippov.fastmap.STATUS`)
+LEFT_WINDOW = 100
 
 
 @dataclass(frozen=True)
@@ -45,6 +48,7 @@ class Attractor:
     lyapunov: float             # NaN where not computed or escaped
     escaped: bool
     reason: str = ""            # why it escaped ('' if it did not)
+    status: int = OK            # OK, the engine's status of the failed return, LEFT_WINDOW
     states: np.ndarray = field(default=None, repr=False)  # kept returns, full state
 
 
@@ -108,22 +112,32 @@ KINK = 0.05
 
 
 def slopes(cmodel: CompiledModel, states: np.ndarray, coordinate: int, step: float,
-           t_max: float, **options) -> np.ndarray:
+           t_max: float, images: np.ndarray | None = None, **options) -> np.ndarray:
     """dP_u/du at each state by central differences of step ``step`` in coordinate u
     (the other coordinates held), P_u the u-component of the first return. NaN where a
     start fails to return or where the point lies on a kink of P (one-sided slopes
     differ by more than :data:`KINK`). Truncation ~ step^2 times the third derivative
     of P, rounding ~ e/step with e the error of one return (~1e-14 here): a step of
     1e-4 of the attractor's scale keeps both below 1e-3 of a slope of order one for
-    scales >= 1e-8."""
+    scales >= 1e-8. ``images``: P(states) where already known (rows with a NaN are
+    computed here), e.g. the next returns of an orbit -- the same numbers a fresh
+    return gives, since a return depends on its start alone."""
     states = np.atleast_2d(np.asarray(states, dtype=float))
+    m = states.shape[0]
     plus, minus = states.copy(), states.copy()
     plus[:, coordinate] += step
     minus[:, coordinate] -= step
-    out = compute_returns(cmodel, np.concatenate([plus, minus, states]), t_max, **options)
-    m = states.shape[0]
-    fp, fm, f0 = (out.state[k * m:(k + 1) * m, coordinate] for k in range(3))
-    ok = np.all(out.status.reshape(3, m) == OK, axis=0)
+    known = (np.zeros(m, dtype=bool) if images is None
+             else np.all(np.isfinite(np.atleast_2d(images)), axis=1))
+    out = compute_returns(cmodel, np.concatenate([plus, minus, states[~known]]), t_max,
+                          **options)
+    fp, fm = out.state[:m, coordinate], out.state[m:2 * m, coordinate]
+    f0 = np.empty(m)
+    f0[~known] = out.state[2 * m:, coordinate]
+    ok = (out.status[:m] == OK) & (out.status[m:2 * m] == OK)
+    ok[~known] &= out.status[2 * m:] == OK
+    if known.any():
+        f0[known] = np.atleast_2d(images)[known, coordinate]
     # the steps actually taken (u +- step rounded), not the nominal one
     up = plus[:, coordinate] - states[:, coordinate]
     down = states[:, coordinate] - minus[:, coordinate]
@@ -146,21 +160,25 @@ def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, kee
     if run.status[0] != OK:
         reason = (f"{STATUS[int(run.status[0])]} after {int(run.returns_done[0])} returns "
                   f"(state {run.state[0].tolist()})")
-        return Attractor(values, 0, np.nan, np.nan, True, reason, states)
+        return Attractor(values, 0, np.nan, np.nan, True, reason, status=int(run.status[0]),
+                         states=states)
     if np.any((values < lo) | (values > hi)):
         bad = values[(values < lo) | (values > hi)][0]
         return Attractor(values, 0, np.nan, np.nan, True,
-                         f"left the window [{lo!r}, {hi!r}] (value {bad!r})", states)
+                         f"left the window [{lo!r}, {hi!r}] (value {bad!r})",
+                         status=LEFT_WINDOW, states=states)
     period = period_of(values, period_tolerance(scale), max_period)
     width = float(values.max() - values.min())
     lyap = np.nan
     if lyapunov_step is not None:
         # points on a kink of P (NaN slopes) are left out; none left: no exponent
-        s = slopes(cmodel, states, coordinate, lyapunov_step, t_max, **options)
+        # each kept return's image is the next one; only the last is computed
+        images = np.vstack([states[1:], np.full((1, states.shape[1]), np.nan)])
+        s = slopes(cmodel, states, coordinate, lyapunov_step, t_max, images, **options)
         s = s[np.isfinite(s)]
         with np.errstate(divide="ignore"):  # a flat return (sliding throughout): -inf
             lyap = float(np.mean(np.log(np.abs(s)))) if s.size else np.nan
-    return Attractor(values, period, width, lyap, False, "", states)
+    return Attractor(values, period, width, lyap, False, states=states)
 
 
 def first_window(periods: np.ndarray, n: int) -> tuple[int, int] | None:

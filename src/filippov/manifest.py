@@ -92,6 +92,11 @@ def _finite_list(values) -> list:
     return [None if not np.isfinite(v) else float(v) for v in values]
 
 
+def _floats(values) -> np.ndarray:
+    """The inverse of :func:`_finite_list`: None back to NaN."""
+    return np.array([np.nan if v is None else v for v in values], dtype=float)
+
+
 def summarize(path: Path) -> dict:
     """The reference values of one dataset: per numeric variable, its tolerance,
     statistics and samples (for a ``trace``, the converged values)."""
@@ -159,10 +164,8 @@ def _compare_variable(g: dict, w: dict, tol: Tolerance) -> str | None:
         return f"shape/NaN count {g['shape']}/{g['nan']} != {w['shape']}/{w['nan']}"
     if tol.rule == "attractor":
         # points of an attractor: each row's extent, within tolerance + jump x its width
-        lo_w, hi_w = (np.array([np.nan if v is None else v for v in w[k]], dtype=float)
-                      for k in ("extent_min", "extent_max"))
-        lo_g, hi_g = (np.array([np.nan if v is None else v for v in g[k]], dtype=float)
-                      for k in ("extent_min", "extent_max"))
+        lo_w, hi_w = _floats(w["extent_min"]), _floats(w["extent_max"])
+        lo_g, hi_g = _floats(g["extent_min"]), _floats(g["extent_max"])
         ref, got = np.concatenate([lo_w, hi_w]), np.concatenate([lo_g, hi_g])
         if np.any(np.isnan(ref) != np.isnan(got)):
             return f"rows without finite values differ {rule}"

@@ -712,6 +712,9 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
     def scalar(func):
         return lambda tt: float(func(Z(tt)))
 
+    if mode != SLIDING:  # dH/dt along the mode's field: extrema of H are its roots
+        dfun = scalar(lambda zz: system.speed_of_switch(mode, zz))
+
     # Sample intervals that may hold an event, found with array operations; only
     # those are examined one by one (a scan of many samples costs a few numpy calls).
     cand = np.zeros(ts.size - 1, dtype=bool)
@@ -731,7 +734,6 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
                 if (mode != SLIDING and first and i == 0
                         and rules.dips_and_returns(mode, D[0], D[1])):
                     # refine beyond the dip: next to the entry H is noise (rules)
-                    dfun = scalar(lambda zz: system.speed_of_switch(mode, zz))
                     tm = brentq(dfun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps)
                     hm = float(func(Z(tm)))
                     if not rules.after(pred, hm):
@@ -743,7 +745,6 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
             # a minimum (in +) or maximum (in -) of H hidden between samples
             H = vals[0]
             if rules.extremum_between(mode, D[i], D[i + 1]):
-                dfun = scalar(lambda zz: system.speed_of_switch(mode, zz))
                 tm = brentq(dfun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps)
                 Hm = float(leave[0][0](Z(tm)))
                 pred = leave[0][1]

@@ -22,8 +22,9 @@ def scene_resolution(scene):
         data = yaml.safe_load(Path(f"config/scenes/{scene}.yaml").read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, yaml.YAMLError):
         return DEFAULT_RESOLUTION
-    blocks = data.get("resolutions") if isinstance(data, dict) else None
-    return RESOLUTION if isinstance(blocks, dict) and RESOLUTION in blocks else DEFAULT_RESOLUTION
+    if not isinstance(data, dict):
+        return DEFAULT_RESOLUTION
+    return apply_resolution(data, RESOLUTION).get("resolution", DEFAULT_RESOLUTION)
 
 
 def scene_chunks():

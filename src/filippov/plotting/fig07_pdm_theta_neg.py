@@ -13,10 +13,7 @@ VARS = ["P_DM", "P_first_order", "P_zero_order", "P_printed", "P_flow", "s0",
 
 
 def eps_label(e: float) -> str:
-    k = np.log10(e)
-    if abs(k - round(k)) < 1e-9:
-        return rf"$10^{{{int(round(k))}}}$"
-    return f"${e:.2g}$"
+    return f"${st.eps_value(e)}$"
 
 
 def eps_colours(n: int):

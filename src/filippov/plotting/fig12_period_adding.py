@@ -5,17 +5,11 @@ from __future__ import annotations
 import numpy as np
 
 from . import style as st
-from .fig13_small_scale_chaos import eps_tex
 
 VARS = ["u", "u_limit", "u_limit0", "period", "period_limit0", "edge", "edge_limit0",
         "edge_gap"]
 S_LABEL = r"$s=(\mu-1)/\varepsilon$"
 U_LABEL = r"$(x_2-1)/\varepsilon$ on $\mathcal{L}_1$"
-
-
-def _diagram(ax, s, u, **kw):
-    ss = np.repeat(s, u.shape[-1])
-    ax.plot(ss, u.reshape(-1), ",", **kw)
 
 
 def draw(ds):
@@ -26,18 +20,18 @@ def draw(ds):
     axes = fig.subplots(2, 3)
     shown = [0, len(eps) // 2, len(eps) - 1]
     for k, (ax, j) in enumerate(zip(axes[0], shown)):
-        _diagram(ax, s, ds.u.values[0, j], color="black", rasterized=False)
-        _diagram(ax, s + 0.35 * (s[1] - s[0]), ds.u_limit.values[0, j], color=st.C_MINUS)
+        st.orbit_diagram(ax, s, ds.u.values[0, j], color="black", rasterized=False)
+        st.orbit_diagram(ax, s + 0.35 * (s[1] - s[0]), ds.u_limit.values[0, j], color=st.C_MINUS)
         ax.set_xlabel(S_LABEL)
         ax.set_ylabel(U_LABEL)
         ax.set_xlim(s.min(), s.max())
-        st.panel_label(ax, f"({'abc'[k]}) $\\varepsilon={eps_tex(eps[j])}$, $\\theta={theta:g}$")
+        st.panel_label(ax, f"({'abc'[k]}) $\\varepsilon={st.eps_value(eps[j])}$, $\\theta={theta:g}$")
         if k == 0:
             ax.plot([], [], "s", ms=3, color="black", label="slow-fast")
             ax.plot([], [], "s", ms=3, color=st.C_MINUS, label="limit map")
             ax.legend(loc="lower left")
     ax = axes[1, 0]
-    _diagram(ax, s, ds.u_limit0.values[0], color=st.C_PLUS)
+    st.orbit_diagram(ax, s, ds.u_limit0.values[0], color=st.C_PLUS)
     ax.set_xlabel(S_LABEL)
     ax.set_ylabel(U_LABEL)
     ax.set_xlim(s.min(), s.max())
@@ -47,7 +41,7 @@ def draw(ds):
     for j, e in enumerate(eps):
         per = np.where(ds.period.values[0, j] > 0, ds.period.values[0, j], np.nan)
         ax.step(s, per, where="mid", color=colors[j % len(colors)], lw=st.LW_THIN,
-                label=f"$\\varepsilon={eps_tex(e)}$")
+                label=f"$\\varepsilon={st.eps_value(e)}$")
     per0 = np.where(ds.period_limit0.values[0] > 0, ds.period_limit0.values[0], np.nan)
     ax.step(s, per0, where="mid", color=st.C_PLUS, lw=st.LW, ls="--",
             label=r"$\varepsilon\to 0$")

@@ -19,15 +19,6 @@ U_LABEL = r"$(x_2-1)/\varepsilon^2$ on $\mathcal{L}_1$"
 COLORS = ["0.6", st.C_PLUS, st.C_SLIDE, st.C_MINUS, "black"]
 
 
-def eps_tex(e: float) -> str:
-    p = np.log10(e)
-    return f"10^{{{int(round(p))}}}" if abs(p - round(p)) < 1e-9 else f"{e:g}"
-
-
-def _diagram(ax, s, u, **kw):
-    ax.plot(np.repeat(s, u.shape[-1]), u.reshape(-1), ",", **kw)
-
-
 def draw(ds):
     st.require(ds, "fig13_small_scale_chaos", VARS)
     s, eps, th = ds.s.values, ds.eps.values, ds.theta.values
@@ -37,14 +28,14 @@ def draw(ds):
     axes = fig.subplots(2, 3)
     picks = [i for i in np.argsort(-th) if th[i] in (0.5, 0.2, 0.1)][:3] or [0, 1, 2][:th.size]
     for k, (ax, i) in enumerate(zip(axes[0], picks)):
-        _diagram(ax, s[lin], ds.u.values[i, j][lin], color="black")
-        _diagram(ax, s[lin] + 0.3 * (s[1] - s[0]), ds.u_limit.values[i, j][lin],
+        st.orbit_diagram(ax, s[lin], ds.u.values[i, j][lin], color="black")
+        st.orbit_diagram(ax, s[lin] + 0.3 * (s[1] - s[0]), ds.u_limit.values[i, j][lin],
                  color=st.C_MINUS)
         ax.set_xlabel(S_LABEL)
         ax.set_ylabel(U_LABEL)
         ax.set_xlim(s[lin].min(), s[lin].max())
         st.panel_label(ax, f"({'abc'[k]}) $\\theta={th[i]:g}$, "
-                           f"$\\varepsilon={eps_tex(eps[j])}$, "
+                           f"$\\varepsilon={st.eps_value(eps[j])}$, "
                            f"$s(\\theta,0,0)={float(ds.slope_pdm.values[i]):.3g}$")
         if k == 0:
             ax.plot([], [], "s", ms=3, color="black", label="slow-fast")
@@ -62,7 +53,7 @@ def draw(ds):
     ax.set_xlabel(S_LABEL)
     ax.set_ylabel("largest Lyapunov exponent")
     ax.legend(loc="lower right", fontsize=6, ncol=2)
-    st.panel_label(ax, f"(d) $\\varepsilon={eps_tex(eps[j])}$; dashed: limit map")
+    st.panel_label(ax, f"(d) $\\varepsilon={st.eps_value(eps[j])}$; dashed: limit map")
     ax = axes[1, 1]
     i = int(np.argmin(np.abs(th - 0.2)))
     pos = s > 0
@@ -70,7 +61,7 @@ def draw(ds):
         w = ds.width_x2.values[i, jj][pos]
         ok = ds.period.values[i, jj][pos] != 1  # a point: width zero up to rounding
         ax.loglog((s[pos] * e * e)[ok], w[ok], "o-", ms=2, lw=st.LW_THIN,
-                  color=COLORS[(jj + 2) % len(COLORS)], label=f"$\\varepsilon={eps_tex(e)}$")
+                  color=COLORS[(jj + 2) % len(COLORS)], label=f"$\\varepsilon={st.eps_value(e)}$")
     ax.set_xlabel(r"$\mu-1$")
     ax.set_ylabel(r"width of the attractor in $x_2$")
     ax.legend(loc="upper left", fontsize=6)

@@ -6,7 +6,6 @@ import matplotlib.colors as mcolors
 import numpy as np
 
 from . import style as st
-from .fig13_small_scale_chaos import eps_tex
 
 VARS = ["attractor_type", "attractor_type_limit", "theta_critical"]
 # classes: escaped, aperiodic, chaotic, period 1, 2, 3, 4, 5, >= 6
@@ -45,7 +44,7 @@ def draw(ds):
         ax.axvline(crit, color="white", ls="-", lw=st.LW)
         ax.axvline(0.0, color="black", lw=st.LW_THIN)
         ax.set_xlabel(st.THETA)
-        st.panel_label(ax, f"({'ab'[k]}) {label}, $\\varepsilon={eps_tex(eps)}$")
+        st.panel_label(ax, f"({'ab'[k]}) {label}, $\\varepsilon={st.eps_value(eps)}$")
     axes[0].set_ylabel(r"$s=(\mu-1)/\varepsilon$ ($\theta<0$), $(\mu-1)/\varepsilon^2$ ($\theta>0$)")
     handles = [axes[0].fill_between([], [], color=c, label=n, ec="0.5", lw=0.3)
                for c, n in zip(COLORS, CLASSES)]

@@ -6,6 +6,7 @@ the output does not depend on which fonts a machine happens to have.
 from __future__ import annotations
 
 import matplotlib as mpl
+import numpy as np
 
 WIDTH_SINGLE = 3.4  # inches, one journal column
 WIDTH_DOUBLE = 7.0  # inches, full text width
@@ -62,6 +63,19 @@ def context():
 def panel_label(ax, text: str) -> None:
     """Panel tag like '(a) crossing' above the axes, left-aligned as in the paper."""
     ax.set_title(text, loc="left")
+
+
+def eps_value(e: float) -> str:
+    """An eps for math text (no dollars): 10^{k} for a power of ten, else 2 digits."""
+    k = np.log10(e)
+    if abs(k - round(k)) < 1e-9:
+        return f"10^{{{int(round(k))}}}"
+    return f"{e:.2g}"
+
+
+def orbit_diagram(ax, s, u, **kw):
+    """An orbit diagram: every kept return u[i, :] as a pixel dot at parameter s[i]."""
+    ax.plot(np.repeat(s, u.shape[-1]), u.reshape(-1), ",", **kw)
 
 
 def new_figure(width: float, height: float):

@@ -16,7 +16,6 @@ import xarray as xr
 from .. import attractors, tolerance
 from ..analytic import limit_map
 from ..config import SceneError
-from ..fastmap import OK
 from ..models import hopf
 from ..progress import Progress
 from ..tolerance import Tolerance
@@ -24,8 +23,6 @@ from .common import require, solver_options
 
 CHUNK_AXIS = "s"
 ENGINES = ("compiled",)
-#: status of a run that left the watched window (beyond the engine's status codes)
-LEFT_WINDOW = 100
 T_RETURN = 1.0  # t_max of one return: four rotations (one return takes one)
 
 
@@ -43,6 +40,10 @@ def s_grid(p: dict) -> np.ndarray:
                              f"{top!r} and {hi!r}")
         grid = np.concatenate([grid, np.geomspace(hi, top, int(p["n_geo"]) + 1)[1:]])
     return grid
+
+
+def chunk_grid(scene: dict) -> np.ndarray:
+    return s_grid(scene["parameters"])
 
 
 def thetas(p: dict) -> list[float]:
@@ -114,9 +115,7 @@ def sweep(scene: dict, s: np.ndarray, *, progress: bool = False) -> xr.Dataset:
                 period[i, j, k] = at.period
                 width[i, j, k] = at.width / sigma
                 lyap[i, j, k] = at.lyapunov
-                status[i, j, k] = (OK if not at.escaped else
-                                   LEFT_WINDOW if at.reason.startswith("left") else
-                                   _status_code(at.reason))
+                status[i, j, k] = at.status
                 bar.step()
     dims = ("theta", "eps", "s")
     return xr.Dataset(
@@ -124,14 +123,6 @@ def sweep(scene: dict, s: np.ndarray, *, progress: bool = False) -> xr.Dataset:
          "lyapunov": (dims, lyap), "status": (dims, status)},
         coords={"theta": ("theta", th), "eps": ("eps", ep), "s": ("s", s),
                 "k": ("k", np.arange(keep, dtype=np.int32))})
-
-
-def _status_code(reason: str) -> int:
-    from ..fastmap import STATUS
-    for code, text in STATUS.items():
-        if reason.startswith(text):
-            return int(code)
-    return -1
 
 
 def limit_diagrams(scene: dict, s: np.ndarray) -> dict:
@@ -155,8 +146,8 @@ def periods_of(u: np.ndarray, scale_tol: float, max_period: int) -> np.ndarray:
     return out.reshape(u.shape[:-1])
 
 
-#: scaled-unit tolerance of a period (attractors.period_tolerance with scale 1)
-PERIOD_TOL = 1e-4
+#: tolerance of a period in scaled units (u is already divided by the scale)
+PERIOD_TOL = attractors.period_tolerance(1.0)
 
 VARIABLE_ATTRS = {
     "u": ("(x2 - 1)/sigma at the kept returns to L1 (sigma = eps for theta < 0, eps^2 for "

@@ -18,7 +18,7 @@ import xarray as xr
 from .. import attractors
 from ..analytic import limit_map
 from ..io import finalize
-from .attractor_common import (CHUNK_AXIS, ENGINES, PERIOD_TOL, T_RETURN,  # noqa: F401
+from .attractor_common import (CHUNK_AXIS, ENGINES, chunk_grid, PERIOD_TOL, T_RETURN,  # noqa: F401
                                VARIABLE_ATTRS as _COMMON_ATTRS, _settle, chaos_tolerances,
                                common_dataset, eps_list, s_grid, sweep, thetas, validate)
 from .common import solver_options
@@ -81,10 +81,6 @@ def tolerances(scene: dict) -> dict:
             out[f"fit_{name}_B"] = Tolerance(0.0, wb * tol_e, "slope: its least-squares "
                                              "weights times edge_tol")
     return out
-
-
-def chunk_grid(scene: dict) -> np.ndarray:
-    return s_grid(scene["parameters"])
 
 
 def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:

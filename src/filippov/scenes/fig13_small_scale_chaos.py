@@ -25,7 +25,7 @@ from .. import tolerance
 from ..analytic import limit_map
 from ..io import finalize
 from ..tolerance import Tolerance
-from .attractor_common import (CHUNK_AXIS, ENGINES, T_RETURN,  # noqa: F401
+from .attractor_common import (CHUNK_AXIS, ENGINES, chunk_grid, T_RETURN,  # noqa: F401
                                VARIABLE_ATTRS as _COMMON_ATTRS, chaos_tolerances,
                                common_dataset, eps_list, lyapunov_limit, s_grid, sweep, thetas)
 from .attractor_common import validate as _validate_common
@@ -58,10 +58,6 @@ def validate(scene: dict) -> None:
     if any(not 0 < t < 1 for t in thetas(scene["parameters"])):
         raise SceneError(f"{scene['id']}: parameters.theta: each theta must lie in (0, 1) "
                          "(the sliding case)")
-
-
-def chunk_grid(scene: dict) -> np.ndarray:
-    return s_grid(scene["parameters"])
 
 
 def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:

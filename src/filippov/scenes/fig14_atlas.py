@@ -15,7 +15,7 @@ import xarray as xr
 
 from ..analytic import limit_map
 from ..io import finalize
-from .attractor_common import (CHUNK_AXIS, ENGINES, T_RETURN,  # noqa: F401
+from .attractor_common import (CHUNK_AXIS, ENGINES, chunk_grid, T_RETURN,  # noqa: F401
                                VARIABLE_ATTRS as _COMMON_ATTRS, chaos_tolerances,
                                common_dataset, lyapunov_limit, s_grid, sweep, validate)
 
@@ -39,10 +39,6 @@ def tolerances(scene: dict) -> dict:
     out = chaos_tolerances(scene)
     out.update({name: out["period"] for name in ("attractor_type", "attractor_type_limit")})
     return out
-
-
-def chunk_grid(scene: dict) -> np.ndarray:
-    return s_grid(scene["parameters"])
 
 
 def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
