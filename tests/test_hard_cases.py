@@ -102,15 +102,17 @@ def test_theta_positive_sliding_return_converges_like_eps_squared_at_bounded_cos
     scaled = gap / d.eps.values ** 2                 # O(eps^2), as the theta > 0 scaling says
     assert np.all((scaled[1:] > 100) & (scaled[1:] < 200)), scaled
     assert np.ptp(scaled[2:]) < 0.05 * scaled[-1]    # converged for eps <= 1e-4
-    # sliding lasts O(1) at every eps; the stiff sliding field is handed to Radau at
-    # small eps, so the cost stays bounded instead of growing like 1/eps
+    # sliding lasts O(1) at every eps; the stiff sliding field is handed to Radau IIA
+    # at small eps, so the cost stays bounded instead of growing like 1/eps
     assert np.all((d.return_sliding_time.values > 0.1) & (d.return_sliding_time.values < 0.3))
-    # (eps = 1e-4 sits near the rent-or-buy point of simulate.STIFF_AFTER)
     stiff = list(d.return_stiff.values)
-    assert stiff[:2] == [0, 0] and stiff[3:] == [1, 1]
-    # before the noise floor of Radau's tolerance (simulate.NOISE_STEPS): 3007 steps
-    # at eps = 1e-6, and 11072 at 1e-7
-    assert d.return_steps.values.max() < 2000
+    assert stiff == [0, 1, 1, 1, 1]
+    # a stiff return costs a few times the non-stiff one at eps = 1e-2 (64 DOP853
+    # steps). Before: 1148-1617 steps with the 3-stage method (scipy's Radau order),
+    # 3007 at eps = 1e-6 before the noise floor (simulate.NOISE_STEPS); measured now
+    # 188, 190, 167, 124 for eps = 1e-3 .. 1e-6
+    steps = d.return_steps.values
+    assert steps[0] < 100 and steps[1:].max() < 4 * steps[0], steps
 
 
 def test_radau_takes_over_stiff_sliding_and_agrees_with_dop853(monkeypatch):
@@ -325,15 +327,20 @@ def test_slow_windows_change_the_cost_not_the_result(theta, eps):
         a = simulate(system, [0.0, x2, 0.0], T_MAX, sections=[section_L1()], dense=False)
         b = simulate(fast_only, [0.0, x2, 0.0], T_MAX, sections=[section_L1()], dense=False)
         assert a.status == b.status == "section:L1"
-        assert [e.kind for e in a.events] == [e.kind for e in b.events]
+        # the events that change the mode; a touch (|H| <= touch_tol, no mode change)
+        # just after a tangential slide exit is there or not by the last bits of the
+        # exit state (x2 = 1.02, eps = 1e-4: slide ends 7e-15 apart, one run touches)
+        kinds = lambda tr: [e.kind for e in tr.events if e.kind != "touch"]
+        assert kinds(a) == kinds(b)
         np.testing.assert_allclose(a.z, b.z, rtol=0, atol=1e-13)
         assert a.t == pytest.approx(b.t, abs=1e-13)
 
 
 def test_stiff_sliding_does_not_depend_on_the_blas_thread_count():
-    # Radau's LU goes through OpenBLAS, whose multi-threaded path rounds differently:
-    # the eps = 1e-4 return moved by 1.4e-15 between a Snakemake job (one thread)
-    # and a plain process. The driver now runs Radau's steps on one BLAS thread.
+    # The implicit method's LU goes through OpenBLAS, whose multi-threaded path rounds
+    # differently: the eps = 1e-4 return moved by 1.4e-15 between a Snakemake job (one
+    # thread) and a plain process (scipy's Radau then). The driver runs the implicit
+    # steps on one BLAS thread.
     import os
     import subprocess
     import sys

@@ -127,7 +127,7 @@ VARIABLES = {
     "return_P_reduced": ("f8", "the same return of the reduced system (eps = 0)", "1"),
     "return_sliding_time": ("f8", "time the orbit slides on the way", "1"),
     "return_steps": ("i4", "driver steps of the return (its cost, deterministic)", "1"),
-    "return_stiff": ("i4", "1 if the sliding was finished by the implicit Radau method "
+    "return_stiff": ("i4", "1 if the sliding was finished by the implicit Radau IIA method "
                            "(DOP853 bounded by stability), else 0", "1"),
     "return_finite": ("i4", "1 if the returned state is finite, else 0", "1"),
 }
@@ -144,7 +144,7 @@ TOLERANCES = {
     "slope_sliding_time": Tolerance(1e-9, sqrt_law(PARAMETERS["slope_probe_floor"], 3.0),
                                     "slide of a probe just past grazing: square-root law; x3"),
     "return_steps": Tolerance(0.5, 10, "a cost counter, not a result: step acceptance and "
-                                       "Radau's Newton and Jacobian-reuse decisions flip with "
+                                       "Radau IIA's Newton decisions flip with "
                                        "last bits (a few percent measured); it shows the cost "
                                        "stays bounded"),
 }
@@ -240,7 +240,7 @@ def sliding_return(eps: float) -> dict:
     """One return to L1 of the Hopf example at theta = return_theta (> 0) with the
     reference driver: the orbit grazes into sliding, whose fast direction
     (x1 + 1 relaxing at rate 1/(theta eps)) makes the sliding field stiff; the
-    driver detects it and finishes with Radau. Its steps are the cost."""
+    driver detects it and finishes with Radau IIA. Its steps are the cost."""
     p = PARAMETERS
     model = hopf.model(eps, p["return_theta"], p["mu"], p["omega"])
     start = [0.0, p["return_x2"], 0.0]

@@ -408,11 +408,11 @@ def _hard_return(ds, m: Macros, eps: list) -> str:
     m.add("rpHardReturnStepsMin", int(steps.min()), "derived: min return_steps over eps")
     m.add("rpHardReturnStepsMax", int(steps.max()), "derived: max return_steps over eps")
     m.add("rpHardReturnStiffN", int(ds.return_stiff.values.sum()),
-          "derived: eps values whose sliding was finished by Radau")
+          "derived: eps values whose sliding was finished by Radau IIA")
     rows = per_eps_rows(ds.assign(gap=("eps", gap), scaled=("eps", scaled)), lambda d: [
         f"${num(float(d.gap), 3)}$", f"${num(float(d.scaled), 4)}$",
         f"${num(float(d.return_sliding_time), 5)}$", f"${int(d.return_steps)}$",
-        "Radau" if int(d.return_stiff) else "DOP853"])
+        "Radau IIA" if int(d.return_stiff) else "DOP853"])
     return tabular("rrrrrl", [
         r"$\epsilon$ & $|P_0-P|$ & $|P_0-P|/\epsilon^2$ & sliding time & steps & "
         r"sliding by \\"], rows)

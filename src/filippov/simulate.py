@@ -25,10 +25,11 @@ from dataclasses import dataclass, field
 from typing import Callable, Optional, Sequence
 
 import numpy as np
-from scipy.integrate import DOP853, Radau
+from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
 from . import checks, rules, variational
+from .radau_iia import RadauIIA
 from .system import MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 
 
@@ -116,10 +117,10 @@ class Trajectory:
     status: str = "running"
     n_steps: int = 0
     integrated_modes: set = field(default_factory=set)
-    # modes whose integration switched from DOP853 to the implicit Radau method
+    # modes whose integration switched from DOP853 to the implicit Radau IIA method
     # because the field proved stiff there (see STIFF_AFTER)
     stiff_modes: set = field(default_factory=set)
-    # mode name -> largest absolute tolerance Radau was given there, where the field's
+    # mode name -> largest absolute tolerance Radau IIA was given there, where the field's
     # rounding noise (see NOISE_STEPS) lifted it above atol: the local accuracy the
     # field's conditioning allowed
     atol_raised: dict = field(default_factory=dict)
@@ -180,7 +181,7 @@ def _blas_controller():
 
 
 def _one_blas_thread():
-    """Radau factorises its Newton matrices with LAPACK. OpenBLAS takes another code
+    """Radau IIA factorises its Newton matrices with LAPACK. OpenBLAS takes another code
     path with more than one thread, and the result moves in the last bits (the
     eps = 1e-4 sliding return differed between OPENBLAS_NUM_THREADS=1, as in a
     Snakemake job, and the default): one thread makes it the same everywhere."""
@@ -188,7 +189,10 @@ def _one_blas_thread():
 
 
 class _IntegratingStepper:
-    """DOP853 (explicit), or Radau (implicit, for a stiff field), with dense output."""
+    """DOP853 (explicit), or Radau IIA (implicit, for a stiff field), with dense output.
+    At an event inside an implicit step the state is the endpoint of a step to the
+    event (``RadauIIA.state_at``), not the collocation polynomial, which between
+    the nodes is only as accurate as the error estimate."""
 
     def __init__(self, fun, z, t, t_end, rtol, atol, max_step, method=DOP853,
                  piece=lambda zz: "the field", noise=None):
@@ -217,7 +221,9 @@ class _IntegratingStepper:
 
         self.method = method
         self.solver = method(checked, t, z, t_end, rtol=rtol, atol=atol,
-                             max_step=max_step if np.isfinite(max_step) else np.inf)
+                             max_step=max_step if np.isfinite(max_step) else np.inf,
+                             **({} if method is DOP853 else
+                                {"vectorized": True, "stages": STIFF_STAGES}))
 
     def _non_finite_message(self, tt, zz):
         zz = np.asarray(zz, dtype=float)
@@ -229,10 +235,10 @@ class _IntegratingStepper:
         ta = s.t
         self.non_finite = None
         if self.noise is not None and s.step_size is not None:
-            # scipy's Radau reads its atol afresh in every step
+            # RadauIIA reads its atol afresh in every step
             s.atol = np.maximum(self.atol, NOISE_STEPS * s.step_size * self.noise)
             self.atol_used = max(self.atol_used, float(np.max(s.atol)))
-        with _one_blas_thread() if self.method is Radau else contextlib.nullcontext():
+        with _one_blas_thread() if self.method is RadauIIA else contextlib.nullcontext():
             msg = s.step()
         if s.status == "failed":
             if self.non_finite is not None:  # the step size collapsed on a NaN or inf
@@ -250,22 +256,32 @@ PROJECT_AFTER = 1000  # steps before the step budget is projected from the mean 
 #: every STIFF_AFTER DOP853 steps in one stay in a mode, the step is compared with
 #: the field's stiffness: when h * rho(J) > 1 the step is bounded by stability, not
 #: accuracy (a fast variable slaved to a slow manifold, e.g. sliding of a slow-fast
-#: system at small eps), and the rest of the stay is integrated by Radau (listed in
-#: Trajectory.stiff_modes). When to switch is a rent-or-buy choice, since the length
-#: of the stay is unknown. Measured on one sliding return of the Hopf example
-#: (theta = 0.5, rtol 1e-12; seconds at eps = 1e-3, 1e-4, 1e-5, 1e-6, 1e-7):
-#: 1000 -> 0.15, 0.61, 1.25, 1.19, 0.88; 250 -> 0.15, 0.80, 0.79, 0.77, 0.40;
-#: 100 -> 0.67, 0.74, 0.76, 0.62, 0.33. 250 is never more than 1.3x the best of
-#: the three (eps = 1e-3 finishes in 261 DOP853 steps; 100 sends it to Radau).
-STIFF_AFTER = 250
+#: system at small eps), and the rest of the stay is integrated by the implicit
+#: Radau IIA method (:mod:`filippov.radau_iia`, STIFF_STAGES stages; listed in
+#: Trajectory.stiff_modes). When to switch is a rent-or-buy choice, since the
+#: length of the stay is unknown. Measured on one sliding return of the Hopf
+#: example (theta = 0.5, rtol 1e-12, 5 stages; seconds at eps = 1e-3, 1e-4, 1e-5,
+#: 1e-6, 1e-7): 100 -> 0.16, 0.17, 0.22, 0.15, 0.17; 50 -> 0.09, 0.09, 0.12, 0.07,
+#: 0.13; 25 -> 0.07, 0.08, 0.07, 0.05, 0.05 (eps = 1e-2 is not stiff: 64 DOP853
+#: steps, 0.04 s, at every choice). With scipy's 3-stage Radau the best was 250.
+STIFF_AFTER = 25
+
+#: stages of the Radau IIA method that takes over a stiff stay (order 2 s - 1).
+#: The same return at eps = 1e-6 took 1427 steps with scipy's 3-stage Radau
+#: (error estimate of order 3; STIFF_AFTER 250), 124 with 5 stages and 197 with 7
+#: (STIFF_AFTER 25); 7 stages are faster at eps >= 1e-5 but the noise floor
+#: holds them back below (eps = 1e-9: 1195 steps against 83).
+STIFF_STAGES = 5
 
 #: A stiff field amplifies the rounding of the state: at eps = 1e-6 the Hopf
 #: example's sliding field moves by ~1e-8 when x1 moves by one ulp (its Jacobian
-#: has entries ~1/eps). Radau's Newton iteration cannot settle an increment below
-#: h times that noise, so its absolute tolerance is kept at least NOISE_STEPS * h *
-#: field_noise (per component, h the last step); below it Radau shrank its step to
-#: 1e-7 and re-factorised on every step (eps = 1e-7: 11072 steps, 10.8 s; with the
-#: floor 785 steps, 0.4 s; the return P moved by < 3e-15 in both).
+#: has entries ~1/eps). The implicit method's error estimate and Newton iteration
+#: cannot settle below h times that noise, so its absolute tolerance is kept at
+#: least NOISE_STEPS * h * field_noise (per component, h the last step). Without
+#: the floor the steps collapsed (scipy's Radau, eps = 1e-7: 11072 steps, 10.8 s,
+#: with it 785 steps; 5-stage Radau IIA at eps = 1e-9: 16425 steps without, 83
+#: with NOISE_STEPS = 10; 1 and 3 left eps <= 1e-8 at 900-2000 steps). The
+#: return P moved by a few ulps at most (tests/test_reliability.py).
 NOISE_STEPS = 10.0
 
 
@@ -430,7 +446,8 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
     crossing (region + is ``H >= 0``). With ``stiff`` (default), an integrated
     mode whose DOP853 steps turn out bounded by stability (step x spectral radius
     of the Jacobian > 1, checked every ``STIFF_AFTER`` steps) continues with the
-    implicit Radau method (listed in ``Trajectory.stiff_modes``), whose absolute
+    implicit Radau IIA method of order 9 (:class:`filippov.radau_iia.RadauIIA`;
+    listed in ``Trajectory.stiff_modes``), whose absolute
     tolerance is kept above the field's rounding noise (``NOISE_STEPS``; where that
     lifted it above ``atol``, ``Trajectory.atol_raised`` says by how much).
     """
@@ -548,6 +565,8 @@ class _Run:
                 stepper = self._stiff_switch(stepper, steps_in_mode, tb - ta)
                 continue
             te, ze, what, idx = found
+            if stepper.method is RadauIIA and te != tb:
+                ze = stepper.solver.state_at(te)
             if self.dense:  # the segment ends at the event
                 self.traj.segments[-1] = (ta, te, mode, Z)
             self.t, self.z = te, ze
@@ -555,9 +574,9 @@ class _Run:
             return self.event(what, idx)
 
     def _note_tolerance(self, stepper):
-        """At the end of a stay: how far the noise floor lifted Radau's atol (the
+        """At the end of a stay: how far the noise floor lifted Radau IIA's atol (the
         stepper keeps the largest; a stay ends with the stepper that lifted it)."""
-        if stepper.method is Radau and stepper.atol_used > self.atol:
+        if stepper.method is RadauIIA and stepper.atol_used > self.atol:
             raised, name = self.traj.atol_raised, MODE_NAMES[self.mode]
             raised[name] = max(raised.get(name, 0.0), stepper.atol_used)
 
@@ -608,7 +627,7 @@ class _Run:
                 f"{self.system.sample_step!r})") from exc
 
     def _stiff_switch(self, stepper, steps_in_mode, h):
-        """Radau for the rest of the stay when DOP853's steps are bounded by stability
+        """Radau IIA for the rest of the stay when DOP853's steps are bounded by stability
         (checked every STIFF_AFTER steps; see there)."""
         if not (self.stiff and stepper.method is DOP853 and steps_in_mode % STIFF_AFTER == 0):
             return stepper
@@ -617,7 +636,7 @@ class _Run:
             return stepper
         self.traj.stiff_modes.add(MODE_NAMES[self.mode])
         return _IntegratingStepper(field, self.z, self.t, self.t_end, self.rtol, self.atol,
-                                   self.max_step, method=Radau, piece=stepper.piece,
+                                   self.max_step, method=RadauIIA, piece=stepper.piece,
                                    noise=field_noise(field, self.t, self.z))
 
     # ------------------------------------------------------------------ one event

@@ -88,8 +88,20 @@ rule bench_attractor_cost:
         "../scripts/bench_attractor_cost.py"
 
 
+# The cost of one stiff sliding return of the Hopf example per eps (reference
+# driver, Radau IIA with 3 and 5 stages), printed as a table.
+rule bench_sliding_cost:
+    output:
+        "results/bench_sliding_cost.nc",
+    params:
+        code=library_hash(exclude="plotting"),
+    script:
+        "../scripts/bench_sliding_cost.py"
+
+
 rule bench:
     input:
         rules.plot_bench.output,
         rules.bench_effect_cost.output,
         rules.bench_attractor_cost.output,
+        rules.bench_sliding_cost.output,
