@@ -248,24 +248,6 @@ class RadauIIA(OdeSolver):
         self.h_abs = h_abs * factor
         return True, None
 
-    def state_at(self, t):
-        """The state at ``t`` inside the last step, as the endpoint of a Radau step
-        from the step's start to ``t`` (order 2 s - 1, where the collocation
-        polynomial between the nodes is only as accurate as the error estimate).
-        Falls back to the dense output if that step's Newton iteration fails."""
-        h = t - self.t_prev
-        if h == 0:
-            return self.y_prev.copy()
-        x = self.tab.c * h / self.h_old
-        guess = (x[:, None] ** np.arange(1, self.tab.stages + 1)) @ self.poly
-        f = self.fun(self.t_prev, self.y_prev)
-        J = self._jacobian(self.t_prev, self.y_prev, f)
-        ok, _, Z = self._newton(self.t_prev, self.y_prev, h, J, guess,
-                                self._scale(self.y_prev))
-        if not ok:
-            return self._dense_output_impl()(t)
-        return self.y_prev + Z[-1]
-
     def _dense_output_impl(self):
         return CollocationOutput(self.t_prev, self.t, self.y_prev, self.h_old, self.poly)
 
