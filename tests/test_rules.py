@@ -17,6 +17,8 @@ def test_the_compiled_engine_compiles_the_rules_themselves():
                              (fastmap._start_on_switch, rules.start_on_switch),
                              (fastmap._accumulates, rules.accumulates),
                              (fastmap._exit_shift, rules.exit_shift),
+                             (fastmap._onto_switch, rules.onto_switch),
+                             (fastmap._exit_drift, rules.exit_drift),
                              (fastmap._same_instant, rules.same_instant),
                              (fastmap._starts_on_section, rules.starts_on_section),
                              (fastmap._after, rules.after), (fastmap._crosses, rules.crosses),
@@ -59,12 +61,45 @@ def test_filippov_decision_table():
 
 def test_exit_shift_only_takes_up_rounding_on_the_wrong_side():
     tol = 1e-15
-    assert rules.exit_shift(PLUS, -2.2e-16, tol) == -2.2e-16     # wrong side, rounding
-    assert rules.exit_shift(PLUS, 3e-16, tol) == 0.0             # right side
-    assert rules.exit_shift(PLUS, -1e-12, tol) == 0.0            # beyond rounding: a crossing
-    assert rules.exit_shift(MINUS, 2.2e-16, tol) == 2.2e-16
-    assert rules.exit_shift(MINUS, -1e-16, tol) == 0.0
-    assert fastmap._exit_shift(PLUS, -2.2e-16, tol) == -2.2e-16
+    assert rules.exit_shift(PLUS, -2.2e-16, tol, False) == -2.2e-16     # wrong side, rounding
+    assert rules.exit_shift(PLUS, 3e-16, tol, False) == 0.0             # right side
+    assert rules.exit_shift(PLUS, -1e-12, tol, False) == 0.0            # beyond rounding
+    assert rules.exit_shift(MINUS, 2.2e-16, tol, False) == 2.2e-16
+    assert rules.exit_shift(MINUS, -1e-16, tol, False) == 0.0
+    assert fastmap._exit_shift(PLUS, -2.2e-16, tol, False) == -2.2e-16
+    # after the exit was moved onto H, what is left is rounding, whatever its size
+    assert rules.exit_shift(PLUS, -1.8e-15, tol, True) == -1.8e-15
+    assert rules.exit_shift(PLUS, 1.8e-15, tol, True) == 0.0
+
+
+def test_only_a_drift_beyond_rounding_on_the_wrong_side_is_projected():
+    tol = 1e-15
+    z, grad = np.array([-1.0, 1e-6, -1.0]), np.array([0.5, 0.0, 0.5])   # Hopf's H at an exit
+    for drift in (rules.exit_drift, fastmap._exit_drift):
+        assert drift(PLUS, -5.7e-14, z, grad, tol) and drift(MINUS, 5.7e-14, z, grad, tol)
+        assert not drift(PLUS, -5e-16, z, grad, tol)       # rounding: exit_shift's
+        assert not drift(PLUS, 5.7e-14, z, grad, tol)      # the right side: left alone
+        assert not drift(MINUS, -5.7e-14, z, grad, tol)
+        # the dry-friction model's H = w - g1 x2 at w ~ 3.1: -3.6e-15 is its rounding
+        assert not drift(PLUS, -3.6e-15, np.array([4.0, 0.0, 3.1]), np.array([0.0, -3.0, 1.0]),
+                         tol)
+
+
+@pytest.mark.parametrize("project", [rules.onto_switch, fastmap._onto_switch])
+def test_a_sliding_exit_is_moved_onto_the_switching_surface(project):
+    # H = theta x1 + (1 - theta) y + 1 of the Hopf example: linear, so one step lands on it
+    theta = 0.5
+    grad = np.array([theta, 0.0, 1 - theta])
+    z = np.array([-1.0 - 4e-14, 1.25e-6, -1.0 - 7e-14])     # drifted: H = -5.5e-14
+    h = lambda zz: theta * zz[0] + (1 - theta) * zz[2] + 1.0
+    before = z.copy()
+    project(z, h(z), grad)
+    assert abs(h(z)) <= 2.3e-16 < abs(h(before))
+    assert z[1] == before[1]                                  # only along grad H
+    np.testing.assert_allclose(z - before, -h(before) * grad / (grad @ grad), rtol=1e-6)
+    flat = np.array([1.0, 2.0, 3.0])
+    project(flat, 1e-3, np.zeros(3))                          # no gradient: left alone
+    assert flat.tolist() == [1.0, 2.0, 3.0]
 
 
 def test_zeno_span_is_relative_beyond_t_of_one():
@@ -129,3 +164,16 @@ def test_a_dip_after_the_entry_moves_the_bracket_beyond_it():
         assert not f(MINUS, 3.5e-3, 1e-2) and not f(MINUS, -1.0, -0.5)
         assert not f(PLUS, -3.5e-3, -1e-2) and not f(PLUS, 1.0, 0.5)
     assert fastmap._dips_and_returns.py_func is rules.dips_and_returns
+
+
+def test_exact_windows_grow_with_the_time_since_the_entry_during_the_transient():
+    # h (the eps scale) at first, then as long as the time gone by, capped at h_slow,
+    # and h_slow once the transient has passed -- on both engines
+    for f in (rules.exact_window, fastmap._exact_window):
+        assert f(0.0, 1.0, 16.0, 40.0) == 1.0
+        assert f(1.0, 1.0, 16.0, 40.0) == 1.0
+        assert f(4.0, 1.0, 16.0, 40.0) == 4.0
+        assert f(32.0, 1.0, 16.0, 40.0) == 16.0
+        assert f(40.0, 1.0, 16.0, 40.0) == 16.0
+        assert f(0.0, 1.0, 16.0, 0.0) == 16.0
+    assert fastmap._exact_window.py_func is rules.exact_window

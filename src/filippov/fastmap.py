@@ -133,10 +133,13 @@ _jit_inline = njit(cache=True, _nrt=False, inline="always")
 # every decision and crossing predicate, compiled from its one source (filippov.rules)
 (_after, _crosses, _clamp, _far_side, _extremum_between, _graze, _section_fd_step,
  _slides_in_section, _starts_on_section, _same_instant, _start_side, _start_on_switch,
- _next_mode, _accumulates, _exit_shift, _dips_and_returns) = (_jit(getattr(rules, name)) for name in (
+ _next_mode, _accumulates, _exit_shift, _dips_and_returns, _exact_window, _onto_switch,
+ _exit_drift) = (
+    _jit(getattr(rules, name)) for name in (
     "after", "crosses", "clamp", "far_side", "extremum_between", "graze", "section_fd_step",
     "slides_in_section", "starts_on_section", "same_instant", "start_side", "start_on_switch",
-    "next_mode", "accumulates", "exit_shift", "dips_and_returns"))
+    "next_mode", "accumulates", "exit_shift", "dips_and_returns", "exact_window",
+    "onto_switch", "exit_drift"))
 assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 
 
@@ -282,7 +285,13 @@ def _refine(sel, pred, ta, tb, va, xtol, mode, sg, za, F, y_old, fns, p, wz, wg,
         r, ok = _brentq(sel, ta, tb, xtol, 4.0 * _EPS, 200, mode, sg, za, F, y_old, fns, p,
                         wz, wg, wf)
         if not ok:
-            return r, False
+            # as simulate._refine: no sign change because the start sample of a
+            # just-entered mode was clamped inside while the true value is already
+            # past the crossing -- the event is at once
+            if _after(pred, _fval(sel, ta, mode, sg, za, F, y_old, fns, p, wz, wg, wf)):
+                r = ta
+            else:
+                return r, False
     a = max(abs(r), _TINY)
     step = 2.0 * (np.nextafter(a, np.inf) - a)
     while not _after(pred, _fval(sel, r, mode, sg, za, F, y_old, fns, p, wz, wg, wf)):
@@ -644,8 +653,9 @@ def _window(mode, ta, tb, frac, first, fns, p, s, w):
 
 @_jit_inline
 def _stay_exact(mode, t, fns, p, s, w):
-    """A stay in region + or - on the exact flow from the mode entry, in windows of
-    hwin during the fast transient after the entry, then hwin_slow; (status, t, what)."""
+    """A stay in region + or - on the exact flow from the mode entry, in the windows of
+    rules.exact_window (hwin growing with the time since the entry during the fast
+    transient, then hwin_slow); (status, t, what)."""
     for k in range(w.z.size):
         w.za[k] = w.z[k]
     w.sg[0] = t
@@ -655,7 +665,7 @@ def _stay_exact(mode, t, fns, p, s, w):
         w.count[1] += 1
         if w.count[1] > s.max_steps:
             return STEP_LIMIT, ta, _W_NONE
-        tb = min(ta + (s.hwin if ta - w.sg[0] < s.transient else s.hwin_slow), s.t_max)
+        tb = min(ta + _exact_window(ta - w.sg[0], s.hwin, s.hwin_slow, s.transient), s.t_max)
         if tb == ta:
             tb = np.nextafter(ta, np.inf)
         st, t, what = _window(mode, ta, tb, s.frac_ex, first, fns, p, s, w)
@@ -725,7 +735,13 @@ def _event(mode, t, what, fns, p, s, w):
     if new_mode == SLIDING and mode != SLIDING and _slides_in(w.z, fns, p, w.wg, w.wf, w.wp,
                                                              w.wz):
         return SECTION_SLIDING, mode
+    drift = False
     if mode == SLIDING:
+        if new_mode != SLIDING:
+            h0 = fns[4](w.z, p)
+            drift = _exit_drift(new_mode, h0, w.z, w.wg, s.touch_tol)
+            if drift:  # w.wg holds grad h at w.z (from _speeds)
+                _onto_switch(w.z, h0, w.wg)
         _end_slide(t, w)
     if new_mode == SLIDING:
         w.tally[1] = t
@@ -744,7 +760,7 @@ def _event(mode, t, what, fns, p, s, w):
         return ZENO, mode
     w.sg[4] = 0.0
     if mode == SLIDING and new_mode != SLIDING:
-        w.sg[4] = _exit_shift(new_mode, fns[4](w.z, p), s.touch_tol)
+        w.sg[4] = _exit_shift(new_mode, fns[4](w.z, p), s.touch_tol, drift)
     return _GO_ON, new_mode
 
 

@@ -153,8 +153,9 @@ class Trajectory:
 
 # --------------------------------------------------------------------------- steppers
 class _ExactStepper:
-    """Walks an exact flow in windows of ``h`` (``h_slow`` once ``transient`` has
-    passed since the mode entry); the evaluator is the flow itself."""
+    """Walks an exact flow in the windows of :func:`filippov.rules.exact_window` (``h``
+    growing with the time since the mode entry, ``h_slow`` once ``transient`` has
+    passed); the evaluator is the flow itself."""
 
     method = None  # not integrated
 
@@ -165,7 +166,7 @@ class _ExactStepper:
 
     def step(self):
         ta = self.t
-        h = self.h if ta - self.ta < self.transient else self.h_slow
+        h = rules.exact_window(ta - self.ta, self.h, self.h_slow, self.transient)
         tb = min(ta + h, self.t_end)
         if tb == ta:  # h below the spacing of floats at t
             tb = np.nextafter(ta, np.inf)
@@ -651,6 +652,15 @@ class _Run:
                 return self.stop(f"section:{sec.name}")
             return None
         new_mode, kind = _decide(self.system, mode, what, ze)
+        drift = False
+        if kind == "slide_end":
+            h0 = float(self.system.switch(ze))
+            grad = self.system.switch_grad(ze[:, None])[:, 0]
+            drift = rules.exit_drift(new_mode, h0, ze, grad, self.touch_tol)
+            if drift:
+                ze = ze.copy()
+                rules.onto_switch(ze, h0, grad)
+                self.z = ze
         if new_mode == SLIDING and mode != SLIDING:
             _refuse_sliding_in_sections(self.system, self.sections, ze, te)
         traj.events.append(Event(te, kind, ze.copy(), mode, new_mode))
@@ -661,7 +671,8 @@ class _Run:
                 f"state {ze.tolist()}")
         self._check_rate(te, ze, new_mode)
         # after a sliding exit the stay measures H from the exit point's rounding
-        self.shift = (rules.exit_shift(new_mode, float(self.system.switch(ze)), self.touch_tol)
+        self.shift = (rules.exit_shift(new_mode, float(self.system.switch(ze)), self.touch_tol,
+                                       drift)
                       if kind == "slide_end" else 0.0)
         self.mode = traj.mode = new_mode
         return None
