@@ -12,6 +12,8 @@ panel) each method is swept over tolerances and scored by
 * ``error_switch``: max |t_switch - t_switch_ref| of the first change of mode;
 * ``wall_time``: the median of ``runs`` runs in this process (one core); for
   fig11 the start points on M_+ are computed once beforehand and not timed;
+* ``time_per_return``: ``wall_time`` over the map's start points, the cost of one
+  return (also printed per configuration, in microseconds);
 
 against a reference computed independently of the method measured. fig04:
 the compiled exact flows at rtol 1e-13 for every integrator, and the project's
@@ -105,7 +107,7 @@ def tolerances() -> dict:
                                  "under a last-bit change (measured)")
     check = Tolerance(1e-6, 1e-12, "difference of two solves at rtol 1e-13 of maps that move "
                                    "by ~3e-13 under a last-bit change (measured)")
-    return {"wall_time": MEASURED, "runs": MEASURED, "time_ours_at_target": MEASURED,
+    return {"wall_time": MEASURED, "time_per_return": MEASURED, "runs": MEASURED, "time_ours_at_target": MEASURED,
             "time_rk45_at_target": MEASURED, "speedup_vs_rk45": MEASURED,
             "error_map": err, "error_switch": err, "reference_check": check}
 
@@ -321,7 +323,8 @@ def run(problems, families, repeat: int, time_cap: float, log=print, budget: flo
             else:
                 err_map[i, j] = max_dev(got_p, want_p, prob.scored)[0]
                 err_sw[i, j], missed[i, j] = max_dev(got_sw, want_sw, prob.scored)
-            log(f"  {fam:24s} rtol {tol:7.0e}  {wall[i, j]:9.4f} s  map err {err_map[i, j]:9.2e}"
+            log(f"  {fam:24s} rtol {tol:7.0e}  {wall[i, j]:9.4f} s "
+                f"({1e6 * wall[i, j] / prob.x2.size:8.1f} us/return)  map err {err_map[i, j]:9.2e}"
                 f"  switch err {err_sw[i, j]:9.2e} ({missed[i, j]} missed)  {status[i, j] if status[i, j] != 'ok' else ''}")
     fam_of = np.array([c[0] for c in configs])
     ratio = np.full(len(problems), np.nan)
@@ -343,6 +346,9 @@ def run(problems, families, repeat: int, time_cap: float, log=print, budget: flo
              "long_name": "start points where only one of method and reference switches "
                           "(a grazing excursion missed or invented)", "units": "1"}),
          "wall_time": (dims, wall, {"long_name": "median wall time of one map", "units": "s"}),
+         "time_per_return": (dims, wall / np.array([p.x2.size for p in problems])[:, None], {
+             "long_name": "cost of one return: median wall time of the map over its start "
+                          "points", "units": "s"}),
          "runs": (dims, runs, {"long_name": "runs the median is taken over", "units": "1"}),
          "status": (dims, status.astype(str), {"long_name": "ok, failed: ..., or time cap: ..."}),
          "reference_check": ("problem", ref_check, {

@@ -60,15 +60,29 @@ def tolerances(scene: dict) -> dict:
     compared as in attractor_common.chaos_tolerances (measured under the emulated CPU:
     up to 0.19 in u and one period changed, all at eps = 1e-2). A window edge is found
     by bisection: a classification that a last-bit change flips at one midpoint moves
-    it by up to edge_tol; the fits carry that through their least-squares weights."""
+    it by up to edge_tol; the fits carry that through their least-squares weights.
+    The bisection starts from the grid's first run of the period, so a flipped grid
+    point next to the edge moves the bracket, and the edge, by one grid step: seen at
+    eps = 1e-2, where periodic and aperiodic grid points interleave at the right edge
+    of the period-4 window (s = 2.975 .. 3.05: periods 4, 0, 4, 0 natively, 4, 4, 0, 0
+    under the emulated CPU, seed 2; the edge moved by 0.025). The slow-fast edges
+    carry that tolerance; the fits use eps <= fit_eps_max, whose edges held to
+    edge_tol under every emulated seed."""
     p = scene["parameters"]
     eps = np.array(eps_list(p))
     tol_e = float(p["edge_tol"])
+    grid = s_grid(p)
+    step = float(f"{grid[1] - grid[0]:.6g}")
     edge = Tolerance(0.0, tol_e, "bisection to edge_tol: one flipped classification")
     out = chaos_tolerances(scene)
     del out["lyapunov_limit"]  # not computed here
-    out.update({"edge": edge, "edge_limit": edge, "edge_limit0": edge,
-                "edge_gap": Tolerance(0.0, 2 * tol_e, "two edges"),
+    out.update({"edge": Tolerance(0.0, step + tol_e, "a flipped grid classification next "
+                                  "to the edge moves the bisection's bracket by one grid "
+                                  "step (eps = 1e-2, where periodic and aperiodic points "
+                                  "interleave at a window's edge); then to edge_tol"),
+                "edge_limit": edge, "edge_limit0": edge,
+                "edge_gap": Tolerance(0.0, step + 2 * tol_e, "an edge by one grid step, "
+                                      "both by edge_tol"),
                 "fit_sqrt_rms": Tolerance(0.0, tol_e, "residual of edges known to edge_tol"),
                 "fit_lin_rms": Tolerance(0.0, tol_e, "residual of edges known to edge_tol")})
     fitted = eps[eps <= float(p["fit_eps_max"])]
