@@ -735,13 +735,14 @@ def _event(mode, t, what, fns, p, s, w):
     if new_mode == SLIDING and mode != SLIDING and _slides_in(w.z, fns, p, w.wg, w.wf, w.wp,
                                                              w.wz):
         return SECTION_SLIDING, mode
-    drift = False
+    drift, h0 = False, 0.0
     if mode == SLIDING:
         if new_mode != SLIDING:
             h0 = fns[4](w.z, p)
             drift = _exit_drift(new_mode, h0, w.z, w.wg, s.touch_tol)
             if drift:  # w.wg holds grad h at w.z (from _speeds)
                 _onto_switch(w.z, h0, w.wg)
+                h0 = fns[4](w.z, p)  # what rounding left
         _end_slide(t, w)
     if new_mode == SLIDING:
         w.tally[1] = t
@@ -760,7 +761,7 @@ def _event(mode, t, what, fns, p, s, w):
         return ZENO, mode
     w.sg[4] = 0.0
     if mode == SLIDING and new_mode != SLIDING:
-        w.sg[4] = _exit_shift(new_mode, fns[4](w.z, p), s.touch_tol, drift)
+        w.sg[4] = _exit_shift(new_mode, h0, s.touch_tol, drift)
     return _GO_ON, new_mode
 
 

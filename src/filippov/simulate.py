@@ -652,7 +652,7 @@ class _Run:
                 return self.stop(f"section:{sec.name}")
             return None
         new_mode, kind = _decide(self.system, mode, what, ze)
-        drift = False
+        drift, h0 = False, 0.0
         if kind == "slide_end":
             h0 = float(self.system.switch(ze))
             grad = self.system.switch_grad(ze[:, None])[:, 0]
@@ -661,6 +661,7 @@ class _Run:
                 ze = ze.copy()
                 rules.onto_switch(ze, h0, grad)
                 self.z = ze
+                h0 = float(self.system.switch(ze))  # what rounding left
         if new_mode == SLIDING and mode != SLIDING:
             _refuse_sliding_in_sections(self.system, self.sections, ze, te)
         traj.events.append(Event(te, kind, ze.copy(), mode, new_mode))
@@ -671,8 +672,7 @@ class _Run:
                 f"state {ze.tolist()}")
         self._check_rate(te, ze, new_mode)
         # after a sliding exit the stay measures H from the exit point's rounding
-        self.shift = (rules.exit_shift(new_mode, float(self.system.switch(ze)), self.touch_tol,
-                                       drift)
+        self.shift = (rules.exit_shift(new_mode, h0, self.touch_tol, drift)
                       if kind == "slide_end" else 0.0)
         self.mode = traj.mode = new_mode
         return None

@@ -18,6 +18,7 @@ import time
 import numpy as np
 import xarray as xr
 
+from ..hard_cases import PARAMETERS
 from ..io import finalize, write_dataset
 from ..models import hopf
 from ..scenes.fig04_retmaps import section_L1
@@ -27,11 +28,13 @@ driver = importlib.import_module("filippov.simulate")
 
 EPS = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8]
 STAGES = [3, 5]
-THETA, START, T_MAX = 0.5, (0.0, 1.2, 0.0), 1.0
+# the hard-case sweep's sliding return (hard_cases.sliding_return), timed alone
+THETA, START, T_MAX = (PARAMETERS["return_theta"], (0.0, PARAMETERS["return_x2"], 0.0),
+                       PARAMETERS["hopf_t_max"])
 
 
 def measure(eps: float, stages: int, repeat: int) -> dict:
-    model = hopf.model(eps, THETA)
+    model = hopf.model(eps, THETA, PARAMETERS["mu"], PARAMETERS["omega"])
     saved = driver.STIFF_STAGES
     driver.STIFF_STAGES = stages
     try:

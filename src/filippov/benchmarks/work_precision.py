@@ -337,6 +337,7 @@ def run(problems, families, repeat: int, time_cap: float, log=print, budget: flo
         t_rk45[i] = time_at_error(err_map[i, rk], wall[i, rk], TARGET_ERROR)
         ratio[i] = t_rk45[i] / t_ours[i]
     dims = ("problem", "config")
+    n_points = np.array([p.x2.size for p in problems], dtype=np.int32)
     ds = xr.Dataset(
         {"error_map": (dims, err_map, {"long_name": "max |P - P_ref| over the grid", "units": "1"}),
          "error_switch": (dims, err_sw, {
@@ -346,7 +347,7 @@ def run(problems, families, repeat: int, time_cap: float, log=print, budget: flo
              "long_name": "start points where only one of method and reference switches "
                           "(a grazing excursion missed or invented)", "units": "1"}),
          "wall_time": (dims, wall, {"long_name": "median wall time of one map", "units": "s"}),
-         "time_per_return": (dims, wall / np.array([p.x2.size for p in problems])[:, None], {
+         "time_per_return": (dims, wall / n_points[:, None], {
              "long_name": "cost of one return: median wall time of the map over its start "
                           "points", "units": "s"}),
          "runs": (dims, runs, {"long_name": "runs the median is taken over", "units": "1"}),
@@ -355,7 +356,7 @@ def run(problems, families, repeat: int, time_cap: float, log=print, budget: flo
              "long_name": "max |P_reference - P_check| (see reference_pair)", "units": "1"}),
          "reference_pair": ("problem", np.array(ref_names, dtype=str), {
              "long_name": "reference and its independent check"}),
-         "n_points": ("problem", np.array([p.x2.size for p in problems], dtype=np.int32),
+         "n_points": ("problem", n_points,
                       {"long_name": "start points per map", "units": "1"}),
          "time_ours_at_target": ("problem", t_ours, {
              "long_name": "fastest project configuration with error <= target", "units": "s"}),
