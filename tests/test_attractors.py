@@ -68,29 +68,41 @@ def test_finite_difference_slopes_are_the_variational_derivative_of_the_return()
         assert s == pytest.approx(J[1, 1], rel=1e-6)
         assert np.abs(J[2, 1:]).max() < 1e-6  # y forgets: rank one up to exp(-T/eps)
     assert np.ptp(fd) > 1.0  # the kept points see both branches of the map
+    # the engine's own derivative (the exponents' source) is the same slope
+    jac = attractors.iterate(cm, [0.0, np.sqrt(mu), 0.0], transient=400, keep=6, t_max=T_MAX,
+                             jacobian=True).orbit_jacobian[0]
+    images = np.vstack([run.orbit[0, 1:], np.full((1, 3), np.nan)])
+    fd_next = attractors.slopes(cm, run.orbit[0], 1, 1e-4 * EPS ** 2, T_MAX, images)
+    np.testing.assert_allclose(jac[1:, 1, 1], fd_next[:-1], rtol=1e-6)
 
 
 def test_the_attractor_at_theta_0_2_is_chaotic_and_at_theta_minus_0_5_periodic():
     chaotic = attractors.settle(hopf.compiled(EPS, 0.2, 1 + 2 * EPS ** 2), [0.0, 1.0, 0.0],
                                 coordinate=1, transient=400, keep=200, t_max=T_MAX,
                                 scale=EPS ** 2, max_period=50, window=(0.99, 1.01),
-                                lyapunov_step=1e-4 * EPS ** 2)
+                                lyapunov=True)
     assert chaotic.period == 0 and chaotic.lyapunov > 0.2
     periodic = attractors.settle(hopf.compiled(EPS, -0.5, 1 + EPS), [0.0, 1.0, 0.0],
                                  coordinate=1, transient=400, keep=100, t_max=T_MAX,
                                  scale=EPS, max_period=50, window=(0.9, 1.1),
-                                 lyapunov_step=1e-4 * EPS)
+                                 lyapunov=True)
     assert periodic.period == 5 and periodic.lyapunov < 0
 
 
-def test_a_slope_on_the_kink_of_p_is_refused_not_averaged():
+@pytest.mark.parametrize("theta", [0.5, 0.2])
+def test_a_slope_on_the_kink_of_p_is_refused(theta):
     # at mu = 1 the attractor is the grazing point itself, where P has a kink (slope
-    # lambda on one side, lambda s(theta,0,0) on the other): central differences would
-    # average the two (at theta = 0.5 to ~0, log -> -9); the exponent is NaN instead
-    at = attractors.settle(hopf.compiled(1e-3, 0.5, 1.0), [0.0, 1.0, 0.0], coordinate=1,
-                           transient=100, keep=20, t_max=T_MAX, scale=1e-6, max_period=10,
-                           window=(0.9, 1.1), lyapunov_step=1e-10)
+    # lambda on one side, lambda s(theta,0,0) on the other; at theta = 0.2 the second
+    # one expands): the orbit touches H, the engine gives no derivative there and the
+    # exponent is NaN -- not the slope of the side the rounding happened to take
+    cm = hopf.compiled(1e-3, theta, 1.0)
+    at = attractors.settle(cm, [0.0, 1.0, 0.0], coordinate=1, transient=100, keep=20,
+                           t_max=T_MAX, scale=1e-6, max_period=10, window=(0.9, 1.1),
+                           lyapunov=True)
     assert at.period == 1 and np.isnan(at.lyapunov)
+    # central differences straddling it would average the two branches: refused too
+    fd = attractors.slopes(cm, [[0.0, 1.0, 0.0]], 1, 1e-10, T_MAX)
+    assert np.isnan(fd[0])
     # one step away from it the slopes are those of the smooth branch
     mu = 1 - 1e-6
     s = attractors.slopes(hopf.compiled(1e-3, 0.5, mu), [[0.0, np.sqrt(mu), 0.0]], 1, 1e-10,

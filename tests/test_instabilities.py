@@ -18,9 +18,7 @@ def _attractor(eps, theta, s, *, transient=200, keep=60, lyapunov=False, window=
     cm = hopf.compiled(eps, theta, mu, OMEGA, sliding=theta > 0)
     return attractors.settle(cm, [0.0, np.sqrt(mu), 0.0], coordinate=1, transient=transient,
                              keep=keep, t_max=T_RETURN, scale=sigma, max_period=30,
-                             window=(1 - window, 1 + window),
-                             lyapunov_step=max(1e-4 * sigma, attractors.MIN_FD_STEP)
-                             if lyapunov else None)
+                             window=(1 - window, 1 + window), lyapunov=lyapunov)
 
 
 def _limit_period(s, eps, theta, order):

@@ -25,7 +25,7 @@ def test_the_compiled_engine_compiles_the_rules_themselves():
                              (fastmap._clamp, rules.clamp), (fastmap._far_side, rules.far_side),
                              (fastmap._extremum_between, rules.extremum_between),
                              (fastmap._graze, rules.graze),
-                             (fastmap._section_fd_step, rules.section_fd_step),
+                             (fastmap._central_step, rules.central_step),
                              (fastmap._slides_in_section, rules.slides_in_section)):
         assert compiled.py_func is source
 
@@ -138,7 +138,7 @@ def test_hidden_extremum_and_graze():
     assert rules.graze(PLUS, 1e-3, 1e-15) == rules.GRAZE_NONE
     assert rules.graze(MINUS, 2e-15, 1e-15) == rules.GRAZE_CROSSES
     assert fastmap._graze(MINUS, 2e-15, 1e-15) == rules.GRAZE_CROSSES
-    assert rules.section_fd_step(1.0, 0.0) == 0.0 and rules.section_fd_step(1.0, np.nan) == 0.0
+    assert rules.central_step(1.0, 0.0) == 0.0 and rules.central_step(1.0, np.nan) == 0.0
     assert not rules.slides_in_section(0.0, 0.0, 1.0, 1.0, 0.0)
     assert rules.slides_in_section(0.0, 1e-5, 1.0, -1.0, 0.0)
     assert not rules.slides_in_section(0.0, 1e-5, 1.0, -1.0, 0.5)

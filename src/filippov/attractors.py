@@ -8,20 +8,19 @@ recorded, all in one compiled call: :func:`filippov.fastmap.compute_returns` wit
 * ``period``: the smallest p with |u_{k+p} - u_k| <= tol over all kept returns
   (0: none up to ``max_period`` -- chaotic, quasi-periodic or not yet settled);
 * ``width``: max - min of the kept values;
-* ``lyapunov``: the mean of log |dP/du| along the kept returns, the slope of the
-  map in the coordinate u by central differences (:func:`slopes`), leaving out points
-  that lie on a kink of P (NaN when all do: the attractor sits on the grazing point);
+* ``lyapunov``: the largest Lyapunov exponent of the map along the kept returns: the
+  mean log growth of a tangent vector carried by the derivative dP/dz that the engine
+  returns with each return (:func:`lyapunov_exponent`; ``compute_returns(jacobian=True)``:
+  variational equations and saltation matrices, no extra returns);
 * ``escaped``: a return failed (no return within t_max: the orbit left for another
   attractor or infinity) or a kept value left the window the caller watches; such an
   attractor is reported as escaped with the reason, never as numbers.
 
-Why one coordinate is enough for the Lyapunov exponent: on a section of a slow-fast
-system the fast coordinates are contracted by exp(-T/eps) per return (T the return
-time), so the derivative of the return map is rank one up to that factor and the
-largest exponent is the mean log-slope of the slow coordinate along the attractor,
-with the fast coordinates held at their values on the orbit. The check against the
-variational equations with saltation matrices (filippov.variational, reference
-driver) is a test (tests/test_attractors.py).
+Why this is the mean log-slope of x2: on a section of a slow-fast system the fast
+coordinates are contracted by exp(-T/eps) per return (T the return time), so dP/dz is
+rank one up to that factor and the vector's growth per return is the slope dP_x2/dx2.
+:func:`slopes` gives that slope by central differences of P (two extra returns per
+point) -- the independent check of the engine's derivative (tests/test_attractors.py).
 """
 from __future__ import annotations
 
@@ -71,19 +70,14 @@ def period_of(values: np.ndarray, tol: float, max_period: int) -> int:
 MIN_FD_STEP = 1e-11
 
 
-def check_resolvable(scale: float, lyapunov_step: float | None = None) -> None:
+def check_resolvable(scale: float) -> None:
     """Refuse an attractor scale that double precision cannot resolve on states of
-    order one: the period test needs 1000 ulp <= 1e-2 scale, the slopes a step of at
-    least MIN_FD_STEP and at most 1e-1 scale (truncation ~1e-2 of the slope there; e.g.
-    theta > 0 at eps = 1e-6: scale eps^2 = 1e-12, below both)."""
+    order one: the period test needs 1000 ulp <= 1e-2 scale (e.g. theta > 0 at eps =
+    1e-6: scale eps^2 = 1e-12, below it)."""
     if period_tolerance(scale) > 1e-2 * scale:
         raise ValueError(f"attractor scale {scale:.3g} is below what double precision "
                          f"resolves on states of order one (1000 ulp = {1e3 * _UNIT:.3g} "
                          f"must be <= 1e-2 of it): periods cannot be told apart")
-    if lyapunov_step is not None and not MIN_FD_STEP <= lyapunov_step <= 1e-1 * scale:
-        raise ValueError(f"lyapunov_step {lyapunov_step:.3g} must lie in [{MIN_FD_STEP:g}, "
-                         f"1e-1 scale = {1e-1 * scale:.3g}]: below, the rounding of one "
-                         f"return dominates the slope; above, the attractor's own scale")
 
 
 def period_tolerance(scale: float) -> float:
@@ -94,13 +88,36 @@ def period_tolerance(scale: float) -> float:
 
 
 def iterate(cmodel: CompiledModel, start, *, transient: int, keep: int, t_max: float,
-            **options):
+            jacobian: bool = False, **options):
     """``transient + keep`` returns from ``start`` (one compiled call); the raw
-    :class:`filippov.fastmap.BatchReturns` with ``orbit`` of shape (1, keep, dim)."""
+    :class:`filippov.fastmap.BatchReturns` with ``orbit`` of shape (1, keep, dim) (and
+    with ``jacobian``: ``orbit_jacobian`` (1, keep, dim, dim), dP/dz of each)."""
     if transient < 0 or keep < 1:
         raise ValueError(f"need transient >= 0 and keep >= 1, got {transient}, {keep}")
     return compute_returns(cmodel, np.atleast_2d(start), t_max, iterations=transient + keep,
-                           keep=keep, **options)
+                           keep=keep, jacobian=jacobian, **options)
+
+
+def lyapunov_exponent(jacobians: np.ndarray, coordinate: int) -> float:
+    """The mean log growth of a tangent vector carried through ``jacobians`` ((k, n, n),
+    dP/dz of consecutive returns), renormalized each return (Benettin's method), started
+    along ``coordinate``. A return without a finite derivative (P not differentiable
+    there: a switch met tangentially) is left out and the vector restarted; none left:
+    NaN. A return that maps the vector to zero (sliding throughout: P flat) gives -inf."""
+    n = jacobians.shape[-1]
+    start = np.zeros(n)
+    start[coordinate] = 1.0
+    v, logs = start, []
+    for J in jacobians:
+        if not np.all(np.isfinite(J)):
+            v = start
+            continue
+        w = J @ v
+        g = float(np.sqrt(w @ w))
+        with np.errstate(divide="ignore"):
+            logs.append(np.log(g))
+        v = w / g if g > 0 else start
+    return float(np.mean(logs)) if logs else np.nan
 
 
 #: one-sided slopes of P that differ by more than this (relative) put the point on a
@@ -114,14 +131,16 @@ KINK = 0.05
 def slopes(cmodel: CompiledModel, states: np.ndarray, coordinate: int, step: float,
            t_max: float, images: np.ndarray | None = None, **options) -> np.ndarray:
     """dP_u/du at each state by central differences of step ``step`` in coordinate u
-    (the other coordinates held), P_u the u-component of the first return. NaN where a
-    start fails to return or where the point lies on a kink of P (one-sided slopes
-    differ by more than :data:`KINK`). Truncation ~ step^2 times the third derivative
-    of P, rounding ~ e/step with e the error of one return (~1e-14 here): a step of
-    1e-4 of the attractor's scale keeps both below 1e-3 of a slope of order one for
-    scales >= 1e-8. ``images``: P(states) where already known (rows with a NaN are
-    computed here), e.g. the next returns of an orbit -- the same numbers a fresh
-    return gives, since a return depends on its start alone."""
+    (the other coordinates held), P_u the u-component of the first return: the check of
+    the engine's derivative. NaN where a start fails to return or where the point lies
+    on a kink of P (one-sided slopes differ by more than :data:`KINK`). Truncation ~
+    step^2 times the third derivative of P, rounding ~ e/step with e the error of one
+    return (~1e-14 here; ``step`` >= :data:`MIN_FD_STEP`): a step of 1e-4 of the
+    attractor's scale keeps both below 1e-3 of a slope of order one for scales >= 1e-8.
+    ``images``: P(states) where already known (rows with a NaN are computed here)."""
+    if not step >= MIN_FD_STEP:
+        raise ValueError(f"step {step!r} must be >= MIN_FD_STEP = {MIN_FD_STEP:g}: below, "
+                         "the rounding of one return dominates the slope")
     states = np.atleast_2d(np.asarray(states, dtype=float))
     m = states.shape[0]
     plus, minus = states.copy(), states.copy()
@@ -149,11 +168,13 @@ def slopes(cmodel: CompiledModel, states: np.ndarray, coordinate: int, step: flo
 
 def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, keep: int,
            t_max: float, scale: float, max_period: int, window: tuple[float, float],
-           lyapunov_step: float | None = None, **options) -> Attractor:
-    """Iterate, classify, and (``lyapunov_step`` given) the Lyapunov exponent.
-    A scale too small to resolve is refused first (:func:`check_resolvable`)."""
-    check_resolvable(scale, lyapunov_step)
-    run = iterate(cmodel, start, transient=transient, keep=keep, t_max=t_max, **options)
+           lyapunov: bool = False, **options) -> Attractor:
+    """Iterate, classify, and (``lyapunov``) the Lyapunov exponent from the engine's
+    dP/dz along the kept returns. A scale too small to resolve is refused first
+    (:func:`check_resolvable`)."""
+    check_resolvable(scale)
+    run = iterate(cmodel, start, transient=transient, keep=keep, t_max=t_max,
+                  jacobian=lyapunov, **options)
     states = run.orbit[0]
     values = states[:, coordinate]
     lo, hi = window
@@ -169,15 +190,7 @@ def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, kee
                          status=LEFT_WINDOW, states=states)
     period = period_of(values, period_tolerance(scale), max_period)
     width = float(values.max() - values.min())
-    lyap = np.nan
-    if lyapunov_step is not None:
-        # points on a kink of P (NaN slopes) are left out; none left: no exponent
-        # each kept return's image is the next one; only the last is computed
-        images = np.vstack([states[1:], np.full((1, states.shape[1]), np.nan)])
-        s = slopes(cmodel, states, coordinate, lyapunov_step, t_max, images, **options)
-        s = s[np.isfinite(s)]
-        with np.errstate(divide="ignore"):  # a flat return (sliding throughout): -inf
-            lyap = float(np.mean(np.log(np.abs(s)))) if s.size else np.nan
+    lyap = lyapunov_exponent(run.orbit_jacobian[0], coordinate) if lyapunov else np.nan
     return Attractor(values, period, width, lyap, False, states=states)
 
 

@@ -128,9 +128,11 @@ FD_STEP = float(np.cbrt(np.finfo(float).eps))
 SLIDE_TANGENT = 1e-6
 
 
-def section_fd_step(size: float, speed: float) -> float:
-    """The central-difference step along the fields (largest component ``speed``) at a
-    state of size ``size`` (>= 1); 0 where the fields give no direction."""
+def central_step(size: float, speed: float) -> float:
+    """The central-difference step along a direction (largest component ``speed``: a
+    field, a column of a derivative) at a state of size ``size`` (>= 1); 0 where the
+    direction is zero or not finite. Truncation and rounding are then both ~u^(2/3)
+    of the derivative (the sliding test, the compiled engine's dP/dz)."""
     if not (np.isfinite(speed) and speed > 0.0):
         return 0.0
     return FD_STEP * size / speed

@@ -346,7 +346,7 @@ def _slides_in(system: PiecewiseSystem, func, z) -> bool:
     (:func:`filippov.rules.slides_in_section`)."""
     z = np.asarray(z, dtype=float)
     fm, fp = np.asarray(system.field_minus(z), float), np.asarray(system.field_plus(z), float)
-    d = rules.section_fd_step(max(1.0, np.abs(z).max()), max(np.abs(fm).max(), np.abs(fp).max()))
+    d = rules.central_step(max(1.0, np.abs(z).max()), max(np.abs(fm).max(), np.abs(fp).max()))
     if d == 0.0:
         return False
 

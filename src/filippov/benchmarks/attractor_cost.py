@@ -32,13 +32,14 @@ def measure(theta: float, eps: float, s: float, returns: int, repeat: int) -> di
     cm = hopf.compiled(eps, theta, mu, OMEGA, sliding=theta > 0)
     start = np.array([[0.0, np.sqrt(mu), 0.0]])
     compute_returns(cm, start, 1.0)  # compile or load the kernel
-    times, switches = [], 0.0
+    times, times_jac, switches = [], [], 0.0
     for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = compute_returns(cm, start, 1.0, iterations=returns, keep=1)
-        times.append(time.perf_counter() - t0)
-        if out.status[0] != OK:
-            raise RuntimeError(f"theta={theta}, eps={eps}, s={s}: a return failed")
+        for jac, into in ((False, times), (True, times_jac)):
+            t0 = time.perf_counter()
+            out = compute_returns(cm, start, 1.0, iterations=returns, keep=1, jacobian=jac)
+            into.append(time.perf_counter() - t0)
+            if out.status[0] != OK:
+                raise RuntimeError(f"theta={theta}, eps={eps}, s={s}: a return failed")
     # switches per return: one more call, returns counted one by one
     z = start
     for _ in range(min(returns, 200)):
@@ -46,6 +47,7 @@ def measure(theta: float, eps: float, s: float, returns: int, repeat: int) -> di
         switches += r.n_switches[0]
         z = r.state
     return {"per_return": statistics.median(times) / returns,
+            "per_return_jac": statistics.median(times_jac) / returns,
             "switches": switches / min(returns, 200)}
 
 
@@ -54,6 +56,9 @@ def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
     ds = xr.Dataset(
         {"time_per_return": ("case", [r["per_return"] for r in rows],
                              {"long_name": "median wall time per return", "units": "s"}),
+         "time_per_return_jacobian": ("case", [r["per_return_jac"] for r in rows],
+                                      {"long_name": "median wall time per return with dP/dz",
+                                       "units": "s"}),
          "switches_per_return": ("case", [r["switches"] for r in rows],
                                  {"long_name": "mean mode changes per return", "units": "1"})},
         coords={"theta": ("case", [c[0] for c in CASES], {"units": "1"}),
@@ -61,9 +66,12 @@ def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
                 "s": ("case", [c[2] for c in CASES],
                       {"long_name": "(mu - 1)/eps (theta < 0), /eps^2 (theta > 0)",
                        "units": "1"})})
-    log(f"{'theta':>6} {'eps':>7} {'s':>4} {'us/return':>10} {'switches':>9}")
+    log(f"{'theta':>6} {'eps':>7} {'s':>4} {'us/return':>10} {'with dP/dz':>11} "
+        f"{'ratio':>6} {'switches':>9}")
     for (t, e, s), r in zip(CASES, rows):
-        log(f"{t:6.2f} {e:7.0e} {s:4.1f} {1e6 * r['per_return']:10.1f} {r['switches']:9.2f}")
+        log(f"{t:6.2f} {e:7.0e} {s:4.1f} {1e6 * r['per_return']:10.1f} "
+            f"{1e6 * r['per_return_jac']:11.1f} {r['per_return_jac'] / r['per_return']:6.2f} "
+            f"{r['switches']:9.2f}")
     return finalize(ds, None, returns=returns, repeat=repeat,
                     title="cost per return of the iterated Hopf return map (compiled engine)")
 

@@ -59,8 +59,7 @@ def validate(scene: dict) -> None:
     for t in thetas(p):
         for e in eps_list(p):
             try:
-                attractors.check_resolvable(limit_map.scale(e, t), fd_step(
-                    limit_map.scale(e, t)) if p.get("lyapunov") else None)
+                attractors.check_resolvable(limit_map.scale(e, t))
             except ValueError as exc:
                 raise SceneError(f"{scene['id']}: parameters.eps: {e:g} at theta = {t:g}: "
                                  f"{exc}") from None
@@ -81,14 +80,7 @@ def _settle(p, theta, eps, s, options, lyapunov):
     return attractors.settle(
         cm, [0.0, np.sqrt(mu), 0.0], coordinate=1, transient=int(p["n_transient"]),
         keep=int(p["n_keep"]), t_max=T_RETURN, scale=sigma, max_period=int(p["max_period"]),
-        window=(1.0 - w, 1.0 + w), lyapunov_step=fd_step(sigma) if lyapunov else None,
-        **options)
-
-
-def fd_step(sigma: float) -> float:
-    """Central-difference step of the Lyapunov slopes: 1e-4 of the attractor's scale,
-    never below attractors.MIN_FD_STEP (the rounding of one return)."""
-    return max(1e-4 * sigma, attractors.MIN_FD_STEP)
+        window=(1.0 - w, 1.0 + w), lyapunov=lyapunov, **options)
 
 
 def sweep(scene: dict, s: np.ndarray, *, progress: bool = False) -> xr.Dataset:
@@ -155,7 +147,8 @@ VARIABLE_ATTRS = {
     "period": ("period of the attractor (0: none up to max_period)", "1"),
     "width": ("width of the attractor in u (max - min of the kept returns)", "1"),
     "lyapunov": ("largest Lyapunov exponent of the return map along the attractor (mean "
-                 "log |dP/dx2|; NaN: not computed or escaped)", "1"),
+                 "log growth of a tangent vector under the engine's dP/dz; NaN: not "
+                 "computed or escaped)", "1"),
     "status": ("0: settled; 100: left the window; else the engine's status code of the "
                "failed return", "1"),
     "u_limit": ("u of the limit map (paper's asymptotics, order 1 in sqrt(eps))", "1"),

@@ -1,0 +1,140 @@
+"""dP/dz from the compiled engine (compute_returns(jacobian=True)) against central
+differences of P on the same engine and against the reference driver's variational
+equations (filippov.variational.return_jacobian): exact flows, integrated stays,
+sliding, iterated returns, and the places where P has no derivative."""
+import numpy as np
+import pytest
+
+from filippov import Section, simulate
+from filippov.compiled_system import FilippovSystem
+from filippov.fastmap import OK, compute_returns
+from filippov.models import hopf
+from filippov.variational import return_jacobian
+
+# a stick-slip oscillator with a third, slowly relaxing state w that shifts the release
+# point: the stick phase (sliding on v = V, released on a curve of H) leaves a derivative
+# of rank one, not a flat map as in the planar case
+F, V, D, C = 1.0, 0.5, 0.2, 0.4
+
+
+def _slip(friction):
+    def field(z, p):
+        return np.array([z[1], -z[0] + friction + D * (z[1] - V) + C * z[2],
+                         -0.5 * z[2] + 0.3 * z[0]])
+    return field
+
+
+def _switch(z, p):
+    return V - z[1]
+
+
+def _switch_grad(z, p):
+    return np.array([0.0, -1.0, 0.0])
+
+
+def _section(z, p):
+    return z[1]
+
+
+STICK = FilippovSystem(("x", "v", "w"), _slip(-F), _slip(F), _switch, _switch_grad,
+                       name="stick-slip 3d")
+Z0 = np.array([1.5, 0.0, 0.2])      # on x' = 0, slipping; sticks once, returns
+MIN_TIME = 1e-3                     # the start lies on the section
+T_MAX = 50.0
+
+
+def _fd(cm, z0, k, h, **options):
+    """Central difference of P along coordinate k, over the steps actually taken."""
+    up, um = np.array(z0, float), np.array(z0, float)
+    up[k] += h
+    um[k] -= h
+    out = compute_returns(cm, np.array([up, um]), options.pop("t_max", T_MAX), **options)
+    assert np.all(out.status == OK)
+    return (out.state[0] - out.state[1]) / (up[k] - um[k])
+
+
+def _reference(system, z0, section):
+    traj = simulate(system, z0, T_MAX, sections=[section], dense=False)
+    assert traj.status == f"section:{section.name}"
+    return traj, return_jacobian(system, traj, section, rtol=1e-11, atol=1e-13)
+
+
+def test_sliding_return_matches_fd_and_reference_driver():
+    cm = STICK.compiled(_section, direction=-1)
+    out = compute_returns(cm, Z0[None], T_MAX, jacobian=True, min_time=MIN_TIME)
+    assert out.status[0] == OK and out.sliding_time[0] > 0.5 and out.n_switches[0] == 2
+    J = out.jacobian[0]
+    # the release curve is one-dimensional: rank one, but not flat (w moves the release)
+    assert np.linalg.matrix_rank(J, tol=1e-6) == 1 and np.abs(J).max() > 0.1
+    # central differences at h = 1e-6: truncation h^2 P''' and rounding 1e-15/h, both
+    # ~1e-9 for P of order one; the closed-form fields leave no other error
+    for k in (0, 2):  # coordinate 1 (v) is the section's: columns along it need care
+        np.testing.assert_allclose(J[:, k], _fd(cm, Z0, k, 1e-6, min_time=MIN_TIME),
+                                   rtol=0, atol=1e-8)
+    # the reference driver: the same product from solve_ivp's variational equations
+    # (rtol 1e-11) against ours from internal differentiation of DOP853 (rtol 1e-12)
+    section = Section("v = 0", lambda z: z[1], direction=-1, min_time=MIN_TIME, terminal=1)
+    traj, Jref = _reference(STICK.python(), Z0, section)
+    assert [e.kind for e in traj.events] == ["start", "slide_start", "slide_end", "section"]
+    np.testing.assert_allclose(J, Jref, rtol=0, atol=1e-8)
+
+
+def test_jacobian_leaves_the_orbit_alone():
+    """Carrying dP/dz changes no number of the orbit itself."""
+    cm = STICK.compiled(_section, direction=-1)
+    a = compute_returns(cm, Z0[None], T_MAX, min_time=MIN_TIME, iterations=5, keep=5)
+    b = compute_returns(cm, Z0[None], T_MAX, min_time=MIN_TIME, iterations=5, keep=5,
+                        jacobian=True)
+    assert a.jacobian is None and a.orbit_jacobian is None
+    np.testing.assert_array_equal(a.orbit, b.orbit)
+    np.testing.assert_array_equal(a.time, b.time)
+
+
+@pytest.mark.parametrize("x2", [1.1, 0.9])  # crossings into H_- and back; no switch
+def test_exact_flows_match_fd_and_integrated_flows(x2):
+    cm = hopf.compiled(1e-2, -0.5, 1.0, sliding=False)
+    z0 = np.array([0.0, x2, 0.0])
+    out = compute_returns(cm, z0[None], 1.0, jacobian=True)
+    assert out.n_switches[0] == (2 if x2 > 1 else 0)
+    J = out.jacobian[0]
+    for k in (1, 2):
+        np.testing.assert_allclose(J[:, k], _fd(cm, z0, k, 1e-6, t_max=1.0), rtol=0,
+                                   atol=1e-8)
+    np.testing.assert_array_equal(J[0], 0.0)  # P stays on x1 = 0
+    # the same system with regions + and - integrated (variational steps, no closed
+    # form): both derivatives approximate the same dP/dz to their tolerances
+    ci = hopf.compiled(1e-2, -0.5, 1.0, sliding=False, exact=False)
+    Ji = compute_returns(ci, z0[None], 1.0, jacobian=True).jacobian[0]
+    np.testing.assert_allclose(Ji, J, rtol=0, atol=1e-8)
+
+
+def test_small_scale_sliding_return_of_the_hopf_example():
+    # theta > 0 on the attractor's scale eps^2 = 1e-6: a short slide per return
+    cm = hopf.compiled(1e-3, 0.2, 1.0 + 2e-6, sliding=True)
+    z0 = np.array([0.0, 1.0, 0.0])
+    out = compute_returns(cm, z0[None], 1.0, jacobian=True)
+    assert out.sliding_time[0] > 0
+    J = out.jacobian[0]
+    # steps well below the scale 1e-6 (no kink inside), above the rounding of a return
+    fd = _fd(cm, z0, 1, 1e-9, t_max=1.0)
+    assert abs(J[1, 1]) > 1  # the expanding slope of the chaotic regime
+    np.testing.assert_allclose(J[1, 1], fd[1], rtol=1e-5)
+
+
+def test_iterated_jacobians_are_those_of_single_returns():
+    cm = hopf.compiled(1e-2, -0.5, 1.0 + 1e-2, sliding=False)
+    z0 = np.array([[0.0, 1.0, 0.0]])
+    it = compute_returns(cm, z0, 1.0, iterations=6, keep=4, jacobian=True)
+    assert it.orbit_jacobian.shape == (1, 4, 3, 3)
+    np.testing.assert_array_equal(it.jacobian[0], it.orbit_jacobian[0, -1])
+    for j in range(1, 4):
+        one = compute_returns(cm, it.orbit[0, j - 1][None], 1.0, jacobian=True)
+        np.testing.assert_array_equal(one.jacobian[0], it.orbit_jacobian[0, j])
+
+
+def test_no_derivative_where_the_start_slides():
+    # a start in the stick phase (v = V, |x - C w| < F): P is not differentiable across H
+    cm = STICK.compiled(_section, direction=-1)
+    out = compute_returns(cm, np.array([[0.2, V, 0.0]]), T_MAX, jacobian=True)
+    assert out.status[0] == OK
+    assert np.all(np.isnan(out.jacobian[0]))
