@@ -5,10 +5,13 @@
 same algorithm for a whole batch of start points inside one compiled call:
 
 * regions ``+`` (``h >= 0``) and ``-`` are followed with the model's exact
-  flows, sampled exactly like the reference driver: windows of ``16 sample_step``
-  from each mode entry (``16 slow_sample_step`` once ``transient_time`` has
-  passed since the entry), each cut into ``16 samples_per_step`` intervals, the
-  flow always taken from the state at the mode entry; a model without exact flows
+  flows in the reference driver's windows: ``16 sample_step`` from each mode entry
+  (``16 slow_sample_step`` once ``transient_time`` has passed since the entry),
+  the flow always taken from the state at the mode entry. Each window is cut into
+  16 intervals: one sample per sample step, the spacing the model declares to
+  resolve its events (the reference driver samples ``samples_per_step`` times
+  denser, since its samples are also the stored trajectory; the two agree to
+  rounding, not bit for bit); a model without exact flows
   (``CompiledModel.exact = False``) has them integrated like sliding, below
   (the reference driver's ``method="integrate"``);
 * the samples are scanned for the same events: ``h`` leaving the region, a
@@ -1120,7 +1123,10 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
                     keep: int = 0, jacobian: bool = False) -> BatchReturns:
     """First returns of ``starts`` (``(m, dim)``) to the model's section, one compiled call.
 
-    Options mean what they mean for :func:`filippov.simulate.simulate`; ``min_time``
+    Options mean what they mean for :func:`filippov.simulate.simulate`, except that
+    ``samples_per_step`` counts samples per integration step only: exact flows are
+    scanned once per ``cmodel.sample_step`` (``slow_sample_step`` after the
+    transient), the resolution the model declares; ``min_time``
     that of :class:`filippov.simulate.Section` (hits before it are ignored; a start
     on the section up to rounding is not a hit either way). Nothing is raised for a
     start point that fails: see ``status``.
@@ -1168,7 +1174,9 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
                          f"got {cmodel.sample_step!r}")
     hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max) if cmodel.exact else np.inf
     hwin_slow = slow_window(cmodel.slow_sample_step, hwin, max_step, t_max)
-    frac_ex = np.linspace(0.0, 1.0, EXACT_BLOCK * samples_per_step + 1)
+    # an exact flow: one sample per sample step (the model's declared resolution);
+    # samples_per_step is for integration steps, whose length error control sets
+    frac_ex = np.linspace(0.0, 1.0, EXACT_BLOCK + 1)
     frac_in = np.linspace(0.0, 1.0, samples_per_step + 1)
     fopts = np.array([rtol, atol, touch_tol, event_xtol, zeno_span, max_step, hwin_slow,
                       cmodel.transient_time, min_time], dtype=float)
