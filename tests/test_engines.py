@@ -100,3 +100,153 @@ def test_a_shallow_crossing_is_followed_past_the_rounding_of_h(engine):
     (zn, tn, nn), (zc, tc, nc) = out
     assert nn == nc == 3  # into region -, into sliding, out of it
     assert abs(zn[1] - zc[1]) < 1e-12 and abs(tn - tc) < 1e-12
+
+
+# ---------------------------------------------------------------------------------------
+# The rest of test_solver_events' known answers on both engines (a run to t_max, not a
+# return: the compiled engine reports where it stopped and its first switch)
+def _run(system, engine, start, t_max, **options):
+    """(first switch time or NaN, number of mode changes, time slid, state at t_max); a
+    slide still going at t_max is not counted in the time slid (on either engine)."""
+    from filippov import compute_returns, simulate
+    from filippov.fastmap import NO_RETURN
+    from filippov.poincare import sliding_time
+
+    never = lambda z, p: z[0] - 1e6  # noqa: E731 -- a section no orbit here reaches
+    if engine == "python":
+        traj = simulate(system.python(), start, t_max, dense=False, **options)
+        sw = traj.switches()
+        return (sw[0].t if sw else np.nan), len(sw), sliding_time(traj.events), traj.z
+    out = compute_returns(system.compiled(never), [start], t_max, **options)
+    assert out.status[0] == NO_RETURN  # ran to t_max
+    return out.first_switch[0], out.n_switches[0], out.sliding_time[0], out.state[0]
+
+
+def _pseudo_equilibrium(eps, theta, **kw):
+    """x' = -sign(h), eps y' = x - y, h = theta x + (1 - theta) y, with the exact flows
+    of its regions (y relaxes to x - c eps under x' = c)."""
+    def flow(c):
+        def phi(z0, tau, p):
+            x = z0[0] + c * tau
+            return np.array([x, x - c * eps + (z0[1] - z0[0] + c * eps) * np.exp(-tau / eps)])
+        return phi
+
+    return FilippovSystem(("x", "y"), lambda z, p: np.array([1.0, (z[0] - z[1]) / eps]),
+                          lambda z, p: np.array([-1.0, (z[0] - z[1]) / eps]),
+                          switch=lambda z, p: theta * z[0] + (1 - theta) * z[1],
+                          switch_grad=lambda z, p: np.array([theta, 1 - theta]),
+                          flow_minus=flow(1.0), flow_plus=flow(-1.0), sample_step=eps / 4,
+                          **kw)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("theta", [-0.5, 0.3, 0.9])
+def test_switch_time_of_the_slow_fast_example(engine, theta):
+    from scipy.optimize import brentq
+
+    eps, x0, y0 = 0.05, 0.4, 0.7
+    t1, _, _, _ = _run(_pseudo_equilibrium(eps, theta), engine, [x0, y0], 1.0)
+    # independent: h along the closed-form solution of region +, by Brent
+    h = lambda t: (theta * (x0 - t)  # noqa: E731
+                   + (1 - theta) * (x0 - t + eps + (y0 - x0 - eps) * np.exp(-t / eps)))
+    assert t1 == pytest.approx(brentq(h, 0.0, 1.0, xtol=1e-300, rtol=8.9e-16), rel=1e-12)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_an_exact_tangency_touches_without_switching(engine):
+    # f_+ = (1, x1) from (-1, 1/2): x2 = 1/2 - t + t^2/2 touches H at t = 1 and stays
+    # above: no switch; at t = 3, x = (2, 2)
+    system = _planar(
+        lambda z, p: np.array([1.0, 0.0]), lambda z, p: np.array([1.0, z[0]]),
+        flow_plus=lambda z0, tau, p: np.array([z0[0] + tau, z0[1] + z0[0] * tau + 0.5 * tau ** 2]),
+        flow_minus=lambda z0, tau, p: np.array([z0[0] + tau, z0[1]]), sample_step=0.1)
+    t1, n, slid, z = _run(system, engine, [-1.0, 0.5], 3.0)
+    assert np.isnan(t1) and n == 0 and slid == 0.0
+    np.testing.assert_allclose(z, [2.0, 2.0], rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_sliding_into_the_pseudo_equilibrium(engine):
+    # from (0.2, 0.1) the orbit crosses H outside the attracting segment |x| < eps theta,
+    # comes back from region - inside it and slides into x = y = 0 (x' = -x/(eps theta))
+    eps, theta = 0.02, 0.4
+    t1, n, slid, z = _run(_pseudo_equilibrium(eps, theta), engine, [0.2, 0.1], 2.0)
+    assert n == 2 and 0 < t1 < 2.0 and slid == 0.0  # the slide lasts beyond t_max
+    # the slide is integrated (no sliding flow given): x = x_s exp(-t/(eps theta)) ~ 1e-100
+    # by t_max, reached to the integration's absolute tolerance (atol = 1e-14)
+    assert np.abs(z).max() < 10 * 1e-14
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_system_built_without_sliding_errs_instead_of_sliding(engine):
+    from filippov.simulate import SlidingNotBuiltError
+
+    system = _pseudo_equilibrium(0.02, 0.4, sliding=False)
+    with pytest.raises(SlidingNotBuiltError, match="sliding"):
+        _returns(system, engine, [0.2, 0.1], lambda z, p: z[0] - 1e6, 0, 2.0)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_the_reduced_example_reaches_its_pseudo_equilibrium_in_finite_time(engine):
+    # eps = 0, theta = -0.5: x' = -sign(x) from 0.7 reaches x = 0 at t = 0.7 and slides
+    system = FilippovSystem(("x",), lambda z, p: np.array([1.0]), lambda z, p: np.array([-1.0]),
+                            switch=lambda z, p: z[0], switch_grad=lambda z, p: np.array([1.0]))
+    t1, n, slid, z = _run(system, engine, [0.7], 2.0)
+    assert n == 1 and t1 == pytest.approx(0.7, rel=1e-14)
+    assert z[0] == pytest.approx(0.0, abs=4e-15)  # event time to ~1e-15
+
+
+# ---------------------------------------------------------------------------------------
+# The guards (tests/test_guards.py) on both engines through the public API
+_NEVER = lambda z, p: z[0] - 1e6  # noqa: E731 -- a section no orbit here reaches
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_the_event_limit_is_an_error_on_both_engines(engine):
+    from filippov import EventLimitError
+
+    with pytest.raises(EventLimitError):
+        _returns(_pseudo_equilibrium(1e-3, -0.5), engine, [0.01, 0.0], _NEVER, 0, 10.0,
+                 max_events=100)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_chatter_below_time_resolution_is_zeno_on_both_engines(engine):
+    from filippov import ZenoError
+
+    with pytest.raises(ZenoError):
+        _returns(_pseudo_equilibrium(1e-13, -0.5), engine, [1e-12, 0.0], _NEVER, 0, 1.0)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("bad,match", [([np.nan, 0.0], "finite"), ([0.0, np.inf], "finite"),
+                                       ([0.0], "components|shape")])
+def test_bad_start_points_are_refused_on_both_engines(engine, bad, match):
+    with pytest.raises(ValueError, match=match):
+        _returns(_pseudo_equilibrium(0.1, -0.5), engine, bad, _NEVER, 0, 1.0)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_nan_field_is_not_handed_on_by_either_engine(engine):
+    from filippov import SimulationError
+
+    # (the compiled system's construction already refuses a piece that is non-finite at
+    # its probe point, 0.5: a field that is NaN only away from it reaches the engine)
+    half = lambda z, p: np.array([np.nan if z[1] > 0.75 else 1.0, 1.0])  # noqa: E731
+    system = FilippovSystem(("a", "b"), half, half, switch=lambda z, p: z[1],
+                            switch_grad=lambda z, p: np.array([0.0, 1.0]))
+    with pytest.raises(SimulationError, match="non-finite|failed"):
+        _returns(system, engine, [0.0, 1.0], _NEVER, 0, 1.0, method="integrate")
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_thousands_of_switches_stay_bounded_on_both_engines(engine):
+    # 2000 half-periods of the chatter orbit of the pseudo-equilibrium example
+    from filippov.analytic import chatter
+
+    eps = 1e-4
+    f = chatter.orbit(eps, -0.5)
+    t1, n, _, z = _run(_pseudo_equilibrium(eps, -0.5), engine, [f["x_switch"], f["y_switch"]],
+                       1000 * f["period"], max_events=4_000)
+    assert n >= 1999
+    assert abs(z[0]) <= abs(f["x_switch"]) * (1 + 1e-9)
