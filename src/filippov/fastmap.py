@@ -1115,6 +1115,38 @@ def _section_pred(direction: int) -> int:
     return rules.section_pred(direction)
 
 
+def _checked_starts(cmodel: CompiledModel, starts) -> np.ndarray:
+    starts = np.ascontiguousarray(np.atleast_2d(np.asarray(starts, dtype=float)))
+    if starts.ndim != 2 or starts.shape[1] != cmodel.dim:
+        raise ValueError(f"start points must have shape (m, {cmodel.dim}) "
+                         f"({', '.join(cmodel.names)}), got {starts.shape}")
+    if not np.all(np.isfinite(starts)):
+        raise ValueError("start points must be finite")
+    return starts
+
+
+def _check_options(cmodel, t_max, samples_per_step, max_step, zeno_count, iterations, keep,
+                   min_time) -> None:
+    """compute_returns' options, each refused with its name where out of range."""
+    if not (np.isfinite(t_max) and t_max >= 0):
+        raise ValueError(f"need a finite t_max >= 0, got {t_max!r}")
+    if samples_per_step < 1:
+        raise ValueError("samples_per_step must be >= 1")
+    if not max_step > 0:
+        raise ValueError(f"max_step must be > 0, got {max_step!r}")
+    if zeno_count < 1:
+        raise ValueError("zeno_count must be >= 1")
+    if not (isinstance(iterations, (int, np.integer)) and iterations >= 1):
+        raise ValueError(f"iterations must be an integer >= 1, got {iterations!r}")
+    if not (isinstance(keep, (int, np.integer)) and 0 <= keep <= iterations):
+        raise ValueError(f"keep must be an integer in [0, iterations={iterations}], got {keep!r}")
+    if not (np.isfinite(min_time) and min_time >= 0):
+        raise ValueError(f"min_time must be a finite number >= 0, got {min_time!r}")
+    if cmodel.exact and not (np.isfinite(cmodel.sample_step) and cmodel.sample_step > 0):
+        raise ValueError(f"the compiled model needs a finite sample_step > 0, "
+                         f"got {cmodel.sample_step!r}")
+
+
 def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float = 1e-12,
                     atol: float = 1e-14, max_step: float = np.inf, max_events: int = 100_000,
                     max_steps: int = 5_000_000, samples_per_step: int = 4,
@@ -1149,29 +1181,9 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     differentiable: a switch or section met tangentially, an orbit that touches H
     (``touch_tol``: the kink of P at grazing), a start that slides.
     """
-    starts = np.ascontiguousarray(np.atleast_2d(np.asarray(starts, dtype=float)))
-    if starts.ndim != 2 or starts.shape[1] != cmodel.dim:
-        raise ValueError(f"start points must have shape (m, {cmodel.dim}) "
-                         f"({', '.join(cmodel.names)}), got {starts.shape}")
-    if not np.all(np.isfinite(starts)):
-        raise ValueError("start points must be finite")
-    if not (np.isfinite(t_max) and t_max >= 0):
-        raise ValueError(f"need a finite t_max >= 0, got {t_max!r}")
-    if samples_per_step < 1:
-        raise ValueError("samples_per_step must be >= 1")
-    if not max_step > 0:
-        raise ValueError(f"max_step must be > 0, got {max_step!r}")
-    if zeno_count < 1:
-        raise ValueError("zeno_count must be >= 1")
-    if not (isinstance(iterations, (int, np.integer)) and iterations >= 1):
-        raise ValueError(f"iterations must be an integer >= 1, got {iterations!r}")
-    if not (isinstance(keep, (int, np.integer)) and 0 <= keep <= iterations):
-        raise ValueError(f"keep must be an integer in [0, iterations={iterations}], got {keep!r}")
-    if not (np.isfinite(min_time) and min_time >= 0):
-        raise ValueError(f"min_time must be a finite number >= 0, got {min_time!r}")
-    if cmodel.exact and not (np.isfinite(cmodel.sample_step) and cmodel.sample_step > 0):
-        raise ValueError(f"the compiled model needs a finite sample_step > 0, "
-                         f"got {cmodel.sample_step!r}")
+    starts = _checked_starts(cmodel, starts)
+    _check_options(cmodel, t_max, samples_per_step, max_step, zeno_count, iterations, keep,
+                   min_time)
     hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max) if cmodel.exact else np.inf
     hwin_slow = slow_window(cmodel.slow_sample_step, hwin, max_step, t_max)
     # an exact flow: one sample per sample step (the model's declared resolution);
