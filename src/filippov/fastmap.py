@@ -48,9 +48,11 @@ recorded (they change nothing in a return).
 """
 from __future__ import annotations
 
+import hashlib
 import warnings
 from collections import namedtuple
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from numba import njit, types
@@ -1079,10 +1081,46 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
 
 
 # ============================================================================= Python side
+#: the files whose code the kernel contains. numba's on-disk cache checks only the file
+#: of each cached function, not those of the functions it calls (a kernel cached before
+#: an edit of rules.py would go on running the old rules: seen, and numba's documented
+#: limit), so the kernel's cache carries a stamp of all of them (_fresh_cache)
+KERNEL_SOURCES = ("fastmap.py", "rules.py", "dop853_tableau.py", "abi.py", "system.py")
+
+
+def _kernel_stamp() -> str:
+    digest = hashlib.sha256()
+    for name in KERNEL_SOURCES:
+        digest.update((Path(__file__).parent / name).read_bytes())
+    return digest.hexdigest()
+
+
+def _fresh_cache() -> None:
+    """Drop every cached compiled function of this module (the rules compiled here
+    included) when the kernel's sources changed since the cache was written."""
+    stamp_file = Path(_batch._cache.cache_path) / "fastmap-kernel.sha256"
+    stamp = _kernel_stamp()
+    try:
+        if stamp_file.read_text() == stamp:
+            return
+    except OSError:
+        pass  # no stamp yet: a cache of unknown sources
+    for obj in list(globals().values()):
+        if hasattr(obj, "py_func") and hasattr(obj, "_cache"):
+            obj._cache.flush()
+    try:
+        stamp_file.parent.mkdir(parents=True, exist_ok=True)
+        stamp_file.write_text(stamp)
+    except OSError:
+        pass  # a read-only cache: numba compiles in memory and caches nothing anyway
+
+
 def compile_kernel() -> bool:
     """Compile the kernel for its one signature (or load it from numba's on-disk
-    cache); done on first use. Returns True if it was loaded from the cache."""
+    cache, if that was written from the same sources); done on first use. Returns True
+    if it was loaded from the cache."""
     if not _batch.signatures:
+        _fresh_cache()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)
             _batch.compile(_KERNEL_SIG)

@@ -1,0 +1,42 @@
+"""The compiled kernel's on-disk cache is dropped when any file whose code the kernel
+contains has changed (filippov.fastmap.KERNEL_SOURCES): numba itself checks only the
+file of each cached function, so an edit of the rule book (rules.py) would otherwise
+leave the kernel running the old rules while the reference driver runs the new ones."""
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+SRC = str(Path(__file__).resolve().parents[1] / "src")
+
+# compiles one small function of the engine module into the cache, after the check
+_RUN = """
+import numpy as np
+from filippov import fastmap
+index = lambda: len(fastmap._dot._cache._cache_file._load_index())
+before = index()
+fastmap._fresh_cache()
+after = index()
+fastmap._dot(np.ones(2), np.ones(2))
+print(before, after, index())
+"""
+
+
+def _run(cache_dir):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache_dir),
+               PYTHONPATH=SRC + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    out = subprocess.run([sys.executable, "-c", _RUN], env=env, capture_output=True,
+                         text=True, check=True)
+    return tuple(int(x) for x in out.stdout.split())
+
+
+def test_a_cache_written_from_other_sources_is_dropped(tmp_path):
+    from filippov import fastmap
+
+    assert _run(tmp_path) == (0, 0, 1)           # a fresh cache: compiled and stored
+    stamps = list(tmp_path.rglob("fastmap-kernel.sha256"))
+    assert len(stamps) == 1 and stamps[0].read_text() == fastmap._kernel_stamp()
+    assert _run(tmp_path) == (1, 1, 1)           # same sources: the cache is kept
+    stamps[0].write_text("written by other sources")
+    assert _run(tmp_path) == (1, 0, 1)           # dropped, compiled again, restamped
+    assert stamps[0].read_text() == fastmap._kernel_stamp()
