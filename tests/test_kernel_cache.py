@@ -1,5 +1,5 @@
 """The compiled kernel's on-disk cache is dropped when any file whose code the kernel
-contains has changed (filippov.fastmap.KERNEL_SOURCES): numba itself checks only the
+contains has changed (filippov.kernel.driver.KERNEL_SOURCES): numba itself checks only the
 file of each cached function, so an edit of the rule book (rules.py) would otherwise
 leave the kernel running the old rules while the reference driver runs the new ones."""
 import os
@@ -12,12 +12,12 @@ SRC = str(Path(__file__).resolve().parents[1] / "src")
 # compiles one small function of the engine module into the cache, after the check
 _RUN = """
 import numpy as np
-from filippov import fastmap
-index = lambda: len(fastmap._dot._cache._cache_file._load_index())
+from filippov.kernel import base, driver
+index = lambda: len(base._dot._cache._cache_file._load_index())
 before = index()
-fastmap._fresh_cache()
+driver._fresh_cache()
 after = index()
-fastmap._dot(np.ones(2), np.ones(2))
+base._dot(np.ones(2), np.ones(2))
 print(before, after, index())
 """
 
@@ -31,12 +31,12 @@ def _run(cache_dir):
 
 
 def test_a_cache_written_from_other_sources_is_dropped(tmp_path):
-    from filippov import fastmap
+    from filippov.kernel import driver
 
     assert _run(tmp_path) == (0, 0, 1)           # a fresh cache: compiled and stored
-    stamps = list(tmp_path.rglob("fastmap-kernel.sha256"))
-    assert len(stamps) == 1 and stamps[0].read_text() == fastmap._kernel_stamp()
+    stamps = list(tmp_path.rglob("kernel.sha256"))
+    assert len(stamps) == 1 and stamps[0].read_text() == driver._kernel_stamp()
     assert _run(tmp_path) == (1, 1, 1)           # same sources: the cache is kept
     stamps[0].write_text("written by other sources")
     assert _run(tmp_path) == (1, 0, 1)           # dropped, compiled again, restamped
-    assert stamps[0].read_text() == fastmap._kernel_stamp()
+    assert stamps[0].read_text() == driver._kernel_stamp()

@@ -1,0 +1,14 @@
+"""The compiled (numba) kernel of :mod:`filippov.fastmap`, split along its seams.
+
+* :mod:`.base` -- what every part shares: the model pieces' function types, status
+  codes, event and predicate codes, the compile decorators, the rule book compiled
+  from its one source (:mod:`filippov.rules`), the model-piece helpers;
+* :mod:`.dop853` -- scipy's DOP853 (step, initial step, dense output);
+* :mod:`.segment` -- the state on the current segment (exact flow or dense output);
+* :mod:`.roots` -- brentq and the far-side refinement of a crossing;
+* :mod:`.scan` -- the samples of one window and its earliest event;
+* :mod:`.derivative` -- dP/dz carried along a return;
+* :mod:`.driver` -- one start point (_one), the batch (_batch), compilation and cache.
+
+Nothing here is public: :func:`filippov.fastmap.compute_returns` is the entry point.
+"""

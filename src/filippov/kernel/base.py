@@ -1,0 +1,107 @@
+"""What every part of the compiled kernel shares: the model pieces' function types,
+the status codes, event and predicate codes, the compile decorators, the rule book
+compiled from its one source (filippov.rules) and the small model-piece helpers."""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, types
+
+from .. import rules
+from ..abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG
+
+
+# ----------------------------------------------------------------------------- signatures
+_vec = types.float64[::1]
+_FLOW = types.FunctionType(FLOW_SIG)
+_FIELD = types.FunctionType(FIELD_SIG)
+_SCALAR = types.FunctionType(SCALAR_SIG)
+_WHERE = types.FunctionType(WHERE_SIG)
+
+# ----------------------------------------------------------------------------- status codes
+OK = 0
+NO_RETURN = 1      # t_max reached before the section
+EVENT_LIMIT = 2    # more than max_events switches
+STEP_LIMIT = 3     # more than max_steps windows / integration steps
+ZENO = 4           # zeno_count switches within zeno_span
+NON_FINITE = 5     # non-finite state or field value
+NO_SLIDING = 6     # attracting sliding reached, but the model declares no sliding
+STEP_FAILED = 7    # the sliding integrator's step size collapsed
+ROOT_FAILED = 8    # an event could not be bracketed / refined
+BAD_START = 9      # non-finite start point
+SECTION_SLIDING = 10  # the orbit slides inside the section (a section on H)
+
+STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event limit",
+          STEP_LIMIT: "step limit", ZENO: "accumulation of switches (Zeno)",
+          NON_FINITE: "non-finite state or field value",
+          NO_SLIDING: "attracting sliding reached, but the model declares no sliding",
+          STEP_FAILED: "sliding integrator: step size too small",
+          ROOT_FAILED: "event refinement failed (no bracket or no convergence)",
+          BAD_START: "non-finite start point",
+          SECTION_SLIDING: "the orbit slides along H inside the section (a section on the "
+                           "switching surface): its crossings there would be rounding noise"}
+
+# crossing predicates (filippov.rules)
+_TO_NEG, _TO_NONNEG, _TO_NONPOS, _EITHER = rules.TO_NEG, rules.TO_NONNEG, rules.TO_NONPOS, rules.EITHER
+# scalar functions of the state whose zeros are events
+_S_H, _S_A, _S_B, _S_SEC = 0, 1, 2, 3
+# what an event is
+_W_NONE, _W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_SECTION = -1, 0, 1, 2, 3
+
+_TINY = np.finfo(float).tiny
+_EPS = np.finfo(float).eps
+
+
+# Every helper of the kernel works on arrays it is handed and allocates nothing, so it is
+# compiled without numba's reference counting (_nrt=False): otherwise each call
+# of a helper pays an atomic incref/decref per array argument, which was half the
+# run time. Only the kernel _batch allocates (its work arrays, once per call).
+_jit = njit(cache=True, _nrt=False)
+# the driver's pieces (kernel.driver: _window, _stay_*, _event) are inlined into _one at the
+# IR level: as separate calls they were 4-13% slower on the fig04/fig11 maps, each
+# call passing the named work arrays by value
+_jit_inline = njit(cache=True, _nrt=False, inline="always")
+
+
+# every decision and crossing predicate, compiled from its one source (filippov.rules)
+(_after, _crosses, _clamp, _far_side, _extremum_between, _graze, _central_step,
+ _slides_in_section, _starts_on_section, _same_instant, _start_side, _start_on_switch,
+ _next_mode, _accumulates, _exit_shift, _dips_and_returns, _exact_window, _onto_switch,
+ _exit_drift) = (
+    _jit(getattr(rules, name)) for name in (
+    "after", "crosses", "clamp", "far_side", "extremum_between", "graze", "central_step",
+    "slides_in_section", "starts_on_section", "same_instant", "start_side", "start_on_switch",
+    "next_mode", "accumulates", "exit_shift", "dips_and_returns", "exact_window",
+    "onto_switch", "exit_drift"))
+assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
+
+
+# ============================================================================= model pieces
+@_jit
+def _dot(u, v):
+    s = 0.0
+    for k in range(u.size):
+        s += u[k] * v[k]
+    return s
+
+
+@_jit
+def _speeds(z, fns, p, wg, wm, wp):
+    """(a, b) = (grad h . F_-, grad h . F_+) at z; fills wg, wm, wp."""
+    fns[5](z, p, wg)
+    fns[3](z, p, wm)
+    fns[2](z, p, wp)
+    return _dot(wg, wm), _dot(wg, wp)
+
+
+@_jit
+def _scalar(sel, z, fns, p, wg, wf):
+    if sel == _S_H:
+        return fns[4](z, p)
+    if sel == _S_SEC:
+        return fns[6](z, p)
+    fns[5](z, p, wg)
+    if sel == _S_A:
+        fns[3](z, p, wf)
+    else:
+        fns[2](z, p, wf)
+    return _dot(wg, wf)

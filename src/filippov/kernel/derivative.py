@@ -1,0 +1,157 @@
+"""dP/dz of a return, carried along the orbit (compute_returns(jacobian=True))."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..system import PLUS
+from .base import (_central_step, _dot, _jit)
+from .dop853 import (_A, _B, _NS, _checked_field)
+
+
+# The derivative of a return, carried in w.M while the orbit runs (Settings.jac), as the
+# reference driver's filippov.variational composes it: an exact-flow stay by central
+# differences of the closed-form flow from its mode entry; an integrated stay (sliding,
+# or a model without flows) by the variational equation taken through the very DOP853
+# steps of the state (internal differentiation: the derivative of the computed
+# solution, the step sizes held); a switch by its saltation matrix; the end of sliding
+# by the identity; the section hit by the projection along the field.
+@_jit
+def _apply(J, M, T):
+    """M <- J M (T: workspace)."""
+    n = M.shape[0]
+    for i in range(n):
+        for j in range(n):
+            acc = 0.0
+            for k in range(n):
+                acc += J[i, k] * M[k, j]
+            T[i, j] = acc
+    for i in range(n):
+        for j in range(n):
+            M[i, j] = T[i, j]
+
+
+@_jit
+def _rank_one(M, u, g, speed):
+    """M <- M + u (g^T M) / speed: a saltation matrix (u = f_after - f_before, g = grad
+    h, speed = g . f_before) or the section's projection (u = f, speed = -g . f). A zero
+    speed (a tangential switch or hit: no derivative) makes M NaN."""
+    n = M.shape[0]
+    for j in range(n):
+        r = 0.0
+        for k in range(n):
+            r += g[k] * M[k, j]
+        r = r / speed if speed != 0.0 else np.nan
+        for i in range(n):
+            M[i, j] += u[i] * r
+
+
+@_jit
+def _flow_jacobian(mode, za, tau, fns, p, J, z1, z2):
+    """J = d flow(za, tau) / d za by central differences of the closed-form flow (step
+    rules.central_step per component; za is restored bit for bit)."""
+    for k in range(za.size):
+        orig = za[k]
+        d = _central_step(max(1.0, abs(orig)), 1.0)
+        za[k] = orig + d
+        up = za[k]
+        if mode == PLUS:
+            fns[0](za, tau, p, z1)
+        else:
+            fns[1](za, tau, p, z1)
+        za[k] = orig - d
+        down = za[k]
+        if mode == PLUS:
+            fns[0](za, tau, p, z2)
+        else:
+            fns[1](za, tau, p, z2)
+        za[k] = orig
+        for i in range(za.size):
+            J[i, k] = (z1[i] - z2[i]) / (up - down)
+
+
+@_jit
+def _jvp(mode, y, v, out, fns, p, w):
+    """out = J(y) v, the field's Jacobian along v, by a central difference
+    (rules.central_step along v)."""
+    n = y.size
+    size, vmax = 1.0, 0.0
+    for k in range(n):
+        size = max(size, abs(y[k]))
+        vmax = max(vmax, abs(v[k]))
+    d = _central_step(size, vmax)
+    if d == 0.0:
+        for k in range(n):
+            out[k] = 0.0 if vmax == 0.0 else np.nan
+        return
+    for k in range(n):
+        w.jz1[k] = y[k] + d * v[k]
+        w.jz2[k] = y[k] - d * v[k]
+    _checked_field(w.jz1, mode, False, fns, p, w.wg, w.wf, w.wp, w.jf1)
+    _checked_field(w.jz2, mode, False, fns, p, w.wg, w.wf, w.wp, w.jf2)
+    for k in range(n):
+        out[k] = (w.jf1[k] - w.jf2[k]) / (2.0 * d)
+
+
+@_jit
+def _var_step(mode, y0, h, fns, p, w):
+    """w.M <- the DOP853 step of size h from y0 applied to the variational equation
+    M' = J(z(t)) M, with the state's stages recomputed from y0 (the same numbers as the
+    step of the state)."""
+    n = y0.size
+    for s in range(_NS):
+        for k in range(n):
+            acc = 0.0
+            for j in range(s):
+                acc += w.KV[j, k] * _A[s, j]
+            w.ys[k] = y0[k] + acc * h
+        _checked_field(w.ys, mode, False, fns, p, w.wg, w.wf, w.wp, w.KV[s])
+        for a in range(n):
+            for b in range(n):
+                acc = 0.0
+                for j in range(s):
+                    acc += w.KP[j, a, b] * _A[s, j]
+                w.Mt[a, b] = w.M[a, b] + acc * h
+        for b in range(n):
+            for a in range(n):
+                w.jv[a] = w.Mt[a, b]
+            _jvp(mode, w.ys, w.jv, w.jo, fns, p, w)
+            for a in range(n):
+                w.KP[s, a, b] = w.jo[a]
+    for a in range(n):
+        for b in range(n):
+            acc = 0.0
+            for j in range(_NS):
+                acc += w.KP[j, a, b] * _B[j]
+            w.M[a, b] += h * acc
+
+
+@_jit
+def _switch_derivative(mode, new_mode, fns, p, w):
+    """w.M <- S w.M, S the saltation matrix of the switch mode -> new_mode at w.z."""
+    _checked_field(w.z, mode, False, fns, p, w.wg, w.wf, w.wp, w.jf1)
+    _checked_field(w.z, new_mode, False, fns, p, w.wg, w.wf, w.wp, w.jf2)
+    fns[5](w.z, p, w.jz1)
+    speed = _dot(w.jz1, w.jf1)
+    for k in range(w.z.size):
+        w.jf2[k] -= w.jf1[k]
+    _rank_one(w.M, w.jf2, w.jz1, speed)
+
+
+@_jit
+def _section_derivative(mode, fns, p, w):
+    """w.M <- (I - f g^T / (g . f)) w.M at the section hit w.z: f the field there, g the
+    section's gradient (central differences; w.z is restored bit for bit)."""
+    z = w.z
+    _checked_field(z, mode, False, fns, p, w.wg, w.wf, w.wp, w.jf1)
+    for k in range(z.size):
+        orig = z[k]
+        d = _central_step(max(1.0, abs(orig)), 1.0)
+        z[k] = orig + d
+        up = z[k]
+        s1 = fns[6](z, p)
+        z[k] = orig - d
+        down = z[k]
+        s2 = fns[6](z, p)
+        z[k] = orig
+        w.jz1[k] = (s1 - s2) / (up - down)
+    _rank_one(w.M, w.jf1, w.jz1, -_dot(w.jz1, w.jf1))

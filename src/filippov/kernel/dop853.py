@@ -1,0 +1,206 @@
+"""scipy's DOP853 inside the kernel: its tableau, one accepted step with scipy's step-size
+control, its initial step, its 7th-order dense output (used for sliding and for the
+regions of a model without exact flows)."""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import dop853_tableau as _dop
+from ..system import MINUS, PLUS
+from .base import (_jit, _speeds)
+
+# ----------------------------------------------------------------------------- DOP853 tableau
+# The coefficients of scipy's DOP853, which the reference driver integrates sliding
+# with (the sliding field is autonomous: the nodes C are not needed).
+_NS = _dop.N_STAGES              # 12
+_NSE = _dop.N_STAGES_EXTENDED    # 16
+_NI = _dop.INTERPOLATOR_POWER    # 7
+_A = np.ascontiguousarray(_dop.A, dtype=np.float64)
+_B = np.ascontiguousarray(_dop.B, dtype=np.float64)
+_E3 = np.ascontiguousarray(_dop.E3, dtype=np.float64)
+_E5 = np.ascontiguousarray(_dop.E5, dtype=np.float64)
+_D = np.ascontiguousarray(_dop.D, dtype=np.float64)
+_SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
+_ERR_EXP = -1.0 / (7 + 1)  # error estimator order 7
+
+
+@_jit
+def _dense_eval(t, t_old, hs, y_old, F, out):
+    """scipy's Dop853DenseOutput at a scalar t."""
+    x = (t - t_old) / hs
+    n = y_old.size
+    for k in range(n):
+        out[k] = 0.0
+    for i in range(_NI):
+        r = _NI - 1 - i
+        for k in range(n):
+            out[k] += F[r, k]
+            if i % 2 == 0:
+                out[k] *= x
+            else:
+                out[k] *= 1.0 - x
+    for k in range(n):
+        out[k] += y_old[k]
+
+
+# A segment of the current mode: exact flow from za at time sg[0], or the dense
+
+
+@_jit
+def _checked_field(z, mode, first_call, fns, p, wg, wm, wp, out):
+    """The field of ``mode`` (the Filippov field when sliding) with
+    simulate._IntegratingStepper's guard: a non-finite value at the first call
+    is an error (False), on a trial stage it is 1e300."""
+    if mode == PLUS:
+        fns[2](z, p, out)
+    elif mode == MINUS:
+        fns[3](z, p, out)
+    else:
+        a, b = _speeds(z, fns, p, wg, wm, wp)
+        for k in range(z.size):
+            out[k] = (a * wp[k] - b * wm[k]) / (a - b)
+    finite = True
+    for k in range(z.size):
+        if not np.isfinite(out[k]):
+            finite = False
+    if not finite:
+        if first_call:
+            return False
+        for k in range(z.size):
+            out[k] = 1e300
+    return True
+
+
+@_jit
+def _rms(x, scale):
+    s = 0.0
+    for k in range(x.size):
+        q = x[k] / scale[k]
+        s += q * q
+    return np.sqrt(s) / np.sqrt(x.size)
+
+
+@_jit
+def _dop_initial_step(mode, t0, y0, f0, t_bound, max_step, rtol, atol, fns, p, wg, wm, wp,
+                      y1, f1, scale):
+    """scipy.integrate._ivp.common.select_initial_step for DOP853 (order 7)."""
+    interval = abs(t_bound - t0)
+    if interval == 0.0:
+        return 0.0
+    n = y0.size
+    for k in range(n):
+        scale[k] = atol + abs(y0[k]) * rtol
+    d0 = _rms(y0, scale)
+    d1 = _rms(f0, scale)
+    if d0 < 1e-5 or d1 < 1e-5:
+        h0 = 1e-6
+    else:
+        h0 = 0.01 * d0 / d1
+    h0 = min(h0, interval)
+    for k in range(n):
+        y1[k] = y0[k] + h0 * f0[k]
+    _checked_field(y1, mode, False, fns, p, wg, wm, wp, f1)
+    s = 0.0
+    for k in range(n):
+        q = (f1[k] - f0[k]) / scale[k]
+        s += q * q
+    d2 = np.sqrt(s) / np.sqrt(n) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, interval, max_step)
+
+
+@_jit
+def _dop_step(mode, t, y, f, h_abs, t_bound, max_step, rtol, atol, fns, p, wg, wm, wp,
+              K, ynew, ytmp, scale):
+    """One accepted step of scipy's DOP853 (RungeKutta._step_impl).
+
+    Returns (ok, t_new, h, h_abs_next); K holds the stages, ynew the new state,
+    K[_NS] the field there."""
+    n = y.size
+    min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+    if h_abs > max_step:
+        h_abs = max_step
+    elif h_abs < min_step:
+        h_abs = min_step
+    rejected = False
+    while True:
+        if not h_abs >= min_step:  # also stops a NaN step size
+            return False, t, 0.0, h_abs
+        h = h_abs
+        t_new = t + h
+        if t_new - t_bound > 0.0:
+            t_new = t_bound
+        h = t_new - t
+        h_abs = abs(h)
+        # rk_step
+        for k in range(n):
+            K[0, k] = f[k]
+        for s in range(1, _NS):
+            for k in range(n):
+                acc = 0.0
+                for j in range(s):
+                    acc += K[j, k] * _A[s, j]
+                ytmp[k] = y[k] + acc * h
+            _checked_field(ytmp, mode, False, fns, p, wg, wm, wp, K[s])
+        for k in range(n):
+            acc = 0.0
+            for j in range(_NS):
+                acc += K[j, k] * _B[j]
+            ynew[k] = y[k] + h * acc
+        _checked_field(ynew, mode, False, fns, p, wg, wm, wp, K[_NS])
+        # error norm (DOP853._estimate_error_norm)
+        for k in range(n):
+            scale[k] = atol + max(abs(y[k]), abs(ynew[k])) * rtol
+        e5, e3 = 0.0, 0.0
+        for k in range(n):
+            a5, a3 = 0.0, 0.0
+            for j in range(_NS + 1):
+                a5 += K[j, k] * _E5[j]
+                a3 += K[j, k] * _E3[j]
+            a5 /= scale[k]
+            a3 /= scale[k]
+            e5 += a5 * a5
+            e3 += a3 * a3
+        e5 = np.sqrt(e5) ** 2
+        e3 = np.sqrt(e3) ** 2
+        if e5 == 0.0 and e3 == 0.0:
+            err = 0.0
+        else:
+            err = abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * n)
+        if err < 1.0:
+            if err == 0.0:
+                factor = _MAX_FACTOR
+            else:
+                factor = min(_MAX_FACTOR, _SAFETY * err ** _ERR_EXP)
+            if rejected:
+                factor = min(1.0, factor)
+            return True, t_new, h, h_abs * factor
+        q = _SAFETY * err ** _ERR_EXP
+        h_abs *= q if q > _MIN_FACTOR else _MIN_FACTOR  # max(MIN_FACTOR, q), NaN -> MIN_FACTOR
+        rejected = True
+
+
+@_jit
+def _dop_dense(mode, h, y_old, y, f_old, f, fns, p, wg, wm, wp, K, ytmp, F):
+    """DOP853._dense_output_impl: extra stages and the interpolant F (7, n)."""
+    n = y.size
+    for s in range(_NS + 1, _NSE):
+        for k in range(n):
+            acc = 0.0
+            for j in range(s):
+                acc += K[j, k] * _A[s, j]
+            ytmp[k] = y_old[k] + acc * h
+        _checked_field(ytmp, mode, False, fns, p, wg, wm, wp, K[s])
+    for k in range(n):
+        dy = y[k] - y_old[k]
+        F[0, k] = dy
+        F[1, k] = h * f_old[k] - dy
+        F[2, k] = 2.0 * dy - h * (f[k] + f_old[k])
+        for r in range(_NI - 3):
+            acc = 0.0
+            for j in range(_NSE):
+                acc += _D[r, j] * K[j, k]
+            F[3 + r, k] = h * acc

@@ -1,0 +1,424 @@
+"""The driver loop: one start point from its initial mode through its stays and events
+to the section (_one), the batch kernel over many start points (_batch), and its
+compilation with the on-disk cache kept in step with the sources."""
+from __future__ import annotations
+
+import hashlib
+import sys
+import warnings
+from collections import namedtuple
+from pathlib import Path
+
+import numpy as np
+from numba import njit, types
+from numba.core.errors import NumbaExperimentalFeatureWarning
+
+from ..system import SLIDING
+from .base import (BAD_START, EVENT_LIMIT, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
+                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO, _FIELD, _FLOW, _SCALAR,
+                   _WHERE, _W_NONE, _W_SECTION, _accumulates, _central_step, _exact_window,
+                   _exit_drift, _exit_shift, _jit, _jit_inline, _next_mode, _onto_switch,
+                   _slides_in_section, _speeds, _start_on_switch, _start_side, _vec)
+from .dop853 import (_NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
+                     _dop_step)
+from .segment import _zat
+from .scan import (_find, _sample)
+from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
+                         _var_step)
+
+
+@_jit
+def _section_rate(z, wm, wp, cm, cp, d, fns, p, wz):
+    """Central difference of the section along the field cm F_- + cp F_+."""
+    for k in range(z.size):
+        wz[k] = z[k] + d * (cm * wm[k] + cp * wp[k])
+    s1 = fns[6](wz, p)
+    for k in range(z.size):
+        wz[k] = z[k] - d * (cm * wm[k] + cp * wp[k])
+    return (s1 - fns[6](wz, p)) / (2.0 * d)
+
+
+@_jit
+def _slides_in(z, fns, p, wg, wm, wp, wz):
+    """simulate._slides_in: the sliding flow at z stays in the section (on H)."""
+    a, b = _speeds(z, fns, p, wg, wm, wp)
+    speed, size = 0.0, 1.0
+    for k in range(z.size):
+        speed = max(speed, abs(wm[k]), abs(wp[k]))
+        size = max(size, abs(z[k]))
+    d = _central_step(size, speed)
+    if d == 0.0:
+        return False
+    return _slides_in_section(fns[6](z, p), d, _section_rate(z, wm, wp, 1.0, 0.0, d, fns, p, wz),
+                              _section_rate(z, wm, wp, 0.0, 1.0, d, fns, p, wz),
+                              _section_rate(z, wm, wp, -b / (a - b), a / (a - b), d, fns, p, wz))
+
+
+@_jit
+def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
+    """simulate.initial_mode (rules.start_side, rules.start_on_switch)."""
+    H = fns[4](z, p)
+    side = _start_side(H, touch_tol)
+    if side != SLIDING:
+        return side
+    a, b = _speeds(z, fns, p, wg, wm, wp)
+    mode, _ = _start_on_switch(H, a, b, sliding)
+    return mode
+
+
+#: what a batch runs with (compute_returns fills it; _batch builds it once per call)
+Settings = namedtuple("Settings", [
+    "t_max", "exact", "hwin", "hwin_slow", "transient", "sec_pred", "sliding",
+    "frac_ex", "frac_in", "rtol", "atol", "touch_tol", "xtol", "zeno_span", "max_step",
+    "min_time", "max_events", "max_steps", "zeno_count", "jac"])
+
+#: the kernel's named work arrays, allocated once per batch by _batch. count: switches,
+#: steps, entries in the Zeno ring; tally: time slid, start of the current slide
+Work = namedtuple("Work", [
+    "ts", "vals", "dvals", "svals", "recent", "sg", "za", "y", "f", "y_old", "f_old", "K",
+    "ynew", "ytmp", "scale", "F", "wz", "wg", "wf", "wp", "z", "first_sw", "slide_dz",
+    "slide_z0", "count", "tally",
+    # dP/dz (Settings.jac): the derivative so far, workspaces, the variational stages
+    "M", "Mt", "KV", "KP", "ys", "jv", "jo", "jz1", "jz2", "jf1", "jf2", "touched"])
+
+_GO_ON = -1  # no event yet / the orbit goes on (never a returned status)
+
+
+@_jit_inline
+def _window(mode, ta, tb, frac, first, fns, p, s, w):
+    """Samples the segment [ta, tb] of the current mode and finds its earliest event:
+    (_GO_ON, tb, _W_NONE) if there is none (the state at tb in w.z), (OK, te, what)
+    at an event (its state in w.z), NO_RETURN at t_max, or an error (status, ta)."""
+    ns = frac.size
+    if not _sample(mode, ta, tb, frac, ns, w.sg, w.za, w.F, w.y_old, fns, p, w.ts, w.vals,
+                   w.dvals, w.svals, w.wz, w.wg, w.wf, w.wp, w.ynew):
+        return NON_FINITE, ta, _W_NONE
+    st, te, what = _find(mode, w.ts, ns, first, s.sec_pred, s.touch_tol, s.xtol, s.min_time,
+                         w.sg, w.za, w.F, w.y_old, fns, p, w.vals, w.dvals, w.svals, w.wz,
+                         w.wg, w.wf, w.touched)
+    if s.jac and w.touched[0]:  # P is not differentiable where the orbit touches H
+        for i in range(w.z.size):
+            for j in range(w.z.size):
+                w.M[i, j] = np.nan
+    if st != OK:
+        return st, ta, _W_NONE
+    if what == _W_NONE:
+        for c in range(w.z.size):
+            w.z[c] = w.ynew[c]
+        return (NO_RETURN if tb >= s.t_max else _GO_ON), tb, _W_NONE
+    _zat(te, mode, w.sg, w.za, w.F, w.y_old, fns, p, w.z)
+    return OK, te, what
+
+
+@_jit_inline
+def _stay_exact(mode, t, fns, p, s, w):
+    """A stay in region + or - on the exact flow from the mode entry, in the windows of
+    rules.exact_window (hwin growing with the time since the entry during the fast
+    transient, then hwin_slow); (status, t, what)."""
+    for k in range(w.z.size):
+        w.za[k] = w.z[k]
+    w.sg[0] = t
+    w.sg[3] = 0.0
+    ta, first = t, True
+    while True:
+        w.count[1] += 1
+        if w.count[1] > s.max_steps:
+            return STEP_LIMIT, ta, _W_NONE
+        tb = min(ta + _exact_window(ta - w.sg[0], s.hwin, s.hwin_slow, s.transient), s.t_max)
+        if tb == ta:
+            tb = np.nextafter(ta, np.inf)
+        st, t, what = _window(mode, ta, tb, s.frac_ex, first, fns, p, s, w)
+        if st != _GO_ON:
+            if st == OK and s.jac:
+                _flow_jacobian(mode, w.za, t - w.sg[0], fns, p, w.Mt, w.jz1, w.jz2)
+                _apply(w.Mt, w.M, w.KP[0])
+            return st, t, what
+        ta, first = tb, False
+
+
+@_jit_inline
+def _stay_integrated(mode, t, fns, p, s, w):
+    """A stay integrated by DOP853 with the mode's field (Filippov's when sliding;
+    regions + and - of a model without exact flows); (status, t, what)."""
+    n = w.z.size
+    w.sg[3] = 1.0
+    for k in range(n):
+        w.y[k] = w.z[k]
+    if not _checked_field(w.y, mode, True, fns, p, w.wg, w.wf, w.wp, w.f):
+        return NON_FINITE, t, _W_NONE
+    h_abs = _dop_initial_step(mode, t, w.y, w.f, s.t_max, s.max_step, s.rtol, s.atol, fns, p,
+                              w.wg, w.wf, w.wp, w.ynew, w.ytmp, w.scale)
+    ta, first = t, True
+    while True:
+        w.count[1] += 1
+        if w.count[1] > s.max_steps:
+            return STEP_LIMIT, ta, _W_NONE
+        ok, tb, hstep, h_abs = _dop_step(mode, ta, w.y, w.f, h_abs, s.t_max, s.max_step, s.rtol,
+                                         s.atol, fns, p, w.wg, w.wf, w.wp, w.K, w.ynew, w.ytmp,
+                                         w.scale)
+        if not ok:
+            return STEP_FAILED, ta, _W_NONE
+        for k in range(n):
+            w.y_old[k] = w.y[k]
+            w.f_old[k] = w.f[k]
+            w.y[k] = w.ynew[k]
+            w.f[k] = w.K[_NS, k]
+        _dop_dense(mode, hstep, w.y_old, w.y, w.f_old, w.f, fns, p, w.wg, w.wf, w.wp, w.K,
+                   w.ytmp, w.F)
+        w.sg[1] = ta
+        w.sg[2] = tb - ta
+        st, t, what = _window(mode, ta, tb, s.frac_in, first, fns, p, s, w)
+        if s.jac and (st == _GO_ON or (st == OK and t > ta)):
+            _var_step(mode, w.y_old, (tb if st == _GO_ON else t) - ta, fns, p, w)
+        if st != _GO_ON:
+            return st, t, what
+        ta, first = tb, False
+
+
+@_jit_inline
+def _end_slide(t, w):
+    """Counts the slide that ends at t (time, and change of state)."""
+    w.tally[0] += t - w.tally[1]
+    for k in range(w.z.size):
+        w.slide_dz[k] += w.z[k] - w.slide_z0[k]
+
+
+@_jit_inline
+def _event(mode, t, what, fns, p, s, w):
+    """The event ``what`` at (t, w.z): a section hit ends the run (OK); a switch is
+    decided (rules.next_mode) and counted against the limits and the Zeno ring.
+    (status, mode to go on in); status _GO_ON unless the run ends here."""
+    if what == _W_SECTION:
+        if mode == SLIDING:
+            _end_slide(t, w)
+        if s.jac:
+            _section_derivative(mode, fns, p, w)
+        return OK, mode
+    a, b = _speeds(w.z, fns, p, w.wg, w.wf, w.wp)
+    new_mode = _next_mode(mode, what, a, b)  # what: rules.SWITCH/EXIT_MINUS/EXIT_PLUS
+    if new_mode == SLIDING and not s.sliding:
+        return NO_SLIDING, mode
+    if new_mode == SLIDING and mode != SLIDING and _slides_in(w.z, fns, p, w.wg, w.wf, w.wp,
+                                                             w.wz):
+        return SECTION_SLIDING, mode
+    drift, h0 = False, 0.0
+    if mode == SLIDING:
+        if new_mode != SLIDING:
+            h0 = fns[4](w.z, p)
+            drift = _exit_drift(new_mode, h0, w.z, w.wg, s.touch_tol)
+            if drift:  # w.wg holds grad h at w.z (from _speeds)
+                _onto_switch(w.z, h0, w.wg)
+                h0 = fns[4](w.z, p)  # what rounding left
+        _end_slide(t, w)
+    if new_mode == SLIDING:
+        w.tally[1] = t
+        for k in range(w.z.size):
+            w.slide_z0[k] = w.z[k]
+    if new_mode != mode:
+        w.count[0] += 1
+        if w.count[0] == 1:
+            w.first_sw[0] = t
+    if w.count[0] > s.max_events:
+        return EVENT_LIMIT, mode
+    w.recent[w.count[2] % s.zeno_count] = t
+    w.count[2] += 1
+    if w.count[2] >= s.zeno_count and _accumulates(w.recent[w.count[2] % s.zeno_count], t,
+                                                   s.zeno_span):
+        return ZENO, mode
+    w.sg[4] = 0.0
+    if mode == SLIDING and new_mode != SLIDING:
+        w.sg[4] = _exit_shift(new_mode, h0, s.touch_tol, drift)
+    if s.jac and mode != SLIDING and new_mode != mode:  # the end of sliding: identity
+        _switch_derivative(mode, new_mode, fns, p, w)
+    return _GO_ON, new_mode
+
+
+@_jit
+def _one(z0, fns, p, s, w):
+    """First return of z0 (the state at the return, or where the run stopped, in w.z);
+    (status, t, n_switches, sliding_time). w.first_sw[0]: time of the first change of
+    mode (left untouched if there is none); w.slide_dz: the change of state summed
+    over the sliding stretches (counted like sliding_time)."""
+    n = z0.size
+    for k in range(n):
+        w.slide_dz[k] = 0.0
+    for k in range(n):
+        w.z[k] = z0[k]
+        if not np.isfinite(z0[k]):
+            return BAD_START, 0.0, 0, 0.0
+    mode = _initial_mode(w.z, fns, p, s.touch_tol, s.sliding, w.wg, w.wf, w.wp)
+    if mode == SLIDING and _slides_in(w.z, fns, p, w.wg, w.wf, w.wp, w.wz):
+        return SECTION_SLIDING, 0.0, 0, 0.0
+    w.touched[0] = False
+    if s.jac:
+        # a start that slides: the return is not differentiable across H there
+        for i in range(n):
+            for j in range(n):
+                w.M[i, j] = np.nan if mode == SLIDING else (1.0 if i == j else 0.0)
+    for k in range(n):
+        w.slide_z0[k] = w.z[k]
+    for k in range(3):
+        w.count[k] = 0
+    w.tally[0] = 0.0
+    w.tally[1] = 0.0
+    w.sg[4] = 0.0
+    t = 0.0
+    while True:
+        if t >= s.t_max:
+            return NO_RETURN, t, w.count[0], w.tally[0]
+        if mode == SLIDING and not s.sliding:
+            return NO_SLIDING, t, w.count[0], w.tally[0]
+        if mode != SLIDING and s.exact:
+            st, t, what = _stay_exact(mode, t, fns, p, s, w)
+        else:
+            st, t, what = _stay_integrated(mode, t, fns, p, s, w)
+        if st == OK:
+            st, mode = _event(mode, t, what, fns, p, s, w)
+        if st != _GO_ON:
+            return st, t, w.count[0], w.tally[0]
+
+
+_KERNEL_SIG = types.void(
+    _FLOW, _FLOW, _FIELD, _FIELD, _SCALAR, _FIELD, _SCALAR, _WHERE,  # the model
+    _vec,                       # params
+    types.float64[:, ::1],      # starts (m, n)
+    types.float64,              # t_max
+    types.boolean,              # exact flows in regions + and - (else DOP853)
+    types.float64,              # window length of the exact flows
+    types.int64,                # section predicate
+    types.boolean,              # sliding declared
+    _vec, _vec,                 # sample fractions: exact windows, integration steps
+    _vec,                       # rtol, atol, touch_tol, event_xtol, zeno_span, max_step,
+                                # slow window, transient time, min_time
+    types.int64[::1],           # max_events, max_steps, zeno_count, returns per start,
+                                # dP/dz wanted (0/1)
+    types.float64[:, ::1], _vec, types.int64[::1], _vec, types.int64[::1], _vec,  # outputs
+    types.float64[:, ::1],
+    types.float64[:, :, ::1],   # the last returns of each start (m, keep, n)
+    types.int64[::1],           # returns completed per start
+    types.float64[:, :, ::1],   # dP/dz of the last return (m, n, n)
+    types.float64[:, :, :, ::1])  # dP/dz of each kept return (m, keep, n, n) or (m, 0, n, n)
+
+
+@njit(cache=True)
+def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, p,
+           starts, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
+           out_state, out_time, out_nsw, out_slide, out_status, out_first, out_slide_dz,
+           out_orbit, out_done, out_jac, out_orbit_jac):
+    """Each start is mapped iopts[3] times by the first-return map, each return
+    starting from the last one's state; the outputs describe the last return made
+    (or where it stopped) and out_orbit[i] holds the last keep returns (with iopts[4]:
+    out_jac and out_orbit_jac their derivatives dP/dz, NaN where not made)."""
+    fns = (flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where)
+    m, n = starts.shape
+    nsmax = max(frac_ex.size, frac_in.size)
+    ts = np.empty(nsmax)
+    vals = np.empty((2, nsmax))
+    dvals = np.empty(nsmax)
+    svals = np.empty(nsmax)
+    recent = np.empty(max(iopts[2], 1))
+    sg = np.zeros(5)
+    za, y, f = np.zeros(n), np.zeros(n), np.zeros(n)
+    y_old, f_old, ynew, ytmp, scale = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+                                       np.zeros(n))
+    wz, wg, wf, wp = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+    K = np.zeros((_NSE, n))
+    F = np.zeros((_NI, n))
+    first = np.zeros(1)
+    w = Work(ts, vals, dvals, svals, recent, sg, za, y, f, y_old, f_old, K, ynew, ytmp, scale,
+             F, wz, wg, wf, wp, np.zeros(n), first, np.zeros(n), np.zeros(n),
+             np.zeros(3, dtype=np.int64), np.zeros(2),
+             np.zeros((n, n)), np.zeros((n, n)), np.zeros((_NS, n)), np.zeros((_NS, n, n)),
+             np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
+             np.zeros(n), np.zeros(1, dtype=np.bool_))
+    jac = iopts[4] != 0
+    s = Settings(t_max, exact, hwin, fopts[6], fopts[7], sec_pred, sliding, frac_ex, frac_in,
+                 fopts[0], fopts[1], fopts[2], fopts[3], fopts[4], fopts[5], fopts[8],
+                 iopts[0], iopts[1], iopts[2], jac)
+    keep_jac = out_orbit_jac.shape[1]
+    n_iter, keep = iopts[3], out_orbit.shape[1]
+    zin = np.empty(n)
+    for i in range(m):
+        for c in range(n):
+            zin[c] = starts[i, c]
+        done = 0
+        while True:
+            first[0] = np.nan
+            st, t, nsw, sl = _one(zin, fns, p, s, w)
+            if st != OK:
+                break
+            done += 1
+            j = done - 1 - (n_iter - keep)
+            if j >= 0:
+                for c in range(n):
+                    out_orbit[i, j, c] = w.z[c]
+                if keep_jac > 0:
+                    out_orbit_jac[i, j] = w.M
+            if done >= n_iter:
+                break
+            for c in range(n):
+                zin[c] = w.z[c]
+        out_done[i] = done
+        out_first[i] = first[0]
+        for c in range(n):
+            out_state[i, c] = w.z[c]
+            out_slide_dz[i, c] = w.slide_dz[c]
+        out_status[i] = st
+        if jac and st == OK:
+            out_jac[i] = w.M
+        else:
+            out_jac[i] = np.nan
+        out_time[i] = t
+        out_nsw[i] = nsw
+        out_slide[i] = sl
+
+
+#: the files whose code the kernel contains: every module of this package and the
+#: library modules it compiles or reads. numba's on-disk cache checks only the file of
+#: each cached function, not those of the functions it calls (a kernel cached before an
+#: edit of rules.py would go on running the old rules: seen, and numba's documented
+#: limit), so the kernel's cache carries a stamp of all of them (_fresh_cache)
+KERNEL_SOURCES = tuple(sorted(f"kernel/{p.name}" for p in Path(__file__).parent.glob("*.py"))
+                       ) + ("rules.py", "dop853_tableau.py", "abi.py", "system.py")
+
+
+def _kernel_stamp() -> str:
+    digest = hashlib.sha256()
+    for name in KERNEL_SOURCES:
+        digest.update(name.encode() + (Path(__file__).parents[1] / name).read_bytes())
+    return digest.hexdigest()
+
+
+def _fresh_cache() -> None:
+    """Drop every cached compiled function of the kernel (the rules compiled for it
+    included) when the kernel's sources changed since the cache was written."""
+    stamp_file = Path(_batch._cache.cache_path) / "kernel.sha256"
+    stamp = _kernel_stamp()
+    try:
+        if stamp_file.read_text() == stamp:
+            return
+    except OSError:
+        pass  # no stamp yet: a cache of unknown sources
+    from . import base, derivative, dop853, roots, scan, segment
+    for module in (base, derivative, dop853, roots, scan, segment, sys.modules[__name__]):
+        for obj in list(vars(module).values()):
+            if hasattr(obj, "py_func") and hasattr(obj, "_cache"):
+                obj._cache.flush()
+    try:
+        stamp_file.parent.mkdir(parents=True, exist_ok=True)
+        stamp_file.write_text(stamp)
+    except OSError:
+        pass  # a read-only cache: numba compiles in memory and caches nothing anyway
+
+
+def compile_kernel() -> bool:
+    """Compile the kernel for its one signature (or load it from numba's on-disk
+    cache, if that was written from the same sources); done on first use. Returns True
+    if it was loaded from the cache."""
+    if not _batch.signatures:
+        _fresh_cache()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)
+            _batch.compile(_KERNEL_SIG)
+        _batch.disable_compile()  # any other argument types are an error, not a recompile
+    return sum(_batch.stats.cache_hits.values()) > 0

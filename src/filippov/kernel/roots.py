@@ -1,0 +1,94 @@
+"""Root finding: a port of scipy's brentq, and the refinement of a crossing to its far
+side (as filippov.simulate._refine)."""
+from __future__ import annotations
+
+import numpy as np
+
+from .base import (_EPS, _TINY, _after, _far_side, _jit)
+from .segment import _fval
+
+
+@_jit
+def _brentq(sel, xa, xb, xtol, rtol, maxiter, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
+    """scipy.optimize.brentq (scipy/optimize/Zeros/brentq.c); returns (root, ok)."""
+    xpre, xcur = xa, xb
+    xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
+    fpre = _fval(sel, xpre, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+    fcur = _fval(sel, xcur, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+    if np.isnan(fpre) or np.isnan(fcur):
+        return xcur, False
+    if fpre == 0.0:
+        return xpre, True
+    if fcur == 0.0:
+        return xcur, True
+    if (fpre < 0.0) == (fcur < 0.0):
+        return xcur, False
+    for _ in range(maxiter):
+        if fpre != 0.0 and fcur != 0.0 and ((fpre < 0.0) != (fcur < 0.0)):
+            xblk = xpre
+            fblk = fpre
+            spre = scur = xcur - xpre
+        if abs(fblk) < abs(fcur):
+            xpre = xcur
+            xcur = xblk
+            xblk = xpre
+            fpre = fcur
+            fcur = fblk
+            fblk = fpre
+        delta = (xtol + rtol * abs(xcur)) / 2.0
+        sbis = (xblk - xcur) / 2.0
+        if fcur == 0.0 or abs(sbis) < delta:
+            return xcur, True
+        if abs(spre) > delta and abs(fcur) < abs(fpre):
+            if xpre == xblk:
+                stry = -fcur * (xcur - xpre) / (fcur - fpre)  # interpolate
+            else:  # extrapolate
+                dpre = (fpre - fcur) / (xpre - xcur)
+                dblk = (fblk - fcur) / (xblk - xcur)
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+            if 2.0 * abs(stry) < min(abs(spre), 3.0 * abs(sbis) - delta):
+                spre = scur
+                scur = stry
+            else:
+                spre = sbis
+                scur = sbis
+        else:
+            spre = sbis
+            scur = sbis
+        xpre = xcur
+        fpre = fcur
+        if abs(scur) > delta:
+            xcur += scur
+        else:
+            xcur += delta if sbis > 0 else -delta
+        fcur = _fval(sel, xcur, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+        if np.isnan(fcur):
+            return xcur, False
+    return xcur, False
+
+
+@_jit
+def _refine(sel, pred, ta, tb, va, xtol, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
+    """simulate._refine: root in [ta, tb] on the far side of the crossing; (t, ok)."""
+    pred = _far_side(pred, va)
+    if va == 0.0:
+        r = ta
+    else:
+        r, ok = _brentq(sel, ta, tb, xtol, 4.0 * _EPS, 200, mode, sg, za, F, y_old, fns, p,
+                        wz, wg, wf)
+        if not ok:
+            # as simulate._refine: no sign change because the start sample of a
+            # just-entered mode was clamped inside while the true value is already
+            # past the crossing -- the event is at once
+            if _after(pred, _fval(sel, ta, mode, sg, za, F, y_old, fns, p, wz, wg, wf)):
+                r = ta
+            else:
+                return r, False
+    a = max(abs(r), _TINY)
+    step = 2.0 * (np.nextafter(a, np.inf) - a)
+    while not _after(pred, _fval(sel, r, mode, sg, za, F, y_old, fns, p, wz, wg, wf)):
+        if r >= tb:
+            return tb, True
+        r = min(r + step, tb)
+        step *= 2.0
+    return r, True

@@ -1,0 +1,27 @@
+"""The state on the current segment of the orbit (an exact flow from the mode entry, or
+the dense output of an integration step) and the event functions evaluated on it."""
+from __future__ import annotations
+
+
+from ..system import PLUS, SLIDING
+from .base import (_S_H, _jit, _scalar)
+from .dop853 import _dense_eval
+
+# output (F, y_old) of the integration step [sg[1], sg[1] + sg[2]] -- always
+# when sliding, and in regions + and - when sg[3] != 0 (a model without flows).
+# sg[4]: what the stay subtracts from H (rules.exit_shift; 0 but after a slide).
+@_jit
+def _zat(t, mode, sg, za, F, y_old, fns, p, out):
+    if mode == SLIDING or sg[3] != 0.0:
+        _dense_eval(t, sg[1], sg[2], y_old, F, out)
+    elif mode == PLUS:
+        fns[0](za, t - sg[0], p, out)
+    else:
+        fns[1](za, t - sg[0], p, out)
+
+
+@_jit
+def _fval(sel, t, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
+    _zat(t, mode, sg, za, F, y_old, fns, p, wz)
+    v = _scalar(sel, wz, fns, p, wg, wf)
+    return v - sg[4] if sel == _S_H else v  # sg[4]: the stay's rules.exit_shift
