@@ -46,3 +46,7 @@ def test_the_readme_compiled_engine_block_runs():
     ret = scope["returns"]
     assert ret.state.shape == (2, 3) and np.all(ret.time > 0)
     np.testing.assert_allclose(ret.state[:, 0], 0.0, atol=1e-14)   # on the section x1 = 0
+    # the compiled engine's dP/dz at the fixed point is the reference driver's
+    ref = scope["return_jacobian"](scope["relay"], scope["orbit"], scope["up"],
+                                   jacobian=lambda mode, z: scope["A"])
+    np.testing.assert_allclose(scope["J"], ref, rtol=0, atol=1e-8)
