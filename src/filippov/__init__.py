@@ -18,6 +18,7 @@ from .checks import SystemContractError
 from .poincare import first_returns, fixed_points
 from .continuation import monodromy, floquet_multipliers, ContinuationError
 from .variational import transition_matrix, return_jacobian, VariationalError
+from .periodic import periodic_orbit, PeriodicOrbit, PeriodicOrbitError
 
 # the compiled engine (numba) is imported on first use, not by `import filippov`
 _COMPILED = {"compile_system": "compiled_system", "with_section": "compiled_system",
@@ -39,6 +40,7 @@ __all__ = [
     "SimulationError", "ZenoError", "EventLimitError", "SystemContractError",
     "first_returns", "fixed_points", "monodromy", "floquet_multipliers", "ContinuationError",
     "transition_matrix", "return_jacobian", "VariationalError",
+    "periodic_orbit", "PeriodicOrbit", "PeriodicOrbitError",
     "FilippovSystem", "compile_system", "with_section", "CompiledModel", "compute_returns",
     "first_returns_compiled", "MINUS", "PLUS", "SLIDING", "__version__",
 ]

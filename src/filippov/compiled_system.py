@@ -290,6 +290,28 @@ class FilippovSystem:
             return self._compiled
         return with_section(self._compiled, section, direction=direction, where=where)
 
+    def python_section(self, section, *, direction: int = 0, where=None, name: str = "section",
+                       min_time: float = 0.0):
+        """The section ``section(z, p) = 0`` for the reference driver: a terminal
+        :class:`~filippov.simulate.Section` whose function is compiled like the pieces
+        and evaluated on one state or a batch of samples."""
+        from .simulate import Section
+
+        n, p = len(self.names), self.params
+        batch = _batch_scalar(_jit(section, "section"), n)
+
+        def func(z):
+            zs, tail = _states(z, n)
+            out = batch(zs, p)
+            return out.reshape(tail) if tail else float(out[0])
+
+        cond = None
+        if where is not None:
+            w = _jit(where, "section_where")
+            cond = lambda z: bool(w(np.ascontiguousarray(z, dtype=float), p))  # noqa: E731
+        return Section(name, func, direction=direction, where=cond, terminal=1,
+                       min_time=min_time)
+
     def python(self):
         """The reference driver's PiecewiseSystem (built once, then reused)."""
         if self._python is None:
