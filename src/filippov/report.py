@@ -273,12 +273,13 @@ def _problem_tex(name: str) -> str:
     return rest
 
 
-def bench(ds, m: Macros, effects=None) -> str:
+def bench(ds, m: Macros, effects=None, returns=None) -> str:
     """The work-precision tables of the default build's sweep (results/work_precision.nc):
     per problem set (fig04, fig11), one row per method and tolerance, error / time /
     missed switches per problem; the speed-up at the target error and what the
     scipy solvers a user reaches for first get wrong; the cost of each model
-    ingredient when results/bench_effect_cost.nc is there (`make bench`)."""
+    ingredient when results/bench_effect_cost.nc is there and the cost of one iterated
+    return when results/bench_attractor_cost.nc is (`make bench`)."""
     sid = "work_precision"
     missing = absent(m, "rpHaveBench", ds, "Work--precision sweep", "results/work_precision.nc")
     if missing:
@@ -327,6 +328,20 @@ def bench(ds, m: Macros, effects=None) -> str:
                 f"${num(float(effects.seconds.values[k]), 3)}$",
                 f"${num(float(effects.relative.values[k]), 3)}$",
                 r"\emph{" + tex_escape(outcome) + "}"]) + r" \\")
+        lines += [r"\bottomrule", r"\end{tabular}", ""]
+    m.flag("rpHaveReturnCost", returns is not None)
+    if returns is not None:
+        lines += [r"\medskip", "", r"\begin{tabular}{rrrrrr}", r"\toprule",
+                  r"$\theta$ & $\epsilon$ & $s$ & $\mu$s/return & with $DP$ & "
+                  r"switches/return \\", r"\midrule"]
+        for k in range(returns.sizes["case"]):
+            lines.append(" & ".join([
+                f"${num(float(returns.theta.values[k]), 2)}$",
+                f"${num(float(returns.eps.values[k]), 1)}$",
+                f"${num(float(returns.s.values[k]), 2)}$",
+                f"${num(1e6 * float(returns.time_per_return.values[k]), 3)}$",
+                f"${num(1e6 * float(returns.time_per_return_jacobian.values[k]), 3)}$",
+                f"${num(float(returns.switches_per_return.values[k]), 3)}$"]) + r" \\")
         lines += [r"\bottomrule", r"\end{tabular}", ""]
     return "\n".join(lines)
 
@@ -444,7 +459,8 @@ def generate(datasets: Mapping[str, Optional[xr.Dataset]]) -> dict[str, str]:
         except KeyError as exc:
             raise KeyError(f"{sid}: the report reads {exc} but the dataset lacks it") from None
         texts[f"{sid}.tex"] = table if table is not None else f"% {sid}: no table\n"
-    tab_bench = bench(datasets.get("work_precision"), m, datasets.get("bench_effect_cost"))
+    tab_bench = bench(datasets.get("work_precision"), m, datasets.get("bench_effect_cost"),
+                      datasets.get("bench_attractor_cost"))
     try:
         tab_hard, tab_return = hard_cases(datasets.get("hard_cases"), m)
     except KeyError as exc:

@@ -5,7 +5,7 @@ import numpy as np
 
 from ..system import PLUS
 from .base import (_central_step, _dot, _jit)
-from .dop853 import (_A, _B, _NS, _checked_field)
+from .dop853 import (_A, _B, _NS, _checked_field, _stage)
 
 
 # The derivative of a return, carried in w.M while the orbit runs (Settings.jac), as the
@@ -99,12 +99,7 @@ def _var_step(mode, y0, h, fns, p, w):
     step of the state)."""
     n = y0.size
     for s in range(_NS):
-        for k in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += w.KV[j, k] * _A[s, j]
-            w.ys[k] = y0[k] + acc * h
-        _checked_field(w.ys, mode, False, fns, p, w.wg, w.wf, w.wp, w.KV[s])
+        _stage(s, mode, y0, h, w.KV, w.ys, fns, p, w.wg, w.wf, w.wp)
         for a in range(n):
             for b in range(n):
                 acc = 0.0

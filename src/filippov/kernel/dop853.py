@@ -72,6 +72,18 @@ def _checked_field(z, mode, first_call, fns, p, wg, wm, wp, out):
 
 
 @_jit
+def _stage(s, mode, y0, h, K, ytmp, fns, p, wg, wm, wp):
+    """Stage s of the tableau from y0 over h: K[s] = field(y0 + h sum_j<s A[s, j] K[j])
+    (ytmp holds the stage's state)."""
+    for k in range(y0.size):
+        acc = 0.0
+        for j in range(s):
+            acc += K[j, k] * _A[s, j]
+        ytmp[k] = y0[k] + acc * h
+    _checked_field(ytmp, mode, False, fns, p, wg, wm, wp, K[s])
+
+
+@_jit
 def _rms(x, scale):
     s = 0.0
     for k in range(x.size):
@@ -139,12 +151,7 @@ def _dop_step(mode, t, y, f, h_abs, t_bound, max_step, rtol, atol, fns, p, wg, w
         for k in range(n):
             K[0, k] = f[k]
         for s in range(1, _NS):
-            for k in range(n):
-                acc = 0.0
-                for j in range(s):
-                    acc += K[j, k] * _A[s, j]
-                ytmp[k] = y[k] + acc * h
-            _checked_field(ytmp, mode, False, fns, p, wg, wm, wp, K[s])
+            _stage(s, mode, y, h, K, ytmp, fns, p, wg, wm, wp)
         for k in range(n):
             acc = 0.0
             for j in range(_NS):
@@ -188,12 +195,7 @@ def _dop_dense(mode, h, y_old, y, f_old, f, fns, p, wg, wm, wp, K, ytmp, F):
     """DOP853._dense_output_impl: extra stages and the interpolant F (7, n)."""
     n = y.size
     for s in range(_NS + 1, _NSE):
-        for k in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += K[j, k] * _A[s, j]
-            ytmp[k] = y_old[k] + acc * h
-        _checked_field(ytmp, mode, False, fns, p, wg, wm, wp, K[s])
+        _stage(s, mode, y_old, h, K, ytmp, fns, p, wg, wm, wp)
     for k in range(n):
         dy = y[k] - y_old[k]
         F[0, k] = dy
