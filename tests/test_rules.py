@@ -27,8 +27,15 @@ def test_the_compiled_engine_compiles_the_rules_themselves():
                              (kernel._extremum_between, rules.extremum_between),
                              (kernel._graze, rules.graze),
                              (kernel._central_step, rules.central_step),
-                             (kernel._slides_in_section, rules.slides_in_section)):
+                             (kernel._slides_in_section, rules.slides_in_section),
+                             (kernel._carried_age, rules.carried_age)):
         assert compiled.py_func is source
+
+
+def test_an_age_is_carried_only_where_the_region_is_unambiguous():
+    for f in (rules.carried_age, kernel._carried_age):
+        assert f(0.3, 1e-15, 2.5) == 2.5 and f(-0.3, 1e-15, 2.5) == 2.5
+        assert f(1e-15, 1e-15, 2.5) == 0.0 and f(0.0, 1e-15, 2.5) == 0.0
 
 
 @pytest.mark.parametrize("mode", [PLUS, MINUS, SLIDING])

@@ -88,20 +88,33 @@ class BatchReturns:
     jacobian: np.ndarray = None
     #: (m, keep, dim, dim): dP/dz of the return that produced each ``orbit`` row
     orbit_jacobian: np.ndarray = None
+    #: (m,): time the orbit had spent in the region of its last return point when it
+    #: returned (0 if sliding there); ``start_age`` of the next return continues the
+    #: orbit as an iterated run does, bit for bit
+    age: np.ndarray = None
 
 
 def _section_pred(direction: int) -> int:
     return rules.section_pred(direction)
 
 
-def _checked_starts(cmodel: CompiledModel, starts) -> np.ndarray:
+def _checked_starts(cmodel: CompiledModel, starts, start_age):
+    """(starts (m, n), ages (m,)) as the kernel takes them, or the error naming them."""
     starts = np.ascontiguousarray(np.atleast_2d(np.asarray(starts, dtype=float)))
     if starts.ndim != 2 or starts.shape[1] != cmodel.dim:
         raise ValueError(f"start points must have shape (m, {cmodel.dim}) "
                          f"({', '.join(cmodel.names)}), got {starts.shape}")
     if not np.all(np.isfinite(starts)):
         raise ValueError("start points must be finite")
-    return starts
+    try:
+        ages = np.array(np.broadcast_to(np.asarray(start_age, dtype=float),
+                                        (starts.shape[0],)))  # a writable copy
+    except ValueError:
+        ages = np.array([np.nan])
+    if not np.all(np.isfinite(ages) & (ages >= 0)):
+        raise ValueError(f"start_age must be finite and >= 0, a scalar or one per start "
+                         f"point ({starts.shape[0]}), got {np.asarray(start_age).tolist()}")
+    return starts, ages
 
 
 def _check_options(cmodel, t_max, samples_per_step, max_step, zeno_count, iterations, keep,
@@ -131,7 +144,7 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
                     max_steps: int = 5_000_000, samples_per_step: int = 4,
                     touch_tol: float = 1e-15, event_xtol: float = 1e-15, zeno_count: int = 64,
                     zeno_span: float = 1e-10, min_time: float = 0.0, iterations: int = 1,
-                    keep: int = 0, jacobian: bool = False) -> BatchReturns:
+                    keep: int = 0, jacobian: bool = False, start_age=0.0) -> BatchReturns:
     """First returns of ``starts`` (``(m, dim)``) to the model's section, one compiled call.
 
     Options mean what they mean for :func:`filippov.simulate.simulate`, except that
@@ -148,6 +161,12 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     counts the returns completed and ``orbit[i]`` holds the last ``keep`` of them
     (rows of a start that stopped early stay NaN).
 
+    A section hit is no mode entry: the next return of an iterated run goes on in the
+    exact-flow windows of the time already spent in its region (its fast transient has
+    decayed; ``rules.carried_age``). ``start_age`` (scalar or (m,)) says the same of the
+    start points -- the ``age`` a previous return reported; the default 0 treats each
+    start as just entered (windows on the fast time scale first).
+
     ``jacobian=True`` also returns the derivative dP/dz of each return
     (``BatchReturns.jacobian``, and ``orbit_jacobian`` for the kept returns), carried
     along the orbit: closed-form flows differentiated by central differences,
@@ -160,7 +179,7 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     differentiable: a switch or section met tangentially, an orbit that touches H
     (``touch_tol``: the kink of P at grazing), a start that slides.
     """
-    starts = _checked_starts(cmodel, starts)
+    starts, ages = _checked_starts(cmodel, starts, start_age)
     _check_options(cmodel, t_max, samples_per_step, max_step, zeno_count, iterations, keep,
                    min_time)
     hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max) if cmodel.exact else np.inf
@@ -186,15 +205,16 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     n = starts.shape[1]
     jac = np.empty((m, n, n))
     orbit_jac = np.full((m, keep if jacobian else 0, n, n), np.nan)
+    age = np.empty(m)
     params = np.ascontiguousarray(cmodel.params, dtype=float)
     compile_kernel()
     _batch(cmodel.flow_plus, cmodel.flow_minus, cmodel.field_plus, cmodel.field_minus,
            cmodel.h, cmodel.grad_h, cmodel.section, cmodel.section_where, params,
-           starts, float(t_max), bool(cmodel.exact), float(hwin), _section_pred(cmodel.section_direction),
+           starts, ages, float(t_max), bool(cmodel.exact), float(hwin), _section_pred(cmodel.section_direction),
            bool(cmodel.sliding), frac_ex, frac_in, fopts, iopts, state, time, nsw, slide, status,
-           first, slide_dz, orbit, done, jac, orbit_jac)
+           first, slide_dz, orbit, done, jac, orbit_jac, age)
     return BatchReturns(state, time, nsw, slide, status, first, slide_dz, orbit, done,
-                        jac if jacobian else None, orbit_jac if jacobian else None)
+                        jac if jacobian else None, orbit_jac if jacobian else None, age)
 
 
 _ERRORS = {EVENT_LIMIT: EventLimitError, STEP_LIMIT: EventLimitError, ZENO: ZenoError,

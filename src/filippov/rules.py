@@ -83,6 +83,15 @@ def extremum_between(mode: int, d0, d1):
     return (d0 > 0.0) & (d1 <= 0.0)
 
 
+def carried_age(H: float, touch_tol: float, age: float) -> float:
+    """The time already spent in the region of a start point that continues an orbit
+    (a return map iterated from its last hit: a section hit is no mode entry), counted
+    only where the start's region is unambiguous (|H| > touch_tol); else 0, as after an
+    entry. It sets where the exact-flow windows stand in the fast transient
+    (:func:`exact_window`)."""
+    return age if abs(H) > touch_tol else 0.0
+
+
 def exact_window(elapsed: float, h: float, h_slow: float, transient: float) -> float:
     """The next window of an exact flow, ``elapsed`` after the mode entry: ``h`` (the
     eps scale) at first, then as long as the time elapsed -- the fast part of the flow

@@ -16,7 +16,7 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 from ..system import SLIDING
 from .base import (BAD_START, EVENT_LIMIT, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
                    SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO, _FIELD, _FLOW, _SCALAR,
-                   _WHERE, _W_NONE, _W_SECTION, _accumulates, _central_step, _exact_window,
+                   _WHERE, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
                    _exit_drift, _exit_shift, _jit, _jit_inline, _next_mode, _onto_switch,
                    _slides_in_section, _speeds, _start_on_switch, _start_side, _vec)
 from .dop853 import (_NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
@@ -73,7 +73,9 @@ Settings = namedtuple("Settings", [
     "min_time", "max_events", "max_steps", "zeno_count", "jac"])
 
 #: the kernel's named work arrays, allocated once per batch by _batch. count: switches,
-#: steps, entries in the Zeno ring; tally: time slid, start of the current slide
+#: steps, entries in the Zeno ring; tally: time slid, start of the current slide, time
+#: already spent in the current mode when the current exact stay began (its age: 0 after
+#: an entry; carried from the last hit when a return continues an orbit)
 Work = namedtuple("Work", [
     "ts", "vals", "dvals", "svals", "recent", "sg", "za", "y", "f", "y_old", "f_old", "K",
     "ynew", "ytmp", "scale", "F", "wz", "wg", "wf", "wp", "z", "first_sw", "slide_dz",
@@ -124,7 +126,8 @@ def _stay_exact(mode, t, fns, p, s, w):
         w.count[1] += 1
         if w.count[1] > s.max_steps:
             return STEP_LIMIT, ta, _W_NONE
-        tb = min(ta + _exact_window(ta - w.sg[0], s.hwin, s.hwin_slow, s.transient), s.t_max)
+        tb = min(ta + _exact_window(ta - w.sg[0] + w.tally[2], s.hwin, s.hwin_slow,
+                                    s.transient), s.t_max)
         if tb == ta:
             tb = np.nextafter(ta, np.inf)
         st, t, what = _window(mode, ta, tb, s.frac_ex, first, fns, p, s, w)
@@ -189,6 +192,9 @@ def _event(mode, t, what, fns, p, s, w):
     decided (rules.next_mode) and counted against the limits and the Zeno ring.
     (status, mode to go on in); status _GO_ON unless the run ends here."""
     if what == _W_SECTION:
+        # the age in this mode at the hit (the next return of an iterated run goes on
+        # from it: a hit is no mode entry)
+        w.tally[2] = t - w.sg[0] + w.tally[2] if (mode != SLIDING and s.exact) else 0.0
         if mode == SLIDING:
             _end_slide(t, w)
         if s.jac:
@@ -230,15 +236,20 @@ def _event(mode, t, what, fns, p, s, w):
         w.sg[4] = _exit_shift(new_mode, h0, s.touch_tol, drift)
     if s.jac and mode != SLIDING and new_mode != mode:  # the end of sliding: identity
         _switch_derivative(mode, new_mode, fns, p, w)
+    if new_mode != mode:
+        w.tally[2] = 0.0  # an entry: the fast transient starts again
+    elif mode != SLIDING and s.exact:
+        w.tally[2] += t - w.sg[0]  # the stay goes on from here
     return _GO_ON, new_mode
 
 
 @_jit
-def _one(z0, fns, p, s, w):
+def _one(z0, age0, fns, p, s, w):
     """First return of z0 (the state at the return, or where the run stopped, in w.z);
     (status, t, n_switches, sliding_time). w.first_sw[0]: time of the first change of
     mode (left untouched if there is none); w.slide_dz: the change of state summed
-    over the sliding stretches (counted like sliding_time)."""
+    over the sliding stretches (counted like sliding_time); age0: the time already spent
+    in the start's region (rules.carried_age), w.tally[2] the same at the return."""
     n = z0.size
     for k in range(n):
         w.slide_dz[k] = 0.0
@@ -261,6 +272,7 @@ def _one(z0, fns, p, s, w):
         w.count[k] = 0
     w.tally[0] = 0.0
     w.tally[1] = 0.0
+    w.tally[2] = 0.0 if mode == SLIDING else _carried_age(fns[4](w.z, p), s.touch_tol, age0)
     w.sg[4] = 0.0
     t = 0.0
     while True:
@@ -282,6 +294,7 @@ _KERNEL_SIG = types.void(
     _FLOW, _FLOW, _FIELD, _FIELD, _SCALAR, _FIELD, _SCALAR, _WHERE,  # the model
     _vec,                       # params
     types.float64[:, ::1],      # starts (m, n)
+    _vec,                       # their ages in their regions (rules.carried_age)
     types.float64,              # t_max
     types.boolean,              # exact flows in regions + and - (else DOP853)
     types.float64,              # window length of the exact flows
@@ -297,14 +310,15 @@ _KERNEL_SIG = types.void(
     types.float64[:, :, ::1],   # the last returns of each start (m, keep, n)
     types.int64[::1],           # returns completed per start
     types.float64[:, :, ::1],   # dP/dz of the last return (m, n, n)
-    types.float64[:, :, :, ::1])  # dP/dz of each kept return (m, keep, n, n) or (m, 0, n, n)
+    types.float64[:, :, :, ::1],  # dP/dz of each kept return (m, keep, n, n) or (m, 0, n, n)
+    _vec)                       # the age at the last return (m,)
 
 
 @njit(cache=True)
 def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, p,
-           starts, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
+           starts, ages, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
            out_state, out_time, out_nsw, out_slide, out_status, out_first, out_slide_dz,
-           out_orbit, out_done, out_jac, out_orbit_jac):
+           out_orbit, out_done, out_jac, out_orbit_jac, out_age):
     """Each start is mapped iopts[3] times by the first-return map, each return
     starting from the last one's state; the outputs describe the last return made
     (or where it stopped) and out_orbit[i] holds the last keep returns (with iopts[4]:
@@ -327,7 +341,7 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
     first = np.zeros(1)
     w = Work(ts, vals, dvals, svals, recent, sg, za, y, f, y_old, f_old, K, ynew, ytmp, scale,
              F, wz, wg, wf, wp, np.zeros(n), first, np.zeros(n), np.zeros(n),
-             np.zeros(3, dtype=np.int64), np.zeros(2),
+             np.zeros(3, dtype=np.int64), np.zeros(3),
              np.zeros((n, n)), np.zeros((n, n)), np.zeros((_NS, n)), np.zeros((_NS, n, n)),
              np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
              np.zeros(n), np.zeros(1, dtype=np.bool_))
@@ -342,9 +356,10 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
         for c in range(n):
             zin[c] = starts[i, c]
         done = 0
+        age = ages[i]
         while True:
             first[0] = np.nan
-            st, t, nsw, sl = _one(zin, fns, p, s, w)
+            st, t, nsw, sl = _one(zin, age, fns, p, s, w)
             if st != OK:
                 break
             done += 1
@@ -358,7 +373,9 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
                 break
             for c in range(n):
                 zin[c] = w.z[c]
+            age = w.tally[2]
         out_done[i] = done
+        out_age[i] = w.tally[2]
         out_first[i] = first[0]
         for c in range(n):
             out_state[i, c] = w.z[c]
