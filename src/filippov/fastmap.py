@@ -6,8 +6,10 @@ same algorithm for a whole batch of start points inside one compiled call:
 
 * regions ``+`` (``h >= 0``) and ``-`` are followed with the model's exact
   flows in the reference driver's windows: ``16 sample_step`` from each mode entry
-  (``16 slow_sample_step`` once ``transient_time`` has passed since the entry),
-  the flow always taken from the state at the mode entry. Each window is cut into
+  (``16 slow_sample_step`` once ``transient_time`` has passed since the entry; the
+  next return of an iterated run carries its time in the region on, a section hit
+  being no entry), the flow taken from the state at the stay's start (the mode entry,
+  or the start point). Each window is cut into
   16 intervals: one sample per sample step, the spacing the model declares to
   resolve its events (the reference driver samples ``samples_per_step`` times
   denser, since its samples are also the stored trajectory; the two agree to
