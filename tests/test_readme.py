@@ -11,7 +11,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_the_readme_user_example_runs_and_finds_the_relay_orbit():
     text = (ROOT / "README.md").read_text()
-    section = text[text.index("## Your own system"):text.index("## Examples")]
+    section = text[text.index("## Your own system"):text.index("## A system written once in SymPy")]
     code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
     assert len(code.strip().splitlines()) <= 30
     out = io.StringIO()
@@ -36,7 +36,7 @@ def test_the_readme_user_example_runs_and_finds_the_relay_orbit():
 
 def test_the_readme_compiled_engine_block_runs():
     text = (ROOT / "README.md").read_text()
-    section = text[text.index("## Your own system"):text.index("## Examples")]
+    section = text[text.index("## Your own system"):text.index("## A system written once in SymPy")]
     blocks = re.findall(r"```python\n(.*?)```", section, re.S)
     assert len(blocks) == 2
     scope = {}
@@ -50,3 +50,23 @@ def test_the_readme_compiled_engine_block_runs():
     ref = scope["return_jacobian"](scope["relay"], scope["orbit"], scope["up"],
                                    jacobian=lambda mode, z: scope["A"])
     np.testing.assert_allclose(scope["J"], ref, rtol=0, atol=1e-8)
+
+
+def test_the_readme_symbolic_block_finds_the_relay_orbit_on_both_engines():
+    text = (ROOT / "README.md").read_text()
+    section = text[text.index("## A system written once in SymPy"):text.index("## Examples")]
+    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    out = io.StringIO()
+    scope = {}
+    with contextlib.redirect_stdout(out):
+        exec(compile(code, "README.md", "exec"), scope)
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("relay", ROOT / "examples" / "relay_feedback.py")
+    relay = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(relay)
+    want = relay.closed_form()
+    assert abs(scope["po"].period - want["period"]) < 1e-12       # the last engine: python
+    np.testing.assert_allclose(scope["po"].multipliers, want["multipliers"], atol=1e-9)
+    assert np.array_equal(np.asarray(scope["relay_sym"].jacobians["plus"], dtype=float), relay.A)
+    assert "compiled 3.67975067086" in out.getvalue()

@@ -20,9 +20,11 @@ from .continuation import monodromy, floquet_multipliers, ContinuationError
 from .variational import transition_matrix, return_jacobian, VariationalError
 from .periodic import periodic_orbit, PeriodicOrbit, PeriodicOrbitError
 
-# the compiled engine (numba) is imported on first use, not by `import filippov`
+# the compiled engine (numba) and the symbolic front-end (sympy) are imported on first
+# use, not by `import filippov`
 _COMPILED = {"compile_system": "compiled_system", "with_section": "compiled_system",
              "FilippovSystem": "compiled_system",
+             "SymbolicSystem": "symbolic", "SymbolicSlowFast": "symbolic",
              "CompiledModel": "abi", "compute_returns": "fastmap",
              "first_returns_compiled": "fastmap"}
 
@@ -41,6 +43,6 @@ __all__ = [
     "first_returns", "fixed_points", "monodromy", "floquet_multipliers", "ContinuationError",
     "transition_matrix", "return_jacobian", "VariationalError",
     "periodic_orbit", "PeriodicOrbit", "PeriodicOrbitError",
-    "FilippovSystem", "compile_system", "with_section", "CompiledModel", "compute_returns",
+    "FilippovSystem", "SymbolicSystem", "SymbolicSlowFast", "compile_system", "with_section", "CompiledModel", "compute_returns",
     "first_returns_compiled", "MINUS", "PLUS", "SLIDING", "__version__",
 ]

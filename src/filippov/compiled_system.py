@@ -251,6 +251,9 @@ def _states(z, n):
     return np.ascontiguousarray(z.reshape(n, -1)), z.shape[1:]
 
 
+_JAC_MODES = ("minus", "sliding", "plus")   # filippov.system.MODE_NAMES
+
+
 class FilippovSystem:
     """One definition of a Filippov system, run by both engines.
 
@@ -261,32 +264,66 @@ class FilippovSystem:
     numba-compiled loops over the samples; :meth:`compiled` gives the compiled
     engine's :class:`~filippov.abi.CompiledModel` with a section of the
     caller's choosing. Sections belong to the caller, not to the system.
+    ``jacobians`` (optional, ``{"minus"|"sliding"|"plus": J(z, p) -> (n, n)}``)
+    gives :meth:`jacobian`, used for Floquet multipliers and dP/dz on the
+    reference driver instead of central differences; :mod:`filippov.symbolic`
+    generates all three from the expressions.
     """
 
     def __init__(self, names, field_minus, field_plus, switch, switch_grad, *, params=(),
                  flow_minus=None, flow_plus=None, sample_step: float = np.inf,
-                 sliding: bool = True, name: str = "user"):
+                 sliding: bool = True, name: str = "user", jacobians=None,
+                 slow_sample_step: float = np.nan, transient_time: float = np.inf):
         self.names = tuple(str(x) for x in names)
+        self.slow_sample_step, self.transient_time = float(slow_sample_step), float(transient_time)
         self.params = np.ascontiguousarray(np.asarray(params, dtype=float).reshape(-1))
         self.name, self.sliding, self.sample_step = name, bool(sliding), float(sample_step)
         self._pieces = dict(field_minus=field_minus, field_plus=field_plus, switch=switch,
                             switch_grad=switch_grad, flow_minus=flow_minus, flow_plus=flow_plus)
+        jacobians = dict(jacobians or {})
+        unknown = set(jacobians) - set(_JAC_MODES)
+        if unknown:
+            raise ValueError(f"jacobians: unknown mode(s) {sorted(unknown)}; expected "
+                             f"{', '.join(_JAC_MODES)}")
+        self._jacobians = {m: _jit(f, f"jacobians[{m!r}]") for m, f in jacobians.items()}
         self._python = None
         self._compiled = None   # the fields compiled once; each call only adds a section
         self._user = None       # the pieces as numba dispatchers, shared by both engines
 
+    # -- hooks: how the pieces become the engines' (a generated system overrides them)
     def _user_pieces(self) -> dict:
         if self._user is None:
             self._user = {k: (None if f is None else _jit(f, k)) for k, f in self._pieces.items()}
         return self._user
 
+    def _batch_pieces(self) -> dict:
+        """The pieces as compiled loops over the columns of ``(n, m)`` states (flows:
+        over the times), for the reference driver."""
+        n, pc = len(self.names), self._user_pieces()
+        out = {k: _batch_vector(pc[k], n) for k in ("field_minus", "field_plus", "switch_grad")}
+        out["switch"] = _batch_scalar(pc["switch"], n)
+        for k in ("flow_minus", "flow_plus"):
+            out[k] = None if pc[k] is None else _batch_flow(pc[k], n)
+        return out
+
+    def _section_batch(self, section):
+        return _batch_scalar(_jit(section, "section"), len(self.names))
+
+    def _jacobian_value(self, key: str, z: np.ndarray) -> np.ndarray:
+        return np.asarray(self._jacobians[key](z, self.params), dtype=float)
+
+    def _jacobian_modes(self) -> set:
+        return set(self._jacobians)
+
+    # -- the engines
     def compiled(self, section, *, direction: int = 0, where=None, probe=None) -> CompiledModel:
         """The compiled engine's model with the section ``section(z, p) = 0``."""
         if self._compiled is None:
-            self._compiled = compile_system(
+            self._compiled = dataclasses.replace(compile_system(
                 self.names, section=section, section_direction=direction, section_where=where,
                 params=self.params, sample_step=self.sample_step, sliding=self.sliding,
-                name=self.name, probe=probe, **self._user_pieces())
+                name=self.name, probe=probe, **self._user_pieces()),
+                slow_sample_step=self.slow_sample_step, transient_time=self.transient_time)
             return self._compiled
         return with_section(self._compiled, section, direction=direction, where=where)
 
@@ -298,7 +335,7 @@ class FilippovSystem:
         from .simulate import Section
 
         n, p = len(self.names), self.params
-        batch = _batch_scalar(_jit(section, "section"), n)
+        batch = self._section_batch(section)
 
         def func(z):
             zs, tail = _states(z, n)
@@ -312,6 +349,28 @@ class FilippovSystem:
         return Section(name, func, direction=direction, where=cond, terminal=1,
                        min_time=min_time)
 
+    @property
+    def has_jacobians(self) -> bool:
+        """Whether :meth:`jacobian` has the Jacobians of both regions' fields (that of
+        sliding may be absent where the system cannot slide)."""
+        return {"minus", "plus"} <= self._jacobian_modes()
+
+    def jacobian(self, mode: int, z) -> np.ndarray:
+        """``dF/dz`` (n, n) of the field of ``mode`` (MINUS, SLIDING, PLUS) at one state,
+        from the ``jacobians`` pieces: the ``jacobian=`` of :func:`filippov.monodromy`,
+        :func:`filippov.variational.return_jacobian` and friends."""
+        from .system import MODE_NAMES
+
+        key = MODE_NAMES.get(mode)
+        if key not in self._jacobian_modes():
+            raise ValueError(f"jacobian: no Jacobian of mode {mode!r} was given "
+                             f"(have {sorted(self._jacobian_modes())})")
+        n = len(self.names)
+        z = np.ascontiguousarray(z, dtype=float)
+        if z.shape != (n,):
+            raise ValueError(f"jacobian: expected one state of shape ({n},), got {z.shape}")
+        return self._jacobian_value(key, z).reshape(n, n)
+
     def python(self):
         """The reference driver's PiecewiseSystem (built once, then reused)."""
         if self._python is None:
@@ -322,11 +381,7 @@ class FilippovSystem:
         from .system import MINUS, PLUS, PiecewiseSystem
 
         n, p = len(self.names), self.params
-        pc = self._user_pieces()
-        fm = _batch_vector(pc["field_minus"], n)
-        fp = _batch_vector(pc["field_plus"], n)
-        gr = _batch_vector(pc["switch_grad"], n)
-        sw = _batch_scalar(pc["switch"], n)
+        bp = self._batch_pieces()
 
         def vector(batch):
             def piece(z):
@@ -336,21 +391,22 @@ class FilippovSystem:
 
         def scalar(z):
             zs, tail = _states(z, n)
-            out = sw(zs, p)
+            out = bp["switch"](zs, p)
             return out.reshape(tail) if tail else float(out[0])
 
         flows = {}
-        if pc["flow_plus"] is not None and pc["flow_minus"] is not None:
+        if bp["flow_plus"] is not None and bp["flow_minus"] is not None:
             for mode, key in ((PLUS, "flow_plus"), (MINUS, "flow_minus")):
-                batch = _batch_flow(pc[key], n)
-
-                def flow(z0, tau, batch=batch):
+                def flow(z0, tau, batch=bp[key]):
                     tau = np.asarray(tau, dtype=float)
                     out = batch(np.ascontiguousarray(z0, dtype=float),
                                 np.ascontiguousarray(tau.reshape(-1)), p)
                     return out.reshape((n,) + tau.shape)
                 flows[mode] = flow
-        return PiecewiseSystem(names=self.names, field_minus=vector(fm), field_plus=vector(fp),
-                               switch=scalar, switch_grad=vector(gr), flows=flows,
+        return PiecewiseSystem(names=self.names, field_minus=vector(bp["field_minus"]),
+                               field_plus=vector(bp["field_plus"]), switch=scalar,
+                               switch_grad=vector(bp["switch_grad"]), flows=flows,
                                sliding=self.sliding, sample_step=self.sample_step,
+                               slow_sample_step=self.slow_sample_step,
+                               transient_time=self.transient_time,
                                description=f"{self.name} (one definition, compiled pieces)")

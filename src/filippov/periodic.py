@@ -55,13 +55,15 @@ def _returns(system, section, direction: int, engine: str, t_max: float, options
     from .variational import return_jacobian
 
     python, sec = system.python(), system.python_section(section, direction=direction)
+    # exact field Jacobians where the system has them (filippov.symbolic), else differences
+    jac = system.jacobian if getattr(system, "has_jacobians", False) else None
 
     def one(z):
         traj = simulate(python, z, t_max, sections=[sec], dense=False, **options)
         if traj.status != f"section:{sec.name}":
             raise PeriodicOrbitError(f"no return from {np.asarray(z).tolist()} within "
                                      f"t_max={t_max!r} (status {traj.status})")
-        J = return_jacobian(python, traj, sec)
+        J = return_jacobian(python, traj, sec, jacobian=jac)
         return np.asarray(traj.z, dtype=float), float(traj.t - traj.t0), J
     return one
 

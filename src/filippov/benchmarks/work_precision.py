@@ -78,7 +78,11 @@ QUICK = [("project compiled exact", [1e-10]), ("project DOP853", [1e-8]),
 BUILD = {"families": [("project compiled exact", [1e-8, 1e-10, 1e-12]),
                       ("project compiled DOP853", [1e-6, 1e-8, 1e-10, 1e-12]),
                       ("project DOP853", [1e-8, 1e-12]),
-                      ("solve_ivp RK45", [1e-4, 1e-6, 1e-8, 1e-10]),
+                      # not rtol 1e-4: there RK45's steps are long enough to step over
+                      # the section itself, and whether it does (no return: a failed row)
+                      # flipped under a 1-ulp change of the field (measured); `make bench`
+                      # still runs it
+                      ("solve_ivp RK45", [1e-6, 1e-8, 1e-10]),
                       ("solve_ivp DOP853", [1e-6, 1e-8, 1e-10, 1e-12])],
          "every": 20, "every11": 3, "repeat": 3, "time_cap": 10.0, "budget": 0.25}
 PRESETS = {"full": {"families": PROJECT + SCIPY, "every": 10, "every11": 5, "repeat": 3,
@@ -107,9 +111,15 @@ def tolerances() -> dict:
                                  "under a last-bit change (measured)")
     check = Tolerance(1e-6, 1e-12, "difference of two solves at rtol 1e-13 of maps that move "
                                    "by ~3e-13 under a last-bit change (measured)")
+    # each missed switch is a discrete choice (does a step straddle a short excursion
+    # into H_-?) that a step-size sequence changed in its last bits can flip
+    missed = Tolerance(0.5, 2.0, "count of grazing excursions an approximate method steps "
+                                 "over: each decided by where its steps end; 0 -> 2 under a "
+                                 "1-ulp change of the field for RK45 at rtol 1e-4 (measured)")
     return {"wall_time": MEASURED, "time_per_return": MEASURED, "runs": MEASURED, "time_ours_at_target": MEASURED,
             "time_rk45_at_target": MEASURED, "speedup_vs_rk45": MEASURED,
-            "error_map": err, "error_switch": err, "reference_check": check}
+            "error_map": err, "error_switch": err, "reference_check": check,
+            "missed_switches": missed}
 
 
 @dataclass(frozen=True)

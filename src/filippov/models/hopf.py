@@ -25,13 +25,66 @@ integration in the tests:
   and y = y_m-(x(t)) + (y(0) - y_m-(x(0))) exp(-t/eps).
 
 Sliding has no closed form; it is integrated on H_s with the Filippov field.
+
+The model is written once, as SymPy expressions (:data:`DEFINITION`, with these
+flows): the reference driver's :class:`~filippov.model.SlowFastModel` (:func:`model`,
+NumPy) and the compiled engine's pieces (:func:`system`, numba) are generated from
+it, with the switching gradient and the Jacobians (:mod:`filippov.symbolic`).
+Sections are the caller's: :data:`L1` is the one of fig:retmaps.
 """
 from __future__ import annotations
 
 import numpy as np
+import sympy as sp
+from sympy.codegen.cfunctions import expm1
 
 from ..model import TRANSIENT, SlowFastModel
-from ..system import MINUS, PLUS
+from ..symbolic import SymbolicSlowFast
+
+
+# ----------------------------------------------------------------- the definition
+x1, x2, y, eps, theta, mu, omega, t = sp.symbols("x1 x2 y eps theta mu omega t")
+_r2 = x1 ** 2 + x2 ** 2
+#: f_+ = the Hopf normal form (x1', x2')
+HOPF_FIELD = (mu * x1 - omega * x2 - _r2 * x1, omega * x1 + mu * x2 - _r2 * x2)
+#: y on M_-, the exact slow invariant manifold of region - (a cubic in x1)
+SLOW_MANIFOLD_MINUS = (x1 + eps * (mu * x1 - omega * x2 - _r2 * x1 - 1)
+                       - eps ** 2 * (mu - 3 * x1 ** 2 - x2 ** 2) - 6 * eps ** 3 * x1
+                       + 6 * eps ** 4)
+
+
+def _polar_flow_exprs():
+    """The Hopf normal form's flow from (x1, x2) over t: r'= mu r - r^3, phi' = omega;
+    r(t)^2 / r0^2 written with expm1 so that r0^2 = mu stays exact."""
+    scale = sp.sqrt(mu / (mu + (mu - _r2) * expm1(-2 * mu * t)))
+    c, s = sp.cos(omega * t), sp.sin(omega * t)
+    return scale * (c * x1 - s * x2), scale * (s * x1 + c * x2)
+
+
+def _definition() -> SymbolicSlowFast:
+    p1, p2 = _polar_flow_exprs()
+    decay = sp.exp(-t / eps)
+    g = eps * HOPF_FIELD[0] + x1 - y
+    flows = {
+        # region +: y - x1 decays like exp(-t/eps) exactly
+        "full": {"plus": [p1, p2, p1 + (y - x1) * decay],
+                 # region -: x drifts along (1, 0); y relaxes onto M_- exactly
+                 "minus": [x1 + t, x2, SLOW_MANIFOLD_MINUS.subs(x1, x1 + t)
+                           + (y - SLOW_MANIFOLD_MINUS) * decay]},
+        "reduced": {"plus": [p1, p2], "minus": [x1 + t, x2]}}
+    return SymbolicSlowFast(
+        (x1, x2), (y,), f_minus=(1, 0), f_plus=HOPF_FIELD, g_minus=(g,), g_plus=(g,),
+        switch=theta * x1 + (1 - theta) * y + 1, eps=eps,
+        params={eps: 0.01, theta: 0.0, mu: 1.0, omega: 8 * np.pi}, time=t, flows=flows,
+        name="hopf")
+
+
+#: the minimal grazing-sliding example, written once (eq:red; eq:exslow2, eq:exfast2)
+DEFINITION = _definition()
+
+#: the section L1 of fig:retmaps: x1 = 0 crossed downwards with x2 > 0 (the caller's choice;
+#: the model carries no section)
+L1 = {"section": x1, "direction": -1, "where": x2 > 0}
 
 
 def check_parameters(eps: float, theta: float, mu: float, omega: float) -> None:
@@ -46,196 +99,60 @@ def check_parameters(eps: float, theta: float, mu: float, omega: float) -> None:
         raise ValueError(f"omega must be finite and nonzero, got {omega!r}")
 
 
-def hopf_rhs(x1, x2, mu, omega):
-    r2 = x1 * x1 + x2 * x2
-    return mu * x1 - omega * x2 - r2 * x1, omega * x1 + mu * x2 - r2 * x2
+# closed-form helpers for the scenes and tests, printed from the same expressions
+hopf_rhs = sp.lambdify((x1, x2, mu, omega), HOPF_FIELD, "numpy")
+hopf_rhs.__doc__ = "(x1', x2') of the Hopf normal form (f_+), elementwise."
+slow_manifold_minus = sp.lambdify((x1, x2, eps, mu, omega), SLOW_MANIFOLD_MINUS, "numpy")
+slow_manifold_minus.__doc__ = "y on M_-, the exact slow invariant manifold of region -."
+_polar = sp.lambdify((x1, x2, t, mu, omega), _polar_flow_exprs(), "numpy")
 
 
 def polar_flow(x10, x20, tau, mu, omega):
     """Exact flow of the Hopf normal form from (x10, x20) over times tau."""
-    r02 = x10 * x10 + x20 * x20
-    if r02 == 0.0:
-        z = np.zeros_like(tau)
-        return z, z.copy()
-    # r^2/r0^2 written with expm1 so that r0^2 = mu stays exact
-    e = np.expm1(-2.0 * mu * tau)  # exp(-2 mu t) - 1
-    scale = np.sqrt(mu / (mu + (mu - r02) * e))
-    c, s = np.cos(omega * tau), np.sin(omega * tau)
-    return scale * (c * x10 - s * x20), scale * (s * x10 + c * x20)
+    return _polar(x10, x20, tau, mu, omega)
 
 
-def slow_manifold_minus(x1, x2, eps, mu, omega):
-    """y on M_-, the exact slow invariant manifold of the flow in region -."""
-    r2 = x1 * x1 + x2 * x2
-    return (x1 + eps * (mu * x1 - omega * x2 - r2 * x1 - 1.0)
-            - eps ** 2 * (mu - 3.0 * x1 * x1 - x2 * x2) - 6.0 * eps ** 3 * x1 + 6.0 * eps ** 4)
+def _values(eps, theta, mu, omega) -> dict:
+    check_parameters(eps, theta, mu, omega)
+    return {"eps": float(eps), "theta": float(theta), "mu": float(mu), "omega": float(omega)}
 
 
 def model(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi) -> SlowFastModel:
-    check_parameters(eps, theta, mu, omega)
-
-    def f_plus(x, y):
-        return np.stack(hopf_rhs(x[0], x[1], mu, omega))
-
-    def f_minus(x, y):
-        return np.stack([np.ones_like(x[0]), np.zeros_like(x[1])])
-
-    def g(x, y):
-        return eps * hopf_rhs(x[0], x[1], mu, omega)[0] + x[0] - y[0]
-
-    g_ = lambda x, y: g(x, y)[None]
-
-    def flow_plus_full(z0, tau):
-        tau = np.asarray(tau, dtype=float)
-        x1, x2 = polar_flow(z0[0], z0[1], tau, mu, omega)
-        return np.stack([x1, x2, x1 + (z0[2] - z0[0]) * np.exp(-tau / eps)])
-
-    def flow_minus_full(z0, tau):
-        tau = np.asarray(tau, dtype=float)
-        x1 = z0[0] + tau
-        x2 = z0[1] + 0.0 * tau
-        dev0 = z0[2] - slow_manifold_minus(z0[0], z0[1], eps, mu, omega)
-        return np.stack([x1, x2, slow_manifold_minus(x1, x2, eps, mu, omega)
-                         + dev0 * np.exp(-tau / eps)])
-
-    def flow_plus_reduced(z0, tau):
-        return np.stack(polar_flow(z0[0], z0[1], np.asarray(tau, dtype=float), mu, omega))
-
-    def flow_minus_reduced(z0, tau):
-        tau = np.asarray(tau, dtype=float)
-        return np.stack([z0[0] + tau, z0[1] + 0.0 * tau])
-
-    flows = {"reduced": {PLUS: flow_plus_reduced, MINUS: flow_minus_reduced}}
-    if eps > 0:
-        flows["full"] = {PLUS: flow_plus_full, MINUS: flow_minus_full}
+    """The reference driver's model (slow-fast and reduced), from :data:`DEFINITION`."""
+    values = _values(eps, theta, mu, omega)
     period = 2 * np.pi / abs(omega)
-    return SlowFastModel(
-        name="hopf", slow_names=("x1", "x2"), fast_names=("y",),
-        f_minus=f_minus, f_plus=f_plus,
-        h=lambda x, y: theta * x[0] + (1 - theta) * y[0] + 1.0,
-        h_grad=lambda x, y: (np.stack([theta * np.ones_like(x[0]), np.zeros_like(x[1])]),
-                             (1 - theta) * np.ones_like(y)),
-        g_minus=g_, g_plus=g_, eps=eps,
-        y0=lambda x: x[:1].copy(),
-        y0_jac=lambda x: np.stack([np.stack([np.ones_like(x[0]), np.zeros_like(x[1])])]),
-        exact_flows=flows,
+    return DEFINITION.model(
+        values,
         sample_step_full=min(eps / 4, period / 64) if eps > 0 else np.inf,
         sample_step_reduced=period / 64,
         # y - x1 (region +) and y - M_-(x) (region -) decay like exp(-t/eps) exactly:
         # after 40 eps (exp(-40) = 4e-18) only the slow dynamics is left
         slow_sample_step_full=period / 64, transient_time_full=TRANSIENT * eps,
-        units={"t": "1", "x1": "1", "x2": "1", "y": "1"},
-        parameters={"eps": eps, "theta": theta, "mu": mu, "omega": omega})
+        units={"t": "1", "x1": "1", "x2": "1", "y": "1"})
 
 
-# --------------------------------------------------------------------------- compiled
-def compiled(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi, *,
-             sliding: bool = True, exact: bool = True):
-    """The slow-fast system z = (x1, x2, y) with its exact flows, compiled for
-    the compiled engine (:mod:`filippov.abi`), with the section L1 of fig:retmaps (x1 = 0, x1
-    decreasing, x2 > 0). The same formulas as :func:`model`, in scalar form.
-    ``exact=False``: the kernel integrates regions + and - with DOP853 instead."""
-    check_parameters(eps, theta, mu, omega)
+_FULL: dict = {}   # exact -> the slow-fast SymbolicSystem (derived once, then copied)
+
+
+def system(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi, *,
+           sliding: bool = True, exact: bool = True):
+    """The slow-fast system z = (x1, x2, y) from :data:`DEFINITION`, for either engine
+    (a :class:`~filippov.symbolic.GeneratedSystem`; no section: the caller gives one,
+    e.g. ``system(...).compiled(**L1)``). ``exact=False``: regions + and - are
+    integrated instead of following their exact flows."""
+    values = _values(eps, theta, mu, omega)
     if eps <= 0:
         raise ValueError("eps must be > 0 for the slow-fast system")
-    from ..abi import CompiledModel
-
-    pieces = _compiled_pieces()
+    if exact not in _FULL:
+        _FULL[exact] = DEFINITION.full(exact=exact)
     period = 2 * np.pi / abs(omega)
-    return CompiledModel(
-        name="hopf", names=("x1", "x2", "y"),
-        params=np.array([eps, theta, mu, omega], dtype=float), **pieces,
-        section_direction=-1, sample_step=min(eps / 4, period / 64), sliding=sliding,
-        slow_sample_step=period / 64, transient_time=TRANSIENT * eps, exact=exact,
-        parameters={"eps": eps, "theta": theta, "mu": mu, "omega": omega})
+    return _FULL[exact].with_params(**values).with_options(
+        sample_step=min(eps / 4, period / 64), slow_sample_step=period / 64,
+        transient_time=TRANSIENT * eps, sliding=sliding).system()
 
 
-_PIECES = {}
-
-
-def _compiled_pieces() -> dict:
-    """numba versions of the pieces; params p = (eps, theta, mu, omega). Each piece
-    is self-contained (no calls to other compiled functions), so numba caches it."""
-    if _PIECES:
-        return _PIECES
-    from numba import njit
-
-    from ..abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG
-
-    @njit(FLOW_SIG, cache=True)
-    def flow_plus(z0, tau, p, out):
-        eps, mu, omega = p[0], p[2], p[3]
-        x10, x20 = z0[0], z0[1]
-        r02 = x10 * x10 + x20 * x20
-        if r02 == 0.0:
-            x1, x2 = 0.0, 0.0
-        else:
-            e = np.expm1(-2.0 * mu * tau)
-            scale = np.sqrt(mu / (mu + (mu - r02) * e))
-            c, s = np.cos(omega * tau), np.sin(omega * tau)
-            x1, x2 = scale * (c * x10 - s * x20), scale * (s * x10 + c * x20)
-        out[0] = x1
-        out[1] = x2
-        out[2] = x1 + (z0[2] - z0[0]) * np.exp(-tau / eps)
-
-    @njit(FLOW_SIG, cache=True)
-    def flow_minus(z0, tau, p, out):
-        eps, mu, omega = p[0], p[2], p[3]
-        e2, e3, e4 = eps ** 2, eps ** 3, eps ** 4
-        a1, a2 = z0[0], z0[1]
-        r2 = a1 * a1 + a2 * a2
-        ym0 = (a1 + eps * (mu * a1 - omega * a2 - r2 * a1 - 1.0)
-               - e2 * (mu - 3.0 * a1 * a1 - a2 * a2) - 6.0 * e3 * a1 + 6.0 * e4)
-        x1 = z0[0] + tau
-        x2 = z0[1] + 0.0 * tau
-        r2 = x1 * x1 + x2 * x2
-        ym = (x1 + eps * (mu * x1 - omega * x2 - r2 * x1 - 1.0)
-              - e2 * (mu - 3.0 * x1 * x1 - x2 * x2) - 6.0 * e3 * x1 + 6.0 * e4)
-        out[0] = x1
-        out[1] = x2
-        out[2] = ym + (z0[2] - ym0) * np.exp(-tau / eps)
-
-    @njit(FIELD_SIG, cache=True)
-    def field_plus(z, p, out):
-        eps, mu, omega = p[0], p[2], p[3]
-        x1, x2 = z[0], z[1]
-        r2 = x1 * x1 + x2 * x2
-        f1 = mu * x1 - omega * x2 - r2 * x1
-        out[0] = f1
-        out[1] = omega * x1 + mu * x2 - r2 * x2
-        out[2] = (eps * f1 + x1 - z[2]) / eps
-
-    @njit(FIELD_SIG, cache=True)
-    def field_minus(z, p, out):
-        eps, mu, omega = p[0], p[2], p[3]
-        x1, x2 = z[0], z[1]
-        r2 = x1 * x1 + x2 * x2
-        f1 = mu * x1 - omega * x2 - r2 * x1
-        out[0] = 1.0
-        out[1] = 0.0
-        out[2] = (eps * f1 + x1 - z[2]) / eps
-
-    @njit(SCALAR_SIG, cache=True)
-    def h(z, p):
-        theta = p[1]
-        return theta * z[0] + (1 - theta) * z[2] + 1.0
-
-    @njit(FIELD_SIG, cache=True)
-    def grad_h(z, p, out):
-        theta = p[1]
-        out[0] = theta
-        out[1] = 0.0
-        out[2] = 1 - theta
-
-    @njit(SCALAR_SIG, cache=True)
-    def section(z, p):
-        return z[0]
-
-    @njit(WHERE_SIG, cache=True)
-    def section_where(z, p):
-        return z[1] > 0
-
-    _PIECES.update(flow_plus=flow_plus, flow_minus=flow_minus, field_plus=field_plus,
-                   field_minus=field_minus, h=h, grad_h=grad_h, section=section,
-                   section_where=section_where)
-    return _PIECES
+def compiled(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi, *,
+             sliding: bool = True, exact: bool = True):
+    """The compiled engine's model of :func:`system` with the section :data:`L1` of
+    fig:retmaps (x1 = 0, x1 decreasing, x2 > 0)."""
+    return system(eps, theta, mu, omega, sliding=sliding, exact=exact).compiled(**L1)
