@@ -30,9 +30,23 @@ from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
 #: piece kinds -> (signature name in filippov.abi, arguments)
-KINDS = {"vector": ("FIELD_SIG", "z, p, out"), "matrix": ("FIELD_SIG", "z, p, out"),
-         "scalar": ("SCALAR_SIG", "z, p"), "where": ("WHERE_SIG", "z, p"),
-         "flow": ("FLOW_SIG", "z0, tau, p, out")}
+KINDS = {"vector": ("FIELD_SIG", "_z, _p, _out"), "matrix": ("FIELD_SIG", "_z, _p, _out"),
+         "scalar": ("SCALAR_SIG", "_z, _p"), "where": ("WHERE_SIG", "_z, _p"),
+         "flow": ("FLOW_SIG", "_z0, _tau, _p, _out")}
+#: names the generated code uses itself: no state or parameter may take them
+RESERVED = {"math", "numpy", "njit", "FIELD_SIG", "FLOW_SIG", "SCALAR_SIG", "WHERE_SIG", "_out"}
+
+
+def check_name(name: str, what: str) -> None:
+    """A symbol name the generated code can use as a variable (else ValueError)."""
+    import keyword
+    import re
+
+    if not name.isidentifier() or keyword.iskeyword(name) or name.startswith("_") \
+            or name in RESERVED or re.fullmatch(r"c_\d+", name):
+        raise ValueError(f"{what}: the symbol name {name!r} cannot be a variable of the "
+                         f"generated code (use a Python identifier, not starting with '_', "
+                         f"not a keyword, not {sorted(RESERVED - {'_out'})} or c_<number>)")
 
 
 class _Printer(PythonCodePrinter):
@@ -114,18 +128,18 @@ def source(title: str, states: Sequence, params: Sequence, pieces: dict,
            "from filippov.abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG", ""]
     for name, (kind, exprs) in pieces.items():
         sig, args = KINDS[kind]
-        zname = "z0" if kind == "flow" else "z"
+        zname = "_z0" if kind == "flow" else "_z"
         head = [f"{s} = {zname}[{i}]" for i, s in enumerate(states)]
-        head += [f"{s} = p[{i}]" for i, s in enumerate(params)]
+        head += [f"{s} = _p[{i}]" for i, s in enumerate(params)]
         if kind == "flow":
-            head.append(f"{time} = tau")
+            head.append(f"{time} = _tau")
         lines, res = _body(list(exprs), head)
         out += ["", f"@njit({sig}, cache=True)", f"def {name}({args}):"]
         out += ["    " + ln for ln in lines]
         if kind in ("scalar", "where"):
             out.append(f"    return {res[0]}")
         else:
-            out += [f"    out[{k}] = {r}" for k, r in enumerate(res)]
+            out += [f"    _out[{k}] = {r}" for k, r in enumerate(res)]
         if kind in _BATCH:
             out.append(_BATCH[kind].format(name=name, n=n))
     return "\n".join(out) + "\n"

@@ -46,6 +46,10 @@ def _symbols(seq, what: str) -> tuple:
         if not isinstance(s, sp.Symbol):
             raise SymbolicError(f"{what}: expected SymPy symbols, got {s!r} "
                                 f"({type(s).__name__})")
+        try:
+            codegen.check_name(s.name, what)
+        except ValueError as exc:
+            raise SymbolicError(str(exc)) from None
     if len(set(out)) != len(out):
         raise SymbolicError(f"{what}: a symbol appears twice in {list(out)}")
     return out
@@ -152,6 +156,7 @@ class SymbolicSystem:
             if set(flows) != set(MODES):
                 raise SymbolicError(f"flows: give the flows of both regions "
                                     f"('minus' and 'plus'), got {sorted(flows)}")
+            _symbols([time], "time")
             self.time = time
             for mode in MODES:
                 self.flows[mode] = _vector(flows[mode], n, f"flows[{mode!r}]")
@@ -341,6 +346,12 @@ class GeneratedSystem(FilippovSystem):
         return super()._section_batch(section)
 
 
+def _regions(flows):
+    """The flows of regions - and +: the compiled engine integrates sliding (a sliding
+    flow serves the reference driver's model only)."""
+    return None if not flows else {m: flows[m] for m in MODES}
+
+
 class SymbolicSlowFast:
     """A slow-fast Filippov model (the paper's eq:sgfilipslow, eq:sgfilipfast) in SymPy.
 
@@ -366,7 +377,9 @@ class SymbolicSlowFast:
     flows : mapping, optional
         Exact flows: ``{"full": {"minus": [...], "plus": [...]}, "reduced": {...}}``,
         each component a function of the start state (the state symbols) and ``time``;
-        either kind may be missing (that system is then integrated).
+        either kind may be missing (that system is then integrated). A ``"sliding"``
+        flow (on the switching surface) serves :meth:`model` (the reference driver);
+        the compiled engine integrates sliding.
     """
 
     def __init__(self, slow, fast, f_minus, f_plus, g_minus, g_plus, switch, *, eps,
@@ -386,6 +399,11 @@ class SymbolicSlowFast:
         if unknown:
             raise SymbolicError(f"flows: unknown system kind(s) {sorted(unknown)}; expected "
                                 f"'full' and/or 'reduced'")
+        for kind, modes in self.flows.items():
+            bad = set(modes) - {"minus", "plus", "sliding"}
+            if bad or not {"minus", "plus"} <= set(modes):
+                raise SymbolicError(f"flows[{kind!r}]: expected the flows of 'minus' and "
+                                    f"'plus' (and optionally 'sliding'), got {sorted(modes)}")
 
     def _params(self, values: Mapping, *, reduced: bool = False) -> dict:
         names = {str(s): s for s in self.params}
@@ -408,7 +426,7 @@ class SymbolicSlowFast:
             raise SymbolicError(f"eps: the slow-fast system needs eps > 0, got "
                                 f"{params[self.eps]!r} (use reduced() for eps = 0)")
         e = self.eps
-        flows = self.flows.get("full") if exact else None
+        flows = _regions(self.flows.get("full")) if exact else None
         return SymbolicSystem(self.slow + self.fast,
                               self.f_minus + tuple(g / e for g in self.g_minus),
                               self.f_plus + tuple(g / e for g in self.g_plus), self.switch,
@@ -437,7 +455,7 @@ class SymbolicSlowFast:
         """The quasi-static system in ``x`` (``y = y0(x)``, eps = 0)."""
         y0 = self.quasi_static()
         sub = lambda e: e.subs(y0).subs(self.eps, 0)  # noqa: E731
-        flows = self.flows.get("reduced") if exact else None
+        flows = _regions(self.flows.get("reduced")) if exact else None
         return SymbolicSystem(self.slow, [sub(f) for f in self.f_minus],
                               [sub(f) for f in self.f_plus], sub(self.switch),
                               params=self._params(values or {}, reduced=True),
@@ -450,21 +468,21 @@ class SymbolicSlowFast:
         ``y0(x, p)``, its Jacobian, and the exact flows ``(z0, tau, p)``."""
         x, y, ps = list(self.slow), list(self.fast), list(self.params)
         nx, ny = len(x), len(y)
-        xy = [("x", x), ("y", y), ("p", ps)]
+        xy = [("_x", x), ("_y", y), ("_p", ps)]
         y0 = self.quasi_static()
-        fns = [(k, xy, exprs, (len(exprs),), "x[0]") for k, exprs in (
+        fns = [(k, xy, exprs, (len(exprs),), "_x[0]") for k, exprs in (
             ("f_minus", self.f_minus), ("f_plus", self.f_plus),
             ("g_minus", self.g_minus), ("g_plus", self.g_plus))]
-        fns += [("h", xy, [self.switch], (), "x[0]"),
-                ("h_grad_x", xy, [sp.diff(self.switch, v) for v in x], (nx,), "x[0]"),
-                ("h_grad_y", xy, [sp.diff(self.switch, v) for v in y], (ny,), "x[0]"),
-                ("y0", [("x", x), ("p", ps)], [y0[v] for v in y], (ny,), "x[0]"),
-                ("y0_jac", [("x", x), ("p", ps)], [sp.diff(y0[v], u) for v in y for u in x],
-                 (ny, nx), "x[0]")]
+        fns += [("h", xy, [self.switch], (), "_x[0]"),
+                ("h_grad_x", xy, [sp.diff(self.switch, v) for v in x], (nx,), "_x[0]"),
+                ("h_grad_y", xy, [sp.diff(self.switch, v) for v in y], (ny,), "_x[0]"),
+                ("y0", [("_x", x), ("_p", ps)], [y0[v] for v in y], (ny,), "_x[0]"),
+                ("y0_jac", [("_x", x), ("_p", ps)], [sp.diff(y0[v], u) for v in y for u in x],
+                 (ny, nx), "_x[0]")]
         for kind, states in (("full", x + y), ("reduced", x)):
             for mode, exprs in self.flows.get(kind, {}).items():
-                fns.append((f"flow_{kind}_{mode}", [("z0", states), ("tau", self.time),
-                                                     ("p", ps)], exprs, (len(states),), "tau"))
+                fns.append((f"flow_{kind}_{mode}", [("_z0", states), ("_tau", self.time),
+                                                     ("_p", ps)], exprs, (len(states),), "_tau"))
         return codegen.numpy_source(f"the slow-fast model {self.name!r}", fns)
 
     def model(self, values: Optional[Mapping] = None, **options):
@@ -472,7 +490,7 @@ class SymbolicSlowFast:
         ``values`` (by name; defaults from ``params``); ``options`` are its sampling
         fields (``sample_step_full``, ``transient_time_full``, ``units``, ...)."""
         from .model import SlowFastModel
-        from .system import MINUS, PLUS
+        from .system import MINUS, PLUS, SLIDING
 
         params = self._params(values or {})
         p = tuple(params.values())
@@ -485,7 +503,7 @@ class SymbolicSlowFast:
         def flow(fn):
             return lambda z0, tau: fn(z0, np.asarray(tau, dtype=float), p)
 
-        codes = {"minus": MINUS, "plus": PLUS}
+        codes = {"minus": MINUS, "plus": PLUS, "sliding": SLIDING}
         flows = {kind: {codes[m]: flow(getattr(mod, f"flow_{kind}_{m}")) for m in modes}
                  for kind, modes in self.flows.items()
                  if kind == "reduced" or params[self.eps] > 0}
