@@ -30,14 +30,20 @@ Each region's friction is a smooth (analytic) branch defined for all nu,
 ``F_plus`` (nu <= 0) and ``F_minus`` (nu > 0), so the fields extend smoothly
 across H_s, as the slow-manifold construction needs.
 
-No region has a closed-form flow: every mode is integrated (DOP853).
+No region has a closed-form flow: every mode is integrated (DOP853). The model is
+written once (:data:`DEFINITION`, SymPy); the reference driver's and the compiled
+engine's pieces and the Jacobians are generated from it.
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
+import sympy as sp
 from scipy.integrate import solve_ivp
 
 from ..model import SlowFastModel
+from ..symbolic import SymbolicSlowFast
 
 CONVENTIONS = ("stribeck", "literal")
 
@@ -104,34 +110,59 @@ def equilibrium(v, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck"):
     return np.stack([-Fp(-np.asarray(v, dtype=float)), np.zeros_like(np.asarray(v, float))])
 
 
+# ----------------------------------------------------------------- the definition
+x1, x2, w, eps, v0, gamma, s0, sc, fv = sp.symbols("x1 x2 w eps v0 gamma s0 sc fv")
+_nu = (1 + gamma) * x2 - w
+# the friction branches with coefficients (s0, sc) of friction_branches: region + (nu < 0)
+# and region - (nu > 0), each extended to all nu
+_F_PLUS = -s0 - sc * (1 - sp.exp(_nu)) + fv * _nu
+_F_MINUS = s0 + sc * (1 - sp.exp(-_nu)) + fv * _nu
+_G = -w + v0 + gamma * x2 - eps * gamma * x1
+
+#: eq:dfo-sf written once; the friction law enters through (s0, sc) (see :func:`_coefficients`)
+DEFINITION = SymbolicSlowFast(
+    (x1, x2), (w,), f_minus=(x2, -x1 - _F_MINUS), f_plus=(x2, -x1 - _F_PLUS),
+    g_minus=(_G,), g_plus=(_G,), switch=w - (1 + gamma) * x2, eps=eps,
+    params={eps: 0.01, v0: 1.0, gamma: 2.0, s0: 2.0, sc: -2.5, fv: 0.3}, name="dry_friction")
+
+#: the section L of fig:dfo-retmap: x2 = 0 crossed downward with x1 > 0 (the caller's choice)
+L = {"section": x2, "direction": -1, "where": x1 > 0}
+
+
+def _coefficients(f0, fc, convention) -> tuple:
+    """(s0, sc) of the branches: F_c(nu) = sgn(nu) [s0 + sc (1 - e^{-|nu|})] + fv nu."""
+    return (-f0, -fc) if convention == "stribeck" else (f0, fc)
+
+
+def _values(eps, v0, gamma, f0, fv, fc, convention) -> dict:
+    check_parameters(eps, v0, gamma, f0, fv, fc, convention)
+    a, c = _coefficients(f0, fc, convention)
+    return {"eps": eps, "v0": v0, "gamma": gamma, "s0": a, "sc": c, "fv": fv}
+
+
 def model(eps: float, v0: float, gamma: float = 2.0, f0: float = -2.0, fv: float = 0.3,
           fc: float = 2.5, convention: str = "stribeck") -> SlowFastModel:
-    check_parameters(eps, v0, gamma, f0, fv, fc, convention)
-    Fp, dFp, Fm, dFm = friction_branches(f0, fv, fc, convention)
-    g1 = 1.0 + gamma
+    """The reference driver's model (slow-fast and reduced), from :data:`DEFINITION`."""
+    m = DEFINITION.model(_values(eps, v0, gamma, f0, fv, fc, convention),
+                         units={"t": "1", "x1": "1", "x2": "1", "w": "1"})
+    return dataclasses.replace(m, parameters={"eps": eps, "v0": v0, "gamma": gamma, "f0": f0,
+                                              "fv": fv, "fc": fc, "convention": convention})
 
-    def slow(F):
-        def f(x, y):
-            return np.stack([x[1] + 0.0 * y[0], -x[0] - F(g1 * x[1] - y[0])])
-        return f
 
-    def g(x, y):
-        return (-y[0] + v0 + gamma * x[1] - eps * gamma * x[0])[None]
+_FULL: dict = {}
 
-    def h_grad(x, y):
-        return (np.stack([np.zeros_like(x[0]), -g1 * np.ones_like(x[1])]),
-                np.ones_like(y))
 
-    return SlowFastModel(
-        name="dry_friction", slow_names=("x1", "x2"), fast_names=("w",),
-        f_minus=slow(Fm), f_plus=slow(Fp),
-        h=lambda x, y: y[0] - g1 * x[1], h_grad=h_grad,
-        g_minus=g, g_plus=g, eps=eps,
-        y0=lambda x: (v0 + gamma * x[1])[None],
-        y0_jac=lambda x: np.stack([np.stack([np.zeros_like(x[0]), gamma * np.ones_like(x[1])])]),
-        units={"t": "1", "x1": "1", "x2": "1", "w": "1"},
-        parameters={"eps": eps, "v0": v0, "gamma": gamma, "f0": f0, "fv": fv, "fc": fc,
-                    "convention": convention})
+def system(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck", *,
+           sliding=True):
+    """The slow-fast system eq:dfo-sf for either engine (a
+    :class:`~filippov.symbolic.GeneratedSystem`, no section). No region has a
+    closed-form flow: every mode is integrated (DOP853)."""
+    values = _values(eps, v0, gamma, f0, fv, fc, convention)
+    if eps <= 0:
+        raise ValueError("eps must be > 0 for the slow-fast system")
+    if not _FULL:
+        _FULL[True] = DEFINITION.full()
+    return _FULL[True].with_params(**values).with_options(sliding=sliding).system()
 
 
 # --------------------------------------------------------------------------- slow manifold
@@ -261,52 +292,24 @@ def plus_field_reduced(v, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck"):
 
 
 def reduced_jacobian(v, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck"):
-    """``jacobian(mode, x)`` of the reduced system's fields, for
-    :func:`filippov.continuation.monodromy`. The Filippov sliding field,
-    written with the region fields as functions of x, is (x2, 0) identically:
-    a = x1 + F_minus, b = x1 + F_plus and its second component
-    (a f_+2 - b f_-2)/(a - b) cancels."""
-    from ..system import MINUS, PLUS
-
-    _, dFp, _, dFm = friction_branches(f0, fv, fc, convention)
-
-    def jac(mode, x):
-        if mode == PLUS:
-            return np.array([[0.0, 1.0], [-1.0, -dFp(x[1] - v)]])
-        if mode == MINUS:
-            return np.array([[0.0, 1.0], [-1.0, -dFm(x[1] - v)]])
-        return np.array([[0.0, 1.0], [0.0, 0.0]])
-
-    return jac
+    """``jacobian(mode, x)`` of the reduced system's fields (region +, region - and
+    Filippov's sliding field), for :func:`filippov.continuation.monodromy`:
+    differentiated from :data:`DEFINITION` (the sliding field, with the region fields
+    as functions of x, is (x2, 0) up to rounding: a = x1 + F_minus, b = x1 + F_plus and
+    its second component cancels)."""
+    a, c = _coefficients(f0, fc, convention)
+    key = ("reduced",)
+    if key not in _FULL:
+        _FULL[key] = DEFINITION.reduced()
+    return _FULL[key].with_params(v0=v, s0=a, sc=c, fv=fv).system().jacobian
 
 
 def full_system(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck",
                 sliding=True):
-    """The slow-fast system eq:dfo-sf as a PiecewiseSystem, identical to
-    ``model(...).full()`` but with the fields written out: the solver calls them
-    thousands of times per return, and the generic stacking costs 5x more."""
-    from ..system import PiecewiseSystem
-
-    check_parameters(eps, v0, gamma, f0, fv, fc, convention)
-    if eps <= 0:
-        raise ValueError("eps must be > 0 for the slow-fast system")
-    Fp, _, Fm, _ = friction_branches(f0, fv, fc, convention)
-    g1, ie, eg = 1.0 + gamma, 1.0 / eps, eps * gamma
-
-    def field(F):
-        def fn(z):
-            x1, x2, w = z[0], z[1], z[2]
-            return np.array([x2, -x1 - F(g1 * x2 - w), (v0 + gamma * x2 - w - eg * x1) * ie])
-        return fn
-
-    grad = np.array([0.0, -g1, 1.0])
-    return PiecewiseSystem(
-        names=("x1", "x2", "w"), field_minus=field(Fm), field_plus=field(Fp),
-        switch=lambda z: z[2] - g1 * z[1],
-        switch_grad=lambda z: grad.copy() if np.ndim(z) == 1 else
-        np.broadcast_to(grad[:, None], np.shape(z)).copy(),
-        sliding=sliding, units={"t": "1", "x1": "1", "x2": "1", "w": "1"},
-        description=f"dry_friction: slow-fast system, eps={eps!r}, v0={v0!r}")
+    """The slow-fast system eq:dfo-sf as the reference driver's PiecewiseSystem: the
+    generated pieces of :func:`system` (compiled loops over the samples; the same code
+    as the compiled engine's, so the two engines see the same field values)."""
+    return system(eps, v0, gamma, f0, fv, fc, convention, sliding=sliding).python()
 
 
 def _barycentric(nodes, weights, values, x):
@@ -360,73 +363,6 @@ def slow_manifold_plus_on_L(x1_lo, x1_hi, eps, v0, n=33, **kwargs):
 # --------------------------------------------------------------------------- compiled
 def compiled(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck", *,
              sliding=True):
-    """The slow-fast system eq:dfo-sf, compiled for the compiled engine (:mod:`filippov.abi`), with
-    the section L of fig:dfo-retmap (x2 = 0 crossed downward, x1 > 0). No region
-    has a closed-form flow, so every mode is integrated (DOP853) inside the
-    kernel. The same formulas as :func:`full_system`, operation for operation."""
-    check_parameters(eps, v0, gamma, f0, fv, fc, convention)
-    if eps <= 0:
-        raise ValueError("eps must be > 0 for the slow-fast system")
-    from ..abi import CompiledModel, no_flow
-
-    s0, sc = (-f0, -fc) if convention == "stribeck" else (f0, fc)
-    return CompiledModel(
-        name="dry_friction", names=("x1", "x2", "w"),
-        params=np.array([eps, v0, gamma, s0, sc, fv], dtype=float),
-        flow_plus=no_flow, flow_minus=no_flow, **_compiled_pieces(),
-        section_direction=-1, sample_step=np.inf, sliding=sliding, exact=False,
-        parameters={"eps": eps, "v0": v0, "gamma": gamma, "f0": f0, "fv": fv, "fc": fc})
-
-
-_PIECES = {}
-
-
-def _compiled_pieces() -> dict:
-    """numba versions of the pieces; p = (eps, v0, gamma, s0, sc, fv) with the
-    friction branches F_+(nu) = -s0 - sc (1 - e^nu) + fv nu (region +) and
-    F_-(nu) = s0 + sc (1 - e^-nu) + fv nu (region -), nu = (1 + gamma) x2 - w."""
-    if _PIECES:
-        return _PIECES
-    from numba import njit
-
-    from ..abi import FIELD_SIG, SCALAR_SIG, WHERE_SIG
-
-    @njit(FIELD_SIG, cache=True)
-    def field_plus(z, p, out):
-        eps, v0, gamma, s0, sc, fv = p[0], p[1], p[2], p[3], p[4], p[5]
-        x1, x2, w = z[0], z[1], z[2]
-        nu = (1.0 + gamma) * x2 - w
-        out[0] = x2
-        out[1] = -x1 - (-s0 - sc * (1.0 - np.exp(nu)) + fv * nu)
-        out[2] = (v0 + gamma * x2 - w - (eps * gamma) * x1) * (1.0 / eps)
-
-    @njit(FIELD_SIG, cache=True)
-    def field_minus(z, p, out):
-        eps, v0, gamma, s0, sc, fv = p[0], p[1], p[2], p[3], p[4], p[5]
-        x1, x2, w = z[0], z[1], z[2]
-        nu = (1.0 + gamma) * x2 - w
-        out[0] = x2
-        out[1] = -x1 - (s0 + sc * (1.0 - np.exp(-nu)) + fv * nu)
-        out[2] = (v0 + gamma * x2 - w - (eps * gamma) * x1) * (1.0 / eps)
-
-    @njit(SCALAR_SIG, cache=True)
-    def h(z, p):
-        return z[2] - (1.0 + p[2]) * z[1]
-
-    @njit(FIELD_SIG, cache=True)
-    def grad_h(z, p, out):
-        out[0] = 0.0
-        out[1] = -(1.0 + p[2])
-        out[2] = 1.0
-
-    @njit(SCALAR_SIG, cache=True)
-    def section(z, p):
-        return z[1]
-
-    @njit(WHERE_SIG, cache=True)
-    def section_where(z, p):
-        return z[0] > 0
-
-    _PIECES.update(field_plus=field_plus, field_minus=field_minus, h=h, grad_h=grad_h,
-                   section=section, section_where=section_where)
-    return _PIECES
+    """:func:`system` on the compiled engine with the section :data:`L` of
+    fig:dfo-retmap (x2 = 0 crossed downward, x1 > 0)."""
+    return system(eps, v0, gamma, f0, fv, fc, convention, sliding=sliding).compiled(**L)
