@@ -9,21 +9,31 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def test_the_readme_user_example_runs_and_finds_the_relay_orbit():
-    text = (ROOT / "README.md").read_text()
-    section = text[text.index("## Your own system"):text.index("## A system written once in SymPy")]
-    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
-    assert len(code.strip().splitlines()) <= 30
-    out = io.StringIO()
-    scope = {}
-    with contextlib.redirect_stdout(out):
-        exec(compile(code, "README.md", "exec"), scope)
-    # the closed form of examples/relay_feedback.py: period and multipliers
+def _relay_example():
+    """examples/relay_feedback.py (its closed form: period, start point, multipliers)."""
     import importlib.util
 
     spec = importlib.util.spec_from_file_location("relay", ROOT / "examples" / "relay_feedback.py")
     relay = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(relay)
+    return relay
+
+
+def _run_first_block(start: str, end: str):
+    """(scope, stdout) of the first python block of the README section start..end."""
+    text = (ROOT / "README.md").read_text()
+    code = re.search(r"```python\n(.*?)```", text[text.index(start):text.index(end)],
+                     re.S).group(1)
+    out, scope = io.StringIO(), {"__code__": code}
+    with contextlib.redirect_stdout(out):
+        exec(compile(code, "README.md", "exec"), scope)
+    return scope, out.getvalue()
+
+
+def test_the_readme_user_example_runs_and_finds_the_relay_orbit():
+    scope, out = _run_first_block("## Your own system", "## A system written once in SymPy")
+    assert len(scope["__code__"].strip().splitlines()) <= 30
+    relay = _relay_example()
     want = relay.closed_form()
     assert abs(scope["orbit"].t - want["period"]) < 1e-10
     got = np.sort(np.abs(np.linalg.eigvals(
@@ -31,7 +41,7 @@ def test_the_readme_user_example_runs_and_finds_the_relay_orbit():
                                  jacobian=lambda mode, z: relay.A))))[::-1]
     # dP/dz has the nontrivial multipliers and a 0 (the section direction)
     np.testing.assert_allclose(got[:2], want["multipliers"][1:], rtol=1e-6)
-    assert "Floquet multipliers" in out.getvalue()
+    assert "Floquet multipliers" in out
 
 
 def test_the_readme_compiled_engine_block_runs():
@@ -53,20 +63,10 @@ def test_the_readme_compiled_engine_block_runs():
 
 
 def test_the_readme_symbolic_block_finds_the_relay_orbit_on_both_engines():
-    text = (ROOT / "README.md").read_text()
-    section = text[text.index("## A system written once in SymPy"):text.index("## Examples")]
-    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
-    out = io.StringIO()
-    scope = {}
-    with contextlib.redirect_stdout(out):
-        exec(compile(code, "README.md", "exec"), scope)
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("relay", ROOT / "examples" / "relay_feedback.py")
-    relay = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(relay)
+    scope, out = _run_first_block("## A system written once in SymPy", "## Examples")
+    relay = _relay_example()
     want = relay.closed_form()
     assert abs(scope["po"].period - want["period"]) < 1e-12       # the last engine: python
     np.testing.assert_allclose(scope["po"].multipliers, want["multipliers"], atol=1e-9)
     assert np.array_equal(np.asarray(scope["relay_sym"].jacobians["plus"], dtype=float), relay.A)
-    assert "compiled 3.67975067086" in out.getvalue()
+    assert "compiled 3.67975067086" in out
