@@ -116,3 +116,21 @@ def test_dense_samples_follow_the_exact_solution():
     assert np.all(mode == PLUS)
     y = x0 - t + eps + (y0 - x0 - eps) * np.exp(-t / eps)
     assert np.max(np.abs(z[1] - y)) < 1e-15
+
+
+def test_a_sign_change_the_samples_saw_survives_refinement():
+    """Samples are array evaluations, the refinement's values scalar ones; the two may
+    round differently (numpy's SIMD loops, another CPU: found by the emulated CPU on
+    fig09, where dH/dt near the grazing point changed sign in the samples but not at the
+    ends of the bracket). The bracket keeps the sampled end values instead of failing."""
+    from filippov import rules
+    from filippov.simulate import _brent, _refine
+
+    fun = lambda t: 1e-17 + 0.0 * t          # noqa: E731  (scalar: positive at both ends)
+    # the samples saw +1e-17 at t = 0 and -1e-17 at t = 1: a root in [0, 1], not an error
+    r = _brent(fun, 0.0, 1.0, 1e-17, -1e-17, 1e-12)
+    assert 0.0 <= r <= 1.0
+    r = _refine(fun, rules.TO_NEG, 0.0, 1.0, 1e-17, -1e-17, 1e-12)
+    assert r == 1.0                          # the scalar never crosses: the sampled end
+    with pytest.raises(ValueError):          # no sign change anywhere: still an error
+        _brent(fun, 0.0, 1.0, 1e-17, 2e-17, 1e-12)

@@ -22,11 +22,22 @@ FIELD_SIG = types.void(_vec, _vec, _vec)
 SCALAR_SIG = types.float64(_vec, _vec)
 #: ``where(z, params)``: the condition a section hit must satisfy.
 WHERE_SIG = types.boolean(_vec, _vec)
+#: ``jacobian(mode, z, params, out)``: dF/dz of the field of ``mode`` (-1 region -,
+#: 0 Filippov's sliding field, +1 region +) at z, row by row into ``out`` (n*n).
+JAC_SIG = types.void(types.int64, _vec, _vec, _vec)
 
 
 @njit(FLOW_SIG, cache=True)
 def no_flow(z0, tau, p, out):
     """Stands in for the flows of a model without them (never called: exact=False)."""
+    for k in range(out.size):
+        out[k] = np.nan
+
+
+@njit(JAC_SIG, cache=True)
+def no_jacobian(mode, z, p, out):
+    """Stands in for the Jacobian of a model without one (never called: the engine
+    takes Jacobian-vector products by central differences of the field instead)."""
     for k in range(out.size):
         out[k] = np.nan
 
@@ -73,6 +84,9 @@ class CompiledModel:
     exact: bool = True
     slow_sample_step: float = np.nan   # see filippov.system.PiecewiseSystem
     transient_time: float = np.inf
+    #: optional :data:`JAC_SIG` piece: exact Jacobians for dP/dz through integrated stays
+    #: (None: Jacobian-vector products by central differences of the field)
+    jacobian: Any = None
 
     @property
     def dim(self) -> int:

@@ -60,7 +60,8 @@ import numpy as np
 
 from . import rules
 # what a model hands the engine (its pieces' signatures, CompiledModel), re-exported here
-from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, no_flow  # noqa: F401
+from .abi import (FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel,  # noqa: F401
+                  no_flow, no_jacobian)
 # the kernel (filippov.kernel) and its status codes, re-exported here
 from .kernel.base import (BAD_START, EVENT_LIMIT, NO_RETURN, NO_SLIDING,  # noqa: F401
                           NON_FINITE, OK, ROOT_FAILED, SECTION_SLIDING, STATUS, STEP_FAILED,
@@ -192,8 +193,9 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     frac_in = np.linspace(0.0, 1.0, samples_per_step + 1)
     fopts = np.array([rtol, atol, touch_tol, event_xtol, zeno_span, max_step, hwin_slow,
                       cmodel.transient_time, min_time], dtype=float)
-    iopts = np.array([max_events, max_steps, zeno_count, iterations, int(bool(jacobian))],
-                     dtype=np.int64)
+    # dP/dz: 0 none, 1 Jacobian-vector products by differences, 2 the model's Jacobians
+    jac_mode = (2 if cmodel.jacobian is not None else 1) if jacobian else 0
+    iopts = np.array([max_events, max_steps, zeno_count, iterations, jac_mode], dtype=np.int64)
     m = starts.shape[0]
     state = np.empty_like(starts)
     time = np.empty(m)
@@ -211,7 +213,8 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     params = np.ascontiguousarray(cmodel.params, dtype=float)
     compile_kernel()
     _batch(cmodel.flow_plus, cmodel.flow_minus, cmodel.field_plus, cmodel.field_minus,
-           cmodel.h, cmodel.grad_h, cmodel.section, cmodel.section_where, params,
+           cmodel.h, cmodel.grad_h, cmodel.section, cmodel.section_where,
+           no_jacobian if cmodel.jacobian is None else cmodel.jacobian, params,
            starts, ages, float(t_max), bool(cmodel.exact), float(hwin), _section_pred(cmodel.section_direction),
            bool(cmodel.sliding), frac_ex, frac_in, fopts, iopts, state, time, nsw, slide, status,
            first, slide_dz, orbit, done, jac, orbit_jac, age)

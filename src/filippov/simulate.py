@@ -314,6 +314,21 @@ def spectral_radius(fun, t, z, iterations: int = 6) -> float:
     return rho
 
 
+def _brent(fun, ta, tb, fa, fb, xtol):
+    """Brent's root of ``fun`` in [ta, tb], whose sampled values ``fa``, ``fb`` differ in
+    sign. The samples come from array evaluations and ``fun`` from scalar ones, which
+    may round differently (numpy's SIMD loops, another CPU): where ``fun`` at the ends
+    has lost the sign change the samples saw, the bracket keeps the sampled end values
+    (the interior is ``fun``'s), so a change the scan decided on is never dropped."""
+    try:
+        return brentq(fun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=200)
+    except ValueError:
+        if not (fa * fb <= 0 and (fa != 0 or fb != 0)):
+            raise
+    pinned = lambda t: fa if t == ta else fb if t == tb else fun(t)  # noqa: E731
+    return brentq(pinned, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=200)
+
+
 def _refine(fun, pred, ta, tb, va, vb, xtol):
     """Root of ``fun`` in [ta, tb], returned on the far side of the crossing."""
     pred = rules.far_side(pred, va)
@@ -328,8 +343,8 @@ def _refine(fun, pred, ta, tb, va, vb, xtol):
             # value a hair past the crossing already: the event is at once
             if rules.after(pred, fun(ta)):
                 r = ta
-            else:
-                raise
+            else:   # the far end lost the sign change the samples saw (see _brent)
+                r = _brent(fun, ta, tb, va, vb, xtol)
     # Brent may stop a hair before the sign flips (rounding in fun near a shallow
     # crossing): step forward by doubling increments until it has flipped.
     step = 2 * np.spacing(max(abs(r), _TINY))
@@ -763,7 +778,7 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
                 if (mode != SLIDING and first and i == 0
                         and rules.dips_and_returns(mode, D[0], D[1])):
                     # refine beyond the dip: next to the entry H is noise (rules)
-                    tm = brentq(dfun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps)
+                    tm = _brent(dfun, ta, tb, D[0], D[1], xtol)
                     hm = float(func(Z(tm)))
                     if not rules.after(pred, hm):
                         lo, vlo = tm, hm
@@ -774,7 +789,7 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
             # a minimum (in +) or maximum (in -) of H hidden between samples
             H = vals[0]
             if rules.extremum_between(mode, D[i], D[i + 1]):
-                tm = brentq(dfun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps)
+                tm = _brent(dfun, ta, tb, D[i], D[i + 1], xtol)
                 Hm = float(leave[0][0](Z(tm)))
                 pred = leave[0][1]
                 kind = rules.graze(mode, Hm, touch_tol)

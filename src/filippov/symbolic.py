@@ -196,7 +196,7 @@ class SymbolicSystem:
         if "system" not in self._generated:
             self._generated["system"] = codegen.source(
                 f"the system {self.name!r}", self.states, self.param_symbols, self._pieces(),
-                time=self.time)
+                time=self.time) + codegen.jacobian_dispatch("sliding" in self.jacobians)
         return self._generated["system"]
 
     def section_source(self, section, where=None) -> str:
@@ -326,7 +326,7 @@ class GeneratedSystem(FilippovSystem):
             grad_h=m.switch_grad, section=sec, section_where=wh or always,
             section_direction=int(direction), sample_step=self.sample_step,
             slow_sample_step=self.slow_sample_step, transient_time=self.transient_time,
-            sliding=self.sliding, exact=exact,
+            sliding=self.sliding, exact=exact, jacobian=m.jacobian,
             parameters={str(k): float(v) for k, v in zip(self.symbolic.param_symbols,
                                                          self.params)})
 

@@ -7,7 +7,7 @@ import numpy as np
 from numba import njit, types
 
 from .. import rules
-from ..abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG
+from ..abi import FIELD_SIG, FLOW_SIG, JAC_SIG, SCALAR_SIG, WHERE_SIG
 
 
 # ----------------------------------------------------------------------------- signatures
@@ -16,6 +16,7 @@ _FLOW = types.FunctionType(FLOW_SIG)
 _FIELD = types.FunctionType(FIELD_SIG)
 _SCALAR = types.FunctionType(SCALAR_SIG)
 _WHERE = types.FunctionType(WHERE_SIG)
+_JAC = types.FunctionType(JAC_SIG)
 
 # ----------------------------------------------------------------------------- status codes
 OK = 0

@@ -93,10 +93,32 @@ def _jvp(mode, y, v, out, fns, p, w):
 
 
 @_jit
-def _var_step(mode, y0, h, fns, p, w):
+def _var_stage(s, mode, exact, fns, p, w):
+    """w.KP[s] = J(w.ys) w.Mt: with the model's exact Jacobian (one evaluation), or
+    column by column with Jacobian-vector products by central differences."""
+    n = w.ys.size
+    if exact:
+        fns[8](mode, w.ys, p, w.Jm)
+        for a in range(n):
+            for b in range(n):
+                acc = 0.0
+                for k in range(n):
+                    acc += w.Jm[a * n + k] * w.Mt[k, b]
+                w.KP[s, a, b] = acc
+        return
+    for b in range(n):
+        for a in range(n):
+            w.jv[a] = w.Mt[a, b]
+        _jvp(mode, w.ys, w.jv, w.jo, fns, p, w)
+        for a in range(n):
+            w.KP[s, a, b] = w.jo[a]
+
+
+@_jit
+def _var_step(mode, y0, h, fns, p, w, exact):
     """w.M <- the DOP853 step of size h from y0 applied to the variational equation
     M' = J(z(t)) M, with the state's stages recomputed from y0 (the same numbers as the
-    step of the state)."""
+    step of the state); J exact where the model has it (``exact``)."""
     n = y0.size
     for s in range(_NS):
         _stage(s, mode, y0, h, w.KV, w.ys, fns, p, w.wg, w.wf, w.wp)
@@ -106,12 +128,7 @@ def _var_step(mode, y0, h, fns, p, w):
                 for j in range(s):
                     acc += w.KP[j, a, b] * _A[s, j]
                 w.Mt[a, b] = w.M[a, b] + acc * h
-        for b in range(n):
-            for a in range(n):
-                w.jv[a] = w.Mt[a, b]
-            _jvp(mode, w.ys, w.jv, w.jo, fns, p, w)
-            for a in range(n):
-                w.KP[s, a, b] = w.jo[a]
+        _var_stage(s, mode, exact, fns, p, w)
     for a in range(n):
         for b in range(n):
             acc = 0.0

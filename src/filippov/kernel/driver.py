@@ -16,7 +16,7 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 from ..system import SLIDING
 from .base import (BAD_START, EVENT_LIMIT, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
                    SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO, _FIELD, _FLOW, _SCALAR,
-                   _WHERE, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
+                   _WHERE, _JAC, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
                    _exit_drift, _exit_shift, _jit, _jit_inline, _next_mode, _onto_switch,
                    _slides_in_section, _speeds, _start_on_switch, _start_side, _vec)
 from .dop853 import (_NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
@@ -81,7 +81,7 @@ Work = namedtuple("Work", [
     "ynew", "ytmp", "scale", "F", "wz", "wg", "wf", "wp", "z", "first_sw", "slide_dz",
     "slide_z0", "count", "tally",
     # dP/dz (Settings.jac): the derivative so far, workspaces, the variational stages
-    "M", "Mt", "KV", "KP", "ys", "jv", "jo", "jz1", "jz2", "jf1", "jf2", "touched"])
+    "M", "Mt", "KV", "KP", "ys", "jv", "jo", "jz1", "jz2", "jf1", "jf2", "touched", "Jm"])
 
 _GO_ON = -1  # no event yet / the orbit goes on (never a returned status)
 
@@ -172,7 +172,7 @@ def _stay_integrated(mode, t, fns, p, s, w):
         w.sg[2] = tb - ta
         st, t, what = _window(mode, ta, tb, s.frac_in, first, fns, p, s, w)
         if s.jac and (st == _GO_ON or (st == OK and t > ta)):
-            _var_step(mode, w.y_old, (tb if st == _GO_ON else t) - ta, fns, p, w)
+            _var_step(mode, w.y_old, (tb if st == _GO_ON else t) - ta, fns, p, w, s.jac == 2)
         if st != _GO_ON:
             return st, t, what
         ta, first = tb, False
@@ -291,7 +291,7 @@ def _one(z0, age0, fns, p, s, w):
 
 
 _KERNEL_SIG = types.void(
-    _FLOW, _FLOW, _FIELD, _FIELD, _SCALAR, _FIELD, _SCALAR, _WHERE,  # the model
+    _FLOW, _FLOW, _FIELD, _FIELD, _SCALAR, _FIELD, _SCALAR, _WHERE, _JAC,  # the model
     _vec,                       # params
     types.float64[:, ::1],      # starts (m, n)
     _vec,                       # their ages in their regions (rules.carried_age)
@@ -315,15 +315,16 @@ _KERNEL_SIG = types.void(
 
 
 @njit(cache=True)
-def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, p,
+def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, jacobian, p,
            starts, ages, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
            out_state, out_time, out_nsw, out_slide, out_status, out_first, out_slide_dz,
            out_orbit, out_done, out_jac, out_orbit_jac, out_age):
     """Each start is mapped iopts[3] times by the first-return map, each return
     starting from the last one's state; the outputs describe the last return made
     (or where it stopped) and out_orbit[i] holds the last keep returns (with iopts[4]:
-    out_jac and out_orbit_jac their derivatives dP/dz, NaN where not made)."""
-    fns = (flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where)
+    out_jac and out_orbit_jac their derivatives dP/dz, NaN where not made; iopts[4] = 2:
+    the variational equation with the model's exact Jacobians)."""
+    fns = (flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, jacobian)
     m, n = starts.shape
     nsmax = max(frac_ex.size, frac_in.size)
     ts = np.empty(nsmax)
@@ -344,8 +345,8 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
              np.zeros(3, dtype=np.int64), np.zeros(3),
              np.zeros((n, n)), np.zeros((n, n)), np.zeros((_NS, n)), np.zeros((_NS, n, n)),
              np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
-             np.zeros(n), np.zeros(1, dtype=np.bool_))
-    jac = iopts[4] != 0
+             np.zeros(n), np.zeros(1, dtype=np.bool_), np.zeros(n * n))
+    jac = iopts[4]
     s = Settings(t_max, exact, hwin, fopts[6], fopts[7], sec_pred, sliding, frac_ex, frac_in,
                  fopts[0], fopts[1], fopts[2], fopts[3], fopts[4], fopts[5], fopts[8],
                  iopts[0], iopts[1], iopts[2], jac)
@@ -381,7 +382,7 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
             out_state[i, c] = w.z[c]
             out_slide_dz[i, c] = w.slide_dz[c]
         out_status[i] = st
-        if jac and st == OK:
+        if jac != 0 and st == OK:
             out_jac[i] = w.M
         else:
             out_jac[i] = np.nan
