@@ -395,6 +395,7 @@ class SymbolicSlowFast:
             raise SymbolicError("eps: the small parameter must be a symbol among params")
         self.eps, self.params, self.name = eps, dict(params), name
         self.time, self.flows = time, dict(flows or {})
+        self._generated: dict = {}   # y0 and the NumPy source, derived once
         unknown = set(self.flows) - {"full", "reduced"}
         if unknown:
             raise SymbolicError(f"flows: unknown system kind(s) {sorted(unknown)}; expected "
@@ -436,6 +437,11 @@ class SymbolicSlowFast:
     def quasi_static(self) -> dict:
         """``{y_i: y0_i(x)}``: the root of ``g(x, y) = 0`` at ``eps = 0``, the same for
         ``g_-`` and ``g_+``; refused when SymPy finds no unique root."""
+        if "y0" not in self._generated:
+            self._generated["y0"] = self._quasi_static()
+        return dict(self._generated["y0"])
+
+    def _quasi_static(self) -> dict:
         roots = []
         for side, g in (("g_minus", self.g_minus), ("g_plus", self.g_plus)):
             eqs = [gi.subs(self.eps, 0) for gi in g]
@@ -466,6 +472,11 @@ class SymbolicSlowFast:
         """Generated NumPy source of the :class:`~filippov.model.SlowFastModel` pieces:
         ``f(x, y, p)``, ``g(x, y, p)``, ``h``, ``h_grad`` (its x and y parts),
         ``y0(x, p)``, its Jacobian, and the exact flows ``(z0, tau, p)``."""
+        if "numpy" not in self._generated:     # printed once (SymPy takes ~40 ms)
+            self._generated["numpy"] = self._numpy_source()
+        return self._generated["numpy"]
+
+    def _numpy_source(self) -> str:
         x, y, ps = list(self.slow), list(self.fast), list(self.params)
         nx, ny = len(x), len(y)
         xy = [("_x", x), ("_y", y), ("_p", ps)]
