@@ -166,17 +166,6 @@ def system(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck", *
 
 
 # --------------------------------------------------------------------------- slow manifold
-def _plus_field_batch(eps, v0, gamma, Fp):
-    """Region-+ field of eq:dfo-sf for m states stacked as (3m,): [x1..., x2..., w...]."""
-    g1 = 1.0 + gamma
-
-    def rhs(t, z):
-        x1, x2, w = z.reshape(3, -1)
-        return np.concatenate([x2, -x1 - Fp(g1 * x2 - w),
-                               (-w + v0 + gamma * x2 - eps * gamma * x1) / eps])
-    return rhs
-
-
 def slow_manifold_plus(x1, x2, eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5,
                        convention="stribeck", relax=30.0, t_max=1.0, rtol=1e-12,
                        atol=1e-14, newton_tol=1e-13, max_iter=8):
