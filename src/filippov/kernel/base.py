@@ -42,9 +42,16 @@ STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event lim
                            "switching surface): its crossings there would be rounding noise"}
 
 # crossing predicates (filippov.rules)
-_TO_NEG, _TO_NONNEG, _TO_NONPOS, _EITHER = rules.TO_NEG, rules.TO_NONNEG, rules.TO_NONPOS, rules.EITHER
+# (codes handed to compiled helpers are numpy integers, not Python ints: numba types a
+# global Python int as a literal and compiles one specialization of the callee per value
+# -- _brentq five times, _refine four: 9 s of a 30 s cold compile)
+_TO_NEG, _TO_NONNEG, _TO_NONPOS, _EITHER = (
+    np.int64(c) for c in (rules.TO_NEG, rules.TO_NONNEG, rules.TO_NONPOS, rules.EITHER))
 # scalar functions of the state whose zeros are events
-_S_H, _S_A, _S_B, _S_SEC = 0, 1, 2, 3
+_S_H, _S_A, _S_B, _S_SEC = (np.int64(c) for c in range(4))
+# brentq's iteration bounds: the reference driver's for an event, scipy's default for the
+# extremum of h between two samples
+_MAXITER_EVENT, _MAXITER_EXTREMUM = np.int64(200), np.int64(100)
 # what an event is
 _W_NONE, _W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_SECTION = -1, 0, 1, 2, 3
 
@@ -56,7 +63,12 @@ _EPS = np.finfo(float).eps
 # compiled without numba's reference counting (_nrt=False): otherwise each call
 # of a helper pays an atomic incref/decref per array argument, which was half the
 # run time. Only the kernel _batch allocates (its work arrays, once per call).
-_jit = njit(cache=True, _nrt=False)
+# Nor are they ever called from Python: built without numba's CPython and C wrappers
+# (which unbox the 40 named work arrays and the model's function tuple: code generated and
+# machine-compiled for every helper, 5 s of a 24 s cold compile)
+_jit = njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+# the rules keep their wrappers (scalars only: cheap), so tests call them from Python
+_jit_rule = njit(cache=True, _nrt=False)
 # the driver's pieces (kernel.driver: _window, _stay_*, _event) are inlined into _one at the
 # IR level: as separate calls they were 4-13% slower on the fig04/fig11 maps, each
 # call passing the named work arrays by value
@@ -68,7 +80,7 @@ _jit_inline = njit(cache=True, _nrt=False, inline="always")
  _slides_in_section, _starts_on_section, _same_instant, _start_side, _start_on_switch,
  _next_mode, _accumulates, _exit_shift, _dips_and_returns, _exact_window, _onto_switch,
  _exit_drift, _carried_age) = (
-    _jit(getattr(rules, name)) for name in (
+    _jit_rule(getattr(rules, name)) for name in (
     "after", "crosses", "clamp", "far_side", "extremum_between", "graze", "central_step",
     "slides_in_section", "starts_on_section", "same_instant", "start_side", "start_on_switch",
     "next_mode", "accumulates", "exit_shift", "dips_and_returns", "exact_window",

@@ -368,8 +368,10 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
             if j >= 0:
                 for c in range(n):
                     out_orbit[i, j, c] = w.z[c]
-                if keep_jac > 0:
-                    out_orbit_jac[i, j] = w.M
+                if keep_jac > 0:  # element by element: a slice assignment compiles
+                    for a in range(n):   # numba's shape-error path (~3 s of compile)
+                        for b in range(n):
+                            out_orbit_jac[i, j, a, b] = w.M[a, b]
             if done >= n_iter:
                 break
             for c in range(n):
@@ -382,10 +384,10 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
             out_state[i, c] = w.z[c]
             out_slide_dz[i, c] = w.slide_dz[c]
         out_status[i] = st
-        if jac != 0 and st == OK:
-            out_jac[i] = w.M
-        else:
-            out_jac[i] = np.nan
+        made = jac != 0 and st == OK
+        for a in range(n):
+            for b in range(n):
+                out_jac[i, a, b] = w.M[a, b] if made else np.nan
         out_time[i] = t
         out_nsw[i] = nsw
         out_slide[i] = sl

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import (_EPS, _TINY, _after, _far_side, _jit)
+from .base import (_EPS, _MAXITER_EVENT, _TINY, _after, _far_side, _jit)
 from .segment import _fval
 
 
@@ -74,7 +74,7 @@ def _refine(sel, pred, ta, tb, va, xtol, mode, sg, za, F, y_old, fns, p, wz, wg,
     if va == 0.0:
         r = ta
     else:
-        r, ok = _brentq(sel, ta, tb, xtol, 4.0 * _EPS, 200, mode, sg, za, F, y_old, fns, p,
+        r, ok = _brentq(sel, ta, tb, xtol, 4.0 * _EPS, _MAXITER_EVENT, mode, sg, za, F, y_old, fns, p,
                         wz, wg, wf)
         if not ok:
             # as simulate._refine: no sign change because the start sample of a

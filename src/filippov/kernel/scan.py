@@ -6,7 +6,7 @@ import numpy as np
 
 from .. import rules
 from ..system import MINUS, PLUS, SLIDING
-from .base import (OK, ROOT_FAILED, _EPS, _S_A, _S_B, _S_H, _S_SEC, _TO_NEG, _TO_NONNEG,
+from .base import (OK, ROOT_FAILED, _EPS, _MAXITER_EXTREMUM, _S_A, _S_B, _S_H, _S_SEC, _TO_NEG, _TO_NONNEG,
                    _TO_NONPOS, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_NONE, _W_SECTION, _W_SWITCH,
                    _after, _clamp, _crosses, _dips_and_returns, _dot, _extremum_between,
                    _graze, _jit, _same_instant, _speeds, _starts_on_section)
@@ -71,7 +71,7 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
         if c0:
             lo, vlo = ta, vals[0, i]
             if first and i == 0 and mode != SLIDING and _dips_and_returns(mode, dvals[0], dvals[1]):
-                tm, ok = _brentq(sel_d, ta, tb, xtol, 4.0 * _EPS, 100, mode, sg, za, F, y_old,
+                tm, ok = _brentq(sel_d, ta, tb, xtol, 4.0 * _EPS, _MAXITER_EXTREMUM, mode, sg, za, F, y_old,
                                  fns, p, wz, wg, wf)
                 hm = _fval(_S_H, tm, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
                 if ok and not _after(pred0, hm):  # refine beyond the dip (rules)
@@ -90,7 +90,7 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
                 best_t, best_w = r, _W_EXIT_PLUS
         if mode != SLIDING and best_w == _W_NONE and cd:
             # a minimum (in +) or maximum (in -) of h hidden between samples
-            tm, ok = _brentq(sel_d, ta, tb, xtol, 4.0 * _EPS, 100, mode, sg, za, F, y_old,
+            tm, ok = _brentq(sel_d, ta, tb, xtol, 4.0 * _EPS, _MAXITER_EXTREMUM, mode, sg, za, F, y_old,
                              fns, p, wz, wg, wf)
             if not ok:
                 return ROOT_FAILED, tm, _W_NONE
