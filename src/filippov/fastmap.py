@@ -43,7 +43,7 @@ this module is its Python side: the batch call, its options and its errors.
 
 A model enters as a :class:`CompiledModel`: numba-compiled pieces with the
 signatures below (passed to the kernel as first-class functions, so the kernel
-is compiled once -- about 25 s on 2 cores -- cached on disk by numba, and serves every
+is compiled once -- about 20 s on 2 cores -- cached on disk by numba, and serves every
 model), plus a parameter vector ``params`` handed to every piece. See
 :func:`filippov.models.hopf.compiled`.
 
