@@ -77,21 +77,43 @@ def test_s0_range_must_be_ordered(tmp_path):
         load_scene(path, SCHEMA)
 
 
-def test_a_scene_brings_its_own_parameter_block(tmp_path):
-    # fig04's parameters are closed by config/schema/scenes/fig04_retmaps.schema.json,
-    # not by a block in the shared schema: a typo there is named, and a broken block
-    # file is named as such
-    import shutil
+def test_a_scene_brings_its_own_parameter_block(tmp_path, monkeypatch):
+    # fig04's parameters are closed by PARAMETERS_SCHEMA in its module
+    # (filippov.scenes.fig04_retmaps), not by a block in the shared schema: a typo there
+    # is named, and a block that is not a literal is named as such
+    import filippov.config as config
     text = (ROOT / "config" / "scenes" / "fig04_retmaps.yaml").read_text()
     assert "closest:" in text
     path = _write(tmp_path, text.replace("closest:", "closets:"), "fig04_retmaps")
     with pytest.raises(SceneError, match=r"fig04_retmaps.yaml: parameters: .*closets"):
         load_scene(path, SCHEMA)
-    schema_dir = tmp_path / "schema"
-    shutil.copytree(SCHEMA.parent, schema_dir)
-    (schema_dir / "scenes" / "fig04_retmaps.schema.json").write_text("{not json")
-    with pytest.raises(SceneError, match=r"fig04_retmaps.schema.json: cannot read"):
-        load_scene(_write(tmp_path, text, "fig04_retmaps"), schema_dir / "scene.schema.json")
+    modules = tmp_path / "modules"
+    modules.mkdir()
+    (modules / "fig04_retmaps.py").write_text("PARAMETERS_SCHEMA = dict(properties={})\n")
+    monkeypatch.setattr(config, "SCENE_MODULES", modules)
+    with pytest.raises(SceneError, match=r"fig04_retmaps.py: PARAMETERS_SCHEMA \(line 1\): "
+                                         "must be a literal dict"):
+        load_scene(_write(tmp_path, text, "fig04_retmaps"), SCHEMA)
+    # a scene module without a block: only the shared schema checks the parameters
+    (modules / "fig04_retmaps.py").write_text("X = 1\n")
+    path = _write(tmp_path, text.replace("closest:", "closets:"), "fig04_retmaps")
+    assert "closets" in load_scene(path, SCHEMA)["parameters"]
+
+
+def test_every_scene_module_declares_a_readable_block():
+    # read without importing (config.scene_schema_block) and equal to what the
+    # imported module holds
+    import importlib
+
+    from filippov.config import scene_schema_block
+    from filippov.scenes import known_scenes
+    blocks = 0
+    for sid in known_scenes():
+        block = scene_schema_block(sid)
+        module = importlib.import_module(f"filippov.scenes.{sid}")
+        assert block == getattr(module, "PARAMETERS_SCHEMA", None), sid
+        blocks += block is not None
+    assert blocks >= 10
 
 
 def test_a_named_resolution_overrides_parameters_and_chunks(tmp_path):
@@ -108,12 +130,31 @@ def test_a_named_resolution_overrides_parameters_and_chunks(tmp_path):
     assert load_scene(plain, SCHEMA, resolution="full") == load_scene(plain, SCHEMA)
     bad = tmp_path / "fig12_period_adding.yaml"
     bad.write_text(path.read_text().replace("n_mu: 1801", "n_mu: 1"))
-    (tmp_path / "scenes").mkdir()
-    own = ROOT / "config" / "schema" / "scenes" / "fig12_period_adding.schema.json"
-    schema_dir = tmp_path / "schema"
-    (schema_dir / "scenes").mkdir(parents=True)
-    (schema_dir / "scene.schema.json").write_text(SCHEMA.read_text())
-    (schema_dir / "scenes" / own.name).write_text(own.read_text())
-    load_scene(bad, schema_dir / "scene.schema.json")  # the default is untouched
+    load_scene(bad, SCHEMA)  # the default is untouched
     with pytest.raises(SceneError, match=r"resolutions\.full: parameters\.n_mu"):
-        load_scene(bad, schema_dir / "scene.schema.json", resolution="full")
+        load_scene(bad, SCHEMA, resolution="full")
+
+
+def test_the_compute_hash_leaves_out_exactly_the_report_part():
+    # the workflow hashes each scene module without its report part for the compute jobs
+    # (workflow/rules/common.smk, strip_reports): editing the report changes nothing
+    # there, editing the computation does, and the computation uses no report name (or
+    # the hash would miss code it runs)
+    import ast
+
+    from filippov.config import SCENE_MODULES, is_report_part, without_report_part
+    from filippov.scenes import known_scenes
+    for sid in known_scenes():
+        text = (SCENE_MODULES / f"{sid}.py").read_text()
+        kept = without_report_part(text)
+        tree = ast.parse(kept)
+        defined = {n.name for n in tree.body if isinstance(n, ast.FunctionDef)}
+        assert "report" not in defined and "def report(" in text, sid
+        used = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+        assert not {u for u in used if is_report_part(u)}, sid
+        edited = text.replace("def report(ds, m: Macros)", "def report(ds, m: Macros):  # x\n"
+                              "    pass\n\n\ndef _report_unused(ds, m: Macros)")
+        assert edited != text and without_report_part(edited) == kept, sid
+        assert without_report_part(text + "\nX_NEW = 1\n") != kept, sid
+    rules = (ROOT / "workflow" / "rules" / "compute.smk").read_text()
+    assert rules.count("library_hash(exclude=NOT_COMPUTE, strip_reports=True)") == 3

@@ -11,10 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-import yaml
 
 from filippov import manifest, scenes, tolerance
-from filippov.config import load_scene
+from filippov.config import load_scene, scene_files
 from filippov.io import write_dataset
 from filippov.tolerance import Tolerance
 
@@ -184,7 +183,7 @@ PARAMETER = {"fig01_slidesketch": "t_end", "fig02_cases": "eps", "fig03_grazings
 
 
 def test_every_scene_has_a_parameter_to_change():
-    listed = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["scenes"]
+    listed = scene_files(ROOT / "config" / "scenes")
     assert sorted(PARAMETER) == sorted(listed)
 
 

@@ -19,6 +19,7 @@ import yaml
 
 from conftest import run_snakemake
 from filippov import report, scenes
+from filippov.config import scene_files
 
 ROOT = Path(__file__).resolve().parents[1]
 TEX_PACKAGES = ("texlive-publishers texlive-latex-extra texlive-latex-recommended "
@@ -37,7 +38,7 @@ def test_number_formatting_round_trips():
 
 
 def test_absent_optional_results_say_not_yet_computed():
-    from filippov.reports import fig10_dfo, fig11_dfo_retmaps
+    from filippov.scenes import fig10_dfo, fig11_dfo_retmaps
     m = report.Macros()
     t10, t11 = fig10_dfo.report(None, m), fig11_dfo_retmaps.report(None, m)
     tb = report.bench(None, m)
@@ -52,7 +53,7 @@ def test_absent_optional_results_say_not_yet_computed():
 def test_optional_tables_show_whatever_the_datasets_hold():
     ds = xr.Dataset({"v_hopf": ((), 2.5, {"long_name": "Hopf point"}),
                      "v_gs": ((), 3.25, {"long_name": "grazing-sliding point"})})
-    from filippov.reports import fig10_dfo
+    from filippov.scenes import fig10_dfo
     m = report.Macros()
     t10 = fig10_dfo.report(ds, m)
     assert "v\\_hopf" in t10 and "2.5" in t10 and report.NOT_YET not in t10
@@ -144,7 +145,7 @@ def built(workflow_build):
     _require_tex()
     work, run = workflow_build["work"], workflow_build["run"]
     assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-4000:]
-    scenes = yaml.safe_load((work / "config" / "config.yaml").read_text())["scenes"]
+    scenes = scene_files(work / "config" / "scenes")
     return {"work": work, "scenes": scenes, "run": run, "seconds": workflow_build["seconds"]}
 
 
@@ -302,7 +303,7 @@ def test_html_report_links_every_figure_to_its_rule(workflow_build, tmp_path):
     rep = _snakemake(work, "--report", str(out))
     assert rep.returncode == 0, rep.stdout[-3000:] + rep.stderr[-3000:]
     html = out.read_text(errors="replace")
-    scenes = yaml.safe_load((work / "config" / "config.yaml").read_text())["scenes"]
+    scenes = scene_files(work / "config" / "scenes")
     for scene in scenes:
         assert f"{scene}.pdf" in html and f"{scene}.png" in html, scene
         # the dataset and the scene file are attached too
@@ -335,7 +336,7 @@ def test_every_scene_declares_its_report_part():
     # the report refuses to go on without a scene that does not declare itself optional
     import importlib
     for sid in scenes.known_scenes():
-        module = importlib.import_module(f"filippov.reports.{sid}")
+        module = importlib.import_module(f"filippov.scenes.{sid}")
         assert callable(module.report), sid
     with pytest.raises(ValueError, match="report needs the datasets of fig01_slidesketch"):
         report.generate({})

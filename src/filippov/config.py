@@ -6,6 +6,7 @@ No Snakemake here: the workflow's scripts call `load_scene`.
 """
 from __future__ import annotations
 
+import ast
 import json
 import math
 import re
@@ -159,18 +160,86 @@ def load_workflow_config(path, schema_path, overrides=None) -> dict:
     error = best_match(Draft202012Validator(schema).iter_errors(merged), key=_RELEVANCE)
     if error is not None:
         raise SceneError(f"{path}: {_field(error.absolute_path)}: {error.message}")
+    # the scenes are the files in scenes/ beside the config (a new figure is its file;
+    # no list to update); `scenes:` in the config or on the command line picks some
+    found = scene_files(path.parent / "scenes")
+    if "scenes" not in merged:
+        merged["scenes"] = found
+    missing = [s for s in merged["scenes"] if s not in found]
+    if missing:
+        raise SceneError(f"{path}: scenes: no scene file {path.parent / 'scenes' / missing[0]}.yaml")
     return merged
+
+
+def scene_files(folder) -> list[str]:
+    """The scene ids of the ``<id>.yaml`` files in ``folder``, sorted."""
+    return sorted(p.stem for p in Path(folder).glob("*.yaml"))
 
 
 #: a scene id (the schema's pattern for ``id``): figNN_name
 SCENE_ID = re.compile(r"fig[0-9]{2}_[a-z0-9_]+")
 
 
-def scene_schema_file(schema_path, scene_id: str) -> Path:
-    """Where a scene keeps the schema of its own parameters: ``scenes/<id>.schema.json``
-    beside the scene schema (optional; a scene whose model block says it all has none).
-    It is one more ``allOf`` entry of the scene schema, so ``#/$defs/...`` refer there."""
-    return Path(schema_path).parent / "scenes" / f"{scene_id}.schema.json"
+#: where the scene modules live: each may declare its block of the scene schema
+SCENE_MODULES = Path(__file__).parent / "scenes"
+
+
+def scene_schema_block(scene_id: str) -> dict | None:
+    """The schema of a scene's own parameters: ``PARAMETERS_SCHEMA`` of its module
+    ``filippov.scenes.<id>`` (None when it has none: a scene whose model block says it
+    all), read from the module's source without importing it (no numerics load to
+    check a scene file). It is one more ``allOf`` entry of the scene schema, so
+    ``#/$defs/...`` refer there."""
+    path = SCENE_MODULES / f"{scene_id}.py"
+    try:
+        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    except FileNotFoundError:
+        return None  # an unknown id: filippov.scenes names the known ones
+    except (OSError, UnicodeDecodeError, SyntaxError) as exc:
+        raise SceneError(f"{path}: cannot read the scene module: {exc}") from exc
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and any(
+                isinstance(t, ast.Name) and t.id == "PARAMETERS_SCHEMA" for t in node.targets):
+            try:
+                block = ast.literal_eval(node.value)
+            except ValueError:
+                block = None
+            if not isinstance(block, dict):
+                raise SceneError(f"{path}: PARAMETERS_SCHEMA (line {node.lineno}): must be a "
+                                 "literal dict (JSON written with True/False/None)")
+            return block
+    return None
+
+
+def is_report_part(name: str) -> bool:
+    """A top-level name of a scene module that belongs to its report part (``report``,
+    ``REPORT_OPTIONAL``, ``_report_*``, ``_REPORT_*``): what the reproduction report
+    reads, and nothing a computation uses."""
+    return name in ("report", "REPORT_OPTIONAL") or name.startswith(("_report", "_REPORT"))
+
+
+def without_report_part(source: str) -> str:
+    """A scene module's source with the statements that define its report part (see
+    :func:`is_report_part`) and blank lines taken out: what the workflow hashes for the
+    compute jobs, so that editing the report rebuilds the report only."""
+    tree = ast.parse(source)
+    lines = source.splitlines(keepends=True)
+    drop = set()
+    for node in tree.body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            names = [node.name]
+        elif isinstance(node, (ast.Assign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            names = [t.id for t in targets if isinstance(t, ast.Name)]
+            if len(names) != len(targets):
+                continue
+        else:
+            continue
+        if names and all(is_report_part(n) for n in names):
+            first = min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])])
+            drop.update(range(first - 1, node.end_lineno))
+    # blank lines go too: those between two parts taken out would otherwise remain
+    return "".join(line for i, line in enumerate(lines) if i not in drop and line.strip())
 
 
 #: the resolution a run asks for when it names none (snakemake --config resolution=full)
@@ -216,12 +285,8 @@ def load_scene(path, schema_path, lim: dict | None = None,
     schema = json.loads(Path(schema_path).read_text(encoding="utf-8"))
     sid = scene.get("id")
     if isinstance(sid, str) and SCENE_ID.fullmatch(sid):  # the scene's own block, if any
-        own = scene_schema_file(schema_path, sid)
-        if own.exists():
-            try:
-                block = json.loads(own.read_text(encoding="utf-8"))
-            except (OSError, UnicodeDecodeError, ValueError) as exc:
-                raise SceneError(f"{own}: cannot read the scene's schema block: {exc}") from exc
+        block = scene_schema_block(sid)
+        if block is not None:
             schema["allOf"] = [*schema.get("allOf", []), block]
     error = best_match(Draft202012Validator(schema).iter_errors(scene), key=_RELEVANCE)
     if error is not None:

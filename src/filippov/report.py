@@ -16,12 +16,13 @@ ones are ``None``) and returns ``{file name: LaTeX text}`` for
 * ``tab_hard_cases.tex``, ``tab_hard_return.tex`` -- the hard-case eps sweep
   (``results/hard_cases.nc``, :mod:`filippov.hard_cases`), one row per eps.
 
-The scenes declare their own part: each module ``filippov.reports.<id>`` defines
+The scenes declare their own part: each scene module ``filippov.scenes.<id>`` defines
 ``report(ds, macros)`` (adds its macros, returns its table or None) and, when the
 report can do without its data, ``REPORT_OPTIONAL = True`` (then ``ds`` may be
-None). There is no list of scenes here. These parts are neither in the code the
-compute jobs depend on nor in the plotting code: editing one rebuilds the report
-tables only.
+None). There is no list of scenes here. A scene's report part (those names and its
+``_report_*`` helpers, :func:`filippov.config.is_report_part`) is left out of the code
+hash of the compute jobs and is not in the plotting code: editing it rebuilds the
+report tables only.
 
 No Snakemake inside; ``workflow/scripts/report_tables.py`` is the thin caller.
 """
@@ -439,7 +440,7 @@ def _scene_modules() -> list:
     import importlib
 
     from .scenes import known_scenes
-    return [(sid, importlib.import_module(f".reports.{sid}", __package__))
+    return [(sid, importlib.import_module(f".scenes.{sid}", __package__))
             for sid in known_scenes()]
 
 

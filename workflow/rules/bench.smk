@@ -7,7 +7,7 @@ rule work_precision:
     output:
         "results/work_precision.nc",
     params:
-        code=library_hash(exclude=("plotting", "reports", "report.py", "manifest.py")),
+        code=library_hash(exclude=("plotting", "report.py", "manifest.py"), strip_reports=True),
     script:
         "../scripts/bench_work_precision.py"
 
@@ -39,7 +39,7 @@ rule bench_work_precision_part:
     wildcard_constraints:
         problems="|".join(BENCH_SETS),
     params:
-        code=library_hash(exclude=("plotting", "reports", "report.py", "manifest.py")),
+        code=library_hash(exclude=("plotting", "report.py", "manifest.py"), strip_reports=True),
         every=config.get("bench", {}).get("every", 10),
     script:
         "../scripts/bench_work_precision.py"

@@ -9,13 +9,18 @@ from pathlib import Path
 
 # Library parts no scene computation imports: editing them must not recompute data.
 # (hard_cases.py is the hard-case sweep's own module: rule hard_cases hashes it.)
-NOT_COMPUTE = ("plotting/", "reports/", "benchmarks/", "report.py", "manifest.py",
+# The report part of each scene module (filippov.config.is_report_part) is left out of
+# their hash as well (strip_reports=True).
+NOT_COMPUTE = ("plotting/", "benchmarks/", "report.py", "manifest.py",
                "hard_cases.py", "paper_labels.py")
 
 
-def library_hash(include="", exclude=()):
+def library_hash(include="", exclude=(), strip_reports=False):
     """sha256 over filippov's *.py files under `include`, minus the paths in
-    `exclude` (a folder "name/" or a file "name.py", relative to the package)."""
+    `exclude` (a folder "name/" or a file "name.py", relative to the package); with
+    `strip_reports`, the scene modules without their report part."""
+    from filippov.config import without_report_part
+
     spec = importlib.util.find_spec("filippov")  # locates without importing numerics
     if spec is None or not spec.origin:
         return "filippov-not-found"
@@ -28,7 +33,10 @@ def library_hash(include="", exclude=()):
         rel = path.relative_to(root).as_posix()
         if any(rel == e or (e.endswith("/") and rel.startswith(e)) for e in exclude):
             continue
-        digest.update(rel.encode() + b"\0" + path.read_bytes() + b"\0")
+        text = path.read_bytes()
+        if strip_reports and rel.startswith("scenes/"):
+            text = without_report_part(text.decode("utf-8")).encode("utf-8")
+        digest.update(rel.encode() + b"\0" + text + b"\0")
     return digest.hexdigest()[:16]
 
 

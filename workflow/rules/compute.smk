@@ -1,5 +1,6 @@
-# Compute one scene's dataset. The schema (and the scene's own block of it) and the script are inputs and the
-# library's hash is a param, so editing any of them reruns the scene. A failed
+# Compute one scene's dataset. The schema and the script are inputs and the library's
+# hash is a param (it covers the scene's own schema block, PARAMETERS_SCHEMA in its
+# module), so editing any of them reruns the scene. A failed
 # job leaves no results/<id>.nc: the library writes atomically and Snakemake
 # removes outputs of failed jobs.
 import functools
@@ -8,7 +9,7 @@ import re
 import yaml
 
 from filippov.config import (DEFAULT_RESOLUTION, SceneError, apply_resolution, check_limits,
-                             limits, scene_schema_file)
+                             limits)
 
 RESOLUTION = config.get("resolution", DEFAULT_RESOLUTION)
 
@@ -61,13 +62,6 @@ def scene_chunks():
     return found
 
 
-def own_schema(scene):
-    """The scene's own schema block, when it has one (an input: editing it reruns
-    that scene alone)."""
-    path = scene_schema_file(config["schema"], scene)
-    return [str(path)] if path.exists() else []
-
-
 CHUNKS = scene_chunks()
 CHUNKED_SCENES = "|".join(re.escape(s) for s in CHUNKS) or "(?!)"  # (?!): matches nothing
 
@@ -76,13 +70,12 @@ rule compute:
     input:
         scene="config/scenes/{scene}.yaml",
         schema=config["schema"],
-        own_schema=lambda wc: own_schema(wc.scene),
         script="workflow/scripts/compute_scene.py",
     output:
         report("results/{scene}.nc", caption="../report/dataset.rst", category="Datasets",
                labels={"scene": "{scene}", "format": "netCDF"}),
     params:
-        code=library_hash(exclude=NOT_COMPUTE),  # see common.smk
+        code=library_hash(exclude=NOT_COMPUTE, strip_reports=True),  # see common.smk
         resolution=lambda wc: scene_resolution(wc.scene),  # --config resolution=full
         scene=lambda wc: scene_summary(wc.scene),  # for the HTML report's caption
     script:
@@ -98,7 +91,6 @@ rule compute_chunk:
     input:
         scene="config/scenes/{scene}.yaml",
         schema=config["schema"],
-        own_schema=lambda wc: own_schema(wc.scene),
         script="workflow/scripts/compute_chunk.py",
     output:
         temp("results/chunks/{scene}/{chunk}.nc"),
@@ -106,7 +98,7 @@ rule compute_chunk:
         scene=CHUNKED_SCENES,
         chunk="[0-9]+",
     params:
-        code=library_hash(exclude=NOT_COMPUTE),  # see common.smk
+        code=library_hash(exclude=NOT_COMPUTE, strip_reports=True),  # see common.smk
         resolution=lambda wc: scene_resolution(wc.scene),  # --config resolution=full
     script:
         "../scripts/compute_chunk.py"
@@ -116,7 +108,6 @@ rule merge_chunks:
     input:
         scene="config/scenes/{scene}.yaml",
         schema=config["schema"],
-        own_schema=lambda wc: own_schema(wc.scene),
         script="workflow/scripts/merge_chunks.py",
         chunks=lambda wc: [f"results/chunks/{wc.scene}/{i}.nc" for i in range(CHUNKS[wc.scene])],
     output:
@@ -125,7 +116,7 @@ rule merge_chunks:
     wildcard_constraints:
         scene=CHUNKED_SCENES,
     params:
-        code=library_hash(exclude=NOT_COMPUTE),  # see common.smk
+        code=library_hash(exclude=NOT_COMPUTE, strip_reports=True),  # see common.smk
         resolution=lambda wc: scene_resolution(wc.scene),  # --config resolution=full
         scene=lambda wc: scene_summary(wc.scene),  # for the HTML report's caption
     script:

@@ -19,7 +19,8 @@ def hard_cases_chunks():
 
 HARD_CASES_SETTINGS = json.dumps(config.get("hard_cases"), sort_keys=True)
 # the compute code (as for the scenes) and filippov/hard_cases.py itself
-HARD_CASES_CODE = library_hash(exclude=[e for e in NOT_COMPUTE if e != "hard_cases.py"])
+HARD_CASES_CODE = library_hash(exclude=[e for e in NOT_COMPUTE if e != "hard_cases.py"],
+                               strip_reports=True)
 
 
 rule hard_cases_part:

@@ -19,7 +19,7 @@ report: "../report/workflow.rst"
 # module; a comment when it has none), for every scene file in config/scenes, so
 # that a scene left out of config["scenes"] gets its "not yet computed" text
 # instead of a stale table. Which scenes the report cannot do without is the
-# scenes' own declaration (REPORT_OPTIONAL in filippov.reports.<id>).
+# scenes' own declaration (REPORT_OPTIONAL in filippov.scenes.<id>).
 SCENE_FILES = sorted(p.stem for p in Path("config/scenes").glob("*.yaml"))
 REPORT_GENERATED = ["macros.tex", *[f"{s}.tex" for s in SCENE_FILES], "tab_bench.tex",
                     "tab_hard_cases.tex", "tab_hard_return.tex"]
@@ -68,7 +68,7 @@ rule report_tables:
     output:
         [f"paper/generated/{name}" for name in REPORT_GENERATED],
     params:
-        code=library_hash(exclude="plotting"),  # filippov.report, reports/ and what they import
+        code=library_hash(exclude="plotting"),  # filippov.report, the scenes' report parts, ...
         bench=bench_stamps(),
     script:
         "../scripts/report_tables.py"

@@ -9,6 +9,7 @@ from ..io import finalize
 from ..models import planar_sketch
 from ..progress import Progress
 from .common import require, solver_options
+from ..report import Macros, tex_escape, var
 
 CASES = ("crossing", "sliding")
 
@@ -64,3 +65,20 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
                     switching_function="h = x2",
                     crossing_fields="f_- = (1, 1 + x1/2), f_+ = (1, 1/2)",
                     sliding_fields="f_- = (1, 1), f_+ = (1, -1 - x1^2/4)")
+
+
+# ============================================================================= report
+# What the reproduction report quotes from this scene's dataset (filippov.report calls
+# `report`). This part -- report, REPORT_OPTIONAL and the _report_* / _REPORT_* names --
+# is left out of the code hash of the compute jobs: editing it rebuilds the report only.
+def report(ds, m: Macros) -> str | None:
+    """The report's macros from this scene's dataset; returns its table (None: none)."""
+    sid = "fig01_slidesketch"
+    for case, word in (("crossing", "Cross"), ("sliding", "Slide")):
+        var(m, f"rpOneHit{word}A", ds, sid, "hit_x1", case=case)
+        var(m, f"rpOneHit{word}B", ds, sid, "hit_x2", case=case)
+    m.add("rpOneFieldsCross", None, f"{sid}:attrs.crossing_fields",
+          text=r"\texttt{" + tex_escape(ds.attrs["crossing_fields"]) + "}")
+    m.add("rpOneFieldsSlide", None, f"{sid}:attrs.sliding_fields",
+          text=r"\texttt{" + tex_escape(ds.attrs["sliding_fields"]) + "}")
+    return None

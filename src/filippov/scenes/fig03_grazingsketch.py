@@ -36,6 +36,50 @@ from ..progress import Progress
 from ..simulate import Section
 from ..tolerance import Tolerance
 from .common import require, solver_options
+import math
+from ..report import Macros, source, value, var
+
+#: this scene's block of the scene schema: filippov.config.load_scene adds it to
+#: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it
+#: from this file without importing it (a literal: JSON with Python's True/False/None)
+PARAMETERS_SCHEMA = {
+  "properties": {
+    "parameters": {
+      "description": "Reduced system: eps and theta do not enter (h0 = x1 + 1).",
+      "required": [
+        "omega",
+        "mu",
+        "x2_start",
+        "settle_tol",
+        "max_periods",
+        "n_samples"
+      ],
+      "additionalProperties": False,
+      "properties": {
+        "omega": True,
+        "mu": {
+          "type": "array",
+          "minItems": 1
+        },
+        "x2_start": {
+          "$ref": "#/$defs/positive"
+        },
+        "settle_tol": {
+          "type": "number",
+          "exclusiveMinimum": 0,
+          "exclusiveMaximum": 1e-06
+        },
+        "max_periods": {
+          "type": "integer",
+          "minimum": 2
+        },
+        "n_samples": {
+          "$ref": "#/$defs/n_samples"
+        }
+      }
+    }
+  }
+}
 
 COMPONENTS = ["x1", "x2"]
 VARIABLE_ATTRS = {"component": ("state component", None),
@@ -198,3 +242,30 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
                     degenerate_slide=DEGENERATE_SLIDE,
                     section_L1="x1 = 0, x2 > 0",
                     title="grazing-sliding of the reduced Hopf example eq:red (fig:grazingsketch)")
+
+
+# ============================================================================= report
+# What the reproduction report quotes from this scene's dataset (filippov.report calls
+# `report`). This part -- report, REPORT_OPTIONAL and the _report_* / _REPORT_* names --
+# is left out of the code hash of the compute jobs: editing it rebuilds the report only.
+def report(ds, m: Macros) -> str | None:
+    """The report's macros from this scene's dataset; returns its table (None: none)."""
+    sid = "fig03_grazingsketch"
+    mus = [float(v) for v in ds.mu.values]
+    m.add("rpThreeOmega", float(ds.attrs["omega"]), f"{sid}:attrs.omega", 6)
+    m.add("rpThreeStart", float(ds.attrs["x2_start"]), f"{sid}:attrs.x2_start")
+    m.add("rpThreeSettle", float(ds.attrs["settle_tol"]), f"{sid}:attrs.settle_tol")
+    for mu, word in zip(mus, ("Below", "At", "Above")):
+        m.add(f"rpThreeMu{word}", mu, source(sid, "mu", mu=mu))
+        var(m, f"rpThreeFixed{word}", ds, sid, "fixed_x2", sig=6, mu=mu)
+        var(m, f"rpThreePeriod{word}", ds, sid, "period", sig=6, mu=mu)
+        var(m, f"rpThreeSlideTime{word}", ds, sid, "sliding_time", sig=3, mu=mu)
+    mu = mus[2]
+    var(m, "rpThreeXhTwo", ds, sid, "x_h", sig=4, mu=mu, component="x2")
+    var(m, "rpThreeXlTwo", ds, sid, "x_l", sig=6, mu=mu, component="x2")
+    var(m, "rpThreeXlFormulaTwo", ds, sid, "x_l_formula", sig=6, mu=mu, component="x2")
+    m.add("rpThreeXlErr", abs(value(ds, "x_l", mu=mu, component="x2")
+                              - value(ds, "x_l_formula", mu=mu, component="x2")),
+          "derived: |x_l - x_l_formula| at mu above 1", 2)
+    m.add("rpThreeSqrtMuBelow", math.sqrt(mus[0]), "derived: sqrt(mu below 1)", 6)
+    return None

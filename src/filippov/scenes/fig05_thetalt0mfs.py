@@ -29,6 +29,68 @@ from ..models import hopf
 from ..simulate import Section
 from ..system import MINUS, PLUS
 from .common import require, solver_options
+from ..report import Macros, var
+
+#: this scene's block of the scene schema: filippov.config.load_scene adds it to
+#: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it
+#: from this file without importing it (a literal: JSON with Python's True/False/None)
+PARAMETERS_SCHEMA = {
+  "properties": {
+    "parameters": {
+      "required": [
+        "eps",
+        "mu",
+        "omega",
+        "theta",
+        "start_x2",
+        "x1_range",
+        "x2_range",
+        "n_grid",
+        "settle",
+        "rate_window",
+        "n_samples"
+      ],
+      "additionalProperties": False,
+      "properties": {
+        "eps": {
+          "$ref": "#/$defs/positive"
+        },
+        "mu": {
+          "const": 1.0
+        },
+        "omega": True,
+        "theta": {
+          "type": "number",
+          "exclusiveMaximum": 0
+        },
+        "start_x2": {
+          "type": "number",
+          "exclusiveMinimum": 1
+        },
+        "x1_range": {
+          "$ref": "#/$defs/point2"
+        },
+        "x2_range": {
+          "$ref": "#/$defs/point2"
+        },
+        "n_grid": {
+          "type": "integer",
+          "minimum": 2
+        },
+        "settle": {
+          "type": "number",
+          "minimum": 10
+        },
+        "rate_window": {
+          "$ref": "#/$defs/positive"
+        },
+        "n_samples": {
+          "$ref": "#/$defs/n_samples"
+        }
+      }
+    }
+  }
+}
 
 #: names and units of the variables without them below (checked by filippov.scenes)
 VARIABLE_ATTRS = {
@@ -235,3 +297,26 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     return finalize(ds, scene, title="manifolds near the grazing point, theta < 0 "
                     "(eq:exslow2/eq:exfast2)", p_g=P_G.tolist(),
                     t_return=float(traj.t), x2_return=float(traj.z[1]))
+
+
+# ============================================================================= report
+# What the reproduction report quotes from this scene's dataset (filippov.report calls
+# `report`). This part -- report, REPORT_OPTIONAL and the _report_* / _REPORT_* names --
+# is left out of the code hash of the compute jobs: editing it rebuilds the report only.
+def report(ds, m: Macros) -> str | None:
+    """The report's macros from this scene's dataset; returns its table (None: none)."""
+    sid = "fig05_thetalt0mfs"
+    m.add("rpFiveEps", float(ds.attrs["eps"]), f"{sid}:attrs.eps")
+    m.add("rpFiveTheta", float(ds.attrs["theta"]), f"{sid}:attrs.theta")
+    m.add("rpFiveStart", float(ds.attrs["start_x2"]), f"{sid}:attrs.start_x2", 6)
+    m.add("rpFiveSettle", float(ds.attrs["settle"]), f"{sid}:attrs.settle")
+    m.add("rpFiveReturn", float(ds.attrs["x2_return"]), f"{sid}:attrs.x2_return", 6)
+    var(m, "rpFiveGap", ds, sid, "gap_pg", sig=6)
+    var(m, "rpFiveDecay", ds, sid, "decay_rate", sig=8)
+    var(m, "rpFiveDecayErr", ds, sid, "decay_rate_rel_error", sig=2)
+    var(m, "rpFiveMminusErr", ds, sid, "M_minus_max_error", sig=2)
+    var(m, "rpFiveExpansionErr", ds, sid, "M_minus_max_expansion_error", sig=3)
+    var(m, "rpFiveSwitchTwoXone", ds, sid, "switch_x1", sig=5, switch=1)
+    var(m, "rpFiveSwitchTwoY", ds, sid, "switch_y", sig=5, switch=1)
+    var(m, "rpFiveSwitchXtwo", ds, sid, "switch_x2", sig=4, switch=0)
+    return None

@@ -8,6 +8,7 @@ import xarray as xr
 from ..analytic import sgraph
 from ..io import finalize
 from .common import require
+from ..report import Macros, source, var
 
 
 def t_grid(p: dict) -> np.ndarray:
@@ -46,3 +47,20 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
                                    "spacing": "geometric from t_min joined to uniform"})})
     return finalize(ds, scene, title="graph of s(theta, omega, ., 0) from eq:xi1r (fig:p:xi12)",
                     max_abs_difference_s=float(np.max(np.abs(s - s_direct))))
+
+
+# ============================================================================= report
+# What the reproduction report quotes from this scene's dataset (filippov.report calls
+# `report`). This part -- report, REPORT_OPTIONAL and the _report_* / _REPORT_* names --
+# is left out of the code hash of the compute jobs: editing it rebuilds the report only.
+def report(ds, m: Macros) -> str | None:
+    """The report's macros from this scene's dataset; returns its table (None: none)."""
+    sid = "fig06_sgraph"
+    m.add("rpSixTheta", float(ds.attrs["theta"]), f"{sid}:attrs.theta")
+    var(m, "rpSixSlopeZero", ds, sid, "slope_at_zero")
+    var(m, "rpSixImageLimit", ds, sid, "image_limit", sig=5)
+    m.add("rpSixSFirst", float(ds.s.values[0]), source(sid, "s") + "[0]", 6)
+    m.add("rpSixTsMin", float(ds.t_s.values[0]), "fig06_sgraph:t_s[0]", 2)
+    m.add("rpSixTsMax", float(ds.t_s.values[-1]), "fig06_sgraph:t_s[-1]", 2)
+    m.add("rpSixXiMin", float(ds.xi1.values[-1]), "fig06_sgraph:xi1[-1]", 4)
+    return None

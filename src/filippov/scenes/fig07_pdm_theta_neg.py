@@ -17,6 +17,66 @@ from ..analytic import pdm as asym
 from ..analytic.s0 import s0_lambert
 from ..io import finalize
 from ..tolerance import EVENT_STATE, ULP, Tolerance
+from ..report import Macros, head, num, per_eps_rows, rate_cell, source, tabular, value, var
+
+#: this scene's block of the scene schema: filippov.config.load_scene adds it to
+#: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it
+#: from this file without importing it (a literal: JSON with Python's True/False/None)
+PARAMETERS_SCHEMA = {
+  "properties": {
+    "parameters": {
+      "description": "theta < 0: P_DM in xi1 = (x1 + 1)/eps (eq:scal), one curve per eps.",
+      "required": [
+        "eps",
+        "mu",
+        "omega",
+        "theta",
+        "xi1_min",
+        "xi1_max",
+        "n_uniform",
+        "n_geometric",
+        "closest"
+      ],
+      "additionalProperties": False,
+      "properties": {
+        "eps": {
+          "type": "array",
+          "minItems": 2,
+          "items": {
+            "$ref": "#/$defs/positive"
+          }
+        },
+        "mu": {
+          "const": 1.0
+        },
+        "omega": True,
+        "theta": {
+          "type": "number",
+          "exclusiveMaximum": 0
+        },
+        "xi1_min": {
+          "type": "number",
+          "exclusiveMaximum": 0
+        },
+        "xi1_max": {
+          "type": "number",
+          "exclusiveMinimum": 0
+        },
+        "n_uniform": {
+          "type": "integer",
+          "minimum": 3
+        },
+        "n_geometric": {
+          "type": "integer",
+          "minimum": 1
+        },
+        "closest": {
+          "$ref": "#/$defs/positive"
+        }
+      }
+    }
+  }
+}
 
 
 def tolerances(scene: dict) -> dict:
@@ -123,3 +183,42 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     return finalize(ds, scene, method=scene["ingredients"]["flow"],
                     rate_first_order_fit=fit1, rate_zero_order_fit=fit0,
                     title="discontinuity map P_DM for theta < 0 (fig:pdmthlt0)")
+
+
+# ============================================================================= report
+# What the reproduction report quotes from this scene's dataset (filippov.report calls
+# `report`). This part -- report, REPORT_OPTIONAL and the _report_* / _REPORT_* names --
+# is left out of the code hash of the compute jobs: editing it rebuilds the report only.
+def _report_table(ds) -> str:
+    """Convergence over eps, one row per eps."""
+    def cells(d):
+        return [f"${num(float(d.P_left), 5)}$", f"${num(float(d.left_limit_error), 2)}$",
+                f"${num(float(d.error_printed))}$", f"${num(float(d.error_zero_order))}$",
+                f"${num(float(d.error_first_order))}$", rate_cell(float(d.rate_first_order), 2)]
+    return tabular("rrrrrrr", [head(
+        r"$\epsilon$", r"$P_\mathrm{DM}(0^-)$", r"$|P_\mathrm{DM}(0^-)$//$-s_0|$", "printed",
+        r"$\xi_1+s_0$", "corrected//1st order", "rate")], per_eps_rows(ds, cells))
+
+
+def report(ds, m: Macros) -> str | None:
+    """The report's macros from this scene's dataset; returns its table (None: none)."""
+    sid = "fig07_pdm_theta_neg"
+    eps = [float(e) for e in ds.eps.values]
+    m.add("rpSevenTheta", value(ds, "theta"), source(sid, "theta"))
+    var(m, "rpSevenSzero", ds, sid, "s0", sig=6)
+    m.add("rpSevenXiMin", float(ds.attrs["xi1_min"]), f"{sid}:attrs.xi1_min")
+    m.add("rpSevenXiMinAbs", abs(float(ds.attrs["xi1_min"])), "derived: |xi1_min|")
+    m.add("rpSevenEpsMax", eps[0], f"{sid}:eps[0]")
+    m.add("rpSevenEpsMin", eps[-1], f"{sid}:eps[-1]")
+    m.add("rpSevenRateFirst", float(ds.attrs["rate_first_order_fit"]),
+          f"{sid}:attrs.rate_first_order_fit", 2)
+    m.add("rpSevenRateZero", float(ds.attrs["rate_zero_order_fit"]),
+          f"{sid}:attrs.rate_zero_order_fit", 2)
+    for name_var, name in (("error_printed", "ErrPrinted"), ("error_first_order", "ErrFirst"),
+                      ("error_zero_order", "ErrZero"), ("left_limit_error", "LeftErr"),
+                      ("jump_x1", "Jump")):
+        var(m, f"rpSeven{name}Max", ds, sid, name_var, eps=eps[0])
+        var(m, f"rpSeven{name}Min", ds, sid, name_var, eps=eps[-1])
+    m.add("rpSevenIdentityErr", float(ds.identity_error_x1.max()),
+          "derived: max identity_error_x1 over eps", 2)
+    return _report_table(ds)

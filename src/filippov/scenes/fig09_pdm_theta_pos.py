@@ -16,6 +16,75 @@ import xarray as xr
 from ..analytic import pdm as asym
 from ..io import finalize
 from ..tolerance import Tolerance
+from ..report import Macros, head, num, per_eps_rows, rate_cell, source, tabular, value, var
+
+#: this scene's block of the scene schema: filippov.config.load_scene adds it to
+#: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it
+#: from this file without importing it (a literal: JSON with Python's True/False/None)
+PARAMETERS_SCHEMA = {
+  "properties": {
+    "parameters": {
+      "description": "0 < theta < 1: P_DM in xi1 = (x1 + 1)/eps^2 (eq:p:scal), one curve per eps; core: half-width of the fixed xi1 window for the convergence rate.",
+      "required": [
+        "eps",
+        "mu",
+        "omega",
+        "theta",
+        "xi1_min",
+        "xi1_max",
+        "n_uniform",
+        "n_geometric",
+        "closest",
+        "core"
+      ],
+      "additionalProperties": False,
+      "properties": {
+        "eps": {
+          "type": "array",
+          "minItems": 2,
+          "items": {
+            "$ref": "#/$defs/positive"
+          }
+        },
+        "mu": {
+          "const": 1.0
+        },
+        "omega": True,
+        "theta": {
+          "type": "number",
+          "exclusiveMinimum": 0,
+          "exclusiveMaximum": 1
+        },
+        "xi1_min": {
+          "type": "number",
+          "exclusiveMaximum": 0
+        },
+        "xi1_max": {
+          "type": "number",
+          "exclusiveMinimum": 0
+        },
+        "n_uniform": {
+          "type": "integer",
+          "minimum": 3
+        },
+        "n_geometric": {
+          "type": "integer",
+          "minimum": 1
+        },
+        "closest": {
+          "$ref": "#/$defs/positive"
+        },
+        "core": {
+          "$ref": "#/$defs/positive"
+        },
+        "n_core": {
+          "type": "integer",
+          "minimum": 2
+        }
+      }
+    }
+  }
+}
 
 #: x1 near -1 after the grazing-sliding passage: the events there move at speed
 #: O(eps), so each leaves x1 reproducible to an ulp or two of 1 (2.2e-16); 450
@@ -131,3 +200,38 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     return finalize(ds, scene, method=scene["ingredients"]["flow"], rate_fit=fit,
                     rate_core_fit=fit_c, core=core,
                     title="discontinuity map P_DM for theta > 0 (fig:pdmthgt0)")
+
+
+# ============================================================================= report
+# What the reproduction report quotes from this scene's dataset (filippov.report calls
+# `report`). This part -- report, REPORT_OPTIONAL and the _report_* / _REPORT_* names --
+# is left out of the code hash of the compute jobs: editing it rebuilds the report only.
+def _report_table(ds) -> str:
+    """Convergence over eps with the core correction, one row per eps."""
+    def cells(d):
+        return [f"${num(float(d.slope_left), 4)}$", f"${num(float(d.error_printed))}$",
+                f"${num(float(d.error))}$", f"${num(float(d.error_core))}$",
+                rate_cell(float(d.rate_core), 3), f"${num(float(d.sliding_limit_xi2))}$"]
+    return tabular("rrrrrrr", [head(
+        r"$\epsilon$", r"$P_\mathrm{DM}(\xi_1^-)$//$/\xi_1^-$", "printed", "corrected",
+        "corrected,//core", "rate//(core)", r"$\xi_2$, sliding//limit")], per_eps_rows(ds, cells))
+
+
+def report(ds, m: Macros) -> str | None:
+    """The report's macros from this scene's dataset; returns its table (None: none)."""
+    sid = "fig09_pdm_theta_pos"
+    eps = [float(e) for e in ds.eps.values]
+    m.add("rpNineTheta", value(ds, "theta"), source(sid, "theta"))
+    var(m, "rpNineSlopeTheory", ds, sid, "slope_theory")
+    m.add("rpNineEpsMax", eps[0], f"{sid}:eps[0]")
+    m.add("rpNineEpsMin", eps[-1], f"{sid}:eps[-1]")
+    var(m, "rpNineXiLeft", ds, sid, "xi1_left")
+    m.add("rpNineCore", float(ds.attrs["core"]), f"{sid}:attrs.core")
+    m.add("rpNineXiMin", float(ds.attrs["xi1_min"]), f"{sid}:attrs.xi1_min")
+    m.add("rpNineRateCore", float(ds.attrs["rate_core_fit"]), f"{sid}:attrs.rate_core_fit", 3)
+    for name_var, name in (("error_printed", "ErrPrinted"), ("error", "Err"),
+                      ("error_core", "ErrCore"), ("slope_left", "SlopeLeft")):
+        var(m, f"rpNine{name}Max", ds, sid, name_var, sig=4 if name_var == "slope_left" else 3, eps=eps[0])
+        var(m, f"rpNine{name}Min", ds, sid, name_var, sig=4 if name_var == "slope_left" else 3, eps=eps[-1])
+    var(m, "rpNineSlideLimitMax", ds, sid, "sliding_limit_xi2", eps=eps[0])
+    return _report_table(ds)

@@ -35,6 +35,73 @@ from ..progress import Progress
 from ..simulate import Section, simulate
 from .common import require
 from ..tolerance import Tolerance
+from ..report import Macros, absent, scalar_table, var
+
+#: this scene's block of the scene schema: filippov.config.load_scene adds it to
+#: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it
+#: from this file without importing it (a literal: JSON with Python's True/False/None)
+PARAMETERS_SCHEMA = {
+  "properties": {
+    "parameters": {
+      "description": "Reduced dry-friction oscillator eq:dfo1 over the belt speed v.",
+      "required": [
+        "f0",
+        "fv",
+        "fc",
+        "v_min",
+        "v_max",
+        "n_stick_slip",
+        "gs_closest",
+        "amp_min",
+        "ds",
+        "nu_max"
+      ],
+      "additionalProperties": False,
+      "properties": {
+        "f0": {
+          "type": "number"
+        },
+        "fv": {
+          "type": "number",
+          "minimum": 0
+        },
+        "fc": {
+          "type": "number"
+        },
+        "convention": {
+          "enum": [
+            "stribeck",
+            "literal"
+          ]
+        },
+        "v_min": {
+          "$ref": "#/$defs/positive"
+        },
+        "v_max": {
+          "$ref": "#/$defs/positive"
+        },
+        "n_stick_slip": {
+          "type": "integer",
+          "minimum": 8
+        },
+        "gs_closest": {
+          "type": "number",
+          "exclusiveMinimum": 0,
+          "exclusiveMaximum": 0.01
+        },
+        "amp_min": {
+          "$ref": "#/$defs/positive"
+        },
+        "ds": {
+          "$ref": "#/$defs/positive"
+        },
+        "nu_max": {
+          "$ref": "#/$defs/positive"
+        }
+      }
+    }
+  }
+}
 
 #: cross-machine tolerances (filippov.tolerance)
 TOLERANCES = {
@@ -451,3 +518,35 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     return finalize(ds, scene, method="integrate", friction_convention=law["convention"],
                     title="dry-friction oscillator eq:dfo1: friction law and bifurcation "
                           "diagram (fig:dfo)")
+
+
+# ============================================================================= report
+# What the reproduction report quotes from this scene's dataset (filippov.report calls
+# `report`). This part -- report, REPORT_OPTIONAL and the _report_* / _REPORT_* names --
+# is left out of the code hash of the compute jobs: editing it rebuilds the report only.
+#: the report does without this scene (its section says "not yet computed")
+REPORT_OPTIONAL = True
+
+
+def report(ds, m: Macros) -> str:
+    """Macros for the bifurcation diagram's findings (Hopf and grazing-sliding points,
+    multipliers), each when its variable is present, and a table of the scalars."""
+    missing = absent(m, "rpHaveTen", ds, "fig10", "results/fig10_dfo.nc")
+    if missing:
+        return missing
+    for name_var, name, sig in (("v_hopf", "rpTenVHopf", 10), ("v_hopf_numeric", "rpTenVHopfNum", 10),
+                                ("v_gs", "rpTenVGS", 9), ("v_gs_branch", "rpTenVGSBranch", 9),
+                                ("x1_gs", "rpTenXGS", 5), ("period_gs", "rpTenPeriodGS", 5),
+                                ("F_c_static", "rpTenStatic", 3)):
+        if name_var in ds:
+            var(m, name, ds, "fig10_dfo", name_var, sig)
+        else:
+            m.add(name, None, f"fig10_dfo:{name_var} (missing)",
+                  text=r"\emph{(" + name_var + " missing)}")
+    if "ss_multiplier" in ds:
+        m.add("rpTenSSMultMax", float(np.nanmax(ds.ss_multiplier.values)),
+              "derived:max(fig10_dfo:ss_multiplier)", 2)
+    if "po_multiplier" in ds:
+        m.add("rpTenPOMultMin", float(np.nanmin(ds.po_multiplier.values)),
+              "derived:min(fig10_dfo:po_multiplier)", 5)
+    return scalar_table(ds)

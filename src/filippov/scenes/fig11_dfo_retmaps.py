@@ -44,6 +44,98 @@ from ..simulate import Section, simulate
 from ..system import SLIDING
 from .common import engine, require, solver_options
 from ..tolerance import Tolerance
+from ..report import Macros, absent, scalar_table, var
+
+#: this scene's block of the scene schema: filippov.config.load_scene adds it to
+#: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it
+#: from this file without importing it (a literal: JSON with Python's True/False/None)
+PARAMETERS_SCHEMA = {
+  "properties": {
+    "parameters": {
+      "description": "Slow-fast dry-friction oscillator eq:dfo-sf; one v0 per eps (panels).",
+      "required": [
+        "gamma",
+        "f0",
+        "fv",
+        "fc",
+        "eps",
+        "v0",
+        "x1_min",
+        "x1_max",
+        "n_x1",
+        "sn_x1_range"
+      ],
+      "additionalProperties": False,
+      "properties": {
+        "f0": {
+          "type": "number"
+        },
+        "fv": {
+          "type": "number",
+          "minimum": 0
+        },
+        "fc": {
+          "type": "number"
+        },
+        "convention": {
+          "enum": [
+            "stribeck",
+            "literal"
+          ]
+        },
+        "gamma": {
+          "type": "number",
+          "minimum": 0
+        },
+        "eps": {
+          "type": "array",
+          "minItems": 1,
+          "items": {
+            "$ref": "#/$defs/positive"
+          }
+        },
+        "v0": {
+          "type": "array",
+          "minItems": 1,
+          "items": {
+            "$ref": "#/$defs/positive"
+          }
+        },
+        "x1_min": {
+          "$ref": "#/$defs/positive"
+        },
+        "x1_max": {
+          "$ref": "#/$defs/positive"
+        },
+        "n_x1": {
+          "type": "integer",
+          "minimum": 3
+        },
+        "sn_x1_range": {
+          "$ref": "#/$defs/point2"
+        },
+        "refine_dP": {
+          "$ref": "#/$defs/positive"
+        },
+        "refine_rounds": {
+          "type": "integer",
+          "minimum": 0
+        },
+        "sn_v0_guess": {
+          "type": "array",
+          "minItems": 2,
+          "maxItems": 2,
+          "items": {
+            "type": "number"
+          }
+        },
+        "sn_search_rtol": {
+          "$ref": "#/$defs/positive"
+        }
+      }
+    }
+  }
+}
 
 #: the scalars' meanings typeset for the report (attribute long_name_tex)
 LATEX_NAMES = {
@@ -589,3 +681,34 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
                 "x1": ("x1", x1, {"long_name": "x1 of the start point on L", "units": one})})
     return finalize(ds, scene, method="integrate", friction_convention=law["convention"],
                     title="return maps of the slow-fast dry-friction oscillator (fig:dfo-retmap)")
+
+
+# ============================================================================= report
+# What the reproduction report quotes from this scene's dataset (filippov.report calls
+# `report`). This part -- report, REPORT_OPTIONAL and the _report_* / _REPORT_* names --
+# is left out of the code hash of the compute jobs: editing it rebuilds the report only.
+#: the report does without this scene (its section says "not yet computed")
+REPORT_OPTIONAL = True
+
+
+def report(ds, m: Macros) -> str:
+    """Macros for the return maps' findings (chi_-, the sticking interval, the
+    saddle-node of each panel), each when present, and a table of the scalars."""
+    missing = absent(m, "rpHaveEleven", ds, "fig11", "results/fig11_dfo_retmaps.nc")
+    if missing:
+        return missing
+    for name_var, name in (("chi_minus", "rpElevenChi"), ("chi_minus_literal", "rpElevenChiLit"),
+                           ("sticking_a", "rpElevenA"), ("sticking_b", "rpElevenB"),
+                           ("sticking_a_literal", "rpElevenALit"),
+                           ("sticking_b_literal", "rpElevenBLit")):
+        if name_var in ds:
+            var(m, name, ds, "fig11_dfo_retmaps", name_var, 3)
+    for k, key in ((0, "A"), (1, "B")):
+        if "panel" not in ds.dims or ds.sizes["panel"] <= k:
+            continue
+        for name_var, name, sig in (("eps", "Eps", 3), ("v0_sn", "VSN", 8), ("x1_sn", "XSN", 6),
+                                    ("sliding_length_sn", "SlideSN", 3),
+                                    ("sliding_time_sn", "SlideTimeSN", 3)):
+            if name_var in ds:
+                var(m, f"rpEleven{name}{key}", ds, "fig11_dfo_retmaps", name_var, sig, panel=k)
+    return scalar_table(ds)

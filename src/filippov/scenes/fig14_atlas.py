@@ -18,6 +18,33 @@ from ..io import finalize
 from .attractor_common import (CHUNK_AXIS, ENGINES, chunk_grid, T_RETURN,  # noqa: F401
                                VARIABLE_ATTRS as _COMMON_ATTRS, chaos_tolerances,
                                common_dataset, lyapunov_limit, s_grid, sweep, validate)
+from ..report import Macros, source, value
+
+#: this scene's block of the scene schema: filippov.config.load_scene adds it to
+#: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it
+#: from this file without importing it (a literal: JSON with Python's True/False/None)
+PARAMETERS_SCHEMA = {
+  "properties": {
+    "parameters": {
+      "required": ["eps", "theta", "omega", "s_min", "s_max", "n_mu", "n_transient", "n_keep",
+                   "max_period", "window", "lyapunov"],
+      "additionalProperties": False,
+      "properties": {
+        "eps": {"type": "array", "minItems": 1, "maxItems": 1, "items": {"type": "number", "exclusiveMinimum": 0, "maximum": 0.1}},
+        "theta": {"type": "array", "minItems": 1, "items": {"type": "number", "minimum": -5, "exclusiveMaximum": 1}},
+        "omega": {"$ref": "#/$defs/positive"},
+        "s_min": {"type": "number"},
+        "s_max": {"type": "number"},
+        "n_mu": {"type": "integer", "minimum": 2},
+        "n_transient": {"type": "integer", "minimum": 0},
+        "n_keep": {"type": "integer", "minimum": 2},
+        "max_period": {"type": "integer", "minimum": 1},
+        "window": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
+        "lyapunov": {"type": "boolean"}
+      }
+    }
+  }
+}
 
 #: attractor types besides a period n >= 1
 CHAOTIC, APERIODIC, ESCAPED = 0, -1, -2
@@ -63,3 +90,33 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     ds["theta_critical"] = ((), lam / (1.0 + lam))
     return finalize(ds, scene, engine="compiled", method="exact",
                     title="atlas of the attractor near grazing, slow-fast Hopf example")
+
+
+# ============================================================================= report
+# What the reproduction report quotes from this scene's dataset (filippov.report calls
+# `report`). This part -- report, REPORT_OPTIONAL and the _report_* / _REPORT_* names --
+# is left out of the code hash of the compute jobs: editing it rebuilds the report only.
+def report(ds, m: Macros) -> str | None:
+    sid = "fig14_atlas"
+    th, s = ds.theta.values, ds.s.values
+    kind, lim = ds.attractor_type.values[:, 0, :], ds.attractor_type_limit.values[:, 0, :]
+    m.add("rpFourteenEps", float(ds.eps.values[0]), f"{sid}:eps[0]")
+    m.add("rpFourteenNTheta", th.size, f"{sid}:theta (size)")
+    m.add("rpFourteenNMu", s.size, f"{sid}:s (size)")
+    m.add("rpFourteenThetaCrit", value(ds, "theta_critical"), source(sid, "theta_critical"), 3)
+    above = s > 0
+    pos = th > 0
+    chaotic = np.array([np.any(kind[i, above] == 0) for i in range(th.size)])
+    one = np.array([np.all(kind[i, above] == 1) for i in range(th.size)])
+    m.add("rpFourteenChaosThetaMax", float(th[pos & chaotic].max()),
+          "derived: largest theta > 0 with a chaotic point above grazing", 3)
+    m.add("rpFourteenPeriodOneThetaMin", float(th[pos & one].min()),
+          "derived: smallest theta > 0 with period one everywhere above grazing", 3)
+    m.add("rpFourteenBelowAllOne", None, "derived: period one at every s < 0",
+          text=r"\text{every}" if np.all(kind[:, s < 0] == 1) else r"\text{\emph{not} every}")
+    m.add("rpFourteenAgree", 100.0 * float(np.mean(kind == lim)),
+          "derived: percent of points where slow-fast and limit-map types agree", 3)
+    neg = th < 0
+    m.add("rpFourteenNegChaos", float(np.sum(kind[neg][:, above] == 0)),
+          "derived: chaotic points at theta < 0", 1)
+    return None
