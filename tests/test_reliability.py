@@ -223,11 +223,27 @@ def test_planning_an_oversized_scene_stops_in_seconds(project):
 
 def test_malformed_config_names_file_line_and_column(project):
     cfg = project / "config/config.yaml"
-    cfg.write_text(cfg.read_text().replace("scenes: [", "scenes: [[", 1))
+    cfg.write_text(cfg.read_text().replace("schema: ", "schema: [", 1))
     run = run_snakemake(project, "-n")
     assert run.returncode != 0
     assert any(line.startswith("error: config/config.yaml: line ") and "column" in line
                for line in _lines(run)), run.stderr[-2000:]
+
+
+def test_the_scenes_are_the_scene_files(project):
+    # no list to keep: every config/scenes/*.yaml is built; a list in config.yaml picks
+    # some, and an id without its file is named
+    from filippov.config import load_workflow_config
+    cfg = project / "config/config.yaml"
+    schema = project / "config/schema/config.schema.json"
+    every = sorted(p.stem for p in (project / "config/scenes").glob("*.yaml"))
+    assert load_workflow_config(cfg, schema)["scenes"] == every and len(every) >= 14
+    assert load_workflow_config(cfg, schema, {"scenes": every[:2]})["scenes"] == every[:2]
+    cfg.write_text(cfg.read_text() + "scenes: [fig02_cases, fig99_nothing]\n")
+    run = run_snakemake(project, "-n")
+    assert run.returncode != 0
+    assert any(line.startswith("error: config/config.yaml: scenes: no scene file") and
+               "fig99_nothing.yaml" in line for line in _lines(run)), run.stderr[-2000:]
 
 
 def test_unknown_top_level_setting_is_named(project):
