@@ -102,10 +102,17 @@ def test_return_jacobian_through_sliding_matches_finite_differences():
     assert traj.status == "section:x3"
     assert [e.kind for e in traj.events][1:3] == ["slide_start", "slide_end"]
     J = return_jacobian(system, traj, section, rtol=1e-11, atol=1e-13)
-    fd = np.empty((3, 3))
-    for k in range(3):   # all three directions: x0 moves the start off x = 0, fine here
-        e = np.zeros(3)
-        e[k] = 1e-5
-        fd[:, k] = (run(z0 + e).z - run(z0 - e).z) / 2e-5
-    np.testing.assert_allclose(J, fd, atol=2e-8)
+
+    def fd(h):  # all three directions: x0 moves the start off x = 0, fine here
+        return np.stack([(run(z0 + e).z - run(z0 - e).z) / (2 * h) for e in h * np.eye(3)],
+                        axis=1)
+
+    # The difference quotient carries the noise of P (integration to rtol 1e-12, event
+    # location) divided by h: ~2e-13/h here, and another CPU rounds differently. Its
+    # error is estimated from two step sizes (the noise differs, the O(h^2) part is
+    # far below it) and bounded, so the check adapts to the noise, not to this machine.
+    fd1, fd2 = fd(1e-5), fd(2e-5)
+    tol = 4 * np.abs(fd1 - fd2).max() + 1e-10
+    assert tol < 1e-6
+    np.testing.assert_allclose(J, fd1, atol=tol)
     assert abs(J[2, 2]) > 0.1 and abs(J[1, 1]) < 1e-8   # w survives, y is collapsed
