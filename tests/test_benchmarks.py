@@ -95,3 +95,14 @@ def test_chunked_benchmark_parts_merge_in_order():
                    log=lambda s: None)
     with pytest.raises(ValueError, match="method/tolerance"):
         wp.merge([parts[0], other])
+
+
+def test_compile_cost_times_a_cold_and_a_warm_process():
+    # one pair of fresh processes (the first compiles the kernel on empty caches, ~20 s)
+    from filippov.benchmarks import compile_cost
+    lines = []
+    ds = compile_cost.run(repeat=1, log=lambda *a, **k: lines.append(" ".join(map(str, a))))
+    assert list(ds.stage.values) == [s for s, _ in compile_cost.STAGES]
+    cold, warm = ds.cold.sel(stage="kernel").item(), ds.warm.sel(stage="kernel").item()
+    assert cold > 10 * warm > 0      # compiled, then loaded from numba's cache
+    assert ds.cold.attrs["units"] == "s" and any(line.startswith("kernel") for line in lines)

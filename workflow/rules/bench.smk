@@ -99,9 +99,21 @@ rule bench_sliding_cost:
         "../scripts/bench_sliding_cost.py"
 
 
+# What the compiled engine costs before its first return: the kernel's compile on empty
+# caches and its load afterwards (fresh processes), printed as a table.
+rule bench_compile_cost:
+    output:
+        "results/bench_compile_cost.nc",
+    params:
+        code=library_hash(exclude="plotting"),
+    script:
+        "../scripts/bench_compile_cost.py"
+
+
 rule bench:
     input:
         rules.plot_bench.output,
         rules.bench_effect_cost.output,
         rules.bench_attractor_cost.output,
         rules.bench_sliding_cost.output,
+        rules.bench_compile_cost.output,

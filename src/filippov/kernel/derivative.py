@@ -5,7 +5,7 @@ import numpy as np
 
 from ..system import PLUS
 from .base import (_central_step, _dot, _jit)
-from .dop853 import (_A, _B, _NS, _checked_field, _stage)
+from .dop853 import (_A, _B, _NS, _TRIAL, _checked_field, _stage)
 
 
 # The derivative of a return, carried in w.M while the orbit runs (Settings.jac), as the
@@ -86,8 +86,8 @@ def _jvp(mode, y, v, out, fns, p, w):
     for k in range(n):
         w.jz1[k] = y[k] + d * v[k]
         w.jz2[k] = y[k] - d * v[k]
-    _checked_field(w.jz1, mode, False, fns, p, w.wg, w.wf, w.wp, w.jf1)
-    _checked_field(w.jz2, mode, False, fns, p, w.wg, w.wf, w.wp, w.jf2)
+    _checked_field(w.jz1, mode, _TRIAL, fns, p, w.wg, w.wf, w.wp, w.jf1)
+    _checked_field(w.jz2, mode, _TRIAL, fns, p, w.wg, w.wf, w.wp, w.jf2)
     for k in range(n):
         out[k] = (w.jf1[k] - w.jf2[k]) / (2.0 * d)
 
@@ -140,8 +140,8 @@ def _var_step(mode, y0, h, fns, p, w, exact):
 @_jit
 def _switch_derivative(mode, new_mode, fns, p, w):
     """w.M <- S w.M, S the saltation matrix of the switch mode -> new_mode at w.z."""
-    _checked_field(w.z, mode, False, fns, p, w.wg, w.wf, w.wp, w.jf1)
-    _checked_field(w.z, new_mode, False, fns, p, w.wg, w.wf, w.wp, w.jf2)
+    _checked_field(w.z, mode, _TRIAL, fns, p, w.wg, w.wf, w.wp, w.jf1)
+    _checked_field(w.z, new_mode, _TRIAL, fns, p, w.wg, w.wf, w.wp, w.jf2)
     fns[5](w.z, p, w.jz1)
     speed = _dot(w.jz1, w.jf1)
     for k in range(w.z.size):
@@ -154,7 +154,7 @@ def _section_derivative(mode, fns, p, w):
     """w.M <- (I - f g^T / (g . f)) w.M at the section hit w.z: f the field there, g the
     section's gradient (central differences; w.z is restored bit for bit)."""
     z = w.z
-    _checked_field(z, mode, False, fns, p, w.wg, w.wf, w.wp, w.jf1)
+    _checked_field(z, mode, _TRIAL, fns, p, w.wg, w.wf, w.wp, w.jf1)
     for k in range(z.size):
         orig = z[k]
         d = _central_step(max(1.0, abs(orig)), 1.0)

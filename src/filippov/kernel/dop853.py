@@ -15,6 +15,9 @@ from .base import (_jit, _speeds)
 _NS = _dop.N_STAGES              # 12
 _NSE = _dop.N_STAGES_EXTENDED    # 16
 _NI = _dop.INTERPOLATOR_POWER    # 7
+# _checked_field's first_call, as numpy booleans: a literal True/False would compile it
+# twice (see base: codes handed to helpers)
+_FIRST_CALL, _TRIAL = np.bool_(True), np.bool_(False)
 _A = np.ascontiguousarray(_dop.A, dtype=np.float64)
 _B = np.ascontiguousarray(_dop.B, dtype=np.float64)
 _E3 = np.ascontiguousarray(_dop.E3, dtype=np.float64)
@@ -80,7 +83,7 @@ def _stage(s, mode, y0, h, K, ytmp, fns, p, wg, wm, wp):
         for j in range(s):
             acc += K[j, k] * _A[s, j]
         ytmp[k] = y0[k] + acc * h
-    _checked_field(ytmp, mode, False, fns, p, wg, wm, wp, K[s])
+    _checked_field(ytmp, mode, _TRIAL, fns, p, wg, wm, wp, K[s])
 
 
 @_jit
@@ -111,7 +114,7 @@ def _dop_initial_step(mode, t0, y0, f0, t_bound, max_step, rtol, atol, fns, p, w
     h0 = min(h0, interval)
     for k in range(n):
         y1[k] = y0[k] + h0 * f0[k]
-    _checked_field(y1, mode, False, fns, p, wg, wm, wp, f1)
+    _checked_field(y1, mode, _TRIAL, fns, p, wg, wm, wp, f1)
     s = 0.0
     for k in range(n):
         q = (f1[k] - f0[k]) / scale[k]
@@ -157,7 +160,7 @@ def _dop_step(mode, t, y, f, h_abs, t_bound, max_step, rtol, atol, fns, p, wg, w
             for j in range(_NS):
                 acc += K[j, k] * _B[j]
             ynew[k] = y[k] + h * acc
-        _checked_field(ynew, mode, False, fns, p, wg, wm, wp, K[_NS])
+        _checked_field(ynew, mode, _TRIAL, fns, p, wg, wm, wp, K[_NS])
         # error norm (DOP853._estimate_error_norm)
         for k in range(n):
             scale[k] = atol + max(abs(y[k]), abs(ynew[k])) * rtol

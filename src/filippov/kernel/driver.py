@@ -19,7 +19,7 @@ from .base import (BAD_START, EVENT_LIMIT, NON_FINITE, NO_RETURN, NO_SLIDING, OK
                    _WHERE, _JAC, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
                    _exit_drift, _exit_shift, _jit, _jit_inline, _next_mode, _onto_switch,
                    _slides_in_section, _speeds, _start_on_switch, _start_side, _vec)
-from .dop853 import (_NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
+from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
                      _dop_step)
 from .segment import _zat
 from .scan import (_find, _sample)
@@ -147,7 +147,7 @@ def _stay_integrated(mode, t, fns, p, s, w):
     w.sg[3] = 1.0
     for k in range(n):
         w.y[k] = w.z[k]
-    if not _checked_field(w.y, mode, True, fns, p, w.wg, w.wf, w.wp, w.f):
+    if not _checked_field(w.y, mode, _FIRST_CALL, fns, p, w.wg, w.wf, w.wp, w.f):
         return NON_FINITE, t, _W_NONE
     h_abs = _dop_initial_step(mode, t, w.y, w.f, s.t_max, s.max_step, s.rtol, s.atol, fns, p,
                               w.wg, w.wf, w.wp, w.ynew, w.ytmp, w.scale)

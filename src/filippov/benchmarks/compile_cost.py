@@ -1,0 +1,111 @@
+"""What the compiled engine costs before its first return: compile and load times.
+
+Run ``python -m filippov.benchmarks.compile_cost`` (part of ``make bench``). Each run is
+a fresh Python process with its own empty caches (numba's, ``NUMBA_CACHE_DIR``, and the
+generated model pieces', ``FILIPPOV_CACHE_DIR``): it imports the engine, compiles the
+kernel (:func:`filippov.fastmap.compile_kernel`), builds the Hopf model's compiled pieces
+and makes one batch call of first returns. A second process on the same caches does the
+same: the loads a user sees from the second session on. Each stage is timed on its own
+(wall time, median over ``--repeat`` pairs of processes); the kernel is one numba
+compilation, so a second core does not help it.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+import xarray as xr
+
+from ..io import finalize, write_dataset
+
+#: the stages one process times, in order (name, what it is)
+STAGES = [("import", "import filippov.fastmap (numba, the rule book, the kernel's types)"),
+          ("kernel", "compile_kernel(): the kernel, compiled or loaded from numba's cache"),
+          ("model", "hopf.compiled(...): the model's pieces, generated and compiled or loaded"),
+          ("first_call", "one batch of 8 first returns, the first call of the process")]
+
+_PROBE = """
+import json, time
+t0 = time.perf_counter()
+from filippov.fastmap import compile_kernel, compute_returns
+t1 = time.perf_counter()
+loaded = compile_kernel()
+t2 = time.perf_counter()
+import numpy as np
+from filippov.models import hopf
+cm = hopf.compiled(1e-2, -0.5, 1.0 + 1e-2)
+t3 = time.perf_counter()
+starts = np.column_stack([np.zeros(8), np.linspace(0.9, 1.1, 8), np.zeros(8)])
+out = compute_returns(cm, starts, 5.0)
+t4 = time.perf_counter()
+print(json.dumps({"import": t1 - t0, "kernel": t2 - t1, "model": t3 - t2,
+                  "first_call": t4 - t3, "loaded": loaded, "ok": int((out.status == 0).sum())}))
+"""
+
+
+def _process(cache: str) -> dict:
+    env = dict(os.environ, NUMBA_CACHE_DIR=os.path.join(cache, "numba"),
+               FILIPPOV_CACHE_DIR=os.path.join(cache, "generated"))
+    run = subprocess.run([sys.executable, "-c", _PROBE], env=env, capture_output=True,
+                         text=True, check=False)
+    if run.returncode != 0:
+        raise RuntimeError(f"compile_cost probe failed:\n{run.stderr[-3000:]}")
+    return json.loads(run.stdout.strip().splitlines()[-1])
+
+
+def measure(repeat: int = 3, log=print) -> dict:
+    """{"cold": {stage: s}, "warm": {stage: s}}: medians over ``repeat`` pairs of
+    processes (the first on empty caches, the second on what the first left)."""
+    runs = {"cold": [], "warm": []}
+    for k in range(repeat):
+        with tempfile.TemporaryDirectory(prefix="filippov-compile-cost-") as cache:
+            cold, warm = _process(cache), _process(cache)
+        if cold["ok"] != 8 or warm["ok"] != 8:
+            raise RuntimeError("compile_cost: a first return of the probe failed")
+        if cold["loaded"] or not warm["loaded"]:
+            raise RuntimeError("compile_cost: the first process loaded a cached kernel or "
+                               "the second compiled it again (a cache outside NUMBA_CACHE_DIR?)")
+        runs["cold"].append(cold)
+        runs["warm"].append(warm)
+        log(f"  pair {k + 1}/{repeat}: kernel {cold['kernel']:.1f} s cold, "
+            f"{warm['kernel']:.2f} s warm", flush=True)
+    return {kind: {s: statistics.median(r[s] for r in rows) for s, _ in STAGES}
+            for kind, rows in runs.items()}
+
+
+def run(repeat: int = 3, log=print) -> xr.Dataset:
+    m = measure(repeat, log)
+    names = [s for s, _ in STAGES]
+    ds = xr.Dataset(
+        {"cold": ("stage", [m["cold"][s] for s in names],
+                  {"long_name": "wall time, empty caches (median)", "units": "s"}),
+         "warm": ("stage", [m["warm"][s] for s in names],
+                  {"long_name": "wall time, caches written by an earlier process (median)",
+                   "units": "s"}),
+         "description": ("stage", [d for _, d in STAGES], {"long_name": "what the stage does"})},
+        coords={"stage": ("stage", names, {"long_name": "stage of a process's first return"})})
+    log(f"{'stage':12s} {'cold [s]':>9s} {'warm [s]':>9s}  what")
+    for s, d in STAGES:
+        log(f"{s:12s} {m['cold'][s]:9.2f} {m['warm'][s]:9.2f}  {d}")
+    log(f"{'total':12s} {sum(m['cold'].values()):9.2f} {sum(m['warm'].values()):9.2f}")
+    return finalize(ds, None, repeat=repeat, cpu_count=os.cpu_count() or 0,
+                    title="compile and load times of the compiled engine")
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3, help="pairs of processes (median)")
+    ap.add_argument("--out", default=None, help="netCDF file for the table")
+    args = ap.parse_args(argv)
+    ds = run(args.repeat)
+    if args.out:
+        write_dataset(ds, args.out)
+
+
+if __name__ == "__main__":
+    main()
