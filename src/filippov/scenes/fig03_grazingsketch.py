@@ -46,36 +46,15 @@ PARAMETERS_SCHEMA = {
   "properties": {
     "parameters": {
       "description": "Reduced system: eps and theta do not enter (h0 = x1 + 1).",
-      "required": [
-        "omega",
-        "mu",
-        "x2_start",
-        "settle_tol",
-        "max_periods",
-        "n_samples"
-      ],
+      "required": ["omega", "mu", "x2_start", "settle_tol", "max_periods", "n_samples"],
       "additionalProperties": False,
       "properties": {
         "omega": True,
-        "mu": {
-          "type": "array",
-          "minItems": 1
-        },
-        "x2_start": {
-          "$ref": "#/$defs/positive"
-        },
-        "settle_tol": {
-          "type": "number",
-          "exclusiveMinimum": 0,
-          "exclusiveMaximum": 1e-06
-        },
-        "max_periods": {
-          "type": "integer",
-          "minimum": 2
-        },
-        "n_samples": {
-          "$ref": "#/$defs/n_samples"
-        }
+        "mu": {"type": "array", "minItems": 1},
+        "x2_start": {"$ref": "#/$defs/positive"},
+        "settle_tol": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1e-06},
+        "max_periods": {"type": "integer", "minimum": 2},
+        "n_samples": {"$ref": "#/$defs/n_samples"}
       }
     }
   }

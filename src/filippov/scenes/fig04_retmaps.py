@@ -32,49 +32,19 @@ from ..report import Macros, source, value, var
 PARAMETERS_SCHEMA = {
   "properties": {
     "parameters": {
-      "required": [
-        "eps",
-        "mu",
-        "omega",
-        "theta",
-        "x2_min",
-        "x2_max",
-        "n_uniform",
-        "n_geometric",
-        "closest"
-      ],
+      "required": ["eps", "mu", "omega", "theta", "x2_min", "x2_max", "n_uniform",
+                   "n_geometric", "closest"],
       "additionalProperties": False,
       "properties": {
-        "eps": {
-          "$ref": "#/$defs/positive"
-        },
+        "eps": {"$ref": "#/$defs/positive"},
         "mu": True,
         "omega": True,
-        "theta": {
-          "type": "array"
-        },
-        "x2_min": {
-          "type": "number",
-          "exclusiveMinimum": 0,
-          "exclusiveMaximum": 1
-        },
-        "x2_max": {
-          "type": "number",
-          "exclusiveMinimum": 1
-        },
-        "n_uniform": {
-          "type": "integer",
-          "minimum": 3
-        },
-        "n_geometric": {
-          "type": "integer",
-          "minimum": 1
-        },
-        "closest": {
-          "type": "number",
-          "exclusiveMinimum": 0,
-          "exclusiveMaximum": 0.01
-        }
+        "theta": {"type": "array"},
+        "x2_min": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
+        "x2_max": {"type": "number", "exclusiveMinimum": 1},
+        "n_uniform": {"type": "integer", "minimum": 3},
+        "n_geometric": {"type": "integer", "minimum": 1},
+        "closest": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 0.01}
       }
     }
   }

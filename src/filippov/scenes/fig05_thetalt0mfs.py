@@ -37,56 +37,21 @@ from ..report import Macros, var
 PARAMETERS_SCHEMA = {
   "properties": {
     "parameters": {
-      "required": [
-        "eps",
-        "mu",
-        "omega",
-        "theta",
-        "start_x2",
-        "x1_range",
-        "x2_range",
-        "n_grid",
-        "settle",
-        "rate_window",
-        "n_samples"
-      ],
+      "required": ["eps", "mu", "omega", "theta", "start_x2", "x1_range", "x2_range",
+                   "n_grid", "settle", "rate_window", "n_samples"],
       "additionalProperties": False,
       "properties": {
-        "eps": {
-          "$ref": "#/$defs/positive"
-        },
-        "mu": {
-          "const": 1.0
-        },
+        "eps": {"$ref": "#/$defs/positive"},
+        "mu": {"const": 1.0},
         "omega": True,
-        "theta": {
-          "type": "number",
-          "exclusiveMaximum": 0
-        },
-        "start_x2": {
-          "type": "number",
-          "exclusiveMinimum": 1
-        },
-        "x1_range": {
-          "$ref": "#/$defs/point2"
-        },
-        "x2_range": {
-          "$ref": "#/$defs/point2"
-        },
-        "n_grid": {
-          "type": "integer",
-          "minimum": 2
-        },
-        "settle": {
-          "type": "number",
-          "minimum": 10
-        },
-        "rate_window": {
-          "$ref": "#/$defs/positive"
-        },
-        "n_samples": {
-          "$ref": "#/$defs/n_samples"
-        }
+        "theta": {"type": "number", "exclusiveMaximum": 0},
+        "start_x2": {"type": "number", "exclusiveMinimum": 1},
+        "x1_range": {"$ref": "#/$defs/point2"},
+        "x2_range": {"$ref": "#/$defs/point2"},
+        "n_grid": {"type": "integer", "minimum": 2},
+        "settle": {"type": "number", "minimum": 10},
+        "rate_window": {"$ref": "#/$defs/positive"},
+        "n_samples": {"$ref": "#/$defs/n_samples"}
       }
     }
   }

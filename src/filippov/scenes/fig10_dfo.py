@@ -44,60 +44,21 @@ PARAMETERS_SCHEMA = {
   "properties": {
     "parameters": {
       "description": "Reduced dry-friction oscillator eq:dfo1 over the belt speed v.",
-      "required": [
-        "f0",
-        "fv",
-        "fc",
-        "v_min",
-        "v_max",
-        "n_stick_slip",
-        "gs_closest",
-        "amp_min",
-        "ds",
-        "nu_max"
-      ],
+      "required": ["f0", "fv", "fc", "v_min", "v_max", "n_stick_slip", "gs_closest",
+                   "amp_min", "ds", "nu_max"],
       "additionalProperties": False,
       "properties": {
-        "f0": {
-          "type": "number"
-        },
-        "fv": {
-          "type": "number",
-          "minimum": 0
-        },
-        "fc": {
-          "type": "number"
-        },
-        "convention": {
-          "enum": [
-            "stribeck",
-            "literal"
-          ]
-        },
-        "v_min": {
-          "$ref": "#/$defs/positive"
-        },
-        "v_max": {
-          "$ref": "#/$defs/positive"
-        },
-        "n_stick_slip": {
-          "type": "integer",
-          "minimum": 8
-        },
-        "gs_closest": {
-          "type": "number",
-          "exclusiveMinimum": 0,
-          "exclusiveMaximum": 0.01
-        },
-        "amp_min": {
-          "$ref": "#/$defs/positive"
-        },
-        "ds": {
-          "$ref": "#/$defs/positive"
-        },
-        "nu_max": {
-          "$ref": "#/$defs/positive"
-        }
+        "f0": {"type": "number"},
+        "fv": {"type": "number", "minimum": 0},
+        "fc": {"type": "number"},
+        "convention": {"enum": ["stribeck", "literal"]},
+        "v_min": {"$ref": "#/$defs/positive"},
+        "v_max": {"$ref": "#/$defs/positive"},
+        "n_stick_slip": {"type": "integer", "minimum": 8},
+        "gs_closest": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 0.01},
+        "amp_min": {"$ref": "#/$defs/positive"},
+        "ds": {"$ref": "#/$defs/positive"},
+        "nu_max": {"$ref": "#/$defs/positive"}
       }
     }
   }

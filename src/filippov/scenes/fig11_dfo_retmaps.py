@@ -53,85 +53,30 @@ PARAMETERS_SCHEMA = {
   "properties": {
     "parameters": {
       "description": "Slow-fast dry-friction oscillator eq:dfo-sf; one v0 per eps (panels).",
-      "required": [
-        "gamma",
-        "f0",
-        "fv",
-        "fc",
-        "eps",
-        "v0",
-        "x1_min",
-        "x1_max",
-        "n_x1",
-        "sn_x1_range"
-      ],
+      "required": ["gamma", "f0", "fv", "fc", "eps", "v0", "x1_min", "x1_max", "n_x1",
+                   "sn_x1_range"],
       "additionalProperties": False,
       "properties": {
-        "f0": {
-          "type": "number"
-        },
-        "fv": {
-          "type": "number",
-          "minimum": 0
-        },
-        "fc": {
-          "type": "number"
-        },
-        "convention": {
-          "enum": [
-            "stribeck",
-            "literal"
-          ]
-        },
-        "gamma": {
-          "type": "number",
-          "minimum": 0
-        },
-        "eps": {
-          "type": "array",
-          "minItems": 1,
-          "items": {
-            "$ref": "#/$defs/positive"
-          }
-        },
-        "v0": {
-          "type": "array",
-          "minItems": 1,
-          "items": {
-            "$ref": "#/$defs/positive"
-          }
-        },
-        "x1_min": {
-          "$ref": "#/$defs/positive"
-        },
-        "x1_max": {
-          "$ref": "#/$defs/positive"
-        },
-        "n_x1": {
-          "type": "integer",
-          "minimum": 3
-        },
-        "sn_x1_range": {
-          "$ref": "#/$defs/point2"
-        },
-        "refine_dP": {
-          "$ref": "#/$defs/positive"
-        },
-        "refine_rounds": {
-          "type": "integer",
-          "minimum": 0
-        },
+        "f0": {"type": "number"},
+        "fv": {"type": "number", "minimum": 0},
+        "fc": {"type": "number"},
+        "convention": {"enum": ["stribeck", "literal"]},
+        "gamma": {"type": "number", "minimum": 0},
+        "eps": {"type": "array", "minItems": 1, "items": {"$ref": "#/$defs/positive"}},
+        "v0": {"type": "array", "minItems": 1, "items": {"$ref": "#/$defs/positive"}},
+        "x1_min": {"$ref": "#/$defs/positive"},
+        "x1_max": {"$ref": "#/$defs/positive"},
+        "n_x1": {"type": "integer", "minimum": 3},
+        "sn_x1_range": {"$ref": "#/$defs/point2"},
+        "refine_dP": {"$ref": "#/$defs/positive"},
+        "refine_rounds": {"type": "integer", "minimum": 0},
         "sn_v0_guess": {
           "type": "array",
           "minItems": 2,
           "maxItems": 2,
-          "items": {
-            "type": "number"
-          }
+          "items": {"type": "number"}
         },
-        "sn_search_rtol": {
-          "$ref": "#/$defs/positive"
-        }
+        "sn_search_rtol": {"$ref": "#/$defs/positive"}
       }
     }
   }
