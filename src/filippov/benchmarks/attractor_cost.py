@@ -9,7 +9,6 @@ process compiles or loads the kernel and is not timed.
 """
 from __future__ import annotations
 
-import argparse
 import statistics
 import time
 
@@ -18,7 +17,8 @@ import xarray as xr
 
 from ..analytic import limit_map
 from ..fastmap import OK, compute_returns
-from ..io import finalize, write_dataset
+from . import command_line
+from ..io import finalize
 from ..models import hopf
 
 #: (theta, eps, s): the cascade (theta < 0) and the chaos (theta > 0) at the scenes' eps
@@ -77,14 +77,7 @@ def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--returns", type=int, default=2000)
-    ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--out", default=None, help="netCDF file for the table")
-    args = ap.parse_args(argv)
-    ds = run(args.returns, args.repeat)
-    if args.out:
-        write_dataset(ds, args.out)
+    command_line(__doc__, run, argv, returns=2000, repeat=5)
 
 
 if __name__ == "__main__":

@@ -11,7 +11,6 @@ compilation, so a second core does not help it.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import statistics
@@ -21,7 +20,8 @@ import tempfile
 
 import xarray as xr
 
-from ..io import finalize, write_dataset
+from . import command_line
+from ..io import finalize
 
 #: the stages one process times, in order (name, what it is)
 STAGES = [("import", "import filippov.fastmap (numba, the rule book, the kernel's types)"),
@@ -98,13 +98,7 @@ def run(repeat: int = 3, log=print) -> xr.Dataset:
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=3, help="pairs of processes (median)")
-    ap.add_argument("--out", default=None, help="netCDF file for the table")
-    args = ap.parse_args(argv)
-    ds = run(args.repeat)
-    if args.out:
-        write_dataset(ds, args.out)
+    command_line(__doc__, run, argv, repeat=3)
 
 
 if __name__ == "__main__":

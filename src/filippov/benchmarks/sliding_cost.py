@@ -10,7 +10,6 @@ time at the largest eps with the default method (not stiff there: DOP853 only).
 """
 from __future__ import annotations
 
-import argparse
 import importlib
 import statistics
 import time
@@ -19,7 +18,8 @@ import numpy as np
 import xarray as xr
 
 from ..hard_cases import PARAMETERS
-from ..io import finalize, write_dataset
+from . import command_line
+from ..io import finalize
 from ..models import hopf
 from ..scenes.fig04_retmaps import section_L1
 
@@ -81,13 +81,7 @@ def run(repeat: int = 5, log=print) -> xr.Dataset:
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--out", default=None, help="netCDF file for the table")
-    args = ap.parse_args(argv)
-    ds = run(args.repeat)
-    if args.out:
-        write_dataset(ds, args.out)
+    command_line(__doc__, run, argv, repeat=5)
 
 
 if __name__ == "__main__":
