@@ -274,13 +274,20 @@ def _problem_tex(name: str) -> str:
     return rest
 
 
-def bench(ds, m: Macros, effects=None, returns=None) -> str:
+def bench(ds, m: Macros, effects=None, returns=None, compile_cost=None) -> str:
     """The work-precision tables of the default build's sweep (results/work_precision.nc):
     per problem set (fig04, fig11), one row per method and tolerance, error / time /
     missed switches per problem; the speed-up at the target error and what the
     scipy solvers a user reaches for first get wrong; the cost of each model
     ingredient when results/bench_effect_cost.nc is there and the cost of one iterated
-    return when results/bench_attractor_cost.nc is (`make bench`)."""
+    return when results/bench_attractor_cost.nc is (`make bench`); the compile and load
+    times of the compiled engine (macros only) when results/bench_compile_cost.nc is."""
+    m.flag("rpHaveCompileCost", compile_cost is not None)
+    if compile_cost is not None:
+        for stage, tag in (("kernel", "Kernel"), ("model", "Model")):
+            for kind in ("cold", "warm"):
+                var(m, f"rpCompile{tag}{kind.title()}", compile_cost, "bench_compile_cost",
+                    kind, sig=2, stage=stage)
     sid = "work_precision"
     missing = absent(m, "rpHaveBench", ds, "Work--precision sweep", "results/work_precision.nc")
     if missing:
@@ -461,7 +468,7 @@ def generate(datasets: Mapping[str, Optional[xr.Dataset]]) -> dict[str, str]:
             raise KeyError(f"{sid}: the report reads {exc} but the dataset lacks it") from None
         texts[f"{sid}.tex"] = table if table is not None else f"% {sid}: no table\n"
     tab_bench = bench(datasets.get("work_precision"), m, datasets.get("bench_effect_cost"),
-                      datasets.get("bench_attractor_cost"))
+                      datasets.get("bench_attractor_cost"), datasets.get("bench_compile_cost"))
     try:
         tab_hard, tab_return = hard_cases(datasets.get("hard_cases"), m)
     except KeyError as exc:
