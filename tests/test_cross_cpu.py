@@ -206,3 +206,12 @@ def test_manifest_catches_a_one_percent_parameter_change(sid, tmp_path):
     for line in problems:
         where, var = line.split(": ")[:2]
         assert where == f"results/{sid}.nc" and var in variables, line
+
+
+def test_the_emulated_build_targets_every_scene():
+    # make cross-cpu rebuilds what the workflow builds: every scene file's figures
+    scenes = scene_files(ROOT / "config" / "scenes")
+    got = cross_cpu.targets()
+    assert [t for t in got if t.startswith("figures/")] == [
+        f"figures/{s}.{ext}" for s in scenes for ext in ("pdf", "png")]
+    assert "results/hard_cases.nc" in got

@@ -84,9 +84,11 @@ def emulation_env(shim: Path, seed: int, cache: Path) -> dict:
 
 
 def targets() -> list[str]:
-    import yaml
+    from filippov.config import load_workflow_config
 
-    scenes = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["scenes"]
+    # the scenes the workflow builds (every scene file, unless config.yaml picks some)
+    scenes = load_workflow_config(ROOT / "config" / "config.yaml",
+                                  ROOT / "config" / "schema" / "config.schema.json")["scenes"]
     return [f"figures/{s}.{ext}" for s in scenes for ext in ("pdf", "png")] + \
         ["results/hard_cases.nc", "results/work_precision.nc"]
 
