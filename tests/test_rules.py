@@ -186,14 +186,3 @@ def test_exact_windows_grow_with_the_time_since_the_entry_during_the_transient()
         assert f(40.0, 1.0, 16.0, 40.0) == 16.0
         assert f(0.0, 1.0, 16.0, 0.0) == 16.0
     assert kernel._exact_window.py_func is rules.exact_window
-
-
-def test_step_past_takes_the_first_probe_beyond_the_crossing():
-    # probes r, r + 2 ulp, r + 6 ulp, ... until past(t) holds; tb when none before it does
-    r = 1.0
-    ulp = np.spacing(r)
-    flip = r + 10 * ulp          # past from here on: probes r, +2, +6, +14 ulp -> +14
-    got = rules.step_past(lambda t, f: t >= f, (flip,), r, 2.0)
-    assert got == r + 14 * ulp
-    assert rules.step_past(lambda t: True, (), r, 2.0) == r          # already past
-    assert rules.step_past(lambda t: False, (), r, r + 5 * ulp) == r + 5 * ulp  # capped at tb

@@ -55,23 +55,6 @@ def far_side(pred: int, v0: float) -> int:
     return pred
 
 
-def step_past(past, args, r: float, tb: float) -> float:
-    """The first of r, r + 2 ulp, r + 6 ulp, r + 14 ulp, ... (doubling increments, at
-    most ``tb``) where ``past(t, *args)`` says the event function is past the crossing
-    (``after(pred, value)``): a root finder may stop a hair before the sign flips
-    (rounding near a shallow crossing), and the event must be taken on its far side.
-    ``tb`` when no probe before it is past. ``past`` is the engine's (a Python callable,
-    or a compiled one with its work arrays in ``args``)."""
-    a = max(abs(r), _TINY)
-    step = 2.0 * (np.nextafter(a, np.inf) - a)
-    while not past(r, *args):
-        if r >= tb:
-            return tb
-        r = min(r + step, tb)
-        step *= 2.0
-    return r
-
-
 def clamp(pred: int, v0: float) -> float:
     """The start sample of a just-entered mode, inside by construction: a value that
     rounding put on the far side is moved to the near side's edge."""

@@ -85,8 +85,6 @@ _jit_inline = njit(cache=True, _nrt=False, inline="always")
     "slides_in_section", "starts_on_section", "same_instant", "start_side", "start_on_switch",
     "next_mode", "accumulates", "exit_shift", "dips_and_returns", "exact_window",
     "onto_switch", "exit_drift", "carried_age"))
-# (a rule that takes the engine's event function as an argument: no CPython wrapper)
-_step_past = _jit(rules.step_past)
 assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 
 

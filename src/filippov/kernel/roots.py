@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import (_EPS, _MAXITER_EVENT, _after, _far_side, _jit, _step_past)
-from .segment import _fval, _past_at
+from .base import (_EPS, _MAXITER_EVENT, _TINY, _after, _far_side, _jit)
+from .segment import _fval
 
 
 @_jit
@@ -84,5 +84,11 @@ def _refine(sel, pred, ta, tb, va, xtol, mode, sg, za, F, y_old, fns, p, wz, wg,
                 r = ta
             else:
                 return r, False
-    return _step_past(_past_at, (pred, sel, mode, sg, za, F, y_old, fns, p, wz, wg, wf), r,
-                      tb), True
+    a = max(abs(r), _TINY)
+    step = 2.0 * (np.nextafter(a, np.inf) - a)
+    while not _after(pred, _fval(sel, r, mode, sg, za, F, y_old, fns, p, wz, wg, wf)):
+        if r >= tb:
+            return tb, True
+        r = min(r + step, tb)
+        step *= 2.0
+    return r, True

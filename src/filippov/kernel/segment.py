@@ -4,7 +4,7 @@ from __future__ import annotations
 
 
 from ..system import PLUS, SLIDING
-from .base import (_S_H, _after, _jit, _scalar)
+from .base import (_S_H, _jit, _scalar)
 from .dop853 import _dense_eval
 
 # output (F, y_old) of the integration step [sg[1], sg[1] + sg[2]] -- always
@@ -25,9 +25,3 @@ def _fval(sel, t, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
     _zat(t, mode, sg, za, F, y_old, fns, p, wz)
     v = _scalar(sel, wz, fns, p, wg, wf)
     return v - sg[4] if sel == _S_H else v  # sg[4]: the stay's rules.exit_shift
-
-
-@_jit
-def _past_at(t, pred, sel, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
-    """Whether the event function is past the crossing at t (rules.step_past's probe)."""
-    return _after(pred, _fval(sel, t, mode, sg, za, F, y_old, fns, p, wz, wg, wf))
