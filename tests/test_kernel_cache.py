@@ -40,3 +40,15 @@ def test_a_cache_written_from_other_sources_is_dropped(tmp_path):
     stamps[0].write_text("written by other sources")
     assert _run(tmp_path) == (1, 0, 1)           # dropped, compiled again, restamped
     assert stamps[0].read_text() == driver._kernel_stamp()
+
+
+def test_the_kernel_can_be_cached():
+    # A runtime address compiled into the kernel (numba's "dynamic globals": e.g. a
+    # compiled function handed to another as a value) makes it uncacheable, and every
+    # process would compile it again (~20 s; seen with a rule taking the event function
+    # as an argument). Loaded from the cache, it was cached; compiled here, it must be
+    # free of such addresses.
+    from filippov.kernel import driver
+    if not driver.compile_kernel():
+        lib = driver._batch.overloads[driver._batch.signatures[0]].library
+        assert not lib.has_dynamic_globals
