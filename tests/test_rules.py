@@ -28,7 +28,8 @@ def test_the_compiled_engine_compiles_the_rules_themselves():
                              (kernel._graze, rules.graze),
                              (kernel._central_step, rules.central_step),
                              (kernel._slides_in_section, rules.slides_in_section),
-                             (kernel._carried_age, rules.carried_age)):
+                             (kernel._carried_age, rules.carried_age),
+                             (kernel._far_side_probe, rules.far_side_probe)):
         assert compiled.py_func is source
 
 
@@ -186,3 +187,21 @@ def test_exact_windows_grow_with_the_time_since_the_entry_during_the_transient()
         assert f(40.0, 1.0, 16.0, 40.0) == 16.0
         assert f(0.0, 1.0, 16.0, 0.0) == 16.0
     assert kernel._exact_window.py_func is rules.exact_window
+
+
+def test_a_refined_root_walks_to_the_first_probe_past_the_crossing():
+    # probes r, r + 2 ulp, r + 6 ulp, r + 14 ulp, ... (capped at tb) until one is past;
+    # the compiled rule walks the same
+    r0 = 1.0
+    ulp = np.spacing(r0)
+    for probe in (rules.far_side_probe, kernel._far_side_probe):
+        def walk(flip, tb):
+            done, r, step, seen = False, r0, 0.0, []
+            while not done:
+                seen.append(r)
+                done, r, step = probe(r, step, tb, r >= flip)
+            return r, seen
+        r, seen = walk(r0 + 10 * ulp, 2.0)
+        assert r == r0 + 14 * ulp and seen == [r0 + k * ulp for k in (0, 2, 6, 14)]
+        assert walk(r0, 2.0)[0] == r0                         # already past
+        assert walk(3.0, r0 + 5 * ulp)[0] == r0 + 5 * ulp     # none past before tb

@@ -55,6 +55,24 @@ def far_side(pred: int, v0: float) -> int:
     return pred
 
 
+def far_side_probe(r: float, step: float, tb: float, past: bool):
+    """One step of the walk of a refined root to the far side of its crossing (a root
+    finder may stop a hair before the sign flips: rounding near a shallow crossing).
+    ``past``: whether the event function is past the crossing at the probe ``r``;
+    ``step``: the last increment (0.0 at the first probe). Returns (done, r, step): done
+    with the event time r (the probe, or ``tb`` when no probe before it is past), else the
+    next probe -- increments double from 2 ulp of the first probe, capped at ``tb``. The
+    engine loops ``done, r, step = far_side_probe(r, step, tb, after(pred, f(r)))``."""
+    if past:
+        return True, r, step
+    if r >= tb:
+        return True, tb, step
+    if step == 0.0:
+        a = max(abs(r), _TINY)
+        step = 2.0 * (np.nextafter(a, np.inf) - a)
+    return False, min(r + step, tb), 2.0 * step
+
+
 def clamp(pred: int, v0: float) -> float:
     """The start sample of a just-entered mode, inside by construction: a value that
     rounding put on the far side is moved to the near side's edge."""

@@ -252,7 +252,6 @@ class _IntegratingStepper:
 
 
 # --------------------------------------------------------------------------- crossings
-_TINY = np.finfo(float).tiny
 EXACT_BLOCK = 16
 PROJECT_AFTER = 1000  # steps before the step budget is projected from the mean step
 #: every STIFF_AFTER DOP853 steps in one stay in a mode, the step is compared with
@@ -345,14 +344,9 @@ def _refine(fun, pred, ta, tb, va, vb, xtol):
                 r = ta
             else:   # the far end lost the sign change the samples saw (see _brent)
                 r = _brent(fun, ta, tb, va, vb, xtol)
-    # Brent may stop a hair before the sign flips (rounding in fun near a shallow
-    # crossing): step forward by doubling increments until it has flipped.
-    step = 2 * np.spacing(max(abs(r), _TINY))
-    while not rules.after(pred, fun(r)):
-        if r >= tb:
-            return tb
-        r = min(r + step, tb)
-        step *= 2
+    done, step = False, 0.0
+    while not done:  # to the far side of the crossing (rules.far_side_probe)
+        done, r, step = rules.far_side_probe(r, step, tb, rules.after(pred, fun(r)))
     return r
 
 

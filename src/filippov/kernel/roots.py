@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import (_EPS, _MAXITER_EVENT, _TINY, _after, _far_side, _jit)
+from .base import (_EPS, _MAXITER_EVENT, _after, _far_side, _far_side_probe, _jit)
 from .segment import _fval
 
 
@@ -84,11 +84,8 @@ def _refine(sel, pred, ta, tb, va, xtol, mode, sg, za, F, y_old, fns, p, wz, wg,
                 r = ta
             else:
                 return r, False
-    a = max(abs(r), _TINY)
-    step = 2.0 * (np.nextafter(a, np.inf) - a)
-    while not _after(pred, _fval(sel, r, mode, sg, za, F, y_old, fns, p, wz, wg, wf)):
-        if r >= tb:
-            return tb, True
-        r = min(r + step, tb)
-        step *= 2.0
+    done, step = False, 0.0
+    while not done:  # to the far side of the crossing (rules.far_side_probe)
+        done, r, step = _far_side_probe(
+            r, step, tb, _after(pred, _fval(sel, r, mode, sg, za, F, y_old, fns, p, wz, wg, wf)))
     return r, True
