@@ -16,6 +16,14 @@ NOT_COMPUTE = ("plotting/", "benchmarks/", "report.py", "manifest.py",
 
 
 def library_hash(include="", exclude=(), strip_reports=False):
+    """See _library_hash; every rule asks, so each distinct question is answered once
+    per workflow run (the files are read, and the scene modules parsed, once)."""
+    exclude = (exclude,) if isinstance(exclude, str) else tuple(exclude)
+    return _library_hash(include, exclude, strip_reports)
+
+
+@functools.lru_cache(maxsize=None)
+def _library_hash(include, exclude, strip_reports):
     """sha256 over filippov's *.py files under `include`, minus the paths in
     `exclude` (a folder "name/" or a file "name.py", relative to the package); with
     `strip_reports`, the scene modules without their report part."""
@@ -25,7 +33,6 @@ def library_hash(include="", exclude=(), strip_reports=False):
     if spec is None or not spec.origin:
         return "filippov-not-found"
     root = Path(spec.origin).parent
-    exclude = (exclude,) if isinstance(exclude, str) else tuple(exclude)
     # a bare name is a folder ("plotting" == "plotting/")
     exclude = tuple(e if e.endswith((".py", "/")) else e + "/" for e in exclude)
     digest = hashlib.sha256()

@@ -13,6 +13,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from filippov.config import scene_files
+
 report: "../report/workflow.rst"
 
 # One generated table per scene (paper/generated/<id>.tex, written by that scene's
@@ -20,7 +22,7 @@ report: "../report/workflow.rst"
 # that a scene left out of config["scenes"] gets its "not yet computed" text
 # instead of a stale table. Which scenes the report cannot do without is the
 # scenes' own declaration (REPORT_OPTIONAL in filippov.scenes.<id>).
-SCENE_FILES = sorted(p.stem for p in Path("config/scenes").glob("*.yaml"))
+SCENE_FILES = scene_files("config/scenes")
 REPORT_GENERATED = ["macros.tex", *[f"{s}.tex" for s in SCENE_FILES], "tab_bench.tex",
                     "tab_hard_cases.tex", "tab_hard_return.tex"]
 TEX_PACKAGES = ("texlive-publishers texlive-latex-extra texlive-latex-recommended "
