@@ -139,3 +139,26 @@ def test_one_definition_with_exact_flows_and_sliding():
     ref = first_returns(seg.python(), [[-2.0, 0.5]], Section("x3", lambda z: np.asarray(z)[0] - 3.0,
                                                               direction=1), 10.0)
     np.testing.assert_allclose(out.state, ref.state, atol=1e-12)
+
+
+@pytest.mark.parametrize("piece,value,match", [
+    ("field_plus", lambda z, p, out: None, r"CompiledModel\.field_plus: expected a numba njit"),
+    ("h", "njit-lazy", r"CompiledModel\.h: expected a numba njit function compiled with"),
+    ("section", "cfunc", r"CompiledModel\.section: expected a numba njit"),
+])
+def test_a_piece_the_kernel_cannot_call_is_refused(piece, value, match):
+    # the kernel calls each piece at its compiled address (kernel.base._piece): a plain
+    # function, a numba function not yet compiled with its signature and a numba cfunc
+    # (which has no such address: it would crash the process) are refused by name
+    import dataclasses
+
+    from numba import cfunc, njit
+
+    from filippov.abi import SCALAR_SIG
+    if value == "njit-lazy":
+        value = njit(lambda z, p: z[0])
+    elif value == "cfunc":
+        value = cfunc(SCALAR_SIG)(lambda z, p: z[0])
+    cm = dataclasses.replace(_relay_compiled(section=lambda z, p: z[0]), **{piece: value})
+    with pytest.raises(TypeError, match=match):
+        fastmap.compute_returns(cm, STARTS, 20.0)

@@ -53,15 +53,20 @@ def test_absent_optional_results_say_not_yet_computed():
 def test_the_compile_cost_is_quoted_when_measured():
     from filippov.benchmarks.compile_cost import STAGES
     names = [s for s, _ in STAGES]
-    cc = xr.Dataset({"cold": ("stage", [0.9, 18.9, 1.9, 0.01]),
-                     "warm": ("stage", [0.7, 0.04, 0.48, 0.0])}, coords={"stage": names})
+    cc = xr.Dataset({"cold": ("stage", [0.9, 13.0, 1.9, 0.01, 11.6]),
+                     "warm": ("stage", [0.7, 0.04, 0.48, 0.0, 0.05])}, coords={"stage": names})
     m = report.Macros()
     report.bench(None, m, compile_cost=cc)
     got = m.values()
     assert m.flags["rpHaveCompileCost"] is True
-    assert got["rpCompileKernelCold"][0] == 18.9
+    assert got["rpCompileKernelCold"][0] == 13.0
     assert got["rpCompileKernelCold"][1].startswith("bench_compile_cost:cold[stage='kernel']")
+    assert got["rpCompileKernelDpdzCold"][0] == 11.6
     assert got["rpCompileModelWarm"][0] == 0.48
+    # a dataset of an older benchmark without a quoted stage: not quoted at all
+    m = report.Macros()
+    report.bench(None, m, compile_cost=cc.isel(stage=slice(0, 4)))
+    assert m.flags["rpHaveCompileCost"] is False and m.items == []
 
 
 def test_optional_tables_show_whatever_the_datasets_hold():

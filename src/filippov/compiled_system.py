@@ -159,7 +159,7 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
 
     Each piece is a plain function of one state, compiled with numba (``njit``); it
     must use numpy and math only. The first call compiles the pieces (a second or
-    two each) and, once per machine, the kernel (about 20 s on 2 cores, cached).
+    two each) and, once per machine, the kernel (about 13 s on 2 cores, cached).
     """
     names = tuple(str(x) for x in names)
     n = len(names)

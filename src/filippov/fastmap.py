@@ -43,8 +43,8 @@ this module is its Python side: the batch call, its options and its errors.
 
 A model enters as a :class:`CompiledModel`: numba-compiled pieces with the
 signatures below (passed to the kernel as first-class functions, so the kernel
-is compiled once -- about 20 s on 2 cores -- cached on disk by numba, and serves every
-model), plus a parameter vector ``params`` handed to every piece. See
+is compiled once -- about 13 s on 2 cores, 10 s more for its build with the dP/dz code
+-- cached on disk by numba, and serves every model), plus a parameter vector ``params`` handed to every piece. See
 :func:`filippov.models.hopf.compiled`.
 
 One deliberate difference from :func:`filippov.poincare.first_returns`: a start
@@ -60,13 +60,13 @@ import numpy as np
 
 from . import rules
 # what a model hands the engine (its pieces' signatures, CompiledModel), re-exported here
-from .abi import (FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel,  # noqa: F401
-                  no_flow, no_jacobian)
+from .abi import (FIELD_SIG, FLOW_SIG, JAC_SIG, SCALAR_SIG, WHERE_SIG,  # noqa: F401
+                  CompiledModel, no_flow, no_jacobian)
 # the kernel (filippov.kernel) and its status codes, re-exported here
 from .kernel.base import (BAD_START, EVENT_LIMIT, NO_RETURN, NO_SLIDING,  # noqa: F401
                           NON_FINITE, OK, ROOT_FAILED, SECTION_SLIDING, STATUS, STEP_FAILED,
                           STEP_LIMIT, ZENO)
-from .kernel.driver import KERNEL_SOURCES, _batch, compile_kernel  # noqa: F401
+from .kernel.driver import KERNEL_SOURCES, compile_kernel, kernel  # noqa: F401
 from .poincare import Returns
 from .progress import Progress
 from .simulate import (EXACT_BLOCK, EventLimitError, SimulationError,
@@ -118,6 +118,26 @@ def _checked_starts(cmodel: CompiledModel, starts, start_age):
         raise ValueError(f"start_age must be finite and >= 0, a scalar or one per start "
                          f"point ({starts.shape[0]}), got {np.asarray(start_age).tolist()}")
     return starts, ages
+
+
+#: each piece of a CompiledModel and the signature the kernel calls it with
+_PIECE_SIGS = {"flow_plus": FLOW_SIG, "flow_minus": FLOW_SIG, "field_plus": FIELD_SIG,
+               "field_minus": FIELD_SIG, "h": SCALAR_SIG, "grad_h": FIELD_SIG,
+               "section": SCALAR_SIG, "section_where": WHERE_SIG, "jacobian": JAC_SIG}
+
+
+def _check_pieces(cmodel: CompiledModel) -> None:
+    """Every piece is a numba-compiled function with its signature: the kernel calls
+    them at their compiled address (kernel.base._piece), which anything else lacks."""
+    for name, sig in _PIECE_SIGS.items():
+        piece = getattr(cmodel, name)
+        if name == "jacobian" and piece is None:
+            continue
+        if not (hasattr(piece, "py_func") and tuple(sig.args) in getattr(piece, "signatures", ())):
+            raise TypeError(
+                f"CompiledModel.{name}: expected a numba njit function compiled with the "
+                f"signature {sig} (filippov.abi; compile_system and SymbolicSystem build "
+                f"them), got {piece!r}")
 
 
 def _check_options(cmodel, t_max, samples_per_step, max_step, zeno_count, iterations, keep,
@@ -183,6 +203,7 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     (``touch_tol``: the kink of P at grazing), a start that slides.
     """
     starts, ages = _checked_starts(cmodel, starts, start_age)
+    _check_pieces(cmodel)
     _check_options(cmodel, t_max, samples_per_step, max_step, zeno_count, iterations, keep,
                    min_time)
     hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max) if cmodel.exact else np.inf
@@ -211,13 +232,15 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     orbit_jac = np.full((m, keep if jacobian else 0, n, n), np.nan)
     age = np.empty(m)
     params = np.ascontiguousarray(cmodel.params, dtype=float)
-    compile_kernel()
-    _batch(cmodel.flow_plus, cmodel.flow_minus, cmodel.field_plus, cmodel.field_minus,
-           cmodel.h, cmodel.grad_h, cmodel.section, cmodel.section_where,
-           no_jacobian if cmodel.jacobian is None else cmodel.jacobian, params,
-           starts, ages, float(t_max), bool(cmodel.exact), float(hwin), _section_pred(cmodel.section_direction),
-           bool(cmodel.sliding), frac_ex, frac_in, fopts, iopts, state, time, nsw, slide, status,
-           first, slide_dz, orbit, done, jac, orbit_jac, age)
+    # the build without the dP/dz code unless it is asked for (kernel.driver)
+    kernel(derivatives=bool(jacobian))(
+        cmodel.flow_plus, cmodel.flow_minus, cmodel.field_plus, cmodel.field_minus,
+        cmodel.h, cmodel.grad_h, cmodel.section, cmodel.section_where,
+        no_jacobian if cmodel.jacobian is None else cmodel.jacobian, params,
+        starts, ages, float(t_max), bool(cmodel.exact), float(hwin),
+        _section_pred(cmodel.section_direction), bool(cmodel.sliding), frac_ex, frac_in, fopts,
+        iopts, state, time, nsw, slide, status, first, slide_dz, orbit, done, jac, orbit_jac,
+        age)
     return BatchReturns(state, time, nsw, slide, status, first, slide_dz, orbit, done,
                         jac if jacobian else None, orbit_jac if jacobian else None, age)
 

@@ -3,9 +3,11 @@
 Run ``python -m filippov.benchmarks.compile_cost`` (part of ``make bench``). Each run is
 a fresh Python process with its own empty caches (numba's, ``NUMBA_CACHE_DIR``, and the
 generated model pieces', ``FILIPPOV_CACHE_DIR``): it imports the engine, compiles the
-kernel (:func:`filippov.fastmap.compile_kernel`), builds the Hopf model's compiled pieces
-and makes one batch call of first returns. A second process on the same caches does the
-same: the loads a user sees from the second session on. Each stage is timed on its own
+kernel (:func:`filippov.fastmap.compile_kernel`: the build without the dP/dz code), builds
+the Hopf model's compiled pieces, makes one batch call of first returns, then compiles the
+kernel's build with the dP/dz code (what ``jacobian=True`` runs on; the helpers both builds
+share are compiled by then). A second process on the same caches does the same: the loads
+a user sees from the second session on. Each stage is timed on its own
 (wall time, median over ``--repeat`` pairs of processes); the kernel is one numba
 compilation, so a second core does not help it.
 """
@@ -27,7 +29,9 @@ from ..io import finalize
 STAGES = [("import", "import filippov.fastmap (numba, the rule book, the kernel's types)"),
           ("kernel", "compile_kernel(): the kernel, compiled or loaded from numba's cache"),
           ("model", "hopf.compiled(...): the model's pieces, generated and compiled or loaded"),
-          ("first_call", "one batch of 8 first returns, the first call of the process")]
+          ("first_call", "one batch of 8 first returns, the first call of the process"),
+          ("kernel_dpdz", "compile_kernel(derivatives=True): the build with the dP/dz code, "
+                          "on top of the helpers already compiled")]
 
 _PROBE = """
 import json, time
@@ -43,8 +47,15 @@ t3 = time.perf_counter()
 starts = np.column_stack([np.zeros(8), np.linspace(0.9, 1.1, 8), np.zeros(8)])
 out = compute_returns(cm, starts, 5.0)
 t4 = time.perf_counter()
+from filippov.kernel import derivative
+# helpers of the dP/dz code compiled so far (none: the returns did not ask for dP/dz)
+dpdz = sum(len(f.signatures) for f in vars(derivative).values()
+           if getattr(getattr(f, "py_func", None), "__module__", None) == derivative.__name__)
+compile_kernel(derivatives=True)
+t5 = time.perf_counter()
 print(json.dumps({"import": t1 - t0, "kernel": t2 - t1, "model": t3 - t2,
-                  "first_call": t4 - t3, "loaded": loaded, "ok": int((out.status == 0).sum())}))
+                  "first_call": t4 - t3, "kernel_dpdz": t5 - t4, "loaded": loaded,
+                  "dpdz_before": dpdz, "ok": int((out.status == 0).sum())}))
 """
 
 
@@ -67,13 +78,17 @@ def measure(repeat: int = 3, log=print) -> dict:
             cold, warm = _process(cache), _process(cache)
         if cold["ok"] != 8 or warm["ok"] != 8:
             raise RuntimeError("compile_cost: a first return of the probe failed")
+        if cold["dpdz_before"]:
+            raise RuntimeError("compile_cost: returns without dP/dz compiled "
+                               f"{cold['dpdz_before']} functions of the dP/dz code")
         if cold["loaded"] or not warm["loaded"]:
             raise RuntimeError("compile_cost: the first process loaded a cached kernel or "
                                "the second compiled it again (a cache outside NUMBA_CACHE_DIR?)")
         runs["cold"].append(cold)
         runs["warm"].append(warm)
         log(f"  pair {k + 1}/{repeat}: kernel {cold['kernel']:.1f} s cold, "
-            f"{warm['kernel']:.2f} s warm", flush=True)
+            f"{warm['kernel']:.2f} s warm; with dP/dz +{cold['kernel_dpdz']:.1f} s cold",
+            flush=True)
     return {kind: {s: statistics.median(r[s] for r in rows) for s, _ in STAGES}
             for kind, rows in runs.items()}
 

@@ -8,7 +8,8 @@
 * :mod:`.roots` -- brentq and the far-side refinement of a crossing;
 * :mod:`.scan` -- the samples of one window and its earliest event;
 * :mod:`.derivative` -- dP/dz carried along a return;
-* :mod:`.driver` -- one start point (_one), the batch (_batch), compilation and cache.
+* :mod:`.driver` -- one start point (_one), the batch (_batch), compilation and cache;
+  two builds of one source: with the dP/dz code and without it (:func:`.driver.kernel`).
 
 Nothing here is public: :func:`filippov.fastmap.compute_returns` is the entry point.
 """

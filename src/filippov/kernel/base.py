@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit, types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 from .. import rules
 from ..abi import FIELD_SIG, FLOW_SIG, JAC_SIG, SCALAR_SIG, WHERE_SIG
@@ -89,6 +91,47 @@ assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MIN
 
 
 # ============================================================================= model pieces
+# The model's pieces are a tuple of numba first-class functions (the order of _batch's
+# arguments). numba's own call of one (fns[k](...)) also carries a path that takes the
+# GIL and asks Python for the piece's address when it is missing: ~150 lines of IR at
+# each of the 34 call sites, compiled into every helper (1-2 s of the cold compile).
+# The address is never missing here (fastmap.compute_returns accepts numba-compiled
+# pieces only), so the pieces are called straight at their compiled address.
+def _call_piece_codegen(index):
+    def codegen(context, builder, signature, args):
+        fty = signature.args[0][index]
+        sig = fty.signature
+        piece = cgutils.create_struct_proxy(fty)(
+            context, builder, value=builder.extract_value(args[0], index))
+        fnptr = builder.bitcast(piece.jit_addr, context.call_conv.get_function_type(
+            sig.return_type, sig.args).as_pointer())
+        status, res = context.call_conv.call_function(builder, fnptr, sig.return_type,
+                                                      sig.args, args[1:])
+        with cgutils.if_unlikely(builder, status.is_error):
+            context.call_conv.return_status_propagate(builder, status)
+        return res
+    return codegen
+
+
+def _piece(index, arity):
+    """An intrinsic ``piece(fns, *args)``: calls fns[index] with its signature's
+    arguments (numba's intrinsics take no ``*args``: one typing function per arity)."""
+    def typed(fns):
+        sig = fns[index].signature
+        return sig.return_type(fns, *sig.args), _call_piece_codegen(index)
+    by_arity = {2: lambda typingctx, fns, a, b: typed(fns),
+                3: lambda typingctx, fns, a, b, c: typed(fns),
+                4: lambda typingctx, fns, a, b, c, d: typed(fns)}
+    return intrinsic(by_arity[arity])
+
+
+# fns[k] by name: (z0, tau, p, out), (z, p, out), (z, p) -> float or bool, (mode, z, p, out)
+_flow_plus, _flow_minus, _field_plus, _field_minus = (_piece(0, 4), _piece(1, 4),
+                                                      _piece(2, 3), _piece(3, 3))
+_h, _grad_h, _section, _where, _jacobian = (_piece(4, 2), _piece(5, 3), _piece(6, 2),
+                                            _piece(7, 2), _piece(8, 4))
+
+
 @_jit
 def _dot(u, v):
     s = 0.0
@@ -100,21 +143,21 @@ def _dot(u, v):
 @_jit
 def _speeds(z, fns, p, wg, wm, wp):
     """(a, b) = (grad h . F_-, grad h . F_+) at z; fills wg, wm, wp."""
-    fns[5](z, p, wg)
-    fns[3](z, p, wm)
-    fns[2](z, p, wp)
+    _grad_h(fns, z, p, wg)
+    _field_minus(fns, z, p, wm)
+    _field_plus(fns, z, p, wp)
     return _dot(wg, wm), _dot(wg, wp)
 
 
 @_jit
 def _scalar(sel, z, fns, p, wg, wf):
     if sel == _S_H:
-        return fns[4](z, p)
+        return _h(fns, z, p)
     if sel == _S_SEC:
-        return fns[6](z, p)
-    fns[5](z, p, wg)
+        return _section(fns, z, p)
+    _grad_h(fns, z, p, wg)
     if sel == _S_A:
-        fns[3](z, p, wf)
+        _field_minus(fns, z, p, wf)
     else:
-        fns[2](z, p, wf)
+        _field_plus(fns, z, p, wf)
     return _dot(wg, wf)

@@ -4,7 +4,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..system import PLUS
-from .base import (_central_step, _dot, _jit)
+from .base import (_central_step, _dot, _flow_minus, _flow_plus, _grad_h, _jacobian, _jit,
+                   _section)
 from .dop853 import (_A, _B, _NS, _TRIAL, _checked_field, _stage)
 
 
@@ -55,15 +56,15 @@ def _flow_jacobian(mode, za, tau, fns, p, J, z1, z2):
         za[k] = orig + d
         up = za[k]
         if mode == PLUS:
-            fns[0](za, tau, p, z1)
+            _flow_plus(fns, za, tau, p, z1)
         else:
-            fns[1](za, tau, p, z1)
+            _flow_minus(fns, za, tau, p, z1)
         za[k] = orig - d
         down = za[k]
         if mode == PLUS:
-            fns[0](za, tau, p, z2)
+            _flow_plus(fns, za, tau, p, z2)
         else:
-            fns[1](za, tau, p, z2)
+            _flow_minus(fns, za, tau, p, z2)
         za[k] = orig
         for i in range(za.size):
             J[i, k] = (z1[i] - z2[i]) / (up - down)
@@ -98,7 +99,7 @@ def _var_stage(s, mode, exact, fns, p, w):
     column by column with Jacobian-vector products by central differences."""
     n = w.ys.size
     if exact:
-        fns[8](mode, w.ys, p, w.Jm)
+        _jacobian(fns, mode, w.ys, p, w.Jm)
         for a in range(n):
             for b in range(n):
                 acc = 0.0
@@ -142,7 +143,7 @@ def _switch_derivative(mode, new_mode, fns, p, w):
     """w.M <- S w.M, S the saltation matrix of the switch mode -> new_mode at w.z."""
     _checked_field(w.z, mode, _TRIAL, fns, p, w.wg, w.wf, w.wp, w.jf1)
     _checked_field(w.z, new_mode, _TRIAL, fns, p, w.wg, w.wf, w.wp, w.jf2)
-    fns[5](w.z, p, w.jz1)
+    _grad_h(fns, w.z, p, w.jz1)
     speed = _dot(w.jz1, w.jf1)
     for k in range(w.z.size):
         w.jf2[k] -= w.jf1[k]
@@ -160,10 +161,10 @@ def _section_derivative(mode, fns, p, w):
         d = _central_step(max(1.0, abs(orig)), 1.0)
         z[k] = orig + d
         up = z[k]
-        s1 = fns[6](z, p)
+        s1 = _section(fns, z, p)
         z[k] = orig - d
         down = z[k]
-        s2 = fns[6](z, p)
+        s2 = _section(fns, z, p)
         z[k] = orig
         w.jz1[k] = (s1 - s2) / (up - down)
     _rank_one(w.M, w.jf1, w.jz1, -_dot(w.jz1, w.jf1))

@@ -7,7 +7,7 @@ import numpy as np
 
 from .. import dop853_tableau as _dop
 from ..system import MINUS, PLUS
-from .base import (_jit, _speeds)
+from .base import (_field_minus, _field_plus, _jit, _speeds)
 
 # ----------------------------------------------------------------------------- DOP853 tableau
 # The coefficients of scipy's DOP853, which the reference driver integrates sliding
@@ -55,9 +55,9 @@ def _checked_field(z, mode, first_call, fns, p, wg, wm, wp, out):
     simulate._IntegratingStepper's guard: a non-finite value at the first call
     is an error (False), on a trial stage it is 1e300."""
     if mode == PLUS:
-        fns[2](z, p, out)
+        _field_plus(fns, z, p, out)
     elif mode == MINUS:
-        fns[3](z, p, out)
+        _field_minus(fns, z, p, out)
     else:
         a, b = _speeds(z, fns, p, wg, wm, wp)
         for k in range(z.size):

@@ -1,10 +1,16 @@
 """The driver loop: one start point from its initial mode through its stays and events
 to the section (_one), the batch kernel over many start points (_batch), and its
-compilation with the on-disk cache kept in step with the sources."""
+compilation with the on-disk cache kept in step with the sources.
+
+The kernel comes in two builds of this one source: with the dP/dz code (_batch) and
+without it (_batch_plain, what returns without derivatives run on). The dP/dz code is
+40% of the kernel's machine code; a user who never asks for dP/dz should not wait for it
+to compile (13 s instead of 18 s cold on 2 cores, filippov.benchmarks.compile_cost)."""
 from __future__ import annotations
 
 import hashlib
 import sys
+import types as pytypes
 import warnings
 from collections import namedtuple
 from pathlib import Path
@@ -18,7 +24,8 @@ from .base import (BAD_START, EVENT_LIMIT, NON_FINITE, NO_RETURN, NO_SLIDING, OK
                    SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO, _FIELD, _FLOW, _SCALAR,
                    _WHERE, _JAC, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
                    _exit_drift, _exit_shift, _jit, _jit_inline, _next_mode, _onto_switch,
-                   _slides_in_section, _speeds, _start_on_switch, _start_side, _vec)
+                   _slides_in_section, _speeds, _start_on_switch, _start_side, _vec, _h,
+                   _section)
 from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
                      _dop_step)
 from .segment import _zat
@@ -32,10 +39,10 @@ def _section_rate(z, wm, wp, cm, cp, d, fns, p, wz):
     """Central difference of the section along the field cm F_- + cp F_+."""
     for k in range(z.size):
         wz[k] = z[k] + d * (cm * wm[k] + cp * wp[k])
-    s1 = fns[6](wz, p)
+    s1 = _section(fns, wz, p)
     for k in range(z.size):
         wz[k] = z[k] - d * (cm * wm[k] + cp * wp[k])
-    return (s1 - fns[6](wz, p)) / (2.0 * d)
+    return (s1 - _section(fns, wz, p)) / (2.0 * d)
 
 
 @_jit
@@ -49,7 +56,8 @@ def _slides_in(z, fns, p, wg, wm, wp, wz):
     d = _central_step(size, speed)
     if d == 0.0:
         return False
-    return _slides_in_section(fns[6](z, p), d, _section_rate(z, wm, wp, 1.0, 0.0, d, fns, p, wz),
+    return _slides_in_section(_section(fns, z, p), d,
+                              _section_rate(z, wm, wp, 1.0, 0.0, d, fns, p, wz),
                               _section_rate(z, wm, wp, 0.0, 1.0, d, fns, p, wz),
                               _section_rate(z, wm, wp, -b / (a - b), a / (a - b), d, fns, p, wz))
 
@@ -57,7 +65,7 @@ def _slides_in(z, fns, p, wg, wm, wp, wz):
 @_jit
 def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
     """simulate.initial_mode (rules.start_side, rules.start_on_switch)."""
-    H = fns[4](z, p)
+    H = _h(fns, z, p)
     side = _start_side(H, touch_tol)
     if side != SLIDING:
         return side
@@ -85,6 +93,11 @@ Work = namedtuple("Work", [
 
 _GO_ON = -1  # no event yet / the orbit goes on (never a returned status)
 
+#: the compile-time switch of the dP/dz code: every branch that carries the derivative
+#: (Settings.jac) is guarded by it too, and numba prunes a branch on a False global before
+#: typing, so the build without it (_batch_plain) never compiles kernel.derivative
+_DERIVATIVES = True
+
 
 @_jit_inline
 def _window(mode, ta, tb, frac, first, fns, p, s, w):
@@ -98,7 +111,8 @@ def _window(mode, ta, tb, frac, first, fns, p, s, w):
     st, te, what = _find(mode, w.ts, ns, first, s.sec_pred, s.touch_tol, s.xtol, s.min_time,
                          w.sg, w.za, w.F, w.y_old, fns, p, w.vals, w.dvals, w.svals, w.wz,
                          w.wg, w.wf, w.touched)
-    if s.jac and w.touched[0]:  # P is not differentiable where the orbit touches H
+    # P is not differentiable where the orbit touches H
+    if _DERIVATIVES and s.jac and w.touched[0]:
         for i in range(w.z.size):
             for j in range(w.z.size):
                 w.M[i, j] = np.nan
@@ -132,7 +146,7 @@ def _stay_exact(mode, t, fns, p, s, w):
             tb = np.nextafter(ta, np.inf)
         st, t, what = _window(mode, ta, tb, s.frac_ex, first, fns, p, s, w)
         if st != _GO_ON:
-            if st == OK and s.jac:
+            if _DERIVATIVES and st == OK and s.jac:
                 _flow_jacobian(mode, w.za, t - w.sg[0], fns, p, w.Mt, w.jz1, w.jz2)
                 _apply(w.Mt, w.M, w.KP[0])
             return st, t, what
@@ -171,7 +185,7 @@ def _stay_integrated(mode, t, fns, p, s, w):
         w.sg[1] = ta
         w.sg[2] = tb - ta
         st, t, what = _window(mode, ta, tb, s.frac_in, first, fns, p, s, w)
-        if s.jac and (st == _GO_ON or (st == OK and t > ta)):
+        if _DERIVATIVES and s.jac and (st == _GO_ON or (st == OK and t > ta)):
             _var_step(mode, w.y_old, (tb if st == _GO_ON else t) - ta, fns, p, w, s.jac == 2)
         if st != _GO_ON:
             return st, t, what
@@ -197,7 +211,7 @@ def _event(mode, t, what, fns, p, s, w):
         w.tally[2] = t - w.sg[0] + w.tally[2] if (mode != SLIDING and s.exact) else 0.0
         if mode == SLIDING:
             _end_slide(t, w)
-        if s.jac:
+        if _DERIVATIVES and s.jac:
             _section_derivative(mode, fns, p, w)
         return OK, mode
     a, b = _speeds(w.z, fns, p, w.wg, w.wf, w.wp)
@@ -210,11 +224,11 @@ def _event(mode, t, what, fns, p, s, w):
     drift, h0 = False, 0.0
     if mode == SLIDING:
         if new_mode != SLIDING:
-            h0 = fns[4](w.z, p)
+            h0 = _h(fns, w.z, p)
             drift = _exit_drift(new_mode, h0, w.z, w.wg, s.touch_tol)
             if drift:  # w.wg holds grad h at w.z (from _speeds)
                 _onto_switch(w.z, h0, w.wg)
-                h0 = fns[4](w.z, p)  # what rounding left
+                h0 = _h(fns, w.z, p)  # what rounding left
         _end_slide(t, w)
     if new_mode == SLIDING:
         w.tally[1] = t
@@ -234,7 +248,8 @@ def _event(mode, t, what, fns, p, s, w):
     w.sg[4] = 0.0
     if mode == SLIDING and new_mode != SLIDING:
         w.sg[4] = _exit_shift(new_mode, h0, s.touch_tol, drift)
-    if s.jac and mode != SLIDING and new_mode != mode:  # the end of sliding: identity
+    # (the end of sliding: identity)
+    if _DERIVATIVES and s.jac and mode != SLIDING and new_mode != mode:
         _switch_derivative(mode, new_mode, fns, p, w)
     if new_mode != mode:
         w.tally[2] = 0.0  # an entry: the fast transient starts again
@@ -261,7 +276,7 @@ def _one(z0, age0, fns, p, s, w):
     if mode == SLIDING and _slides_in(w.z, fns, p, w.wg, w.wf, w.wp, w.wz):
         return SECTION_SLIDING, 0.0, 0, 0.0
     w.touched[0] = False
-    if s.jac:
+    if _DERIVATIVES and s.jac:
         # a start that slides: the return is not differentiable across H there
         for i in range(n):
             for j in range(n):
@@ -272,7 +287,7 @@ def _one(z0, age0, fns, p, s, w):
         w.count[k] = 0
     w.tally[0] = 0.0
     w.tally[1] = 0.0
-    w.tally[2] = 0.0 if mode == SLIDING else _carried_age(fns[4](w.z, p), s.touch_tol, age0)
+    w.tally[2] = 0.0 if mode == SLIDING else _carried_age(_h(fns, w.z, p), s.touch_tol, age0)
     w.sg[4] = 0.0
     t = 0.0
     while True:
@@ -402,6 +417,27 @@ KERNEL_SOURCES = tuple(sorted(f"kernel/{p.name}" for p in Path(__file__).parent.
                        ) + ("rules.py", "dop853_tableau.py", "abi.py", "system.py")
 
 
+def _without_derivatives(decorated):
+    """The driver functions ``decorated`` ({name: decorator}, callees first) built again
+    from the same code with _DERIVATIVES False, in globals of their own (each copy calls
+    the others' copies); each copy gets a qualified name of its own, which numba names
+    its cache files by. Returns the copies by name."""
+    env = dict(globals(), _DERIVATIVES=False)
+    for name, decorator in decorated.items():
+        f = globals()[name].py_func
+        g = pytypes.FunctionType(f.__code__, env, f.__name__, f.__defaults__, f.__closure__)
+        g.__qualname__, g.__doc__ = f"{f.__qualname__}_plain", f.__doc__
+        env[name] = decorator(g)
+    return {name: env[name] for name in decorated}
+
+
+# the functions on the way from _batch to a _DERIVATIVES branch
+_PLAIN = _without_derivatives({"_window": _jit_inline, "_stay_exact": _jit_inline,
+                               "_stay_integrated": _jit_inline, "_event": _jit_inline,
+                               "_one": _jit, "_batch": njit(cache=True)})
+_one_plain, _batch_plain = _PLAIN["_one"], _PLAIN["_batch"]
+
+
 def _kernel_stamp() -> str:
     digest = hashlib.sha256()
     for name in KERNEL_SOURCES:
@@ -431,14 +467,20 @@ def _fresh_cache() -> None:
         pass  # a read-only cache: numba compiles in memory and caches nothing anyway
 
 
-def compile_kernel() -> bool:
-    """Compile the kernel for its one signature (or load it from numba's on-disk
-    cache, if that was written from the same sources); done on first use. Returns True
-    if it was loaded from the cache."""
-    if not _batch.signatures:
+def kernel(derivatives: bool = False):
+    """The kernel with (or without) the dP/dz code, compiled for its one signature or
+    loaded from numba's on-disk cache (if that was written from the same sources)."""
+    batch = _batch if derivatives else _batch_plain
+    if not batch.signatures:
         _fresh_cache()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NumbaExperimentalFeatureWarning)
-            _batch.compile(_KERNEL_SIG)
-        _batch.disable_compile()  # any other argument types are an error, not a recompile
-    return sum(_batch.stats.cache_hits.values()) > 0
+            batch.compile(_KERNEL_SIG)
+        batch.disable_compile()  # any other argument types are an error, not a recompile
+    return batch
+
+
+def compile_kernel(derivatives: bool = False) -> bool:
+    """Compile the kernel (:func:`kernel`) now rather than at its first use; True if it
+    was loaded from the cache."""
+    return sum(kernel(derivatives).stats.cache_hits.values()) > 0

@@ -9,7 +9,8 @@ from ..system import MINUS, PLUS, SLIDING
 from .base import (OK, ROOT_FAILED, _EPS, _MAXITER_EXTREMUM, _S_A, _S_B, _S_H, _S_SEC, _TO_NEG, _TO_NONNEG,
                    _TO_NONPOS, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_NONE, _W_SECTION, _W_SWITCH,
                    _after, _clamp, _crosses, _dips_and_returns, _dot, _extremum_between,
-                   _graze, _jit, _same_instant, _speeds, _starts_on_section)
+                   _graze, _jit, _same_instant, _speeds, _starts_on_section, _field_minus,
+                   _field_plus, _grad_h, _h, _section, _where)
 from .segment import (_fval, _zat)
 from .roots import (_brentq, _refine)
 
@@ -31,14 +32,14 @@ def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, s
             vals[0, k] = a
             vals[1, k] = b
         else:
-            vals[0, k] = fns[4](wz, p) - sg[4]
-            fns[5](wz, p, wg)
+            vals[0, k] = _h(fns, wz, p) - sg[4]
+            _grad_h(fns, wz, p, wg)
             if mode == PLUS:
-                fns[2](wz, p, wf)
+                _field_plus(fns, wz, p, wf)
             else:
-                fns[3](wz, p, wf)
+                _field_minus(fns, wz, p, wf)
             dvals[k] = _dot(wg, wf)
-        svals[k] = fns[6](wz, p)
+        svals[k] = _section(fns, wz, p)
     for c in range(wz.size):
         zlast[c] = wz[c]
     return True
@@ -115,11 +116,11 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
             if r >= min_time and (best_w == _W_NONE
                                   or r <= best_t + _same_instant(xtol, best_t)):
                 _zat(r, mode, sg, za, F, y_old, fns, p, wz)
-                if fns[7](wz, p):
+                if _where(fns, wz, p):
                     at_start = False
                     if ts[i] == 0.0:
                         _zat(ts[i], mode, sg, za, F, y_old, fns, p, wg)
-                        at_start = _starts_on_section(svals[i], wg, fns[6](wz, p), wz)
+                        at_start = _starts_on_section(svals[i], wg, _section(fns, wz, p), wz)
                     if not at_start:
                         best_t, best_w = r, _W_SECTION
         if best_w != _W_NONE:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 
 from ..system import PLUS, SLIDING
-from .base import (_S_H, _jit, _scalar)
+from .base import (_S_H, _flow_minus, _flow_plus, _jit, _scalar)
 from .dop853 import _dense_eval
 
 # output (F, y_old) of the integration step [sg[1], sg[1] + sg[2]] -- always
@@ -15,9 +15,9 @@ def _zat(t, mode, sg, za, F, y_old, fns, p, out):
     if mode == SLIDING or sg[3] != 0.0:
         _dense_eval(t, sg[1], sg[2], y_old, F, out)
     elif mode == PLUS:
-        fns[0](za, t - sg[0], p, out)
+        _flow_plus(fns, za, t - sg[0], p, out)
     else:
-        fns[1](za, t - sg[0], p, out)
+        _flow_minus(fns, za, t - sg[0], p, out)
 
 
 @_jit
