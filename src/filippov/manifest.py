@@ -133,9 +133,11 @@ def summarize(path: Path) -> dict:
 
 
 def _close(a, b, tol: Tolerance) -> bool:
+    """``a`` (a build's) within ``tol`` of ``b`` (the reference): the same test as
+    :func:`filippov.tolerance.spread` applies to full arrays (Tolerance.agree)."""
     if a is None or b is None:
         return a is None and b is None
-    return abs(a - b) <= tol.atol + tol.rtol * abs(b)
+    return bool(tol.agree(b, a))
 
 
 def _worst(pairs, tol: Tolerance) -> float:
@@ -184,8 +186,16 @@ def _compare_variable(g: dict, w: dict, tol: Tolerance) -> str | None:
         return f"{len(out)} sampled entries beyond {tol.atol:g} + {tol.rtol:g}*|value| (by " \
                f"up to {max(out, default=0):.3e}; at most {tol.changed} may, by at most " \
                f"{tol.jump:g}) {rule}"
-    worst = max(_worst(((g[k], w[k]) for k in ("min", "max", "mean")), tol),
-                _worst(zip(g["sample"], w["sample"]), tol))
+    pairs = [(g[k], w[k]) for k in ("min", "max", "mean")] + list(zip(g["sample"], w["sample"]))
+    if tol.rule == "order":
+        # a magnitude: within a factor rtol either way, above the floor atol
+        off = [(a, b) for a, b in pairs if not _close(a, b, tol)]
+        if not off:
+            return None
+        worst = max(np.inf if a is None or b is None else float(tol.factor(a, b)) for a, b in off)
+        return f"differs by a factor up to {worst:.3g} (tolerance: a factor {tol.rtol:g} " \
+               f"above {tol.atol:g}) {rule}"
+    worst = _worst(pairs, tol)
     return None if worst == 0 else \
         f"differs by up to {worst:.3e} (tolerance {tol.atol:g} + {tol.rtol:g}*|value|) {rule}"
 

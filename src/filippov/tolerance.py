@@ -30,6 +30,18 @@ Rules:
   ``atol + rtol |value|`` plus ``jump`` times the row's reference width (0 for a
   periodic row, which must agree closely; a fraction of the width for a chaotic one,
   whose extent is sampled by a different orbit).
+* ``order``: a magnitude whose value is not a result, only its order is: the error
+  of an approximate method, decided by its step sequence, which a last-bit change
+  re-draws (cancellations of local errors make any value below the error's envelope
+  possible). Magnitudes below ``atol`` (the floor) count as ``atol``; above it the
+  two must agree within a factor ``rtol`` (>= 1) either way. Unlike ``close``, whose
+  ``atol + rtol |reference|`` is asymmetric (with rtol 10 it lets a value fall to 0
+  but rise only 11-fold), the rule is symmetric: which of two builds wrote the
+  manifest does not decide whether they agree.
+
+Every rule but ``order`` measures a difference against its reference value; with
+``rtol`` << 1 (all ``close`` tolerances that are not counts) the asymmetry is of
+order rtol and does not matter.
 """
 from __future__ import annotations
 
@@ -38,7 +50,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import xarray as xr
 
-RULES = ("close", "tangency", "trace", "measured", "attractor")
+RULES = ("close", "tangency", "trace", "measured", "attractor", "order")
 PREFIX = "repro_"
 
 
@@ -62,6 +74,9 @@ class Tolerance:
             raise ValueError("tolerance: `changed` > 0 goes with rule 'tangency' (and only there)")
         if not self.why.strip():
             raise ValueError("tolerance: a reason (why) is required")
+        if self.rule == "order" and not (self.rtol >= 1 and self.atol > 0):
+            raise ValueError("tolerance rule 'order': rtol is a factor (>= 1) and atol a "
+                             f"floor (> 0), got {self.rtol}, {self.atol}")
 
     def attrs(self) -> dict:
         return {PREFIX + k: v for k, v in asdict(self).items()}
@@ -77,6 +92,23 @@ class Tolerance:
     def allowed(self, reference: np.ndarray) -> np.ndarray:
         """The admissible difference at each entry of ``reference``."""
         return self.atol + self.rtol * np.abs(reference)
+
+    def factor(self, a, b) -> np.ndarray:
+        """Rule ``order``: how many times larger the larger of ``|a|`` and ``|b|`` is
+        than the smaller, each raised to the floor ``atol`` (1 where they agree);
+        symmetric in ``a`` and ``b``."""
+        a = np.maximum(np.abs(np.asarray(a, dtype=float)), self.atol)
+        b = np.maximum(np.abs(np.asarray(b, dtype=float)), self.atol)
+        return np.maximum(a, b) / np.minimum(a, b)
+
+    def agree(self, reference, other) -> np.ndarray:
+        """Whether ``other`` is within this tolerance of ``reference``, entry by entry
+        (``close``-style: the difference against :meth:`allowed`; ``order``: the
+        factor against ``rtol``)."""
+        if self.rule == "order":
+            return self.factor(reference, other) <= self.rtol
+        return np.abs(np.asarray(other, dtype=float) - np.asarray(reference, dtype=float)) \
+            <= self.allowed(reference)
 
 
 #: exact inputs, grids and well-conditioned outputs of solves at rtol <= 1e-12:
@@ -157,7 +189,9 @@ def spread(reference: xr.DataArray, other: xr.DataArray) -> dict:
     """How far ``other`` is from ``reference`` (full arrays), against the tolerance
     declared on ``reference``: max_abs, max_rel, changed (entries that differ at
     all), margin (smallest tolerance / difference; inf when equal; for the
-    entries the tangency rule exempts, jump / difference) and ok."""
+    entries the tangency rule exempts, jump / difference; for the order rule,
+    rtol / factor), ok, and worst: the [reference, other] values at the entry that
+    sets the margin (None when nothing moved)."""
     tol = Tolerance.from_attrs(reference.attrs)
     a, b = np.asarray(reference.values, dtype=float), np.asarray(other.values, dtype=float)
     allowed = tol.allowed
@@ -170,19 +204,24 @@ def spread(reference: xr.DataArray, other: xr.DataArray) -> dict:
         limit = limit[~np.isnan(a)]  # the entries compared below (NaN rows dropped)
         allowed = lambda ref: limit  # noqa: E731
     bad = {"max_abs": np.inf, "max_rel": np.inf, "changed": max(a.size, b.size),
-           "margin": 0.0, "ok": False, "rule": tol.rule}
+           "margin": 0.0, "ok": False, "rule": tol.rule, "worst": None}
     if a.shape != b.shape:
         return bad
     if tol.rule == "measured":  # a timing: no two runs agree, only the shape is a result
         return {"max_abs": 0.0, "max_rel": 0.0, "changed": 0, "margin": np.inf, "ok": True,
-                "rule": tol.rule}
+                "rule": tol.rule, "worst": None}
     nan_a, nan_b = np.isnan(a), np.isnan(b)
     if np.any(nan_a != nan_b):
         return dict(bad, changed=int(np.count_nonzero(nan_a != nan_b)))
     a, b = a[~nan_a], b[~nan_a]
     diff = np.abs(a - b)
-    ratio = np.where(diff > 0, allowed(a) / np.where(diff > 0, diff, 1.0), np.inf)
+    if tol.rule == "order":   # tolerance / spread as factors: rtol / (max / min)
+        factor = tol.factor(a, b)
+        ratio = np.where(factor > 1.0, tol.rtol / factor, np.inf)
+    else:
+        ratio = np.where(diff > 0, allowed(a) / np.where(diff > 0, diff, 1.0), np.inf)
     ok = bool(np.all(ratio >= 1.0))
+    at = int(np.argmin(ratio)) if ratio.size and np.isfinite(ratio.min()) else None
     if tol.rule == "tangency":
         # the `changed` worst entries are exempt from the close tolerance, not from `jump`
         worst = np.argsort(ratio)[:tol.changed]
@@ -190,10 +229,14 @@ def spread(reference: xr.DataArray, other: xr.DataArray) -> dict:
         ok = bool(np.all(diff[exempt] <= tol.jump)) and \
             bool(np.all(np.delete(ratio, exempt) >= 1.0))
         jumps = tol.jump / diff[exempt] if tol.jump > 0 else np.zeros(exempt.size)
-        ratio = np.concatenate([np.delete(ratio, exempt), jumps])
+        keep = np.delete(np.arange(ratio.size), exempt)
+        ratio = np.concatenate([ratio[keep], jumps])
+        order = np.concatenate([keep, exempt])
+        at = int(order[np.argmin(ratio)]) if ratio.size and np.isfinite(ratio.min()) else None
     nonzero = (diff > 0) & (a != 0)   # relative spread where the reference is not 0
     rel = diff[nonzero] / np.abs(a[nonzero])
     return {"max_abs": float(diff.max()) if diff.size else 0.0,
             "max_rel": float(rel.max()) if rel.size else 0.0,
             "changed": int(np.count_nonzero(diff)),
-            "margin": float(ratio.min()) if ratio.size else np.inf, "ok": ok, "rule": tol.rule}
+            "margin": float(ratio.min()) if ratio.size else np.inf, "ok": ok, "rule": tol.rule,
+            "worst": None if at is None else [float(a[at]), float(b[at])]}

@@ -94,21 +94,34 @@ PRESETS = {"full": {"families": PROJECT + SCIPY, "every": 10, "every11": 5, "rep
 #: how closely two runs agree (filippov.tolerance): times never do. An error
 #: |P - P_ref| of an approximate method is not a well-conditioned result: it is decided
 #: by the method's discrete choices (a step accepted or rejected at an error norm near
-#: 1, a sign change of h seen or missed at a step end) and, for the dry-friction maps,
-#: by orbits that slide and leave H near a tangency, whose reference map itself moves
-#: by ~3e-13 under a last-bit change. Measured with the emulated CPU of tests/crosscpu:
-#: errors move by up to a factor ~5 (5.2e-11 -> 2.2e-10 at rtol 1e-10, 5.7e-12 ->
-#: 3.0e-11 for a switching time at rtol 1e-12; with OpenBLAS's kernels switched too, a
-#: switching-time error near 1e-12 went to 1.3e-10, so a floor of 1e-10 failed). So errors
-#: are compared to within a decade (rtol 10) above a floor of 1e-9, the level where a
-#: method run at rtol 1e-12..1e-13 is decided by one step or event choice: enough to tell
-#: methods and tolerances apart, which differ by decades.
+#: 1, a sign change of h seen or missed at a step end), which a last-bit change
+#: re-draws, and local errors that cancel can leave any value below the error's
+#: envelope. Only its order of magnitude is a result, so errors are compared by rule
+#: "order": within a factor 10 either way (methods and tolerances differ by decades),
+#: symmetric in the two builds, above a floor under which step choices decide them.
+#: (Rule "close" with rtol 10, used before, let a value fall to 0 but rise only 11-fold
+#: from the reference: whether two builds agreed depended on which wrote the manifest.)
+#: Floors, measured by re-drawing the step sequence (rtol scaled by 1 + k 1e-9, 16
+#: sequences, native) and with the emulated CPU of tests/crosscpu (seeds 1-3):
+#: * error_map, 1e-9: the level where a method run at rtol 1e-12..1e-13 is decided by
+#:   one step or event choice (below it, e.g. the fig11 (b) map error at rtol 1e-10:
+#:   1.7e-10 <-> 1.9e-11); above it the map errors moved by a factor <= 1.2;
+#: * error_switch, 1e-8: a switching time is conditioned by 1/(dh/dt) at the
+#:   crossing, which grows as 1/sqrt(distance to grazing): the fig11 (b) start x1 =
+#:   4.31875 lies 3.8e-3 past the grazing start 4.31495 (dt_sw/dx1 = -10.4 there,
+#:   -1.1..-2.2 at the other starts), and its first-switch error at rtol 1e-10 is
+#:   anything from 1.6e-9 to 2.6e-8 over the 16 step sequences (max over 5 builds:
+#:   1.4e-9 .. 2.5e-8, a factor 16 apart); with the floor at 1e-8 that is a factor <= 2.6.
 def tolerances() -> dict:
     from ..tolerance import MEASURED, Tolerance
 
-    err = Tolerance(10.0, 1e-9, "error of an approximate method: decided by discrete step "
-                                 "and event choices near tangencies; moves by up to ~5x "
-                                 "under a last-bit change (measured)")
+    why = ("error of an approximate method: decided by discrete step and event choices, "
+           "re-drawn by a last-bit change; only its order is a result")
+    err = Tolerance(10.0, 1e-9, why + "; floor: one step choice at rtol 1e-12 (measured)",
+                    rule="order")
+    err_switch = Tolerance(10.0, 1e-8, why + "; floor: step choices near grazing, "
+                           "conditioning 1/sqrt(distance): 1.6e-9..2.6e-8 at rtol 1e-10 "
+                           "(measured)", rule="order")
     check = Tolerance(1e-6, 1e-12, "difference of two solves at rtol 1e-13 of maps that move "
                                    "by ~3e-13 under a last-bit change (measured)")
     # each missed switch is a discrete choice (does a step straddle a short excursion
@@ -118,7 +131,7 @@ def tolerances() -> dict:
                                  "1-ulp change of the field for RK45 at rtol 1e-4 (measured)")
     return {"wall_time": MEASURED, "time_per_return": MEASURED, "runs": MEASURED, "time_ours_at_target": MEASURED,
             "time_rk45_at_target": MEASURED, "speedup_vs_rk45": MEASURED,
-            "error_map": err, "error_switch": err, "reference_check": check,
+            "error_map": err, "error_switch": err_switch, "reference_check": check,
             "missed_switches": missed}
 
 
