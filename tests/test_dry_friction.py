@@ -185,3 +185,14 @@ def test_fig11_engines_agree():
     a = f11.P_pair(4.4, v0, eps, LAW11, 1e-12, 1e-14)
     b = f11.P_pair(4.4, v0, eps, LAW11, 1e-12, 1e-14, engine="compiled")
     np.testing.assert_allclose(b, a, rtol=0, atol=1e-11)
+
+
+def test_the_reduced_jacobian_first_then_the_slow_fast_system():
+    # both are derived once and kept in one module cache; asking for the reduced
+    # Jacobian first once made system() fail with KeyError (found by test order in
+    # tests/test_cross_cpu.py: fig10's continuation, then fig11's compiled returns)
+    from filippov.models import dry_friction as df
+    df._FULL.clear()
+    jac = df.reduced_jacobian(1.0)
+    assert callable(jac)
+    assert df.system(0.1, 3.32).names

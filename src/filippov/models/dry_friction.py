@@ -149,7 +149,7 @@ def model(eps: float, v0: float, gamma: float = 2.0, f0: float = -2.0, fv: float
                                               "fv": fv, "fc": fc, "convention": convention})
 
 
-_FULL: dict = {}
+_FULL: dict = {}   # 'full' / 'reduced' -> the SymbolicSystem (derived once, then copied)
 
 
 def system(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck", *,
@@ -160,9 +160,9 @@ def system(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck", *
     values = _values(eps, v0, gamma, f0, fv, fc, convention)
     if eps <= 0:
         raise ValueError("eps must be > 0 for the slow-fast system")
-    if not _FULL:
-        _FULL[True] = DEFINITION.full()
-    return _FULL[True].with_params(**values).with_options(sliding=sliding).system()
+    if "full" not in _FULL:
+        _FULL["full"] = DEFINITION.full()
+    return _FULL["full"].with_params(**values).with_options(sliding=sliding).system()
 
 
 # --------------------------------------------------------------------------- slow manifold
@@ -287,10 +287,9 @@ def reduced_jacobian(v, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck"):
     as functions of x, is (x2, 0) up to rounding: a = x1 + F_minus, b = x1 + F_plus and
     its second component cancels)."""
     a, c = _coefficients(f0, fc, convention)
-    key = ("reduced",)
-    if key not in _FULL:
-        _FULL[key] = DEFINITION.reduced()
-    return _FULL[key].with_params(v0=v, s0=a, sc=c, fv=fv).system().jacobian
+    if "reduced" not in _FULL:
+        _FULL["reduced"] = DEFINITION.reduced()
+    return _FULL["reduced"].with_params(v0=v, s0=a, sc=c, fv=fv).system().jacobian
 
 
 def full_system(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck",
