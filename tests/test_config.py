@@ -158,3 +158,26 @@ def test_the_compute_hash_leaves_out_exactly_the_report_part():
         assert without_report_part(text + "\nX_NEW = 1\n") != kept, sid
     rules = (ROOT / "workflow" / "rules" / "compute.smk").read_text()
     assert rules.count("library_hash(exclude=NOT_COMPUTE, strip_reports=True)") == 3
+
+
+# the parameters that several scenes share are declared once in the scene schema's $defs
+# (attractor_sweep, pdm_sweep, friction_law) and referenced by each scene's block; a name
+# a block does not list is refused by its propertyNames
+@pytest.mark.parametrize("sid,old,new,message", [
+    ("fig12_period_adding", "  n_mu: 181", "  n_muu: 181", r"parameters: 'n_muu' is not one of"),
+    ("fig14_atlas", "  n_keep: 40", "  n_keep: 1",
+     r"parameters\.n_keep: 1 is less than the minimum of 2"),
+    ("fig11_dfo_retmaps", "  gamma: 2.0", "  gama: 2.0", r"parameters: 'gama' is not one of"),
+    ("fig10_dfo", "  fv: 0.3", "  fv: -0.3", r"parameters\.fv: -0\.3 is less than the minimum of 0"),
+    ("fig07_pdm_theta_neg", "  closest: 1.0e-8", "  closest: 0.0",
+     r"parameters\.closest: 0\.0 is less than or equal to the minimum of 0"),
+    ("fig09_pdm_theta_pos", "  closest: 1.0e-3", "  closest: 1.0e-3\n  extra: 1",
+     r"parameters: 'extra' is not one of"),
+], ids=["fig12-misspelt", "fig14-shared-bound", "fig11-misspelt", "fig10-shared-bound",
+        "fig07-shared-bound", "fig09-unknown"])
+def test_shared_parameters_are_checked_and_named(tmp_path, sid, old, new, message):
+    text = (ROOT / "config" / "scenes" / f"{sid}.yaml").read_text()
+    assert old in text
+    path = _write(tmp_path, text.replace(old, new, 1), name=sid)
+    with pytest.raises(SceneError, match=rf"^{path}: {message}"):
+        load_scene(path, SCHEMA)

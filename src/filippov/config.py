@@ -119,7 +119,15 @@ _Loader.add_implicit_resolver(
     list("-+0123456789"))
 
 # When a typo'd key also makes a required key "missing", report the typo.
-_RELEVANCE = by_relevance(strong=frozenset({"additionalProperties"}))
+_BY_RELEVANCE = by_relevance(strong=frozenset({"additionalProperties"}))
+
+
+def _RELEVANCE(error):
+    """jsonschema's relevance, with a name a block does not allow (``additionalProperties``
+    or ``propertyNames``: the latter reports as the ``enum`` it descends into) first: a
+    misspelt key is named rather than the required key it stands in for."""
+    *head, strong, matches_type = _BY_RELEVANCE(error)
+    return (*head, strong or "propertyNames" in error.schema_path, matches_type)
 
 
 def _field(path) -> str:

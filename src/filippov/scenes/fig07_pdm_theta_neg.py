@@ -28,17 +28,13 @@ PARAMETERS_SCHEMA = {
       "description": "theta < 0: P_DM in xi1 = (x1 + 1)/eps (eq:scal), one curve per eps.",
       "required": ["eps", "mu", "omega", "theta", "xi1_min", "xi1_max", "n_uniform",
                    "n_geometric", "closest"],
-      "additionalProperties": False,
+      "$ref": "#/$defs/pdm_sweep",
+      "propertyNames": {"enum": [
+        "eps", "mu", "omega", "theta", "xi1_min", "xi1_max", "n_uniform", "n_geometric",
+        "closest"
+      ]},
       "properties": {
-        "eps": {"type": "array", "minItems": 2, "items": {"$ref": "#/$defs/positive"}},
-        "mu": {"const": 1.0},
-        "omega": True,
-        "theta": {"type": "number", "exclusiveMaximum": 0},
-        "xi1_min": {"type": "number", "exclusiveMaximum": 0},
-        "xi1_max": {"type": "number", "exclusiveMinimum": 0},
-        "n_uniform": {"type": "integer", "minimum": 3},
-        "n_geometric": {"type": "integer", "minimum": 1},
-        "closest": {"$ref": "#/$defs/positive"}
+        "theta": {"type": "number", "exclusiveMaximum": 0}
       }
     }
   }

@@ -27,17 +27,13 @@ PARAMETERS_SCHEMA = {
       "description": "0 < theta < 1: P_DM in xi1 = (x1 + 1)/eps^2 (eq:p:scal), one curve per eps; core: half-width of the fixed xi1 window for the convergence rate.",
       "required": ["eps", "mu", "omega", "theta", "xi1_min", "xi1_max", "n_uniform",
                    "n_geometric", "closest", "core"],
-      "additionalProperties": False,
+      "$ref": "#/$defs/pdm_sweep",
+      "propertyNames": {"enum": [
+        "eps", "mu", "omega", "theta", "xi1_min", "xi1_max", "n_uniform", "n_geometric",
+        "closest", "core", "n_core"
+      ]},
       "properties": {
-        "eps": {"type": "array", "minItems": 2, "items": {"$ref": "#/$defs/positive"}},
-        "mu": {"const": 1.0},
-        "omega": True,
         "theta": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
-        "xi1_min": {"type": "number", "exclusiveMaximum": 0},
-        "xi1_max": {"type": "number", "exclusiveMinimum": 0},
-        "n_uniform": {"type": "integer", "minimum": 3},
-        "n_geometric": {"type": "integer", "minimum": 1},
-        "closest": {"$ref": "#/$defs/positive"},
         "core": {"$ref": "#/$defs/positive"},
         "n_core": {"type": "integer", "minimum": 2}
       }

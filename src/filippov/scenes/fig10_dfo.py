@@ -46,12 +46,12 @@ PARAMETERS_SCHEMA = {
       "description": "Reduced dry-friction oscillator eq:dfo1 over the belt speed v.",
       "required": ["f0", "fv", "fc", "v_min", "v_max", "n_stick_slip", "gs_closest",
                    "amp_min", "ds", "nu_max"],
-      "additionalProperties": False,
+      "$ref": "#/$defs/friction_law",
+      "propertyNames": {"enum": [
+        "f0", "fv", "fc", "convention", "v_min", "v_max", "n_stick_slip", "gs_closest", "amp_min",
+        "ds", "nu_max"
+      ]},
       "properties": {
-        "f0": {"type": "number"},
-        "fv": {"type": "number", "minimum": 0},
-        "fc": {"type": "number"},
-        "convention": {"enum": ["stribeck", "literal"]},
         "v_min": {"$ref": "#/$defs/positive"},
         "v_max": {"$ref": "#/$defs/positive"},
         "n_stick_slip": {"type": "integer", "minimum": 8},

@@ -55,12 +55,12 @@ PARAMETERS_SCHEMA = {
       "description": "Slow-fast dry-friction oscillator eq:dfo-sf; one v0 per eps (panels).",
       "required": ["gamma", "f0", "fv", "fc", "eps", "v0", "x1_min", "x1_max", "n_x1",
                    "sn_x1_range"],
-      "additionalProperties": False,
+      "$ref": "#/$defs/friction_law",
+      "propertyNames": {"enum": [
+        "f0", "fv", "fc", "convention", "gamma", "eps", "v0", "x1_min", "x1_max", "n_x1",
+        "sn_x1_range", "refine_dP", "refine_rounds", "sn_v0_guess", "sn_search_rtol"
+      ]},
       "properties": {
-        "f0": {"type": "number"},
-        "fv": {"type": "number", "minimum": 0},
-        "fc": {"type": "number"},
-        "convention": {"enum": ["stribeck", "literal"]},
         "gamma": {"type": "number", "minimum": 0},
         "eps": {"type": "array", "minItems": 1, "items": {"$ref": "#/$defs/positive"}},
         "v0": {"type": "array", "minItems": 1, "items": {"$ref": "#/$defs/positive"}},

@@ -33,19 +33,15 @@ PARAMETERS_SCHEMA = {
     "parameters": {
       "required": ["eps", "theta", "omega", "s_min", "s_max", "n_mu", "n_transient", "n_keep",
                    "max_period", "window", "lyapunov", "window_periods", "edge_tol", "fit_eps_max"],
-      "additionalProperties": False,
+      "$ref": "#/$defs/attractor_sweep",
+      "propertyNames": {"enum": [
+        "eps", "theta", "omega", "s_min", "s_max", "n_mu", "n_transient", "n_keep", "max_period",
+        "window", "lyapunov", "window_periods", "edge_tol", "fit_eps_max"
+      ]},
       "properties": {
         "eps": {"type": "array", "minItems": 1, "items": {"type": "number", "exclusiveMinimum": 0, "maximum": 0.1}},
         "theta": {"type": "number", "exclusiveMaximum": 0, "minimum": -5},
-        "omega": {"$ref": "#/$defs/positive"},
-        "s_min": {"type": "number"},
         "s_max": {"type": "number"},
-        "n_mu": {"type": "integer", "minimum": 2},
-        "n_transient": {"type": "integer", "minimum": 0},
-        "n_keep": {"type": "integer", "minimum": 2},
-        "max_period": {"type": "integer", "minimum": 1},
-        "window": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
-        "lyapunov": {"type": "boolean"},
         "window_periods": {"type": "array", "minItems": 1, "items": {"type": "integer", "minimum": 1}},
         "edge_tol": {"type": "number", "exclusiveMinimum": 0},
         "fit_eps_max": {"type": "number", "exclusiveMinimum": 0}

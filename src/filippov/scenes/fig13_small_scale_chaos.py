@@ -40,21 +40,17 @@ PARAMETERS_SCHEMA = {
     "parameters": {
       "required": ["eps", "theta", "omega", "s_min", "s_max", "n_mu", "n_geo", "s_geo_max",
                    "n_transient", "n_keep", "max_period", "window", "lyapunov", "fit_eps_max"],
-      "additionalProperties": False,
+      "$ref": "#/$defs/attractor_sweep",
+      "propertyNames": {"enum": [
+        "eps", "theta", "omega", "s_min", "s_max", "n_mu", "n_geo", "s_geo_max", "n_transient",
+        "n_keep", "max_period", "window", "lyapunov", "fit_eps_max"
+      ]},
       "properties": {
         "eps": {"type": "array", "minItems": 1, "items": {"type": "number", "exclusiveMinimum": 0, "maximum": 0.1}},
         "theta": {"type": "array", "minItems": 1, "items": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1}},
-        "omega": {"$ref": "#/$defs/positive"},
-        "s_min": {"type": "number"},
         "s_max": {"type": "number", "exclusiveMinimum": 0},
-        "n_mu": {"type": "integer", "minimum": 2},
         "n_geo": {"type": "integer", "minimum": 0},
         "s_geo_max": {"type": "number", "exclusiveMinimum": 0},
-        "n_transient": {"type": "integer", "minimum": 0},
-        "n_keep": {"type": "integer", "minimum": 2},
-        "max_period": {"type": "integer", "minimum": 1},
-        "window": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1},
-        "lyapunov": {"type": "boolean"},
         "fit_eps_max": {"type": "number", "exclusiveMinimum": 0}
       }
     }
