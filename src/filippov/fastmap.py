@@ -66,7 +66,8 @@ from .abi import (FIELD_SIG, FLOW_SIG, JAC_SIG, SCALAR_SIG, WHERE_SIG,  # noqa: 
 from .kernel.base import (BAD_START, EVENT_LIMIT, NO_RETURN, NO_SLIDING,  # noqa: F401
                           NON_FINITE, OK, ROOT_FAILED, SECTION_SLIDING, STATUS, STEP_FAILED,
                           STEP_LIMIT, ZENO)
-from .kernel.driver import KERNEL_SOURCES, compile_kernel, kernel  # noqa: F401
+from .kernel.driver import (KERNEL_SOURCES, Outputs, Settings,  # noqa: F401
+                            compile_kernel, kernel)
 from .poincare import Returns
 from .progress import Progress
 from .simulate import (EXACT_BLOCK, EventLimitError, SimulationError,
@@ -212,37 +213,36 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     # samples_per_step is for integration steps, whose length error control sets
     frac_ex = np.linspace(0.0, 1.0, EXACT_BLOCK + 1)
     frac_in = np.linspace(0.0, 1.0, samples_per_step + 1)
-    fopts = np.array([rtol, atol, touch_tol, event_xtol, zeno_span, max_step, hwin_slow,
-                      cmodel.transient_time, min_time], dtype=float)
     # dP/dz: 0 none, 1 Jacobian-vector products by differences, 2 the model's Jacobians
     jac_mode = (2 if cmodel.jacobian is not None else 1) if jacobian else 0
-    iopts = np.array([max_events, max_steps, zeno_count, iterations, jac_mode], dtype=np.int64)
-    m = starts.shape[0]
-    state = np.empty_like(starts)
-    time = np.empty(m)
-    nsw = np.empty(m, dtype=np.int64)
-    slide = np.empty(m)
-    status = np.empty(m, dtype=np.int64)
-    first = np.empty(m)
-    slide_dz = np.empty_like(starts)
-    orbit = np.full((m, keep, starts.shape[1]), np.nan)
-    done = np.empty(m, dtype=np.int64)
-    n = starts.shape[1]
-    jac = np.empty((m, n, n))
-    orbit_jac = np.full((m, keep if jacobian else 0, n, n), np.nan)
-    age = np.empty(m)
+    # the kernel's ABI (kernel.driver: PIECES, Settings, Outputs; their numba types are
+    # the kernel's one signature: Python floats, ints and bools as such)
+    settings = Settings(
+        t_max=float(t_max), exact=bool(cmodel.exact), hwin=float(hwin),
+        hwin_slow=float(hwin_slow), transient=float(cmodel.transient_time),
+        sec_pred=int(_section_pred(cmodel.section_direction)), sliding=bool(cmodel.sliding),
+        frac_ex=frac_ex, frac_in=frac_in, rtol=float(rtol), atol=float(atol),
+        touch_tol=float(touch_tol), xtol=float(event_xtol), zeno_span=float(zeno_span),
+        max_step=float(max_step), min_time=float(min_time), max_events=int(max_events),
+        max_steps=int(max_steps), zeno_count=int(zeno_count), jac=jac_mode,
+        iterations=int(iterations))
+    m, n = starts.shape
+    out = Outputs(state=np.empty_like(starts), time=np.empty(m),
+                  n_switches=np.empty(m, dtype=np.int64), sliding_time=np.empty(m),
+                  status=np.empty(m, dtype=np.int64), first_switch=np.empty(m),
+                  sliding_displacement=np.empty_like(starts),
+                  orbit=np.full((m, keep, n), np.nan), returns_done=np.empty(m, dtype=np.int64),
+                  jacobian=np.empty((m, n, n)),
+                  orbit_jacobian=np.full((m, keep if jacobian else 0, n, n), np.nan),
+                  age=np.empty(m))
+    pieces = (cmodel.flow_plus, cmodel.flow_minus, cmodel.field_plus, cmodel.field_minus,
+              cmodel.h, cmodel.grad_h, cmodel.section, cmodel.section_where,
+              no_jacobian if cmodel.jacobian is None else cmodel.jacobian)  # kernel PIECES
     params = np.ascontiguousarray(cmodel.params, dtype=float)
     # the build without the dP/dz code unless it is asked for (kernel.driver)
-    kernel(derivatives=bool(jacobian))(
-        cmodel.flow_plus, cmodel.flow_minus, cmodel.field_plus, cmodel.field_minus,
-        cmodel.h, cmodel.grad_h, cmodel.section, cmodel.section_where,
-        no_jacobian if cmodel.jacobian is None else cmodel.jacobian, params,
-        starts, ages, float(t_max), bool(cmodel.exact), float(hwin),
-        _section_pred(cmodel.section_direction), bool(cmodel.sliding), frac_ex, frac_in, fopts,
-        iopts, state, time, nsw, slide, status, first, slide_dz, orbit, done, jac, orbit_jac,
-        age)
-    return BatchReturns(state, time, nsw, slide, status, first, slide_dz, orbit, done,
-                        jac if jacobian else None, orbit_jac if jacobian else None, age)
+    kernel(derivatives=bool(jacobian))(*pieces, params, starts, ages, settings, out)
+    return BatchReturns(**dict(out._asdict(), jacobian=out.jacobian if jacobian else None,
+                               orbit_jacobian=out.orbit_jacobian if jacobian else None))
 
 
 _ERRORS = {EVENT_LIMIT: EventLimitError, STEP_LIMIT: EventLimitError, ZENO: ZenoError,

@@ -74,11 +74,31 @@ def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
     return mode
 
 
-#: what a batch runs with (compute_returns fills it; _batch builds it once per call)
+# The kernel's ABI: _batch(*pieces, params, starts, ages, settings, out): the model's nine
+# pieces (filippov.abi; numba converts a compiled function handed over on its own to a
+# first-class function, not one inside a tuple), arrays and two named tuples;
+# fastmap.compute_returns builds them (_KERNEL_SIG: their types).
+
+#: the model's pieces, in the order kernel.base._piece calls them by (fns[k])
+PIECES = ("flow_plus", "flow_minus", "field_plus", "field_minus", "h", "grad_h", "section",
+          "where", "jacobian")
+
+#: what a batch runs with: t_max per return; exact flows in regions + and - (else DOP853)
+#: in windows hwin (hwin_slow after the transient time); the section predicate; sliding
+#: declared; sample fractions of an exact window and of an integration step; tolerances and
+#: limits as compute_returns' options; iterations: returns per start; jac: dP/dz (0 none,
+#: 1 Jacobian-vector products by differences, 2 the model's Jacobians)
 Settings = namedtuple("Settings", [
     "t_max", "exact", "hwin", "hwin_slow", "transient", "sec_pred", "sliding",
     "frac_ex", "frac_in", "rtol", "atol", "touch_tol", "xtol", "zeno_span", "max_step",
-    "min_time", "max_events", "max_steps", "zeno_count", "jac"])
+    "min_time", "max_events", "max_steps", "zeno_count", "jac", "iterations"])
+
+#: what a batch returns, per start (m) -- fastmap.BatchReturns' fields: state (m, n), time,
+#: n_switches, sliding_time, status, first_switch, sliding_displacement (m, n), orbit
+#: (m, keep, n), returns_done, jacobian (m, n, n), orbit_jacobian (m, keep or 0, n, n), age
+Outputs = namedtuple("Outputs", [
+    "state", "time", "n_switches", "sliding_time", "status", "first_switch",
+    "sliding_displacement", "orbit", "returns_done", "jacobian", "orbit_jacobian", "age"])
 
 #: the kernel's named work arrays, allocated once per batch by _batch. count: switches,
 #: steps, entries in the Zeno ring; tally: time slid, start of the current slide, time
@@ -305,48 +325,34 @@ def _one(z0, age0, fns, p, s, w):
             return st, t, w.count[0], w.tally[0]
 
 
+_f8, _i8, _b1 = types.float64, types.int64, types.boolean
 _KERNEL_SIG = types.void(
-    _FLOW, _FLOW, _FIELD, _FIELD, _SCALAR, _FIELD, _SCALAR, _WHERE, _JAC,  # the model
+    _FLOW, _FLOW, _FIELD, _FIELD, _SCALAR, _FIELD, _SCALAR, _WHERE, _JAC,  # PIECES
     _vec,                       # params
     types.float64[:, ::1],      # starts (m, n)
     _vec,                       # their ages in their regions (rules.carried_age)
-    types.float64,              # t_max
-    types.boolean,              # exact flows in regions + and - (else DOP853)
-    types.float64,              # window length of the exact flows
-    types.int64,                # section predicate
-    types.boolean,              # sliding declared
-    _vec, _vec,                 # sample fractions: exact windows, integration steps
-    _vec,                       # rtol, atol, touch_tol, event_xtol, zeno_span, max_step,
-                                # slow window, transient time, min_time
-    types.int64[::1],           # max_events, max_steps, zeno_count, returns per start,
-                                # dP/dz wanted (0/1)
-    types.float64[:, ::1], _vec, types.int64[::1], _vec, types.int64[::1], _vec,  # outputs
-    types.float64[:, ::1],
-    types.float64[:, :, ::1],   # the last returns of each start (m, keep, n)
-    types.int64[::1],           # returns completed per start
-    types.float64[:, :, ::1],   # dP/dz of the last return (m, n, n)
-    types.float64[:, :, :, ::1],  # dP/dz of each kept return (m, keep, n, n) or (m, 0, n, n)
-    _vec)                       # the age at the last return (m,)
+    types.NamedTuple([_f8, _b1, _f8, _f8, _f8, _i8, _b1, _vec, _vec, _f8, _f8, _f8, _f8, _f8,
+                      _f8, _f8, _i8, _i8, _i8, _i8, _i8], Settings),
+    types.NamedTuple([types.float64[:, ::1], _vec, types.int64[::1], _vec, types.int64[::1],
+                      _vec, types.float64[:, ::1], types.float64[:, :, ::1], types.int64[::1],
+                      types.float64[:, :, ::1], types.float64[:, :, :, ::1], _vec], Outputs))
 
 
 @njit(cache=True)
-def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, jacobian, p,
-           starts, ages, t_max, exact, hwin, sec_pred, sliding, frac_ex, frac_in, fopts, iopts,
-           out_state, out_time, out_nsw, out_slide, out_status, out_first, out_slide_dz,
-           out_orbit, out_done, out_jac, out_orbit_jac, out_age):
-    """Each start is mapped iopts[3] times by the first-return map, each return
+def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, jacobian,
+           p, starts, ages, s, out):
+    """Each start is mapped s.iterations times by the first-return map, each return
     starting from the last one's state; the outputs describe the last return made
-    (or where it stopped) and out_orbit[i] holds the last keep returns (with iopts[4]:
-    out_jac and out_orbit_jac their derivatives dP/dz, NaN where not made; iopts[4] = 2:
-    the variational equation with the model's exact Jacobians)."""
+    (or where it stopped) and out.orbit[i] holds the last keep returns (with s.jac:
+    out.jacobian and out.orbit_jacobian their derivatives dP/dz, NaN where not made)."""
     fns = (flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, jacobian)
     m, n = starts.shape
-    nsmax = max(frac_ex.size, frac_in.size)
+    nsmax = max(s.frac_ex.size, s.frac_in.size)
     ts = np.empty(nsmax)
     vals = np.empty((2, nsmax))
     dvals = np.empty(nsmax)
     svals = np.empty(nsmax)
-    recent = np.empty(max(iopts[2], 1))
+    recent = np.empty(max(s.zeno_count, 1))
     sg = np.zeros(5)
     za, y, f = np.zeros(n), np.zeros(n), np.zeros(n)
     y_old, f_old, ynew, ytmp, scale = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
@@ -361,12 +367,8 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
              np.zeros((n, n)), np.zeros((n, n)), np.zeros((_NS, n)), np.zeros((_NS, n, n)),
              np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
              np.zeros(n), np.zeros(1, dtype=np.bool_), np.zeros(n * n))
-    jac = iopts[4]
-    s = Settings(t_max, exact, hwin, fopts[6], fopts[7], sec_pred, sliding, frac_ex, frac_in,
-                 fopts[0], fopts[1], fopts[2], fopts[3], fopts[4], fopts[5], fopts[8],
-                 iopts[0], iopts[1], iopts[2], jac)
-    keep_jac = out_orbit_jac.shape[1]
-    n_iter, keep = iopts[3], out_orbit.shape[1]
+    keep_jac = out.orbit_jacobian.shape[1]
+    n_iter, keep = s.iterations, out.orbit.shape[1]
     zin = np.empty(n)
     for i in range(m):
         for c in range(n):
@@ -382,30 +384,30 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
             j = done - 1 - (n_iter - keep)
             if j >= 0:
                 for c in range(n):
-                    out_orbit[i, j, c] = w.z[c]
+                    out.orbit[i, j, c] = w.z[c]
                 if keep_jac > 0:  # element by element: a slice assignment compiles
                     for a in range(n):   # numba's shape-error path (~3 s of compile)
                         for b in range(n):
-                            out_orbit_jac[i, j, a, b] = w.M[a, b]
+                            out.orbit_jacobian[i, j, a, b] = w.M[a, b]
             if done >= n_iter:
                 break
             for c in range(n):
                 zin[c] = w.z[c]
             age = w.tally[2]
-        out_done[i] = done
-        out_age[i] = w.tally[2]
-        out_first[i] = first[0]
+        out.returns_done[i] = done
+        out.age[i] = w.tally[2]
+        out.first_switch[i] = first[0]
         for c in range(n):
-            out_state[i, c] = w.z[c]
-            out_slide_dz[i, c] = w.slide_dz[c]
-        out_status[i] = st
-        made = jac != 0 and st == OK
+            out.state[i, c] = w.z[c]
+            out.sliding_displacement[i, c] = w.slide_dz[c]
+        out.status[i] = st
+        made = s.jac != 0 and st == OK
         for a in range(n):
             for b in range(n):
-                out_jac[i, a, b] = w.M[a, b] if made else np.nan
-        out_time[i] = t
-        out_nsw[i] = nsw
-        out_slide[i] = sl
+                out.jacobian[i, a, b] = w.M[a, b] if made else np.nan
+        out.time[i] = t
+        out.n_switches[i] = nsw
+        out.sliding_time[i] = sl
 
 
 #: the files whose code the kernel contains: every module of this package and the
