@@ -27,6 +27,13 @@ WHERE_SIG = types.boolean(_vec, _vec)
 JAC_SIG = types.void(types.int64, _vec, _vec, _vec)
 
 
+#: the pieces of a :class:`CompiledModel` with their signatures, in the order the
+#: compiled engine takes them (its kernel's arguments, and the index it calls each by)
+PIECES = (("flow_plus", FLOW_SIG), ("flow_minus", FLOW_SIG), ("field_plus", FIELD_SIG),
+          ("field_minus", FIELD_SIG), ("h", SCALAR_SIG), ("grad_h", FIELD_SIG),
+          ("section", SCALAR_SIG), ("section_where", WHERE_SIG), ("jacobian", JAC_SIG))
+
+
 @njit(FLOW_SIG, cache=True)
 def no_flow(z0, tau, p, out):
     """Stands in for the flows of a model without them (never called: exact=False)."""

@@ -60,7 +60,7 @@ import numpy as np
 
 from . import rules
 # what a model hands the engine (its pieces' signatures, CompiledModel), re-exported here
-from .abi import (FIELD_SIG, FLOW_SIG, JAC_SIG, SCALAR_SIG, WHERE_SIG,  # noqa: F401
+from .abi import (FIELD_SIG, FLOW_SIG, PIECES, SCALAR_SIG, WHERE_SIG,  # noqa: F401
                   CompiledModel, no_flow, no_jacobian)
 # the kernel (filippov.kernel) and its status codes, re-exported here
 from .kernel.base import (BAD_START, EVENT_LIMIT, NO_RETURN, NO_SLIDING,  # noqa: F401
@@ -121,24 +121,23 @@ def _checked_starts(cmodel: CompiledModel, starts, start_age):
     return starts, ages
 
 
-#: each piece of a CompiledModel and the signature the kernel calls it with
-_PIECE_SIGS = {"flow_plus": FLOW_SIG, "flow_minus": FLOW_SIG, "field_plus": FIELD_SIG,
-               "field_minus": FIELD_SIG, "h": SCALAR_SIG, "grad_h": FIELD_SIG,
-               "section": SCALAR_SIG, "section_where": WHERE_SIG, "jacobian": JAC_SIG}
-
-
-def _check_pieces(cmodel: CompiledModel) -> None:
-    """Every piece is a numba-compiled function with its signature: the kernel calls
-    them at their compiled address (kernel.base._piece), which anything else lacks."""
-    for name, sig in _PIECE_SIGS.items():
+def _pieces(cmodel: CompiledModel) -> tuple:
+    """The model's pieces in the kernel's order (filippov.abi.PIECES), each a numba-compiled
+    function with its signature: the kernel calls them at their compiled address
+    (kernel.base._piece), which anything else lacks. A model without Jacobians hands
+    :func:`no_jacobian`."""
+    pieces = []
+    for name, sig in PIECES:
         piece = getattr(cmodel, name)
         if name == "jacobian" and piece is None:
-            continue
+            piece = no_jacobian
         if not (hasattr(piece, "py_func") and tuple(sig.args) in getattr(piece, "signatures", ())):
             raise TypeError(
                 f"CompiledModel.{name}: expected a numba njit function compiled with the "
                 f"signature {sig} (filippov.abi; compile_system and SymbolicSystem build "
                 f"them), got {piece!r}")
+        pieces.append(piece)
+    return tuple(pieces)
 
 
 def _check_options(cmodel, t_max, samples_per_step, max_step, zeno_count, iterations, keep,
@@ -204,7 +203,7 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     (``touch_tol``: the kink of P at grazing), a start that slides.
     """
     starts, ages = _checked_starts(cmodel, starts, start_age)
-    _check_pieces(cmodel)
+    pieces = _pieces(cmodel)
     _check_options(cmodel, t_max, samples_per_step, max_step, zeno_count, iterations, keep,
                    min_time)
     hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max) if cmodel.exact else np.inf
@@ -215,7 +214,7 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     frac_in = np.linspace(0.0, 1.0, samples_per_step + 1)
     # dP/dz: 0 none, 1 Jacobian-vector products by differences, 2 the model's Jacobians
     jac_mode = (2 if cmodel.jacobian is not None else 1) if jacobian else 0
-    # the kernel's ABI (kernel.driver: PIECES, Settings, Outputs; their numba types are
+    # the kernel's ABI (kernel.driver: abi.PIECES, Settings, Outputs; their numba types are
     # the kernel's one signature: Python floats, ints and bools as such)
     settings = Settings(
         t_max=float(t_max), exact=bool(cmodel.exact), hwin=float(hwin),
@@ -235,9 +234,6 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
                   jacobian=np.empty((m, n, n)),
                   orbit_jacobian=np.full((m, keep if jacobian else 0, n, n), np.nan),
                   age=np.empty(m))
-    pieces = (cmodel.flow_plus, cmodel.flow_minus, cmodel.field_plus, cmodel.field_minus,
-              cmodel.h, cmodel.grad_h, cmodel.section, cmodel.section_where,
-              no_jacobian if cmodel.jacobian is None else cmodel.jacobian)  # kernel PIECES
     params = np.ascontiguousarray(cmodel.params, dtype=float)
     # the build without the dP/dz code unless it is asked for (kernel.driver)
     kernel(derivatives=bool(jacobian))(*pieces, params, starts, ages, settings, out)

@@ -9,16 +9,13 @@ from numba.core import cgutils
 from numba.extending import intrinsic
 
 from .. import rules
-from ..abi import FIELD_SIG, FLOW_SIG, JAC_SIG, SCALAR_SIG, WHERE_SIG
+from ..abi import PIECES
 
 
 # ----------------------------------------------------------------------------- signatures
 _vec = types.float64[::1]
-_FLOW = types.FunctionType(FLOW_SIG)
-_FIELD = types.FunctionType(FIELD_SIG)
-_SCALAR = types.FunctionType(SCALAR_SIG)
-_WHERE = types.FunctionType(WHERE_SIG)
-_JAC = types.FunctionType(JAC_SIG)
+#: the numba types of the model's pieces, in the kernel's order (filippov.abi.PIECES)
+_PIECE_TYPES = tuple(types.FunctionType(sig) for _, sig in PIECES)
 
 # ----------------------------------------------------------------------------- status codes
 OK = 0
@@ -113,9 +110,13 @@ def _call_piece_codegen(index):
     return codegen
 
 
-def _piece(index, arity):
-    """An intrinsic ``piece(fns, *args)``: calls fns[index] with its signature's
-    arguments (numba's intrinsics take no ``*args``: one typing function per arity)."""
+def _piece(name):
+    """An intrinsic ``piece(fns, *args)``: calls the piece ``name`` of filippov.abi.PIECES
+    (fns[its index]) with its signature's arguments (numba's intrinsics take no ``*args``:
+    one typing function per arity)."""
+    index = [n for n, _ in PIECES].index(name)
+    arity = len(PIECES[index][1].args)
+
     def typed(fns):
         sig = fns[index].signature
         return sig.return_type(fns, *sig.args), _call_piece_codegen(index)
@@ -126,10 +127,8 @@ def _piece(index, arity):
 
 
 # fns[k] by name: (z0, tau, p, out), (z, p, out), (z, p) -> float or bool, (mode, z, p, out)
-_flow_plus, _flow_minus, _field_plus, _field_minus = (_piece(0, 4), _piece(1, 4),
-                                                      _piece(2, 3), _piece(3, 3))
-_h, _grad_h, _section, _where, _jacobian = (_piece(4, 2), _piece(5, 3), _piece(6, 2),
-                                            _piece(7, 2), _piece(8, 4))
+(_flow_plus, _flow_minus, _field_plus, _field_minus, _h, _grad_h, _section, _where,
+ _jacobian) = (_piece(name) for name, _ in PIECES)
 
 
 @_jit

@@ -21,8 +21,7 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from ..system import SLIDING
 from .base import (BAD_START, EVENT_LIMIT, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
-                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO, _FIELD, _FLOW, _SCALAR,
-                   _WHERE, _JAC, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
+                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO, _PIECE_TYPES, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
                    _exit_drift, _exit_shift, _jit, _jit_inline, _next_mode, _onto_switch,
                    _slides_in_section, _speeds, _start_on_switch, _start_side, _vec, _h,
                    _section)
@@ -75,13 +74,9 @@ def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
 
 
 # The kernel's ABI: _batch(*pieces, params, starts, ages, settings, out): the model's nine
-# pieces (filippov.abi; numba converts a compiled function handed over on its own to a
-# first-class function, not one inside a tuple), arrays and two named tuples;
+# pieces (filippov.abi.PIECES; numba converts a compiled function handed over on its own
+# to a first-class function, not one inside a tuple), arrays and two named tuples;
 # fastmap.compute_returns builds them (_KERNEL_SIG: their types).
-
-#: the model's pieces, in the order kernel.base._piece calls them by (fns[k])
-PIECES = ("flow_plus", "flow_minus", "field_plus", "field_minus", "h", "grad_h", "section",
-          "where", "jacobian")
 
 #: what a batch runs with: t_max per return; exact flows in regions + and - (else DOP853)
 #: in windows hwin (hwin_slow after the transient time); the section predicate; sliding
@@ -327,7 +322,7 @@ def _one(z0, age0, fns, p, s, w):
 
 _f8, _i8, _b1 = types.float64, types.int64, types.boolean
 _KERNEL_SIG = types.void(
-    _FLOW, _FLOW, _FIELD, _FIELD, _SCALAR, _FIELD, _SCALAR, _WHERE, _JAC,  # PIECES
+    *_PIECE_TYPES,              # the model (filippov.abi.PIECES)
     _vec,                       # params
     types.float64[:, ::1],      # starts (m, n)
     _vec,                       # their ages in their regions (rules.carried_age)
