@@ -141,11 +141,15 @@ def _close(a, b, tol: Tolerance) -> bool:
 
 
 def _worst(pairs, tol: Tolerance) -> float:
-    """The largest difference among the pairs that are not within ``tol`` (0: all are)."""
+    """The largest distance among the pairs that are not within ``tol`` (0: all are): the
+    difference, or for rule ``order`` the factor between them (Tolerance.factor)."""
     worst = 0.0
     for a, b in pairs:
-        if not _close(a, b, tol):
-            worst = max(worst, np.inf if a is None or b is None else abs(a - b))
+        if _close(a, b, tol):
+            continue
+        if a is None or b is None:
+            return np.inf
+        worst = max(worst, float(tol.factor(a, b)) if tol.rule == "order" else abs(a - b))
     return worst
 
 
@@ -187,17 +191,13 @@ def _compare_variable(g: dict, w: dict, tol: Tolerance) -> str | None:
                f"up to {max(out, default=0):.3e}; at most {tol.changed} may, by at most " \
                f"{tol.jump:g}) {rule}"
     pairs = [(g[k], w[k]) for k in ("min", "max", "mean")] + list(zip(g["sample"], w["sample"]))
-    if tol.rule == "order":
-        # a magnitude: within a factor rtol either way, above the floor atol
-        off = [(a, b) for a, b in pairs if not _close(a, b, tol)]
-        if not off:
-            return None
-        worst = max(np.inf if a is None or b is None else float(tol.factor(a, b)) for a, b in off)
+    worst = _worst(pairs, tol)
+    if worst == 0:
+        return None
+    if tol.rule == "order":  # a magnitude: within a factor rtol either way, above atol
         return f"differs by a factor up to {worst:.3g} (tolerance: a factor {tol.rtol:g} " \
                f"above {tol.atol:g}) {rule}"
-    worst = _worst(pairs, tol)
-    return None if worst == 0 else \
-        f"differs by up to {worst:.3e} (tolerance {tol.atol:g} + {tol.rtol:g}*|value|) {rule}"
+    return f"differs by up to {worst:.3e} (tolerance {tol.atol:g} + {tol.rtol:g}*|value|) {rule}"
 
 
 def compare_data(got: dict, want: dict) -> list[str]:
