@@ -35,7 +35,7 @@ ALLOW_NO_TESTS ?=
 
 # Top-level packages resolved by `make lock` (everything else is transitive).
 LOCK_PKGS = numpy scipy xarray netCDF4 matplotlib "snakemake>=8,<10" \
-            pyyaml jsonschema numba threadpoolctl sympy pytest pygments snakemake-executor-plugin-slurm
+            pyyaml jsonschema numba threadpoolctl sympy pytest hypothesis pygments snakemake-executor-plugin-slurm
 
 export MPLBACKEND = Agg
 export SOURCE_DATE_EPOCH = 0

@@ -202,6 +202,14 @@ def check_switch_grad(system: PiecewiseSystem, z0: np.ndarray) -> None:
     """``switch_grad(z0)`` against central differences of ``switch`` along two
     directions: the gradient's own and a fixed one (see :data:`GRAD_RTOL`)."""
     g = np.asarray(system.switch_grad(z0), dtype=float).reshape(-1)
+    gradient_check(lambda Z: np.asarray(system.switch(Z), dtype=float), g, z0)
+
+
+def gradient_check(switch_at, g: np.ndarray, z0: np.ndarray, *, piece: str = "switch_grad",
+                   of: str = "switch") -> None:
+    """Raise :class:`SystemContractError` unless ``g`` is the gradient at ``z0`` of the
+    function ``switch_at`` (states (n, k) -> values (k,)) -- the check of both engines
+    (:func:`check_switch_grad`, :func:`check_compiled`); ``piece``/``of`` name them."""
     if not np.all(np.isfinite(g)):
         return
     n = z0.size
@@ -215,9 +223,9 @@ def check_switch_grad(system: PiecewiseSystem, z0: np.ndarray) -> None:
     steps = [h0 * f for f in GRAD_STEPS]
     pts = [z0 + sign * h * d for h in steps for d in dirs for sign in (1.0, -1.0)]
     try:
-        H = np.asarray(system.switch(np.stack(pts, axis=1)), dtype=float)
+        H = np.asarray(switch_at(np.stack(pts, axis=1)), dtype=float)
         H = H.reshape(len(steps), len(dirs), 2)
-        H0 = abs(float(np.asarray(system.switch(z0), dtype=float).reshape(())))
+        H0 = abs(float(np.asarray(switch_at(z0[:, None]), dtype=float).reshape(())))
     except Exception:  # switch fails next to z0: no verdict here, the solver meets it
         return
     # rounding of H at the sample points: eps times the size of H's terms
@@ -239,12 +247,43 @@ def check_switch_grad(system: PiecewiseSystem, z0: np.ndarray) -> None:
             return
     d, gd, fd, h = worst
     raise SystemContractError(
-        f"switch_grad does not match a finite difference of switch at the start state "
-        f"z={z0.tolist()}: along d={d.tolist()}, switch_grad(z).d = {gd!r} but "
-        f"(switch(z + h d) - switch(z - h d)) / 2h = {float(fd)!r} (h = {h:.3g}; smaller steps "
-        f"disagree too). switch_grad must return the gradient dH/dz of switch; one of "
+        f"{piece} does not match a finite difference of {of} at the start state "
+        f"z={z0.tolist()}: along d={d.tolist()}, {piece}(z).d = {gd!r} but "
+        f"({of}(z + h d) - {of}(z - h d)) / 2h = {float(fd)!r} (h = {h:.3g}; smaller steps "
+        f"disagree too). {piece} must return the gradient dH/dz of {of}; one of "
         f"the wrong sign makes attracting sliding look repelling (and crossings look "
         f"like sliding)")
+
+
+# id(compiled model) -> weak reference to one that passed check_compiled
+_PASSED_COMPILED: dict = {}
+
+
+def check_compiled(cmodel, z0: np.ndarray) -> None:
+    """The compiled engine's start check (:func:`filippov.fastmap.compute_returns`), the
+    same as the reference driver's :func:`check_switch_grad`: ``grad_h`` is the gradient
+    of ``h`` at the first start point; once per model object. (The pieces' output sizes
+    are checked where a model is built: ``compile_system``, ``FilippovSystem``.)"""
+    key = id(cmodel)
+    ref = _PASSED_COMPILED.get(key)
+    if ref is not None and ref() is cmodel:
+        return
+    z0 = np.ascontiguousarray(z0, dtype=float)
+    p = cmodel.params
+    g = np.full(z0.size, np.nan)
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        cmodel.grad_h(z0, p, g)
+
+        def switch_at(Z):
+            return np.array([cmodel.h(np.ascontiguousarray(Z[:, j]), p)
+                             for j in range(Z.shape[1])])
+
+        gradient_check(switch_at, g, z0)  # the user's names (compile_system's arguments)
+    try:
+        _PASSED_COMPILED[key] = weakref.ref(cmodel,
+                                            lambda _, key=key: _PASSED_COMPILED.pop(key, None))
+    except TypeError:
+        pass
 
 
 def non_finite_piece(system: PiecewiseSystem, mode: int, z: np.ndarray) -> str:

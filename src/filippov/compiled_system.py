@@ -18,6 +18,7 @@ import numpy as np
 from numba import njit
 from numba.core.errors import NumbaError
 
+from .checks import SystemContractError
 from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, always, no_flow
 
 _DOC_PIECE = ("write it for one state z (1-D float array) and the parameter array p, "
@@ -37,11 +38,16 @@ def _compile(adapter_src: Callable, sig, piece: str):
             warnings.simplefilter("ignore")
             return njit(sig)(adapter_src)
     except NumbaError as exc:
-        lines = [ln.strip() for ln in str(exc).splitlines() if ln.strip()]
-        # numba's first line names the compiler stage; the next one names the problem
-        detail = next((ln for ln in lines if not ln.startswith(("Failed in", "During:"))),
-                      lines[0] if lines else type(exc).__name__)
-        raise ValueError(f"{piece}: numba cannot compile it ({detail}); {_DOC_PIECE}") from None
+        raise _cannot_compile(exc, piece) from None
+
+
+def _cannot_compile(exc: Exception, piece: str) -> ValueError:
+    """numba's failure to compile ``piece`` as one readable line."""
+    lines = [ln.strip() for ln in str(exc).splitlines() if ln.strip()]
+    # numba's first line names the compiler stage; the next one names the problem
+    detail = next((ln for ln in lines if not ln.startswith(("Failed in", "During:"))),
+                  lines[0] if lines else type(exc).__name__)
+    return ValueError(f"{piece}: numba cannot compile it ({detail}); {_DOC_PIECE}")
 
 
 def _vector_piece(fn, piece: str, n: int):
@@ -94,23 +100,65 @@ def _check_shapes(cm: CompiledModel, probe: np.ndarray) -> None:
     """Run every piece once at ``probe``: wrong output sizes and non-finite values
     are named here, not deep in the kernel."""
     n, p = cm.dim, cm.params
-    for piece in ("field_minus", "field_plus", "grad_h"):
-        out = np.full(n, np.nan)
+
+    def vector(fn):
+        def value(z):
+            out = np.full(n, np.nan)
+            fn(z, p, out)
+            return out
+        return value
+
+    pieces = {_USER_NAME[k]: vector(getattr(cm, k)) for k in ("field_minus", "field_plus", "grad_h")}
+    pieces.update({_USER_NAME[k]: (lambda z, fn=getattr(cm, k): fn(z, p)) for k in ("h", "section")})
+    _probe(pieces, cm.names, probe)
+
+
+def _probe(pieces: dict, names, probe: np.ndarray) -> None:
+    """Each of ``pieces`` ({user's name: z -> value}) once at ``probe``: a failure (the
+    wrong number of values, ...) or a non-finite value is an error naming the piece --
+    the construction check of both engines (compile_system, FilippovSystem.python)."""
+    n = len(names)
+    for piece, value in pieces.items():
         try:
-            getattr(cm, piece)(probe, p, out)
+            with np.errstate(all="ignore"):
+                v = np.asarray(value(probe), dtype=float)
+        except NumbaError as exc:
+            raise _cannot_compile(exc, piece) from None
         except Exception as exc:  # the wrong number of values, ...
-            raise ValueError(f"{_USER_NAME[piece]} failed at z={probe.tolist()}: {exc} "
-                             f"(expected {n} values, one per component of "
-                             f"{', '.join(cm.names)})") from None
-        if not np.all(np.isfinite(out)):
-            raise ValueError(f"{_USER_NAME[piece]} must return {n} finite values at "
-                             f"z={probe.tolist()}, got {out.tolist()}")
-    for piece in ("h", "section"):
-        v = getattr(cm, piece)(probe, p)
-        if not np.isfinite(v):
-            raise ValueError(f"{_USER_NAME[piece]} returned {v!r} at z={probe.tolist()}")
+            want = "one value" if piece in _SCALARS else \
+                f"{n} values, one per component of {', '.join(names)}"
+            raise SystemContractError(f"{piece} failed at z={probe.tolist()}: {exc} (expected "
+                                      f"{want})") from None
+        if not np.all(np.isfinite(v)):
+            what = "a finite value" if piece in _SCALARS else f"{n} finite values"
+            raise SystemContractError(f"{piece} must return {what} at z={probe.tolist()}, "
+                                      f"got {v.tolist()}")
 
 
+def _probe_batches(batches: dict, names, params, probe) -> None:
+    """The reference driver's pieces (compiled loops over samples) probed like the
+    compiled engine's (:func:`_check_shapes`): compiled here, so that a piece numba
+    cannot compile is named now, and run once at the probe state."""
+    n = len(names)
+    probe = _probe_state(probe, n)
+    col = np.ascontiguousarray(probe.reshape(n, 1))
+    pieces = {k: (lambda z, b=batches[k]: b(col, params)[:, 0])
+              for k in ("field_minus", "field_plus", "switch_grad")}
+    pieces["switch"] = lambda z: batches["switch"](col, params)[0]
+    for k in ("flow_minus", "flow_plus"):
+        if batches.get(k) is not None:
+            pieces[k] = lambda z, b=batches[k]: b(probe, np.zeros(1), params)[:, 0]
+    _probe(pieces, names, probe)
+
+
+def _probe_state(probe, n: int) -> np.ndarray:
+    probe = np.full(n, 0.5) if probe is None else np.ascontiguousarray(probe, dtype=float)
+    if probe.shape != (n,):
+        raise ValueError(f"probe: expected shape ({n},), got {probe.shape}")
+    return probe
+
+
+_SCALARS = ("switch", "section")
 _USER_NAME = {"field_minus": "field_minus", "field_plus": "field_plus", "grad_h": "switch_grad",
               "h": "switch", "section": "section"}
 
@@ -185,10 +233,7 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
         section_where=_where_piece(section_where, "section_where"),
         section_direction=int(section_direction), sample_step=float(sample_step),
         sliding=bool(sliding), exact=exact, parameters={})
-    probe = np.full(n, 0.5) if probe is None else np.ascontiguousarray(probe, dtype=float)
-    if probe.shape != (n,):
-        raise ValueError(f"probe: expected shape ({n},), got {probe.shape}")
-    _check_shapes(cm, probe)
+    _check_shapes(cm, _probe_state(probe, n))
     return cm
 
 
@@ -203,8 +248,11 @@ def with_section(cm: CompiledModel, section: Callable, *, direction: int = 0,
 
 
 # ----------------------------------------------------------------------------- one definition
-def _batch_vector(user, n: int):
-    """A vector piece f(z, p) -> (n,) evaluated on (n,) or (n, m) states, compiled."""
+def _batch_vector(user, n: int, piece: str = "a vector piece"):
+    """A vector piece f(z, p) -> (n,) evaluated on (n,) or (n, m) states, compiled; a
+    value of the wrong length is an error, never memory past its end."""
+    wrong = f"{piece} returned the wrong number of values"
+
     @njit
     def batch(zs, p):
         m = zs.shape[1]
@@ -214,6 +262,8 @@ def _batch_vector(user, n: int):
             for i in range(n):
                 z[i] = zs[i, j]
             v = user(z, p)
+            if len(v) != n:
+                raise ValueError(wrong)
             for i in range(n):
                 out[i, j] = v[i]
         return out
@@ -234,12 +284,16 @@ def _batch_scalar(user, n: int):
     return batch
 
 
-def _batch_flow(user, n: int):
+def _batch_flow(user, n: int, piece: str = "a flow"):
+    wrong = f"{piece} returned the wrong number of values"
+
     @njit
     def batch(z0, taus, p):
         out = np.empty((n, taus.size))
         for j in range(taus.size):
             v = user(z0, taus[j], p)
+            if len(v) != n:
+                raise ValueError(wrong)
             for i in range(n):
                 out[i, j] = v[i]
         return out
@@ -265,7 +319,8 @@ class FilippovSystem:
     engine's :class:`~filippov.abi.CompiledModel` with a section of the
     caller's choosing. Sections belong to the caller, not to the system.
     ``jacobians`` (optional, ``{"minus"|"sliding"|"plus": J(z, p) -> (n, n)}``)
-    gives :meth:`jacobian`, used for Floquet multipliers and dP/dz on the
+    gives :meth:`jacobian` (that of sliding derived from the two fields' where it is
+    not given), used for Floquet multipliers and dP/dz on the
     reference driver instead of central differences; :mod:`filippov.symbolic`
     generates all three from the expressions.
     """
@@ -273,8 +328,10 @@ class FilippovSystem:
     def __init__(self, names, field_minus, field_plus, switch, switch_grad, *, params=(),
                  flow_minus=None, flow_plus=None, sample_step: float = np.inf,
                  sliding: bool = True, name: str = "user", jacobians=None,
-                 slow_sample_step: float = np.nan, transient_time: float = np.inf):
+                 slow_sample_step: float = np.nan, transient_time: float = np.inf,
+                 probe=None):
         self.names = tuple(str(x) for x in names)
+        self._probe = probe   # where both engines' pieces are run once when built
         self.slow_sample_step, self.transient_time = float(slow_sample_step), float(transient_time)
         self.params = np.ascontiguousarray(np.asarray(params, dtype=float).reshape(-1))
         self.name, self.sliding, self.sample_step = name, bool(sliding), float(sample_step)
@@ -300,10 +357,11 @@ class FilippovSystem:
         """The pieces as compiled loops over the columns of ``(n, m)`` states (flows:
         over the times), for the reference driver."""
         n, pc = len(self.names), self._user_pieces()
-        out = {k: _batch_vector(pc[k], n) for k in ("field_minus", "field_plus", "switch_grad")}
+        out = {k: _batch_vector(pc[k], n, k) for k in ("field_minus", "field_plus", "switch_grad")}
         out["switch"] = _batch_scalar(pc["switch"], n)
         for k in ("flow_minus", "flow_plus"):
-            out[k] = None if pc[k] is None else _batch_flow(pc[k], n)
+            out[k] = None if pc[k] is None else _batch_flow(pc[k], n, k)
+        _probe_batches(out, self.names, self.params, self._probe)
         return out
 
     def _section_batch(self, section):
@@ -322,7 +380,8 @@ class FilippovSystem:
             self._compiled = dataclasses.replace(compile_system(
                 self.names, section=section, section_direction=direction, section_where=where,
                 params=self.params, sample_step=self.sample_step, sliding=self.sliding,
-                name=self.name, probe=probe, **self._user_pieces()),
+                name=self.name, probe=self._probe if probe is None else probe,
+                **self._user_pieces()),
                 slow_sample_step=self.slow_sample_step, transient_time=self.transient_time)
             return self._compiled
         return with_section(self._compiled, section, direction=direction, where=where)
@@ -362,6 +421,8 @@ class FilippovSystem:
         from .system import MODE_NAMES
 
         key = MODE_NAMES.get(mode)
+        if key == "sliding" and key not in self._jacobian_modes() and self.has_jacobians:
+            return self._sliding_jacobian(np.ascontiguousarray(z, dtype=float))
         if key not in self._jacobian_modes():
             raise ValueError(f"jacobian: no Jacobian of mode {mode!r} was given "
                              f"(have {sorted(self._jacobian_modes())})")
@@ -370,6 +431,35 @@ class FilippovSystem:
         if z.shape != (n,):
             raise ValueError(f"jacobian: expected one state of shape ({n},), got {z.shape}")
         return self._jacobian_value(key, z).reshape(n, n)
+
+    def _sliding_jacobian(self, z: np.ndarray) -> np.ndarray:
+        """dF_s/dz of Filippov's sliding field F_s = (a F_+ - b F_-)/(a - b), a = g.F_-,
+        b = g.F_+ (g = switch_grad), from the Jacobians of the two fields; the Hessian
+        of the switching function (it moves g) by central differences of switch_grad
+        (step eps^(1/3) times the state's size; exact for a planar switching surface)."""
+        n = len(self.names)
+        if z.shape != (n,):
+            raise ValueError(f"jacobian: expected one state of shape ({n},), got {z.shape}")
+        sysp = self.python()
+        Fm, Fp = (np.asarray(sysp.field_minus(z), float), np.asarray(sysp.field_plus(z), float))
+        g = np.asarray(sysp.switch_grad(z), dtype=float)
+        Jm, Jp = (self._jacobian_value(k, z).reshape(n, n) for k in ("minus", "plus"))
+        step = np.cbrt(np.finfo(float).eps) * max(1.0, float(np.abs(z).max()))
+        Hh = np.empty((n, n))   # Hh[:, k] = d g / d z_k
+        for k in range(n):
+            e = np.zeros(n)
+            e[k] = step
+            Hh[:, k] = (np.asarray(sysp.switch_grad(z + e), float)
+                        - np.asarray(sysp.switch_grad(z - e), float)) / (2 * step)
+        a, b = g @ Fm, g @ Fp
+        if not abs(a - b) > 0:
+            raise ValueError(f"jacobian: no Jacobian of mode 0 (sliding) at z={z.tolist()}: "
+                             f"Filippov's sliding field is not defined where dH.F_- = dH.F_+ "
+                             f"(= {a!r})")
+        da, db = Hh.T @ Fm + Jm.T @ g, Hh.T @ Fp + Jp.T @ g   # gradients of a and b
+        num = a * Fp - b * Fm
+        dnum = np.outer(Fp, da) + a * Jp - np.outer(Fm, db) - b * Jm
+        return dnum / (a - b) - np.outer(num, da - db) / (a - b) ** 2
 
     def python(self):
         """The reference driver's PiecewiseSystem (built once, then reused)."""

@@ -68,6 +68,7 @@ from .kernel.base import (BAD_START, EVENT_LIMIT, NO_RETURN, NO_SLIDING,  # noqa
                           STEP_LIMIT, ZENO)
 from .kernel.driver import (KERNEL_SOURCES, Outputs, Settings,  # noqa: F401
                             compile_kernel, kernel)
+from .checks import check_compiled
 from .poincare import Returns
 from .progress import Progress
 from .simulate import (EXACT_BLOCK, EventLimitError, SimulationError,
@@ -96,6 +97,8 @@ class BatchReturns:
     #: returned (0 if sliding there); ``start_age`` of the next return continues the
     #: orbit as an iterated run does, bit for bit
     age: np.ndarray = None
+    #: (m,): the mode at the return, or the one the run stopped in (MINUS, SLIDING, PLUS)
+    mode: np.ndarray = None
 
 
 def _section_pred(direction: int) -> int:
@@ -204,6 +207,8 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     """
     starts, ages = _checked_starts(cmodel, starts, start_age)
     pieces = _pieces(cmodel)
+    if starts.shape[0]:
+        check_compiled(cmodel, starts[0])  # the reference driver's start check, once a model
     _check_options(cmodel, t_max, samples_per_step, max_step, zeno_count, iterations, keep,
                    min_time)
     hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max) if cmodel.exact else np.inf
@@ -233,12 +238,59 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
                   orbit=np.full((m, keep, n), np.nan), returns_done=np.empty(m, dtype=np.int64),
                   jacobian=np.empty((m, n, n)),
                   orbit_jacobian=np.full((m, keep if jacobian else 0, n, n), np.nan),
-                  age=np.empty(m))
+                  age=np.empty(m), mode=np.empty(m, dtype=np.int64))
     params = np.ascontiguousarray(cmodel.params, dtype=float)
     # the build without the dP/dz code unless it is asked for (kernel.driver)
     kernel(derivatives=bool(jacobian))(*pieces, params, starts, ages, settings, out)
     return BatchReturns(**dict(out._asdict(), jacobian=out.jacobian if jacobian else None,
                                orbit_jacobian=out.orbit_jacobian if jacobian else None))
+
+
+class _Pieces:
+    """A compiled model's fields and gradient as functions of one state (what
+    :func:`filippov.checks.non_finite_piece` asks of a system)."""
+
+    def __init__(self, cmodel: CompiledModel):
+        self.cm = cmodel
+
+    def _vector(self, piece, z):
+        out = np.full(self.cm.dim, np.nan)
+        piece(np.ascontiguousarray(z, dtype=float), self.cm.params, out)
+        return out
+
+    def field_minus(self, z):
+        return self._vector(self.cm.field_minus, z)
+
+    def field_plus(self, z):
+        return self._vector(self.cm.field_plus, z)
+
+    def switch_grad(self, z):
+        return self._vector(self.cm.grad_h, z)
+
+
+def failure(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:
+    """Why start ``i`` of ``out`` did not return, in words: its status, where (t, state)
+    and in which mode; for a non-finite value the piece that gave it (checked by
+    evaluating the pieces at that state)."""
+    from .checks import non_finite_piece
+    from .system import MODE_NAMES
+
+    code, z = int(out.status[i]), out.state[i]
+    mode = int(out.mode[i]) if out.mode is not None else None
+    where = f"{STATUS[code]} at t={float(out.time[i])!r}, state {z.tolist()}"
+    if mode is not None:
+        where += f", mode {MODE_NAMES.get(mode, mode)}"
+    if code != NON_FINITE:
+        return where
+    from .system import MINUS, PLUS
+
+    if cmodel.exact and mode in (MINUS, PLUS):  # exact flows are sampled, not integrated
+        piece = "flow_plus" if mode == PLUS else "flow_minus"
+        return where + f" ({piece} returned a non-finite value from there)"
+    if not np.all(np.isfinite(z)):
+        return where + " (the state itself)"
+    return where + f" ({non_finite_piece(_Pieces(cmodel), mode, z)} returned a non-finite " \
+                   f"value there)"
 
 
 _ERRORS = {EVENT_LIMIT: EventLimitError, STEP_LIMIT: EventLimitError, ZENO: ZenoError,
@@ -265,9 +317,8 @@ def first_returns_compiled(cmodel: CompiledModel, starts, t_max: float, *,
         code = int(out.status[i])
         z0 = np.atleast_2d(np.asarray(starts, dtype=float))[i]
         msg = (f"start point {z0.tolist()} did not return to the section of "
-               f"{cmodel.name!r} within t_max={t_max!r}: {STATUS[code]} at t={out.time[i]!r}, "
-               f"state {out.state[i].tolist()} ({bad.size} of {out.status.size} start "
-               f"points failed)")
+               f"{cmodel.name!r} within t_max={t_max!r}: {failure(cmodel, out, i)} "
+               f"({bad.size} of {out.status.size} start points failed)")
         if code == NO_RETURN:
             raise RuntimeError(msg)
         raise _ERRORS.get(code, SimulationError)(msg)

@@ -133,8 +133,10 @@ def _dop_step(mode, t, y, f, h_abs, t_bound, max_step, rtol, atol, fns, p, wg, w
     """One accepted step of scipy's DOP853 (RungeKutta._step_impl).
 
     Returns (ok, t_new, h, h_abs_next); K holds the stages, ynew the new state,
-    K[_NS] the field there."""
+    K[_NS] the field there. On failure (the step size collapsed): (False, t, the last
+    step tried, h_abs), K holding that step's stages (see _non_finite_stage)."""
     n = y.size
+    h = 0.0
     min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
     if h_abs > max_step:
         h_abs = max_step
@@ -143,7 +145,7 @@ def _dop_step(mode, t, y, f, h_abs, t_bound, max_step, rtol, atol, fns, p, wg, w
     rejected = False
     while True:
         if not h_abs >= min_step:  # also stops a NaN step size
-            return False, t, 0.0, h_abs
+            return False, t, h, h_abs
         h = h_abs
         t_new = t + h
         if t_new - t_bound > 0.0:
@@ -191,6 +193,26 @@ def _dop_step(mode, t, y, f, h_abs, t_bound, max_step, rtol, atol, fns, p, wg, w
         q = _SAFETY * err ** _ERR_EXP
         h_abs *= q if q > _MIN_FACTOR else _MIN_FACTOR  # max(MIN_FACTOR, q), NaN -> MIN_FACTOR
         rejected = True
+
+
+@_jit
+def _non_finite_stage(y, h, K, out):
+    """After a failed step from y over h (stages in K): True if a stage met a non-finite
+    field value (_checked_field put 1e300 in its row), with that stage's state in out."""
+    n = y.size
+    for s in range(1, _NS + 1):
+        hit = True
+        for k in range(n):
+            if K[s, k] != 1e300:
+                hit = False
+        if hit:
+            for k in range(n):
+                acc = 0.0
+                for j in range(s):
+                    acc += K[j, k] * (_B[j] if s == _NS else _A[s, j])
+                out[k] = y[k] + acc * h
+            return True
+    return False
 
 
 @_jit

@@ -26,7 +26,7 @@ from .base import (BAD_START, EVENT_LIMIT, NON_FINITE, NO_RETURN, NO_SLIDING, OK
                    _slides_in_section, _speeds, _start_on_switch, _start_side, _vec, _h,
                    _section)
 from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
-                     _dop_step)
+                     _dop_step, _non_finite_stage)
 from .segment import _zat
 from .scan import (_find, _sample)
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
@@ -90,10 +90,12 @@ Settings = namedtuple("Settings", [
 
 #: what a batch returns, per start (m) -- fastmap.BatchReturns' fields: state (m, n), time,
 #: n_switches, sliding_time, status, first_switch, sliding_displacement (m, n), orbit
-#: (m, keep, n), returns_done, jacobian (m, n, n), orbit_jacobian (m, keep or 0, n, n), age
+#: (m, keep, n), returns_done, jacobian (m, n, n), orbit_jacobian (m, keep or 0, n, n), age,
+#: mode (the mode at the return, or the one the run stopped in)
 Outputs = namedtuple("Outputs", [
     "state", "time", "n_switches", "sliding_time", "status", "first_switch",
-    "sliding_displacement", "orbit", "returns_done", "jacobian", "orbit_jacobian", "age"])
+    "sliding_displacement", "orbit", "returns_done", "jacobian", "orbit_jacobian", "age",
+    "mode"])
 
 #: the kernel's named work arrays, allocated once per batch by _batch. count: switches,
 #: steps, entries in the Zeno ring; tally: time slid, start of the current slide, time
@@ -188,8 +190,9 @@ def _stay_integrated(mode, t, fns, p, s, w):
         ok, tb, hstep, h_abs = _dop_step(mode, ta, w.y, w.f, h_abs, s.t_max, s.max_step, s.rtol,
                                          s.atol, fns, p, w.wg, w.wf, w.wp, w.K, w.ynew, w.ytmp,
                                          w.scale)
-        if not ok:
-            return STEP_FAILED, ta, _W_NONE
+        if not ok:  # a non-finite field collapses the step too: say which
+            return (NON_FINITE if _non_finite_stage(w.y, hstep, w.K, w.z) else STEP_FAILED,
+                    ta, _W_NONE)
         for k in range(n):
             w.y_old[k] = w.y[k]
             w.f_old[k] = w.f[k]
@@ -276,7 +279,7 @@ def _event(mode, t, what, fns, p, s, w):
 @_jit
 def _one(z0, age0, fns, p, s, w):
     """First return of z0 (the state at the return, or where the run stopped, in w.z);
-    (status, t, n_switches, sliding_time). w.first_sw[0]: time of the first change of
+    (status, t, n_switches, sliding_time, mode at the return or where the run stopped). w.first_sw[0]: time of the first change of
     mode (left untouched if there is none); w.slide_dz: the change of state summed
     over the sliding stretches (counted like sliding_time); age0: the time already spent
     in the start's region (rules.carried_age), w.tally[2] the same at the return."""
@@ -286,10 +289,10 @@ def _one(z0, age0, fns, p, s, w):
     for k in range(n):
         w.z[k] = z0[k]
         if not np.isfinite(z0[k]):
-            return BAD_START, 0.0, 0, 0.0
+            return BAD_START, 0.0, 0, 0.0, 0
     mode = _initial_mode(w.z, fns, p, s.touch_tol, s.sliding, w.wg, w.wf, w.wp)
     if mode == SLIDING and _slides_in(w.z, fns, p, w.wg, w.wf, w.wp, w.wz):
-        return SECTION_SLIDING, 0.0, 0, 0.0
+        return SECTION_SLIDING, 0.0, 0, 0.0, mode
     w.touched[0] = False
     if _DERIVATIVES and s.jac:
         # a start that slides: the return is not differentiable across H there
@@ -307,17 +310,17 @@ def _one(z0, age0, fns, p, s, w):
     t = 0.0
     while True:
         if t >= s.t_max:
-            return NO_RETURN, t, w.count[0], w.tally[0]
+            return NO_RETURN, t, w.count[0], w.tally[0], mode
         if mode == SLIDING and not s.sliding:
-            return NO_SLIDING, t, w.count[0], w.tally[0]
+            return NO_SLIDING, t, w.count[0], w.tally[0], mode
         if mode != SLIDING and s.exact:
             st, t, what = _stay_exact(mode, t, fns, p, s, w)
         else:
             st, t, what = _stay_integrated(mode, t, fns, p, s, w)
         if st == OK:
             st, mode = _event(mode, t, what, fns, p, s, w)
-        if st != _GO_ON:
-            return st, t, w.count[0], w.tally[0]
+        if st != _GO_ON:  # _event hands back the mode it was asked about unless it goes on
+            return st, t, w.count[0], w.tally[0], mode
 
 
 _f8, _i8, _b1 = types.float64, types.int64, types.boolean
@@ -330,7 +333,8 @@ _KERNEL_SIG = types.void(
                       _f8, _f8, _i8, _i8, _i8, _i8, _i8], Settings),
     types.NamedTuple([types.float64[:, ::1], _vec, types.int64[::1], _vec, types.int64[::1],
                       _vec, types.float64[:, ::1], types.float64[:, :, ::1], types.int64[::1],
-                      types.float64[:, :, ::1], types.float64[:, :, :, ::1], _vec], Outputs))
+                      types.float64[:, :, ::1], types.float64[:, :, :, ::1], _vec,
+                      types.int64[::1]], Outputs))
 
 
 @njit(cache=True)
@@ -372,7 +376,7 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
         age = ages[i]
         while True:
             first[0] = np.nan
-            st, t, nsw, sl = _one(zin, age, fns, p, s, w)
+            st, t, nsw, sl, mode = _one(zin, age, fns, p, s, w)
             if st != OK:
                 break
             done += 1
@@ -403,6 +407,7 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
         out.time[i] = t
         out.n_switches[i] = nsw
         out.sliding_time[i] = sl
+        out.mode[i] = mode
 
 
 #: the files whose code the kernel contains: every module of this package and the

@@ -1,0 +1,200 @@
+"""No silent wrong answer on a user's own system, on either engine (issue 28's defects).
+
+A 3-D stick-slip oscillator with negative damping and a slave variable,
+
+    x' = u,  u' = -x - 2 zeta u -/+ 1  (u below / above the belt speed V),  w' = -k w + x,
+
+has a stable periodic orbit that slides on u = V. Sliding collapses the (x, u) plane to a
+point (the sliding exit), so the return map's derivative has the multiplier 0 there, and
+w is driven but never feeds back: its multiplier is exactly exp(-k T), T the period
+(the monodromy is block triangular; the saltation at u = V has no w component). Its
+multipliers are therefore [1, exp(-k T), 0] in closed form. With k = 1 the genuine one is
+1.6e-3, next to the two zeros of dP/dz (flow direction and sliding collapse): picking the
+flow's eigenvalue by its eigenvector reported [1, ~1e-10, 0] here.
+
+The other tests are each a broken system that an engine ran without a word, or
+refused with the wrong words: a field with too few values, a switching gradient of the
+wrong sign, a NaN from a field, Jacobians given for the two fields only, a piece numba
+cannot compile.
+"""
+import numpy as np
+import pytest
+from numba import njit
+
+from filippov import (FilippovSystem, PeriodicOrbitError, SimulationError,
+                      SystemContractError, periodic_orbit, simulate)
+from filippov.fastmap import NON_FINITE, compute_returns, first_returns_compiled
+from filippov.system import MINUS
+
+ZETA, V, K = -0.05, 0.5, 1.0
+ENGINES = ("compiled", "python")
+A = np.array([[0.0, 1.0, 0.0], [-1.0, -2 * ZETA, 0.0], [1.0, 0.0, -K]])
+
+
+def _field(friction):
+    return lambda z, p: np.array([z[1], -z[0] - 2 * p[0] * z[1] + friction,
+                                  -p[2] * z[2] + z[0]])
+
+
+def _affine_flow(friction):
+    """The exact flow of z' = A z + b, b = (0, friction, 0): e^{A t}(z0 - c) + c with the
+    equilibrium c = -A^{-1} b, e^{A t} from the eigendecomposition of A (distinct
+    eigenvalues -zeta +- i omega and -k), computed here, outside the library."""
+    b = np.array([0.0, friction, 0.0])
+    c = -np.linalg.solve(A, b)
+    lam, vec = np.linalg.eig(A.astype(complex))
+    inv = np.linalg.inv(vec)
+
+    @njit
+    def flow(z0, tau, p):
+        y = np.empty(3, dtype=np.complex128)
+        for i in range(3):
+            acc = 0j
+            for j in range(3):
+                acc += inv[i, j] * (z0[j] - c[j])
+            y[i] = np.exp(lam[i] * tau) * acc
+        out = np.empty(3)
+        for i in range(3):
+            acc = 0j
+            for j in range(3):
+                acc += vec[i, j] * y[j]
+            out[i] = acc.real + c[i]
+        return out
+    return flow
+
+
+def stick_slip(exact=False, **kw):
+    args = dict(params=(ZETA, V, K), **kw)
+    if exact:
+        args.update(flow_minus=_affine_flow(1.0), flow_plus=_affine_flow(-1.0),
+                    sample_step=0.1)
+    return FilippovSystem(("x", "u", "w"), _field(1.0), _field(-1.0),
+                          lambda z, p: z[1] - p[1], lambda z, p: np.array([0.0, 1.0, 0.0]),
+                          **args)
+
+
+def _section(z, p):
+    return z[0] - 1.0   # the centre of the slip spiral, crossed with u < 0 (no sliding)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("exact", [False, True], ids=["integrated", "exact"])
+def test_multipliers_of_an_orbit_that_slides(engine, exact):
+    orbit = periodic_orbit(stick_slip(exact), [1.0, -0.5, 1.0], _section, direction=-1,
+                           engine=engine, t_max=50.0)
+    truth = np.exp(-K * orbit.period)
+    assert 1e-3 < truth < 3e-3   # the case that was confused with the zeros
+    assert orbit.multipliers[0] == 1.0
+    # the genuine multiplier: relative 1e-6, far above the engines' error in dP/dz
+    # (rtol 1e-12 steps, 1e-10 on the reference driver's variational equations) and far
+    # below the 1e-10 / 1.6e-3 the old choice put in its place
+    assert orbit.multipliers[1] == pytest.approx(truth, rel=1e-6)
+    # the sliding collapse: 0 up to the derivative's error (|dP/dz| ~ 1)
+    assert abs(orbit.multipliers[2]) < 1e-8
+
+
+def test_the_multipliers_do_not_depend_on_the_chart():
+    # the same fixed point and dP/dz seen through another section normal and with no
+    # normal at all (complement of the flow): the eigenvalues of P on the section
+    from filippov.periodic import _field_at, floquet_from_return
+
+    system = stick_slip()
+    orbit = periodic_orbit(system, [1.0, -0.5, 1.0], _section, direction=-1,
+                           engine="compiled", t_max=50.0)
+    f = _field_at(system.python(), orbit.point)
+    for normal in ([1.0, 0.0, 0.0], [1.0, 0.3, -0.2], None):
+        mult = floquet_from_return(orbit.jacobian, f, normal=normal)
+        np.testing.assert_allclose(mult, orbit.multipliers, rtol=1e-6, atol=1e-8)
+    with pytest.raises(PeriodicOrbitError, match="tangent to the section"):
+        floquet_from_return(orbit.jacobian, f, normal=[0.0, -f[2], f[1]])
+
+
+def test_a_field_with_too_few_values_is_refused_by_the_reference_engine():
+    system = FilippovSystem(("x", "u", "w"), lambda z, p: np.array([z[1], -z[0]]),
+                            _field(-1.0), lambda z, p: z[1] - p[1],
+                            lambda z, p: np.array([0.0, 1.0, 0.0]), params=(ZETA, V, K))
+    with pytest.raises(SystemContractError, match="field_minus.*wrong number of values"):
+        system.python()
+    with pytest.raises(SystemContractError, match="field_minus"):
+        system.compiled(_section)
+
+
+def test_a_flow_with_too_few_values_is_refused_by_the_reference_engine():
+    system = stick_slip(exact=True)
+    system._pieces["flow_plus"] = lambda z0, tau, p: np.array([z0[0], z0[1]])
+    with pytest.raises(SystemContractError, match="flow_plus.*wrong number of values"):
+        system.python()
+
+
+def _wrong_gradient():
+    return FilippovSystem(("x", "u", "w"), _field(1.0), _field(-1.0), lambda z, p: z[1] - p[1],
+                          lambda z, p: np.array([0.0, -1.0, 0.0]), params=(ZETA, V, K))
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_switching_gradient_of_the_wrong_sign_is_refused(engine):
+    system = _wrong_gradient()
+    with pytest.raises(SystemContractError, match="switch_grad does not match"):
+        periodic_orbit(system, [1.0, -0.5, 1.0], _section, direction=-1, engine=engine,
+                       t_max=50.0)
+
+
+def test_the_compiled_engine_checks_the_gradient_at_the_start():
+    cm = _wrong_gradient().compiled(_section)
+    with pytest.raises(SystemContractError, match="switch_grad does not match"):
+        compute_returns(cm, [[1.0, -0.5, 1.0]], 50.0)
+
+
+def _nan_beyond_two(z, p):
+    return np.array([1.0, np.sqrt(2.0 - z[0]), -z[2]])   # NaN for x > 2
+
+
+def _runs_into_nan():
+    return FilippovSystem(("x", "y", "w"), _nan_beyond_two,
+                          lambda z, p: np.array([1.0, 1.0, -z[2]]),
+                          lambda z, p: z[1] - 10.0, lambda z, p: np.array([0.0, 1.0, 0.0]))
+
+
+def test_a_nan_from_a_field_is_named_by_the_compiled_engine():
+    system = _runs_into_nan()
+    cm = system.compiled(lambda z, p: z[0] - 5.0)
+    out = compute_returns(cm, [[0.0, 0.0, 1.0]], 10.0)
+    assert out.status[0] == NON_FINITE and out.mode[0] == MINUS
+    assert out.time[0] == pytest.approx(2.0, abs=1e-12)   # where the root's domain ends
+    assert out.state[0][0] > 2.0   # the stage state where the field is NaN
+    with pytest.raises(SimulationError, match=r"non-finite .* t=1\.99.*mode minus "
+                                              r"\(field_minus returned a non-finite"):
+        first_returns_compiled(cm, [[0.0, 0.0, 1.0]], 10.0)
+    # and the reference driver, in its words
+    with pytest.raises(SimulationError, match="field_minus returned a non-finite value"):
+        simulate(system.python(), [0.0, 0.0, 1.0], 10.0,
+                 sections=[system.python_section(lambda z, p: z[0] - 5.0)])
+
+
+def test_a_nan_from_a_field_on_the_way_to_a_periodic_orbit_is_named():
+    system = _runs_into_nan()
+    with pytest.raises(PeriodicOrbitError, match="field_minus returned a non-finite"):
+        periodic_orbit(system, [0.0, 0.0, 1.0], lambda z, p: z[0] - 5.0, engine="compiled",
+                       t_max=10.0)
+
+
+def test_jacobians_of_the_two_fields_give_the_sliding_one():
+    jac = lambda z, p: np.array([[0.0, 1.0, 0.0], [-1.0, -2 * p[0], 0.0], [1.0, 0.0, -p[2]]])
+    system = stick_slip(jacobians={"minus": jac, "plus": jac})
+    z = np.array([0.2, V, 0.3])
+    # the sliding field here is (u, 0, -k w + x): its Jacobian in closed form
+    want = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, -K]])
+    np.testing.assert_allclose(system.jacobian(0, z), want, rtol=0, atol=1e-12)
+    orbit = periodic_orbit(system, [1.0, -0.5, 1.0], _section, direction=-1, engine="python",
+                           t_max=50.0)
+    assert orbit.multipliers[1] == pytest.approx(np.exp(-K * orbit.period), rel=1e-6)
+
+
+def test_a_piece_numba_cannot_compile_is_explained_on_both_engines():
+    system = FilippovSystem(("x", "u", "w"), lambda z, p: np.array([z[0], "a"]), _field(-1.0),
+                            lambda z, p: z[1] - p[1], lambda z, p: np.array([0.0, 1.0, 0.0]),
+                            params=(ZETA, V, K))
+    with pytest.raises(ValueError, match="field_minus: numba cannot compile it"):
+        system.python()
+    with pytest.raises(ValueError, match="field_minus: numba cannot compile it"):
+        system.compiled(_section)
