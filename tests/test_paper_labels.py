@@ -149,3 +149,22 @@ def test_derive_a_snippet(tmp_path):
         "fig:left": "Fig.~1(a)", "fig:one": "Fig.~1", "thm:one": "Lemma~1",
         "eq:inlemma": "Eq.~(3)", "sec:sub": "Sec.~1.1", "it:first": "Item~(1)",
         "sec:app": "Appendix~A", "sec:appsub": "Appendix~A.1"}
+
+
+def test_no_reference_word_is_printed_twice():
+    # \pref{label} prints the paper's word with its number ("Lemma~3", "Fig.~4"): the
+    # word must not stand before it again in our text ("Lemma Lemma 3")
+    import re
+
+    printed = dict(re.findall(r"\\pnumdef\{([^}]*)\}\{([^}]*)\}", COMMITTED.read_text()))
+    sources = sorted((ROOT / "paper").glob("sec_*.tex")) + [ROOT / "paper" / "main.tex"]
+    sources += sorted((ROOT / "src" / "filippov").rglob("*.py"))
+    doubled = []
+    for path in sources:
+        text = path.read_text()
+        for m in re.finditer(r"([A-Za-z.]+)[~\s]*\\\\?pref\{([^}]*)\}", text):
+            word, label = m.group(1), m.group(2)
+            first = printed.get(label, "").split("~")[0]
+            if first and word.rstrip(".").lower() == first.rstrip(".").lower():
+                doubled.append(f"{path.name}: {m.group(0)}")
+    assert not doubled, doubled
