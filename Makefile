@@ -2,12 +2,16 @@
 #
 #   make figures   build every figure (and the report) with Snakemake
 #   make test      run the test suite
+#   make test-deep the property-based tests (tests/test_properties.py) with the
+#                  hypothesis profile "deep": many more generated systems, randomized
 #   make verify    two clean builds in a temporary directory: byte-identical,
 #                  and in agreement with tests/reference/manifest.json
 #   make manifest  rewrite the manifest from results/ and figures/ (prints changes)
 #   make cross-cpu emulate another CPU's last bits (libm, numpy SIMD, numba) and check
-#                  every scene against the manifest; CROSS_CPU_ARGS="--record" stores
-#                  the measured spread next to each tolerance
+#                  every scene against the manifest: results moved by up to 2 ulps
+#                  (CROSS_CPU_ARGS="--ulps N"), three seeds and one build where every
+#                  result moves; CROSS_CPU_ARGS="--record" stores the measured spread
+#                  next to each tolerance, "--scenes ID ..." checks only some datasets
 #   make report    the reproduction report paper/main.pdf (needs TeX)
 #   make report-html  snakemake's HTML report (report.html): figures captioned with the
 #                  paper's number, description and parameters; datasets, scene files
@@ -46,7 +50,7 @@ export DEBIAN_FRONTEND = noninteractive
 # `python` inside Snakemake shell rules is the venv's interpreter.
 VENV_PATH = PATH="$(abspath $(VENV))/bin:$$PATH" VIRTUAL_ENV="$(abspath $(VENV))"
 
-.PHONY: all help archive venv figures test verify cross-cpu manifest report report-html bench bench-fig04 lock clean distclean check-python
+.PHONY: all help archive venv figures test test-deep verify cross-cpu manifest report report-html bench bench-fig04 lock clean distclean check-python
 
 all: figures
 
@@ -102,6 +106,10 @@ test: $(VENV)/.done
 	  echo "warning: pytest collected no tests (exit 5); accepted because ALLOW_NO_TESTS is set" >&2; rc=0; \
 	fi; \
 	exit $$rc
+
+# the property suite with many more examples (HYPOTHESIS_PROFILE: tests/conftest.py)
+test-deep: $(VENV)/.done
+	HYPOTHESIS_PROFILE=deep $(VENV_PATH) $(PY) -m pytest tests/test_properties.py $(PYTEST_ARGS)
 
 verify: $(VENV)/.done
 	$(VENV_PATH) $(PY) workflow/scripts/verify.py

@@ -14,6 +14,21 @@ if str(SRC) not in sys.path:
     sys.path.insert(0, str(SRC))
 
 
+# hypothesis profiles (tests/test_properties.py): "ci", the default, is derandomized (the
+# same examples on every run and machine) and small enough for `make test`; "deep"
+# (HYPOTHESIS_PROFILE=deep, `make test-deep`) draws many more, at random.
+import os  # noqa: E402
+
+from hypothesis import HealthCheck, settings  # noqa: E402
+
+settings.register_profile("ci", derandomize=True, max_examples=12, deadline=None,
+                          print_blob=True,
+                          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+settings.register_profile("deep", max_examples=400, deadline=None, print_blob=True,
+                          suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+
+
 # one definition of "a fresh copy of the project" and "run snakemake there",
 # shared with `make verify`
 sys.path.insert(0, str(ROOT / "workflow" / "scripts"))

@@ -79,3 +79,20 @@ def test_no_convergence_and_bad_guesses_are_errors():
     with pytest.raises(ValueError, match="engine"):
         periodic_orbit(_relay(), [0.0, 0.1, 0.0], lambda z, p: z[0], t_max=20.0,
                        engine="fortran")
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_an_orbit_counted_twice_has_the_squared_multipliers(engine):
+    # returns=2: the same orbit as a fixed point of P^2 -- twice the period, d(P^2)/dz, and
+    # the multipliers squared (the flow's 1 stays 1)
+    want = _example("relay_feedback").closed_form()
+    once = periodic_orbit(_relay(), [0.0, 0.1, 0.0], lambda z, p: z[0], direction=+1,
+                          engine=engine, t_max=20.0)
+    twice = periodic_orbit(_relay(), once.point, lambda z, p: z[0], direction=+1,
+                           returns=2, engine=engine, t_max=20.0)
+    assert twice.period == pytest.approx(2 * want["period"], rel=1e-12)
+    np.testing.assert_allclose(twice.point, once.point, rtol=0, atol=1e-10)
+    np.testing.assert_allclose(twice.multipliers, np.asarray(want["multipliers"]) ** 2,
+                               rtol=0, atol=1e-9)
+    with pytest.raises(ValueError, match="returns must be an integer >= 1"):
+        periodic_orbit(_relay(), once.point, lambda z, p: z[0], returns=0, t_max=20.0)

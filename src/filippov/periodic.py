@@ -36,36 +36,50 @@ class PeriodicOrbit:
     residual: float            # max |P(z) - z| at the point
 
 
-def _returns(system, section, direction: int, engine: str, t_max: float, options: dict):
-    """(z -> (P(z), return time, dP/dz), z -> section value) on the chosen engine."""
+def _returns(system, section, direction: int, where, engine: str, t_max: float, returns: int,
+             options: dict):
+    """(z -> (P^returns(z), its time, its dP/dz), z -> section value) on the chosen engine:
+    ``returns`` single returns, each from the last one's state (the compiled engine
+    carries the time spent in the region across a hit, as an iterated run does), their
+    derivatives multiplied."""
     if engine == "compiled":
         from .fastmap import OK, compute_returns, failure
 
-        cm = system.compiled(section, direction=direction)
+        cm = system.compiled(section, direction=direction, where=where)
 
-        def one(z):
-            out = compute_returns(cm, [z], t_max, jacobian=True, **options)
+        def single(z, age):
+            out = compute_returns(cm, [z], t_max, jacobian=True, start_age=age, **options)
             if out.status[0] != OK:
                 raise PeriodicOrbitError(f"no return from {np.asarray(z).tolist()}: "
                                          f"{failure(cm, out, 0)}")
-            return out.state[0], float(out.time[0]), out.jacobian[0]
-        return one, lambda z: float(cm.section(np.ascontiguousarray(z, dtype=float), cm.params))
+            return out.state[0], float(out.time[0]), out.jacobian[0], float(out.age[0])
+        value = lambda z: float(cm.section(np.ascontiguousarray(z, dtype=float), cm.params))  # noqa: E731
+    else:
+        from .simulate import simulate
+        from .variational import return_jacobian
 
-    from .simulate import simulate
-    from .variational import return_jacobian
+        python = system.python()
+        sec = system.python_section(section, direction=direction, where=where)
+        # exact field Jacobians where the system has them (filippov.symbolic), else differences
+        jac = system.jacobian if getattr(system, "has_jacobians", False) else None
 
-    python, sec = system.python(), system.python_section(section, direction=direction)
-    # exact field Jacobians where the system has them (filippov.symbolic), else differences
-    jac = system.jacobian if getattr(system, "has_jacobians", False) else None
+        def single(z, age):
+            traj = simulate(python, z, t_max, sections=[sec], dense=False, **options)
+            if traj.status != f"section:{sec.name}":
+                raise PeriodicOrbitError(f"no return from {np.asarray(z).tolist()} within "
+                                         f"t_max={t_max!r} (status {traj.status})")
+            J = return_jacobian(python, traj, sec, jacobian=jac)
+            return np.asarray(traj.z, dtype=float), float(traj.t - traj.t0), J, 0.0
+        value = lambda z: float(np.asarray(sec.func(z)).reshape(()))  # noqa: E731
 
     def one(z):
-        traj = simulate(python, z, t_max, sections=[sec], dense=False, **options)
-        if traj.status != f"section:{sec.name}":
-            raise PeriodicOrbitError(f"no return from {np.asarray(z).tolist()} within "
-                                     f"t_max={t_max!r} (status {traj.status})")
-        J = return_jacobian(python, traj, sec, jacobian=jac)
-        return np.asarray(traj.z, dtype=float), float(traj.t - traj.t0), J
-    return one, lambda z: float(np.asarray(sec.func(z)).reshape(()))
+        total, D, age = 0.0, np.eye(z.size), 0.0
+        for _ in range(returns):
+            z, t, J, age = single(z, age)
+            total += t
+            D = J @ D
+        return z, total, D
+    return one, value
 
 
 def _section_normal(value, z: np.ndarray) -> np.ndarray:
@@ -80,11 +94,26 @@ def _section_normal(value, z: np.ndarray) -> np.ndarray:
     return g
 
 
-def _field_at(python, z: np.ndarray) -> np.ndarray:
-    """The field of the region z lies in (region + where the switching function >= 0)."""
-    from .system import MINUS, PLUS
+def _onto_section(value, z: np.ndarray) -> np.ndarray:
+    """z moved along the section's gradient onto it (one Newton step on the section
+    function: exact for a planar section, O(offset^2) off for a curved one)."""
+    s = value(z)
+    if s == 0.0 or not np.isfinite(s):
+        return z
+    g = _section_normal(value, z)
+    gg = float(g @ g)
+    return z - (s / gg) * g if gg > 0 else z
 
-    mode = PLUS if float(python.switch(z)) >= 0 else MINUS
+
+def _field_at(python, z: np.ndarray, touch_tol: float = 1e-15) -> np.ndarray:
+    """The field the orbit from z starts with: that of its region, and on H (|h| <=
+    touch_tol, e.g. a section on the switching surface) the one both engines start
+    with, decided by the normal speeds (simulate.initial_mode) -- not by the sign of a
+    rounded h: a fixed point at h = -1e-17 starts in region + like one at h = 0, and dP/dz
+    annihilates F_+ there, not F_-."""
+    from .simulate import initial_mode
+
+    mode, _ = initial_mode(python, np.asarray(z, dtype=float), touch_tol)
     return np.asarray(python.field(mode, z), dtype=float)
 
 
@@ -148,10 +177,28 @@ def floquet_from_return(J: np.ndarray, f: np.ndarray, *, normal=None,
     return out.real if np.all(np.abs(out.imag) <= 1e-12 * np.maximum(1.0, np.abs(out))) else out
 
 
-def periodic_orbit(system, guess, section, *, direction: int = 0, engine: str = "compiled",
-                   t_max: float, tol: float = 1e-12, max_iter: int = 20,
-                   **options) -> PeriodicOrbit:
-    """The periodic orbit through ``section`` near ``guess``, by Newton on P(z) - z.
+#: a "return" whose path (return time times the speed |f| at z) is shorter than this,
+#: relative to the state's size, is the start itself: z lies on the section up to the
+#: rounding of the flow and the section, and a sign change of that rounding was taken
+#: for a crossing. A genuine orbit travels a length the sampling resolves.
+SHORTEST_PATH = 1e-9
+
+
+def _refuse_the_start_itself(z, period, f) -> None:
+    path = period * float(np.abs(f).max())
+    if not path > SHORTEST_PATH * (1.0 + float(np.abs(z).max())):
+        raise PeriodicOrbitError(
+            f"the return from {z.tolist()} came back after t = {period:.3g} (a path of "
+            f"length {path:.3g}): the start itself, a hair before the section by the "
+            "rounding of the flow or the section, not a periodic orbit. Start Newton from "
+            "a guess off the section, or make the exact flow's rounding smaller")
+
+
+def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
+                   returns: int = 1, engine: str = "compiled", t_max: float,
+                   tol: float = 1e-12, max_iter: int = 20, **options) -> PeriodicOrbit:
+    """The periodic orbit through ``section`` near ``guess``, by Newton on P^n(z) - z
+    (n = ``returns``, the times the orbit meets the section in one period).
 
     Parameters
     ----------
@@ -163,6 +210,12 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, engine: str = 
         ``s(z, p) -> float``: the section ``s = 0`` (the caller's, not the system's).
     direction : int
         -1 decreasing crossings of ``s`` only, +1 increasing, 0 both.
+    where : callable, optional
+        ``w(z, p) -> bool`` that must hold at a hit (a SymPy condition with a SymPy
+        section of a symbolic system).
+    returns : int
+        n: the orbit's period is n returns to the section (its point is a fixed point
+        of P^n; ``period`` is the time of all n, ``jacobian`` d(P^n)/dz).
     engine : {"compiled", "python"}
         The compiled engine (numba, dP/dz carried along the return) or the reference
         driver (dP/dz from the variational equations afterwards).
@@ -183,8 +236,10 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, engine: str = 
     Raises
     ------
     PeriodicOrbitError
-        No convergence within ``max_iter``, a failed return, or a derivative that does
-        not annihilate the flow direction at the fixed point.
+        No convergence within ``max_iter``, a failed return, a derivative that does
+        not annihilate the flow direction at the fixed point, or a "fixed point" whose
+        return is the start itself (a path shorter than ``SHORTEST_PATH`` of the state's
+        size: the start a hair before the section by rounding).
     """
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
@@ -192,12 +247,16 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, engine: str = 
     if z.size != len(system.names) or not np.all(np.isfinite(z)):
         raise ValueError(f"guess: expected {len(system.names)} finite values "
                          f"({', '.join(system.names)}), got {np.asarray(guess).tolist()}")
-    ret, section_value = _returns(system, section, direction, engine, t_max, options)
+    if not (isinstance(returns, (int, np.integer)) and returns >= 1):
+        raise ValueError(f"returns must be an integer >= 1, got {returns!r}")
+    ret, section_value = _returns(system, section, direction, where, engine, t_max,
+                                  int(returns), options)
     for it in range(1, max_iter + 1):
         Pz, period, J = ret(z)
         residual = float(np.abs(Pz - z).max())
         if residual <= tol * (1.0 + np.abs(z).max()):
-            f = _field_at(system.python(), z)
+            f = _field_at(system.python(), z, options.get("touch_tol", 1e-15))
+            _refuse_the_start_itself(z, period, f)
             mult = floquet_from_return(J, f, normal=_section_normal(section_value, z))
             return PeriodicOrbit(z, period, mult, J, it - 1, residual)
         A = J - np.eye(z.size)
@@ -206,5 +265,10 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, engine: str = 
         except np.linalg.LinAlgError:
             raise PeriodicOrbitError(f"dP/dz - I is singular at {z.tolist()}: a multiplier "
                                      "1 besides the flow's (a bifurcation)") from None
+        # the fixed point lies on the section, and so does the next iterate up to the
+        # error of dP/dz times the step (1e-10 x 1e-3 from variational equations at rtol
+        # 1e-10): back onto it, or an iterate a hair before the section "returns" at once
+        # and Newton converges to that (tests/test_properties.py)
+        z = _onto_section(section_value, z)
     raise PeriodicOrbitError(f"Newton did not converge in {max_iter} steps (last residual "
                              f"{residual:.3g} at {z.tolist()})")

@@ -1,0 +1,240 @@
+"""Property-based tests: generated Filippov systems against closed forms, on both engines.
+
+Hypothesis generates piecewise-affine systems in 2-4 dimensions (tests/generated_systems.py:
+real and rotation-scaling spectra, planar and curved switching surfaces) and the tests
+ask each engine -- the compiled one (``compute_returns``, ``jacobian=True``) and the
+reference driver (``simulate`` + ``return_jacobian``), each with the regions' exact flows
+and with every mode integrated (DOP853) -- for switch times, sliding entry and exit, the
+return P to a section, dP/dz, and relay feedback orbits with their Floquet multipliers
+(``periodic_orbit``). The answers are computed independently: scipy.linalg.expm of the
+generated matrices and brentq on h along the closed-form flows, never the library.
+
+Cases near a tangency are filtered out by the generators (``assume``: |dh/dt| >= RATE
+= 0.2 along every stay that ends at a crossing, normal speeds >= 0.2 away from the ends
+of sliding regions, exits through a visible fold at rate >= 0.2): there the answer is
+ill-conditioned (an error dh of h moves an event by dh/|dh/dt|) and no tolerance would
+be stated honestly. What remains must be answered, to the tolerances below.
+
+Profiles (tests/conftest.py): ``ci`` (default) is derandomized with a modest number of
+examples; ``HYPOTHESIS_PROFILE=deep`` (``make test-deep``) runs many more, randomized.
+Every failure found is kept below as an explicit ``@example``/regression test.
+"""
+import numpy as np
+import pytest
+from hypothesis import example, given
+
+import generated_systems as gs
+from filippov import return_jacobian, simulate
+from filippov.poincare import sliding_time
+
+ENGINES = ("compiled", "python")
+FLOWS = ("exact", "integrate")
+
+# Tolerances (absolute, on O(1) states and times: the generators keep |z| <~ 3, t <~ 16).
+# Events are refined to xtol 1e-15 and integrated stays run at rtol 1e-12, atol 1e-14;
+# every crossing the generators keep has |dh/dt| >= 0.2, so an error dh of h moves a switch
+# by at most 5 dh, and the states after it by |f| times that. Exact flows: rounding of the
+# closed forms (a few 1e-15 relative, amplified by e^{|re| t} <= e^{1.2 * 16} at worst
+# growth only along short stays in practice) -> 1e-10. Integrated: DOP853's global error
+# at rtol 1e-12 over t <= 16 with the same growth -> 1e-9.
+TOL = {"exact": 1e-10, "integrate": 1e-9}
+# dP/dz: the compiled engine differentiates closed-form flows by central differences
+# (truncation and rounding ~ eps^(2/3) ~ 4e-11 relative each) and integrated stays by
+# the variational equation at rtol 1e-12; the reference driver integrates the
+# variational equations at rtol 1e-10 (return_jacobian's default). dP/dz is a product of
+# factors (flows' transition matrices, saltation matrices, the projection onto the
+# section) and each one's relative error is carried by the others: the tolerance is
+# relative to max(1, product of the factors' norms) (a slide collapses directions, so
+# |dP/dz| itself can be ~1e-12 while its factors are ~1e2).
+TOL_JAC = 1e-7
+
+
+def _return(case_n, engine, flows, z0):
+    """The first return of z0 to the section h = sigma crossed upwards, on one engine:
+    {P, time, first_switch, n_switches, sliding_time, dP} (dP None if not asked)."""
+    fs = gs.system(case_n, flows == "exact")
+    if engine == "compiled":
+        from filippov.fastmap import OK, compute_returns, failure
+
+        cm = fs.compiled(gs.section, direction=+1)
+        out = compute_returns(cm, [z0], gs.T_MAX, jacobian=True)
+        assert out.status[0] == OK, failure(cm, out, 0)
+        return dict(P=out.state[0], time=float(out.time[0]),
+                    first_switch=float(out.first_switch[0]), n_switches=int(out.n_switches[0]),
+                    sliding_time=float(out.sliding_time[0]), dP=out.jacobian[0])
+    python, sec = fs.python(), fs.python_section(gs.section, direction=+1)
+    traj = simulate(python, z0, gs.T_MAX, sections=[sec], dense=False, method=flows)
+    assert traj.status == f"section:{sec.name}", traj.status
+    sw = traj.switches()
+    return dict(P=np.asarray(traj.z), time=traj.t - traj.t0,
+                first_switch=sw[0].t - traj.t0 if sw else np.nan, n_switches=len(sw),
+                sliding_time=sliding_time(traj.events), traj=traj,
+                dP=lambda: return_jacobian(python, traj, sec, jacobian=fs.jacobian))
+
+
+def _jac(got):
+    return got["dP"]() if callable(got["dP"]) else got["dP"]
+
+
+def _close(got, want, tol, what, scale=None):
+    """max |got - want| <= tol * scale (default: max(1, |want|))."""
+    got, want = np.asarray(got, dtype=float), np.asarray(want, dtype=float)
+    err = float(np.max(np.abs(got - want)))
+    scale = max(1.0, float(np.max(np.abs(want)))) if scale is None else scale
+    assert err <= tol * scale, \
+        f"{what}: got {got.tolist()}, closed form {want.tolist()} (|error| {err:.3g})"
+
+
+# ----------------------------------------------------------------------------- crossings
+@pytest.mark.parametrize("flows", FLOWS)
+@pytest.mark.parametrize("engine", ENGINES)
+@given(case=gs.crossings())
+def test_a_crossing_and_the_return_agree_with_the_closed_form(engine, flows, case):
+    """From below H (or on it: in the crossing region, or where H repels, whence the
+    library takes region +) across H to the section h = sigma: the switch time, the
+    return, its time and (off H) dP/dz."""
+    gs.load(gs.system(case.g.n, flows == "exact"), case.g.p)
+    got = _return(case.g.n, engine, flows, case.z0)
+    tol = TOL[flows]
+    if case.start == "below":
+        assert got["n_switches"] == 1
+        _close(got["first_switch"], case.t1, tol, "switch time")
+    else:   # a start on H: region + at once (rules.start_on_switch), no switch
+        assert got["n_switches"] == 0, got
+    assert got["sliding_time"] == 0.0
+    _close(got["time"], case.time, tol, "return time")
+    _close(got["P"], case.P, tol, "P(z0)")
+    if case.dP is not None:
+        _close(_jac(got), case.dP, TOL_JAC, "dP/dz", scale=max(1.0, case.scale))
+
+
+# ----------------------------------------------------------------------------- sliding
+# integrated flows only: with exact flows both engines may re-enter sliding right after
+# the exit at a fold (FOLD_EXIT below, a strict xfail until fixed); the compiled one did so
+# in most examples, each failing and shrinking for minutes
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("flows", ["integrate"])
+@given(case=gs.slides())
+def test_sliding_entry_exit_and_return_agree_with_the_closed_form(engine, flows, case):
+    """Into attracting sliding (or starting on it), along the linear sliding field, out
+    at the visible fold where F_+ turns tangent, and on to the section."""
+    gs.load(gs.system(case.g.n, flows == "exact"), case.g.p)
+    got = _return(case.g.n, engine, flows, case.z0)
+    tol = TOL[flows]
+    if case.on_h:
+        # the first change of mode is the exit; the compiled engine counts the slide the
+        # start begins in (fastmap's docstring), the reference's event log does not
+        assert got["n_switches"] == 1
+        _close(got["first_switch"], case.ts, tol, "sliding exit")
+        if engine == "compiled":
+            _close(got["sliding_time"], case.ts, tol, "time slid")
+    else:
+        assert got["n_switches"] == 2
+        _close(got["first_switch"], case.t1, tol, "sliding entry")
+        _close(got["sliding_time"], case.ts, tol, "time slid")
+    _close(got["time"], case.time, tol, "return time")
+    _close(got["P"], case.P, tol, "P(z0)")
+    if case.dP is not None:
+        _close(_jac(got), case.dP, TOL_JAC, "dP/dz", scale=max(1.0, case.scale))
+
+
+# ----------------------------------------------------------------------------- relay orbits
+# Found by this suite: Newton's fixed point a hair before H (x1 = 0 exactly; the exact
+# flow's V e^{Bt} V^-1 rounds h to -1e-15 at t = 0) "returned" after 7e-15 s, and
+# periodic_orbit gave period 7e-15 with multipliers [1, 1, 1] (reference driver) or
+# 8e-15 with the point 6e-7 off (compiled engine). Now refused with its reason.
+RELAY_START_ITSELF = dict(lam=(0.4375, 0.6875, 1.1875), amplitude=1.0, gamma=0.0)
+
+
+@pytest.mark.parametrize("flows", FLOWS)
+@pytest.mark.parametrize("engine", ENGINES)
+@example(case=gs.relay_from(**RELAY_START_ITSELF))
+@given(case=gs.relays())
+def test_relay_orbits_and_multipliers_agree_with_the_half_period_condition(engine, flows, case):
+    """periodic_orbit from a guess next to the symmetric relay orbit: its point, period,
+    dP/dz and Floquet multipliers against the half-period condition and the monodromy
+    matrix from e^{AT} and the saltation matrices -- or, with exact flows, the refusal of
+    a "return" that is the start itself (the flow's rounding at t = 0 put Newton's
+    point a hair before H; filippov.periodic.SHORTEST_PATH)."""
+    from filippov import PeriodicOrbitError, periodic_orbit
+
+    fs = gs.system(case.g.n, flows == "exact")
+    gs.load(fs, case.g.p)
+    guess = case.x0 + 1e-3 * np.cos(np.arange(case.g.n))
+    options = {} if engine == "compiled" else {"method": flows}
+    try:
+        orbit = periodic_orbit(fs, guess, gs.section, direction=+1, engine=engine,
+                               t_max=1.5 * case.period + 1.0, **options)
+    except PeriodicOrbitError as exc:
+        # integrated flows start from the state itself: no rounding offset at t = 0
+        assert flows == "exact" and "the start itself" in str(exc), exc
+        return
+    # Newton stops at |P(z) - z| <= 1e-12 (1 + |z|); the fixed point then moves by that
+    # times |(dP/dz - I)^-1| (<= ~1e2 here) on top of the return's own error (TOL)
+    tol = TOL[flows] * 10
+    _close(orbit.period, case.period, tol, "period")
+    _close(orbit.point, case.x0, tol * 10, "fixed point")
+    _close(orbit.jacobian, case.dP, TOL_JAC * 10, "dP/dz at the fixed point")
+    assert orbit.multipliers[0] == 1.0
+    rest, want = np.sort_complex(orbit.multipliers[1:]), np.sort_complex(case.multipliers[1:])
+    _close(rest.real, want.real, TOL_JAC * 10, "multipliers (real parts)")
+    _close(rest.imag, want.imag, TOL_JAC * 10, "multipliers (imaginary parts)")
+    assert abs(case.multipliers[0] - 1) < 1e-9   # the reference's own check
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_return_that_is_the_start_itself_is_no_periodic_orbit(engine):
+    """The minimal failure above, on its own: the orbit or the refusal, never a period
+    of 1e-14."""
+    from filippov import PeriodicOrbitError, periodic_orbit
+
+    case = gs.relay_from(**RELAY_START_ITSELF)
+    fs = gs.system(3, True)
+    gs.load(fs, case.g.p)
+    guess = case.x0 + 1e-3 * np.cos(np.arange(3))
+    options = {} if engine == "compiled" else {"method": "exact"}
+    try:
+        orbit = periodic_orbit(fs, guess, gs.section, direction=+1, engine=engine,
+                               t_max=1.5 * case.period + 1.0, **options)
+    except PeriodicOrbitError as exc:
+        assert "the start itself" in str(exc)
+        return
+    _close(orbit.period, case.period, TOL["exact"] * 10, "period")
+
+
+# Found by this suite, not fixed (both engines' event logic with exact flows): from the
+# origin, on H in attracting sliding, the slide ends at the visible fold at t = 0.6486 and
+# the orbit must leave into region + (h grows like t^2/2 there). With exact flows the
+# first sample of the closed-form flow of region + reads h = -1.1e-15 (its rounding at
+# tau ~ 0, while h' = 0), which both engines take for a return to H: sliding again, a
+# second exit, a touch -- 3 mode changes instead of 1 (the return itself stays right to
+# 1e-13). In other generated examples the compiled engine then stops with a Zeno error or
+# gives a NaN dP/dz. With integrated flows both engines are right.
+FOLD_EXIT = dict(n=3, z0=[0.0, 0.0, 0.0], p=[0.2362261611142302, -0.7117437722419927, 0.4003558718861209, 3.0023344901311506, 3.0180390935664905, -1.9788969901311508, 3.2114332216803696, 2.1886243354311445, -1.7311011886800187, 1.0, 0.0625, 0.875, 0.5, -0.375, 0.0, 0.0, 1.0234375, 0.5625, 0.5, 0.46875, 1.0, 2.768683274021352, 1.3665480427046262, -0.7686832740213522, 1.0249110320284696, 1.8220640569395015, -1.0249110320284696, -1.8647686832740211, -1.5373665480427043, 1.8647686832740211, 1.011582033000351, 1.011582033000351, -0.5, 0.5, -0.5, 0.0, -1.1632078736256892, 0.3096204680593388, -1.2610016862179891, 0.2362261611142302, -0.7117437722419927, 0.4003558718861209, 3.0023344901311506, 3.0180390935664905, -1.9788969901311508, 3.2114332216803696, 2.1886243354311445, -1.7311011886800187, -0.5, 0.4375, 1.875, 0.5, -0.375, 0.0, 0.0, 1.0234375, 0.5625, 0.5, 0.46875, 1.0, 2.768683274021352, 1.3665480427046262, -0.7686832740213522, 1.0249110320284696, 1.8220640569395015, -1.0249110320284696, -1.8647686832740211, -1.5373665480427043, 1.8647686832740211, 1.011582033000351, 1.011582033000351, -0.5, 0.5, -0.5, 0.0, 1.0466898499830366, 4.661472583630355, 8.918361903663023, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5])
+
+
+def _fold_exit(engine, flows):
+    """(mode changes, first of them, return time) of FOLD_EXIT on one engine."""
+    got = None
+    gs.load(gs.system(FOLD_EXIT["n"], flows == "exact"), np.array(FOLD_EXIT["p"]))
+    got = _return(FOLD_EXIT["n"], engine, flows, np.array(FOLD_EXIT["z0"]))
+    return got["n_switches"], got["first_switch"], got["time"]
+
+
+def _fold_exit_is_right(engine, flows):
+    n, first, time = _fold_exit(engine, flows)
+    assert n == 1   # the exit from sliding, nothing else
+    assert first == pytest.approx(0.6485564734511751, abs=1e-10)   # the closed form's
+    assert time == pytest.approx(1.3350097436206927, abs=1e-10)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_integrated_flows_leave_sliding_at_a_fold_once(engine):
+    _fold_exit_is_right(engine, "integrate")
+
+
+@pytest.mark.xfail(strict=True, reason="exact flows: the flow's rounding at tau ~ 0 after a "
+                   "visible-fold exit reads as a return to H (reported, not fixed here)")
+@pytest.mark.parametrize("engine", ENGINES)
+def test_exact_flows_leave_sliding_at_a_fold_once(engine):
+    _fold_exit_is_right(engine, "exact")
