@@ -206,6 +206,71 @@ def test_emulation_moves_last_bits_of_math_numpy_and_numba(shim, tmp_path):
     np.testing.assert_array_equal(seed1["exact"], [1.0, 1.0, 8.0, 0.0])
 
 
+def _ulps_moved(native, emulated):
+    """By how many ulps of the native value each result moved (rounded)."""
+    return np.round((emulated - native) / np.spacing(np.abs(native)))
+
+
+@pytest.mark.parametrize("all_moved", [False, True])
+def test_emulation_moves_results_by_up_to_n_ulps(shim, tmp_path, all_moved):
+    # --ulps 2: half the results stay, the others move by 1 or 2 ulps up or down; with
+    # all_moved every result moves. The draw is per input and seed, and math, numpy's
+    # scalar loops and numba all see it
+    native = _probe({}, tmp_path)
+    env = cross_cpu.emulation_env(shim, 1, tmp_path / "c1", ulps=2, all_moved=all_moved)
+    moved = _probe(env, tmp_path)
+    for key in ("math", "numba"):   # libm's own results: k exactly
+        k = _ulps_moved(native[key], moved[key])
+        assert np.abs(k).max() <= 2, key
+        counts = {int(v): int(np.count_nonzero(k == v)) for v in (-2, -1, 0, 1, 2)}
+        share = np.array(list(counts.values())) / k.size
+        if all_moved:
+            assert counts[0] == 0, (key, counts)   # no unmoved fraction
+            assert np.all(np.delete(share, 2) > 0.2), (key, counts)
+        else:
+            assert 0.4 < share[2] < 0.6, (key, counts)
+            assert np.all((np.delete(share, 2) > 0.08) & (np.delete(share, 2) < 0.17)), \
+                (key, counts)
+    # numpy's native SIMD loops may already be an ulp away from libm
+    k = _ulps_moved(native["numpy"], moved["numpy"])
+    assert np.abs(k).max() <= 3 and np.mean(k != 0) > (0.9 if all_moved else 0.4)
+    np.testing.assert_array_equal(moved["exact"], [1.0, 1.0, 8.0, 0.0])
+    with pytest.raises(ValueError):
+        cross_cpu.emulation_env(shim, 1, tmp_path / "c2", ulps=0)
+
+
+BOUNDED = r"""
+import json, math
+import numpy as np
+x = np.pi / 2 + np.arange(-3000, 3000) * 1e-10      # sin within a few ulps of 1
+tiny = [-744.0 - 0.01 * k for k in range(60)]         # exp: subnormal, down to 5e-324
+print(json.dumps({"sin": [math.sin(v) for v in x], "cos": [math.cos(v - np.pi / 2) for v in x],
+                  "tanh": [math.tanh(v) for v in np.linspace(18.0, 19.0, 2000)],
+                  "exp": [math.exp(v) for v in tiny]}))
+"""
+
+
+def test_moved_results_keep_what_every_libm_keeps(shim, tmp_path):
+    # several ulps near 1 must not carry sin, cos or tanh past 1, nor exp below 0
+    env = dict(os.environ, **cross_cpu.emulation_env(shim, 3, tmp_path / "c", ulps=4,
+                                                     all_moved=True))
+    out = subprocess.run([sys.executable, "-c", BOUNDED], env=env, capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    res = {k: np.array(v) for k, v in json.loads(out.stdout).items()}
+    for key in ("sin", "cos", "tanh"):
+        assert np.all(np.abs(res[key]) <= 1.0), key
+        assert np.any(res[key] < 1.0), key     # they do move there
+    assert np.all(res["exp"] > 0.0)
+
+
+def test_runs_are_the_seeds_and_one_with_every_result_moved():
+    assert cross_cpu.runs_of([1, 2, 3], True) == [
+        (1, False, "seed 1"), (2, False, "seed 2"), (3, False, "seed 3"),
+        (4, True, "seed 4, every result moved")]
+    assert cross_cpu.runs_of([5], False) == [(5, False, "seed 5")]
+
+
 def test_environment_fingerprint_tracks_the_arithmetic(shim):
     code = "from filippov import manifest; print(manifest.environment())"
 
@@ -257,6 +322,19 @@ def test_manifest_catches_a_one_percent_parameter_change(sid, tmp_path):
     for line in problems:
         where, var = line.split(": ")[:2]
         assert where == f"results/{sid}.nc" and var in variables, line
+
+
+def test_a_partial_run_builds_and_checks_only_the_named_datasets():
+    got = cross_cpu.targets(["fig04_retmaps", "hard_cases"])
+    assert got == ["figures/fig04_retmaps.pdf", "figures/fig04_retmaps.png",
+                   "results/hard_cases.nc"]
+    with pytest.raises(SystemExit, match="fig99_nothing"):
+        cross_cpu.targets(["fig99_nothing"])
+    man = json.loads(manifest.MANIFEST.read_text())
+    part = cross_cpu.restrict(man, ["fig04_retmaps", "hard_cases"])
+    assert sorted(part["data"]) == ["fig04_retmaps", "hard_cases"]
+    assert sorted(part["figures"]) == ["fig04_retmaps"]
+    assert cross_cpu.restrict(man, None) is man
 
 
 def test_the_emulated_build_targets_every_scene():

@@ -153,3 +153,53 @@ def test_a_figure_of_chaotic_orbits_declares_a_wider_image_tolerance(tmp_path):
     changed = _figure(tmp_path / "g.png", box=True)
     assert "image differs" in manifest.compare_image(changed, tmp_path / "ref" / "f.png")
     assert manifest.compare_image(changed, tmp_path / "ref" / "f.png", limit=1.0) is None
+
+
+def _declared(path, atol):
+    ds = xr.Dataset({"rate": ("k", np.array([1.0, 1.02, 0.98]))})
+    tol = tolerance.Tolerance(1e-9, atol, "log-log slope of errors >= 1e-3 known to 1e-9: "
+                                          "2 delta/(e ln 10)")
+    return manifest.summarize(write_dataset(tolerance.annotate(ds, {"rate": tol}), path))
+
+
+def test_a_declaration_is_compared_as_a_formulas_value(tmp_path):
+    # fig07's rate tolerance 2 delta/(e ln 10): another libm rounds ln 10 differently by
+    # an ulp or two; the declaration is the same, the data are the same -- only the
+    # tolerance's last bits differ, and the check must accept that
+    delta, e = 1e-9, 1e-3
+    ln10 = np.log(10.0)
+    ref = _declared(tmp_path / "ref.nc", 2 * delta / (e * ln10))
+    for ulps in (-4, -2, -1, 1, 2, 4):
+        moved = ln10 + ulps * np.spacing(ln10)
+        atol = 2 * delta / (e * moved)
+        assert atol != ref["rate"]["tolerance"]["atol"], ulps   # the bits do differ
+        got = _declared(tmp_path / f"moved{ulps}.nc", atol)
+        assert manifest.compare_data(got, ref) == [], ulps
+        assert tolerance.same_declaration(got["rate"]["tolerance"], ref["rate"]["tolerance"])
+    # a different declaration is still one: another error floor (3e-3, fig09's), a
+    # relative change of 1e-12 (far beyond any rounding of the formula), another rule
+    for atol in (2 * delta / (3e-3 * ln10), 2 * delta / (e * ln10) * (1 + 1e-12)):
+        got = _declared(tmp_path / "other.nc", atol)
+        problems = manifest.compare_data(got, ref)
+        assert len(problems) == 1 and problems[0].startswith("rate: the data declares "
+                                                             "tolerance"), problems
+    want = ref["rate"]["tolerance"]
+    assert not tolerance.same_declaration(dict(want, rule="trace"), want)
+    assert not tolerance.same_declaration(dict(want, why="another reason"), want)
+    assert not tolerance.same_declaration(dict(want, rtol=0.0), want)
+    assert tolerance.same_declaration(dict(want, rtol=0.0), dict(want, rtol=0.0))
+
+
+def test_update_keeps_a_spread_measured_against_the_same_declaration(tmp_path):
+    path = _dataset(tmp_path / "results" / "fig99_test.nc")
+    old = {"data": {"fig99_test": {"variables": manifest.summarize(path)}}}
+    tol = old["data"]["fig99_test"]["variables"]["P"]["tolerance"]
+    old["data"]["fig99_test"]["variables"]["P"]["spread"] = {"margin": 50.0}
+    # the same declaration, its last bits rounded elsewhere: the spread stays ...
+    tol["rtol"] = float(np.nextafter(tol["rtol"], 1.0))
+    new = manifest.build_manifest(tmp_path / "results", tmp_path / "figures", old)
+    assert new["data"]["fig99_test"]["variables"]["P"]["spread"] == {"margin": 50.0}
+    # ... another declaration: it was not measured against this one
+    tol["rtol"] = 2e-9
+    new = manifest.build_manifest(tmp_path / "results", tmp_path / "figures", old)
+    assert "spread" not in new["data"]["fig99_test"]["variables"]["P"]

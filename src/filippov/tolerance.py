@@ -133,6 +133,33 @@ U = ULP / 2
 EVENT_STATE = 1e-12
 
 
+#: a declared tolerance is often a formula's value (2 delta/(e ln 10), u/(2 sqrt(offset))):
+#: on another machine the transcendental functions in it round differently, by up to a
+#: few ulps each (and the arithmetic after them by half an ulp per operation), so the
+#: numbers of two declarations are the same declaration when they agree to this many
+#: ulps relative (3.6e-15): room for a formula of a few such functions, each a few ulps
+#: off; any real change of a declaration (a parameter, a factor) is many orders larger
+DECLARATION_ULPS = 16
+
+
+def same_declaration(a, b) -> bool:
+    """Whether two declared tolerances (:class:`Tolerance` or its ``asdict``, as the
+    manifest stores it) are the same declaration: rule, count and reason equal, rtol,
+    atol and jump equal to :data:`DECLARATION_ULPS` ulps relative."""
+    a, b = (asdict(t) if isinstance(t, Tolerance) else dict(t) for t in (a, b))
+    if set(a) != set(b):
+        return False
+    for key in a:
+        x, y = a[key], b[key]
+        if key in ("rtol", "atol", "jump"):
+            x, y = float(x), float(y)
+            if not abs(x - y) <= DECLARATION_ULPS * ULP * max(abs(x), abs(y)):
+                return False
+        elif x != y:
+            return False
+    return True
+
+
 def sqrt_law(offset: float, factor: float = 1.0) -> float:
     """Spread of a quantity that varies as sqrt(distance to a tangency) at the
     smallest distance ``offset``: a last-bit change u of the distance moves it by

@@ -5,10 +5,13 @@ Other machines round transcendental functions differently in the last bit
 (numpy's AVX-512 loops, another libm). This check makes such a machine out of
 the one it runs on, then builds every figure there:
 
-* ``lastbit.c`` (beside this file), preloaded into every process, moves the last
-  bit of exp, log, sin, atan2, ... results, deterministically per input and
-  per seed (``LASTBIT_SEED``): Python's math module, numba-compiled code and
-  numpy's scalar loops all call those symbols;
+* ``lastbit.c`` (beside this file), preloaded into every process, moves half the
+  exp, log, sin, atan2, ... results by 1..N ulps up or down (``--ulps N``: real
+  libms differ by up to a few ulps), deterministically per input and per seed
+  (``LASTBIT_SEED``; N = 1 is the draw this check always made): Python's math
+  module, numba-compiled code and numpy's scalar loops all call those symbols.
+  Besides the seeds, one build moves every result (by -N..-1, 1..N ulps: no
+  unmoved fraction, ``LASTBIT_ALL``);
 * numpy's SIMD dispatch is switched down to its baseline
   (``NPY_DISABLE_CPU_FEATURES``), so numpy's own vector loops give way to the
   perturbed libm wherever the machine had something to switch;
@@ -24,14 +27,17 @@ declared tolerance, figures by image). The emulated data are also compared
 with a native build of the same tree, full arrays: every dataset whose numbers
 pass through a transcendental function must change (an emulation that changes
 nothing emulates nothing), and the spread per variable over the seeds is set
-against its tolerance (margin = tolerance / spread; >= 10 is healthy). A margin
+against its tolerance (margin = tolerance / spread; >= 10 is healthy; a count
+allowed to jump by one crossing pair has margin 1 when it does). A margin
 below 1 is a problem: the tolerance declared for that variable does not hold
 between two machines (a manifest check can still pass then, if the manifest was
 written on a machine whose values happen to lie between the two).
 ``--record`` writes the measured spreads into the manifest next to each
-tolerance.
+tolerance. ``--scenes`` rebuilds only some datasets (scene ids, ``hard_cases``,
+``work_precision``) and checks only those: for iterating on one tolerance.
 
-    python tests/crosscpu/cross_cpu.py [--seeds 1 2 3] [--record] [--keep]
+    python tests/crosscpu/cross_cpu.py [--ulps 2] [--seeds 1 2 3] [--no-all-moved]
+                                       [--scenes ID ...] [--native DIR] [--record] [--keep]
 """
 from __future__ import annotations
 
@@ -76,8 +82,15 @@ def build_shim(dest: Path) -> Path:
     return out
 
 
-def emulation_env(shim: Path, seed: int, cache: Path) -> dict:
-    env = {"LD_PRELOAD": str(shim), "LASTBIT_SEED": str(seed), "NUMBA_CPU_NAME": "generic",
+def emulation_env(shim: Path, seed: int, cache: Path, ulps: int = 1,
+                  all_moved: bool = False) -> dict:
+    """The environment of an emulated build: results moved by up to ``ulps`` ulps
+    (every one of them when ``all_moved``), numpy at its SIMD baseline, numba for a
+    generic CPU with an empty cache ``cache``, OpenBLAS's SSE3 kernels."""
+    if ulps < 1:
+        raise ValueError(f"ulps: at least 1, got {ulps}")
+    env = {"LD_PRELOAD": str(shim), "LASTBIT_SEED": str(seed), "LASTBIT_ULPS": str(ulps),
+           "LASTBIT_ALL": "1" if all_moved else "0", "NUMBA_CPU_NAME": "generic",
            "NUMBA_CACHE_DIR": str(cache), "PYTHONDONTWRITEBYTECODE": "1",
            "OPENBLAS_CORETYPE": "Prescott"}
     disable = manifest.numpy_simd()   # switched down to numpy's baseline
@@ -86,24 +99,45 @@ def emulation_env(shim: Path, seed: int, cache: Path) -> dict:
     return env
 
 
-def targets() -> list[str]:
+#: datasets of the build that are not scenes (no figure in the manifest)
+SWEEPS = ("hard_cases", "work_precision")
+
+
+def targets(only: list[str] | None = None) -> list[str]:
+    """What the workflow builds (every scene file's figures, unless config.yaml picks
+    some, and the sweeps); ``only``: just these scene ids and sweeps."""
     from filippov.config import load_workflow_config
 
-    # the scenes the workflow builds (every scene file, unless config.yaml picks some)
     scenes = load_workflow_config(ROOT / "config" / "config.yaml",
                                   ROOT / "config" / "schema" / "config.schema.json")["scenes"]
-    return [f"figures/{s}.{ext}" for s in scenes for ext in ("pdf", "png")] + \
-        ["results/hard_cases.nc", "results/work_precision.nc"]
+    if only is not None:
+        unknown = sorted(set(only) - set(scenes) - set(SWEEPS))
+        if unknown:
+            raise SystemExit(f"cross-cpu: --scenes: not a scene or sweep: {', '.join(unknown)}")
+    keep = (lambda name: True) if only is None else (lambda name: name in only)
+    return [f"figures/{s}.{ext}" for s in scenes if keep(s) for ext in ("pdf", "png")] + \
+        [f"results/{d}.nc" for d in SWEEPS if keep(d)]
 
 
-def build(work: Path, env: dict | None, label: str) -> None:
+def restrict(man: dict, only: list[str] | None) -> dict:
+    """The manifest of the datasets and figures ``only`` names (all: None)."""
+    if only is None:
+        return man
+    return dict(man, data={k: v for k, v in man["data"].items() if k in only},
+                figures={k: v for k, v in man["figures"].items() if k in only})
+
+
+def build(work: Path, env: dict | None, label: str, only: list[str] | None = None) -> float:
+    """Build ``work`` (a project copy); the wall time in seconds."""
     t0 = time.perf_counter()
     print(f"== {label}: building in {work}", flush=True)
-    run = run_snakemake(work, *targets(), cores="all", env=env)
+    run = run_snakemake(work, *targets(only), cores="all", env=env)
     if run.returncode != 0:
         sys.stdout.write(run.stdout[-4000:] + run.stderr[-4000:])
         raise SystemExit(f"cross-cpu: {label} build failed (exit {run.returncode})")
-    print(f"== {label}: {time.perf_counter() - t0:.0f} s", flush=True)
+    elapsed = time.perf_counter() - t0
+    print(f"== {label}: {elapsed:.0f} s", flush=True)
+    return elapsed
 
 
 def compare_builds(native: Path, emulated: Path) -> dict:
@@ -149,7 +183,8 @@ def report(merged: dict, lowest: int = 15) -> list[str]:
             problems.append(f"results/{sid}.nc: listed as algebraic but moved: update ALGEBRAIC")
     rows = sorted((s["margin"], sid, n, s) for sid, v in merged.items() for n, s in v.items()
                   if s["changed"])
-    print(f"\nsmallest margins (tolerance / spread over {max(s['seeds'] for v in merged.values() for s in v.values())} seeds):")
+    n = max((s["seeds"] for v in merged.values() for s in v.values()), default=0)
+    print(f"\nsmallest margins (tolerance / spread over {n} emulated builds):")
     print(f"{'margin':>9s}  {'max abs':>9s}  {'max rel':>9s}  variable  "
           f"(native -> emulated at the entry that sets the margin)")
     for margin, sid, name, s in rows[:lowest]:
@@ -164,7 +199,9 @@ def report(merged: dict, lowest: int = 15) -> list[str]:
     return problems
 
 
-def record(merged: dict, path: Path = manifest.MANIFEST) -> None:
+def record(merged: dict, ulps: int, path: Path = manifest.MANIFEST) -> None:
+    """The spreads into the manifest, next to each tolerance (with the emulation's
+    size: ``ulps``; ``seeds`` counts the emulated builds, the all-moved one included)."""
     man = json.loads(path.read_text())
     for sid, variables in merged.items():
         for name, s in variables.items():
@@ -172,39 +209,63 @@ def record(merged: dict, path: Path = manifest.MANIFEST) -> None:
             if entry is not None:
                 entry["spread"] = {k: (None if k == "margin" and not np.isfinite(v) else v)
                                    for k, v in s.items() if k != "ok"}
+                entry["spread"]["ulps"] = ulps
     path.write_text(json.dumps(man, indent=1, sort_keys=True) + "\n")
     print(f"recorded the spreads in {path}")
 
 
+def runs_of(seeds: list[int], all_moved: bool) -> list[tuple[int, bool, str]]:
+    """(seed, every result moved, label) of each emulated build: the seeds, then one
+    build where every result moves (its seed the next after the largest)."""
+    runs = [(seed, False, f"seed {seed}") for seed in seeds]
+    if all_moved:
+        seed = max(seeds, default=0) + 1
+        runs.append((seed, True, f"seed {seed}, every result moved"))
+    return runs
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--ulps", type=int, default=2,
+                    help="results move by up to N ulps (half of them, per input and seed; "
+                         "all in one more build; default 2)")
     ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
+    ap.add_argument("--all-moved", action=argparse.BooleanOptionalAction, default=True,
+                    help="one more build in which every result moves (default: yes)")
+    ap.add_argument("--scenes", nargs="+", metavar="ID",
+                    help="build and check only these scenes/sweeps (iteration; not a full check)")
     ap.add_argument("--native", type=Path, help="a finished native build (project copy) to reuse")
     ap.add_argument("--record", action="store_true", help="write the spreads into the manifest")
     ap.add_argument("--keep", action="store_true", help="keep the build directories")
     args = ap.parse_args(argv)
-    man = json.loads(manifest.MANIFEST.read_text())
+    if args.ulps < 1:
+        ap.error(f"--ulps: at least 1, got {args.ulps}")
+    if args.record and args.scenes:
+        ap.error("--record needs the full build (no --scenes)")
+    only = args.scenes
+    man = restrict(json.loads(manifest.MANIFEST.read_text()), only)
+    runs_planned = runs_of(args.seeds, args.all_moved)
     tmp = Path(tempfile.mkdtemp(prefix="filippov-cross-cpu-"))
-    problems, runs = [], []
+    problems, runs, times = [], [], {}
     try:
         shim = build_shim(tmp)
         native = args.native
         if native is None:
             native = copy_project(tmp / "native")
-            build(native, None, "native")
+            times["native"] = build(native, None, "native", only)
         problems += [f"native: {p}" for p in manifest.check(native / "results",
                                                             native / "figures", man)]
-        for seed in args.seeds:
+        for seed, every, label in runs_planned:
             work = copy_project(tmp / f"seed{seed}")
-            env = emulation_env(shim, seed, tmp / f"numba-cache-{seed}")
-            build(work, env, f"emulated CPU, seed {seed}")
-            problems += [f"seed {seed}: {p}" for p in
+            env = emulation_env(shim, seed, tmp / f"numba-cache-{seed}", args.ulps, every)
+            times[label] = build(work, env, f"emulated CPU (+-{args.ulps} ulps), {label}", only)
+            problems += [f"{label}: {p}" for p in
                          manifest.check(work / "results", work / "figures", man)]
             runs.append(compare_builds(native, work))
         merged = merge_spreads(runs)
         problems += report(merged)
         if args.record:
-            record(merged)
+            record(merged, args.ulps)
     finally:
         if args.keep:
             print(f"builds kept in {tmp}")
@@ -212,7 +273,10 @@ def main(argv=None) -> int:
             shutil.rmtree(tmp, ignore_errors=True)
     for p in problems:
         print(f"MISMATCH {p}")
-    print(f"cross-cpu: {len(args.seeds)} emulated builds: "
+    print("build times: " + ", ".join(f"{k} {v:.0f} s" for k, v in times.items()))
+    print(f"cross-cpu: {len(runs_planned)} emulated builds (results moved by up to "
+          f"{args.ulps} ulps{'; one with every result moved' if args.all_moved else ''}"
+          f"{'; only ' + ' '.join(only) if only else ''}): "
           f"{'OK' if not problems else f'{len(problems)} problems'}")
     return 1 if problems else 0
 
