@@ -39,6 +39,8 @@ def small_scene(sid: str) -> dict:
             p["theta"] = p["theta"][:1] + p["theta"][-2:]
         if "n_geo" in p:
             p["n_geo"] = 2
+        if "boundary_s" in p:   # fig14's flips: one s, one eps (each costs ~0.3 s)
+            p.update(boundary_s=[1.0], boundary_eps=[1e-3])
     else:
         p.update(n_uniform=9, n_geometric=4)
         p["eps"] = p["eps"][:2]

@@ -85,3 +85,94 @@ def slopes(u, s, *, eps: float, theta: float, omega: float, order: int = 1,
     truncation is ~h^2 and the rounding ~1e-16/h."""
     kw = dict(eps=eps, theta=theta, omega=omega, order=order)
     return (step(u + h, s, **kw) - step(u - h, s, **kw)) / (2.0 * h)
+
+
+# ----------------------------------------------------------------------------- boundaries
+# theta > 0, past grazing: near the border the map is piecewise linear (the border-collision
+# normal form of Nusse & Yorke 1992), u' = tau_miss u + c on the side that misses H and
+# tau_hit u + c on the side that slides, with tau_miss = lambda (one smooth turn) and
+# tau_hit = lambda s(theta,0,0), s(theta,0,0) = (theta - 1)/theta the slope of P_DM at 0-.
+# With 0 < tau_miss < 1 the attractor past grazing is (Banerjee, Yorke & Grebogi 1998):
+#   tau_hit > -1                         the fixed point: period one;
+#   -1/tau_miss < tau_hit < -1           the orbit of period two (multiplier tau_miss tau_hit);
+#   tau_hit < -1/tau_miss                chaos (bands of a skew tent map).
+# In theta: period one for theta > lambda/(1 + lambda), period two down to
+# lambda^2/(1 + lambda^2), chaos below. The paper's s(theta,0,0) < -1 is necessary only.
+def flip_threshold(lam: float) -> float:
+    """theta where the period-one orbit of the normal form loses stability:
+    lambda s(theta,0,0) = -1, theta = lambda/(1 + lambda)."""
+    return lam / (1.0 + lam)
+
+
+def chaos_threshold(lam: float) -> float:
+    """theta where the period-two orbit of the normal form loses stability and chaos
+    begins: lambda^2 s(theta,0,0) = -1, theta = lambda^2/(1 + lambda^2)."""
+    return lam * lam / (1.0 + lam * lam)
+
+
+def cycle(u0: float, s: float, n: int, *, eps: float, theta: float, omega: float,
+          order: int = 1, tol: float = 1e-13, max_iter: int = 50) -> tuple[np.ndarray, float]:
+    """The period-n orbit of the map through the point near ``u0`` (Newton on
+    step^n(u) - u, derivative by :func:`slopes` along the orbit) and its multiplier, the
+    product of the slopes: (orbit points (n,), multiplier). ValueError if Newton does
+    not converge or the orbit touches the border (the kink at rho = 0: slopes undefined)."""
+    kw = dict(eps=eps, theta=theta, omega=omega, order=order)
+    h = 1e-6   # the central step of slopes()
+    u = float(u0)
+    for _ in range(max_iter):
+        # the orbit and its neighbours at +-h in one call per return (each step solves
+        # the sliding time: its cost is per call, not per point)
+        pts, mult = [u], 1.0
+        for _k in range(n):
+            x = pts[-1]
+            img = step(np.array([x - h, x, x + h]), s, **kw)
+            mult *= float(img[2] - img[0]) / (2.0 * h)
+            pts.append(float(img[1]))
+        image = pts.pop()
+        if abs(image - u) <= tol * (1.0 + abs(u)):
+            return np.array(pts), mult
+        if mult == 1.0 or not np.isfinite(mult):
+            break
+        u = u - (image - u) / (mult - 1.0)
+    raise ValueError(f"no period-{n} orbit near u = {u0!r} at theta = {theta!r}, s = {s!r}")
+
+
+def flip_point(s: float, n: int, inside: float, outside: float, *, eps: float, omega: float,
+               order: int = 1, xtol: float = 1e-10) -> float:
+    """theta between ``inside`` (where the map's attractor is the period-n orbit) and
+    ``outside`` at which that orbit's multiplier crosses -1: the orbit followed in theta
+    by Newton (:func:`cycle`) from the attractor at ``inside``, the crossing bracketed on
+    eight steps towards ``outside`` and located by bisection to ``xtol``."""
+    kw = dict(eps=eps, omega=omega, order=order)
+    last = {"u": float(orbit([s], theta=inside, transient=300, keep=1, **kw)[0, -1])}
+
+    def excess(theta):   # multiplier + 1 of the followed orbit: > 0 while it is stable
+        pts, mult = cycle(last["u"], s, n, theta=theta, **kw)
+        last["u"] = float(pts[0])
+        return mult + 1.0
+
+    return bisect_crossing(excess, inside, outside, xtol, what=f"period-{n} orbit")
+
+
+def bisect_crossing(excess, inside: float, outside: float, xtol: float, *, what: str) -> float:
+    """Where ``excess`` (> 0 at ``inside``) first falls to <= 0 on the way to ``outside``:
+    bracketed on eight equal steps (so that a followed orbit moves a little at a time),
+    then bisected to ``xtol``."""
+    a = float(inside)
+    if not excess(a) > 0:
+        raise ValueError(f"the {what} at {a!r} is not stable")
+    lo = a
+    for th in np.linspace(a, float(outside), 9)[1:]:
+        if not excess(th) > 0:
+            hi = th
+            break
+        lo = th
+    else:
+        raise ValueError(f"the {what} stays stable up to {outside!r}")
+    while abs(hi - lo) > xtol:
+        mid = 0.5 * (lo + hi)
+        if excess(mid) > 0:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
