@@ -69,6 +69,7 @@ from .kernel.base import (BAD_START, EVENT_LIMIT, NO_RETURN, NO_SLIDING,  # noqa
 from .kernel.driver import (KERNEL_SOURCES, Outputs, Settings,  # noqa: F401
                             compile_kernel, kernel)
 from .checks import check_compiled
+from .system import MINUS, MODE_NAMES, PLUS
 from .poincare import Returns
 from .progress import Progress
 from .simulate import (EXACT_BLOCK, EventLimitError, SimulationError,
@@ -273,7 +274,6 @@ def failure(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:
     and in which mode; for a non-finite value the piece that gave it (checked by
     evaluating the pieces at that state)."""
     from .checks import non_finite_piece
-    from .system import MODE_NAMES
 
     code, z = int(out.status[i]), out.state[i]
     mode = int(out.mode[i]) if out.mode is not None else None
@@ -282,8 +282,6 @@ def failure(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:
         where += f", mode {MODE_NAMES.get(mode, mode)}"
     if code != NON_FINITE:
         return where
-    from .system import MINUS, PLUS
-
     if cmodel.exact and mode in (MINUS, PLUS):  # exact flows are sampled, not integrated
         piece = "flow_plus" if mode == PLUS else "flow_minus"
         return where + f" ({piece} returned a non-finite value from there)"

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from .. import attractors
 from ..analytic import limit_map
 from ..io import finalize
 from ..models import hopf
@@ -156,7 +157,7 @@ def slow_fast_flip(eps: float, s: float, n: int, omega: float, inside: float,
     from the attractor at ``inside`` towards ``outside``)."""
     sigma = eps * eps
     mu = 1.0 + s * sigma
-    at = _attractor_point(eps, inside, mu, omega, n)
+    at = _attractor_point(eps, inside, mu, omega)
     last = {"z": at}
 
     def excess(theta):
@@ -174,12 +175,12 @@ def slow_fast_flip(eps: float, s: float, n: int, omega: float, inside: float,
                                      what=f"slow-fast period-{n} orbit")
 
 
-def _attractor_point(eps, theta, mu, omega, n):
-    from ..fastmap import compute_returns
-
+def _attractor_point(eps, theta, mu, omega):
+    """The state after 400 returns from the cycle's point (Newton's start)."""
     cm = hopf.compiled(eps, theta, mu, omega, sliding=True)
-    out = compute_returns(cm, [[0.0, np.sqrt(mu), 0.0]], T_RETURN, iterations=400)
-    return out.state[0]
+    run = attractors.iterate(cm, [0.0, np.sqrt(mu), 0.0], transient=399, keep=1,
+                             t_max=T_RETURN)
+    return run.orbit[0, -1]
 
 
 # ============================================================================= report
