@@ -46,7 +46,8 @@ def test_absent_optional_results_say_not_yet_computed():
     for text in (t10, t11, tb, th, tr):
         assert report.NOT_YET in text
     assert m.flags == {"rpHaveTen": False, "rpHaveEleven": False, "rpHaveBench": False,
-                       "rpHaveHardCases": False, "rpHaveCompileCost": False}
+                       "rpHaveBenchTiming": False, "rpHaveHardCases": False,
+                       "rpHaveCompileCost": False}
     assert m.items == []
 
 

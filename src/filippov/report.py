@@ -274,6 +274,30 @@ def _problem_tex(name: str) -> str:
     return rest
 
 
+def _bench_timing(ds, m: Macros) -> None:
+    """How the sweep's times were measured (filippov.benchmarks.timing): the statistic
+    shown, the warm-up runs, the least rounds and seconds asked for, and the rounds the
+    shown cells took. A sweep measured before the convention (no ``timing_statistic``)
+    sets ``rpHaveBenchTiming`` false and quotes nothing."""
+    have = "timing_statistic" in ds.attrs and "runs" in ds
+    m.flag("rpHaveBenchTiming", have)
+    if not have:
+        return
+    sid = "work_precision"
+    stat = str(ds.attrs["timing_statistic"])
+    m.add("rpBenchStatistic", None, f"{sid}:attrs.timing_statistic",
+          text=r"\text{" + tex_escape(stat) + "}")
+    for name, attr, sig in (("rpBenchWarmup", "timing_warmup", 4),
+                            ("rpBenchMinRounds", "timing_min_rounds", 4),
+                            ("rpBenchMinTime", "timing_min_time", 3)):
+        m.add(name, float(ds.attrs[attr]), f"{sid}:attrs.{attr}", sig)
+    timed = np.asarray(ds.runs.values)[np.asarray(ds.status.values).astype(str) == "ok"]
+    m.add("rpBenchRoundsLeast", float(timed.min()) if timed.size else math.nan,
+          "derived: min of work_precision:runs over the configurations that ran", 4)
+    m.add("rpBenchRoundsMost", float(timed.max()) if timed.size else math.nan,
+          "derived: max of work_precision:runs over the configurations that ran", 4)
+
+
 def bench(ds, m: Macros, effects=None, returns=None, compile_cost=None) -> str:
     """The work-precision tables of the default build's sweep (results/work_precision.nc):
     per problem set (fig04, fig11), one row per method and tolerance, error / time /
@@ -293,6 +317,7 @@ def bench(ds, m: Macros, effects=None, returns=None, compile_cost=None) -> str:
                     kind, sig=2, stage=stage)
     sid = "work_precision"
     missing = absent(m, "rpHaveBench", ds, "Work--precision sweep", "results/work_precision.nc")
+    m.flag("rpHaveBenchTiming", False)  # set by _bench_timing when the sweep says how it timed
     if missing:
         return missing
     if "method" not in ds.coords or "problem" not in ds.dims:
@@ -325,6 +350,7 @@ def bench(ds, m: Macros, effects=None, returns=None, compile_cost=None) -> str:
         np.char.startswith(ds.status.values.astype(str), "failed"))),
         "derived: configurations of work_precision:status that failed", 4)
     m.add("rpBenchConfigs", float(ds.sizes["config"]), "work_precision:config (size)", 4)
+    _bench_timing(ds, m)
     m.flag("rpHaveEffects", effects is not None)
     if effects is not None:
         lines += [r"\medskip", "", r"\begin{tabular}{llrrl}", r"\toprule",

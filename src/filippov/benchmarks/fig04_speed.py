@@ -6,9 +6,12 @@ method computes P on the scene's full grid (or every k-th point with
 reference, the compiled exact flows; the reference itself is checked against
 the project's DOP853 at rtol 1e-13 (the "reference check" row). Points within
 1e-6 of the grazing value x2 = 1 are left out of the error (the map jumps
-there). Times are the median of ``--repeat`` runs in this process, one core;
-the kernel's compilation (or cache load) is done before timing. The
-tolerance sweep over every method is :mod:`filippov.benchmarks.work_precision`.
+there). Times follow the benchmarks' convention (:mod:`filippov.benchmarks.timing`):
+one untimed run of each method per problem first (the kernel's compilation or cache
+load, the model's pieces), then the median of at least ``--repeat`` timed runs in this
+process (more until ``--min-time`` seconds were timed), one core; solve_ivp is timed
+as often as the project's modes (on the full grid that takes minutes: ``--every``).
+The tolerance sweep over every method is :mod:`filippov.benchmarks.work_precision`.
 """
 from __future__ import annotations
 
@@ -19,36 +22,44 @@ import numpy as np
 
 from ..fastmap import compile_kernel
 from . import baseline
+from .timing import STATISTIC
 from .work_precision import GRAZING_GAP, fig04_problems, runner, timed
 
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--every", type=int, default=1, help="use every k-th grid point")
-    ap.add_argument("--repeat", type=int, default=5, help="runs per method (median)")
+    ap.add_argument("--repeat", type=int, default=3,
+                    help="timed runs per method at least (median), after one untimed run")
+    ap.add_argument("--min-time", type=float, default=0.2,
+                    help="time more runs of a method until this many seconds")
     args = ap.parse_args(argv)
     compile_kernel()
-    print(f"median of {args.repeat} runs (solve_ivp and DOP853: one run); one core")
+    print(f"{STATISTIC} of at least {args.repeat} timed runs (more until {args.min_time:g} s "
+          f"were timed) after one untimed run of each method; one core")
     print(f"{'problem':18s} {'method':44s} {'time [s]':>9s} {'max error':>10s} {'x ours':>8s}")
     total = 0.0
     for prob in fig04_problems(args.every):
         away = np.abs(prob.x2 - 1) > GRAZING_GAP
 
-        def one(family, tol, repeat):
-            t, _, out = timed(lambda: runner(prob, family, tol, np.inf)()[0], repeat, np.inf)
-            return t, out
+        warmed = set()  # methods run once untimed on this problem
 
-        runner(prob, "project compiled exact", 1e-12, np.inf)()  # load the model's cached pieces
-        t_ours, ref = one("project compiled exact", 1e-12, args.repeat)
+        def one(family, tol):
+            t = timed(lambda: runner(prob, family, tol, np.inf)()[0], args.repeat,
+                      args.min_time, warmup=0 if family in warmed else 1)
+            warmed.add(family)
+            return t.shown, t.value
+
+        t_ours, ref = one("project compiled exact", 1e-12)
         total += t_ours
-        _, check = one("project DOP853", 1e-13, 1)
+        check = runner(prob, "project DOP853", 1e-13, np.inf)()[0]  # not timed
         rows = [("project compiled exact (reference)", t_ours, 0.0),
                 ("reference check: project DOP853 rtol 1e-13", np.nan,
                  np.max(np.abs(check - ref)[away]))]
         for family, tol in (("project python exact", 1e-12), ("solve_ivp RK45", 1e-6),
                             ("solve_ivp RK45", 1e-10)):
             try:
-                t, val = one(family, tol, 1 if family.startswith("solve") else args.repeat)
+                t, val = one(family, tol)
             except (RuntimeError, baseline.TimeCapExceeded) as err:  # listed, not dropped
                 rows.append((f"{family} rtol {tol:g}", np.nan, f"failed: {err}"))
                 continue

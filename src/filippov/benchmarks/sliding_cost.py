@@ -5,20 +5,21 @@ return is the hard-case sweep's (theta = 0.5 from (0, 1.2, 0) to L1, rtol 1e-12)
 the sliding field is stiff for eps <= 1e-3 and the driver hands the stay to the
 implicit Radau IIA method. For each eps and each number of stages of that method
 (3 = the order of scipy's Radau, 5 = the driver's default) the table gives the
-driver steps, the median wall time over ``--repeat`` runs and its ratio to the
-time at the largest eps with the default method (not stiff there: DOP853 only).
+driver steps, the median wall time (the benchmarks' convention,
+:mod:`filippov.benchmarks.timing`: one untimed run, then at least ``--repeat`` timed
+runs, more until :data:`MIN_TIME` seconds were timed; the min is stored too) and its
+ratio to the time at the largest eps with the default method (not stiff there: DOP853
+only).
 """
 from __future__ import annotations
 
 import importlib
-import statistics
-import time
 
 import numpy as np
 import xarray as xr
 
 from ..hard_cases import PARAMETERS
-from . import command_line
+from . import command_line, timing
 from ..io import finalize
 from ..models import hopf
 from ..scenes.fig04_retmaps import section_L1
@@ -31,6 +32,8 @@ STAGES = [3, 5]
 # the hard-case sweep's sliding return (hard_cases.sliding_return), timed alone
 THETA, START, T_MAX = (PARAMETERS["return_theta"], (0.0, PARAMETERS["return_x2"], 0.0),
                        PARAMETERS["hopf_t_max"])
+#: seconds timed per return at least (timing.measure's min_time)
+MIN_TIME = 0.2
 
 
 def measure(eps: float, stages: int, repeat: int) -> dict:
@@ -38,18 +41,16 @@ def measure(eps: float, stages: int, repeat: int) -> dict:
     saved = driver.STIFF_STAGES
     driver.STIFF_STAGES = stages
     try:
-        times = []
-        for _ in range(repeat):
-            t0 = time.perf_counter()
-            traj = driver.simulate(model.full(), list(START), T_MAX, sections=[section_L1()],
-                                   dense=False)
-            times.append(time.perf_counter() - t0)
+        t = timing.measure(lambda: driver.simulate(model.full(), list(START), T_MAX,
+                                                   sections=[section_L1()], dense=False),
+                           min_rounds=repeat, min_time=MIN_TIME)
     finally:
         driver.STIFF_STAGES = saved
+    traj = t.value
     if traj.status != "section:L1":
         raise RuntimeError(f"eps={eps}, stages={stages}: no return ({traj.status})")
-    return {"time": statistics.median(times), "steps": traj.n_steps, "P": float(traj.z[1]),
-            "stiff": int("sliding" in traj.stiff_modes)}
+    return {"time": t.median, "time_min": t.min, "runs": t.rounds, "steps": traj.n_steps,
+            "P": float(traj.z[1]), "stiff": int("sliding" in traj.stiff_modes)}
 
 
 def run(repeat: int = 5, log=print) -> xr.Dataset:
@@ -62,6 +63,10 @@ def run(repeat: int = 5, log=print) -> xr.Dataset:
     ds = xr.Dataset(
         {"time": (*table("time"), {"long_name": "median wall time of the return",
                                    "units": "s"}),
+         "time_min": (*table("time_min"), {"long_name": "min wall time of the return "
+                                                        "(fastest run)", "units": "s"}),
+         "runs": (*table("runs"), {"long_name": "timed runs (after a warm-up run)",
+                                   "units": "1"}),
          "steps": (*table("steps"), {"long_name": "driver steps of the return", "units": "1"}),
          "return_P": (*table("P"), {"long_name": "x2 at the return to L1", "units": "1"}),
          "stiff": (*table("stiff"), {"long_name": "1 if the slide went to Radau IIA",
@@ -76,6 +81,7 @@ def run(repeat: int = 5, log=print) -> xr.Dataset:
             f"{rows[(e, s)]['steps']:12d} {1e3 * rows[(e, s)]['time']:7.1f} "
             f"{rows[(e, s)]['time'] / base:6.2f}" for s in STAGES))
     return finalize(ds, None, repeat=repeat, theta=THETA, rtol=1e-12,
+                    **timing.describe(min_rounds=repeat, min_time=MIN_TIME),
                     title="cost of one sliding return of the Hopf example per eps "
                           "(reference driver)")
 

@@ -10,8 +10,13 @@ panel) each method is swept over tolerances and scored by
   an infinite slope: the error measures the conditioning, not the method); the
   fig11 maps are continuous and every point is scored;
 * ``error_switch``: max |t_switch - t_switch_ref| of the first change of mode;
-* ``wall_time``: the median of ``runs`` runs in this process (one core); for
-  fig11 the start points on M_+ are computed once beforehand and not timed;
+* ``wall_time``: the median of ``runs`` timed runs in this process (one core), by
+  the benchmarks' timing convention (:mod:`filippov.benchmarks.timing`): one untimed
+  run of each method on each problem first (the first tolerance of its family: it
+  pays for compiling and loading the kernel and the model's generated pieces), then
+  at least ``repeat`` timed runs per configuration, more until ``min_time`` seconds
+  were timed; ``wall_time_min`` is the fastest of them. For fig11 the start points on
+  M_+ are computed once beforehand and not timed;
 * ``time_per_return``: ``wall_time`` over the map's start points, the cost of one
   return (also printed per configuration, in microseconds);
 
@@ -35,7 +40,6 @@ with its status, never dropped. A table is printed; the dataset goes to
 from __future__ import annotations
 
 import argparse
-import statistics
 import sys
 import time
 from dataclasses import dataclass
@@ -51,7 +55,7 @@ from ..io import finalize, write_dataset
 from ..models import dry_friction
 from ..models import hopf
 from ..scenes.fig04_retmaps import return_map, x2_grid
-from . import baseline
+from . import baseline, timing
 
 ROOT = Path(__file__).resolve().parents[3]
 SCENE = ROOT / "config" / "scenes" / "fig04_retmaps.yaml"
@@ -71,8 +75,9 @@ SCIPY = [("solve_ivp RK45", [1e-3, 1e-4, 1e-6, 1e-8, 1e-10]),
          ("solve_ivp LSODA", [1e-4, 1e-6, 1e-8, 1e-10])]
 QUICK = [("project compiled exact", [1e-10]), ("project DOP853", [1e-8]),
          ("solve_ivp RK45", [1e-6])]
-#: the default build's sweep (rule work_precision, results/work_precision.nc): a
-#: few seconds on subgrids of both scenes, with what a user reaches for first
+#: the default build's sweep (rule work_precision, results/work_precision.nc): about
+#: a minute on subgrids of both scenes (most of it the >= 3 timed runs of the Python
+#: and solve_ivp configurations), with what a user reaches for first
 #: (solve_ivp RK45 and DOP853) next to the project's modes; `make bench` runs the
 #: full sweep
 BUILD = {"families": [("project compiled exact", [1e-8, 1e-10, 1e-12]),
@@ -84,12 +89,14 @@ BUILD = {"families": [("project compiled exact", [1e-8, 1e-10, 1e-12]),
                       # still runs it
                       ("solve_ivp RK45", [1e-6, 1e-8, 1e-10]),
                       ("solve_ivp DOP853", [1e-6, 1e-8, 1e-10, 1e-12])],
-         "every": 20, "every11": 3, "repeat": 3, "time_cap": 10.0, "budget": 0.25}
+         "every": 20, "every11": 3, "repeat": 3, "time_cap": 10.0, "min_time": 0.2}
+#: ``repeat``: timed runs per configuration at least (after the warm-up run of each
+#: method on each problem); ``min_time``: more runs until that many seconds were timed
 PRESETS = {"full": {"families": PROJECT + SCIPY, "every": 10, "every11": 5, "repeat": 3,
-                    "time_cap": 120.0, "budget": 10.0},
+                    "time_cap": 120.0, "min_time": 1.0},
            "build": BUILD,
            "quick": {"families": QUICK, "every": 10, "every11": 5, "repeat": 3,
-                     "time_cap": 120.0, "budget": 10.0}}
+                     "time_cap": 120.0, "min_time": 0.2}}
 
 #: how closely two runs agree (filippov.tolerance): times never do. An error
 #: |P - P_ref| of an approximate method is not a well-conditioned result: it is decided
@@ -129,7 +136,8 @@ def tolerances() -> dict:
     missed = Tolerance(0.5, 2.0, "count of grazing excursions an approximate method steps "
                                  "over: each decided by where its steps end; 0 -> 2 under a "
                                  "1-ulp change of the field for RK45 at rtol 1e-4 (measured)")
-    return {"wall_time": MEASURED, "time_per_return": MEASURED, "runs": MEASURED, "time_ours_at_target": MEASURED,
+    return {"wall_time": MEASURED, "wall_time_min": MEASURED, "time_per_return": MEASURED,
+            "runs": MEASURED, "time_ours_at_target": MEASURED,
             "time_rk45_at_target": MEASURED, "speedup_vs_rk45": MEASURED,
             "error_map": err, "error_switch": err_switch, "reference_check": check,
             "missed_switches": missed}
@@ -273,16 +281,12 @@ def runner(problem: Problem, family: str, tol: float, time_cap: float) -> Callab
     return run
 
 
-def timed(fn, repeat: int, time_cap: float, budget: float = 10.0):
-    """Median wall time of up to ``repeat`` runs (fewer once they took ``budget`` s)."""
-    times, out = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-        if sum(times) > min(budget, time_cap):
-            break
-    return statistics.median(times), len(times), out
+def timed(fn, repeat: int, min_time: float = timing.MIN_TIME, warmup: int = 1
+          ) -> timing.Timing:
+    """``fn`` timed by the benchmarks' convention (:func:`filippov.benchmarks.timing.measure`):
+    ``warmup`` untimed runs, then at least ``repeat`` timed runs, more until ``min_time``
+    seconds were timed. The result of the last run is the Timing's ``value``."""
+    return timing.measure(fn, warmup=warmup, min_rounds=repeat, min_time=min_time)
 
 
 def max_dev(a, b, mask):
@@ -312,13 +316,18 @@ def time_at_error(errors, times, target):
     return float(np.exp(t[i] + w * (t[j] - t[i])))
 
 
-def run(problems, families, repeat: int, time_cap: float, log=print, budget: float = 10.0,
-        **settings) -> xr.Dataset:
+def run(problems, families, repeat: int, time_cap: float, log=print,
+        min_time: float = timing.MIN_TIME, **settings) -> xr.Dataset:
     """Every configuration on every problem; ``settings`` (preset, grid strides) are
-    stored as attributes."""
+    stored as attributes. Timing (:mod:`filippov.benchmarks.timing`): before the first
+    configuration of a family on a problem, one untimed run of it (compilation and
+    caches paid there; repeated at the next tolerance if that run fails); then at
+    least ``repeat`` timed runs per configuration, more until ``min_time`` s were timed;
+    ``wall_time`` is their median, ``wall_time_min`` their min."""
     configs = [(fam, tol) for fam, tols in families for tol in tols]
     shape = (len(problems), len(configs))
     err_map, err_sw, wall = np.full(shape, np.nan), np.full(shape, np.nan), np.full(shape, np.nan)
+    wall_min = np.full(shape, np.nan)
     runs, missed = np.zeros(shape, dtype=np.int32), np.zeros(shape, dtype=np.int32)
     status = np.full(shape, "ok", dtype=object)
     ref_check = np.empty(len(problems))
@@ -331,12 +340,16 @@ def run(problems, families, repeat: int, time_cap: float, log=print, budget: flo
         ref_names.append(f"{ref_fam} rtol {ref_tol:g} vs {chk_fam} rtol {chk_tol:g}")
         log(f"{prob.name}: {prob.x2.size} start points; reference check "
             f"({ref_names[-1]}): {ref_check[i]:.2e}")
+        warmed = set()  # families run once untimed on this problem
         for j, (fam, tol) in enumerate(configs):
             # the reference's own method is scored against the independent check
             want_p, want_sw = (chk_p, chk_sw) if prob.scored_by_check(fam) else (ref_p, ref_sw)
             try:
-                wall[i, j], runs[i, j], (got_p, got_sw) = timed(
-                    runner(prob, fam, tol, time_cap), repeat, time_cap, budget)
+                t = timed(runner(prob, fam, tol, time_cap), repeat, min_time,
+                          warmup=0 if fam in warmed else 1)
+                warmed.add(fam)
+                wall[i, j], wall_min[i, j], runs[i, j] = t.median, t.min, t.rounds
+                got_p, got_sw = t.value
             except NotApplicable:
                 status[i, j] = "n/a"
             except baseline.TimeCapExceeded as exc:
@@ -346,8 +359,9 @@ def run(problems, families, repeat: int, time_cap: float, log=print, budget: flo
             else:
                 err_map[i, j] = max_dev(got_p, want_p, prob.scored)[0]
                 err_sw[i, j], missed[i, j] = max_dev(got_sw, want_sw, prob.scored)
-            log(f"  {fam:24s} rtol {tol:7.0e}  {wall[i, j]:9.4f} s "
-                f"({1e6 * wall[i, j] / prob.x2.size:8.1f} us/return)  map err {err_map[i, j]:9.2e}"
+            log(f"  {fam:24s} rtol {tol:7.0e}  {wall[i, j]:9.4f} s (min {wall_min[i, j]:9.4f} s, "
+                f"{runs[i, j]:4d} runs; {1e6 * wall[i, j] / prob.x2.size:8.1f} us/return)  "
+                f"map err {err_map[i, j]:9.2e}"
                 f"  switch err {err_sw[i, j]:9.2e} ({missed[i, j]} missed)  {status[i, j] if status[i, j] != 'ok' else ''}")
     fam_of = np.array([c[0] for c in configs])
     ratio = np.full(len(problems), np.nan)
@@ -369,11 +383,17 @@ def run(problems, families, repeat: int, time_cap: float, log=print, budget: flo
          "missed_switches": (dims, missed, {
              "long_name": "start points where only one of method and reference switches "
                           "(a grazing excursion missed or invented)", "units": "1"}),
-         "wall_time": (dims, wall, {"long_name": "median wall time of one map", "units": "s"}),
+         "wall_time": (dims, wall, {
+             "long_name": "median wall time of one map (timed runs after a warm-up run)",
+             "units": "s", "statistic": timing.STATISTIC}),
+         "wall_time_min": (dims, wall_min, {
+             "long_name": "min wall time of one map (the fastest timed run)", "units": "s",
+             "statistic": "min"}),
          "time_per_return": (dims, wall / n_points[:, None], {
              "long_name": "cost of one return: median wall time of the map over its start "
-                          "points", "units": "s"}),
-         "runs": (dims, runs, {"long_name": "runs the median is taken over", "units": "1"}),
+                          "points", "units": "s", "statistic": timing.STATISTIC}),
+         "runs": (dims, runs, {"long_name": "timed runs the median and min are taken over "
+                                            "(the warm-up run not counted)", "units": "1"}),
          "status": (dims, status.astype(str), {"long_name": "ok, failed: ..., or time cap: ..."}),
          "reference_check": ("problem", ref_check, {
              "long_name": "max |P_reference - P_check| (see reference_pair)", "units": "1"}),
@@ -398,7 +418,8 @@ def run(problems, families, repeat: int, time_cap: float, log=print, budget: flo
 
     ds = annotate(ds, tolerances())
     return finalize(ds, None, target_error=TARGET_ERROR, time_cap=time_cap, repeat=repeat,
-                    grazing_gap=GRAZING_GAP, budget=budget, **settings,
+                    grazing_gap=GRAZING_GAP, min_time=min_time, **settings,
+                    **timing.describe(min_rounds=repeat, min_time=min_time),
                     title="work-precision of the fig04 and fig11 return maps: project vs solve_ivp")
 
 
@@ -413,7 +434,8 @@ def merge(parts: list[xr.Dataset]) -> xr.Dataset:
         if not (np.array_equal(ds.method.values, first.method.values)
                 and np.array_equal(ds.tolerance.values, first.tolerance.values)):
             raise ValueError("benchmark parts were run with different method/tolerance lists")
-        for key in ("target_error", "time_cap", "repeat", "grazing_gap", "preset", "budget"):
+        for key in ("target_error", "time_cap", "repeat", "grazing_gap", "preset", "min_time",
+                    "timing_statistic", "timing_warmup", "timing_max_rounds"):
             if ds.attrs.get(key) != first.attrs.get(key):
                 raise ValueError(f"benchmark parts differ in their setting {key!r}")
     names = np.concatenate([ds.problem.values for ds in parts])
@@ -424,16 +446,20 @@ def merge(parts: list[xr.Dataset]) -> xr.Dataset:
 
 
 def table(ds: xr.Dataset) -> str:
-    lines = []
+    stat = ds.attrs.get("timing_statistic", "median")
+    has_min = "wall_time_min" in ds
+    lines = [f"times: {ds.attrs.get('timing', stat)}"]
     for i, prob in enumerate(ds.problem.values):
         lines.append(f"\n{prob}: {int(ds.n_points[i])} points, reference check "
                      f"{float(ds.reference_check[i]):.1e}")
-        lines.append(f"{'method':26s} {'rtol':>7s} {'time [s]':>10s} {'map error':>10s} "
-                     f"{'switch err':>10s} {'missed':>6s}  status")
+        lines.append(f"{'method':26s} {'rtol':>7s} {stat + ' [s]':>10s} {'min [s]':>10s} "
+                     f"{'runs':>5s} {'map error':>10s} {'switch err':>10s} {'missed':>6s}  status")
         for j in range(ds.sizes["config"]):
             st = str(ds.status.values[i, j])
+            t_min = float(ds.wall_time_min[i, j]) if has_min else np.nan
             lines.append(f"{str(ds.method.values[j]):26s} {float(ds.tolerance[j]):7.0e} "
-                         f"{float(ds.wall_time[i, j]):10.4f} {float(ds.error_map[i, j]):10.2e} "
+                         f"{float(ds.wall_time[i, j]):10.4f} {t_min:10.4f} "
+                         f"{int(ds.runs[i, j]):5d} {float(ds.error_map[i, j]):10.2e} "
                          f"{float(ds.error_switch[i, j]):10.2e} {int(ds.missed_switches[i, j]):6d}  {'' if st == 'ok' else st}")
         lines.append(f"at error {TARGET_ERROR:g}: project {float(ds.time_ours_at_target[i]):.4f} s, "
                      f"RK45 {float(ds.time_rk45_at_target[i]):.4f} s, "
@@ -445,12 +471,16 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--preset", choices=sorted(PRESETS), default="full",
                     help="methods, tolerances, grids and repeats: full (make bench), build "
-                         "(the default build's seconds-long sweep) or quick (smoke test)")
+                         "(the default build's minute-long sweep) or quick (smoke test)")
     ap.add_argument("--every", type=int, help="use every k-th fig04 grid point")
     ap.add_argument("--every11", type=int, help="use every k-th point of the fig11 base grid")
     ap.add_argument("--problems", default="fig04,fig11",
                     help="comma-separated problem sets: fig04, fig11")
-    ap.add_argument("--repeat", type=int, help="runs per configuration (median)")
+    ap.add_argument("--repeat", type=int,
+                    help="timed runs per configuration at least (median and min; after one "
+                         "untimed run of each method per problem)")
+    ap.add_argument("--min-time", type=float,
+                    help="time more runs of a configuration until this many seconds")
     ap.add_argument("--time-cap", type=float, help="seconds per configuration")
     ap.add_argument("--quick", action="store_true", help="same as --preset quick")
     ap.add_argument("--out", default=str(ROOT / "results" / "bench_work_precision.nc"))
@@ -466,19 +496,20 @@ def main(argv=None) -> None:
         print(f"\nwrote {args.out}")
         return
     preset = dict(PRESETS["quick" if args.quick else args.preset])
-    for key in ("every", "every11", "repeat", "time_cap"):
+    for key in ("every", "every11", "repeat", "time_cap", "min_time"):
         if getattr(args, key) is not None:
             preset[key] = getattr(args, key)
     if preset["every"] < 1 or preset["every11"] < 1 or preset["repeat"] < 1 \
-            or not preset["time_cap"] > 0:
-        ap.error("--every, --every11 and --repeat must be >= 1 and --time-cap > 0")
+            or not preset["time_cap"] > 0 or not preset["min_time"] >= 0:
+        ap.error("--every, --every11 and --repeat must be >= 1, --time-cap > 0 and "
+                 "--min-time >= 0")
     sets = [s.strip() for s in args.problems.split(",") if s.strip()]
     if not sets or set(sets) - {"fig04", "fig11"}:
         ap.error(f"--problems: choose from fig04, fig11, got {args.problems!r}")
     problems = ((fig04_problems(preset["every"]) if "fig04" in sets else [])
                 + (fig11_problems(preset["every11"]) if "fig11" in sets else []))
     ds = run(problems, preset["families"], preset["repeat"], preset["time_cap"],
-             log=lambda s: print(s, file=sys.stderr, flush=True), budget=preset["budget"],
+             log=lambda s: print(s, file=sys.stderr, flush=True), min_time=preset["min_time"],
              preset="quick" if args.quick else args.preset, every=preset["every"],
              every11=preset["every11"])
     write_dataset(ds, args.out)
