@@ -226,3 +226,76 @@ def fig11(n: int = 41) -> xr.Dataset:
          "eps": ("panel", [0.1, 0.01]), "v0": ("panel", [3.32, 3.1]),
          "v0_sn": ("panel", [3.3228, 3.1721])},
         coords={"panel": [0, 1], "x1": x1})
+
+
+def fig12(n_s: int = 19, k: int = 6) -> xr.Dataset:
+    """Orbit diagrams of made-up period-n windows; edges converging like eps."""
+    s = np.linspace(-0.5, 4.0, n_s)
+    eps = np.array([1e-2, 1e-3, 1e-4])
+    per = np.where(s < 0, 1, 2 + (np.floor(s) % 3)).astype(np.int32)
+    u0 = 0.1 * s[:, None] - 0.2 * (np.arange(k)[None, :] % per[:, None])
+    u = np.broadcast_to(u0, (1, eps.size, n_s, k)) + 0.01 * eps[None, :, None, None]
+    n = np.array([2, 3])
+    edge0 = np.array([[1.0, 1.6], [0.5, 0.8]])
+    return xr.Dataset(
+        {"u": (("theta", "eps", "s", "k"), u.copy()), "u_limit": (("theta", "eps", "s", "k"), u.copy()),
+         "u_limit0": (("theta", "s", "k"), u0[None]),
+         "period": (("theta", "eps", "s"), np.broadcast_to(per, (1, eps.size, n_s)).copy()),
+         "period_limit0": (("theta", "s"), per[None]),
+         "edge": (("eps", "n", "side"), edge0[None] + eps[:, None, None]),
+         "edge_limit0": (("n", "side"), edge0), "edge_gap": ("eps", 2 * eps)},
+        coords={"theta": [-0.5], "eps": eps, "s": s, "k": np.arange(k), "n": n, "side": [0, 1]},
+        attrs={"theta": -0.5, "s_max": 4.0})
+
+
+def fig13(k: int = 5) -> xr.Dataset:
+    """Fans of made-up chaotic returns; widths ~ eps^2 (mu - 1)."""
+    theta = np.array([0.5, 0.2, 0.1])
+    eps = np.array([1e-2, 1e-3])
+    s = np.concatenate([np.linspace(-1.0, 5.0, 13), [20.0, 100.0]])
+    shape = (theta.size, eps.size, s.size)
+    fan = np.maximum(s, 0)[None, None, :, None] * np.linspace(-0.3, 0.1, k)
+    u = np.broadcast_to(fan, shape + (k,)).copy()
+    lyap = np.broadcast_to(np.where(s > 0, 0.3, -0.5), shape).copy()
+    width = np.broadcast_to(np.maximum(s, 0) * eps[None, :, None] ** 2 + 1e-12, shape).copy()
+    return xr.Dataset(
+        {"u": (("theta", "eps", "s", "k"), u), "u_limit": (("theta", "eps", "s", "k"), u),
+         "lyapunov": (("theta", "eps", "s"), lyap), "lyapunov_limit": (("theta", "eps", "s"), lyap),
+         "width_x2": (("theta", "eps", "s"), width),
+         "width_exponent": (("theta", "s"), np.broadcast_to(np.where(s > 0, 2.0, np.nan),
+                                                           (theta.size, s.size)).copy()),
+         "slope_pdm": ("theta", (theta - 1) / theta),
+         "period": (("theta", "eps", "s"), np.where(np.broadcast_to(s, shape) > 0, 0, 1)
+                    .astype(np.int32))},
+        coords={"theta": theta, "eps": eps, "s": s, "k": np.arange(k)},
+        attrs={"s_max": 5.0})
+
+
+def fig14() -> xr.Dataset:
+    """Every attractor class once or more on a coarse (theta, s) grid."""
+    theta = np.linspace(-1.0, 0.8, 7)
+    s = np.linspace(-1.0, 5.0, 7)
+    kind = (np.add.outer(np.arange(theta.size), np.arange(s.size)) % 10 - 2).astype(np.int32)
+    sb, eb = np.array([0.5, 1.0, 2.0]), np.array([1e-2, 1e-3])
+    flip = 0.38 + 0.01 * sb
+    return xr.Dataset(
+        {"attractor_type": (("theta", "eps", "s"), kind[:, None, :]),
+         "attractor_type_limit": (("theta", "eps", "s"), kind[::-1, None, :].copy()),
+         "theta_critical": 0.3775, "theta_chaos": 0.2689,
+         "theta_flip": (("eps_boundary", "s_boundary"), np.stack([flip, flip])),
+         "theta_chaos_flip": (("eps_boundary", "s_boundary"), np.stack([flip, flip]) - 0.1),
+         "theta_flip_limit": ("s_boundary", flip), "theta_chaos_limit": ("s_boundary", flip - 0.1)},
+        coords={"theta": theta, "eps": [1e-3], "s": s, "s_boundary": sb, "eps_boundary": eb})
+
+
+def work_precision() -> xr.Dataset:
+    """Two problems, two methods at three tolerances each."""
+    method = ["project compiled exact"] * 3 + ["solve_ivp RK45"] * 3
+    err = np.array([[1e-12, 1e-11, 1e-10, 1e-3, 1e-5, 1e-7]] * 2)
+    wall = np.array([[1e-3, 1.2e-3, 1.5e-3, 0.1, 0.3, 1.0]] * 2)
+    return xr.Dataset(
+        {"error_map": (("problem", "config"), err), "wall_time": (("problem", "config"), wall),
+         "status": (("problem", "config"), np.full(err.shape, "ok", dtype=object)),
+         "reference_check": ("problem", [1e-13, 1e-13]), "n_points": ("problem", [60, 9])},
+        coords={"problem": ["fig04 theta=-0.5", "fig11 (a) eps=0.1"],
+                "method": ("config", method), "tolerance": ("config", [1e-6, 1e-8, 1e-10] * 2)})

@@ -24,7 +24,7 @@ def draw(ds):
     n = ds.sizes["problem"]
     ncols = min(n, 2)
     nrows = -(-n // ncols)
-    fig = st.new_figure(st.WIDTH_DOUBLE, 3.0 * nrows)
+    fig = st.new_figure(st.TEXT_WIDTH, 2.4 * nrows)
     axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
     for ax in axes[n:]:
         ax.set_visible(False)
@@ -45,7 +45,8 @@ def draw(ds):
         ax.axhline(check, color=st.C_AUX, lw=0.8, ls=":", label="reference check")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel("wall time of one map [s]")
+        # the statistic the sweep shows (filippov.benchmarks.timing; older sweeps: median)
+        ax.set_xlabel(f"{ds.attrs.get('timing_statistic', 'median')} wall time of one map [s]")
         name = str(ds.problem.values[i]).replace("theta=", r"$\theta=$").replace(
             "eps=", r"$\varepsilon=$")   # the paper's symbols
         st.panel_label(ax, f"({'abcd'[i]}) {name}, {int(ds.n_points.values[i])} points")
@@ -56,6 +57,6 @@ def draw(ds):
     for ax in axes:
         for h, label in zip(*ax.get_legend_handles_labels()):
             handles.setdefault(label, h)
-    fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncol=4,
-               fontsize=6.5, frameon=False)
+    fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncol=3,
+               frameon=False)
     return fig

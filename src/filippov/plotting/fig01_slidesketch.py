@@ -57,7 +57,7 @@ def _panel(ax, d) -> None:
 
 def draw(ds):
     st.require(ds, "fig01_slidesketch", VARS)
-    fig = st.new_figure(st.WIDTH_DOUBLE, 2.6)
+    fig = st.new_figure(st.TEXT_WIDTH, 2.1)
     axes = fig.subplots(1, 2)
     for ax, (tag, case) in zip(axes, (("a", "crossing"), ("b", "sliding"))):
         _panel(ax, ds.sel(case=case))

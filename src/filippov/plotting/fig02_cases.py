@@ -79,7 +79,7 @@ def draw(ds):
     thetas = ds.theta.values
     pos, neg = float(thetas[thetas > 0][0]), float(thetas[thetas < 0][0])
     half = _half_width(ds, eps)
-    fig = st.new_figure(st.WIDTH_DOUBLE, 3.4)
+    fig = st.new_figure(st.TEXT_WIDTH, 2.7)
     ax_a, ax_b = fig.subplots(1, 2)
 
     # (a) theta > 0: the attracting sliding segment |x| < eps theta on H_s.

@@ -60,7 +60,7 @@ def draw(ds):
     mus = ds.mu.values
     if mus.size != 3:
         raise ValueError(f"fig03_grazingsketch: expected three values of mu, got {mus.tolist()}")
-    fig = st.new_figure(st.WIDTH_DOUBLE, 2.55)
+    fig = st.new_figure(st.TEXT_WIDTH, 2.0)
     axes = fig.subplots(1, 3, sharey=True)
     relation = {-1: "<1", 0: "=1", 1: ">1"}
     for k, (ax, mu) in enumerate(zip(axes, mus)):

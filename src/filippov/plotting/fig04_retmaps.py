@@ -12,7 +12,7 @@ VARS = ["P", "residual", "fixed_point", "n_switches"]
 def draw(ds):
     st.require(ds, "fig04_retmaps", VARS)
     x2 = ds.x2.values
-    fig = st.new_figure(st.WIDTH_DOUBLE, 3.1)
+    fig = st.new_figure(st.TEXT_WIDTH, 2.5)
     axes = fig.subplots(1, 2)
     lo, hi = x2.min(), x2.max()
     for k, (ax, theta) in enumerate(zip(axes, ds.theta.values)):

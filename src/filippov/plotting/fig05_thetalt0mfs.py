@@ -77,7 +77,7 @@ def draw(ds):
     box = ((g1[0], g1[-1]), (g2[0], g2[-1]), (lo_y - pad, hi_y + pad))
     cols = np.flatnonzero(np.all((ym >= box[2][0]) & (ym <= box[2][1]), axis=0))
 
-    fig = st.new_figure(st.WIDTH_SINGLE + 0.4, 3.9)
+    fig = st.new_figure(0.85 * st.TEXT_WIDTH, 4.2)  # printed at 0.85\textwidth
     ax = fig.add_subplot(projection="3d")
     ax.computed_zorder = False  # translucent surfaces first, curves on top
     ax.view_init(**VIEW)
@@ -107,7 +107,8 @@ def draw(ds):
     ax.set_xlabel(st.X1, labelpad=-7)
     ax.set_ylabel(st.X2, labelpad=-7)
     ax.set_zlabel(st.Y, labelpad=-7)
-    ax.tick_params(pad=-3, labelsize=6)
+    ax.tick_params(pad=-3, labelsize=st.FONT_MIN)
+    ax.tick_params(axis="z", pad=0)  # clear of the tick marks
     for axis, prune in ((ax.xaxis, "both"), (ax.yaxis, "both"), (ax.zaxis, None)):
         axis.set_major_locator(MaxNLocator(4, steps=[1, 2, 2.5, 5, 10], prune=prune))
         axis.pane.set_alpha(0.0)
@@ -132,9 +133,9 @@ def draw(ds):
                Line2D([], [], color="k", lw=0.5, ls=(0, (4, 3)),
                       label=r"$\mathcal{H}_s\cap\mathcal{M}_{+}$")]
     fig.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.93), ncols=3,
-               handlelength=1.6, columnspacing=0.9, borderaxespad=0.0, fontsize=7)
+               handlelength=1.6, columnspacing=0.9, borderaxespad=0.0)
     fig.suptitle(rf"$\theta={theta:g}$, $\mu=1$, $\varepsilon={eps:g}$, $\omega={_omega(ds)}$",
-                 x=0.02, y=0.99, ha="left", va="top", fontsize=9)
+                 x=0.02, y=0.99, ha="left", va="top")
     return fig
 
 

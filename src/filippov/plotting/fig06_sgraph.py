@@ -31,14 +31,14 @@ def _marks(ax, ts, xi, img, values, offset, ha, va) -> None:
             k = int(np.argmin(np.abs(ts - t)))
             ax.plot([xi[k]], [img[k]], "o", ms=2.6, color=st.C_PLUS, zorder=5)
             ax.annotate(rf"$t_s={t:g}$", (xi[k], img[k]), xytext=offset,
-                        textcoords="offset points", ha=ha, va=va, fontsize=7)
+                        textcoords="offset points", ha=ha, va=va, fontsize=st.FONT_MIN)
 
 
 def draw(ds):
     st.require(ds, "fig06_sgraph", VARS)
     xi, img, ts = ds.xi1.values, ds.image.values, ds.t_s.values
     slope, level = float(ds.slope_at_zero), float(ds.image_limit)
-    fig = st.new_figure(st.WIDTH_DOUBLE, 2.5)
+    fig = st.new_figure(0.8 * st.TEXT_WIDTH, 2.1)  # printed at 0.8\textwidth
     ax, zx = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.25, 1.0]})
 
     # (a) the whole graph
@@ -55,19 +55,22 @@ def draw(ds):
 
     # (b) near the grazing point, equal scales
     near = ts <= ZOOM_T
-    xmin = 1.05 * xi[near].min()
+    xmin = 1.2 * xi[near].min()  # room for the leftmost t_s label
     ymax = 1.3 * img[near].max()
     zx.plot(xi[near], img[near], color=st.C_PLUS, lw=st.LW, zorder=3)
     _axes_lines(zx)
     x = np.array([min(xmin, ymax / slope if slope < 0 else xmin), 0.0])
-    zx.plot(x, slope * x, ls=(0, (4, 2)), color="k", lw=st.LW_THIN, zorder=4,
-            label=rf"slope $(\theta-1)/\theta={slope:g}$")
+    zx.plot(x, slope * x, ls=(0, (4, 2)), color="k", lw=st.LW_THIN, zorder=4)
+    # named along itself, on its empty side (a legend box would cover the curve or the line)
+    xm = 0.5 * max(x[0], ymax / slope if slope < 0 else x[0])  # mid-way along the visible part
+    zx.text(xm - 0.03 * xmin, slope * xm, rf"slope $(\theta-1)/\theta={slope:g}$",
+            rotation=np.degrees(np.arctan(slope)), transform_rotates_text=True,
+            rotation_mode="anchor", ha="center", va="bottom")
     _marks(zx, ts, xi, img, MARK_ZOOM, (-2, -3), "right", "top")
     zx.set_xlim(xmin, -0.05 * xmin)
     zx.set_ylim(-0.05 * ymax, ymax)
     zx.set_xlabel(XI1)
     zx.set_ylabel(IMAGE)
-    zx.legend(loc="lower left")
     st.panel_label(zx, r"(b) near $\xi_1=0$")
     box = zx.get_xlim(), zx.get_ylim()
     ax.add_patch(Rectangle((box[0][0], box[1][0]), box[0][1] - box[0][0], box[1][1] - box[1][0],

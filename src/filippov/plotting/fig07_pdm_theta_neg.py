@@ -28,7 +28,7 @@ def reference_slope(ax, x, y0, p, label, above=True, at=0.5, **kw):
     ax.plot(x, y0 * (x / x[0]) ** p, **kw)
     xm = x[0] * (x[-1] / x[0]) ** at
     ax.annotate(label, (xm, y0 * (xm / x[0]) ** p), textcoords="offset points",
-                xytext=(2, 4) if above else (-4, -11), fontsize=7,
+                xytext=(2, 4) if above else (-4, -11), fontsize=st.FONT_MIN,
                 ha="left" if above else "right", color=kw.get("color", "k"))
 
 
@@ -39,7 +39,7 @@ def draw(ds):
     s0 = float(ds.s0)
     theta = float(ds.theta) if "theta" in ds else float(ds.attrs.get("theta", np.nan))
     cols = eps_colours(eps.size)
-    fig = st.new_figure(st.WIDTH_DOUBLE, 3.0)
+    fig = st.new_figure(st.TEXT_WIDTH, 3.3)
     ax, bx = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.55, 1.0]})
 
     neg, pos = xi < 0, xi >= 0
@@ -78,14 +78,14 @@ def draw(ds):
     st.panel_label(ax, rf"(a) $\theta={theta:g}$, $\mu=1$, $x_1=-1+\varepsilon\xi_1$")
     handles, labels = ax.get_legend_handles_labels()
     is_eps = [lab.startswith(r"$\varepsilon=$") for lab in labels]
-    leg = ax.legend([h for h, e in zip(handles, is_eps) if e],
-                    [lab for lab, e in zip(labels, is_eps) if e],
-                    loc="lower right", fontsize=6.5, handlelength=1.6, title="numerical",
-                    title_fontsize=6.5)
-    ax.add_artist(leg)
-    ax.legend([h for h, e in zip(handles, is_eps) if not e],
-              [lab for lab, e in zip(labels, is_eps) if not e],
-              loc="upper left", fontsize=6.5, handlelength=2.2)
+    # off the curves: the numerical eps in the empty corner right of xi1 = 0, the line
+    # styles below the panels (lower left, under (a))
+    ax.legend([h for h, e in zip(handles, is_eps) if e],
+              [lab for lab, e in zip(labels, is_eps) if e],
+              loc="upper right", handlelength=1.6, labelspacing=0.3, title="numerical")
+    fig.legend([h for h, e in zip(handles, is_eps) if not e],
+               [lab for lab, e in zip(labels, is_eps) if not e],
+               loc="outside lower left", handlelength=2.2)
 
     e1 = ds.error_first_order.values
     e0 = ds.error_zero_order.values
@@ -105,5 +105,5 @@ def draw(ds):
     bx.set_ylabel(r"$\max_{\xi_1<0}\,|P_{\mathrm{DM}}-P_{\mathrm{asymptotic}}|$")
     bx.invert_xaxis()
     st.panel_label(bx, "(b) deviation from the expansions")
-    bx.legend(loc="lower left", fontsize=6.5)
+    fig.legend(*bx.get_legend_handles_labels(), loc="outside lower right")  # under (b)
     return fig

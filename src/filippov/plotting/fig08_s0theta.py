@@ -12,7 +12,7 @@ VARS = ["s0", "s0_root"]
 def draw(ds):
     st.require(ds, "fig08_s0theta", VARS)
     theta = ds.theta.values
-    fig = st.new_figure(st.WIDTH_SINGLE, 2.5)
+    fig = st.new_figure(0.6 * st.TEXT_WIDTH, 2.2)  # printed at 0.6\textwidth
     ax = fig.add_subplot()
     ax.plot(theta, -theta, ls="--", color=st.C_AUX, lw=st.LW, label=r"$-\theta$")
     ax.plot(theta, ds.s0.values, color=st.C_PLUS, lw=st.LW, label=st.S0)

@@ -20,7 +20,7 @@ def draw(ds):
     theta = float(ds.theta) if "theta" in ds else float(ds.attrs.get("theta", np.nan))
     core = float(ds.attrs.get("core", 5.0))
     cols = eps_colours(eps.size)
-    fig = st.new_figure(st.WIDTH_DOUBLE, 2.9)
+    fig = st.new_figure(st.TEXT_WIDTH, 3.2)
     ax, zx, bx = fig.subplots(1, 3, gridspec_kw={"width_ratios": [1.35, 1.0, 1.0]})
     neg, pos = xi < 0, xi >= 0
 
@@ -51,17 +51,12 @@ def draw(ds):
     ax.set_ylabel(r"$P_{\mathrm{DM}}(\xi_1)$")
     st.panel_label(ax, rf"(a) $\theta={theta:g}$, $\mu=1$, $x_1=-1+\varepsilon^2\xi_1$")
     st.panel_label(zx, "(b) near the grazing point")
+    # off the curves, below the panels: one legend for (a) and (b) (the same curves;
+    # numerical eps in the first column), lower left; (c)'s lower right
     handles, labels = ax.get_legend_handles_labels()
-    is_eps = [lab.startswith(r"$\varepsilon=$") for lab in labels]
-    leg = ax.legend([h for h, e in zip(handles, is_eps) if e],
-                    [lab for lab, e in zip(labels, is_eps) if e], loc="upper right",
-                    fontsize=6.5, handlelength=1.6, title="numerical", title_fontsize=6.5)
-    ax.add_artist(leg)
-    ax.legend([h for h, e in zip(handles, is_eps) if not e],
-              [lab for lab, e in zip(labels, is_eps) if not e], loc="upper left",
-              fontsize=6.5, handlelength=2.2)
     zh, zl = zx.get_legend_handles_labels()
-    zx.legend(zh[-1:], zl[-1:], loc="lower left", fontsize=6.5, handlelength=2.2)
+    fig.legend(handles + zh[-1:], labels + zl[-1:], loc="outside lower left", ncol=2,
+               handlelength=2.2)
 
     err, core_err, errp = (ds[v].values for v in ("error", "error_core", "error_printed"))
     bx.loglog(eps, errp, "^-", ms=3.5, lw=st.LW_THIN, color="0.45",
@@ -75,6 +70,6 @@ def draw(ds):
     bx.set_xlabel(r"$\varepsilon$")
     bx.set_ylabel(r"$\max\,|P_{\mathrm{DM}}-P_{\mathrm{zero\ order}}|$")
     bx.invert_xaxis()
-    st.panel_label(bx, "(c) deviation from zero order")
-    bx.legend(loc="lower left", fontsize=6.5)
+    st.panel_label(bx, "(c) deviation from\nzero order")
+    fig.legend(*bx.get_legend_handles_labels(), loc="outside lower right")
     return fig

@@ -43,7 +43,7 @@ def _setup(ax):
 
 def draw(ds):
     st.require(ds, "fig10_dfo", VARS)
-    fig = st.new_figure(st.WIDTH_DOUBLE, 2.6)
+    fig = st.new_figure(st.TEXT_WIDTH, 2.75)
     gs = fig.add_gridspec(1, 3, width_ratios=[1.0, 0.9, 1.35])
     ax_a, ax_b, ax_c = (fig.add_subplot(gs[0, i]) for i in range(3))
     _setup(ax_a)
@@ -59,8 +59,8 @@ def draw(ds):
         Fl = ds.F_c_literal.values
         for k, side in enumerate((nu < 0, nu > 0)):
             ax_b.plot(nu[side], Fl[side], color=st.C_AUX, lw=st.LW_THIN, ls="--",
-                      label="printed law, literal" if k == 0 else None)
-        ax_b.legend(loc="lower right", fontsize=7)
+                      label="printed law,\nliteral" if k == 0 else None)
+        st.legend_below(ax_b)
     ax_b.axhline(0, color=st.C_AUX, lw=st.LW_THIN)
     ax_b.set_xlabel(r"$v_\mathrm{rel}=x_2-v$")
     ax_b.set_ylabel(r"$F_c$")
@@ -89,6 +89,6 @@ def draw(ds):
     ax_c.set_xlabel("belt speed $v$")
     ax_c.set_ylabel(r"$\max\,x_1$ on the orbit")
     ax_c.set_xlim(float(ev.min()), float(ev.max()))
-    ax_c.legend(loc="upper left", fontsize=7)
+    st.legend_below(ax_c)
     st.panel_label(ax_c, "(c) bifurcation diagram")
     return fig

@@ -36,7 +36,7 @@ def _stable(fp, x1, P):
 def draw(ds):
     st.require(ds, "fig11_dfo_retmaps", VARS)
     x1 = ds.x1.values
-    fig = st.new_figure(st.WIDTH_DOUBLE, 3.3)
+    fig = st.new_figure(st.TEXT_WIDTH, 2.7)
     axes = fig.subplots(1, ds.sizes["panel"], squeeze=False)[0]
     lo, hi = x1.min(), x1.max()
     handles = {}
@@ -72,9 +72,9 @@ def draw(ds):
         st.panel_label(ax, f"({'ab'[k]}) $\\epsilon={eps:g}$, $v_0={v0:g}$")
         if "v0_sn" in ds:
             ax.text(0.97, 0.04, f"saddle-node at $v_0={float(ds.v0_sn.values[k]):.6f}$",
-                    transform=ax.transAxes, ha="right", va="bottom", fontsize=7)
+                    transform=ax.transAxes, ha="right", va="bottom", fontsize=st.FONT_MIN)
     order = ["diag", "free", "stick", "onset", "fp_s", "fp_u"]
     hs = [handles[n] for n in order if n in handles]
     fig.legend(hs, [h.get_label() for h in hs], loc="outside lower center", ncol=3,
-               fontsize=7, frameon=False)
+               frameon=False)
     return fig

@@ -16,7 +16,7 @@ def draw(ds):
     st.require(ds, "fig12_period_adding", VARS)
     s, eps = ds.s.values, ds.eps.values
     theta = float(ds.theta.values[0])
-    fig = st.new_figure(st.WIDTH_DOUBLE, 5.2)
+    fig = st.new_figure(st.TEXT_WIDTH, 5.0)
     axes = fig.subplots(2, 3)
     shown = [0, len(eps) // 2, len(eps) - 1]
     for k, (ax, j) in enumerate(zip(axes[0], shown)):
@@ -51,7 +51,7 @@ def draw(ds):
     ax.set_xlabel(S_LABEL)
     ax.set_ylabel("period of the attractor")
     ax.set_xlim(s.min(), s.max())
-    ax.legend(loc="upper right", fontsize=6)
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2)  # under (e)
     st.panel_label(ax, "(e) period (gaps: none found)")
     ax = axes[1, 2]
     edge, edge0 = ds.edge.values, ds.edge_limit0.values
@@ -67,6 +67,6 @@ def draw(ds):
               label="slow-fast vs limit map")
     ax.set_xlabel(st.EPS)
     ax.set_ylabel(r"$|$edge $-$ edge$_{\varepsilon\to0}|$ in $s$")
-    ax.legend(loc="lower right", fontsize=6)
-    st.panel_label(ax, "(f) window edges: left o, right \u25a1")
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower right")  # under (f)
+    st.panel_label(ax, "(f) window edges:\nleft o, right \u25a1")
     return fig

@@ -24,7 +24,7 @@ def draw(ds):
     s, eps, th = ds.s.values, ds.eps.values, ds.theta.values
     lin = s <= float(ds.attrs["s_max"]) + 1e-12
     j = len(eps) - 1
-    fig = st.new_figure(st.WIDTH_DOUBLE, 5.2)
+    fig = st.new_figure(st.TEXT_WIDTH, 4.9)
     axes = fig.subplots(2, 3)
     picks = [i for i in np.argsort(-th) if th[i] in (0.5, 0.2, 0.1)][:3] or [0, 1, 2][:th.size]
     for k, (ax, i) in enumerate(zip(axes[0], picks)):
@@ -35,12 +35,12 @@ def draw(ds):
         ax.set_ylabel(U_LABEL)
         ax.set_xlim(s[lin].min(), s[lin].max())
         st.panel_label(ax, f"({'abc'[k]}) $\\theta={th[i]:g}$, "
-                           f"$\\varepsilon={st.eps_value(eps[j])}$, "
+                           f"$\\varepsilon={st.eps_value(eps[j])}$,\n"
                            f"$s(\\theta,0,0)={float(ds.slope_pdm.values[i]):.3g}$")
         if k == 0:
             ax.plot([], [], "s", ms=3, color="black", label="slow-fast")
             ax.plot([], [], "s", ms=3, color=st.C_MINUS, label="limit map")
-            ax.legend(loc="upper left")
+            ax.legend(loc="lower right")  # below the attractor: empty
     ax = axes[1, 0]
     for i, t in enumerate(th):
         c = COLORS[i % len(COLORS)]
@@ -52,7 +52,7 @@ def draw(ds):
     ax.set_xlim(s[lin].min(), s[lin].max())
     ax.set_xlabel(S_LABEL)
     ax.set_ylabel("largest Lyapunov exponent")
-    ax.legend(loc="lower right", fontsize=6, ncol=2)
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower left", ncol=2)  # under (d)
     st.panel_label(ax, f"(d) $\\varepsilon={st.eps_value(eps[j])}$; dashed: limit map")
     ax = axes[1, 1]
     i = int(np.argmin(np.abs(th - 0.2)))
@@ -64,7 +64,7 @@ def draw(ds):
                   color=COLORS[(jj + 2) % len(COLORS)], label=f"$\\varepsilon={st.eps_value(e)}$")
     ax.set_xlabel(r"$\mu-1$")
     ax.set_ylabel(r"width of the attractor in $x_2$")
-    ax.legend(loc="upper left", fontsize=6)
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center")  # under (e)
     st.panel_label(ax, f"(e) $\\theta={th[i]:g}$: chaos on the scale $\\varepsilon^2$")
     ax = axes[1, 2]
     for i, t in enumerate(th):
@@ -76,6 +76,6 @@ def draw(ds):
     ax.set_ylim(0.0, 4.0)
     ax.set_xlabel(S_LABEL)
     ax.set_ylabel(r"$k$ in width $\propto\varepsilon^k$")
-    ax.legend(loc="lower left", fontsize=6)
-    st.panel_label(ax, "(f) scaling exponent of the width")
+    ax.legend(loc="lower left")
+    st.panel_label(ax, "(f) scaling exponent\nof the width")
     return fig

@@ -37,7 +37,7 @@ def draw(ds):
     eps = float(ds.eps.values[0])
     cmap = mcolors.ListedColormap(COLORS)
     norm = mcolors.BoundaryNorm(np.arange(len(COLORS) + 1) - 0.5, len(COLORS))
-    fig = st.new_figure(st.WIDTH_DOUBLE, 3.3)
+    fig = st.new_figure(st.TEXT_WIDTH, 2.8)
     axes = fig.subplots(1, 2, sharey=True)
     crit, chaos = float(ds.theta_critical.values), float(ds.theta_chaos.values)
     sb = ds.s_boundary.values
@@ -69,5 +69,5 @@ def draw(ds):
                              **_LINE)[0],
                 axes[0].plot([], [], ls="-", marker="o", ms=3, mfc="white", mec="black",
                              mew=0.6, label="multiplier $-1$ of\nperiod one, two", **_LINE)[0]]
-    fig.legend(handles=handles, loc="outside right center", fontsize=6, frameon=False)
+    fig.legend(handles=handles, loc="outside right center", frameon=False)
     return fig

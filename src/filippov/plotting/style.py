@@ -8,8 +8,14 @@ from __future__ import annotations
 import matplotlib as mpl
 import numpy as np
 
-WIDTH_SINGLE = 3.4  # inches, one journal column
-WIDTH_DOUBLE = 7.0  # inches, full text width
+# Figures are drawn at the size they are printed (scale factor 1), so every size below
+# is a size on paper. The report, paper/main.tex, is \documentclass[preprint,11pt,
+# a4paper]{elsarticle} without a geometry package: \textwidth = 360pt (a LaTeX run
+# printing \the\textwidth says 360.0pt; TeX has 72.27 pt to the inch), 4.98 in. A figure
+# included with \includegraphics[width=f\textwidth] is drawn f * TEXT_WIDTH wide
+# (tests/test_print_size.py reads the widths from paper/*.tex and checks the fonts).
+TEXT_WIDTH = 360.0 / 72.27  # inches
+FONT_MIN = 7  # pt: nothing is printed smaller (tick labels, legends, notes)
 
 # The paper's symbols, so every module labels things the same way. Sub-
 # scripts +/- are braced: mathtext spaces a bare `_+` like a binary operator.
@@ -31,12 +37,14 @@ RC = {
     "font.family": "serif",
     "font.serif": ["STIXGeneral", "DejaVu Serif"],
     "mathtext.fontset": "stix",
-    "font.size": 9,
-    "axes.labelsize": 9,
-    "axes.titlesize": 9,
-    "legend.fontsize": 8,
-    "xtick.labelsize": 8,
-    "ytick.labelsize": 8,
+    "font.size": 8,
+    "axes.labelsize": 8,
+    "axes.titlesize": 8,
+    "figure.titlesize": 8,
+    "legend.fontsize": FONT_MIN,
+    "legend.title_fontsize": FONT_MIN,
+    "xtick.labelsize": FONT_MIN,
+    "ytick.labelsize": FONT_MIN,
     "axes.linewidth": 0.6,
     "lines.linewidth": LW,
     "xtick.direction": "in",
@@ -63,6 +71,24 @@ def context():
 def panel_label(ax, text: str) -> None:
     """Panel tag like '(a) crossing' above the axes, left-aligned as in the paper."""
     ax.set_title(text, loc="left")
+
+
+def legend_below(ax, *args, **kw):
+    """A legend of one panel under its x label, off the data; constrained layout makes
+    room for it (it belongs to the axes' tight box), so it must not be wider than the
+    panel (the layout would narrow the axes). Arguments as for ax.legend."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.transforms import ScaledTranslation
+
+    rc = mpl.rcParams
+    tick = FontProperties(size=rc["xtick.labelsize"]).get_size_in_points()
+    label = FontProperties(size=rc["axes.labelsize"]).get_size_in_points()
+    # tick pad, tick labels, label pad and the x label (room for sub- and superscripts)
+    drop = rc["xtick.major.pad"] + 1.4 * tick + rc["axes.labelpad"] + 1.6 * label
+    where = ax.transAxes + ScaledTranslation(0, -drop / 72, ax.figure.dpi_scale_trans)
+    kw.setdefault("loc", "upper center")
+    return ax.legend(*args, bbox_to_anchor=(0.5, 0.0), bbox_transform=where, borderaxespad=0.0,
+                     **kw)
 
 
 def eps_value(e: float) -> str:
