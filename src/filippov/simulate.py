@@ -509,6 +509,7 @@ class _Run:
         self.recent = deque(maxlen=self.zeno_count)
         self.n_switch = 0
         self.shift = 0.0  # subtracted from H in this stay (rules.exit_shift)
+        self.band = 0.0   # the rounding band of the exit the stay began at (rules.exit_band)
         self.frac_integrated = np.linspace(0.0, 1.0, self.samples_per_step + 1)
         # An exact flow is evaluated EXACT_BLOCK windows at a time: the same sample
         # spacing, a sixteenth of the Python overhead.
@@ -543,12 +544,16 @@ class _Run:
                                    self.rtol, self.atol, self.max_step,
                                    piece=lambda zz: checks.non_finite_piece(system, mode, zz))
 
-    def _leave(self, mode):
-        """Functions whose crossing ends this mode, with what that crossing is."""
+    def _leave(self, mode, banded=True):
+        """Functions whose crossing ends this mode, with what that crossing is (H
+        measured from the exit's rounding band while the stay is inside it, unless not
+        ``banded``)."""
         system = self.system
         if mode != SLIDING:
-            switch = (system.switch if self.shift == 0.0
-                      else (lambda zz, c=self.shift: system.switch(zz) - c))
+            shift = (rules.banded_shift(mode, self.shift, self.band)
+                     if banded and self.band > 0.0 else self.shift)
+            switch = (system.switch if shift == 0.0
+                      else (lambda zz, c=shift: system.switch(zz) - c))
             return [(switch, rules.TO_NEG if mode == PLUS else rules.TO_NONNEG, "switch")]
         return [(lambda zz: system.normal_speeds(zz)[0], rules.TO_NONPOS, "exit_minus"),
                 (lambda zz: system.normal_speeds(zz)[1], rules.TO_NONNEG, "exit_plus")]
@@ -563,12 +568,18 @@ class _Run:
         while True:
             ta, tb, Z = self._step(stepper)
             ts, zs = self._samples(stepper, Z, ta, tb)
+            band = self.band
             found = self._scan(Z, ts, zs, leave, first, ta, tb)
             first = False
             if self.dense:
                 self.traj.segments.append((ta, tb, mode, Z))
             if found is None:
                 self.t, self.z = tb, zs[:, -1].copy()
+                if self.band > 0.0 and rules.clears_band(
+                        mode, float(leave[0][0](zs[:, -1:])[0]), self.band):
+                    self.band = 0.0  # out of the exit's rounding band: H unbiased on
+                if self.band != band:
+                    leave = self._leave(mode)
                 if tb >= self.t_end:
                     self._note_tolerance(stepper)
                     return self.stop("t_end")
@@ -626,14 +637,18 @@ class _Run:
 
     def _scan(self, Z, ts, zs, leave, first, ta, tb):
         try:
-            return _scan(self.system, self.mode, Z, ts, zs, leave, self.sections, self.preds,
-                         first, self.touch_tol, self.event_xtol, self.traj)
+            found, band = _scan(self.system, self.mode, Z, ts, zs, leave, self.sections,
+                                self.preds, first, self.touch_tol, self.event_xtol, self.traj,
+                                self.band, self._leave(self.mode, banded=False)
+                                if self.band > 0.0 else None)
         except ValueError as exc:  # scipy's root finders: no context of their own
             raise SimulationError(
                 f"event location failed in mode {MODE_NAMES[self.mode]} between t={ta!r} and "
                 f"t={tb!r} (state at ta {self.z.tolist()}): {exc}; the sampled sign change "
                 f"did not survive refinement (time scale of the system: sample_step "
                 f"{self.system.sample_step!r})") from exc
+        self.band = band
+        return found
 
     def _stiff_switch(self, stepper, steps_in_mode, h):
         """Radau IIA for the rest of the stay when DOP853's steps are bounded by stability
@@ -661,7 +676,7 @@ class _Run:
                 return self.stop(f"section:{sec.name}")
             return None
         new_mode, kind = _decide(self.system, mode, what, ze)
-        drift, h0 = False, 0.0
+        drift, h0, band = False, 0.0, 0.0
         if kind == "slide_end":
             h0 = float(self.system.switch(ze))
             grad = self.system.switch_grad(ze[:, None])[:, 0]
@@ -671,6 +686,7 @@ class _Run:
                 rules.onto_switch(ze, h0, grad)
                 self.z = ze
                 h0 = float(self.system.switch(ze))  # what rounding left
+            band = rules.exit_band(ze, self._flow_at_zero(new_mode, ze), grad)
         if new_mode == SLIDING and mode != SLIDING:
             _refuse_sliding_in_sections(self.system, self.sections, ze, te)
         traj.events.append(Event(te, kind, ze.copy(), mode, new_mode))
@@ -683,8 +699,18 @@ class _Run:
         # after a sliding exit the stay measures H from the exit point's rounding
         self.shift = (rules.exit_shift(new_mode, h0, self.touch_tol, drift)
                       if kind == "slide_end" else 0.0)
+        self.band = band
         self.mode = traj.mode = new_mode
         return None
+
+    def _flow_at_zero(self, mode, z):
+        """The state the next stay in ``mode`` starts from as its stepper evaluates it:
+        the exact flow of z over time 0 (its rounding, rules.exit_band), or z itself for
+        an integrated stay."""
+        if self.method == "exact" and self.system.has_flow(mode):
+            zf = self.system.flows[mode](z, np.zeros(1))
+            return np.asarray(zf, dtype=float).reshape(-1)
+        return z
 
     def _check_rate(self, te, ze, new_mode):
         """The Zeno ring: zeno_count switches in no time is an accumulation; at the
@@ -734,8 +760,13 @@ def _decide(system, mode, what, z):
     return SLIDING, "slide_start"
 
 
-def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xtol, traj):
-    """Earliest event in the samples ``ts`` of one segment, or None."""
+def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xtol, traj,
+          band=0.0, unbanded=None):
+    """Earliest event in the samples ``ts`` of one segment, or None; and the band still
+    in force after it. ``band``: the rounding band of the sliding exit the stay began
+    at, while the orbit is inside it (rules.exit_band, rules.graze; ``leave`` then
+    measures H from the band's edge, ``unbanded`` from the exit shift alone): it ends at
+    the first sample interval examined whose start is out of the band (rules.clears_band)."""
     vals = []
     for func, pred, what in leave:
         v = np.asarray(func(zs), dtype=float)
@@ -763,7 +794,22 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
     for pred, sv in zip(preds, svals):
         cand |= rules.crosses(pred, sv[:-1], sv[1:])
 
-    for i in np.flatnonzero(cand):
+    order, pos = np.flatnonzero(cand), 0
+    while pos < order.size:
+        i = int(order[pos])
+        pos += 1
+        if band > 0.0 and rules.clears_band(mode, vals[0][i], band):
+            # out of the exit's rounding band at ts[i]: H unbiased from there on, so a
+            # return across H is refined at H = 0 (as the compiled engine's _find)
+            band, leave = 0.0, unbanded
+            vals[0] = np.asarray(leave[0][0](zs), dtype=float)
+            again = rules.crosses(leave[0][1], vals[0][:-1], vals[0][1:])
+            again |= rules.extremum_between(mode, D[:-1], D[1:])
+            for pred, sv in zip(preds, svals):
+                again |= rules.crosses(pred, sv[:-1], sv[1:])
+            again[:i] = False
+            order, pos = np.flatnonzero(again), 0
+            continue
         best = None  # (t, z, what, idx)
         ta, tb = ts[i], ts[i + 1]
         for (func, pred, what), v in zip(leave, vals):
@@ -777,6 +823,15 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
                     if not rules.after(pred, hm):
                         lo, vlo = tm, hm
                 r = _refine(scalar(func), pred, lo, tb, vlo, v[i + 1], xtol)
+                if band > 0.0 and what == "switch":
+                    # found beyond the exit's band: again on H itself (rules.band_probe)
+                    h = scalar(unbanded[0][0])
+                    tq, step, done, clear = r, 0.0, False, False
+                    while not done:
+                        clear = rules.clears_band(mode, float(func(Z(tq))), band)
+                        done, tq, step = rules.band_probe(tq, step, lo, clear)
+                    if clear:
+                        r = _refine(h, pred, tq, r, h(tq), h(r), xtol)
                 if best is None or r < best[0]:
                     best = (r, what, -1)
         if mode != SLIDING and best is None:
@@ -786,7 +841,7 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
                 tm = _brent(dfun, ta, tb, D[i], D[i + 1], xtol)
                 Hm = float(leave[0][0](Z(tm)))
                 pred = leave[0][1]
-                kind = rules.graze(mode, Hm, touch_tol)
+                kind = rules.graze(mode, Hm, touch_tol, band)
                 if kind == rules.GRAZE_CROSSES:
                     r = _refine(scalar(leave[0][0]), pred, ta, tm, H[i], Hm, xtol)
                     best = (r, "switch", -1)
@@ -812,5 +867,5 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
                 best = (r, "section", k)
         if best is not None:
             r, what, k = best
-            return r, np.asarray(Z(r), dtype=float).reshape(-1).copy(), what, k
-    return None
+            return (r, np.asarray(Z(r), dtype=float).reshape(-1).copy(), what, k), band
+    return None, band

@@ -78,12 +78,14 @@ _jit_inline = njit(cache=True, _nrt=False, inline="always")
 (_after, _crosses, _clamp, _far_side, _extremum_between, _graze, _central_step,
  _slides_in_section, _starts_on_section, _same_instant, _start_side, _start_on_switch,
  _next_mode, _accumulates, _exit_shift, _dips_and_returns, _exact_window, _onto_switch,
- _exit_drift, _carried_age, _far_side_probe) = (
+ _exit_drift, _carried_age, _far_side_probe, _exit_band, _banded_shift, _clears_band,
+ _band_probe) = (
     _jit_rule(getattr(rules, name)) for name in (
     "after", "crosses", "clamp", "far_side", "extremum_between", "graze", "central_step",
     "slides_in_section", "starts_on_section", "same_instant", "start_side", "start_on_switch",
     "next_mode", "accumulates", "exit_shift", "dips_and_returns", "exact_window",
-    "onto_switch", "exit_drift", "carried_age", "far_side_probe"))
+    "onto_switch", "exit_drift", "carried_age", "far_side_probe", "exit_band",
+    "banded_shift", "clears_band", "band_probe"))
 assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 
 

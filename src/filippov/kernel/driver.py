@@ -19,10 +19,11 @@ import numpy as np
 from numba import njit, types
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
-from ..system import SLIDING
+from ..system import PLUS, SLIDING
 from .base import (BAD_START, EVENT_LIMIT, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
                    SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO, _PIECE_TYPES, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
-                   _exit_drift, _exit_shift, _jit, _jit_inline, _next_mode, _onto_switch,
+                   _banded_shift, _clears_band, _exit_band, _exit_drift, _exit_shift,
+                   _flow_minus, _flow_plus, _jit, _jit_inline, _next_mode, _onto_switch,
                    _slides_in_section, _speeds, _start_on_switch, _start_side, _vec, _h,
                    _section)
 from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
@@ -138,6 +139,9 @@ def _window(mode, ta, tb, frac, first, fns, p, s, w):
     if what == _W_NONE:
         for c in range(w.z.size):
             w.z[c] = w.ynew[c]
+        if w.sg[5] > 0.0 and _clears_band(mode, w.vals[0, ns - 1], w.sg[5]):
+            w.sg[4] = w.sg[6]  # out of the exit's rounding band: H unbiased from here
+            w.sg[5] = 0.0
         return (NO_RETURN if tb >= s.t_max else _GO_ON), tb, _W_NONE
     _zat(te, mode, w.sg, w.za, w.F, w.y_old, fns, p, w.z)
     return OK, te, what
@@ -239,7 +243,7 @@ def _event(mode, t, what, fns, p, s, w):
     if new_mode == SLIDING and mode != SLIDING and _slides_in(w.z, fns, p, w.wg, w.wf, w.wp,
                                                              w.wz):
         return SECTION_SLIDING, mode
-    drift, h0 = False, 0.0
+    drift, h0, band = False, 0.0, 0.0
     if mode == SLIDING:
         if new_mode != SLIDING:
             h0 = _h(fns, w.z, p)
@@ -247,6 +251,16 @@ def _event(mode, t, what, fns, p, s, w):
             if drift:  # w.wg holds grad h at w.z (from _speeds)
                 _onto_switch(w.z, h0, w.wg)
                 h0 = _h(fns, w.z, p)  # what rounding left
+            # the state the next stay starts from as it evaluates it: the exact flow
+            # over time 0 (its rounding), or w.z itself when integrated (rules.exit_band)
+            for k in range(w.z.size):
+                w.wz[k] = w.z[k]
+            if s.exact:
+                if new_mode == PLUS:
+                    _flow_plus(fns, w.z, 0.0, p, w.wz)
+                else:
+                    _flow_minus(fns, w.z, 0.0, p, w.wz)
+            band = _exit_band(w.z, w.wz, w.wg)
         _end_slide(t, w)
     if new_mode == SLIDING:
         w.tally[1] = t
@@ -264,8 +278,12 @@ def _event(mode, t, what, fns, p, s, w):
                                                    s.zeno_span):
         return ZENO, mode
     w.sg[4] = 0.0
+    w.sg[5] = 0.0
+    w.sg[6] = 0.0
     if mode == SLIDING and new_mode != SLIDING:
-        w.sg[4] = _exit_shift(new_mode, h0, s.touch_tol, drift)
+        w.sg[6] = _exit_shift(new_mode, h0, s.touch_tol, drift)
+        w.sg[5] = band
+        w.sg[4] = _banded_shift(new_mode, w.sg[6], band) if band > 0.0 else w.sg[6]
     # (the end of sliding: identity)
     if _DERIVATIVES and s.jac and mode != SLIDING and new_mode != mode:
         _switch_derivative(mode, new_mode, fns, p, w)
@@ -307,6 +325,8 @@ def _one(z0, age0, fns, p, s, w):
     w.tally[1] = 0.0
     w.tally[2] = 0.0 if mode == SLIDING else _carried_age(_h(fns, w.z, p), s.touch_tol, age0)
     w.sg[4] = 0.0
+    w.sg[5] = 0.0
+    w.sg[6] = 0.0
     t = 0.0
     while True:
         if t >= s.t_max:
@@ -352,7 +372,7 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
     dvals = np.empty(nsmax)
     svals = np.empty(nsmax)
     recent = np.empty(max(s.zeno_count, 1))
-    sg = np.zeros(5)
+    sg = np.zeros(7)
     za, y, f = np.zeros(n), np.zeros(n), np.zeros(n)
     y_old, f_old, ynew, ytmp, scale = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                                        np.zeros(n))

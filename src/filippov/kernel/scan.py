@@ -8,7 +8,7 @@ from .. import rules
 from ..system import MINUS, PLUS, SLIDING
 from .base import (OK, ROOT_FAILED, _EPS, _MAXITER_EXTREMUM, _S_A, _S_B, _S_H, _S_SEC, _TO_NEG, _TO_NONNEG,
                    _TO_NONPOS, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_NONE, _W_SECTION, _W_SWITCH,
-                   _after, _clamp, _crosses, _dips_and_returns, _dot, _extremum_between,
+                   _after, _band_probe, _clamp, _clears_band, _crosses, _dips_and_returns, _dot, _extremum_between,
                    _graze, _jit, _same_instant, _speeds, _starts_on_section, _field_minus,
                    _field_plus, _grad_h, _h, _section, _where)
 from .segment import (_fval, _zat)
@@ -67,6 +67,16 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
         cs = _crosses(sec_pred, svals[i], svals[i + 1])
         if not (c0 or c1 or cd or cs):
             continue
+        if sg[5] > 0.0 and _clears_band(mode, vals[0, i], sg[5]):
+            # the orbit is out of its exit's rounding band at ts[i]: from there H is
+            # unbiased (rules.clears_band), so a return across H is refined at H = 0
+            sg[4] = sg[6]
+            sg[5] = 0.0
+            for k in range(i, ns):
+                vals[0, k] = _fval(_S_H, ts[k], mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+            c0 = _crosses(pred0, vals[0, i], vals[0, i + 1])
+            if not (c0 or c1 or cd or cs):
+                continue
         ta, tb = ts[i], ts[i + 1]
         best_t, best_w = np.inf, _W_NONE
         if c0:
@@ -81,6 +91,21 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
                             fns, p, wz, wg, wf)
             if not ok:
                 return ROOT_FAILED, r, _W_NONE
+            if sg[5] > 0.0:  # found beyond the exit's band: again on H itself (rules.band_probe)
+                tq, step, done, clear = r, 0.0, False, False
+                while not done:
+                    clear = _clears_band(mode, _fval(_S_H, tq, mode, sg, za, F, y_old, fns, p,
+                                                     wz, wg, wf), sg[5])
+                    done, tq, step = _band_probe(tq, step, lo, clear)
+                if clear:
+                    banded = sg[4]
+                    sg[4] = sg[6]
+                    r2, ok = _refine(sel0, pred0, tq, r, _fval(_S_H, tq, mode, sg, za, F, y_old,
+                                                               fns, p, wz, wg, wf),
+                                     xtol, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+                    sg[4] = banded
+                    if ok:
+                        r = r2
             best_t, best_w = r, what0
         if c1:
             r, ok = _refine(_S_B, _TO_NONNEG, ta, tb, vals[1, i], xtol, mode, sg, za, F,
@@ -96,7 +121,7 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
             if not ok:
                 return ROOT_FAILED, tm, _W_NONE
             hm = _fval(_S_H, tm, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
-            kind = _graze(mode, hm, touch_tol)
+            kind = _graze(mode, hm, touch_tol, sg[5])  # sg[5]: the exit's band (rules)
             if kind == rules.GRAZE_CROSSES:
                 r, ok = _refine(_S_H, pred0, ta, tm, vals[0, i], xtol, mode, sg, za, F,
                                 y_old, fns, p, wz, wg, wf)

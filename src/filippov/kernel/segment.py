@@ -9,7 +9,9 @@ from .dop853 import _dense_eval
 
 # output (F, y_old) of the integration step [sg[1], sg[1] + sg[2]] -- always
 # when sliding, and in regions + and - when sg[3] != 0 (a model without flows).
-# sg[4]: what the stay subtracts from H (rules.exit_shift; 0 but after a slide).
+# sg[4]: what the stay subtracts from H (rules.exit_shift; 0 but after a slide), moved by
+# sg[5], the rounding band of the exit the stay began at, while the orbit is inside it
+# (rules.exit_band, rules.banded_shift; 0 once it is out); sg[6]: the exit_shift alone.
 @_jit
 def _zat(t, mode, sg, za, F, y_old, fns, p, out):
     if mode == SLIDING or sg[3] != 0.0:
