@@ -243,7 +243,9 @@ def fig12(n_s: int = 19, k: int = 6) -> xr.Dataset:
          "period": (("theta", "eps", "s"), np.broadcast_to(per, (1, eps.size, n_s)).copy()),
          "period_limit0": (("theta", "s"), per[None]),
          "edge": (("eps", "n", "side"), edge0[None] + eps[:, None, None]),
-         "edge_limit0": (("n", "side"), edge0), "edge_gap": ("eps", 2 * eps)},
+         "edge_limit0": (("n", "side"), edge0), "edge_gap": ("eps", 2 * eps),
+         "edge_kind": (("eps", "n", "side"),
+                       np.broadcast_to(np.array([-1, 0], dtype=np.int32), (eps.size, 2, 2)).copy())},
         coords={"theta": [-0.5], "eps": eps, "s": s, "k": np.arange(k), "n": n, "side": [0, 1]},
         attrs={"theta": -0.5, "s_max": 4.0})
 

@@ -127,3 +127,56 @@ def test_a_slope_on_the_kink_of_p_is_refused(theta):
     s = attractors.slopes(hopf.compiled(1e-3, 0.5, mu), [[0.0, np.sqrt(mu), 0.0]], 1, 1e-10,
                           T_MAX)
     assert s[0] == pytest.approx(np.exp(-4 * np.pi * mu / (8 * np.pi)), rel=1e-3)
+
+
+# ------------------------------------------------------- classification by convergence
+def _at(theta, eps, s, transient=200, keep=60, lyapunov=True):
+    from filippov.analytic import limit_map
+    sigma = limit_map.scale(eps, theta)
+    mu = 1.0 + s * sigma
+    cm = hopf.compiled(eps, theta, mu, 8 * np.pi, sliding=theta > 0)
+    return attractors.settle(cm, [0.0, np.sqrt(mu), 0.0], coordinate=1, transient=transient,
+                             keep=keep, t_max=1.0, scale=sigma, max_period=30,
+                             window=(0.8, 1.2), lyapunov=lyapunov)
+
+
+def test_a_slowly_converging_orbit_is_its_own_period_not_twice_it():
+    # theta = 0.2, eps = 1e-4, s = 265.9 (a point of fig13): after 260 returns the kept
+    # values still alternate around the fixed point (multiplier ~ -0.97), so a count of
+    # repeats says period two with a width four decades below the neighbours'; Newton
+    # finds the period-one orbit, stable, and the returns approaching it
+    at = _at(0.2, 1e-4, 265.9147948472494, transient=300, keep=100)   # fig13's run
+    assert attractors.period_of(at.values, attractors.period_tolerance(1e-8), 30) == 2
+    assert at.period == 1 and at.width == 0.0
+    assert -1.0 < at.cycle.radius < 1.0 and at.cycle.converging
+    assert at.lyapunov == pytest.approx(np.log(at.cycle.radius))
+
+
+def test_an_orbit_still_settling_is_found_where_the_count_sees_none():
+    # theta = -0.5, eps = 1e-2, s = 1.5 (fig12): no repeat within the kept returns (a
+    # multiplier of modulus 0.95 per period), but a stable period-4 orbit they approach
+    at = _at(-0.5, 1e-2, 1.5, lyapunov=False)
+    assert attractors.period_of(at.values, attractors.period_tolerance(1e-2), 30) == 0
+    assert at.period == 4 and at.cycle.radius < 1.0 and at.cycle.converging
+
+
+def test_a_repeat_with_a_positive_exponent_is_chaos_not_a_period():
+    # theta = 0.2, eps = 1e-2, s = 0.05 (fig13): the kept values repeat with period 6 to
+    # the count's tolerance, but the exponent is positive beyond three standard errors
+    at = _at(0.2, 1e-2, 0.05)
+    assert at.unconfirmed == 6 and at.period == 0
+    assert at.lyapunov > attractors.LYAPUNOV_SIGMAS * at.lyapunov_err > 0
+    with pytest.raises(ValueError, match="contradiction"):
+        attractors.Attractor(at.values, 6, at.width, 0.1, False)
+
+
+@pytest.mark.parametrize("theta,eps,s", [
+    (-0.5, 1e-2, 1.45), (-0.5, 1e-2, 1.55), (-0.5, 1e-3, 2.1), (-0.5, 1e-3, 2.3),
+    (0.4, 1e-2, 3.2), (0.4, 1e-2, 3.65), (0.2, 1e-4, 265.9147948472494),
+    (0.15, 1e-3, 1.0), (0.3, 1e-3, 0.5), (0.2, 1e-3, 0.5)])
+def test_doubling_the_transient_does_not_change_the_type(theta, eps, s):
+    # points on both sides of type changes in fig12-14 (and the ones the count got wrong)
+    a, b = _at(theta, eps, s), _at(theta, eps, s, transient=400)
+    chaotic = [x.period == 0 and x.lyapunov > attractors.LYAPUNOV_SIGMAS * x.lyapunov_err
+               for x in (a, b)]
+    assert (a.period, chaotic[0]) == (b.period, chaotic[1])

@@ -4,7 +4,9 @@ fig12_period_adding and fig13_small_scale_chaos show the same on finer grids."""
 import numpy as np
 import pytest
 
-from filippov import attractors
+from filippov import attractors, branches
+from filippov.fastmap import compute_returns
+from filippov.scenes import fig12_period_adding as fig12
 from filippov.analytic import limit_map
 from filippov.models import hopf
 
@@ -50,23 +52,86 @@ def test_above_grazing_periods_fall_as_mu_grows_in_an_inverted_adding_cascade():
     assert order == sorted(order)
 
 
+def _window(eps, n, s0, order=None):
+    """(left end, right end) of the period-n orbit followed from s0 (branches.follow):
+    slow-fast for order None, else the limit map of that order."""
+    if order is None:
+        at = fig12._slow_fast_orbit_at({"omega": OMEGA}, -0.5, eps, n, {})
+        guess = _attractor(eps, -0.5, s0, transient=400).states[-1]
+    else:
+        at = fig12._limit_orbit_at(-0.5, eps, OMEGA, n, order)
+        guess = limit_map.orbit([s0], eps=eps, theta=-0.5, omega=OMEGA, transient=400,
+                                keep=1, order=order)[0]
+    return [branches.follow(at, s0, guess, lim, step=0.025, xtol=1e-9, near=0.5)
+            for lim in (-0.5, 4.0)]
+
+
 def test_window_edges_converge_in_s_left_like_eps_right_like_sqrt_eps():
-    # the first window of period 3 at theta = -0.5: its edges in s = (mu - 1)/eps
-    # tend to those of the eps -> 0 limit map; the left edge (an orbit point reaching
-    # grazing from the side the sqrt term does not act on) with O(eps) corrections,
-    # the right one with O(sqrt(eps)) corrections
-    grid = np.linspace(0.3, 2.0, 35)
-    def edges(classify):
-        per = np.array([classify(s) for s in grid])
-        return np.array(attractors.window_edges(grid, per, 3, classify, 1e-5))
-    limit = edges(lambda s: _limit_period(s, 1e-6, -0.5, 0))
-    err = {}
-    for eps in (1e-4, 1e-6):
-        err[eps] = np.abs(edges(lambda s, e=eps: _attractor(e, -0.5, s).period) - limit)
+    # the window of period 3 at theta = -0.5: its edges in s = (mu - 1)/eps, where its
+    # orbit followed in s stops being stable, tend to those of the eps -> 0 limit map;
+    # the left edge with O(eps) corrections, the right one with O(sqrt(eps))
+    limit = np.array([e.parameter for e in _window(1e-6, 3, 0.7, order=0)])
+    err = {eps: np.abs([e.parameter for e in _window(eps, 3, 0.7)] - limit)
+           for eps in (1e-4, 1e-6)}
     ratio = err[1e-4] / err[1e-6]
-    assert 30 < ratio[0] < 300   # ~eps: a factor 100 over two decades
-    assert 5 < ratio[1] < 20     # ~sqrt(eps): a factor 10
+    assert 30 < ratio[0] < 300   # ~eps: a factor 100 over two decades (measured 98)
+    assert 5 < ratio[1] < 20     # ~sqrt(eps): a factor 10 (measured 11.3)
     assert err[1e-6][1] < 0.05
+
+
+def test_window_edges_are_a_period_doubling_and_a_border_collision():
+    # eps = 1e-3, period 3: the left end has the multiplier -1; at the right end one
+    # orbit point sits where a single return's number of switches changes (grazing),
+    # found here by bisection in u on the engine's switch count, not by the follower
+    eps = 1e-3
+    left, right = _window(eps, 3, 1.5)
+    assert left.kind == branches.FLIP
+    assert left.inside.multiplier.real == pytest.approx(-1.0, abs=1e-3)
+    assert right.kind == branches.BORDER and abs(right.inside.multiplier) < 0.5
+    mu = 1.0 + right.parameter * eps
+    cm = hopf.compiled(eps, -0.5, mu, OMEGA, sliding=False)
+    run = attractors.iterate(cm, right.inside.state, transient=0, keep=3, t_max=T_RETURN)
+    u = (run.orbit[0, :, 1] - 1.0) / eps
+
+    def switches(v):
+        out = compute_returns(cm, [[0.0, 1.0 + eps * v, 0.0]], T_RETURN)
+        return int(out.n_switches[0])
+    lo, hi = -1.5, 0.5   # a bracket of u with 0 switches at one end and 2 at the other
+    a, b = lo, hi
+    assert switches(a) != switches(b)
+    while b - a > 1e-9:
+        m = 0.5 * (a + b)
+        if switches(m) == switches(a):
+            a = m
+        else:
+            b = m
+    graze = 0.5 * (a + b)
+    assert np.min(np.abs(u - graze)) < 1e-5, (u, graze)
+
+
+def test_two_windows_orbits_coexist_where_the_followed_branches_overlap():
+    # eps = 1e-3: the period-2 orbit is stable down to its flip, below the border
+    # collision that ends the period-3 orbit; between them a run from each orbit's point
+    # stays on it (two attractors), while the cycle's start sees only one
+    eps = 1e-3
+    two_left, _ = _window(eps, 2, 3.0)
+    _, three_right = _window(eps, 3, 1.5)
+    assert two_left.parameter < three_right.parameter - 0.1
+    s = 0.5 * (two_left.parameter + three_right.parameter)
+    mu = 1.0 + s * eps
+    cm = hopf.compiled(eps, -0.5, mu, OMEGA, sliding=False)
+    periods = []
+    for n, start in ((2, 3.0), (3, 1.5)):
+        at = fig12._slow_fast_orbit_at({"omega": OMEGA}, -0.5, eps, n, {})
+        end = branches.follow(at, start, _attractor(eps, -0.5, start, transient=400)
+                              .states[-1], s, step=0.025, xtol=1e-9, near=0.5)
+        assert end.kind == branches.BEYOND   # still stable at s
+        # perturb the orbit's point a little and let the map settle
+        z = end.inside.state + np.array([0.0, 1e-3 * eps, 0.0])
+        got = attractors.settle(cm, z, coordinate=1, transient=300, keep=60, t_max=T_RETURN,
+                                scale=eps, max_period=30, window=(0.8, 1.2))
+        periods.append(got.period)
+    assert periods == [2, 3]
 
 
 def test_the_slow_fast_map_agrees_with_the_limit_map_better_as_eps_shrinks():

@@ -5,8 +5,14 @@ map is iterated from a start (``transient`` returns discarded, ``keep`` returns
 recorded, all in one compiled call: :func:`filippov.fastmap.compute_returns` with
 ``iterations``) and the recorded returns are classified:
 
-* ``period``: the smallest p with |u_{k+p} - u_k| <= tol over all kept returns
-  (0: none up to ``max_period`` -- chaotic, quasi-periodic or not yet settled);
+* ``period``: decided by convergence, not by a count. The smallest p with
+  |u_{k+p} - u_k| <= tol over the kept returns (or, for an orbit still converging, to
+  LOOSE of the scale) is only a candidate; for each divisor d of it, smallest first,
+  Newton on P^d(z) - z from the last return with the engine's dP/dz (:func:`confirm`)
+  looks for the orbit, whose spectral radius decides stability and which the kept
+  returns must approach. Found: the period is d, the width the orbit's and the
+  exponent log(radius)/d, exact. Not found: 0 (chaotic, quasi-periodic or a repeat
+  that is no stable orbit); a period with a positive exponent is refused;
 * ``width``: max - min of the kept values;
 * ``lyapunov``: the largest Lyapunov exponent of the map along the kept returns: the
   mean log growth of a tangent vector carried by the derivative dP/dz that the engine
@@ -49,6 +55,14 @@ class Attractor:
     reason: str = ""            # why it escaped ('' if it did not)
     status: int = OK            # OK, the engine's status of the failed return, LEFT_WINDOW
     states: np.ndarray = field(default=None, repr=False)  # kept returns, full state
+    lyapunov_err: float = np.nan  # standard error of ``lyapunov`` (0: a confirmed cycle's)
+    cycle: "Cycle" = field(default=None, repr=False)   # the confirmed periodic orbit
+    unconfirmed: int = 0        # a period the kept returns repeat with, not confirmed
+
+    def __post_init__(self):
+        if self.period > 0 and self.lyapunov > 0:
+            raise ValueError(f"period {self.period} with a positive Lyapunov exponent "
+                             f"{self.lyapunov!r}: a contradiction, not an attractor")
 
 
 def period_of(values: np.ndarray, tol: float, max_period: int) -> int:
@@ -120,6 +134,32 @@ def lyapunov_exponent(jacobians: np.ndarray, coordinate: int) -> float:
     return float(np.mean(logs)) if logs else np.nan
 
 
+#: the kept returns of an orbit still converging repeat only to this fraction of the
+#: attractor's scale: the candidate period Newton is asked to confirm (a multiplier of
+#: -0.99 leaves 1e-2 of the start's offset after ~460 returns)
+LOOSE = 1e-2
+#: an exponent counts as positive (chaos) when it exceeds this many standard errors
+LYAPUNOV_SIGMAS = 3.0
+#: where it does not after the kept returns, the run goes on for EXTEND x keep more
+EXTEND = 8
+#: blocks of the kept returns over which the Lyapunov exponent's standard error is
+#: estimated (batch means: the log-slopes are correlated over a few returns)
+LYAPUNOV_BLOCKS = 5
+
+
+def lyapunov_estimate(jacobians: np.ndarray, coordinate: int) -> tuple[float, float]:
+    """(exponent, standard error): :func:`lyapunov_exponent` over all of ``jacobians``
+    and the spread of its value over :data:`LYAPUNOV_BLOCKS` consecutive blocks (batch
+    means), std/sqrt(blocks). NaN error with fewer than two returns per block."""
+    lam = lyapunov_exponent(jacobians, coordinate)
+    k = len(jacobians) // LYAPUNOV_BLOCKS
+    if k < 2 or not np.isfinite(lam):
+        return lam, np.nan
+    means = [lyapunov_exponent(jacobians[b * k:(b + 1) * k], coordinate)
+             for b in range(LYAPUNOV_BLOCKS)]
+    return lam, float(np.std(means, ddof=1) / np.sqrt(LYAPUNOV_BLOCKS))
+
+
 #: one-sided slopes of P that differ by more than this (relative) put the point on a
 #: kink of P (the grazing point): central differences straddling it average two
 #: branches, so the slope there is refused (NaN). Smooth parts stay far below: the
@@ -166,6 +206,91 @@ def slopes(cmodel: CompiledModel, states: np.ndarray, coordinate: int, step: flo
     return np.where(ok & ~kink, (fp - fm) / (up + down), np.nan)
 
 
+@dataclass(frozen=True)
+class Cycle:
+    """A periodic orbit of P confirmed by Newton (:func:`confirm`)."""
+
+    period: int
+    points: np.ndarray          # (period, dim): its points, the first nearest the iterates
+    radius: float               # spectral radius of d(P^period)/dz: stable iff < 1
+    distance: float             # max |last kept returns - orbit points| (watched coordinate)
+    converging: bool            # the iterates approach it over the kept returns
+
+
+def _divisors(p: int) -> list[int]:
+    return [d for d in range(1, p + 1) if p % d == 0]
+
+
+def _cycle_newton(cmodel: CompiledModel, z: np.ndarray, d: int, age: float, t_max: float,
+                  tol: float, max_iter: int, options: dict):
+    """Newton on P^d(z) - z with the engine's dP/dz (the product over the d returns):
+    (point, d(P^d)/dz there) or None. Each iterate is put back on the section (one
+    gradient step on the section function, as periodic_orbit does)."""
+    from .periodic import _onto_section
+
+    value = lambda x: float(cmodel.section(np.ascontiguousarray(x, dtype=float),  # noqa: E731
+                                           cmodel.params))
+    z = np.array(z, dtype=float)
+    for _ in range(max_iter):
+        run = compute_returns(cmodel, [z], t_max, iterations=d, keep=d, jacobian=True,
+                              start_age=age, **options)
+        if run.status[0] != OK:
+            return None
+        J = np.eye(z.size)
+        for Jk in run.orbit_jacobian[0]:
+            J = Jk @ J
+        r = run.orbit[0, -1] - z
+        if np.abs(r).max() <= tol * (1.0 + np.abs(z).max()):
+            return z, J      # J may be non-finite: the orbit touches H (a grazing cycle)
+        if not np.all(np.isfinite(J)):
+            return None
+        try:
+            z = z - np.linalg.solve(J - np.eye(z.size), r)
+        except np.linalg.LinAlgError:
+            return None
+        z = _onto_section(value, z)
+    return None
+
+
+def confirm(cmodel: CompiledModel, states: np.ndarray, age: float, candidate: int, *,
+            coordinate: int, t_max: float, scale: float, settled: float = 0.0,
+            tol: float = 1e-13, max_iter: int = 12, **options) -> Cycle | None:
+    """The periodic orbit the iterates ``states`` (the kept returns, full states) settle
+    on, if any: Newton on P^d - z from the last state for each divisor d of
+    ``candidate`` (smallest first: a period-one orbit converging with multiplier near -1
+    repeats with period two before it repeats with period one), accepted when it
+    converges and its points lie within ``scale`` of the last d kept returns. ``radius``
+    then decides stability, and ``converging`` whether the iterates approach it (their
+    distance at the end of the kept returns below that at the start, or below
+    ``settled``: on it up to rounding). None: no orbit
+    of a divisor's period near the iterates."""
+    states = np.asarray(states, dtype=float)
+    for d in _divisors(int(candidate)):
+        found = _cycle_newton(cmodel, states[-1], d, age, t_max, tol, max_iter, options)
+        if found is None:
+            continue
+        z, J = found
+        pts = iterate(cmodel, z, transient=0, keep=d, t_max=t_max, start_age=age,
+                      **options).orbit[0]
+        pts = np.roll(pts, 1, axis=0)          # z first (P^d(z) = z is the last one)
+        k = states.shape[0]
+        # Newton may converge to any of the orbit's points: the last kept return sits at
+        # the nearest one, j, and the kept return i at (j + i - k + 1) mod d
+        j = int(np.argmin(np.abs(pts[:, coordinate] - states[-1, coordinate])))
+        phase = np.array([pts[(j + i - k + 1) % d, coordinate] for i in range(k)])
+        gap = np.abs(states[:, coordinate] - phase)
+        tail = float(gap[-d:].max())
+        if not tail <= scale:
+            continue
+        head = float(gap[:d].max())
+        # NaN: P is not differentiable on the orbit (it touches H tangentially)
+        radius = (float(np.max(np.abs(np.linalg.eigvals(J)))) if np.all(np.isfinite(J))
+                  else np.nan)
+        # approaching it, or already on it up to the returns' rounding
+        return Cycle(d, pts, radius, tail, bool(tail <= max(head, settled)))
+    return None
+
+
 def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, keep: int,
            t_max: float, scale: float, max_period: int, window: tuple[float, float],
            lyapunov: bool = False, **options) -> Attractor:
@@ -189,9 +314,34 @@ def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, kee
                          f"left the window [{lo!r}, {hi!r}] (value {bad!r})",
                          status=LEFT_WINDOW, states=states)
     period = period_of(values, period_tolerance(scale), max_period)
+    # a count of repeats is only a candidate: the orbit is confirmed by Newton, its
+    # multipliers decide stability and the iterates must approach it (module docstring)
+    candidate = period or period_of(values, LOOSE * scale, max_period)
+    cycle = (confirm(cmodel, states, float(run.age[0]), candidate, coordinate=coordinate,
+                     t_max=t_max, scale=LOOSE * scale, settled=period_tolerance(scale),
+                     **options) if candidate else None)
+    # a cycle on which P is not differentiable (grazing) has no multipliers: it counts
+    # as the attractor only if the kept returns already repeat on it to the tolerance
+    stable = cycle is not None and cycle.converging and (
+        cycle.radius < 1.0 or (np.isnan(cycle.radius) and period == cycle.period))
+    if stable:
+        u = cycle.points[:, coordinate]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lyap = float(np.log(cycle.radius) / cycle.period)
+        return Attractor(values, cycle.period, float(u.max() - u.min()), lyap, False,
+                         states=states, lyapunov_err=0.0, cycle=cycle)
     width = float(values.max() - values.min())
-    lyap = lyapunov_exponent(run.orbit_jacobian[0], coordinate) if lyapunov else np.nan
-    return Attractor(values, period, width, lyap, False, states=states)
+    lyap, err = (lyapunov_estimate(run.orbit_jacobian[0], coordinate) if lyapunov
+                 else (np.nan, np.nan))
+    if lyapunov and lyap > 0 and not lyap > LYAPUNOV_SIGMAS * err:
+        # positive but not yet beyond its error: iterate longer, only here
+        more = iterate(cmodel, states[-1], transient=0, keep=EXTEND * keep, t_max=t_max,
+                       jacobian=True, start_age=float(run.age[0]), **options)
+        if more.status[0] == OK:
+            lyap, err = lyapunov_estimate(
+                np.concatenate([run.orbit_jacobian[0], more.orbit_jacobian[0]]), coordinate)
+    return Attractor(values, 0, width, lyap, False, states=states, lyapunov_err=err,
+                     unconfirmed=period)
 
 
 def first_window(periods: np.ndarray, n: int) -> tuple[int, int] | None:
@@ -210,31 +360,3 @@ def first_window(periods: np.ndarray, n: int) -> tuple[int, int] | None:
         else:
             i += 1
     return None
-
-
-def edge(classify, inside: float, outside: float, n: int, tol: float) -> float:
-    """Bisection for where the period ``n`` at ``inside`` stops (``classify(s)`` gives
-    the period at s, ``outside`` has another one): the midpoint of the last bracket,
-    no wider than ``tol``."""
-    a, b = float(inside), float(outside)
-    while abs(b - a) > tol:
-        m = 0.5 * (a + b)
-        if classify(m) == n:
-            a = m
-        else:
-            b = m
-    return 0.5 * (a + b)
-
-
-def window_edges(grid: np.ndarray, periods: np.ndarray, n: int, classify,
-                 tol: float) -> tuple[float, float]:
-    """(left, right) edges of the first window of period n on ``grid`` (see
-    :func:`first_window`), located by bisection to ``tol``; NaN where the window
-    is not there or reaches the end of the grid (the edge lies outside)."""
-    w = first_window(periods, n)
-    if w is None:
-        return np.nan, np.nan
-    i0, i1 = w
-    left = edge(classify, grid[i0], grid[i0 - 1], n, tol) if i0 > 0 else np.nan
-    right = edge(classify, grid[i1], grid[i1 + 1], n, tol) if i1 + 1 < grid.size else np.nan
-    return left, right

@@ -27,6 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from .pdm import pdm_theta_neg, pdm_theta_pos
+from .s0 import s0_lambert
 
 
 def multiplier(mu: float, omega: float) -> float:
@@ -110,24 +111,55 @@ def chaos_threshold(lam: float) -> float:
     return lam * lam / (1.0 + lam * lam)
 
 
+def slope(u, s, *, eps: float, theta: float, omega: float, order: int = 1):
+    """du'/du of one return for theta < 0 in closed form, on the piece u lies in:
+    lambda dP_DM/dxi1 with dP_DM/dxi1 = 1 where the orbit misses H (xi1 >= 0) and
+    1 - sqrt(eps) s0 (omega/(theta + s0) - 2/omega)/sqrt(-2 xi1) where it hits (order 1;
+    1 at order 0). Unbounded as xi1 -> 0- at order 1: no central difference straddles
+    the border here (the slope of :func:`slopes` averages the two pieces within h of it)."""
+    if not theta < 0:
+        raise ValueError("the closed-form slope is for theta < 0")
+    sigma = scale(eps, theta)
+    u, s = np.asarray(u, dtype=float), np.asarray(s, dtype=float)
+    if order == 0:
+        lam, ustar = np.exp(-4.0 * np.pi / abs(omega)), 0.5 * s
+    else:
+        mu = 1.0 + s * sigma
+        lam = np.exp(-4.0 * np.pi * mu / abs(omega))
+        ustar = (np.sqrt(mu) - 1.0) / sigma
+    xi = -(ustar + lam ** 0.25 * (u - ustar))
+    d = np.ones(np.broadcast(xi, s).shape)
+    if order >= 1:
+        s0 = s0_lambert(theta)
+        k = np.sqrt(eps) * s0 * (omega / (theta + s0) - 2.0 / omega)
+        with np.errstate(divide="ignore"):
+            d = np.where(xi < 0, 1.0 - k / np.sqrt(-2.0 * np.minimum(xi, 0.0)), d)
+    return lam * d
+
+
 def cycle(u0: float, s: float, n: int, *, eps: float, theta: float, omega: float,
           order: int = 1, tol: float = 1e-13, max_iter: int = 50) -> tuple[np.ndarray, float]:
     """The period-n orbit of the map through the point near ``u0`` (Newton on
-    step^n(u) - u, derivative by :func:`slopes` along the orbit) and its multiplier, the
+    step^n(u) - u, derivative by :func:`slope` for theta < 0 and central differences
+    as in :func:`slopes` for theta > 0, along the orbit) and its multiplier, the
     product of the slopes: (orbit points (n,), multiplier). ValueError if Newton does
     not converge or the orbit touches the border (the kink at rho = 0: slopes undefined)."""
     kw = dict(eps=eps, theta=theta, omega=omega, order=order)
-    h = 1e-6   # the central step of slopes()
+    h = 1e-6   # the central step of slopes() (theta > 0)
     u = float(u0)
     for _ in range(max_iter):
-        # the orbit and its neighbours at +-h in one call per return (each step solves
-        # the sliding time: its cost is per call, not per point)
         pts, mult = [u], 1.0
         for _k in range(n):
             x = pts[-1]
-            img = step(np.array([x - h, x, x + h]), s, **kw)
-            mult *= float(img[2] - img[0]) / (2.0 * h)
-            pts.append(float(img[1]))
+            if theta < 0:   # the slope of the piece the point lies in, in closed form
+                mult *= float(slope(x, s, **kw))
+                pts.append(float(step(x, s, **kw)))
+            else:
+                # the point and its neighbours at +-h in one call per return (each step
+                # solves the sliding time: its cost is per call, not per point)
+                img = step(np.array([x - h, x, x + h]), s, **kw)
+                mult *= float(img[2] - img[0]) / (2.0 * h)
+                pts.append(float(img[1]))
         image = pts.pop()
         if abs(image - u) <= tol * (1.0 + abs(u)):
             return np.array(pts), mult
@@ -176,3 +208,20 @@ def bisect_crossing(excess, inside: float, outside: float, xtol: float, *, what:
         else:
             hi = mid
     return 0.5 * (lo + hi)
+
+
+def itinerary(points, s: float, *, eps: float, theta: float, omega: float,
+              order: int = 1) -> tuple:
+    """For each point u of an orbit, whether its return meets H (True: rho > 0 at L2,
+    the discontinuity map's jump; False: the orbit misses H): the piece of the map the
+    point lies in. A periodic orbit keeps its itinerary until one of its points reaches
+    the border rho = 0 (a border collision)."""
+    sigma = scale(eps, theta)
+    if order == 0:
+        lam, ustar = np.exp(-4.0 * np.pi / abs(omega)), 0.5 * s
+    else:
+        mu = 1.0 + s * sigma
+        lam = np.exp(-4.0 * np.pi * mu / abs(omega))
+        ustar = (np.sqrt(mu) - 1.0) / sigma
+    rho = ustar + lam ** 0.25 * (np.asarray(points, dtype=float) - ustar)
+    return tuple(bool(r > 0) for r in rho)

@@ -7,7 +7,7 @@ import numpy as np
 from . import style as st
 
 VARS = ["u", "u_limit", "u_limit0", "period", "period_limit0", "edge", "edge_limit0",
-        "edge_gap"]
+        "edge_gap", "edge_kind"]
 S_LABEL = r"$s=(\mu-1)/\varepsilon$"
 U_LABEL = r"$(x_2-1)/\varepsilon$ on $\mathcal{L}_1$"
 
@@ -42,6 +42,18 @@ def draw(ds):
         per = np.where(ds.period.values[0, j] > 0, ds.period.values[0, j], np.nan)
         ax.step(s, per, where="mid", color=colors[j % len(colors)], lw=st.LW_THIN,
                 label=f"$\\varepsilon={st.eps_value(e)}$")
+    # the window's orbit followed in s: stable between its two bifurcations (bars, one
+    # height per eps), so overlapping bars of n and n + 1 are coexisting attractors
+    for j in range(len(eps)):
+        for m, n in enumerate(ds.n.values):
+            lo, hi = ds.edge.values[j, m]
+            lo = s.min() if not np.isfinite(lo) else lo
+            hi = s.max() if not np.isfinite(hi) else hi
+            if ds.edge_kind.values[j, m, 0] == -9:
+                continue
+            y = n * (1.0 + 0.035 * (j - (len(eps) - 1) / 2))
+            ax.plot([lo, hi], [y, y], color=colors[j % len(colors)], lw=1.6,
+                    solid_capstyle="butt")
     per0 = np.where(ds.period_limit0.values[0] > 0, ds.period_limit0.values[0], np.nan)
     ax.step(s, per0, where="mid", color=st.C_PLUS, lw=st.LW, ls="--",
             label=r"$\varepsilon\to 0$")
@@ -52,7 +64,7 @@ def draw(ds):
     ax.set_ylabel("period of the attractor")
     ax.set_xlim(s.min(), s.max())
     fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=2)  # under (e)
-    st.panel_label(ax, "(e) period (gaps: none found)")
+    st.panel_label(ax, "(e) period; bars: orbit\nstable (its bifurcations)")
     ax = axes[1, 2]
     edge, edge0 = ds.edge.values, ds.edge_limit0.values
     for m, n in enumerate(ds.n.values):

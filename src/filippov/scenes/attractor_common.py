@@ -96,7 +96,7 @@ def sweep(scene: dict, s: np.ndarray, *, progress: bool = False) -> xr.Dataset:
     shape = (len(th), len(ep), s.size)
     u = np.full(shape + (keep,), np.nan)
     period, status = np.zeros(shape, dtype=np.int32), np.zeros(shape, dtype=np.int32)
-    width, lyap = np.full(shape, np.nan), np.full(shape, np.nan)
+    width, lyap, lyap_err = np.full(shape, np.nan), np.full(shape, np.nan), np.full(shape, np.nan)
     bar = Progress(scene["id"], int(np.prod(shape)), progress)
     for i, theta in enumerate(th):
         for j, eps in enumerate(ep):
@@ -107,12 +107,13 @@ def sweep(scene: dict, s: np.ndarray, *, progress: bool = False) -> xr.Dataset:
                 period[i, j, k] = at.period
                 width[i, j, k] = at.width / sigma
                 lyap[i, j, k] = at.lyapunov
+                lyap_err[i, j, k] = at.lyapunov_err
                 status[i, j, k] = at.status
                 bar.step()
     dims = ("theta", "eps", "s")
     return xr.Dataset(
         {"u": (dims + ("k",), u), "period": (dims, period), "width": (dims, width),
-         "lyapunov": (dims, lyap), "status": (dims, status)},
+         "lyapunov": (dims, lyap), "lyapunov_err": (dims, lyap_err), "status": (dims, status)},
         coords={"theta": ("theta", th), "eps": ("eps", ep), "s": ("s", s),
                 "k": ("k", np.arange(keep, dtype=np.int32))})
 
@@ -144,10 +145,15 @@ PERIOD_TOL = attractors.period_tolerance(1.0)
 VARIABLE_ATTRS = {
     "u": ("(x2 - 1)/sigma at the kept returns to L1 (sigma = eps for theta < 0, eps^2 for "
           "theta > 0)", "1"),
-    "period": ("period of the attractor (0: none up to max_period)", "1"),
+    "period": ("period of the attractor: a periodic orbit found by Newton from the kept "
+               "returns, stable, and approached by them (0: none up to max_period)", "1"),
+    "lyapunov_err": ("standard error of lyapunov (batch means over five blocks of the kept "
+                     "returns; 0 for a confirmed periodic orbit, whose exponent is "
+                     "log of its spectral radius over its period)", "1"),
     "width": ("width of the attractor in u (max - min of the kept returns)", "1"),
     "lyapunov": ("largest Lyapunov exponent of the return map along the attractor (mean "
-                 "log growth of a tangent vector under the engine's dP/dz; NaN: not "
+                 "log growth of a tangent vector under the engine's dP/dz; for a confirmed "
+                 "periodic orbit log of its spectral radius over its period; NaN: not "
                  "computed or escaped)", "1"),
     "status": ("0: settled; 100: left the window; else the engine's status code of the "
                "failed return", "1"),
@@ -226,4 +232,6 @@ def chaos_tolerances(scene: dict) -> dict:
     return {"period": kind, "period_limit": kind, "period_limit0": kind,
             "u": pts, "u_limit": lim, "u_limit0": lim, "lyapunov": mean,
             "lyapunov_limit": mean,
+            "lyapunov_err": Tolerance(1.0, 6.0 / np.sqrt(int(p["n_keep"])),
+                                      f"{stat}: spread of block means, itself sampled"),
             "width": Tolerance(0.5, u_atol, f"{stat}: extent of the kept points")}

@@ -3,12 +3,16 @@ slow-fast Hopf example across mu = 1, for several eps, beside the limit map.
 
 Orbit diagram in s = (mu - 1)/eps, u = (x2 - 1)/eps (attractor_common). On top of
 the shared sweep this scene locates the windows of the cascade: for each period n of
-``window_periods`` the first window of period n (scanning s upwards), its edges found by
-bisection on the slow-fast system (to ``edge_tol`` in s), on the order-1 limit map
-for the same eps and on the order-0 limit map (eps -> 0). The edges at eps <=
-``fit_eps_max`` are then fitted by edge = A + B eps^(1/2) (the order-1 term of P_DM
-is of order sqrt(eps) relative to the order-0 jump) and by edge = A + B eps; the
-intercept A of the first is compared with the order-0 edge.
+``window_periods`` the first window of period n on the grid (scanning s upwards); its
+periodic orbit is followed in s from the window's middle, down and up (Newton on
+P^n(z) - z with the engine's dP/dz; branches.follow), and the ends of its stability --
+a period doubling, a border collision at grazing, a fold -- are located by bisection to
+``edge_tol`` in s: bifurcation points, not basin boundaries, so where two windows'
+orbits are stable at once (hysteresis) both edges are seen. The same on the order-1
+limit map for the same eps and on the order-0 limit map (eps -> 0). The edges at
+eps <= ``fit_eps_max`` are then fitted by edge = A + B eps^(1/2) (the order-1 term of
+P_DM is of order sqrt(eps) relative to the order-0 jump) and by edge = A + B eps; the
+intercepts are compared with the order-0 edges.
 """
 from __future__ import annotations
 
@@ -17,11 +21,16 @@ import xarray as xr
 
 from .. import attractors
 from ..analytic import limit_map
+from .. import branches
+from ..fastmap import OK, compute_returns
 from ..io import finalize
+from ..models import hopf
+from ..periodic import periodic_orbit
 from .attractor_common import (CHUNK_AXIS, ENGINES, chunk_grid, PERIOD_TOL, T_RETURN,  # noqa: F401
                                VARIABLE_ATTRS as _COMMON_ATTRS, _settle, chaos_tolerances,
                                common_dataset, eps_list, s_grid, sweep, thetas, validate)
 from .common import solver_options
+from .. import tolerance
 from ..tolerance import Tolerance
 from ..report import Macros, eps_tex, head, num, source, tabular, value
 
@@ -54,11 +63,21 @@ VARIABLE_ATTRS = dict(_COMMON_ATTRS)
 VARIABLE_ATTRS.update({
     "n": ("period of the window", "1"),
     "side": ("0: left edge (smaller s), 1: right edge", "1"),
-    "edge": ("edge in s of the first window of period n, slow-fast system (NaN: not on "
-             "the grid)", "1"),
-    "edge_limit": ("edge in s of the first window of period n, limit map order 1", "1"),
+    "edge": ("edge in s of the first window of period n, slow-fast system: where its "
+             "orbit, followed from inside the window, stops being stable (NaN: stable to "
+             "the end of the grid or no window)", "1"),
+    "edge_kind": ("how the window's orbit ends there: -1 period doubling, 0 border "
+                  "collision (an orbit point reaches grazing), 1 fold, 2 stable to the end "
+                  "of the grid, 3 torus, -9 no window on the grid", "1"),
+    "edge_multiplier": ("multiplier of the window's orbit at its last stable point", "1"),
+    "edge_limit": ("edge in s of the first window of period n, limit map order 1 "
+                   "(followed orbit)", "1"),
+    "edge_limit_kind": ("as edge_kind, limit map order 1", "1"),
     "edge_limit0": ("edge in s of the first window of period n, limit map order 0 "
-                    "(eps -> 0)", "1"),
+                    "(eps -> 0, followed orbit)", "1"),
+    "edge_limit0_kind": ("as edge_kind, limit map order 0", "1"),
+    "coexistence": ("right edge of the window of n + 1 minus left edge of the window of "
+                    "n: > 0 both orbits stable there (hysteresis), < 0 a gap", "1"),
     "fit_sqrt_A": ("intercept A of edge = A + B eps^(1/2) over eps <= fit_eps_max", "1"),
     "fit_sqrt_B": ("slope B of edge = A + B eps^(1/2)", "1"),
     "fit_sqrt_rms": ("rms residual of edge = A + B eps^(1/2)", "1"),
@@ -83,43 +102,47 @@ def tolerances(scene: dict) -> dict:
     H, the sqrt(eps) term of P_DM makes its slope unbounded: at the larger eps orbits
     that pass close to the jump separate, and where no period is found (between the
     windows) the attractor is chaotic. Points, widths and periods are therefore
-    compared as in attractor_common.chaos_tolerances (measured under the emulated CPU:
-    up to 0.19 in u and one period changed, all at eps = 1e-2). A window edge is found
-    by bisection: a classification that a last-bit change flips at one midpoint moves
-    it by up to edge_tol; the fits carry that through their least-squares weights.
-    The bisection starts from the grid's first run of the period, so a flipped grid
-    point next to the edge moves the bracket, and the edge, by one grid step: seen at
-    eps = 1e-2, where periodic and aperiodic grid points interleave at the right edge
-    of the period-4 window (s = 2.975 .. 3.05: periods 4, 0, 4, 0 natively, 4, 4, 0, 0
-    under the emulated CPU, seed 2; the edge moved by 0.025). The slow-fast edges
-    carry that tolerance; the fits use eps <= fit_eps_max, whose edges held to
-    edge_tol under every emulated seed."""
+    compared as in attractor_common.chaos_tolerances.
+
+    The window edges are bifurcation points of the followed orbits (branches.follow),
+    not basin edges, so they do not depend on which attractor a start falls into.
+    Bisected to edge_tol; a last-bit change moves a border collision by the rounding of
+    the grazing point in u (EVENT_STATE/eps) over du/ds of the orbit point (>= 0.1 on
+    every window, fig12 data): 10 EVENT_STATE/eps_min; a flip by the rounding of the
+    multiplier over its slope in s (steep near grazing: less). The fits carry the
+    edges' tolerance through their least-squares weights."""
     p = scene["parameters"]
     eps = np.array(eps_list(p))
     tol_e = float(p["edge_tol"])
-    grid = s_grid(p)
-    step = float(f"{grid[1] - grid[0]:.6g}")
-    edge = Tolerance(0.0, tol_e, "bisection to edge_tol: one flipped classification")
+    e_atol = 2 * tol_e + 10 * tolerance.EVENT_STATE / float(eps.min())
+    edge = Tolerance(0.0, e_atol, "bisection to edge_tol (twice: one midpoint's verdict "
+                     "may flip) plus the rounding of the grazing point in s, "
+                     "10 EVENT_STATE/eps_min")
+    lim = Tolerance(0.0, 2 * tol_e, "limit map (numpy, closed-form slopes): bisection to "
+                    "edge_tol, one midpoint's verdict may flip")
     out = chaos_tolerances(scene)
     del out["lyapunov_limit"]  # not computed here
-    out.update({"edge": Tolerance(0.0, step + tol_e, "a flipped grid classification next "
-                                  "to the edge moves the bisection's bracket by one grid "
-                                  "step (eps = 1e-2, where periodic and aperiodic points "
-                                  "interleave at a window's edge); then to edge_tol"),
-                "edge_limit": edge, "edge_limit0": edge,
-                "edge_gap": Tolerance(0.0, step + 2 * tol_e, "an edge by one grid step, "
-                                      "both by edge_tol"),
-                "fit_sqrt_rms": Tolerance(0.0, tol_e, "residual of edges known to edge_tol"),
-                "fit_lin_rms": Tolerance(0.0, tol_e, "residual of edges known to edge_tol")})
+    kind = Tolerance(0.0, 0.0, "the kind of a bifurcation: discrete, decided by the sign "
+                     "and size of a multiplier away from its threshold")
+    out.update({"edge": edge, "edge_limit": lim, "edge_limit0": lim,
+                "edge_kind": kind, "edge_limit_kind": kind, "edge_limit0_kind": kind,
+                "edge_multiplier": Tolerance(0.0, 1e-2, "the multiplier at the last stable "
+                                             "point, within edge_tol of the edge: at a flip "
+                                             "near grazing it changes fast with s"),
+                "coexistence": Tolerance(0.0, 2 * e_atol, "difference of two edges"),
+                "edge_gap": Tolerance(0.0, e_atol + 2 * tol_e, "slow-fast and limit-map "
+                                      "edges"),
+                "fit_sqrt_rms": Tolerance(0.0, e_atol, "residual of edges known to that"),
+                "fit_lin_rms": Tolerance(0.0, e_atol, "residual of edges known to that")})
     fitted = eps[eps <= float(p["fit_eps_max"])]
     if fitted.size >= 2:
         for name, x in (("sqrt", np.sqrt(fitted)), ("lin", fitted)):
             # three digits: the weights come through LAPACK, whose last bits vary
             wa, wb = (float(f"{w:.3g}") for w in _fit_weights(x))
-            out[f"fit_{name}_A"] = Tolerance(0.0, wa * tol_e, "intercept: its least-squares "
-                                             "weights times edge_tol")
-            out[f"fit_{name}_B"] = Tolerance(0.0, wb * tol_e, "slope: its least-squares "
-                                             "weights times edge_tol")
+            out[f"fit_{name}_A"] = Tolerance(0.0, wa * e_atol, "intercept: its least-squares "
+                                             "weights times the edges' tolerance")
+            out[f"fit_{name}_B"] = Tolerance(0.0, wb * e_atol, "slope: its least-squares "
+                                             "weights times the edges' tolerance")
     return out
 
 
@@ -137,34 +160,134 @@ def _fit(x: np.ndarray, y: np.ndarray):
     return float(a), float(b), float(np.sqrt(np.mean((M @ [a, b] - y[ok]) ** 2)))
 
 
+def _slow_fast_orbit_at(p: dict, theta: float, eps: float, n: int, options: dict):
+    """orbit_at(s, guess) for branches.follow: the period-n orbit of the slow-fast return
+    map to L1 at mu = 1 + s eps (Newton with the engine's dP/dz), its largest nontrivial
+    multiplier and its itinerary: the number of switches on each of its n returns."""
+    omega = float(p["omega"])
+
+    def at(s, guess):
+        mu = 1.0 + s * eps
+        system = hopf.system(eps, theta, mu, omega, sliding=False)
+        orbit = periodic_orbit(system, guess, hopf.L1["section"], returns=n,
+                               direction=hopf.L1["direction"], where=hopf.L1["where"],
+                               engine="compiled", t_max=T_RETURN, **options)
+        cm = system.compiled(**hopf.L1)
+        run = attractors.iterate(cm, orbit.point, transient=0, keep=n, t_max=T_RETURN,
+                                 **options)
+        points = np.concatenate([orbit.point[None], run.orbit[0, :-1]])
+        _distinct(points[:, 1] / eps, n, s)
+        points = points[_phase(points[:, 1], guess[1]):]  # Newton may land on another
+        points = np.concatenate([points, run.orbit[0, :n - len(points)]])  # of its points
+        one = compute_returns(cm, points, T_RETURN, **options)
+        if np.any(one.status != OK):
+            raise RuntimeError(f"a return of the period-{n} orbit at s = {s!r} failed")
+        return branches.Orbit(points[0], float((points[0, 1] - 1.0) / eps),
+                              complex(orbit.multipliers[1]),
+                              tuple(int(k) for k in one.n_switches))
+    return at
+
+
+def _limit_orbit_at(theta: float, eps: float, omega: float, n: int, order: int):
+    """orbit_at(s, guess) for branches.follow on the limit map (limit_map.cycle)."""
+    def at(s, guess):
+        u = float(np.asarray(guess).reshape(-1)[0])
+        points, mult = limit_map.cycle(u, s, n, eps=eps, theta=theta, omega=omega,
+                                       order=order)
+        _distinct(points, n, s)
+        points = np.roll(points, -_phase(points, u))
+        return branches.Orbit(points[:1].copy(), float(points[0]), complex(mult),
+                              limit_map.itinerary(points, s, eps=eps, theta=theta,
+                                                  omega=omega, order=order))
+    return at
+
+
+def _phase(values: np.ndarray, guess: float) -> int:
+    """Index of the orbit point nearest the guess: Newton from the last orbit's point may
+    converge to the same orbit at another of its points, and the follower compares
+    itineraries point by point from the one it started with."""
+    return int(np.argmin(np.abs(np.asarray(values) - guess)))
+
+
+def _distinct(u: np.ndarray, n: int, s: float) -> None:
+    """Refuse an 'orbit of period n' whose points repeat with a shorter period (Newton on
+    P^n - z also converges to the fixed points of P^d, d | n)."""
+    for d in range(1, n):
+        if n % d == 0 and np.all(np.abs(u[d:] - u[:-d]) <= PERIOD_TOL):
+            raise ValueError(f"the period-{n} orbit at s = {s!r} has period {d}")
+
+
+def window_edges(orbit_at, grid, periods, n: int, start_state, xtol: float):
+    """The first window of period n on the grid, its orbit followed from the window's
+    middle grid point down and up in s (branches.follow): ((left, right), (kind_l,
+    kind_r), (multiplier at the left end, at the right end)); NaN / BEYOND where the
+    orbit stays stable to the end of the grid, NOT_FOUND where the grid has no window."""
+    w = attractors.first_window(periods, n)
+    if w is None:
+        return (np.nan, np.nan), (NOT_FOUND, NOT_FOUND), (np.nan, np.nan)
+    mid = (w[0] + w[1]) // 2
+    s0 = float(grid[mid])
+    step = float(grid[1] - grid[0])
+    ends = [branches.follow(orbit_at, s0, start_state(s0), lim, step=step, xtol=xtol,
+                            near=NEAR) for lim in (float(grid[0]), float(grid[-1]))]
+    return (tuple(e.parameter for e in ends), tuple(e.kind for e in ends),
+            tuple(float(np.real(e.inside.multiplier)) for e in ends))
+
+
+#: edge_kind where the grid shows no window of that period
+NOT_FOUND = -9
+#: a followed orbit whose point moves by more than this in u between two parameters is
+#: another orbit (Newton across a border): the windows' orbits move by ~0.3 in u per unit
+#: of s (fig12 data), the continuation steps are one grid step (0.025) or less
+NEAR = 0.5
+
+
+def _coexistence(ns: list, edge: np.ndarray) -> np.ndarray:
+    """Per eps and n: right edge of the window of n + 1 minus left edge of the window of
+    n (the cascade falls with s: window n + 1 lies left of window n). Positive: both
+    orbits are stable on that interval (hysteresis); negative: neither is, and other
+    attractors fill the gap; NaN where n + 1 is not followed or an edge is missing."""
+    out = np.full(edge.shape[:2], np.nan)
+    for m, n in enumerate(ns):
+        if n + 1 in ns:
+            out[:, m] = edge[:, ns.index(n + 1), 1] - edge[:, m, 0]
+    return out
+
+
 def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     p = scene["parameters"]
     ds = common_dataset(scene, raw)
     (theta,) = thetas(p)
     eps, s = eps_list(p), s_grid(p)
     ns = [int(n) for n in p["window_periods"]]
-    tol, mp = float(p["edge_tol"]), int(p["max_period"])
-    omega, n_tr, keep = float(p["omega"]), int(p["n_transient"]), int(p["n_keep"])
+    tol = float(p["edge_tol"])
+    omega, n_tr = float(p["omega"]), int(p["n_transient"])
     opts = solver_options(scene)
     opts.pop("method")
 
-    def limit_period(order, e):
-        return lambda x: attractors.period_of(
-            limit_map.orbit([x], eps=e, theta=theta, omega=omega, transient=n_tr, keep=keep,
-                            order=order)[0], PERIOD_TOL, mp)
+    def limit_start(e, order):
+        return lambda x: limit_map.orbit([x], eps=e, theta=theta, omega=omega,
+                                         transient=n_tr, keep=1, order=order)[0]
 
-    edge = np.full((len(eps), len(ns), 2), np.nan)
-    edge_lim = np.full_like(edge, np.nan)
+    shape = (len(eps), len(ns), 2)
+    edge, kind, mult = np.full(shape, np.nan), np.full(shape, NOT_FOUND, np.int32), \
+        np.full(shape, np.nan)
+    edge_lim, kind_lim = np.full(shape, np.nan), np.full(shape, NOT_FOUND, np.int32)
     for j, e in enumerate(eps):
-        sf = lambda x, e=e: _settle(p, theta, e, x, opts, False).period  # noqa: E731
+        def sf_start(x, e=e):
+            return _settle(p, theta, e, x, opts, False).states[-1]
         for m, n in enumerate(ns):
-            edge[j, m] = attractors.window_edges(s, ds.period.values[0, j], n, sf, tol)
-            edge_lim[j, m] = attractors.window_edges(s, ds.period_limit.values[0, j], n,
-                                                     limit_period(1, e), tol)
-    edge0 = np.full((len(ns), 2), np.nan)
+            edge[j, m], kind[j, m], mult[j, m] = window_edges(
+                _slow_fast_orbit_at(p, theta, e, n, opts), s, ds.period.values[0, j], n,
+                sf_start, tol)
+            edge_lim[j, m], kind_lim[j, m], _ = window_edges(
+                _limit_orbit_at(theta, e, omega, n, 1), s, ds.period_limit.values[0, j], n,
+                limit_start(e, 1), tol)
+    edge0, kind0 = np.full((len(ns), 2), np.nan), np.full((len(ns), 2), NOT_FOUND, np.int32)
     for m, n in enumerate(ns):
-        edge0[m] = attractors.window_edges(s, ds.period_limit0.values[0], n,
-                                           limit_period(0, eps[-1]), tol)
+        edge0[m], kind0[m], _ = window_edges(
+            _limit_orbit_at(theta, eps[-1], omega, n, 0), s, ds.period_limit0.values[0], n,
+            limit_start(eps[-1], 0), tol)
     fits = {k: np.full((len(ns), 2), np.nan) for k in (
         "fit_sqrt_A", "fit_sqrt_B", "fit_sqrt_rms", "fit_lin_A", "fit_lin_B", "fit_lin_rms")}
     ea = np.array(eps)
@@ -181,6 +304,11 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     ds["edge"] = (("eps", "n", "side"), edge)
     ds["edge_limit"] = (("eps", "n", "side"), edge_lim)
     ds["edge_limit0"] = (("n", "side"), edge0)
+    ds["edge_kind"] = (("eps", "n", "side"), kind)
+    ds["edge_multiplier"] = (("eps", "n", "side"), mult)
+    ds["edge_limit_kind"] = (("eps", "n", "side"), kind_lim)
+    ds["edge_limit0_kind"] = (("n", "side"), kind0)
+    ds["coexistence"] = (("eps", "n"), _coexistence(ns, edge))
     for k, v in fits.items():
         ds[k] = (("n", "side"), v)
     gap = np.abs(edge - edge_lim).reshape(len(eps), -1)
@@ -197,8 +325,15 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
 _REPORT_WORD = {2: "Two", 3: "Three", 4: "Four", 5: "Five", 6: "Six"}
 
 
-def _report_edge_cell(pair) -> str:
-    return " & ".join("--" if not np.isfinite(v) else f"${num(float(v), 3)}$" for v in pair)
+#: superscripts of the table's edges: how the window's orbit ends (branches kinds)
+_REPORT_KIND = {-1: r"^{\mathrm{d}}", 0: r"^{\mathrm{b}}", 1: r"^{\mathrm{f}}",
+                3: r"^{\mathrm{t}}"}
+
+
+def _report_edge_cell(pair, kinds=(None, None)) -> str:
+    return " & ".join("--" if not np.isfinite(v) else
+                      f"${num(float(v), 4)}{_REPORT_KIND.get(k, '') if k is not None else ''}$"
+                      for v, k in zip(pair, kinds))
 
 
 def _report_table(ds) -> str:
@@ -208,10 +343,13 @@ def _report_table(ds) -> str:
     rows = []
     for j, e in enumerate(ds.eps.values):
         rows.append(" & ".join([f"${eps_tex(float(e))}$",
-                                *(_report_edge_cell(ds.edge.values[j, m]) for m in range(len(ns)))])
+                                *(_report_edge_cell(ds.edge.values[j, m],
+                                                    ds.edge_kind.values[j, m])
+                                  for m in range(len(ns)))])
                     + r" \\")
     rows.append(r"\midrule")
-    rows.append(" & ".join([r"$\to 0$", *(_report_edge_cell(ds.edge_limit0.values[m])
+    rows.append(" & ".join([r"$\to 0$", *(_report_edge_cell(ds.edge_limit0.values[m],
+                                                             ds.edge_limit0_kind.values[m])
                                           for m in range(len(ns)))]) + r" \\")
     fit = [(ds.fit_lin_A.values[m, 0], ds.fit_sqrt_A.values[m, 1]) for m in range(len(ns))]
     rows.append(" & ".join(["fit", *(_report_edge_cell(f) for f in fit)]) + r" \\")
@@ -273,4 +411,42 @@ def report(ds, m: Macros) -> str | None:
         if w:
             m.add(f"rpTwelveLeftZero{w}", float(e0[k, 0]), source(sid, "edge_limit0", n=int(n), side=0), 4)
             m.add(f"rpTwelveRightZero{w}", float(e0[k, 1]), source(sid, "edge_limit0", n=int(n), side=1), 4)
+    _report_bifurcations(ds, m, sid)
     return _report_table(ds)
+
+
+def _report_bifurcations(ds, m: Macros, sid: str) -> None:
+    """How the windows end, and where neighbouring windows overlap or leave a gap."""
+    from ..branches import BORDER, FLIP
+
+    def every(kinds, kind):   # over the edges that lie on the grid (not BEYOND/no window)
+        k = np.asarray(kinds).ravel()
+        k = k[np.isin(k, [-1, 0, 1, 3])]
+        return bool(k.size) and bool(np.all(k == kind))
+
+    left, right = ds.edge_kind.values[..., 0], ds.edge_kind.values[..., 1]
+    m.add("rpTwelveLeftKind", None, "derived: edge_kind == -1 at every left edge on the grid",
+          text=r"	ext{every}" if every(left, FLIP) else r"	ext{\emph{not} every}")
+    m.add("rpTwelveRightKind", None, "derived: edge_kind == 0 at every right edge on the grid",
+          text=r"	ext{every}" if every(right, BORDER) else r"	ext{\emph{not} every}")
+    m.add("rpTwelveZeroKind", None, "derived: edge_limit0_kind == 0 at every edge",
+          text=r"	ext{every}" if every(ds.edge_limit0_kind.values, BORDER)
+          else r"	ext{\emph{not} every}")
+    mult = np.abs(ds.edge_multiplier.values[..., 0][left == FLIP] + 1.0)
+    m.add("rpTwelveFlipMultErr", float(mult.max()), "derived: max |edge_multiplier + 1| "
+          "over the left edges", 1)
+    border = np.abs(ds.edge_multiplier.values[..., 1][right == BORDER])
+    m.add("rpTwelveBorderMultMax", float(border.max()), "derived: max |edge_multiplier| "
+          "over the right edges", 2)
+    c = ds.coexistence.values
+    eps = ds.eps.values
+    over = [j for j in range(len(eps)) if np.nanmax(c[j], initial=-np.inf) > 0]
+    m.add("rpTwelveCoexistMax", float(np.nanmax(c)), "derived: max coexistence", 2)
+    m.add("rpTwelveGapMax", float(-np.nanmin(c)), "derived: -min coexistence", 2)
+    m.add("rpTwelveCoexistEps", None, "derived: eps with a positive coexistence",
+          text=(" and ".join(eps_tex(float(eps[j])) for j in over) if over else r"	ext{none}"))
+    # periods three and two at the eps with the largest overlap of that pair
+    j = int(np.nanargmax(c[:, 0]))
+    m.add("rpTwelveCoexistTwoThree", float(c[j, 0]),
+          source(sid, "coexistence", eps=float(eps[j]), n=int(ds.n.values[0])), 2)
+    m.add("rpTwelveCoexistTwoThreeEps", float(eps[j]), f"derived: eps of max coexistence[n=0]", 2)

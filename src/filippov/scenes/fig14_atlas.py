@@ -53,8 +53,9 @@ CHAOTIC, APERIODIC, ESCAPED = 0, -1, -2
 
 VARIABLE_ATTRS = dict(_COMMON_ATTRS)
 VARIABLE_ATTRS.update({
-    "attractor_type": ("n >= 1: period n; 0: chaotic (no period, Lyapunov exponent > 0); "
-                       "-1: no period, exponent <= 0; -2: escaped", "1"),
+    "attractor_type": ("n >= 1: period n (a confirmed, stable periodic orbit); 0: chaotic "
+                       "(no period, Lyapunov exponent above three standard errors); -1: no "
+                       "period, exponent not positive beyond its error; -2: escaped", "1"),
     "attractor_type_limit": ("attractor_type of the limit map (order 1 at the scene's eps)",
                              "1"),
     "lyapunov_limit": ("Lyapunov exponent of the limit map along its attractor", "1"),
@@ -103,9 +104,16 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     return assemble(scene, sweep(scene, chunk_grid(scene), progress=progress))
 
 
-def classify(period, lyapunov, escaped) -> np.ndarray:
+def classify(period, lyapunov, escaped, lyapunov_err=None) -> np.ndarray:
+    """Type per point: the confirmed period, else chaotic where the exponent is positive
+    beyond attractors.LYAPUNOV_SIGMAS standard errors (``lyapunov_err``; without it, where it is
+    positive: the limit map's, a mean over its kept points), else aperiodic."""
     period, lyapunov = np.asarray(period), np.asarray(lyapunov)
-    out = np.where(period > 0, period, np.where(lyapunov > 0, CHAOTIC, APERIODIC))
+    positive = lyapunov > 0
+    if lyapunov_err is not None:
+        err = np.asarray(lyapunov_err)
+        positive = np.isfinite(err) & (lyapunov > attractors.LYAPUNOV_SIGMAS * err)
+    out = np.where(period > 0, period, np.where(positive, CHAOTIC, APERIODIC))
     return np.where(escaped, ESCAPED, out).astype(np.int32)
 
 
@@ -114,7 +122,8 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     ds = common_dataset(scene, raw)
     ds["lyapunov_limit"] = (("theta", "eps", "s"), lyapunov_limit(ds, float(p["omega"])))
     ds["attractor_type"] = (("theta", "eps", "s"),
-                            classify(ds.period.values, ds.lyapunov.values, ds.status.values != 0))
+                            classify(ds.period.values, ds.lyapunov.values, ds.status.values != 0,
+                                     ds.lyapunov_err.values))
     ds["attractor_type_limit"] = (("theta", "eps", "s"), classify(
         ds.period_limit.values, ds.lyapunov_limit.values, ~np.isfinite(ds.u_limit.values).all(-1)))
     lam = limit_map.multiplier(1.0, float(p["omega"]))
