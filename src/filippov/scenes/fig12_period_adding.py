@@ -383,13 +383,15 @@ def report(ds, m: Macros) -> str | None:
     onset = [float(s[np.flatnonzero((s > 0) & (per[j] != 1))[0]]) for j in range(len(eps))]
     m.add("rpTwelveOnsetMax", max(onset), "derived: largest first s > 0 with period != 1", 2)
     lin_l = float(np.nanmax(ds.fit_lin_rms.values[:, 0]))
-    sq_l = float(np.nanmin(ds.fit_sqrt_rms.values[:, 0]))
-    lin_r = float(np.nanmin(ds.fit_lin_rms.values[:, 1]))
     sq_r = float(np.nanmax(ds.fit_sqrt_rms.values[:, 1]))
+    # each window's two fits compared with each other (residuals differ by decades across n)
+    ratio = ds.fit_sqrt_rms.values / ds.fit_lin_rms.values
     m.add("rpTwelveLeftLinRms", lin_l, "derived: max fit_lin_rms over n, left edges", 2)
-    m.add("rpTwelveLeftSqrtRms", sq_l, "derived: min fit_sqrt_rms over n, left edges", 2)
-    m.add("rpTwelveRightLinRms", lin_r, "derived: min fit_lin_rms over n, right edges", 2)
     m.add("rpTwelveRightSqrtRms", sq_r, "derived: max fit_sqrt_rms over n, right edges", 2)
+    m.add("rpTwelveLeftRatioMin", float(np.nanmin(ratio[:, 0])), "derived: min over n of "
+          "fit_sqrt_rms / fit_lin_rms, left edges", 2)
+    m.add("rpTwelveRightRatioMax", float(np.nanmax(ratio[:, 1])), "derived: max over n of "
+          "fit_sqrt_rms / fit_lin_rms, right edges", 2)
     e0 = ds.edge_limit0.values
     m.add("rpTwelveLeftAErr", float(np.nanmax(np.abs(ds.fit_lin_A.values[:, 0] - e0[:, 0]))),
           "derived: max |fit_lin_A - edge_limit0|, left edges", 2)
@@ -415,6 +417,13 @@ def report(ds, m: Macros) -> str | None:
     return _report_table(ds)
 
 
+def _report_list(items: list) -> str:
+    """'a', 'a and b', 'a, b and c' in math mode; none: the word."""
+    if not items:
+        return r"\text{none}"
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + r"\text{ and }" + items[-1]
+
+
 def _report_bifurcations(ds, m: Macros, sid: str) -> None:
     """How the windows end, and where neighbouring windows overlap or leave a gap."""
     from ..branches import BORDER, FLIP
@@ -426,12 +435,12 @@ def _report_bifurcations(ds, m: Macros, sid: str) -> None:
 
     left, right = ds.edge_kind.values[..., 0], ds.edge_kind.values[..., 1]
     m.add("rpTwelveLeftKind", None, "derived: edge_kind == -1 at every left edge on the grid",
-          text=r"	ext{every}" if every(left, FLIP) else r"	ext{\emph{not} every}")
+          text=r"\text{every}" if every(left, FLIP) else r"\text{\emph{not} every}")
     m.add("rpTwelveRightKind", None, "derived: edge_kind == 0 at every right edge on the grid",
-          text=r"	ext{every}" if every(right, BORDER) else r"	ext{\emph{not} every}")
+          text=r"\text{every}" if every(right, BORDER) else r"\text{\emph{not} every}")
     m.add("rpTwelveZeroKind", None, "derived: edge_limit0_kind == 0 at every edge",
-          text=r"	ext{every}" if every(ds.edge_limit0_kind.values, BORDER)
-          else r"	ext{\emph{not} every}")
+          text=r"\text{every}" if every(ds.edge_limit0_kind.values, BORDER)
+          else r"\text{\emph{not} every}")
     mult = np.abs(ds.edge_multiplier.values[..., 0][left == FLIP] + 1.0)
     m.add("rpTwelveFlipMultErr", float(mult.max()), "derived: max |edge_multiplier + 1| "
           "over the left edges", 1)
@@ -444,7 +453,7 @@ def _report_bifurcations(ds, m: Macros, sid: str) -> None:
     m.add("rpTwelveCoexistMax", float(np.nanmax(c)), "derived: max coexistence", 2)
     m.add("rpTwelveGapMax", float(-np.nanmin(c)), "derived: -min coexistence", 2)
     m.add("rpTwelveCoexistEps", None, "derived: eps with a positive coexistence",
-          text=(" and ".join(eps_tex(float(eps[j])) for j in over) if over else r"	ext{none}"))
+          text=_report_list([eps_tex(float(eps[j])) for j in over]))
     # periods three and two at the eps with the largest overlap of that pair
     j = int(np.nanargmax(c[:, 0]))
     m.add("rpTwelveCoexistTwoThree", float(c[j, 0]),
