@@ -171,6 +171,35 @@ def test_the_chaotic_attractor_shrinks_like_eps_squared():
     assert k == pytest.approx(2.0, abs=0.15)
 
 
+def test_the_chaos_ends_at_smaller_s_as_eps_shrinks():
+    # theta = 0.2: at s = 70.7 (fig13's geometric grid) the attractor is chaotic at
+    # eps = 1e-3 (an exponent above three standard errors) but periodic at eps = 1e-5,
+    # where the chaos ended by s = 18.8: the chaotic range is not one multiple of eps^2
+    def chaotic(eps, s):
+        at = _attractor(eps, 0.2, s, transient=300, keep=100, lyapunov=True)
+        return at.period == 0 and at.lyapunov > attractors.LYAPUNOV_SIGMAS * at.lyapunov_err
+    assert chaotic(1e-3, 70.71067811865474)
+    assert not chaotic(1e-5, 70.71067811865474)
+    assert not chaotic(1e-5, 18.80301546543197)
+    assert chaotic(1e-5, 5.0)
+
+
+def test_width_exponents_are_fitted_over_three_eps_with_their_error():
+    from filippov.scenes.fig13_small_scale_chaos import width_exponents
+    eps = np.array([1e-2, 1e-3, 1e-4, 1e-5])
+    fitted = eps <= 1e-3
+    w = np.array([3.0, 2.0, 1.0])[None, None, :] * eps[None, :, None] ** 2
+    w[0, 2, 1] *= 1.1                                   # one width off by 10%
+    chaos = np.ones((1, 4, 3), dtype=np.int32)
+    chaos[0, 3, 2] = 0                                  # periodic at eps = 1e-5 here
+    k, err = width_exponents(w, chaos, fitted, eps)
+    assert k[0, 0] == pytest.approx(2.0) and err[0, 0] == pytest.approx(0.0, abs=1e-12)
+    assert abs(k[0, 1] - 2.0) < 0.03 and err[0, 1] > 0.01
+    assert np.isnan(k[0, 2]) and np.isnan(err[0, 2])   # not chaotic at every fitted eps
+    k2, _ = width_exponents(w, chaos, eps <= 1e-4, eps)  # two eps: no fit
+    assert np.all(np.isnan(k2))
+
+
 def test_hard_cases_grazing_itself_tiny_eps_and_escape():
     # mu exactly 1, from the grazing orbit itself: a point, no NaN
     for theta in (-0.5, 0.2):

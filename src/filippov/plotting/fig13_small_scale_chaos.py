@@ -12,7 +12,7 @@ from . import style as st
 #: under the emulated CPU); lines and labels still have to agree
 IMAGE_RMS = 0.15
 
-VARS = ["u", "u_limit", "lyapunov", "lyapunov_limit", "width_x2", "width_exponent",
+VARS = ["u", "u_limit", "lyapunov", "lyapunov_limit", "width_x2", "width_exponent", "chaotic",
         "slope_pdm", "period"]
 S_LABEL = r"$s=(\mu-1)/\varepsilon^2$"
 U_LABEL = r"$(x_2-1)/\varepsilon^2$ on $\mathcal{L}_1$"
@@ -59,11 +59,11 @@ def draw(ds):
     pos = s > 0
     for jj, e in enumerate(eps):
         w = ds.width_x2.values[i, jj][pos]
-        ok = ds.period.values[i, jj][pos] != 1  # a point: width zero up to rounding
+        ok = ds.chaotic.values[i, jj][pos] == 1  # chaotic attractors only
         ax.loglog((s[pos] * e * e)[ok], w[ok], "o-", ms=2, lw=st.LW_THIN,
                   color=COLORS[(jj + 2) % len(COLORS)], label=f"$\\varepsilon={st.eps_value(e)}$")
     ax.set_xlabel(r"$\mu-1$")
-    ax.set_ylabel(r"width of the attractor in $x_2$")
+    ax.set_ylabel(r"width of the chaotic attractor in $x_2$")
     fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center")  # under (e)
     st.panel_label(ax, f"(e) $\\theta={th[i]:g}$: chaos on the scale $\\varepsilon^2$")
     ax = axes[1, 2]

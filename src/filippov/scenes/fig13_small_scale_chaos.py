@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .. import tolerance
+from .. import attractors, tolerance
 from ..analytic import limit_map
 from ..io import finalize
 from ..tolerance import Tolerance
@@ -63,8 +63,12 @@ VARIABLE_ATTRS.update({
     "slope_return": ("lambda s(theta,0,0): slope of the return map on the sliding side", "1"),
     "lyapunov_limit": ("Lyapunov exponent of the limit map along its attractor", "1"),
     "width_x2": ("width of the attractor in x2 (width times eps^2)", "1"),
-    "width_exponent": ("k of width_x2 ~ eps^k: least-squares slope over eps <= fit_eps_max "
-                       "(NaN: the attractor is a point at one of them)", "1"),
+    "width_exponent": ("k of width_x2 ~ eps^k: least-squares slope of log width against "
+                       "log eps over eps <= fit_eps_max (three or more), where the attractor "
+                       "is chaotic at each of them (NaN elsewhere)", "1"),
+    "width_exponent_err": ("standard error of width_exponent (residuals, n - 2 degrees of "
+                           "freedom)", "1"),
+    "chaotic": ("1: chaotic (no confirmed period, exponent above three standard errors)", "1"),
 })
 
 
@@ -75,7 +79,11 @@ def tolerances(scene: dict) -> dict:
     out = chaos_tolerances(scene)
     stat = "a sampled statistic of a chaotic orbit (another orbit on another machine)"
     out["width_x2"] = Tolerance(0.5, tolerance.EVENT_STATE, f"{stat}: extent of the points")
-    out["width_exponent"] = Tolerance(0.0, 0.5, f"{stat}: log10 of a width ratio")
+    out["width_exponent"] = Tolerance(0.0, 0.5, f"{stat}: slope of log widths over three or "
+                                      "more eps, each width to 50% (ln 3 moves the slope by "
+                                      "< 0.25 a decade apart)")
+    out["width_exponent_err"] = Tolerance(0.0, 0.5, f"{stat}: residuals of the same fit")
+    out["chaotic"] = out["period"]   # a classification, as the period
     return out
 
 
@@ -90,6 +98,38 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     return assemble(scene, sweep(scene, chunk_grid(scene), progress=progress))
 
 
+def chaotic(ds) -> np.ndarray:
+    """1 where the attractor is chaotic: no confirmed period and a Lyapunov exponent
+    above attractors.LYAPUNOV_SIGMAS standard errors (0 elsewhere)."""
+    return ((ds.period.values == 0) & (ds.status.values == 0) &
+            (ds.lyapunov.values > attractors.LYAPUNOV_SIGMAS * ds.lyapunov_err.values)
+            ).astype(np.int32)
+
+
+def width_exponents(wx: np.ndarray, chaos: np.ndarray, fitted: np.ndarray, eps: np.ndarray):
+    """k and its standard error per (theta, s): the least-squares slope of log width
+    against log eps over the ``fitted`` eps (at least three), where the attractor is
+    chaotic at every one of them (a periodic attractor's width is its orbit's extent,
+    which need not scale like a chaotic band's); NaN elsewhere. The error is the slope's
+    standard error from the residuals (n - 2 degrees of freedom)."""
+    le = np.log(eps[fitted])
+    n = le.size
+    k, err = np.full(wx.shape[::2], np.nan), np.full(wx.shape[::2], np.nan)
+    if n < 3:
+        return k, err
+    sxx = float(np.sum((le - le.mean()) ** 2))
+    for i in range(wx.shape[0]):
+        for m in range(wx.shape[2]):
+            w = wx[i, fitted, m]
+            if not (np.all(chaos[i, fitted, m] == 1) and np.all(np.isfinite(w) & (w > 0))):
+                continue
+            slope, icpt = np.polyfit(le, np.log(w), 1)
+            res = np.log(w) - (icpt + slope * le)
+            k[i, m] = slope
+            err[i, m] = float(np.sqrt(np.sum(res ** 2) / (n - 2) / sxx))
+    return k, err
+
+
 def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     p = scene["parameters"]
     ds = common_dataset(scene, raw)
@@ -100,17 +140,10 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     ds["lyapunov_limit"] = (("theta", "eps", "s"), lyapunov_limit(ds, float(p["omega"])))
     wx = ds.width.values * (eps ** 2)[None, :, None]
     ds["width_x2"] = (("theta", "eps", "s"), wx)
-    k = np.full((th.size, ds.sizes["s"]), np.nan)
-    fitted = eps <= float(p["fit_eps_max"])
-    le = np.log(eps[fitted])
-    for i in range(th.size):
-        for m in range(ds.sizes["s"]):
-            w = wx[i, fitted, m]
-            # a period-one attractor has width zero up to rounding: no exponent
-            if le.size >= 2 and np.all(np.isfinite(w) &
-                                       (ds.period.values[i, fitted, m] != 1)):
-                k[i, m] = np.polyfit(le, np.log(w), 1)[0]
+    ds["chaotic"] = (("theta", "eps", "s"), chaotic(ds))
+    k, k_err = width_exponents(wx, ds.chaotic.values, eps <= float(p["fit_eps_max"]), eps)
     ds["width_exponent"] = (("theta", "s"), k)
+    ds["width_exponent_err"] = (("theta", "s"), k_err)
     return finalize(ds, scene, engine="compiled", method="exact",
                     title="small-scale chaos of the slow-fast Hopf example, theta > 0")
 
@@ -182,16 +215,31 @@ def report(ds, m: Macros) -> str | None:
         m.add(f"rpThirteenLyapMin{w}", float(np.min(ly)),
               "derived: min lyapunov over all eps and 0 < s <= s_max", 2)
         per = ds.period.values[i, j]
-        chaotic = np.flatnonzero((s > 0) & (ds.lyapunov.values[i, j] > 0))
-        if chaotic.size:
-            m.add(f"rpThirteenChaosEnd{w}", float(s[chaotic[-1]]),
-                  "derived: largest s with a positive exponent at the smallest eps", 3)
+        ends = [s[np.flatnonzero((s > 0) & (ds.chaotic.values[i, jj] == 1))]
+                for jj in range(len(eps))]
+        if all(e.size for e in ends):
+            m.add(f"rpThirteenChaosEnd{w}", float(ends[-1][-1]),
+                  "derived: largest s where chaotic == 1 at the smallest eps", 3)
+            m.add(f"rpThirteenChaosEndFirst{w}", float(ends[0][-1]),
+                  "derived: largest s where chaotic == 1 at the largest eps", 3)
+            last = np.array([e[-1] for e in ends])
+            m.add(f"rpThirteenChaosEndSpread{w}", float(last.max() / last.min()),
+                  "derived: max/min over eps of the largest s where chaotic == 1", 3)
+            # on the geometric grid, the ends' indices: how many grid steps apart
+            idx = np.array([int(np.flatnonzero(s == v)[0]) for v in last])
+            m.add(f"rpThirteenChaosEndSteps{w}", float(idx.max() - idx.min()),
+                  "derived: grid steps between the largest and smallest chaos end over eps", 1)
         k = ds.width_exponent.values[i][near]
         if np.isfinite(k).any():
             m.add(f"rpThirteenK{w}", float(np.nanmedian(k)),
                   "derived: median width_exponent over 0 < s <= s_max", 3)
             m.add(f"rpThirteenKMax{w}", float(np.nanmax(np.abs(k - 2.0))),
                   "derived: max |width_exponent - 2| over 0 < s <= s_max", 2)
+            ke = ds.width_exponent_err.values[i][near]
+            m.add(f"rpThirteenKErr{w}", float(np.nanmedian(ke)),
+                  "derived: median width_exponent_err over 0 < s <= s_max", 2)
+            m.add(f"rpThirteenKN{w}", float(np.isfinite(k).sum()),
+                  "derived: number of s in 0 < s <= s_max with a width exponent", 2)
         m.add(f"rpThirteenPeriodOne{w}", float(np.all(per[near] == 1)),
               "derived: 1 if period == 1 on 0 < s <= s_max at the smallest eps", 1)
     return _report_table(ds)
