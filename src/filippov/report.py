@@ -83,6 +83,119 @@ def tex_escape(text: str) -> str:
     return "".join(repl.get(c, c) for c in str(text))
 
 
+#: names a plain-text formula may use besides one-letter variables (x, x1, y)
+MATH_NAMES = {"exp": r"\exp", "log": r"\log", "sin": r"\sin", "cos": r"\cos",
+              "tanh": r"\tanh", "theta": r"\theta", "eps": r"\epsilon", "mu": r"\mu",
+              "omega": r"\omega"}
+
+
+def plain_math_tex(expr: str) -> str:
+    """A formula typed in plain text, as the datasets' attributes hold them, as LaTeX
+    math without dollars: '-1 - x1^2/4' -> '-1-x_1^2/4' (an indexed variable gets its
+    subscript, spaces go, '*' is a thin space; a name other than a one-letter variable
+    or one of MATH_NAMES is refused)."""
+    s = str(expr).replace(" ", "")
+    if not re.fullmatch(r"[0-9A-Za-z+\-*/^().]+", s) or re.search(r"\^[^0-9A-Za-z]", s):
+        raise ValueError(f"not a plain formula: {expr!r}")
+
+    def name(m):
+        letters, index = m.group(1), m.group(2)
+        if letters in MATH_NAMES and not index:
+            return MATH_NAMES[letters] + " "
+        if len(letters) != 1:
+            raise ValueError(f"unknown name {letters + index!r} in the formula {expr!r}")
+        return letters + ("" if not index else f"_{index}" if len(index) == 1
+                          else f"_{{{index}}}")
+    s = re.sub(r"([A-Za-z]+)([0-9]*)", name, s)
+    s = re.sub(r"\^([0-9]{2,})", r"^{\1}", s)
+    return s.replace("*", r"\,").strip()
+
+
+def _split_top(text: str) -> list[str]:
+    """``text`` split at the commas outside parentheses."""
+    parts, depth, cur = [], 0, ""
+    for c in text:
+        depth += (c == "(") - (c == ")")
+        if c == "," and depth == 0:
+            parts.append(cur)
+            cur = ""
+        else:
+            cur += c
+    return [p.strip() for p in parts + [cur] if p.strip()]
+
+
+def formulas_tex(text: str, argument: str = "x") -> str:
+    """Definitions typed in plain text, 'f_- = (1, 1 + x1/2), f_+ = (1, 1/2)' or
+    'h = x2', as the paper writes them: '$f_-(x)=(1,\\,1+x_1/2)$ and
+    $f_+(x)=(1,\\,1/2)$', '$h(x)=x_2$' (each a function of ``argument``)."""
+    out = []
+    for part in _split_top(text):
+        name, eq, rhs = part.partition("=")
+        name, rhs = name.strip(), rhs.strip()
+        if not eq or not re.fullmatch(r"[A-Za-z]+(_[-+A-Za-z0-9])?", name):
+            raise ValueError(f"not a definition 'name = value': {part!r}")
+        if rhs.startswith("(") and rhs.endswith(")"):
+            value = "(" + r",\,".join(plain_math_tex(c) for c in _split_top(rhs[1:-1])) + ")"
+        else:
+            value = plain_math_tex(rhs)
+        out.append(f"${name}({argument})={value}$")
+    if not out:
+        raise ValueError(f"no definition in {text!r}")
+    return ", ".join(out[:-1]) + (" and " if len(out) > 1 else "") + out[-1]
+
+
+NUMBER_WORDS = ("no", "one", "two", "three", "four", "five", "six", "seven", "eight",
+                "nine", "ten", "eleven", "twelve")
+
+
+def count_word(n) -> str:
+    """A count as prose writes it: a word up to twelve ('no' for zero), digits above."""
+    n = int(n)
+    if n < 0:
+        raise ValueError(f"a count is not negative: {n}")
+    return NUMBER_WORDS[n] if n < len(NUMBER_WORDS) else str(n)
+
+
+def _capital(text: str, capital: bool) -> str:
+    return text[0].upper() + text[1:] if capital else text
+
+
+def count_phrase(n, singular: str, plural: Optional[str] = None, *,
+                 capital: bool = False) -> str:
+    """A count with its noun: 'no configuration', 'one configuration', 'three
+    configurations', '16 configurations' (``plural`` defaults to ``singular`` + 's';
+    ``capital`` for the start of a sentence)."""
+    n = int(n)
+    noun = singular if n in (0, 1) else (plural or singular + "s")
+    return _capital(f"{count_word(n)} {noun}", capital)
+
+
+def range_phrase(lo, hi, singular: str, plural: Optional[str] = None) -> str:
+    """From ``lo`` to ``hi`` of a noun: '3 to 250 runs' (digits for both ends when one
+    is above twelve), 'three to five runs', or one count when they agree ('one run')."""
+    lo, hi = int(lo), int(hi)
+    if lo == hi:
+        return count_phrase(lo, singular, plural)
+    a, b = (count_word(lo), count_word(hi)) if hi < len(NUMBER_WORDS) else (str(lo), str(hi))
+    return f"{a} to {b} {plural or singular + 's'}"
+
+
+def share_phrase(k, n, singular: str, plural: Optional[str] = None) -> str:
+    """``k`` of ``n`` things with their noun: 'none of the values', 'one of the five
+    values', 'four of the five values', 'both values', 'all five values' ('the only
+    value' for one of one)."""
+    k, n = int(k), int(n)
+    if not 0 <= k <= n:
+        raise ValueError(f"{k} of {n}")
+    nouns = plural or singular + "s"
+    if k == 0:
+        return f"{'neither' if n == 2 else 'none'} of the {nouns}"
+    if k == n:
+        return (f"the only {singular}" if n == 1 else f"both {nouns}" if n == 2
+                else f"all {count_word(n)} {nouns}")
+    return f"{count_word(k)} of the {count_word(n)} {nouns}"
+
+
 _NAME = re.compile(r"[A-Za-z]+")
 
 
@@ -224,7 +337,8 @@ def table_frame(ds: xr.Dataset, max_rows: int = 30) -> str:
     head = " & ".join(r"\texttt{" + tex_escape(c) + "}" for c in cols) + r" \\"
     rows = [" & ".join(_cell(r[c]) for c in cols) + r" \\" for _, r in df.head(max_rows).iterrows()]
     if len(df) > max_rows:
-        rows.append(rf"\multicolumn{{{len(cols)}}}{{l}}{{\emph{{\dots\ {len(df) - max_rows} more rows in the dataset}}}} \\")
+        more = count_phrase(len(df) - max_rows, "more row")
+        rows.append(rf"\multicolumn{{{len(cols)}}}{{l}}{{\emph{{\dots\ {more} in the dataset}}}} \\")
     return tabular("l" * len(dims) + "r" * len(names), [head], rows)
 
 
@@ -291,11 +405,28 @@ def _bench_timing(ds, m: Macros) -> None:
                             ("rpBenchMinRounds", "timing_min_rounds", 4),
                             ("rpBenchMinTime", "timing_min_time", 3)):
         m.add(name, float(ds.attrs[attr]), f"{sid}:attrs.{attr}", sig)
+    # the counts as the prose says them ("one untimed run", "3 to 250 runs")
+    m.add("rpBenchWarmupRuns", None, f"{sid}:attrs.timing_warmup",
+          text=count_phrase(ds.attrs["timing_warmup"], "untimed run"))
+    m.add("rpBenchMinRoundsRuns", None, f"{sid}:attrs.timing_min_rounds",
+          text=count_phrase(ds.attrs["timing_min_rounds"], "timed run"))
     timed = np.asarray(ds.runs.values)[np.asarray(ds.status.values).astype(str) == "ok"]
     m.add("rpBenchRoundsLeast", float(timed.min()) if timed.size else math.nan,
           "derived: min of work_precision:runs over the configurations that ran", 4)
     m.add("rpBenchRoundsMost", float(timed.max()) if timed.size else math.nan,
           "derived: max of work_precision:runs over the configurations that ran", 4)
+    m.add("rpBenchRoundsRange", None,
+          "derived: min to max of work_precision:runs over the configurations that ran",
+          text=range_phrase(timed.min(), timed.max(), "run") if timed.size else "no runs")
+
+
+def failed_sentence(n: int) -> str:
+    """The sentence of the work-precision text on the configurations that failed."""
+    if n == 0:
+        return "No configuration failed outright on any map."
+    return (count_phrase(n, "configuration", capital=True)
+            + r" failed outright over all maps (cells marked \emph{failed}; the dataset's "
+            r"\texttt{status} says why).")
 
 
 def bench(ds, m: Macros, effects=None, returns=None, compile_cost=None) -> str:
@@ -318,6 +449,10 @@ def bench(ds, m: Macros, effects=None, returns=None, compile_cost=None) -> str:
     sid = "work_precision"
     missing = absent(m, "rpHaveBench", ds, "Work--precision sweep", "results/work_precision.nc")
     m.flag("rpHaveBenchTiming", False)  # set by _bench_timing when the sweep says how it timed
+    # the blocks of `make bench` (set below when measured): defined for every build, as
+    # the table's caption asks for them
+    m.flag("rpHaveEffects", False)
+    m.flag("rpHaveReturnCost", False)
     if missing:
         return missing
     if "method" not in ds.coords or "problem" not in ds.dims:
@@ -346,9 +481,12 @@ def bench(ds, m: Macros, effects=None, returns=None, compile_cost=None) -> str:
             m.add(f"rpBenchBest{tag}{key}",
                   float(np.nanmin(ds.error_map.values[i, sel])) if sel.any() else math.nan,
                   f"derived: min of work_precision:error_map[{i}] over {family}", 2)
-    m.add("rpBenchFailed", float(np.count_nonzero(
-        np.char.startswith(ds.status.values.astype(str), "failed"))),
-        "derived: configurations of work_precision:status that failed", 4)
+    failed = int(np.count_nonzero(np.char.startswith(ds.status.values.astype(str), "failed")))
+    m.add("rpBenchFailed", float(failed),
+          "derived: configurations of work_precision:status that failed", 4)
+    m.add("rpBenchFailedSentence", None,
+          "derived: configurations of work_precision:status that failed",
+          text=failed_sentence(failed))
     m.add("rpBenchConfigs", float(ds.sizes["config"]), "work_precision:config (size)", 4)
     _bench_timing(ds, m)
     m.flag("rpHaveEffects", effects is not None)
@@ -394,6 +532,7 @@ def hard_cases(ds, m: Macros) -> str:
     eps = [float(e) for e in ds.eps.values]
     kmax, kmin = int(np.argmax(eps)), int(np.argmin(eps))
     m.add("rpHardN", len(eps), f"{sid}:eps (size)")
+    m.add("rpHardNValues", None, f"{sid}:eps (size)", text=count_phrase(len(eps), "value"))
     m.add("rpHardEpsMax", eps[kmax], f"{sid}:eps[{kmax}]")
     m.add("rpHardEpsMin", eps[kmin], f"{sid}:eps[{kmin}]")
     for attr, name, sig in (("jump_theta", "JumpTheta", 3), ("jump_x2_offset", "JumpOffset", 3),
@@ -461,6 +600,9 @@ def _hard_return(ds, m: Macros, eps: list) -> str:
     m.add("rpHardReturnStepsMax", int(steps.max()), "derived: max return_steps over eps")
     m.add("rpHardReturnStiffN", int(ds.return_stiff.values.sum()),
           "derived: eps values whose sliding was finished by Radau IIA")
+    m.add("rpHardReturnStiffShare", None,
+          "derived: eps values whose sliding was finished by Radau IIA, of all",
+          text=share_phrase(ds.return_stiff.values.sum(), len(eps), r"$\epsilon$ value"))
     rows = per_eps_rows(ds.assign(gap=("eps", gap), scaled=("eps", scaled)), lambda d: [
         f"${num(float(d.gap), 3)}$", f"${num(float(d.scaled), 4)}$",
         f"${num(float(d.return_sliding_time), 5)}$", f"${int(d.return_steps)}$",

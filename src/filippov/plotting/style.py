@@ -33,6 +33,36 @@ C_PLUS, C_MINUS, C_SLIDE = "#0072B2", "#D55E00", "#009E73"
 C_AUX = "0.55"  # grey for reference lines (manifolds, asymptotes)
 LW_THIN, LW, LW_BOLD = 0.6, 1.0, 1.8
 
+#: The word a caption uses for each colour the figures draw: the style's colours and
+#: the other hues the figure modules use. Greys, black and white are named by
+#: colour_name from their lightness. A caption's colour words must name colours its
+#: figure draws (tests/test_caption_colours.py).
+COLOUR_NAMES = {
+    C_PLUS: "blue",        # Okabe-Ito blue
+    C_MINUS: "orange",     # Okabe-Ito vermillion, a red-orange
+    C_SLIDE: "green",      # Okabe-Ito bluish green
+    C_AUX: "grey",
+    "#CC79A7": "pink",     # Okabe-Ito reddish purple (fig14: period 5)
+    "#E69F00": "yellow",   # Okabe-Ito orange, a golden yellow beside C_MINUS (fig14)
+    "#e7298a": "magenta",  # work_precision: compiled DOP853
+    "#7b3294": "purple",   # work_precision: solve_ivp DOP853
+    "#1b9e77": "green",    # work_precision: solve_ivp Radau
+    "#d95f02": "orange",   # work_precision: solve_ivp LSODA
+}
+
+
+def colour_name(colour) -> str | None:
+    """The word for a matplotlib colour: "black", "grey" or "white" for a colour without
+    hue, the COLOUR_NAMES word for a named hue, None for any other (a colour map's)."""
+    from matplotlib.colors import to_hex, to_rgb
+
+    r, g, b = to_rgb(colour)
+    if max(r, g, b) - min(r, g, b) < 0.04:  # no hue: by lightness
+        light = (r + g + b) / 3
+        return "black" if light < 0.15 else "white" if light > 0.97 else "grey"
+    named = {to_hex(c): word for c, word in COLOUR_NAMES.items()}
+    return named.get(to_hex((r, g, b)))
+
 RC = {
     "font.family": "serif",
     "font.serif": ["STIXGeneral", "DejaVu Serif"],

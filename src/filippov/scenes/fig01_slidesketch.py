@@ -73,12 +73,18 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
 # is left out of the code hash of the compute jobs: editing it rebuilds the report only.
 def report(ds, m: Macros) -> str | None:
     """The report's macros from this scene's dataset; returns its table (None: none)."""
+    from ..report import formulas_tex  # here: the module's imports are in its code hash
+
     sid = "fig01_slidesketch"
     for case, word in (("crossing", "Cross"), ("sliding", "Slide")):
         var(m, f"rpOneHit{word}A", ds, sid, "hit_x1", case=case)
         var(m, f"rpOneHit{word}B", ds, sid, "hit_x2", case=case)
+    # the fields and the switching function as formulas in the paper's notation
+    # ("$f_-(x)=(1,\,1+x_1/2)$ and ...", "$h(x)=x_2$"), from the dataset's plain text
     m.add("rpOneFieldsCross", None, f"{sid}:attrs.crossing_fields",
-          text=r"\texttt{" + tex_escape(ds.attrs["crossing_fields"]) + "}")
+          text=formulas_tex(ds.attrs["crossing_fields"]))
     m.add("rpOneFieldsSlide", None, f"{sid}:attrs.sliding_fields",
-          text=r"\texttt{" + tex_escape(ds.attrs["sliding_fields"]) + "}")
+          text=formulas_tex(ds.attrs["sliding_fields"]))
+    m.add("rpOneSwitching", None, f"{sid}:attrs.switching_function",
+          text=formulas_tex(ds.attrs["switching_function"]))
     return None

@@ -332,7 +332,7 @@ _REPORT_KIND = {-1: r"^{\mathrm{d}}", 0: r"^{\mathrm{b}}", 1: r"^{\mathrm{f}}",
 
 def _report_edge_cell(pair, kinds=(None, None)) -> str:
     return " & ".join("--" if not np.isfinite(v) else
-                      f"${num(float(v), 4)}{_REPORT_KIND.get(k, '') if k is not None else ''}$"
+                      f"${num(float(v), 3)}{_REPORT_KIND.get(k, '') if k is not None else ''}$"
                       for v, k in zip(pair, kinds))
 
 

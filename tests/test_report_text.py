@@ -1,0 +1,132 @@
+"""Words the report generates (issue 31): counts said as prose says them ("no
+configuration failed", "one untimed run", "four of the five eps values"), and the
+formulas of the datasets' plain-text attributes in the paper's notation."""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import synthetic
+from filippov import report
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.mark.parametrize("n, text", [(0, "no configuration"), (1, "one configuration"),
+                                     (2, "two configurations"), (12, "twelve configurations"),
+                                     (16, "16 configurations")])
+def test_count_phrase(n, text):
+    assert report.count_phrase(n, "configuration") == text
+    assert report.count_phrase(n, "configuration", capital=True) == text[0].upper() + text[1:]
+
+
+def test_count_phrase_irregular_plural_and_bad_counts():
+    assert report.count_phrase(3, "matrix", "matrices") == "three matrices"
+    assert report.count_phrase(1, "matrix", "matrices") == "one matrix"
+    assert report.count_phrase(np.int64(0), "value") == "no value"
+    with pytest.raises(ValueError):
+        report.count_phrase(-1, "value")
+
+
+def test_range_phrase():
+    assert report.range_phrase(3, 250, "run") == "3 to 250 runs"
+    assert report.range_phrase(3, 5, "run") == "three to five runs"
+    assert report.range_phrase(1, 1, "run") == "one run"
+    assert report.range_phrase(4, 4, "run") == "four runs"
+
+
+def test_share_phrase():
+    v = r"$\epsilon$ value"
+    assert report.share_phrase(0, 5, v) == r"none of the $\epsilon$ values"
+    assert report.share_phrase(0, 2, v) == r"neither of the $\epsilon$ values"
+    assert report.share_phrase(1, 5, v) == r"one of the five $\epsilon$ values"
+    assert report.share_phrase(4, 5, v) == r"four of the five $\epsilon$ values"
+    assert report.share_phrase(5, 5, v) == r"all five $\epsilon$ values"
+    assert report.share_phrase(2, 2, v) == r"both $\epsilon$ values"
+    assert report.share_phrase(1, 1, v) == r"the only $\epsilon$ value"
+    with pytest.raises(ValueError):
+        report.share_phrase(3, 2, v)
+
+
+def test_failed_sentence_says_zero_naturally():
+    assert report.failed_sentence(0) == "No configuration failed outright on any map."
+    one, many = report.failed_sentence(1), report.failed_sentence(16)
+    assert one.startswith("One configuration failed outright") and "cells marked" in one
+    assert many.startswith("16 configurations failed outright")
+    for text in (report.failed_sentence(n) for n in range(0, 20)):
+        assert not re.search(r"\b0 \w+s\b", text) and not re.search(r"\b1 \w+s\b", text)
+
+
+def _bench_dataset(failed: int):
+    ds = synthetic.work_precision()
+    status = np.full(ds.status.shape, "ok", dtype=object)
+    status.flat[:failed] = "failed: step size underflow"
+    return ds.assign(status=(ds.status.dims, status),
+                     missed_switches=(ds.error_map.dims, np.zeros(ds.error_map.shape, int)),
+                     speedup_vs_rk45=("problem", [10.0, 20.0]),
+                     runs=(ds.error_map.dims, np.full(ds.error_map.shape, 3)))\
+        .assign_attrs(timing_statistic="median", timing_warmup=1, timing_min_rounds=3,
+                      timing_min_time=0.2)
+
+
+@pytest.mark.parametrize("failed, start", [(0, "No configuration failed"),
+                                           (1, "One configuration failed"),
+                                           (3, "Three configurations failed")])
+def test_bench_macros_count_in_words(failed, start):
+    m = report.Macros()
+    report.bench(_bench_dataset(failed), m)
+    got = {name: body for name, _, _, body in m.items}
+    assert got["rpBenchFailedSentence"].startswith(start)
+    assert got["rpBenchWarmupRuns"] == "one untimed run"
+    assert got["rpBenchMinRoundsRuns"] == "three timed runs"
+    assert got["rpBenchRoundsRange"] == "three runs"
+    assert m.flags["rpHaveEffects"] is False and m.flags["rpHaveReturnCost"] is False
+    # the numbers stay quotable (and checked against the dataset) as before
+    assert m.values()["rpBenchFailed"][0] == failed
+
+
+def test_no_count_macro_stands_before_a_noun_in_the_text():
+    """A count the report prints with its noun comes from a phrase macro, so that zero and
+    one read right: no '\\rpBenchFailed{} configurations' in the text."""
+    for name in ("rpBenchFailed", "rpBenchWarmup", "rpBenchMinRounds", "rpHardN",
+                 "rpHardReturnStiffN"):
+        for tex in sorted((ROOT / "paper").glob("sec_*.tex")):
+            text = tex.read_text()
+            assert not re.search(rf"\\{name}(\{{\}})?\$?[~ ]+(of the )?[a-z$]", text), (
+                f"{tex.name}: \\{name} before its noun; use its phrase macro")
+
+
+@pytest.mark.parametrize("plain, tex", [
+    ("f_- = (1, 1 + x1/2), f_+ = (1, 1/2)", r"$f_-(x)=(1,\,1+x_1/2)$ and $f_+(x)=(1,\,1/2)$"),
+    ("f_- = (1, 1), f_+ = (1, -1 - x1^2/4)", r"$f_-(x)=(1,\,1)$ and $f_+(x)=(1,\,-1-x_1^2/4)$"),
+    ("h = x2", r"$h(x)=x_2$"),
+    ("h = exp(-x1)*theta", r"$h(x)=\exp (-x_1)\,\theta$"),
+    ("g = 2*x12^10 + y, k = x1, m = x2", r"$g(x)=2\,x_{12}^{10}+y$, $k(x)=x_1$ and $m(x)=x_2$"),
+])
+def test_formulas_in_the_papers_notation(plain, tex):
+    assert report.formulas_tex(plain) == tex
+
+
+@pytest.mark.parametrize("bad", ["f_- = (1, import os)", "x1 + 1", "", "f = {1}",
+                                 "h = x1^(1/2)", "h = \\input{x}"])
+def test_formulas_refuse_what_they_cannot_read(bad):
+    with pytest.raises(ValueError):
+        report.formulas_tex(bad)
+
+
+def test_fig01_fields_are_math_not_code():
+    from filippov.scenes import fig01_slidesketch
+    ds = synthetic.fig01().assign_attrs(
+        crossing_fields="f_- = (1, 1 + x1/2), f_+ = (1, 1/2)",
+        sliding_fields="f_- = (1, 1), f_+ = (1, -1 - x1^2/4)", switching_function="h = x2")
+    m = report.Macros()
+    fig01_slidesketch.report(ds, m)
+    got = {name: body for name, _, _, body in m.items}
+    for name in ("rpOneFieldsCross", "rpOneFieldsSlide", "rpOneSwitching"):
+        assert r"\texttt" not in got[name] and got[name].startswith("$f" if "Fields" in name
+                                                                   else "$h(x)")
+    text = (ROOT / "paper" / "sec_figures.tex").read_text()
+    assert r"\rpOneSwitching" in text and r"\rpOneFieldsCross" in text
