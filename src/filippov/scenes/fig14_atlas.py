@@ -217,8 +217,10 @@ def report(ds, m: Macros) -> str | None:
     m.add("rpFourteenAgree", 100.0 * float(np.mean(kind == lim)),
           "derived: percent of points where slow-fast and limit-map types agree", 3)
     neg = th < 0
-    m.add("rpFourteenNegChaos", float(np.sum(kind[neg][:, above] == 0)),
-          "derived: chaotic points at theta < 0", 1)
+    n_neg = int(np.sum(kind[neg][:, above] == 0))
+    m.add("rpFourteenNegChaos", None, "derived: chaotic points at theta < 0 (count)",
+          text=r"\text{no chaotic point}" if n_neg == 0 else
+          (r"\text{one chaotic point}" if n_neg == 1 else rf"{n_neg}\text{{ chaotic points}}"))
     _report_flips(ds, m, sid)
     return None
 
