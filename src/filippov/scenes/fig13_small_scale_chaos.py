@@ -177,7 +177,8 @@ def _report_table(ds) -> str:
     e_head = [f"${eps_tex(e)}$" for e in eps]
     top = " & ".join(["", "", rf"\multicolumn{{{len(eps)}}}{{c}}{{largest exponent}}",
                       rf"\multicolumn{{{len(eps)}}}{{c}}{{gap to the limit map}}"]) + r" \\"
-    return tabular("rr" + "r" * 2 * len(eps),
+    # two columns per eps: narrower column gaps keep four eps within the text width
+    return r"\setlength{\tabcolsep}{3.5pt}" + "\n" + tabular("rr" + "r" * 2 * len(eps),
                    [top, head(r"$\theta$", r"$s(\theta,0,0)$", *e_head, *e_head)], rows)
 
 
