@@ -265,6 +265,7 @@ def fig13(k: int = 5) -> xr.Dataset:
          "lyapunov": (("theta", "eps", "s"), lyap), "lyapunov_limit": (("theta", "eps", "s"), lyap),
          "width_x2": (("theta", "eps", "s"), width),
          "chaotic": (("theta", "eps", "s"), (lyap > 0).astype(np.int32)),
+         "width_exponent_err": (("theta", "s"), np.full((theta.size, s.size), 0.01)),
          "width_exponent": (("theta", "s"), np.broadcast_to(np.where(s > 0, 2.0, np.nan),
                                                            (theta.size, s.size)).copy()),
          "slope_pdm": ("theta", (theta - 1) / theta),

@@ -13,6 +13,7 @@ from . import style as st
 IMAGE_RMS = 0.15
 
 VARS = ["u", "u_limit", "lyapunov", "lyapunov_limit", "width_x2", "width_exponent", "chaotic",
+        "width_exponent_err",
         "slope_pdm", "period"]
 S_LABEL = r"$s=(\mu-1)/\varepsilon^2$"
 U_LABEL = r"$(x_2-1)/\varepsilon^2$ on $\mathcal{L}_1$"
@@ -63,15 +64,17 @@ def draw(ds):
         ax.loglog((s[pos] * e * e)[ok], w[ok], "o-", ms=2, lw=st.LW_THIN,
                   color=COLORS[(jj + 2) % len(COLORS)], label=f"$\\varepsilon={st.eps_value(e)}$")
     ax.set_xlabel(r"$\mu-1$")
-    ax.set_ylabel(r"width of the chaotic attractor in $x_2$")
+    ax.set_ylabel(r"width in $x_2$ (chaotic points)")
     fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center")  # under (e)
     st.panel_label(ax, f"(e) $\\theta={th[i]:g}$: chaos on the scale $\\varepsilon^2$")
     ax = axes[1, 2]
     for i, t in enumerate(th):
         k = ds.width_exponent.values[i]
         if np.isfinite(k).any():
-            ax.semilogx(s[pos], k[pos], "o-", ms=2, lw=st.LW_THIN, color=COLORS[i % len(COLORS)],
-                        label=f"$\\theta={t:g}$")
+            ax.errorbar(s[pos], k[pos], yerr=ds.width_exponent_err.values[i][pos], fmt="o-",
+                        ms=2, lw=st.LW_THIN, elinewidth=st.LW_THIN, capsize=0,
+                        color=COLORS[i % len(COLORS)], label=f"$\\theta={t:g}$")
+            ax.set_xscale("log")
     ax.axhline(2.0, color=st.C_AUX, lw=st.LW_THIN, ls="--", label="$k=2$")
     ax.set_ylim(0.0, 4.0)
     ax.set_xlabel(S_LABEL)
