@@ -66,6 +66,14 @@ def _window(eps, n, s0, order=None):
             for lim in (-0.5, 4.0)]
 
 
+def test_past_the_window_of_two_the_periods_rise_until_period_one_is_back():
+    # theta = -0.5, eps = 1e-5 (fig12): 2 -> 3 -> 4 -> back to 1 as s grows past the
+    # window of period two; at eps = 1e-3 the window of two still holds at s = 3.9
+    periods = [_attractor(1e-5, -0.5, s, transient=400).period for s in (1.5, 2.3, 2.6, 3.0)]
+    assert periods == [2, 3, 4, 1]
+    assert _attractor(1e-3, -0.5, 3.9, transient=400).period == 2
+
+
 def test_window_edges_converge_in_s_left_like_eps_right_like_sqrt_eps():
     # the window of period 3 at theta = -0.5: its edges in s = (mu - 1)/eps, where its
     # orbit followed in s stops being stable, tend to those of the eps -> 0 limit map;

@@ -382,6 +382,7 @@ def report(ds, m: Macros) -> str | None:
           text=r"\text{every}" if np.all(per[:, below] == 1) else r"\text{\emph{not} every}")
     onset = [float(s[np.flatnonzero((s > 0) & (per[j] != 1))[0]]) for j in range(len(eps))]
     m.add("rpTwelveOnsetMax", max(onset), "derived: largest first s > 0 with period != 1", 2)
+    _report_sequence(ds, m, s, per, eps)
     lin_l = float(np.nanmax(ds.fit_lin_rms.values[:, 0]))
     sq_r = float(np.nanmax(ds.fit_sqrt_rms.values[:, 1]))
     # each window's two fits compared with each other (residuals differ by decades across n)
@@ -422,6 +423,38 @@ def _report_list(items: list) -> str:
     if not items:
         return r"\text{none}"
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + r"\text{ and }" + items[-1]
+
+
+def _report_back(s, per) -> float:
+    """First s > 0 from which the period is one up to the end of the grid (NaN: none)."""
+    for k in range(s.size):
+        if s[k] > 0 and np.all(per[k:] == 1):
+            return float(s[k])
+    return np.nan
+
+
+def _report_sequence(ds, m: Macros, s, per, eps) -> None:
+    """Past the window of period two: the periods rise again until the period-one orbit
+    is back; where (per eps) and how high the periods go at the smallest eps."""
+    back = [_report_back(s, per[j]) for j in range(len(eps))]
+    found = [j for j in range(len(eps)) if np.isfinite(back[j])]
+    m.add("rpTwelveBackEps", None, "derived: eps at which period one is back on the grid",
+          text=_report_list([eps_tex(eps[j]) for j in found]))
+    m.add("rpTwelveNotBackEps", None, "derived: eps at which period one is not back",
+          text=_report_list([eps_tex(eps[j]) for j in range(len(eps)) if j not in found]))
+    m.add("rpTwelveBackSmall", back[-1], "derived: first s from which period == 1 to s_max, "
+          "smallest eps", 3)
+    if found:
+        m.add("rpTwelveBackMax", float(np.nanmax(back)), "derived: max over eps of that s", 3)
+    j = len(eps) - 1
+    right2 = float(ds.edge.values[j, list(ds.n.values).index(2), 1]) \
+        if 2 in ds.n.values else np.nan
+    rise = per[j][(s > right2) & (s < back[j])] if np.isfinite(right2 + back[j]) else []
+    m.add("rpTwelveRiseMax", float(np.max(rise)) if len(rise) else np.nan,
+          "derived: largest period between the right edge of the window of two and the "
+          "return of period one, smallest eps", 3)
+    m.add("rpTwelveBackZero", _report_back(s, ds.period_limit0.values[0]),
+          "derived: first s from which period_limit0 == 1 to s_max", 3)
 
 
 def _report_bifurcations(ds, m: Macros, sid: str) -> None:
