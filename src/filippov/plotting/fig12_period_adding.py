@@ -37,7 +37,9 @@ def draw(ds):
     ax.set_xlim(s.min(), s.max())
     st.panel_label(ax, r"(d) limit map, $\varepsilon\to 0$")
     ax = axes[1, 1]
-    colors = ["0.75", "0.6", "0.45", "0.3", "black"]
+    # one hue per eps from a sequential map (five greys could not be told apart)
+    from matplotlib import colormaps
+    colors = [colormaps["viridis"](x) for x in np.linspace(0.0, 0.85, max(len(eps), 2))]
     for j, e in enumerate(eps):
         per = np.where(ds.period.values[0, j] > 0, ds.period.values[0, j], np.nan)
         ax.step(s, per, where="mid", color=colors[j % len(colors)], lw=st.LW_THIN,
@@ -74,11 +76,11 @@ def draw(ds):
             ax.loglog(eps[ok], d[ok], marker=marker, ms=3, lw=st.LW_THIN,
                       mfc="none" if side else None,
                       color=[st.C_PLUS, st.C_MINUS, st.C_SLIDE, "black"][m % 4],
-                      label=f"$n={n}$" if side == 0 else None)
+                      label=f"$n={n}$: edge $-$ edge$_{{\\varepsilon\\to0}}$" if side == 0 else None)
     ax.loglog(eps, ds.edge_gap.values, color=st.C_AUX, lw=st.LW, ls="--",
-              label="slow-fast vs limit map")
+              label="max |slow-fast $-$ limit-map edge|")
     ax.set_xlabel(st.EPS)
-    ax.set_ylabel(r"$|$edge $-$ edge$_{\varepsilon\to0}|$ in $s$")
+    ax.set_ylabel(r"distance of window edges in $s$")
     fig.legend(*ax.get_legend_handles_labels(), loc="outside lower right")  # under (f)
     st.panel_label(ax, "(f) window edges:\nleft o, right \u25a1")
     return fig
