@@ -140,7 +140,8 @@ def lyapunov_exponent(jacobians: np.ndarray, coordinate: int) -> float:
 LOOSE = 1e-2
 #: an exponent counts as positive (chaos) when it exceeds this many standard errors
 LYAPUNOV_SIGMAS = 3.0
-#: where it does not after the kept returns, the run goes on for EXTEND x keep more
+#: a run undecided after its kept returns (no confirmed cycle, no exponent clearly
+#: positive) goes on for EXTEND x keep more
 EXTEND = 8
 #: blocks of the kept returns over which the Lyapunov exponent's standard error is
 #: estimated (batch means: the log-slopes are correlated over a few returns)
@@ -291,17 +292,9 @@ def confirm(cmodel: CompiledModel, states: np.ndarray, age: float, candidate: in
     return None
 
 
-def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, keep: int,
-           t_max: float, scale: float, max_period: int, window: tuple[float, float],
-           lyapunov: bool = False, **options) -> Attractor:
-    """Iterate, classify, and (``lyapunov``) the Lyapunov exponent from the engine's
-    dP/dz along the kept returns. A scale too small to resolve is refused first
-    (:func:`check_resolvable`)."""
-    check_resolvable(scale)
-    run = iterate(cmodel, start, transient=transient, keep=keep, t_max=t_max,
-                  jacobian=lyapunov, **options)
+def _escape(run, values, window) -> Attractor | None:
+    """An Attractor that escaped (a failed return, or kept returns out of the window)."""
     states = run.orbit[0]
-    values = states[:, coordinate]
     lo, hi = window
     if run.status[0] != OK:
         reason = (f"{STATUS[int(run.status[0])]} after {int(run.returns_done[0])} returns "
@@ -313,35 +306,77 @@ def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, kee
         return Attractor(values, 0, np.nan, np.nan, True,
                          f"left the window [{lo!r}, {hi!r}] (value {bad!r})",
                          status=LEFT_WINDOW, states=states)
+    return None
+
+
+def _periodic(cmodel, states, age, coordinate, scale, max_period, t_max, options):
+    """(the Attractor of a confirmed, stable cycle or None, the count's period)."""
+    values = states[:, coordinate]
     period = period_of(values, period_tolerance(scale), max_period)
     # a count of repeats is only a candidate: the orbit is confirmed by Newton, its
     # multipliers decide stability and the iterates must approach it (module docstring)
     candidate = period or period_of(values, LOOSE * scale, max_period)
-    cycle = (confirm(cmodel, states, float(run.age[0]), candidate, coordinate=coordinate,
-                     t_max=t_max, scale=LOOSE * scale, settled=period_tolerance(scale),
-                     **options) if candidate else None)
+    cycle = (confirm(cmodel, states, age, candidate, coordinate=coordinate, t_max=t_max,
+                     scale=LOOSE * scale, settled=period_tolerance(scale), **options)
+             if candidate else None)
     # a cycle on which P is not differentiable (grazing) has no multipliers: it counts
     # as the attractor only if the kept returns already repeat on it to the tolerance
     stable = cycle is not None and cycle.converging and (
         cycle.radius < 1.0 or (np.isnan(cycle.radius) and period == cycle.period))
-    if stable:
-        u = cycle.points[:, coordinate]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            lyap = float(np.log(cycle.radius) / cycle.period)
-        return Attractor(values, cycle.period, float(u.max() - u.min()), lyap, False,
-                         states=states, lyapunov_err=0.0, cycle=cycle)
-    width = float(values.max() - values.min())
+    if not stable:
+        return None, period
+    u = cycle.points[:, coordinate]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lyap = float(np.log(cycle.radius) / cycle.period)
+    return Attractor(values, cycle.period, float(u.max() - u.min()), lyap, False,
+                     states=states, lyapunov_err=0.0, cycle=cycle), period
+
+
+def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, keep: int,
+           t_max: float, scale: float, max_period: int, window: tuple[float, float],
+           lyapunov: bool = False, **options) -> Attractor:
+    """Iterate, classify, and (``lyapunov``) the Lyapunov exponent from the engine's
+    dP/dz along the kept returns. A scale too small to resolve is refused first
+    (:func:`check_resolvable`).
+
+    Undecided after ``transient + keep`` returns -- no stable cycle confirmed and (with
+    ``lyapunov``) no exponent above LYAPUNOV_SIGMAS standard errors -- the run goes on
+    for EXTEND x keep more returns and is judged again on the last ``keep`` of them
+    (its exponent on all of them): an orbit that converges slowly (a multiplier near
+    one in modulus) is then found, whatever the fixed transient was."""
+    check_resolvable(scale)
+    run = iterate(cmodel, start, transient=transient, keep=keep, t_max=t_max,
+                  jacobian=lyapunov, **options)
+    states = run.orbit[0]
+    values = states[:, coordinate]
+    escaped = _escape(run, values, window)
+    if escaped is not None:
+        return escaped
+    args = (coordinate, scale, max_period, t_max, options)
+    found, period = _periodic(cmodel, states, float(run.age[0]), *args)
+    if found is not None:
+        return found
     lyap, err = (lyapunov_estimate(run.orbit_jacobian[0], coordinate) if lyapunov
                  else (np.nan, np.nan))
-    if lyapunov and lyap > 0 and not lyap > LYAPUNOV_SIGMAS * err:
-        # positive but not yet beyond its error: iterate longer, only here
-        more = iterate(cmodel, states[-1], transient=0, keep=EXTEND * keep, t_max=t_max,
-                       jacobian=True, start_age=float(run.age[0]), **options)
-        if more.status[0] == OK:
-            lyap, err = lyapunov_estimate(
-                np.concatenate([run.orbit_jacobian[0], more.orbit_jacobian[0]]), coordinate)
-    return Attractor(values, 0, width, lyap, False, states=states, lyapunov_err=err,
-                     unconfirmed=period)
+    if lyapunov and lyap > LYAPUNOV_SIGMAS * err:
+        return Attractor(values, 0, float(values.max() - values.min()), lyap, False,
+                         states=states, lyapunov_err=err, unconfirmed=period)
+    # undecided: iterate on, from where the run stopped
+    more = iterate(cmodel, states[-1], transient=0, keep=EXTEND * keep, t_max=t_max,
+                   jacobian=lyapunov, start_age=float(run.age[0]), **options)
+    states2 = more.orbit[0][-keep:]
+    values2 = states2[:, coordinate]
+    escaped = _escape(more, values2, window)
+    if escaped is not None:
+        return escaped
+    found, period2 = _periodic(cmodel, states2, float(more.age[0]), *args)
+    if found is not None:
+        return found
+    if lyapunov:
+        lyap, err = lyapunov_estimate(
+            np.concatenate([run.orbit_jacobian[0], more.orbit_jacobian[0]]), coordinate)
+    return Attractor(values2, 0, float(values2.max() - values2.min()), lyap, False,
+                     states=states2, lyapunov_err=err, unconfirmed=period2)
 
 
 def first_window(periods: np.ndarray, n: int) -> tuple[int, int] | None:
