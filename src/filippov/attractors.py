@@ -141,8 +141,9 @@ LOOSE = 1e-2
 #: an exponent counts as positive (chaos) when it exceeds this many standard errors
 LYAPUNOV_SIGMAS = 3.0
 #: a run undecided after its kept returns (no confirmed cycle, no exponent clearly
-#: positive) goes on for EXTEND x keep more
+#: positive) goes on, at most MAX_EXTENSIONS times, for EXTEND x keep more
 EXTEND = 8
+MAX_EXTENSIONS = 3
 #: blocks of the kept returns over which the Lyapunov exponent's standard error is
 #: estimated (batch means: the log-slopes are correlated over a few returns)
 LYAPUNOV_BLOCKS = 5
@@ -309,15 +310,28 @@ def _escape(run, values, window) -> Attractor | None:
     return None
 
 
-def _periodic(cmodel, states, age, coordinate, scale, max_period, t_max, options):
-    """(the Attractor of a confirmed, stable cycle or None, the count's period)."""
+def _best_repeat(values: np.ndarray, max_period: int) -> int:
+    """The p <= max_period with the smallest max |u_{k+p} - u_k| over the kept returns:
+    the period an orbit still converging (too slowly to repeat to any tolerance yet)
+    comes closest to."""
+    gaps = [np.abs(values[p:] - values[:-p]).max() for p in range(1, max_period + 1)]
+    return int(np.argmin(gaps)) + 1
+
+
+def _periodic(cmodel, states, age, coordinate, scale, max_period, t_max, options,
+              last_chance=False):
+    """(the Attractor of a confirmed, stable cycle or None, the count's period). With
+    ``last_chance`` (after the extension) the candidate is the best repeat and the cycle
+    may lie up to the attractor's scale from the returns, as long as they approach it."""
     values = states[:, coordinate]
     period = period_of(values, period_tolerance(scale), max_period)
     # a count of repeats is only a candidate: the orbit is confirmed by Newton, its
     # multipliers decide stability and the iterates must approach it (module docstring)
-    candidate = period or period_of(values, LOOSE * scale, max_period)
+    near = scale if last_chance else LOOSE * scale
+    candidate = period or (_best_repeat(values, max_period) if last_chance
+                           else period_of(values, near, max_period))
     cycle = (confirm(cmodel, states, age, candidate, coordinate=coordinate, t_max=t_max,
-                     scale=LOOSE * scale, settled=period_tolerance(scale), **options)
+                     scale=near, settled=period_tolerance(scale), **options)
              if candidate else None)
     # a cycle on which P is not differentiable (grazing) has no multipliers: it counts
     # as the attractor only if the kept returns already repeat on it to the tolerance
@@ -339,11 +353,13 @@ def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, kee
     dP/dz along the kept returns. A scale too small to resolve is refused first
     (:func:`check_resolvable`).
 
-    Undecided after ``transient + keep`` returns -- no stable cycle confirmed and (with
-    ``lyapunov``) no exponent above LYAPUNOV_SIGMAS standard errors -- the run goes on
-    for EXTEND x keep more returns and is judged again on the last ``keep`` of them
-    (its exponent on all of them): an orbit that converges slowly (a multiplier near
-    one in modulus) is then found, whatever the fixed transient was."""
+    Without a stable cycle confirmed after ``transient + keep`` returns the run goes on
+    for EXTEND x keep more returns and is judged again on the last ``keep`` of them, up
+    to MAX_EXTENSIONS times or until (with ``lyapunov``) the exponent over all returns
+    so far exceeds LYAPUNOV_SIGMAS standard errors: an orbit that converges slowly (a
+    multiplier near one in modulus) or lingers near a saddle cycle -- whose exponent
+    over a short window can look positive -- is then found, whatever the fixed
+    transient was."""
     check_resolvable(scale)
     run = iterate(cmodel, start, transient=transient, keep=keep, t_max=t_max,
                   jacobian=lyapunov, **options)
@@ -356,25 +372,30 @@ def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, kee
     found, period = _periodic(cmodel, states, float(run.age[0]), *args)
     if found is not None:
         return found
-    lyap, err = (lyapunov_estimate(run.orbit_jacobian[0], coordinate) if lyapunov
-                 else (np.nan, np.nan))
-    if lyapunov and lyap > LYAPUNOV_SIGMAS * err:
-        return Attractor(values, 0, float(values.max() - values.min()), lyap, False,
-                         states=states, lyapunov_err=err, unconfirmed=period)
-    # undecided: iterate on, from where the run stopped
-    more = iterate(cmodel, states[-1], transient=0, keep=EXTEND * keep, t_max=t_max,
-                   jacobian=lyapunov, start_age=float(run.age[0]), **options)
-    states2 = more.orbit[0][-keep:]
-    values2 = states2[:, coordinate]
-    escaped = _escape(more, values2, window)
-    if escaped is not None:
-        return escaped
-    found, period2 = _periodic(cmodel, states2, float(more.age[0]), *args)
-    if found is not None:
-        return found
-    if lyapunov:
-        lyap, err = lyapunov_estimate(
-            np.concatenate([run.orbit_jacobian[0], more.orbit_jacobian[0]]), coordinate)
+    lyap, err = np.nan, np.nan
+    # no cycle yet: iterate on, from where the run stopped, up to MAX_EXTENSIONS times (an
+    # orbit converging with a multiplier near one, or lingering near a saddle cycle, whose
+    # exponent over a short window can even look positive); chaos is called only after
+    # at least one extension, on the exponent over all returns so far
+    jacs = [run.orbit_jacobian[0]] if lyapunov else []
+    last, age = states[-1], float(run.age[0])
+    for _ in range(MAX_EXTENSIONS):
+        more = iterate(cmodel, last, transient=0, keep=EXTEND * keep, t_max=t_max,
+                       jacobian=lyapunov, start_age=age, **options)
+        states2 = more.orbit[0][-keep:]
+        values2 = states2[:, coordinate]
+        escaped = _escape(more, values2, window)
+        if escaped is not None:
+            return escaped
+        last, age = states2[-1], float(more.age[0])
+        found, period2 = _periodic(cmodel, states2, age, *args, last_chance=True)
+        if found is not None:
+            return found
+        if lyapunov:
+            jacs.append(more.orbit_jacobian[0])
+            lyap, err = lyapunov_estimate(np.concatenate(jacs), coordinate)
+            if lyap > LYAPUNOV_SIGMAS * err:
+                break
     return Attractor(values2, 0, float(values2.max() - values2.min()), lyap, False,
                      states=states2, lyapunov_err=err, unconfirmed=period2)
 

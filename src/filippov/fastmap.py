@@ -27,9 +27,11 @@ same algorithm for a whole batch of start points inside one compiled call:
   ``b = grad h . F_+`` exactly as :func:`filippov.simulate._decide`;
 * sliding is integrated with a port of scipy's ``DOP853`` (same coefficients,
   step-size control, initial step and 7th-order dense output) with the Filippov
-  field ``(a F_+ - b F_-)/(a - b)``; it ends where ``a`` or ``b`` reaches zero.
-  Each integrated step is sampled at ``samples_per_step + 1`` points of its
-  dense output.
+  field ``(a F_+ - b F_-)/(a - b)``; it ends where ``a`` or ``b`` reaches zero,
+  at the samples or between them (a minimum of ``a`` or maximum of ``b`` found
+  from their rates along the orbit, as a hidden extremum of ``h``:
+  ``rules.speed_graze``; a touch there is no exit). Each integrated step is
+  sampled at ``samples_per_step + 1`` points of its dense output.
 
 Failures never raise inside the compiled code and never hang: each start point
 gets a status code (:data:`STATUS`) -- event or step bound hit, accumulation of

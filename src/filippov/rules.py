@@ -160,6 +160,89 @@ FD_STEP = float(np.cbrt(np.finfo(float).eps))
 SLIDE_TANGENT = 1e-6
 
 
+# ------------------------------------------------------------- the end of sliding, hidden
+# While sliding, the samples hold the normal speeds a (> 0) and b (< 0); a slide ends
+# where a sign change puts one of them past 0 (a <= 0: TO_NONPOS, b >= 0: TO_NONNEG). A
+# window where b > 0 (or a < 0) shorter than the sample spacing shows at no sample (a
+# polynomial sliding flow has error estimates ~0, so DOP853's steps grow tenfold and its 4
+# samples per step stepped over b > 0 lasting 0.01 of a step of ~1: the orbit slid on past
+# the exit, a silently wrong return). As for a hidden extremum of h in regions + and -
+# (extremum_between, graze), the rates of a and b along the orbit at the samples show an
+# extremum toward the exit between two of them; it is refined (a root of the rate), and
+# the speed there decides: an exit, a touch, or nothing.
+
+def speed_extremum_between(pred: int, d0, d1):
+    """While sliding: the normal speed whose sign change ``pred`` ends the slide (a:
+    TO_NONPOS, b: TO_NONNEG) has an extremum toward that change between two samples where
+    its rate is d0 and d1 -- a minimum of a (d0 < 0 <= d1), a maximum of b (d0 > 0 >= d1)
+    -- which may put it past 0 between samples that are not (elementwise on arrays)."""
+    if pred == TO_NONPOS:
+        return (d0 < 0.0) & (d1 >= 0.0)
+    return (d0 > 0.0) & (d1 <= 0.0)
+
+
+#: (4 sqrt 2) / 3: the area of the cap v > 0 of v = vm - kappa t^2 / 2 is
+#: (4 sqrt 2 / 3) vm^(3/2) / sqrt(kappa)
+_CAP = 4.0 * np.sqrt(2.0) / 3.0
+
+
+def speed_graze(pred: int, vm: float, d0: float, d1: float, dt: float,
+                touch_tol: float) -> int:
+    """What the extremum ``vm`` of a normal speed hidden between two samples of a slide
+    (speed_extremum_between; its rates d0, d1 at the samples, dt apart) is: GRAZE_CROSSES
+    (an exit: the slide ends at the speed's root before it), GRAZE_TOUCHES (no exit; the
+    return map has a kink there, as at a touch of h) or GRAZE_NONE.
+
+    Near the extremum the speed is v ~ vm - kappa (t - tm)^2 / 2 (kappa ~ |d1 - d0| / dt,
+    the change of its rate over the interval). Past 0 it drives the orbit off H for
+    2 sqrt(2 |vm| / kappa), by at most the cap's area (4 sqrt2 / 3) |vm|^1.5 / sqrt(kappa)
+    in h (h' = v there), and the orbit differs from the one that slides on by that times
+    |F_+ - F_-| / (a - b): the same scale. So a touch is an extremum whose cap is within
+    touch_tol, on either side of 0, as graze's |hm| <= touch_tol for a hidden extremum
+    of h; beyond it an extremum past 0 is an exit. (An extremum at 0 up to rounding of the
+    speed, ~1e-15, makes a cap ~1e-23 at kappa = 40: a touch; b's maximum 5e-4 there,
+    over a window of 0.01, makes 3e-6: an exit.)"""
+    kappa = abs(d1 - d0) / dt if dt > 0.0 else np.inf
+    v = abs(vm)
+    if v == 0.0:
+        cap = 0.0
+    elif kappa > 0.0 and np.isfinite(kappa):
+        cap = _CAP * v * np.sqrt(v / kappa)
+    else:
+        cap = np.inf
+    if cap <= touch_tol:
+        return GRAZE_TOUCHES
+    past = vm < 0.0 if pred == TO_NONPOS else vm > 0.0
+    return GRAZE_CROSSES if past else GRAZE_NONE
+
+
+#: the forward-difference step of the rates of a and b along a slide, relative to the
+#: state's size (rate_step): truncation and rounding are then both ~u^(1/2) of the rate
+RATE_STEP = float(np.sqrt(np.finfo(float).eps))
+
+
+def rate_step(z, fm, fp, a: float, b: float) -> float:
+    """The time step d of the forward differences (v(t + d) - v(t)) / d on the orbit that
+    give the rates of a and b along a slide, from a sample (state z, F_-, F_+, a and b
+    there): the orbit moves RATE_STEP max(1, |z|_inf) along Filippov's field
+    (a F_+ - b F_-)/(a - b) over it, so truncation and rounding of the rates are ~u^(1/2)
+    of them, plenty for their signs; a forward difference is the rate at t + d/2, which
+    moves a located extremum by d/2 and its value by ~u |z|^2 |v''| / |F|^2: nothing. One
+    evaluation of a and b per sample, where a central difference took two (the cost of a
+    return on the Hopf example's chaotic attractor: +9% against +18% at eps = 1e-2).
+    0 (no rates, no check) where that field is zero, not finite or not defined."""
+    den = a - b
+    if not den > 0.0:  # not sliding at this sample (a <= b): no Filippov field
+        return 0.0
+    size, speed = 1.0, 0.0
+    for k in range(z.size):
+        size = max(size, abs(z[k]))
+        speed = max(speed, abs((a * fp[k] - b * fm[k]) / den))
+    if not (np.isfinite(speed) and speed > 0.0):
+        return 0.0
+    return RATE_STEP * size / speed
+
+
 def central_step(size: float, speed: float) -> float:
     """The central-difference step along a direction (largest component ``speed``: a
     field, a column of a derivative) at a state of size ``size`` (>= 1); 0 where the
@@ -276,6 +359,25 @@ def exit_shift(mode: int, h0: float, touch_tol: float, projected: bool) -> float
 #: the rounding band of H around a sliding exit, in roundings of the stay's state (see
 #: exit_band): the widest noise measured was 8.9 of them, 16 leaves a factor ~2
 EXIT_BAND_ULPS = 16.0
+#: the largest rounding of an exact flow at tau = 0 that exit_band accepts, relative to
+#: the state's size (the generated systems' worst is ~1e-14; FOLD_EXIT's 1.1e-15)
+EXIT_BAND_FLOW_MAX = 1e-10
+
+
+#: an exact flow may move a state by at most this many times the window times the
+#: larger field speed at the window's two ends (the mean-value bound, with room for a
+#: speed that peaks inside the window)
+FLOW_SPEED_FACTOR = 100.0
+
+
+def flow_consistent(dz: float, dt: float, speed_a: float, speed_b: float,
+                    size: float) -> bool:
+    """Whether an exact flow's move |dz| over a window dt agrees with its own field:
+    |dz| <= FLOW_SPEED_FACTOR dt max(|f(z_a)|, |f(z_b)|) plus the rounding of the
+    states (1e3 ulps of their size). A closed form that fails this computes something
+    else than the field's flow (the Hopf example at eps = 1e6: y from 0 to 1e9 in
+    8e-10 time units, the field's speed there 1e3), and the run must not go on."""
+    return dz <= FLOW_SPEED_FACTOR * dt * max(speed_a, speed_b) + 1e3 * _EPS * max(1.0, size)
 
 
 def exit_band(z, z_flow, grad) -> float:
@@ -299,7 +401,12 @@ def exit_band(z, z_flow, grad) -> float:
         g2 += grad[k] * grad[k]
         z2 += z[k] * z[k]
         d2 += (z_flow[k] - z[k]) * (z_flow[k] - z[k])
-    return EXIT_BAND_ULPS * np.sqrt(g2) * max(_EPS * np.sqrt(z2), np.sqrt(d2))
+    # a closed form that misses its own start by more than EXIT_BAND_FLOW_MAX of the
+    # state's size is no rounding to step over (eps = 1e6 in the Hopf example: the band
+    # would swallow genuine crossings and the run drift to y ~ 1e16 without a word):
+    # the band stays at that size, and the crossings it cannot hide are seen
+    d = min(np.sqrt(d2), EXIT_BAND_FLOW_MAX * max(1.0, np.sqrt(z2)))
+    return EXIT_BAND_ULPS * np.sqrt(g2) * max(_EPS * np.sqrt(z2), d)
 
 
 def banded_shift(mode: int, shift: float, band: float) -> float:

@@ -7,8 +7,10 @@ The loop is the textbook one for Filippov systems:
    and ``method="exact"``, else a DOP853 step with its 7th-order dense output;
 2. scan each segment for the earliest event: ``H`` leaving the region, a hidden
    grazing crossing (a sign change of ``dH/dt`` whose minimum of ``H`` goes
-   through zero), the end of sliding (``dH.F_-`` or ``dH.F_+`` reaching zero),
-   or a user :class:`Section`; refine it with Brent's method;
+   through zero), the end of sliding (``dH.F_-`` or ``dH.F_+`` reaching zero, at
+   a sample or between samples: an extremum of theirs toward zero, from their
+   rates along the orbit, :func:`filippov.rules.speed_graze`), or a user
+   :class:`Section`; refine it with Brent's method;
 3. at a hit of ``H = 0`` decide from ``a = dH.F_-`` and ``b = dH.F_+`` (eq:atSl,
    eq:eminus) whether the trajectory crosses or starts sliding, log it, restart.
 
@@ -633,7 +635,28 @@ class _Run:
             raise SimulationError(
                 f"non-finite state in mode {MODE_NAMES[self.mode]} between t={ta!r} and "
                 f"t={tb!r}, last finite state {self.z.tolist()}")
+        if stepper.method is None:
+            self._check_flow(ta, tb, zs[:, -1])
         return ts, zs
+
+    def _check_flow(self, ta, tb, zb):
+        """An exact flow must move the state as its field does (rules.flow_consistent):
+        a closed form that loses its accuracy (cancellation at extreme parameters) is
+        refused here, not followed to a wrong answer."""
+        za = self.z
+        fa = np.asarray(self.system.field(self.mode, za), dtype=float)
+        fb = np.asarray(self.system.field(self.mode, zb), dtype=float)
+        dz = float(np.linalg.norm(zb - za))
+        if not rules.flow_consistent(dz, tb - ta, float(np.linalg.norm(fa)),
+                                     float(np.linalg.norm(fb)),
+                                     float(max(np.abs(za).max(), np.abs(zb).max()))):
+            raise SimulationError(
+                f"the exact flow of mode {MODE_NAMES[self.mode]} moved the state by "
+                f"{dz:.3g} from t={ta!r} to t={tb!r}, but its field's speed is "
+                f"{np.linalg.norm(fa):.3g} .. {np.linalg.norm(fb):.3g}: the closed form "
+                f"does not follow the field there (state at ta {za.tolist()}, at tb "
+                f"{zb.tolist()}); use integrated flows (method='integrate') or check the "
+                "flow's formula")
 
     def _scan(self, Z, ts, zs, leave, first, ta, tb):
         try:
@@ -760,6 +783,25 @@ def _decide(system, mode, what, z):
     return SLIDING, "slide_start"
 
 
+def _speed_rates(system, Z, z0):
+    """While sliding: ``rates(t) -> (da/dt, db/dt)`` on the segment ``Z`` (forward
+    differences on the orbit, of the step rules.rate_step gives at its first sample z0),
+    or None where that step is 0."""
+    fm = np.asarray(system.field_minus(z0), dtype=float)
+    fp = np.asarray(system.field_plus(z0), dtype=float)
+    a, b = (float(v) for v in system.normal_speeds(z0))
+    d = rules.rate_step(z0, fm, fp, a, b)
+    if d == 0.0:
+        return None
+
+    def rates(tt):
+        tt = np.asarray(tt, dtype=float)
+        a1, b1 = system.normal_speeds(Z(tt + d))
+        a0, b0 = system.normal_speeds(Z(tt))
+        return (a1 - a0) / d, (b1 - b0) / d
+    return rates
+
+
 def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xtol, traj,
           band=0.0, unbanded=None):
     """Earliest event in the samples ``ts`` of one segment, or None; and the band still
@@ -783,6 +825,11 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
 
     if mode != SLIDING:  # dH/dt along the mode's field: extrema of H are its roots
         dfun = scalar(lambda zz: system.speed_of_switch(mode, zz))
+        rates = None
+    else:  # the rates of a and b along the orbit: their extrema are roots (rules)
+        rates = _speed_rates(system, Z, np.asarray(zs[:, 0], dtype=float))
+        if rates is not None:
+            R = rates(ts)
 
     # Sample intervals that may hold an event, found with array operations; only
     # those are examined one by one (a scan of many samples costs a few numpy calls).
@@ -791,6 +838,9 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
         cand |= rules.crosses(pred, v[:-1], v[1:])
     if mode != SLIDING:
         cand |= rules.extremum_between(mode, D[:-1], D[1:])
+    elif rates is not None:
+        for (_, pred, _), Dv in zip(leave, R):
+            cand |= rules.speed_extremum_between(pred, Dv[:-1], Dv[1:])
     for pred, sv in zip(preds, svals):
         cand |= rules.crosses(pred, sv[:-1], sv[1:])
 
@@ -834,6 +884,26 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
                         r = _refine(h, pred, tq, r, h(tq), h(r), xtol)
                 if best is None or r < best[0]:
                     best = (r, what, -1)
+        if mode == SLIDING and best is None and rates is not None:
+            # the end of sliding hidden between the samples (rules.speed_graze): refined
+            # at the extremum of a or b, an exit at the speed's root before it
+            touches = []
+            for j, ((func, pred, what), v, Dv) in enumerate(zip(leave, vals, R)):
+                if not rules.speed_extremum_between(pred, Dv[i], Dv[i + 1]):
+                    continue
+                tm = _brent(lambda tt, j=j: float(rates(tt)[j]), ta, tb, Dv[i], Dv[i + 1],
+                            xtol)
+                vm = float(func(Z(tm)))
+                kind = rules.speed_graze(pred, vm, Dv[i], Dv[i + 1], tb - ta, touch_tol)
+                if kind == rules.GRAZE_CROSSES:
+                    r = _refine(scalar(func), pred, ta, tm, v[i], vm, xtol)
+                    if best is None or r < best[0]:
+                        best = (r, what, -1)
+                elif kind == rules.GRAZE_TOUCHES:
+                    touches.append(tm)
+            for tm in sorted(touches):  # a touch before any exit: P has a kink there
+                if best is None or tm < best[0]:
+                    traj.events.append(Event(tm, "touch", Z(tm).copy(), mode, mode))
         if mode != SLIDING and best is None:
             # a minimum (in +) or maximum (in -) of H hidden between samples
             H = vals[0]

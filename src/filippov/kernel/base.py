@@ -46,8 +46,10 @@ STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event lim
 # -- _brentq five times, _refine four: 9 s of a 30 s cold compile)
 _TO_NEG, _TO_NONNEG, _TO_NONPOS, _EITHER = (
     np.int64(c) for c in (rules.TO_NEG, rules.TO_NONNEG, rules.TO_NONPOS, rules.EITHER))
-# scalar functions of the state whose zeros are events
-_S_H, _S_A, _S_B, _S_SEC = (np.int64(c) for c in range(4))
+# scalar functions of the state whose zeros are events; and the rates of a and b along
+# the orbit (forward differences on the segment, step sg[7]: rules.rate_step), whose
+# zeros are their extrema while sliding
+_S_H, _S_A, _S_B, _S_SEC, _S_DA, _S_DB = (np.int64(c) for c in range(6))
 # brentq's iteration bounds: the reference driver's for an event, scipy's default for the
 # extremum of h between two samples
 _MAXITER_EVENT, _MAXITER_EXTREMUM = np.int64(200), np.int64(100)
@@ -79,13 +81,14 @@ _jit_inline = njit(cache=True, _nrt=False, inline="always")
  _slides_in_section, _starts_on_section, _same_instant, _start_side, _start_on_switch,
  _next_mode, _accumulates, _exit_shift, _dips_and_returns, _exact_window, _onto_switch,
  _exit_drift, _carried_age, _far_side_probe, _exit_band, _banded_shift, _clears_band,
- _band_probe) = (
+ _band_probe, _speed_extremum_between, _speed_graze, _rate_step) = (
     _jit_rule(getattr(rules, name)) for name in (
     "after", "crosses", "clamp", "far_side", "extremum_between", "graze", "central_step",
     "slides_in_section", "starts_on_section", "same_instant", "start_side", "start_on_switch",
     "next_mode", "accumulates", "exit_shift", "dips_and_returns", "exact_window",
     "onto_switch", "exit_drift", "carried_age", "far_side_probe", "exit_band",
-    "banded_shift", "clears_band", "band_probe"))
+    "banded_shift", "clears_band", "band_probe", "speed_extremum_between", "speed_graze",
+    "rate_step"))
 assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 
 

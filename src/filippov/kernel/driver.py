@@ -369,10 +369,10 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
     nsmax = max(s.frac_ex.size, s.frac_in.size)
     ts = np.empty(nsmax)
     vals = np.empty((2, nsmax))
-    dvals = np.empty(nsmax)
+    dvals = np.empty((2, nsmax))
     svals = np.empty(nsmax)
     recent = np.empty(max(s.zeno_count, 1))
-    sg = np.zeros(7)
+    sg = np.zeros(8)
     za, y, f = np.zeros(n), np.zeros(n), np.zeros(n)
     y_old, f_old, ynew, ytmp, scale = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                                        np.zeros(n))

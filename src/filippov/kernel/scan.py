@@ -6,12 +6,13 @@ import numpy as np
 
 from .. import rules
 from ..system import MINUS, PLUS, SLIDING
-from .base import (OK, ROOT_FAILED, _EPS, _MAXITER_EXTREMUM, _S_A, _S_B, _S_H, _S_SEC, _TO_NEG, _TO_NONNEG,
+from .base import (OK, ROOT_FAILED, _EPS, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB, _S_H, _S_SEC, _TO_NEG, _TO_NONNEG,
                    _TO_NONPOS, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_NONE, _W_SECTION, _W_SWITCH,
                    _after, _band_probe, _clamp, _clears_band, _crosses, _dips_and_returns, _dot, _extremum_between,
-                   _graze, _jit, _same_instant, _speeds, _starts_on_section, _field_minus,
+                   _graze, _jit, _rate_step, _same_instant, _speed_extremum_between, _speed_graze,
+                   _speeds, _starts_on_section, _field_minus,
                    _field_plus, _grad_h, _h, _section, _where)
-from .segment import (_fval, _zat)
+from .segment import (_fval, _rates, _zat)
 from .roots import (_brentq, _refine)
 
 
@@ -19,7 +20,8 @@ from .roots import (_brentq, _refine)
 def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, svals,
             wz, wg, wf, wp, zlast):
     """Samples of one window: times ts, the leave functions (h, or a and b when
-    sliding), dh/dt and the section; the last state in zlast. False: non-finite."""
+    sliding), their rates (dh/dt; the rates of a and b along the orbit while sliding,
+    rules.rate_step: sg[7]) and the section; the last state in zlast. False: non-finite."""
     for k in range(ns):
         tk = ta + frac[k] * (tb - ta) if k < ns - 1 else tb
         ts[k] = tk
@@ -27,10 +29,20 @@ def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, s
         for c in range(wz.size):
             if not np.isfinite(wz[c]):
                 return False
+        svals[k] = _section(fns, wz, p)
+        if k == ns - 1:
+            for c in range(wz.size):
+                zlast[c] = wz[c]
         if mode == SLIDING:
             a, b = _speeds(wz, fns, p, wg, wf, wp)
             vals[0, k] = a
             vals[1, k] = b
+            if k == 0:  # one difference step for the window (wf, wp: F_-, F_+ at wz)
+                sg[7] = _rate_step(wz, wf, wp, a, b)
+            if sg[7] > 0.0:  # (overwrites wz)
+                da, db = _rates(tk, a, b, mode, sg, za, F, y_old, fns, p, wz, wg, wf, wp)
+                dvals[0, k] = da
+                dvals[1, k] = db
         else:
             vals[0, k] = _h(fns, wz, p) - sg[4]
             _grad_h(fns, wz, p, wg)
@@ -38,10 +50,7 @@ def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, s
                 _field_plus(fns, wz, p, wf)
             else:
                 _field_minus(fns, wz, p, wf)
-            dvals[k] = _dot(wg, wf)
-        svals[k] = _section(fns, wz, p)
-    for c in range(wz.size):
-        zlast[c] = wz[c]
+            dvals[0, k] = _dot(wg, wf)
     return True
 
 
@@ -63,9 +72,14 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
     for i in range(ns - 1):
         c0 = _crosses(pred0, vals[0, i], vals[0, i + 1])
         c1 = nleave == 2 and _crosses(_TO_NONNEG, vals[1, i], vals[1, i + 1])
-        cd = mode != SLIDING and _extremum_between(mode, dvals[i], dvals[i + 1])
+        cd = mode != SLIDING and _extremum_between(mode, dvals[0, i], dvals[0, i + 1])
         cs = _crosses(sec_pred, svals[i], svals[i + 1])
-        if not (c0 or c1 or cd or cs):
+        # while sliding: a minimum of a, a maximum of b between the samples (rules)
+        ha = nleave == 2 and sg[7] > 0.0 and _speed_extremum_between(
+            _TO_NONPOS, dvals[0, i], dvals[0, i + 1])
+        hb = nleave == 2 and sg[7] > 0.0 and _speed_extremum_between(
+            _TO_NONNEG, dvals[1, i], dvals[1, i + 1])
+        if not (c0 or c1 or cd or cs or ha or hb):
             continue
         if sg[5] > 0.0 and _clears_band(mode, vals[0, i], sg[5]):
             # the orbit is out of its exit's rounding band at ts[i]: from there H is
@@ -81,7 +95,7 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
         best_t, best_w = np.inf, _W_NONE
         if c0:
             lo, vlo = ta, vals[0, i]
-            if first and i == 0 and mode != SLIDING and _dips_and_returns(mode, dvals[0], dvals[1]):
+            if first and i == 0 and mode != SLIDING and _dips_and_returns(mode, dvals[0, 0], dvals[0, 1]):
                 tm, ok = _brentq(sel_d, ta, tb, xtol, 4.0 * _EPS, _MAXITER_EXTREMUM, mode, sg, za, F, y_old,
                                  fns, p, wz, wg, wf)
                 hm = _fval(_S_H, tm, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
@@ -114,6 +128,32 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
                 return ROOT_FAILED, r, _W_NONE
             if best_w == _W_NONE or r < best_t:
                 best_t, best_w = r, _W_EXIT_PLUS
+        if best_w == _W_NONE and (ha or hb):
+            # the end of sliding hidden between the samples (rules.speed_graze): refined
+            # at the extremum of a or b, an exit at the speed's root before it
+            touch_t = np.inf
+            for q in range(2):
+                if not (ha if q == 0 else hb):
+                    continue
+                sel_v, sel_r = (_S_A, _S_DA) if q == 0 else (_S_B, _S_DB)
+                pred = _TO_NONPOS if q == 0 else _TO_NONNEG
+                tm, ok = _brentq(sel_r, ta, tb, xtol, 4.0 * _EPS, _MAXITER_EXTREMUM, mode, sg,
+                                 za, F, y_old, fns, p, wz, wg, wf)
+                if not ok:
+                    return ROOT_FAILED, tm, _W_NONE
+                vm = _fval(sel_v, tm, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+                kind = _speed_graze(pred, vm, dvals[q, i], dvals[q, i + 1], tb - ta, touch_tol)
+                if kind == rules.GRAZE_CROSSES:
+                    r, ok = _refine(sel_v, pred, ta, tm, vals[q, i], xtol, mode, sg, za, F,
+                                    y_old, fns, p, wz, wg, wf)
+                    if not ok:
+                        return ROOT_FAILED, r, _W_NONE
+                    if best_w == _W_NONE or r < best_t:
+                        best_t, best_w = r, (_W_EXIT_MINUS if q == 0 else _W_EXIT_PLUS)
+                elif kind == rules.GRAZE_TOUCHES:
+                    touch_t = min(touch_t, tm)
+            if touch_t < best_t:
+                touched[0] = True  # a touch before any exit: P has a kink here
         if mode != SLIDING and best_w == _W_NONE and cd:
             # a minimum (in +) or maximum (in -) of h hidden between samples
             tm, ok = _brentq(sel_d, ta, tb, xtol, 4.0 * _EPS, _MAXITER_EXTREMUM, mode, sg, za, F, y_old,
