@@ -319,7 +319,7 @@ def _best_repeat(values: np.ndarray, max_period: int) -> int:
 
 
 def _periodic(cmodel, states, age, coordinate, scale, max_period, t_max, options,
-              last_chance=False):
+              last_chance=False, lyapunov=True):
     """(the Attractor of a confirmed, stable cycle or None, the count's period). With
     ``last_chance`` (after the extension) the candidate is the best repeat and the cycle
     may lie up to the attractor's scale from the returns, as long as they approach it."""
@@ -340,10 +340,13 @@ def _periodic(cmodel, states, age, coordinate, scale, max_period, t_max, options
     if not stable:
         return None, period
     u = cycle.points[:, coordinate]
+    # the exponent only where asked for: a sweep without it keeps NaN throughout (a
+    # point whose type another machine decides otherwise changes no NaN pattern)
     with np.errstate(divide="ignore", invalid="ignore"):
-        lyap = float(np.log(cycle.radius) / cycle.period)
+        lyap = float(np.log(cycle.radius) / cycle.period) if lyapunov else np.nan
     return Attractor(values, cycle.period, float(u.max() - u.min()), lyap, False,
-                     states=states, lyapunov_err=0.0, cycle=cycle), period
+                     states=states, lyapunov_err=0.0 if lyapunov else np.nan,
+                     cycle=cycle), period
 
 
 def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, keep: int,
@@ -369,7 +372,8 @@ def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, kee
     if escaped is not None:
         return escaped
     args = (coordinate, scale, max_period, t_max, options)
-    found, period = _periodic(cmodel, states, float(run.age[0]), *args)
+    kw = {"lyapunov": lyapunov}
+    found, period = _periodic(cmodel, states, float(run.age[0]), *args, **kw)
     if found is not None:
         return found
     lyap, err = np.nan, np.nan
@@ -388,7 +392,7 @@ def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, kee
         if escaped is not None:
             return escaped
         last, age = states2[-1], float(more.age[0])
-        found, period2 = _periodic(cmodel, states2, age, *args, last_chance=True)
+        found, period2 = _periodic(cmodel, states2, age, *args, last_chance=True, **kw)
         if found is not None:
             return found
         if lyapunov:
