@@ -14,8 +14,11 @@
 #                  next to each tolerance, "--scenes ID ..." checks only some datasets
 #   make report    the reproduction report paper/main.pdf (needs TeX)
 #   make report-html  snakemake's HTML report (report.html): figures captioned with the
-#                  paper's number, description and parameters; datasets, scene files
+#                  paper's number, description and parameters; every dataset, the
+#                  work-precision figure, scene files
 #   make archive   one tarball of code, results, figures and report, with its sha256
+#                  (CITATION.cff and .zenodo.json in it: ready to deposit for a DOI)
+#   make archive-files  the file list of that tarball
 #   make help      this list
 #   make lock      re-resolve requirements.lock in a throw-away venv
 #   make clean     remove workflow outputs (keeps .venv)
@@ -39,7 +42,8 @@ ALLOW_NO_TESTS ?=
 
 # Top-level packages resolved by `make lock` (everything else is transitive).
 LOCK_PKGS = numpy scipy xarray netCDF4 matplotlib "snakemake>=8,<10" \
-            pyyaml jsonschema numba threadpoolctl sympy pytest hypothesis pygments snakemake-executor-plugin-slurm
+            pyyaml jsonschema numba threadpoolctl sympy pytest hypothesis pygments snakemake-executor-plugin-slurm \
+            compliance-checker
 
 export MPLBACKEND = Agg
 export SOURCE_DATE_EPOCH = 0
@@ -50,7 +54,7 @@ export DEBIAN_FRONTEND = noninteractive
 # `python` inside Snakemake shell rules is the venv's interpreter.
 VENV_PATH = PATH="$(abspath $(VENV))/bin:$$PATH" VIRTUAL_ENV="$(abspath $(VENV))"
 
-.PHONY: all help archive venv figures test test-deep verify cross-cpu manifest report report-html bench bench-fig04 lock clean distclean check-python
+.PHONY: all help archive archive-files venv figures test test-deep verify cross-cpu manifest report report-html bench bench-fig04 lock clean distclean check-python
 
 all: figures
 
@@ -59,12 +63,20 @@ help:
 	@sed -n '/^#   make /,/^# *$$/p' $(firstword $(MAKEFILE_LIST)) | sed 's/^# \{0,3\}//' | sed '/^$$/d'
 
 # One tarball of what a reader needs: the code, the results, the figures and the
-# report, with its sha256 beside it (a tracked file list: no venv, no caches).
+# report, with its sha256 beside it (a tracked file list: no venv, no caches, no logs).
+# The licence and the citation metadata are listed by name as well (a deposit reads
+# CITATION.cff or .zenodo.json), so that they are in it even before they are committed.
 ARCHIVE ?= filippov-$(shell git describe --always --dirty 2>/dev/null || echo snapshot).tar.gz
+ARCHIVE_META = LICENSE README.md CITATION.cff .zenodo.json
+ARCHIVE_FILES = { git ls-files; ls $(ARCHIVE_META); \
+                  ls results/*.nc figures/*.pdf figures/*.png paper/main.pdf 2>/dev/null || true; } | sort -u
+archive-files:
+	@$(ARCHIVE_FILES)
+
 archive: figures
 	@test -d results && test -n "$$(ls figures/*.pdf 2>/dev/null)" || { echo "error: no build to archive" >&2; exit 1; }
 	tmp=$$(mktemp); trap 'rm -f "$$tmp"' EXIT; \
-	{ git ls-files; ls results/*.nc figures/*.pdf figures/*.png; ls paper/main.pdf 2>/dev/null || true; } | sort -u > "$$tmp"; \
+	$(ARCHIVE_FILES) > "$$tmp"; \
 	tar --sort=name --mtime='@0' --owner=0 --group=0 --numeric-owner -czf $(ARCHIVE).tmp -T "$$tmp"; \
 	mv $(ARCHIVE).tmp $(ARCHIVE); sha256sum $(ARCHIVE) > $(ARCHIVE).sha256; \
 	echo "wrote $(ARCHIVE) ($$(wc -l < "$$tmp") files) and $(ARCHIVE).sha256"
@@ -160,7 +172,7 @@ lock: | check-python
 	echo "wrote requirements.lock ($$(grep -c '==' requirements.lock) pins)"
 
 clean:
-	rm -rf results/ .snakemake/ paper/generated paper/.build.* report.html
+	rm -rf results/ .snakemake/ logs/ paper/generated paper/.build.* report.html
 	rm -f figures/*.pdf figures/*.png
 	rm -f paper/main.pdf paper/main.log paper/main.fls paper/main.build.log
 

@@ -1,5 +1,6 @@
-"""CF-1.8 attributes on every dataset a build writes (an attribute check in place
-of compliance-checker, which needs a network connection for its tables)."""
+"""CF-1.8 attributes on every dataset a build writes, as the project reads them
+(tests/test_cf_compliance.py runs the real checker, compliance-checker, on the same
+build)."""
 import numpy as np
 import pytest
 import xarray as xr

@@ -35,9 +35,11 @@ def test_an_installed_copy_reports_its_version(monkeypatch, tmp_path):
 
 
 def test_licence_and_citation_are_there():
+    # the software is cited as itself, the paper under references (tests/test_citation.py)
     assert "MIT License" in (ROOT / "LICENSE").read_text()
     cff = (ROOT / "CITATION.cff").read_text()
-    assert "preferred-citation" in cff and "Sieber" in cff and "doi:" in cff
+    assert "type: software" in cff and "references:" in cff and "Sieber" in cff
+    assert "preferred-citation" not in cff and (ROOT / ".zenodo.json").is_file()
 
 
 def test_progress_lines_name_the_chunk_and_the_time_left(capsys):

@@ -5,9 +5,16 @@
 # reproducible.
 rule work_precision:
     output:
-        "results/work_precision.nc",
+        report("results/work_precision.nc", caption="../report/work_precision.rst",
+               category="Datasets", labels=dataset_labels),
     params:
-        code=library_hash(exclude=("plotting", "report.py", "manifest.py"), strip_reports=True),
+        code=library_hash(exclude=("plotting", "report.py", "report_html.py", "manifest.py"),
+                          strip_reports=True),
+        caption=dataset_caption,  # the HTML report's (report_html.smk; no rerun trigger)
+    log:
+        "logs/work_precision.log",
+    conda:
+        "../envs/filippov.yaml"
     script:
         "../scripts/bench_work_precision.py"
 
@@ -17,10 +24,19 @@ rule plot_work_precision:
         data="results/work_precision.nc",
         script="workflow/scripts/plot_scene.py",
     output:
-        pdf="figures/work_precision.pdf",
-        png="figures/work_precision.png",
+        pdf=report("figures/work_precision.pdf", caption="../report/work_precision_figure.rst",
+                   category="Figures", subcategory="work_precision",
+                   labels={"figure": "work_precision", "format": "PDF (vector)"}),
+        png=report("figures/work_precision.png", caption="../report/work_precision_figure.rst",
+                   category="Figures", subcategory="work_precision",
+                   labels={"figure": "work_precision", "format": "PNG"}),
     params:
         code=library_hash("plotting"),
+        caption=figure_caption,  # the HTML report's (report_html.smk; no rerun trigger)
+    log:
+        "logs/plot_work_precision.log",
+    conda:
+        "../envs/filippov.yaml"
     script:
         "../scripts/plot_scene.py"
 
@@ -39,8 +55,13 @@ rule bench_work_precision_part:
     wildcard_constraints:
         problems="|".join(BENCH_SETS),
     params:
-        code=library_hash(exclude=("plotting", "report.py", "manifest.py"), strip_reports=True),
+        code=library_hash(exclude=("plotting", "report.py", "report_html.py", "manifest.py"),
+                          strip_reports=True),
         every=config.get("bench", {}).get("every", 10),
+    log:
+        "logs/bench_work_precision_part/{problems}.log",
+    conda:
+        "../envs/filippov.yaml"
     script:
         "../scripts/bench_work_precision.py"
 
@@ -51,6 +72,10 @@ rule bench_work_precision:
         script="workflow/scripts/bench_work_precision.py",
     output:
         "results/bench_work_precision.nc",
+    log:
+        "logs/bench_work_precision.log",
+    conda:
+        "../envs/filippov.yaml"
     script:
         "../scripts/bench_work_precision.py"
 
@@ -64,6 +89,10 @@ rule plot_bench:
         png="figures/bench_work_precision.png",
     params:
         code=library_hash("plotting"),
+    log:
+        "logs/plot_bench.log",
+    conda:
+        "../envs/filippov.yaml"
     script:
         "../scripts/plot_scene.py"
 
@@ -73,6 +102,10 @@ rule bench_effect_cost:
         "results/bench_effect_cost.nc",
     params:
         code=library_hash(exclude="plotting"),
+    log:
+        "logs/bench_effect_cost.log",
+    conda:
+        "../envs/filippov.yaml"
     script:
         "../scripts/bench_effect_cost.py"
 
@@ -84,6 +117,10 @@ rule bench_attractor_cost:
         "results/bench_attractor_cost.nc",
     params:
         code=library_hash(exclude="plotting"),
+    log:
+        "logs/bench_attractor_cost.log",
+    conda:
+        "../envs/filippov.yaml"
     script:
         "../scripts/bench_attractor_cost.py"
 
@@ -95,6 +132,10 @@ rule bench_sliding_cost:
         "results/bench_sliding_cost.nc",
     params:
         code=library_hash(exclude="plotting"),
+    log:
+        "logs/bench_sliding_cost.log",
+    conda:
+        "../envs/filippov.yaml"
     script:
         "../scripts/bench_sliding_cost.py"
 
@@ -106,6 +147,10 @@ rule bench_compile_cost:
         "results/bench_compile_cost.nc",
     params:
         code=library_hash(exclude="plotting"),
+    log:
+        "logs/bench_compile_cost.log",
+    conda:
+        "../envs/filippov.yaml"
     script:
         "../scripts/bench_compile_cost.py"
 

@@ -1,18 +1,30 @@
+# The workflow's functions, kept apart from its rules (snakemake --lint): the
+# library fingerprints, the scene helpers of compute.smk, the hard-case chunks of
+# hard_cases.smk and the report's inputs of report.smk.
+#
 # Library fingerprints. Snakemake reruns a job when its script changes, but not
 # when the library code the script imports changes; passing a hash of that code
 # as a param makes it do so (params are a default rerun trigger in Snakemake 8+).
 import functools
 import hashlib
-import sys
 import importlib.util
+import posixpath
+import shutil
+import subprocess
+import sys
 from pathlib import Path
+
+import yaml
+
+from filippov.config import (DEFAULT_RESOLUTION, SceneError, apply_resolution, check_limits,
+                             limits)
 
 # Library parts no scene computation imports: editing them must not recompute data.
 # (hard_cases.py is the hard-case sweep's own module: rule hard_cases hashes it.)
 # The report part of each scene module (filippov.config.is_report_part) is left out of
 # their hash as well (strip_reports=True).
 NOT_COMPUTE = ("plotting/", "benchmarks/", "report.py", "manifest.py",
-               "hard_cases.py", "paper_labels.py")
+               "hard_cases.py", "paper_labels.py", "report_html.py")
 
 
 def library_hash(include="", exclude=(), strip_reports=False):
@@ -33,8 +45,8 @@ def _library_hash(include, exclude, strip_reports):
     if spec is None or not spec.origin:
         return "filippov-not-found"
     root = Path(spec.origin).parent
-    # a bare name is a folder ("plotting" == "plotting/")
-    exclude = tuple(e if e.endswith((".py", "/")) else e + "/" for e in exclude)
+    # a bare name is a folder ("plotting" == "plotting/"); join(e, "") adds the slash
+    exclude = tuple(e if e.endswith(".py") else posixpath.join(e, "") for e in exclude)
     digest = hashlib.sha256()
     for path in sorted((root / include).rglob("*.py")):
         rel = path.relative_to(root).as_posix()
@@ -43,7 +55,7 @@ def _library_hash(include, exclude, strip_reports):
         text = path.read_bytes()
         if strip_reports and rel.startswith("scenes/"):
             text = without_report_part(text.decode("utf-8")).encode("utf-8")
-        digest.update(rel.encode() + b"\0" + text + b"\0")
+        digest.update(b"\0".join([rel.encode(), text, b""]))  # rel NUL text NUL
     return digest.hexdigest()[:16]
 
 
@@ -54,34 +66,102 @@ def fail(message):
     sys.exit(1)
 
 
-@functools.lru_cache(maxsize=None)
-def _paper_labels():
-    """paper/paper_labels.tex read once per workflow run (every scene's jobs ask)."""
-    path = Path("paper/paper_labels.tex")
-    if not path.exists():
-        return {}
-    from filippov.paper_labels import read_tex
+# (the HTML report's captions: report_html.smk and filippov.report_html)
 
-    return read_tex(path.read_text())
+
+# ----------------------------------------------------------------------------- scenes
+# (compute.smk) The resolution each scene is built at, and the scenes split into chunks.
+RESOLUTION = config.get("resolution", DEFAULT_RESOLUTION)
 
 
 @functools.lru_cache(maxsize=None)
-def scene_summary(scene):
-    """What the HTML report shows with a scene's figure, dataset and scene file: its
-    description, the paper figure it reproduces (the printed number, from
-    paper/paper_labels.tex), its model, ingredients and physical parameters."""
-    import yaml
+def scene_resolution(scene):
+    """The resolution scene `scene` is built at: the run's, if the scene file has a
+    block of that name under `resolutions`, else the default -- so that asking for
+    another resolution reruns only the scenes that have one."""
+    try:
+        data = yaml.safe_load(Path(f"config/scenes/{scene}.yaml").read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return DEFAULT_RESOLUTION
+    if not isinstance(data, dict):
+        return DEFAULT_RESOLUTION
+    return apply_resolution(data, RESOLUTION).get("resolution", DEFAULT_RESOLUTION)
 
-    path = Path(f"config/scenes/{scene}.yaml")
-    if not path.exists():
-        return {}
-    data = yaml.safe_load(path.read_text()) or {}
-    label = str(data.get("paper_figure", ""))
-    printed = _paper_labels().get(label, label).replace("~", " ")
-    # a scene beyond the paper's figures (the instabilities) has no paper figure
-    ref = f"{printed} of the paper" if printed else "beyond the paper's figures"
-    return {"description": " ".join(str(data.get("description", "")).split()),
-            "paper_figure": printed, "paper_ref": ref, "paper_label": label,
-            "model": str(data.get("model", "")),
-            "ingredients": ", ".join(f"{k}: {v}" for k, v in data.get("ingredients", {}).items()),
-            "parameters": [f"{k} = {v}" for k, v in data.get("parameters", {}).items()]}
+
+def scene_chunks():
+    """{id: N} for the scene files with a top-level `chunks: N` (N >= 1).
+
+    Read when the DAG is built, so the chunk jobs are known statically (no
+    checkpoint). Each scene is checked against the size limits first (cheap,
+    from its parameters), so that no oversized plan is ever built: a scene over
+    a limit stops the run here with one line. A malformed file or `chunks`
+    value is left to rule `compute`, whose job reports it (schema validation
+    names the field).
+    """
+    found = {}
+    try:
+        lim = limits(config)
+    except SceneError as exc:
+        fail(exc)
+    for path in sorted(Path("config/scenes").glob("*.yaml")):
+        try:
+            data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, yaml.YAMLError):
+            continue
+        try:
+            if isinstance(data, dict) and isinstance(data.get("parameters", {}), dict):
+                data = apply_resolution(data, RESOLUTION)
+                check_limits(data, lim, path)
+        except SceneError as exc:
+            fail(exc)
+        except (TypeError, ValueError, AttributeError):
+            pass  # malformed: the schema check of the job names the field
+        n = data.get("chunks") if isinstance(data, dict) else None
+        if isinstance(n, int) and not isinstance(n, bool) and n >= 1:
+            found[path.stem] = n
+    return found
+
+
+# ----------------------------------------------------------------------------- hard cases
+def hard_cases_chunks():
+    """`chunks` of config["hard_cases"], read when the DAG is built (hard_cases.smk). A
+    malformed block is left to the jobs, which report it naming the field (as rule
+    `compute` does for scenes), so one job is planned for it."""
+    block = config.get("hard_cases")
+    n = block.get("chunks", 1) if isinstance(block, dict) else 1
+    return n if isinstance(n, int) and not isinstance(n, bool) and n >= 1 else 1
+
+
+# ----------------------------------------------------------------------------- report
+# (report.smk)
+def tex_available():
+    """pdflatex, latexmk and elsarticle.cls are all installed."""
+    if not (shutil.which("latexmk") and shutil.which("pdflatex") and shutil.which("kpsewhich")):
+        return False
+    found = subprocess.run(["kpsewhich", "elsarticle.cls"], capture_output=True, text=True)
+    return found.returncode == 0 and bool(found.stdout.strip())
+
+
+def report_scenes():
+    return list(config["scenes"])
+
+
+def report_data(wildcards):
+    data = [f"results/{s}.nc" for s in report_scenes()]
+    return data
+
+
+# The benchmarks' outputs (`make bench`) are read when present but are not inputs:
+# an input would make every library edit rerun the minutes-long benchmark before
+# the report. Their modification times are a param instead, so a new benchmark
+# run still refreshes the report.
+BENCH_OUTPUTS = ["results/bench_effect_cost.nc", "results/bench_attractor_cost.nc",
+                 "results/bench_compile_cost.nc"]
+
+
+def bench_stamps():
+    return {p: Path(p).stat().st_mtime_ns for p in BENCH_OUTPUTS if Path(p).exists()}
+
+
+def report_figures(wildcards):
+    return [f"figures/{s}.pdf" for s in report_scenes()]

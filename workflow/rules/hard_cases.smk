@@ -5,17 +5,8 @@
 # one process. The settings and the library's hash are params, so editing
 # either reruns the sweep (see common.smk); scenes do not import hard_cases.py,
 # so editing it reruns the sweep only.
+# (hard_cases_chunks: common.smk)
 import json
-
-
-def hard_cases_chunks():
-    """`chunks` of config["hard_cases"], read when the DAG is built. A malformed
-    block is left to the jobs, which report it naming the field (as rule
-    `compute` does for scenes), so one job is planned for it."""
-    block = config.get("hard_cases")
-    n = block.get("chunks", 1) if isinstance(block, dict) else 1
-    return n if isinstance(n, int) and not isinstance(n, bool) and n >= 1 else 1
-
 
 HARD_CASES_SETTINGS = json.dumps(config.get("hard_cases"), sort_keys=True)
 # the compute code (as for the scenes) and filippov/hard_cases.py itself
@@ -33,6 +24,10 @@ rule hard_cases_part:
     params:
         settings=HARD_CASES_SETTINGS,
         code=HARD_CASES_CODE,  # see common.smk
+    log:
+        "logs/hard_cases_part/{i}.log",
+    conda:
+        "../envs/filippov.yaml"
     script:
         "../scripts/hard_cases_part.py"
 
@@ -42,10 +37,16 @@ rule hard_cases:
         script="workflow/scripts/hard_cases_merge.py",
         parts=[f"results/chunks/hard_cases/{i}.nc" for i in range(hard_cases_chunks())],
     output:
-        "results/hard_cases.nc",
+        report("results/hard_cases.nc", caption="../report/hard_cases.rst", category="Datasets",
+               labels=dataset_labels),
     params:
         settings=HARD_CASES_SETTINGS,
         code=HARD_CASES_CODE,  # see common.smk
+        caption=dataset_caption,  # the HTML report's (report_html.smk; no rerun trigger)
+    log:
+        "logs/hard_cases.log",
+    conda:
+        "../envs/filippov.yaml"
     script:
         "../scripts/hard_cases_merge.py"
 

@@ -11,6 +11,10 @@ rule plot:
                    subcategory="{scene}", labels={"figure": "{scene}", "format": "PNG"}),
     params:
         code=library_hash("plotting"),  # restyle -> redraw, without recomputing
-        scene=lambda wc: scene_summary(wc.scene),  # for the HTML report's caption
+        caption=figure_caption,  # the HTML report's (report_html.smk; no rerun trigger)
+    log:
+        "logs/plot/{scene}.log",
+    conda:
+        "../envs/filippov.yaml"
     script:
         "../scripts/plot_scene.py"

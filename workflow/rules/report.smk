@@ -8,11 +8,8 @@
 # computed" for whatever is absent. Rule `all` asks for paper/main.pdf only when
 # TeX is installed (see TEX_OK in the Snakefile). The hard-case eps sweep
 # (results/hard_cases.nc, rule hard_cases) is an input: it takes seconds.
-import shutil
-import subprocess
-import sys
-from pathlib import Path
-
+# The helpers (tex_available, report_data, report_figures, bench_stamps) are in
+# common.smk.
 from filippov.config import scene_files
 
 report: "../report/workflow.rst"
@@ -29,39 +26,6 @@ TEX_PACKAGES = ("texlive-publishers texlive-latex-extra texlive-latex-recommende
                 "texlive-fonts-recommended latexmk")
 
 
-def tex_available():
-    """pdflatex, latexmk and elsarticle.cls are all installed."""
-    if not (shutil.which("latexmk") and shutil.which("pdflatex") and shutil.which("kpsewhich")):
-        return False
-    found = subprocess.run(["kpsewhich", "elsarticle.cls"], capture_output=True, text=True)
-    return found.returncode == 0 and bool(found.stdout.strip())
-
-
-def report_scenes():
-    return list(config["scenes"])
-
-
-def report_data(wildcards):
-    data = [f"results/{s}.nc" for s in report_scenes()]
-    return data
-
-
-# The benchmarks' outputs (`make bench`) are read when present but are not inputs:
-# an input would make every library edit rerun the minutes-long benchmark before
-# the report. Their modification times are a param instead, so a new benchmark
-# run still refreshes the report.
-BENCH_OUTPUTS = ["results/bench_effect_cost.nc", "results/bench_attractor_cost.nc",
-                 "results/bench_compile_cost.nc"]
-
-
-def bench_stamps():
-    return {p: Path(p).stat().st_mtime_ns for p in BENCH_OUTPUTS if Path(p).exists()}
-
-
-def report_figures(wildcards):
-    return [f"figures/{s}.pdf" for s in report_scenes()]
-
-
 rule report_tables:
     input:
         data=report_data,
@@ -73,13 +37,17 @@ rule report_tables:
     params:
         code=library_hash(exclude="plotting"),  # filippov.report, the scenes' report parts, ...
         bench=bench_stamps(),
+    log:
+        "logs/report_tables.log",
+    conda:
+        "../envs/filippov.yaml"
     script:
         "../scripts/report_tables.py"
 
 
 # latexmk builds in a fresh directory under paper/; only a complete PDF is moved
-# onto paper/main.pdf (same file system: atomic). The build log is kept in
-# paper/main.build.log (and the TeX log/recorder file next to it) even on failure.
+# onto paper/main.pdf (same file system: atomic). latexmk's output is kept in
+# logs/paper.log (and the TeX log/recorder file in paper/main.{log,fls}) even on failure.
 rule paper:
     input:
         tex=sorted(str(p) for p in Path("paper").glob("*.tex")),
@@ -92,7 +60,9 @@ rule paper:
         report("paper/main.pdf", category="Reproduction report",
                caption="../report/paper.rst"),
     log:
-        "paper/main.build.log",
+        "logs/paper.log",
+    conda:
+        "../envs/filippov.yaml"
     shell:
         r"""
         set -u

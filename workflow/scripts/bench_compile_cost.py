@@ -1,4 +1,9 @@
 """Thin: time the compiled engine's compile and load, write results/bench_compile_cost.nc."""
-import filippov.benchmarks.compile_cost as cc
+
+import joblog
+
+joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, logs/)
+
+import filippov.benchmarks.compile_cost as cc  # noqa: E402
 
 cc.main(["--repeat", "1", "--out", snakemake.output[0]])  # noqa: F821

@@ -1,4 +1,9 @@
 """Thin: time every scene with each ingredient switched, write results/bench_effect_cost.nc."""
-import filippov.benchmarks.effect_cost as ec
+
+import joblog
+
+joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, logs/)
+
+import filippov.benchmarks.effect_cost as ec  # noqa: E402
 
 ec.main(["--out", snakemake.output[0]])  # noqa: F821

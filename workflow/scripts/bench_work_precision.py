@@ -1,6 +1,11 @@
 """Thin: the default build's work-precision sweep, one problem set of the full
 benchmark (a chunk job), or the merge."""
-import filippov.benchmarks.work_precision as wp
+
+import joblog
+
+joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, logs/)
+
+import filippov.benchmarks.work_precision as wp  # noqa: E402
 
 if snakemake.rule == "work_precision":  # noqa: F821
     wp.main(["--preset", "build", "--out", snakemake.output[0]])  # noqa: F821

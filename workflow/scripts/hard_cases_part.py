@@ -1,10 +1,15 @@
 """Thin: config hard_cases + chunk index -> filippov.hard_cases.compute_part
 -> results/chunks/hard_cases/<i>.nc (no numerics here)."""
-import json
-import sys
 
-import filippov.io
-from filippov import hard_cases
+import joblog
+
+joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, logs/)
+
+import json  # noqa: E402
+import sys  # noqa: E402
+
+import filippov.io  # noqa: E402
+from filippov import hard_cases  # noqa: E402
 
 try:
     settings = hard_cases.check_config(json.loads(snakemake.params.settings))  # noqa: F821

@@ -1,9 +1,14 @@
 """Thin: results/chunks/<id>/*.nc -> filippov.scenes.merge -> results/<id>.nc (no numerics here)."""
-import sys
 
-import filippov.io
-import filippov.scenes
-from filippov.config import SceneError, limits, load_scene
+import joblog
+
+joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, logs/)
+
+import sys  # noqa: E402
+
+import filippov.io  # noqa: E402
+import filippov.scenes  # noqa: E402
+from filippov.config import SceneError, limits, load_scene  # noqa: E402
 
 try:
     scene = load_scene(snakemake.input.scene, snakemake.input.schema,  # noqa: F821

@@ -2,11 +2,16 @@
 
 filippov.plotting builds pyplot-free Figures, so no GUI backend is involved.
 """
-import sys
-from pathlib import Path
 
-import filippov.io
-import filippov.plotting
+import joblog
+
+joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, logs/)
+
+import sys  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import filippov.io  # noqa: E402
+import filippov.plotting  # noqa: E402
 
 # the figure's id is its file name: figures/<id>.pdf (scenes and benchmarks alike)
 fid = Path(snakemake.output.pdf).stem  # noqa: F821

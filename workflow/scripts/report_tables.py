@@ -1,9 +1,14 @@
 """Thin: results/*.nc -> filippov.report.generate -> paper/generated/*.tex."""
-import sys
-from pathlib import Path
 
-import filippov.io
-import filippov.report
+import joblog
+
+joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, logs/)
+
+import sys  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import filippov.io  # noqa: E402
+import filippov.report  # noqa: E402
 
 datasets = {}
 # the scenes' datasets, the hard-case and work-precision sweeps (inputs), and the

@@ -1,0 +1,49 @@
+"""A workflow job's output, on the terminal as before and in its rule's log file.
+
+Every script of the workflow starts with ``joblog.tee(snakemake)``: from then on what
+the script writes to stdout and stderr -- progress lines (filippov.progress), the
+benchmarks' tables, warnings, the one-line errors of ``sys.exit`` and tracebacks --
+is also written to ``snakemake.log[0]`` (the rule's ``log:``, under ``logs/``). The
+terminal shows the same as without it, so ``make figures`` keeps its progress; the log
+holds one job's output on its own (jobs run in parallel, or on a cluster node).
+
+Only what goes through Python's ``sys.stdout``/``sys.stderr`` is copied: a child
+process's output is not (the benchmarks capture their children's output themselves).
+Imported from workflow/scripts, which Snakemake puts on the path of every script.
+"""
+from __future__ import annotations
+
+import sys
+
+
+class _Tee:
+    """A text stream that writes to ``stream`` and to ``log``; everything else
+    (fileno, isatty, encoding, ...) is the original stream's."""
+
+    def __init__(self, stream, log):
+        self._stream, self._log = stream, log
+
+    def write(self, text):
+        self._log.write(text)
+        return self._stream.write(text)
+
+    def writelines(self, lines):
+        for line in lines:
+            self.write(line)
+
+    def flush(self):
+        self._log.flush()
+        self._stream.flush()
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+def tee(smk) -> None:
+    """Copy stdout and stderr into the job's first log file (none: nothing to do)."""
+    if not smk.log:
+        return
+    # line-buffered: a job that is killed leaves every complete line in its log
+    log = open(smk.log[0], "w", encoding="utf-8", buffering=1)
+    sys.stdout = _Tee(sys.stdout, log)
+    sys.stderr = _Tee(sys.stderr, log)
