@@ -41,18 +41,23 @@ def scale(eps: float, theta: float) -> float:
     return eps if theta < 0 else eps * eps
 
 
+def _global(s, eps: float, theta: float, omega: float, order: int):
+    """(lambda, u*) of the global part at s: the cycle's multiplier per turn and its point
+    on L1 in scaled terms; order 0 is the eps -> 0 limit throughout (mu = 1 in lambda,
+    u* = s/2)."""
+    if order == 0:
+        return np.exp(-4.0 * np.pi / abs(omega)), 0.5 * s
+    sigma = scale(eps, theta)
+    mu = 1.0 + s * sigma
+    return np.exp(-4.0 * np.pi * mu / abs(omega)), (np.sqrt(mu) - 1.0) / sigma
+
+
 def step(u, s, *, eps: float, theta: float, omega: float, order: int = 1):
     """One return of the limit map: u -> u' (arrays broadcast; s scaled as u). Order 1
     keeps eps in the global part (mu = 1 + s sigma) and, for theta < 0, the sqrt(eps)
     term of P_DM; order 0 is the limit eps -> 0 of both."""
-    sigma = scale(eps, theta)
     u, s = np.asarray(u, dtype=float), np.asarray(s, dtype=float)
-    if order == 0:  # the eps -> 0 limit throughout: mu = 1 in lambda, u* = s/2
-        lam, ustar = np.exp(-4.0 * np.pi / abs(omega)), 0.5 * s
-    else:
-        mu = 1.0 + s * sigma
-        lam = np.exp(-4.0 * np.pi * mu / abs(omega))
-        ustar = (np.sqrt(mu) - 1.0) / sigma
+    lam, ustar = _global(s, eps, theta, omega, order)
     rho = ustar + lam ** 0.25 * (u - ustar)
     xi = -rho
     if theta < 0:
@@ -119,14 +124,8 @@ def slope(u, s, *, eps: float, theta: float, omega: float, order: int = 1):
     the border here (the slope of :func:`slopes` averages the two pieces within h of it)."""
     if not theta < 0:
         raise ValueError("the closed-form slope is for theta < 0")
-    sigma = scale(eps, theta)
     u, s = np.asarray(u, dtype=float), np.asarray(s, dtype=float)
-    if order == 0:
-        lam, ustar = np.exp(-4.0 * np.pi / abs(omega)), 0.5 * s
-    else:
-        mu = 1.0 + s * sigma
-        lam = np.exp(-4.0 * np.pi * mu / abs(omega))
-        ustar = (np.sqrt(mu) - 1.0) / sigma
+    lam, ustar = _global(s, eps, theta, omega, order)
     xi = -(ustar + lam ** 0.25 * (u - ustar))
     d = np.ones(np.broadcast(xi, s).shape)
     if order >= 1:
@@ -216,12 +215,6 @@ def itinerary(points, s: float, *, eps: float, theta: float, omega: float,
     the discontinuity map's jump; False: the orbit misses H): the piece of the map the
     point lies in. A periodic orbit keeps its itinerary until one of its points reaches
     the border rho = 0 (a border collision)."""
-    sigma = scale(eps, theta)
-    if order == 0:
-        lam, ustar = np.exp(-4.0 * np.pi / abs(omega)), 0.5 * s
-    else:
-        mu = 1.0 + s * sigma
-        lam = np.exp(-4.0 * np.pi * mu / abs(omega))
-        ustar = (np.sqrt(mu) - 1.0) / sigma
+    lam, ustar = _global(s, eps, theta, omega, order)
     rho = ustar + lam ** 0.25 * (np.asarray(points, dtype=float) - ustar)
     return tuple(bool(r > 0) for r in rho)
