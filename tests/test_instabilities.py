@@ -179,6 +179,17 @@ def test_the_chaotic_attractor_shrinks_like_eps_squared():
     assert k == pytest.approx(2.0, abs=0.15)
 
 
+@pytest.mark.parametrize("eps", [1e-3, 1e-4])
+def test_inside_the_band_of_period_two_the_attractor_has_period_two(eps):
+    # theta = 0.3: lambda^2/(1 + lambda^2) < theta < lambda/(1 + lambda) (the normal
+    # form's band of period two past grazing); a confirmed, stable period-two orbit
+    lam = limit_map.multiplier(1.0, OMEGA)
+    assert limit_map.chaos_threshold(lam) < 0.3 < limit_map.flip_threshold(lam)
+    for s in (0.5, 2.0, 4.0):
+        at = _attractor(eps, 0.3, s, transient=300, keep=100, lyapunov=True)
+        assert at.period == 2 and at.cycle.radius < 1.0, (s, at.period)
+
+
 def test_the_chaos_ends_at_smaller_s_as_eps_shrinks():
     # theta = 0.2: at s = 70.7 (fig13's geometric grid) the attractor is chaotic at
     # eps = 1e-3 (an exponent above three standard errors) but periodic at eps = 1e-5,

@@ -17,7 +17,7 @@ VARS = ["u", "u_limit", "lyapunov", "lyapunov_limit", "width_x2", "width_exponen
         "slope_pdm", "period"]
 S_LABEL = r"$s=(\mu-1)/\varepsilon^2$"
 U_LABEL = r"$(x_2-1)/\varepsilon^2$ on $\mathcal{L}_1$"
-COLORS = ["0.6", st.C_PLUS, st.C_SLIDE, st.C_MINUS, "black"]
+COLORS = ["0.6", st.C_PLUS, st.C_SLIDE, "#CC79A7", st.C_MINUS, "black"]
 
 
 def draw(ds):
@@ -27,7 +27,8 @@ def draw(ds):
     j = len(eps) - 1
     fig = st.new_figure(st.TEXT_WIDTH, 4.9)
     axes = fig.subplots(2, 3)
-    picks = [i for i in np.argsort(-th) if th[i] in (0.5, 0.2, 0.1)][:3] or [0, 1, 2][:th.size]
+    # one theta in each band past grazing: period one, period two, chaos
+    picks = [i for i in np.argsort(-th) if th[i] in (0.5, 0.3, 0.2)][:3] or [0, 1, 2][:th.size]
     for k, (ax, i) in enumerate(zip(axes[0], picks)):
         st.orbit_diagram(ax, s[lin], ds.u.values[i, j][lin], color="black")
         st.orbit_diagram(ax, s[lin] + 0.3 * (s[1] - s[0]), ds.u_limit.values[i, j][lin],

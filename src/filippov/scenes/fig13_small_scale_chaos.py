@@ -152,7 +152,7 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
 # What the reproduction report quotes from this scene's dataset (filippov.report calls
 # `report`). This part -- report, REPORT_OPTIONAL and the _report_* / _REPORT_* names --
 # is left out of the code hash of the compute jobs: editing it rebuilds the report only.
-_REPORT_WORD = {0.7: "Seven", 0.5: "Half", 0.4: "Four", 0.2: "Two", 0.1: "One"}
+_REPORT_WORD = {0.7: "Seven", 0.5: "Half", 0.4: "Four", 0.3: "Three", 0.2: "Two", 0.1: "One"}
 
 
 def _report_near(s, ds) -> np.ndarray:
@@ -241,6 +241,8 @@ def report(ds, m: Macros) -> str | None:
                   "derived: median width_exponent_err over 0 < s <= s_max", 2)
             m.add(f"rpThirteenKN{w}", float(np.isfinite(k).sum()),
                   "derived: number of s in 0 < s <= s_max with a width exponent", 2)
+        m.add(f"rpThirteenPeriodTwoShare{w}", float(np.mean(per[near] == 2)),
+              "derived: share of 0 < s <= s_max with period == 2 at the smallest eps", 2)
         m.add(f"rpThirteenPeriodOne{w}", float(np.all(per[near] == 1)),
               "derived: 1 if period == 1 on 0 < s <= s_max at the smallest eps", 1)
     return _report_table(ds)
