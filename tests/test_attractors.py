@@ -176,7 +176,10 @@ def test_a_repeat_with_a_positive_exponent_is_chaos_not_a_period():
     (0.15, 1e-3, 1.0), (0.3, 1e-3, 0.5), (0.2, 1e-3, 0.5),
     # fig12 points whose orbit converges so slowly (multipliers 0.97-0.99 per return)
     # that a fixed transient of 200 returns called them aperiodic and 400 periodic
-    (-0.5, 1e-2, 0.65), (-0.5, 1e-2, 1.425), (-0.5, 1e-2, 3.025), (-0.5, 1e-2, 3.25)])
+    (-0.5, 1e-2, 0.65), (-0.5, 1e-2, 1.425), (-0.5, 1e-2, 3.025), (-0.5, 1e-2, 3.25),
+    # multipliers 0.9967 (period 4) and 0.9988 (period 3) per period, and a best repeat
+    # (5) that is no multiple of the stable period (6): waited for by their contraction
+    (-0.5, 1e-2, 1.4), (-0.5, 1e-2, 3.225), (-0.5, 1e-2, 0.575)])
 def test_doubling_the_transient_does_not_change_the_type(theta, eps, s):
     # points on both sides of type changes in fig12-14 (and the ones the count got wrong)
     a, b = _at(theta, eps, s), _at(theta, eps, s, transient=400)

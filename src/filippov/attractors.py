@@ -400,8 +400,61 @@ def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, kee
             lyap, err = lyapunov_estimate(np.concatenate(jacs), coordinate)
             if lyap > LYAPUNOV_SIGMAS * err:
                 break
+    if not (lyapunov and lyap > LYAPUNOV_SIGMAS * err):
+        # last: a stable cycle next to the returns whose contraction is too slow for the
+        # extensions (multipliers 0.997-0.999 per period at eps = 1e-2 in fig12): iterate
+        # as long as its measured contraction says the transient needs, then judge again
+        wait = _slow_cycle(cmodel, states2, age, coordinate, scale, max_period, t_max,
+                           options)
+        if wait:
+            more = iterate(cmodel, last, transient=wait, keep=keep, t_max=t_max,
+                           start_age=age, **options)
+            if more.status[0] == OK:
+                found, _ = _periodic(cmodel, more.orbit[0], float(more.age[0]), *args,
+                                     last_chance=True, **kw)
+                if found is not None:
+                    return found
     return Attractor(values2, 0, float(values2.max() - values2.min()), lyap, False,
                      states=states2, lyapunov_err=err, unconfirmed=period2)
+
+
+#: the most returns :func:`settle` waits for a slowly contracting cycle (SLOW_CAP x the
+#: period's returns at a multiplier 0.999 leave 1e-4 of the start's distance)
+SLOW_CAP = 20000
+
+
+def _slow_cycle(cmodel, states, age, coordinate, scale, max_period, t_max, options):
+    """Returns to wait for a stable cycle found by Newton within the attractor's scale of
+    the last return -- tried for the periods of the three best repeats and their
+    divisors (the best repeat need not be a multiple of the cycle's period) -- until its
+    measured contraction brings the returns within the period tolerance:
+    d ln(tol/dist)/ln(radius), capped at SLOW_CAP. None: no such cycle."""
+    values = states[:, coordinate]
+    gaps = [np.abs(values[p:] - values[:-p]).max() for p in range(1, max_period + 1)]
+    tol = period_tolerance(scale)
+    tried = set()
+    for p in np.argsort(gaps, kind="stable")[:3] + 1:
+        for d in _divisors(int(p)):
+            if d in tried:
+                continue
+            tried.add(d)
+            found = _cycle_newton(cmodel, states[-1], d, age, t_max, 1e-13, 12, options)
+            if found is None or not np.all(np.isfinite(found[1])):
+                continue
+            z, J = found
+            radius = float(np.max(np.abs(np.linalg.eigvals(J))))
+            if not radius < 1.0:
+                continue
+            pts = iterate(cmodel, z, transient=0, keep=d, t_max=t_max, start_age=age,
+                          **options).orbit[0][:, coordinate]
+            dist = float(np.min(np.abs(pts - values[-1])))
+            if not dist <= scale:
+                continue
+            if dist <= tol:
+                return d
+            need = d * np.log(tol / dist) / np.log(radius) if radius > 0 else d
+            return int(min(np.ceil(need) + d, SLOW_CAP))
+    return None
 
 
 def first_window(periods: np.ndarray, n: int) -> tuple[int, int] | None:
