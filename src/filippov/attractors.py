@@ -310,12 +310,17 @@ def _escape(run, values, window) -> Attractor | None:
     return None
 
 
+def _repeat_gaps(values: np.ndarray, max_period: int) -> np.ndarray:
+    """max |u_{k+p} - u_k| over the kept returns for p = 1 .. max_period."""
+    return np.array([np.abs(values[p:] - values[:-p]).max()
+                     for p in range(1, max_period + 1)])
+
+
 def _best_repeat(values: np.ndarray, max_period: int) -> int:
-    """The p <= max_period with the smallest max |u_{k+p} - u_k| over the kept returns:
-    the period an orbit still converging (too slowly to repeat to any tolerance yet)
-    comes closest to."""
-    gaps = [np.abs(values[p:] - values[:-p]).max() for p in range(1, max_period + 1)]
-    return int(np.argmin(gaps)) + 1
+    """The p <= max_period with the smallest repeat gap (:func:`_repeat_gaps`): the
+    period an orbit still converging (too slowly to repeat to any tolerance yet) comes
+    closest to."""
+    return int(np.argmin(_repeat_gaps(values, max_period))) + 1
 
 
 def _periodic(cmodel, states, age, coordinate, scale, max_period, t_max, options,
@@ -430,7 +435,7 @@ def _slow_cycle(cmodel, states, age, coordinate, scale, max_period, t_max, optio
     measured contraction brings the returns within the period tolerance:
     d ln(tol/dist)/ln(radius), capped at SLOW_CAP. None: no such cycle."""
     values = states[:, coordinate]
-    gaps = [np.abs(values[p:] - values[:-p]).max() for p in range(1, max_period + 1)]
+    gaps = _repeat_gaps(values, max_period)
     tol = period_tolerance(scale)
     tried = set()
     for p in np.argsort(gaps, kind="stable")[:3] + 1:

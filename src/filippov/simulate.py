@@ -509,6 +509,7 @@ class _Run:
         self.preds = [rules.section_pred(sec.direction) for sec in sections]
         self.hits = [0] * len(sections)
         self.recent = deque(maxlen=self.zeno_count)
+        self._flow_field = None  # (mode, f, z) at the end of the last exact window
         self.n_switch = 0
         self.shift = 0.0  # subtracted from H in this stay (rules.exit_shift)
         self.band = 0.0   # the rounding band of the exit the stay began at (rules.exit_band)
@@ -644,8 +645,13 @@ class _Run:
         a closed form that loses its accuracy (cancellation at extreme parameters) is
         refused here, not followed to a wrong answer."""
         za = self.z
-        fa = np.asarray(self.system.field(self.mode, za), dtype=float)
+        # the field at the window's start is the last window's end value: kept, not redone
+        last = self._flow_field
+        fa = (last[1] if last is not None and last[0] == self.mode
+              and np.array_equal(last[2], za)
+              else np.asarray(self.system.field(self.mode, za), dtype=float))
         fb = np.asarray(self.system.field(self.mode, zb), dtype=float)
+        self._flow_field = (self.mode, fb, zb.copy())
         dz = float(np.linalg.norm(zb - za))
         if not rules.flow_consistent(dz, tb - ta, float(np.linalg.norm(fa)),
                                      float(np.linalg.norm(fb)),
