@@ -141,9 +141,12 @@ LOOSE = 1e-2
 #: an exponent counts as positive (chaos) when it exceeds this many standard errors
 LYAPUNOV_SIGMAS = 3.0
 #: a run undecided after its kept returns (no confirmed cycle, no exponent clearly
-#: positive) goes on, at most MAX_EXTENSIONS times, for EXTEND x keep more
+#: positive) goes on, at most MAX_EXTENSIONS times, for EXTEND x keep more. Chaotic
+#: transients before a stable cycle last up to ~1800 returns on fig12's grid (eps = 1e-2,
+#: s = 0.575, 3.05); 12 x 8 x 60 = 5760 returns cover three times that (with 3, a start
+#: and the same start with its transient doubled were typed differently)
 EXTEND = 8
-MAX_EXTENSIONS = 3
+MAX_EXTENSIONS = 12
 #: blocks of the kept returns over which the Lyapunov exponent's standard error is
 #: estimated (batch means: the log-slopes are correlated over a few returns)
 LYAPUNOV_BLOCKS = 5
@@ -265,8 +268,10 @@ def confirm(cmodel: CompiledModel, states: np.ndarray, age: float, candidate: in
     then decides stability, and ``converging`` whether the iterates approach it (their
     distance at the end of the kept returns below that at the start, or below
     ``settled``: on it up to rounding). None: no orbit
-    of a divisor's period near the iterates."""
+    of a divisor's period near the iterates. A stable, approached orbit of a larger
+    divisor wins over an unstable or unapproached one of a smaller (reported if none is)."""
     states = np.asarray(states, dtype=float)
+    first = None
     for d in _divisors(int(candidate)):
         found = _cycle_newton(cmodel, states[-1], d, age, t_max, tol, max_iter, options)
         if found is None:
@@ -284,13 +289,22 @@ def confirm(cmodel: CompiledModel, states: np.ndarray, age: float, candidate: in
         tail = float(gap[-d:].max())
         if not tail <= scale:
             continue
-        head = float(gap[:d].max())
+        # approach measured over two periods at each end: with a multiplier near -1 the
+        # returns alternate sides of the orbit, at distances that differ more between the
+        # sides than they shrink in a period (fig12, eps = 1e-2, s = 3.225: -0.9988)
+        two = min(2 * d, k)
+        head, end = float(gap[:two].max()), float(gap[-two:].max())
         # NaN: P is not differentiable on the orbit (it touches H tangentially)
         radius = (float(np.max(np.abs(np.linalg.eigvals(J)))) if np.all(np.isfinite(J))
                   else np.nan)
         # approaching it, or already on it up to the returns' rounding
-        return Cycle(d, pts, radius, tail, bool(tail <= max(head, settled)))
-    return None
+        cycle = Cycle(d, pts, radius, tail, bool(end <= max(head, settled)))
+        if cycle.converging and cycle.radius < 1.0:
+            return cycle
+        # an unstable orbit of a divisor's period can lie within ``scale`` of the returns
+        # (a saddle the stable cycle winds around): the next divisor may be the attractor
+        first = first or cycle
+    return first
 
 
 def _escape(run, values, window) -> Attractor | None:
