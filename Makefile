@@ -19,6 +19,8 @@
 #   make archive   one tarball of code, results, figures and report, with its sha256
 #                  (CITATION.cff and .zenodo.json in it: ready to deposit for a DOI)
 #   make archive-files  the file list of that tarball
+#   make docs      the documentation site (docs/: getting started, tutorial, examples,
+#                  pipeline guide, API reference) into docs/_build/html; warnings are errors
 #   make help      this list
 #   make lock      re-resolve requirements.lock in a throw-away venv
 #   make clean     remove workflow outputs (keeps .venv)
@@ -43,7 +45,7 @@ ALLOW_NO_TESTS ?=
 # Top-level packages resolved by `make lock` (everything else is transitive).
 LOCK_PKGS = numpy scipy xarray netCDF4 matplotlib "snakemake>=8,<10" \
             pyyaml jsonschema numba threadpoolctl sympy pytest hypothesis pygments snakemake-executor-plugin-slurm \
-            compliance-checker
+            compliance-checker sphinx myst-parser sphinx-gallery
 
 export MPLBACKEND = Agg
 export SOURCE_DATE_EPOCH = 0
@@ -54,7 +56,7 @@ export DEBIAN_FRONTEND = noninteractive
 # `python` inside Snakemake shell rules is the venv's interpreter.
 VENV_PATH = PATH="$(abspath $(VENV))/bin:$$PATH" VIRTUAL_ENV="$(abspath $(VENV))"
 
-.PHONY: all help archive archive-files venv figures test test-deep verify cross-cpu manifest report report-html bench bench-fig04 lock clean distclean check-python
+.PHONY: all help archive archive-files venv figures test test-deep docs verify cross-cpu manifest report report-html bench bench-fig04 lock clean distclean check-python
 
 all: figures
 
@@ -123,6 +125,13 @@ test: $(VENV)/.done
 test-deep: $(VENV)/.done
 	HYPOTHESIS_PROFILE=deep $(VENV_PATH) $(PY) -m pytest tests/test_properties.py $(PYTEST_ARGS)
 
+# The documentation site: the pages in docs/, the API reference from the docstrings, the
+# scripts in examples/ run by sphinx-gallery (a few seconds each). -W --keep-going: every
+# warning is reported, and any fails the build.
+docs: $(VENV)/.done
+	$(VENV_PATH) $(PY) -m sphinx -W --keep-going -q -b html -d docs/_build/doctrees docs docs/_build/html
+	@echo "wrote docs/_build/html/index.html"
+
 verify: $(VENV)/.done
 	$(VENV_PATH) $(PY) workflow/scripts/verify.py
 
@@ -175,6 +184,7 @@ clean:
 	rm -rf results/ .snakemake/ logs/ paper/generated paper/.build.* report.html
 	rm -f figures/*.pdf figures/*.png
 	rm -f paper/main.pdf paper/main.log paper/main.fls paper/main.build.log
+	rm -rf docs/_build docs/generated docs/auto_examples
 
 distclean: clean
 	rm -rf $(VENV)

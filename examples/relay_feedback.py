@@ -1,4 +1,8 @@
-"""Relay feedback: x' = A x - b sign(c^T x), the lag 1/(s+1)^3 under an ideal relay.
+"""
+Relay feedback
+==============
+
+x' = A x - b sign(c^T x): the lag 1/(s+1)^3 under an ideal relay.
 
 The plant (companion form of 1/(s+1)^3, output c^T x = x1) settles on a symmetric
 periodic orbit that crosses c^T x = 0 every half-period h (the relay auto-tuning

@@ -1,12 +1,18 @@
-"""A sliding segment solvable by hand: slide in on H = y = 0, slide off at a fold.
+"""
+A sliding segment
+=================
 
-Above y = 0 the field is F_+ = (2, -1), below it F_- = (1, 1 - x). Along y = 0,
-a = dH.F_- = 1 - x and b = dH.F_+ = -1: sliding attracts for x < 1 and ends at the
-fold x = 1 of F_- (a = 0). Filippov's field (a F_+ - b F_-)/(a - b) is
-x' = (3 - 2x)/(2 - x), y' = 0, so dt = dx (1/2 + 1/(2 (3 - 2x))): from (x0, y0), y0 > 0,
+Solvable by hand: slide in on H = y = 0, slide off at a fold.
+
+Above y = 0 the field is ``F_+ = (2, -1)``, below it ``F_- = (1, 1 - x)``. Along y = 0,
+``a = dH.F_- = 1 - x`` and ``b = dH.F_+ = -1``: sliding attracts for x < 1 and ends at the
+fold x = 1 of ``F_-`` (a = 0). Filippov's field ``(a F_+ - b F_-)/(a - b)`` is
+x' = (3 - 2x)/(2 - x), y' = 0, so dt = dx (1/2 + 1/(2 (3 - 2x))): from (x0, y0), y0 > 0::
+
     slide start  t1 = y0,                                  x1 = x0 + 2 y0  (< 1),
     slide end    t2 = t1 + (1 - x1)/2 + ln(3 - 2 x1)/4,   x = 1,
     afterwards   x = 1 + s, y = -s^2/2,  s = t - t2       (F_- leaves tangentially).
+
 The + and - modes have exact flows here (the sliding mode is always integrated):
 method "exact" uses them, "integrate" integrates every mode with DOP853.
 

@@ -1,9 +1,13 @@
-"""Stick-slip: a block on a spring dragged by a belt, x'' + x = -F sign(x' - v) + d (x' - v).
+"""
+Stick-slip
+==========
+
+A block on a spring dragged by a belt: x'' + x = -F sign(x' - v) + d (x' - v).
 
 Coulomb friction F, weakening with the slip speed (slope d > 0; with d = 0 the slip
 circle through the release point only grazes x' = v: no stick phase, a continuum of
 orbits). Sticking (x' = v) is sliding on H = v - x' = 0: a = x + F > 0 > b = x - F, so
-the block sticks for |x| < F and is released at x = F. Closed form: slipping below
+the block sticks for ``|x| < F`` and is released at x = F. Closed form: slipping below
 belt speed, u = x - x* (x* = F - d v) solves u'' - d u' + u = 0 from u = d v, u' = v:
 u = e^{dt/2} (d v cos wt + C sin wt), x' = e^{dt/2} (v cos wt + K sin wt),
 w = sqrt(1 - d^2/4), C = v (1 - d^2/2)/w, K = d C/2 - w d v. The slip ends at the

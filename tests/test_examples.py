@@ -5,7 +5,7 @@ Tolerances. The orbits are integrated by DOP853 at simulate's default rtol 1e-12
 global error over a period stays within a few rtol (<= 3 rtol on the orbits of
 test_continuation.py, see floquet_multipliers), so a state is trusted to
 TOL = 10 rtol, and an event time to TOL divided by the speed at which the event
-function crosses zero there. Measured errors are 1e-12 or less (README, Examples).
+function crosses zero there. Measured errors are 1e-12 or less (docs: Examples).
 """
 import ast
 import importlib.util

@@ -6,7 +6,7 @@ recorded, all in one compiled call: :func:`filippov.fastmap.compute_returns` wit
 ``iterations``) and the recorded returns are classified:
 
 * ``period``: decided by convergence, not by a count. The smallest p with
-  |u_{k+p} - u_k| <= tol over the kept returns (or, for an orbit still converging, to
+  ``|u_{k+p} - u_k| <= tol`` over the kept returns (or, for an orbit still converging, to
   LOOSE of the scale) is only a candidate; for each divisor d of it, smallest first,
   Newton on P^d(z) - z from the last return with the engine's dP/dz (:func:`confirm`)
   looks for the orbit, whose spectral radius decides stability and which the kept
@@ -66,7 +66,7 @@ class Attractor:
 
 
 def period_of(values: np.ndarray, tol: float, max_period: int) -> int:
-    """Smallest p <= max_period with |u_{k+p} - u_k| <= tol for every kept k (0: none).
+    """Smallest p <= max_period with ``|u_{k+p} - u_k| <= tol`` for every kept k (0: none).
     Needs at least 2 max_period values, so that each candidate is seen to repeat."""
     u = np.asarray(values, dtype=float)
     if u.size < 2 * max_period:
@@ -325,7 +325,7 @@ def _escape(run, values, window) -> Attractor | None:
 
 
 def _repeat_gaps(values: np.ndarray, max_period: int) -> np.ndarray:
-    """max |u_{k+p} - u_k| over the kept returns for p = 1 .. max_period."""
+    """``max |u_{k+p} - u_k|`` over the kept returns for p = 1 .. max_period."""
     return np.array([np.abs(values[p:] - values[:-p]).max()
                      for p in range(1, max_period + 1)])
 

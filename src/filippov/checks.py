@@ -35,10 +35,10 @@ PROBE_RTOL = 1e-8
 
 #: switch_grad check: relative tolerance of the directional derivative. The
 #: central difference (H(z + h d) - H(z - h d)) / 2h has truncation error
-#: h^2/6 |D^3 H| and rounding error ~ eps |H| / h; with h = eps^(1/3) s (s the
+#: ``h^2/6 |D^3 H|`` and rounding error ``~ eps |H| / h``; with h = eps^(1/3) s (s the
 #: size of the state) both are ~1e-11 relative when H varies on the scale s, so
 #: 1e-3 leaves eight orders of margin, while a gradient of the wrong sign is off
-#: by 2 along d = grad/|grad| (and one of another function by O(1)). A switch
+#: by 2 along ``d = grad/|grad|`` (and one of another function by O(1)). A switch
 #: that varies on a scale far below s is met by the smaller steps
 #: GRAD_STEPS: the check fails only if no step agrees.
 GRAD_RTOL = 1e-3

@@ -277,17 +277,19 @@ def floquet_multipliers(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None,
     monodromy matrix (or the orbit) is wrong.
 
     Tolerance, by first-order perturbation theory: an error E in M moves a simple
-    eigenvalue lambda_i by at most kappa_i |E| (kappa_i = 1 / |w_i^H v_i|, unit left
+    eigenvalue lambda_i by at most ``kappa_i |E|`` (``kappa_i = 1 / |w_i^H v_i|``, unit left
     and right eigenvectors; large near a defective eigenvalue, e.g. a second
     multiplier near 1 at a fold, where the check cannot decide and passes).
-    |E| / max(1, |M|) is estimated as the sum of
+    ``|E| / max(1, |M|)`` is estimated as the sum of
+
     * 100 (rtol + atol): the DOP853 global error of the variational equations, seen
       at <= 3 rtol over a period on the orbits of tests/test_continuation.py and the
       stick-slip orbits (rtol 1e-6 .. 1e-12), with a x30 margin;
     * 1e-8 when no ``jacobian`` is given: central differences at step 1e-6 carry a
       rounding error eps/1e-6 ~ 2e-10 relative to the field, seen at <= 3e-9 in M;
-    * |f(z_T) - f(z0)| / |f(z0)|: ``traj`` ends at z_T, not exactly at z0, and M
+    * ``|f(z_T) - f(z0)| / |f(z0)|``: ``traj`` ends at z_T, not exactly at z0, and M
       maps f(z0) to f(z_T), so the trivial multiplier is off by that much.
+
     A missing saltation matrix shifts it by O(1)."""
     M, _ = monodromy(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
     lam, wl, vr = scipy.linalg.eig(M, left=True, right=True)

@@ -133,7 +133,7 @@ def floquet_from_return(J: np.ndarray, f: np.ndarray, *, normal=None,
                         tol: float = 1e-6) -> np.ndarray:
     """Floquet multipliers from dP/dz at a fixed point with the field ``f`` there: the
     flow's 1 first, then the multipliers of the section's chart by decreasing modulus.
-    Refused when |dP/dz f| > tol |dP/dz| |f| (the derivative does not annihilate the
+    Refused when ``|dP/dz f| > tol |dP/dz| |f|`` (the derivative does not annihilate the
     flow), or when ``f`` is (nearly) tangent to the section.
 
     The multipliers are the eigenvalues of dP/dz on the section, never chosen among
@@ -146,7 +146,7 @@ def floquet_from_return(J: np.ndarray, f: np.ndarray, *, normal=None,
     triangular and M ((n-1) x (n-1), the derivative of P in the chart Q) has exactly the
     eigenvalues of dP/dz but the flow's, whatever the small residual d of dP/dz f.
     Without it, Q spans the complement of f, which is exact when dP/dz f = 0 and
-    off by O(|dP/dz f|) otherwise."""
+    off by ``O(|dP/dz f|)`` otherwise."""
     J, f = np.asarray(J, dtype=float), np.asarray(f, dtype=float)
     n = f.size
     scale = max(np.abs(J).max(), 1.0) * np.abs(f).max()
@@ -177,7 +177,7 @@ def floquet_from_return(J: np.ndarray, f: np.ndarray, *, normal=None,
     return out.real if np.all(np.abs(out.imag) <= 1e-12 * np.maximum(1.0, np.abs(out))) else out
 
 
-#: a "return" whose path (return time times the speed |f| at z) is shorter than this,
+#: a "return" whose path (return time times the speed ``|f|`` at z) is shorter than this,
 #: relative to the state's size, is the start itself: z lies on the section up to the
 #: rounding of the flow and the section, and a sign change of that rounding was taken
 #: for a crossing. A genuine orbit travels a length the sampling resolves.
@@ -222,7 +222,7 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
     t_max : float
         Longest time a return may take.
     tol : float
-        Converged when max |P(z) - z| <= tol (1 + max |z|).
+        Converged when ``max |P(z) - z| <= tol (1 + max |z|)``.
     max_iter : int
         Newton steps at most.
     **options

@@ -129,7 +129,7 @@ ULP = float(np.finfo(float).eps)
 U = ULP / 2
 
 #: an O(1) state after located events: two events, each placed to 1e-15 + 4u t
-#: in time at speeds |f| <= 8 pi (the Hopf example), ~1e-13; x10
+#: in time at speeds ``|f| <= 8 pi`` (the Hopf example), ~1e-13; x10
 EVENT_STATE = 1e-12
 
 

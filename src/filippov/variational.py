@@ -35,7 +35,7 @@ class VariationalError(RuntimeError):
 
 def fd_jacobian(fun: Callable[[np.ndarray], np.ndarray], u: np.ndarray,
                 step: float = 1e-7) -> np.ndarray:
-    """Central differences; ``step`` is relative to max(1, |u_i|)."""
+    """Central differences; ``step`` is relative to ``max(1, |u_i|)``."""
     u = np.asarray(u, dtype=float)
     cols = []
     for i in range(u.size):

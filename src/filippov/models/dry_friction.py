@@ -12,13 +12,13 @@ The reduced system (eps = 0) has w = y0(x) = v0 + gamma x2, so h0 = v0 - x2 and
 the slow equations become eq:dfo1 with belt speed v = v0.
 
 Friction law. The caption of fig:dfo-retmap prints
-F_c(nu) = f0 sgn(nu) + fv nu + fc (1 - exp(-|nu|)) sgn(nu) with f0 = -2,
+``F_c(nu) = f0 sgn(nu) + fv nu + fc (1 - exp(-|nu|)) sgn(nu)`` with f0 = -2,
 fv = 0.3, fc = 2.5. Read literally with eq:dfo1 (force -F_c on the block) this
 gives F_c(0+) = -2: friction would push the block along its relative velocity,
 sticking on x2 = v is repelling (eq:atSl fails) and the equilibrium never loses
 stability. The convention adopted here ("stribeck") is the one of the paper's
 commented-out friction curve: F_c acts against the relative velocity with a
-static level |f0| = 2 that decays to -f0 - fc = -0.5 and then grows with fv:
+static level ``|f0| = 2`` that decays to -f0 - fc = -0.5 and then grows with fv::
 
     F_c(nu) = sgn(nu) [-f0 - fc (1 - exp(-|nu|))] + fv nu.
 
@@ -187,7 +187,7 @@ def slow_manifold_plus(x1, x2, eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5,
     runs away like exp(nu)): M_+ is only defined up to terms of order
     exp(-(time since the switch)/eps) anyway, which is what the paper neglects.
 
-    Returns (w, estimate): ``estimate`` = |w(T) - w(1.5 T)|, the change when the
+    Returns (w, estimate): ``estimate`` = ``|w(T) - w(1.5 T)|``, the change when the
     relaxation is lengthened by half (an estimate of the distance to M_+ that
     includes that exponentially small ambiguity).
     """

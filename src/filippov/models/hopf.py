@@ -1,6 +1,6 @@
 """The minimal grazing-sliding example (eq:red; eq:exslow2, eq:exfast2).
 
-Slow state x = (x1, x2), fast state y:
+Slow state x = (x1, x2), fast state y::
 
     x' = f_+(x) = (mu x1 - omega x2 - r^2 x1, omega x1 + mu x2 - r^2 x2)   if h >= 0
     x' = f_-    = (1, 0)                                                  if h < 0
@@ -15,9 +15,9 @@ integration in the tests:
 * region +: in polar coordinates r' = mu r - r^3, phi' = omega, so
   r(t)^2 = mu r0^2 / (r0^2 + (mu - r0^2) exp(-2 mu t)); and since g = eps x1' + x1 - y,
   (y - x1)' = -(y - x1)/eps, i.e. y - x1 decays exactly like exp(-t/eps);
-  M_+ = {y = x1} is invariant.
+  ``M_+ = {y = x1}`` is invariant.
 * region -: x1 = x1(0) + t, x2 constant, and y' = -y/eps + p(x1(t)) with p a cubic,
-  whose polynomial solution is the slow manifold M_- (exactly, not only to O(eps)):
+  whose polynomial solution is the slow manifold ``M_-`` (exactly, not only to O(eps))::
 
       y_m-(x) = x1 + eps [mu x1 - omega x2 - r^2 x1 - 1] - eps^2 [mu - 3 x1^2 - x2^2]
                 - 6 eps^3 x1 + 6 eps^4,
@@ -47,7 +47,7 @@ x1, x2, y, eps, theta, mu, omega, t = sp.symbols("x1 x2 y eps theta mu omega t")
 _r2 = x1 ** 2 + x2 ** 2
 #: f_+ = the Hopf normal form (x1', x2')
 HOPF_FIELD = (mu * x1 - omega * x2 - _r2 * x1, omega * x1 + mu * x2 - _r2 * x2)
-#: y on M_-, the exact slow invariant manifold of region - (a cubic in x1)
+#: y on ``M_-``, the exact slow invariant manifold of region - (a cubic in x1)
 SLOW_MANIFOLD_MINUS = (x1 + eps * (mu * x1 - omega * x2 - _r2 * x1 - 1)
                        - eps ** 2 * (mu - 3 * x1 ** 2 - x2 ** 2) - 6 * eps ** 3 * x1
                        + 6 * eps ** 4)
@@ -103,7 +103,7 @@ def check_parameters(eps: float, theta: float, mu: float, omega: float) -> None:
 hopf_rhs = sp.lambdify((x1, x2, mu, omega), HOPF_FIELD, "numpy")
 hopf_rhs.__doc__ = "(x1', x2') of the Hopf normal form (f_+), elementwise."
 slow_manifold_minus = sp.lambdify((x1, x2, eps, mu, omega), SLOW_MANIFOLD_MINUS, "numpy")
-slow_manifold_minus.__doc__ = "y on M_-, the exact slow invariant manifold of region -."
+slow_manifold_minus.__doc__ = "y on ``M_-``, the exact slow invariant manifold of region -."
 _polar = sp.lambdify((x1, x2, t, mu, omega), _polar_flow_exprs(), "numpy")
 
 
