@@ -15,7 +15,7 @@ flow's eigenvalue by its eigenvector reported [1, ~1e-10, 0] here.
 The other tests are each a broken system that an engine ran without a word, or
 refused with the wrong words: a field with too few values, a switching gradient of the
 wrong sign, a NaN from a field, Jacobians given for the two fields only, a piece numba
-cannot compile.
+cannot compile, an exact flow that does not follow its own field.
 """
 import numpy as np
 import pytest
@@ -23,8 +23,9 @@ from numba import njit
 
 from filippov import (FilippovSystem, PeriodicOrbitError, SimulationError,
                       SystemContractError, periodic_orbit, simulate)
-from filippov.fastmap import NON_FINITE, compute_returns, first_returns_compiled
-from filippov.system import MINUS
+from filippov.fastmap import (FLOW_OFF_FIELD, NON_FINITE, compute_returns, failure,
+                              first_returns_compiled)
+from filippov.system import MINUS, MODE_NAMES
 
 ZETA, V, K = -0.05, 0.5, 1.0
 ENGINES = ("compiled", "python")
@@ -198,3 +199,79 @@ def test_a_piece_numba_cannot_compile_is_explained_on_both_engines():
         system.python()
     with pytest.raises(ValueError, match="field_minus: numba cannot compile it"):
         system.compiled(_section)
+
+
+# An exact flow that does not follow its own field (rules.flow_consistent): a planar
+# system that crosses y = 0 upwards, fast below (speed sqrt 2) and 1e4 times slower above,
+#     minus (y < 0): (x, y)' = (1, 1),     plus (y >= 0): (x, y)' = SLOW (1, 1),
+# with the section x = 0.51 crossed upwards. From (0, -0.5) the orbit switches at
+# t = 0.5, (0.5, 0) and returns at t = 0.5 + 0.01 / SLOW = 100.5, (0.51, 0.01).
+SLOW = 1e-4
+
+
+def _drift(rate):
+    return lambda z0, tau, p: np.array([z0[0] + rate * tau, z0[1] + rate * tau])
+
+
+def _planar(flow_minus, flow_plus):
+    return FilippovSystem(("x", "y"), lambda z, p: np.array([1.0, 1.0]),
+                          lambda z, p: np.array([SLOW, SLOW]), lambda z, p: z[1],
+                          lambda z, p: np.array([0.0, 1.0]), flow_minus=flow_minus,
+                          flow_plus=flow_plus, sample_step=0.05, name="planar")
+
+
+def _planar_section(z, p):
+    return z[0] - 0.51
+
+
+def _planar_return(system, engine):
+    """(state, time) of the first return from (0, -0.5) on ``engine``."""
+    if engine == "compiled":
+        cm = system.compiled(_planar_section, direction=+1)
+        r = first_returns_compiled(cm, [[0.0, -0.5]], 200.0)
+        return r.state[0], float(r.time[0])
+    sec = system.python_section(_planar_section, direction=+1)
+    traj = simulate(system.python(), [0.0, -0.5], 200.0, sections=[sec], dense=False)
+    assert traj.status == f"section:{sec.name}"
+    return np.asarray(traj.z), float(traj.t)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_exact_flows_that_follow_their_fields_return_where_the_closed_form_says(engine):
+    z, t = _planar_return(_planar(_drift(1.0), _drift(SLOW)), engine)
+    np.testing.assert_allclose(z, [0.51, 0.01], rtol=0, atol=1e-12)
+    assert t == pytest.approx(100.5, rel=1e-12)
+
+
+# the wrong flows, each 1e4 times its field's speed: beyond the rule's factor 100 by 100
+WRONG_FLOWS = {
+    # region +'s flow written with region -'s: ran to x = 0.51 at t = 0.51 on the
+    # compiled engine without a word
+    "plus given the flow of minus": ("plus", _drift(1.0), _drift(1.0)),
+    # region -'s flow with time in the wrong unit (1e4 too fast)
+    "minus at the wrong rate": ("minus", _drift(1.0 / SLOW), _drift(SLOW)),
+}
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("case", WRONG_FLOWS)
+def test_an_exact_flow_off_its_field_is_refused(engine, case):
+    mode, flow_minus, flow_plus = WRONG_FLOWS[case]
+    with pytest.raises(SimulationError, match=rf"exact flow of mode {mode}\b.*does not follow"):
+        _planar_return(_planar(flow_minus, flow_plus), engine)
+
+
+@pytest.mark.parametrize("case", WRONG_FLOWS)
+def test_the_compiled_engine_names_where_the_flow_left_its_field(case):
+    mode, flow_minus, flow_plus = WRONG_FLOWS[case]
+    cm = _planar(flow_minus, flow_plus).compiled(_planar_section, direction=+1)
+    out = compute_returns(cm, [[0.0, -0.5]], 200.0)
+    assert out.status[0] == FLOW_OFF_FIELD and MODE_NAMES[int(out.mode[0])] == mode
+    # refused in the first window of the wrong mode: its entry (the switch at t = 0.5 onto
+    # (0.5, 0)) or the start
+    want_t, want_z = (0.5, [0.5, 0.0]) if mode == "plus" else (0.0, [0.0, -0.5])
+    assert out.time[0] == pytest.approx(want_t, abs=1e-12)
+    np.testing.assert_allclose(out.state[0], want_z, rtol=0, atol=1e-12)
+    msg = failure(cm, out, 0)
+    assert f"t={float(out.time[0])!r}" in msg and f"mode {mode}" in msg
+    assert f"flow_{mode}, does not follow its field field_{mode}" in msg

@@ -35,9 +35,10 @@ same algorithm for a whole batch of start points inside one compiled call:
 
 Failures never raise inside the compiled code and never hang: each start point
 gets a status code (:data:`STATUS`) -- event or step bound hit, accumulation of
-switches (Zeno), non-finite state, no return within ``t_max``, ...; the wrapper
-:func:`first_returns_compiled` turns a failure into the same exception types as
-the reference driver.
+switches (Zeno), non-finite state, an exact flow that does not follow its field
+(``rules.flow_consistent``, as the reference driver), no return within ``t_max``,
+...; the wrapper :func:`first_returns_compiled` turns a failure into the same
+exception types as the reference driver.
 
 The kernel itself lives in :mod:`filippov.kernel`, split along its seams (shared
 codes and rules, DOP853, segments, root finding, event scan, dP/dz, driver loop);
@@ -65,8 +66,8 @@ from . import rules
 from .abi import (FIELD_SIG, FLOW_SIG, PIECES, SCALAR_SIG, WHERE_SIG,  # noqa: F401
                   CompiledModel, no_flow, no_jacobian)
 # the kernel (filippov.kernel) and its status codes, re-exported here
-from .kernel.base import (BAD_START, EVENT_LIMIT, NO_RETURN, NO_SLIDING,  # noqa: F401
-                          NON_FINITE, OK, ROOT_FAILED, SECTION_SLIDING, STATUS, STEP_FAILED,
+from .kernel.base import (BAD_START, EVENT_LIMIT, FLOW_OFF_FIELD, NO_RETURN,  # noqa: F401
+                          NO_SLIDING, NON_FINITE, OK, ROOT_FAILED, SECTION_SLIDING, STATUS, STEP_FAILED,
                           STEP_LIMIT, ZENO)
 from .kernel.driver import (KERNEL_SOURCES, Outputs, Settings,  # noqa: F401
                             compile_kernel, kernel)
@@ -282,6 +283,8 @@ def failure(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:
     where = f"{STATUS[code]} at t={float(out.time[i])!r}, state {z.tolist()}"
     if mode is not None:
         where += f", mode {MODE_NAMES.get(mode, mode)}"
+    if code == FLOW_OFF_FIELD and mode in (MINUS, PLUS):
+        return where + _flow_off_field(cmodel, mode, z)
     if code != NON_FINITE:
         return where
     if cmodel.exact and mode in (MINUS, PLUS):  # exact flows are sampled, not integrated
@@ -291,6 +294,27 @@ def failure(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:
         return where + " (the state itself)"
     return where + f" ({non_finite_piece(_Pieces(cmodel), mode, z)} returned a non-finite " \
                    f"value there)"
+
+
+def _flow_off_field(cmodel: CompiledModel, mode: int, z) -> str:
+    """Why the exact flow of ``mode`` was refused at ``z`` (the state at the start of the
+    window the kernel checked, rules.flow_consistent), with its move over one sample
+    step from z next to its field's speed there as evidence."""
+    name = MODE_NAMES[mode]
+    flow, field = ((cmodel.flow_plus, cmodel.field_plus) if mode == PLUS
+                   else (cmodel.flow_minus, cmodel.field_minus))
+    z = np.ascontiguousarray(z, dtype=float)
+    moved, speed = np.full(cmodel.dim, np.nan), np.full(cmodel.dim, np.nan)
+    flow(z, cmodel.sample_step, cmodel.params, moved)
+    field(z, cmodel.params, speed)
+    return (f" (the exact flow of mode {name}, flow_{name}, does not follow its field "
+            f"field_{name} there: over the window from that state it moved the state "
+            f"farther than {rules.FLOW_SPEED_FACTOR:g} times the window times the field's "
+            f"speed at the window's ends (rules.flow_consistent); over one sample step "
+            f"({cmodel.sample_step:g}) from there it moves it by "
+            f"{np.linalg.norm(moved - z):.3g}, the field's speed there being "
+            f"{np.linalg.norm(speed):.3g}; use integrated flows (method='integrate') or "
+            f"check the flow's formula)")
 
 
 _ERRORS = {EVENT_LIMIT: EventLimitError, STEP_LIMIT: EventLimitError, ZENO: ZenoError,

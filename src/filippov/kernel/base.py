@@ -29,6 +29,7 @@ STEP_FAILED = 7    # the sliding integrator's step size collapsed
 ROOT_FAILED = 8    # an event could not be bracketed / refined
 BAD_START = 9      # non-finite start point
 SECTION_SLIDING = 10  # the orbit slides inside the section (a section on H)
+FLOW_OFF_FIELD = 11  # an exact flow moved the state farther than its field allows
 
 STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event limit",
           STEP_LIMIT: "step limit", ZENO: "accumulation of switches (Zeno)",
@@ -38,7 +39,8 @@ STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event lim
           ROOT_FAILED: "event refinement failed (no bracket or no convergence)",
           BAD_START: "non-finite start point",
           SECTION_SLIDING: "the orbit slides along H inside the section (a section on the "
-                           "switching surface): its crossings there would be rounding noise"}
+                           "switching surface): its crossings there would be rounding noise",
+          FLOW_OFF_FIELD: "the exact flow does not follow its field"}
 
 # crossing predicates (filippov.rules)
 # (codes handed to compiled helpers are numpy integers, not Python ints: numba types a
@@ -81,14 +83,14 @@ _jit_inline = njit(cache=True, _nrt=False, inline="always")
  _slides_in_section, _starts_on_section, _same_instant, _start_side, _start_on_switch,
  _next_mode, _accumulates, _exit_shift, _dips_and_returns, _exact_window, _onto_switch,
  _exit_drift, _carried_age, _far_side_probe, _exit_band, _banded_shift, _clears_band,
- _band_probe, _speed_extremum_between, _speed_graze, _rate_step) = (
+ _band_probe, _speed_extremum_between, _speed_graze, _rate_step, _flow_consistent) = (
     _jit_rule(getattr(rules, name)) for name in (
     "after", "crosses", "clamp", "far_side", "extremum_between", "graze", "central_step",
     "slides_in_section", "starts_on_section", "same_instant", "start_side", "start_on_switch",
     "next_mode", "accumulates", "exit_shift", "dips_and_returns", "exact_window",
     "onto_switch", "exit_drift", "carried_age", "far_side_probe", "exit_band",
     "banded_shift", "clears_band", "band_probe", "speed_extremum_between", "speed_graze",
-    "rate_step"))
+    "rate_step", "flow_consistent"))
 assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 
 

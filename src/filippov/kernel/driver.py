@@ -20,7 +20,7 @@ from numba import njit, types
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from ..system import PLUS, SLIDING
-from .base import (BAD_START, EVENT_LIMIT, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
+from .base import (BAD_START, EVENT_LIMIT, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
                    SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO, _PIECE_TYPES, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
                    _banded_shift, _clears_band, _exit_band, _exit_drift, _exit_shift,
                    _flow_minus, _flow_plus, _jit, _jit_inline, _next_mode, _onto_switch,
@@ -29,7 +29,7 @@ from .base import (BAD_START, EVENT_LIMIT, NON_FINITE, NO_RETURN, NO_SLIDING, OK
 from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
                      _dop_step, _non_finite_stage)
 from .segment import _zat
-from .scan import (_find, _sample)
+from .scan import (_find, _flow_follows, _sample)
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
 
@@ -123,9 +123,16 @@ def _window(mode, ta, tb, frac, first, fns, p, s, w):
     (_GO_ON, tb, _W_NONE) if there is none (the state at tb in w.z), (OK, te, what)
     at an event (its state in w.z), NO_RETURN at t_max, or an error (status, ta)."""
     ns = frac.size
-    if not _sample(mode, ta, tb, frac, ns, w.sg, w.za, w.F, w.y_old, fns, p, w.ts, w.vals,
-                   w.dvals, w.svals, w.wz, w.wg, w.wf, w.wp, w.ynew):
+    ok, speed2_a = _sample(mode, ta, tb, frac, ns, w.sg, w.za, w.F, w.y_old, fns, p, w.ts,
+                           w.vals, w.dvals, w.svals, w.wz, w.wg, w.wf, w.wp, w.ynew)
+    if not ok:
         return NON_FINITE, ta, _W_NONE
+    # an exact flow (sg[3] == 0) must follow its field over the window: from the state at
+    # ta (w.z) to that at tb (w.ynew), the field at tb left in w.wf by the last sample;
+    # else the run stops at ta (w.z)
+    if mode != SLIDING and w.sg[3] == 0.0 and not _flow_follows(w.z, w.ynew, tb - ta,
+                                                                 speed2_a, w.wf):
+        return FLOW_OFF_FIELD, ta, _W_NONE
     st, te, what = _find(mode, w.ts, ns, first, s.sec_pred, s.touch_tol, s.xtol, s.min_time,
                          w.sg, w.za, w.F, w.y_old, fns, p, w.vals, w.dvals, w.svals, w.wz,
                          w.wg, w.wf, w.touched)

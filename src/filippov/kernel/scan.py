@@ -9,7 +9,7 @@ from ..system import MINUS, PLUS, SLIDING
 from .base import (OK, ROOT_FAILED, _EPS, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB, _S_H, _S_SEC, _TO_NEG, _TO_NONNEG,
                    _TO_NONPOS, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_NONE, _W_SECTION, _W_SWITCH,
                    _after, _band_probe, _clamp, _clears_band, _crosses, _dips_and_returns, _dot, _extremum_between,
-                   _graze, _jit, _rate_step, _same_instant, _speed_extremum_between, _speed_graze,
+                   _flow_consistent, _graze, _jit, _rate_step, _same_instant, _speed_extremum_between, _speed_graze,
                    _speeds, _starts_on_section, _field_minus,
                    _field_plus, _grad_h, _h, _section, _where)
 from .segment import (_fval, _rates, _zat)
@@ -21,14 +21,16 @@ def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, s
             wz, wg, wf, wp, zlast):
     """Samples of one window: times ts, the leave functions (h, or a and b when
     sliding), their rates (dh/dt; the rates of a and b along the orbit while sliding,
-    rules.rate_step: sg[7]) and the section; the last state in zlast. False: non-finite."""
+    rules.rate_step: sg[7]) and the section; the last state in zlast. (False: non-finite,
+    |f|^2 at the first sample outside sliding -- the state at ta -- for _flow_follows)."""
+    speed2_a = 0.0
     for k in range(ns):
         tk = ta + frac[k] * (tb - ta) if k < ns - 1 else tb
         ts[k] = tk
         _zat(tk, mode, sg, za, F, y_old, fns, p, wz)
         for c in range(wz.size):
             if not np.isfinite(wz[c]):
-                return False
+                return False, speed2_a
         svals[k] = _section(fns, wz, p)
         if k == ns - 1:
             for c in range(wz.size):
@@ -51,7 +53,21 @@ def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, s
             else:
                 _field_minus(fns, wz, p, wf)
             dvals[0, k] = _dot(wg, wf)
-    return True
+            if k == 0:
+                speed2_a = _dot(wf, wf)
+    return True, speed2_a
+
+
+@_jit
+def _flow_follows(za, zb, dt, speed2_a, fb):
+    """rules.flow_consistent for an exact flow's window of length dt from za to zb, the
+    field's |f|^2 at ta and f at zb given (the values _sample evaluated for dh/dt): as
+    simulate._Run._check_flow, from the same field values, no evaluation of its own."""
+    d2, size = 0.0, 0.0
+    for c in range(za.size):
+        d2 += (zb[c] - za[c]) * (zb[c] - za[c])
+        size = max(size, abs(za[c]), abs(zb[c]))
+    return _flow_consistent(np.sqrt(d2), dt, np.sqrt(speed2_a), np.sqrt(_dot(fb, fb)), size)
 
 
 @_jit
