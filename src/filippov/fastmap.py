@@ -61,7 +61,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import rules
+from . import options, rules
 # what a model hands the engine (its pieces' signatures, CompiledModel), re-exported here
 from .abi import (FIELD_SIG, FLOW_SIG, PIECES, SCALAR_SIG, WHERE_SIG,  # noqa: F401
                   CompiledModel, no_flow, no_jacobian)
@@ -147,17 +147,11 @@ def _pieces(cmodel: CompiledModel) -> tuple:
     return tuple(pieces)
 
 
-def _check_options(cmodel, t_max, samples_per_step, max_step, zeno_count, iterations, keep,
-                   min_time) -> None:
-    """compute_returns' options, each refused with its name where out of range."""
+def _check_options(cmodel, t_max, iterations, keep, min_time) -> None:
+    """compute_returns' own options (the shared ones: filippov.options), each refused
+    with its name where out of range."""
     if not (np.isfinite(t_max) and t_max >= 0):
         raise ValueError(f"need a finite t_max >= 0, got {t_max!r}")
-    if samples_per_step < 1:
-        raise ValueError("samples_per_step must be >= 1")
-    if not max_step > 0:
-        raise ValueError(f"max_step must be > 0, got {max_step!r}")
-    if zeno_count < 1:
-        raise ValueError("zeno_count must be >= 1")
     if not (isinstance(iterations, (int, np.integer)) and iterations >= 1):
         raise ValueError(f"iterations must be an integer >= 1, got {iterations!r}")
     if not (isinstance(keep, (int, np.integer)) and 0 <= keep <= iterations):
@@ -213,8 +207,10 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     pieces = _pieces(cmodel)
     if starts.shape[0]:
         check_compiled(cmodel, starts[0])  # the reference driver's start check, once a model
-    _check_options(cmodel, t_max, samples_per_step, max_step, zeno_count, iterations, keep,
-                   min_time)
+    options.check(rtol=rtol, atol=atol, max_step=max_step, max_events=max_events,
+                  max_steps=max_steps, samples_per_step=samples_per_step, touch_tol=touch_tol,
+                  event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span)
+    _check_options(cmodel, t_max, iterations, keep, min_time)
     hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max) if cmodel.exact else np.inf
     hwin_slow = slow_window(cmodel.slow_sample_step, hwin, max_step, t_max)
     # an exact flow: one sample per sample step (the model's declared resolution);

@@ -30,7 +30,7 @@ import numpy as np
 from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
-from . import checks, rules, variational
+from . import checks, options, rules, variational
 from .radau_iia import RadauIIA
 from .system import MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 
@@ -411,37 +411,6 @@ def slow_window(slow_sample_step, h, max_step, span):
     return max(h, min(EXACT_BLOCK * slow_sample_step, max_step, span))
 
 
-def _check_options(**opts) -> None:
-    """Every option of :func:`simulate` where it enters: a bad value is named."""
-    def number(name, low, strict, allow_inf=False):
-        v = opts[name]
-        ok = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool) \
-            and not np.isnan(v) and (allow_inf or np.isfinite(v)) \
-            and (v > low if strict else v >= low)
-        if not ok:
-            bound = f"> {low}" if strict else f">= {low}"
-            raise ValueError(f"{name} must be a {'' if allow_inf else 'finite '}number "
-                             f"{bound}, got {v!r}")
-
-    def integer(name, low):
-        v = opts[name]
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < low:
-            raise ValueError(f"{name} must be an integer >= {low}, got {v!r}")
-
-    number("rtol", 0.0, True)
-    number("atol", 0.0, True)
-    number("max_step", 0.0, True, allow_inf=True)
-    number("touch_tol", 0.0, False)
-    number("event_xtol", 0.0, True)
-    number("zeno_span", 0.0, False)
-    integer("max_events", 1)
-    integer("max_steps", 1)
-    integer("samples_per_step", 1)
-    integer("zeno_count", 2)
-    if not isinstance(opts["stiff"], (bool, np.bool_)):
-        raise ValueError(f"stiff must be True or False, got {opts['stiff']!r}")
-
-
 @_quiet_floating_point
 def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
              method: str = "exact", rtol: float = 1e-12, atol: float = 1e-14,
@@ -474,10 +443,10 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
         raise ValueError(f"initial state must be finite, got {z.tolist()}")
     if not (np.isfinite(t0) and np.isfinite(t_end) and t_end >= t0):
         raise ValueError(f"need finite t0 <= t_end, got t0={t0!r}, t_end={t_end!r}")
-    _check_options(rtol=rtol, atol=atol, max_step=max_step, max_events=max_events,
-                   max_steps=max_steps, samples_per_step=samples_per_step,
-                   touch_tol=touch_tol, event_xtol=event_xtol, zeno_count=zeno_count,
-                   zeno_span=zeno_span, stiff=stiff)
+    options.check(rtol=rtol, atol=atol, max_step=max_step, max_events=max_events,
+                  max_steps=max_steps, samples_per_step=samples_per_step,
+                  touch_tol=touch_tol, event_xtol=event_xtol, zeno_count=zeno_count,
+                  zeno_span=zeno_span, stiff=stiff)
     for k, sec in enumerate(sections):
         if not isinstance(sec, Section):
             raise TypeError(f"sections[{k}]: expected a filippov.simulate.Section, got "

@@ -1,0 +1,53 @@
+"""The solver options both engines take, checked once, by one rule each.
+
+:func:`filippov.simulate.simulate` and :func:`filippov.fastmap.compute_returns` share
+their tolerances and limits; before this module each checked them on its own and the two
+disagreed (``zeno_count >= 2`` on one side, ``>= 1`` on the other; ``rtol``, ``atol``,
+``touch_tol``, ``event_xtol``, ``zeno_span``, ``max_events`` and ``max_steps`` checked
+by the reference driver only). A bad value is refused with its name and the bound.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+#: (lower bound, strict, infinity allowed) of each real option
+NUMBERS = {
+    "rtol": (0.0, True, False),
+    "atol": (0.0, True, False),
+    "max_step": (0.0, True, True),
+    "touch_tol": (0.0, False, False),
+    "event_xtol": (0.0, True, False),
+    "zeno_span": (0.0, False, False),
+}
+#: the least value of each integer option; zeno_count: the Zeno ring compares the
+#: newest switch with the zeno_count-th before it, so one switch is no accumulation
+INTEGERS = {
+    "max_events": 1,
+    "max_steps": 1,
+    "samples_per_step": 1,
+    "zeno_count": 2,
+}
+
+
+def check(**opts) -> None:
+    """Refuse any of ``opts`` (the names above, and ``stiff``) out of range, naming it."""
+    for name, v in opts.items():
+        if name in NUMBERS:
+            low, strict, allow_inf = NUMBERS[name]
+            ok = (isinstance(v, (int, float, np.integer, np.floating))
+                  and not isinstance(v, (bool, np.bool_)) and not np.isnan(v)
+                  and (allow_inf or np.isfinite(v)) and (v > low if strict else v >= low))
+            if not ok:
+                bound = f"> {low}" if strict else f">= {low}"
+                raise ValueError(f"{name} must be a {'' if allow_inf else 'finite '}number "
+                                 f"{bound}, got {v!r}")
+        elif name in INTEGERS:
+            low = INTEGERS[name]
+            if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) \
+                    or v < low:
+                raise ValueError(f"{name} must be an integer >= {low}, got {v!r}")
+        elif name == "stiff":
+            if not isinstance(v, (bool, np.bool_)):
+                raise ValueError(f"stiff must be True or False, got {v!r}")
+        else:
+            raise TypeError(f"unknown solver option {name!r}")
