@@ -130,3 +130,13 @@ def test_fig01_fields_are_math_not_code():
                                                                    else "$h(x)")
     text = (ROOT / "paper" / "sec_figures.tex").read_text()
     assert r"\rpOneSwitching" in text and r"\rpOneFieldsCross" in text
+
+
+def test_the_extension_budget_in_the_text_is_the_code_s():
+    # sec_instabilities says in words how far an undecided run is extended
+    from filippov import attractors
+
+    words = {8: "eight", 12: "twelve"}
+    text = " ".join((ROOT / "paper" / "sec_instabilities.tex").read_text().split())
+    assert f"goes on for {words[attractors.EXTEND]} times as many returns" in text
+    assert f"up to {words[attractors.MAX_EXTENSIONS]} times" in text
