@@ -24,7 +24,8 @@
 #   make help      this list
 #   make lock      re-resolve requirements.lock in a throw-away venv
 #   make clean     remove workflow outputs (keeps .venv)
-#   make bench        work-precision sweep and cost of each model ingredient
+#   make bench        work-precision sweep, cost of each model ingredient, scaling
+#                     of a batch of returns with its threads
 #                     (results/bench_*.nc, figures/bench_work_precision.pdf)
 #   make bench-fig04  time the fig04 return maps against scipy solve_ivp
 #

@@ -108,3 +108,18 @@ def test_compile_cost_times_a_cold_and_a_warm_process():
         assert cold > 10 * warm > 0, stage
     # (run() raises if returns without dP/dz compiled any of the dP/dz code)
     assert ds.cold.attrs["units"] == "s" and any(line.startswith("kernel") for line in lines)
+
+
+def test_parallel_scaling_table(monkeypatch):
+    # a small batch with 1..N workers: the table has a row per worker count, the results
+    # were checked equal across them (run raises otherwise), and the CPU times are there
+    from filippov.benchmarks import parallel_scaling as ps
+    monkeypatch.setattr(ps, "MIN_TIME", 0.0)
+    monkeypatch.setattr(ps, "cores", lambda: 2)
+    lines = []
+    ds = ps.run(starts=40, returns=2, repeat=1, log=lines.append)
+    assert list(ds.workers.values) == [1, 2]
+    assert ds.returns_per_second.shape == (len(ps.CASES), 2)
+    assert np.all(ds.returns_per_second.values > 0)
+    assert np.all(ds.span.values <= ds.cpu_time.values * 1.05)  # one thread's share
+    assert "load average" in lines[0] and ds.attrs["load_average_before"] >= 0

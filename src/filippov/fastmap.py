@@ -57,6 +57,8 @@ recorded (they change nothing in a return).
 """
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -163,12 +165,85 @@ def _check_options(cmodel, t_max, iterations, keep, min_time) -> None:
                          f"got {cmodel.sample_step!r}")
 
 
+#: the environment variable that caps the default number of workers (the workflow's
+#: scripts set it to their rule's ``threads:``, so that jobs side by side do not
+#: oversubscribe the cores)
+WORKERS_ENV = "FILIPPOV_WORKERS"
+#: returns (starts x iterations) a slice of a batch must hold at least: each call of the
+#: kernel costs ~0.3 ms of Python (numba unboxing the model's nine first-class functions,
+#: GIL held), the work of ~20-30 returns of the Hopf example; 256 keep that under ~10%
+MIN_RETURNS_PER_SLICE = 256
+#: slices per worker: starts differ in cost (a sliding return, a failure), so a large
+#: batch is cut finer than one slice per thread and a thread takes the next slice when done
+SLICES_PER_WORKER = 4
+
+
+def default_workers() -> int:
+    """Threads a batch may use when ``workers`` is not given: ``FILIPPOV_WORKERS`` if set
+    (an integer >= 1), else the cores this process may run on."""
+    value = os.environ.get(WORKERS_ENV, "").strip()
+    if value:
+        try:
+            n = int(value)
+        except ValueError:
+            n = 0
+        if n < 1:
+            raise ValueError(f"{WORKERS_ENV} must be an integer >= 1, got {value!r}")
+        return n
+    try:
+        return len(os.sched_getaffinity(0))  # what a cgroup, taskset or SLURM allows
+    except AttributeError:  # not on every platform
+        return os.cpu_count() or 1
+
+
+def _checked_workers(workers) -> int:
+    if workers is None:
+        return default_workers()
+    if not (isinstance(workers, (int, np.integer)) and not isinstance(workers, bool)
+            and workers >= 1):
+        raise ValueError(f"workers must be an integer >= 1 or None (the default: "
+                         f"{WORKERS_ENV} or the cores available), got {workers!r}")
+    return int(workers)
+
+
+def _slices(m: int, iterations: int, workers: int) -> list:
+    """Contiguous [lo, hi) slices of a batch of m starts, iterated ``iterations`` times,
+    for ``workers`` threads: up to SLICES_PER_WORKER a worker, each of at least
+    MIN_RETURNS_PER_SLICE returns and 2 starts (one slice: the calling thread runs it)."""
+    count = min(workers * SLICES_PER_WORKER, m * iterations // MIN_RETURNS_PER_SLICE, m // 2)
+    if workers <= 1 or count <= 1:
+        return [(0, m)]
+    bounds = np.linspace(0, m, count + 1).round().astype(int)
+    return [(int(lo), int(hi)) for lo, hi in zip(bounds[:-1], bounds[1:])]
+
+
+def _run_batch(batch, pieces, params, starts, ages, settings, out, workers: int) -> None:
+    """The kernel over the whole batch, cut into contiguous slices run on ``workers``
+    threads (the kernel releases the GIL). Each start is computed by the same compiled
+    code from its own row whichever slice holds it, so the outputs do not depend on
+    ``workers``, bit for bit (tests/test_parallel.py)."""
+    slices = _slices(starts.shape[0], settings.iterations, workers)
+    if len(slices) == 1:
+        batch(*pieces, params, starts, ages, settings, out)
+        return
+
+    def run(lo_hi):  # views of the rows lo:hi: C-contiguous, as the kernel's signature
+        lo, hi = lo_hi
+        batch(*pieces, params, starts[lo:hi], ages[lo:hi], settings,
+              Outputs(*(a[lo:hi] for a in out)))
+
+    with ThreadPoolExecutor(max_workers=min(workers, len(slices))) as pool:
+        for _ in pool.map(run, slices):
+            pass  # the kernel raises nothing itself; map re-raises what a thread did
+
+
 def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float = 1e-12,
                     atol: float = 1e-14, max_step: float = np.inf, max_events: int = 100_000,
                     max_steps: int = 5_000_000, samples_per_step: int = 4,
                     touch_tol: float = 1e-15, event_xtol: float = 1e-15, zeno_count: int = 64,
                     zeno_span: float = 1e-10, min_time: float = 0.0, iterations: int = 1,
-                    keep: int = 0, jacobian: bool = False, start_age=0.0) -> BatchReturns:
+                    keep: int = 0, jacobian: bool = False, start_age=0.0,
+                    workers: int | None = None) -> BatchReturns:
     """First returns of ``starts`` (``(m, dim)``) to the model's section, one compiled call.
 
     Options mean what they mean for :func:`filippov.simulate.simulate`, except that
@@ -202,7 +277,15 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     ``filippov.benchmarks.attractor_cost``). NaN where P is not
     differentiable: a switch or section met tangentially, an orbit that touches H
     (``touch_tol``: the kink of P at grazing), a start that slides.
+
+    ``workers`` threads share the start points (contiguous slices of the batch; each
+    start's return, iterations included, is computed on one thread): the results are
+    the same bit for bit for any number. None: :func:`default_workers` (the
+    environment variable ``FILIPPOV_WORKERS``, else the cores available). A batch of
+    few returns (starts x iterations, :data:`MIN_RETURNS_PER_SLICE` a slice) uses
+    fewer threads, down to the calling thread alone.
     """
+    workers = _checked_workers(workers)
     starts, ages = _checked_starts(cmodel, starts, start_age)
     pieces = _pieces(cmodel)
     if starts.shape[0]:
@@ -241,7 +324,8 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
                   age=np.empty(m), mode=np.empty(m, dtype=np.int64))
     params = np.ascontiguousarray(cmodel.params, dtype=float)
     # the build without the dP/dz code unless it is asked for (kernel.driver)
-    kernel(derivatives=bool(jacobian))(*pieces, params, starts, ages, settings, out)
+    _run_batch(kernel(derivatives=bool(jacobian)), pieces, params, starts, ages, settings,
+               out, workers)
     return BatchReturns(**dict(out._asdict(), jacobian=out.jacobian if jacobian else None,
                                orbit_jacobian=out.orbit_jacobian if jacobian else None))
 

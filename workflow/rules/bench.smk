@@ -155,6 +155,23 @@ rule bench_compile_cost:
         "../scripts/bench_compile_cost.py"
 
 
+# Returns per second of a batch of iterated Hopf returns with 1, 2, ... workers up to the
+# cores (compute_returns(workers=)), with CPU times and the load average, printed as a
+# table. It takes every core (threads), so no other job runs beside it.
+rule bench_parallel_scaling:
+    output:
+        "results/bench_parallel_scaling.nc",
+    params:
+        code=library_hash(exclude="plotting"),
+    threads: workflow.cores
+    log:
+        "logs/bench_parallel_scaling.log",
+    conda:
+        "../envs/filippov.yaml"
+    script:
+        "../scripts/bench_parallel_scaling.py"
+
+
 rule bench:
     input:
         rules.plot_bench.output,
@@ -162,3 +179,4 @@ rule bench:
         rules.bench_attractor_cost.output,
         rules.bench_sliding_cost.output,
         rules.bench_compile_cost.output,
+        rules.bench_parallel_scaling.output,

@@ -9,10 +9,16 @@ holds one job's output on its own (jobs run in parallel, or on a cluster node).
 
 Only what goes through Python's ``sys.stdout``/``sys.stderr`` is copied: a child
 process's output is not (the benchmarks capture their children's output themselves).
+It also hands the job's thread budget to the library: ``FILIPPOV_WORKERS`` is set to
+the rule's ``threads:`` (1 unless a rule says otherwise), the default number of threads
+of a batch of returns (filippov.fastmap.default_workers), so that jobs run side by side
+by Snakemake do not oversubscribe the cores.
+
 Imported from workflow/scripts, which Snakemake puts on the path of every script.
 """
 from __future__ import annotations
 
+import os
 import sys
 
 
@@ -40,7 +46,9 @@ class _Tee:
 
 
 def tee(smk) -> None:
-    """Copy stdout and stderr into the job's first log file (none: nothing to do)."""
+    """Copy stdout and stderr into the job's first log file (none: nothing to do), and
+    set the library's default number of threads to the job's (module docstring)."""
+    os.environ["FILIPPOV_WORKERS"] = str(max(1, int(getattr(smk, "threads", 1) or 1)))
     if not smk.log:
         return
     # line-buffered: a job that is killed leaves every complete line in its log

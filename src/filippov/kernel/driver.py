@@ -5,7 +5,11 @@ compilation with the on-disk cache kept in step with the sources.
 The kernel comes in two builds of this one source: with the dP/dz code (_batch) and
 without it (_batch_plain, what returns without derivatives run on). The dP/dz code is
 40% of the kernel's machine code; a user who never asks for dP/dz should not wait for it
-to compile (13 s instead of 18 s cold on 2 cores, filippov.benchmarks.compile_cost)."""
+to compile (13 s instead of 18 s cold on 2 cores, filippov.benchmarks.compile_cost).
+
+The batch kernel releases the GIL (nogil) and keeps no state between calls but its
+arguments: each call allocates its own work arrays, and start i writes row i of the
+outputs only, so fastmap runs contiguous slices of a batch on threads at once."""
 from __future__ import annotations
 
 import hashlib
@@ -364,7 +368,7 @@ _KERNEL_SIG = types.void(
                       types.int64[::1]], Outputs))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, jacobian,
            p, starts, ages, s, out):
     """Each start is mapped s.iterations times by the first-return map, each return
@@ -463,7 +467,7 @@ def _without_derivatives(decorated):
 # the functions on the way from _batch to a _DERIVATIVES branch
 _PLAIN = _without_derivatives({"_window": _jit_inline, "_stay_exact": _jit_inline,
                                "_stay_integrated": _jit_inline, "_event": _jit_inline,
-                               "_one": _jit, "_batch": njit(cache=True)})
+                               "_one": _jit, "_batch": njit(cache=True, nogil=True)})
 _one_plain, _batch_plain = _PLAIN["_one"], _PLAIN["_batch"]
 
 
