@@ -850,23 +850,49 @@ def fold_starts(draw, dims=DIMS):
     bO = bO + c * ((speed if field == "plus" else -speed) - c @ Az - c @ bO)
     bm, bp = (bO, bT) if field == "plus" else (bT, bO)
     g = build(n, ((A, bm, V, re, im), (A, bp, V, re, im)), c, d, 0.0, np.zeros(n), 0.0)
+    case = fold_answer(g, z0, field, visible, draw(st.floats(0.1, 1.0), label="|sigma|"))
+    assume(case is not None)
+    return case
+
+
+def fold_answer(g: Generated, z0, field, visible, sigma_size):
+    """The FoldStart of a start z0 at the fold of ``field`` (None where the generator's
+    conditions fail); the section h = +-sigma_size on the exit's side."""
     if visible:
         ts, region = 0.0, field
     else:
         sl = _affine_sliding(g)
+        tangent = g.plus if field == "plus" else g.minus
+        kappa = abs(float(g.c @ tangent.A @ tangent.f(z0)))
         # leave the fold's neighbourhood first: the tangent speed is 0 at t = 0
-        end = slide_exit(g, sl, z0, t_start=1e-3, clear_from=2 * RATE / abs(kappa))
-        assume(end is not None)
+        end = slide_exit(g, sl, z0, t_start=1e-3, clear_from=2 * RATE / kappa)
+        if end is None:
+            return None
         ts, region = end
     zx = z0 if ts == 0.0 else _affine_sliding(g).flow(z0, ts)
     direction = 1 if region == "plus" else -1
-    g = _section_side(g, direction * draw(st.floats(0.1, 1.0), label="|sigma|"))
+    g = _section_side(g, direction * sigma_size)
     side = g.plus if region == "plus" else g.minus
     left = _leave_to_section(g, side, zx, direction, t_start=1e-3)
-    assume(left is not None)
+    if left is None:
+        return None
     tau, P = left
-    assume(np.abs(P).max() <= GROWTH)
+    if np.abs(P).max() > GROWTH:
+        return None
     return FoldStart(g, z0, field, visible, ts, region, direction, ts + tau, P)
+
+
+def fold_start_from(n, p, z0) -> FoldStart:
+    """A fold start kept as numbers (p, z0): the tangent field is the one whose normal
+    speed is 0 at z0, the fold's kind the sign of h'' = c.A F(z0) along it."""
+    g = from_p(n, p)
+    z0 = np.array(z0, dtype=float)
+    a, b = g.c @ g.minus.f(z0), g.c @ g.plus.f(z0)
+    field = "plus" if abs(b) < abs(a) else "minus"
+    T = g.plus if field == "plus" else g.minus
+    curv = float(g.c @ T.A @ T.f(z0))
+    visible = curv > 0 if field == "plus" else curv < 0
+    return fold_answer(g, z0, field, visible, abs(g.sigma))
 
 
 @dataclasses.dataclass

@@ -6,7 +6,9 @@ ask each engine -- the compiled one (``compute_returns``, ``jacobian=True``) and
 reference driver (``simulate`` + ``return_jacobian``), each with the regions' exact flows
 and with every mode integrated (DOP853) -- for switch times, sliding entry and exit, the
 return P to a section, dP/dz, and relay feedback orbits with their Floquet multipliers
-(``periodic_orbit``). The answers are computed independently: scipy.linalg.expm of the
+(``periodic_orbit``); orbits passing a fold near H, starts at a fold (visible or
+invisible) and on the section, and sliding on a parabolic H (an integrated reference:
+scipy's DOP853 at rtol 1e-12, TOL_CURVED). The answers are computed independently: scipy.linalg.expm of the
 generated matrices and brentq on h along the closed-form flows, never the library.
 
 Cases near a tangency are filtered out by the generators (``assume``: |dh/dt| >= RATE
@@ -293,8 +295,19 @@ def test_an_orbit_that_passes_a_fold_close_to_H_is_no_switch(flows, case):
 AT_START = 1e-6
 
 
+# Found by this suite (deep profile), shrunk: z0 = 0 on H where F_- is tangent exactly
+# (a = 0, an invisible fold) and F_+ points down (b = -1). The start rule took region +
+# by the sign of H (0), its field pointing across H at once: region + -> region - ->
+# sliding at t = 1e-323, then the exit -- 3 mode changes, the first at 1e-323, on the
+# compiled engine with integrated flows (the return itself right to 1e-13). Now a tangent
+# field whose partner pushes into its region starts in the tangent field's region
+# (rules.start_on_switch).
+FOLD_START_AT_ORIGIN = dict(n=3, z0=[0.0, 0.0, 0.0], p=[1.0, -1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, -1.0, 0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, -1.0, 1.0, -1.0, 0.0, 0.5, 0.5, 0.0, 1.0, -1.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, -1.0, -1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, -1.0, 1.0, -1.0, 0.0, 0.5, -0.5, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0])
+
+
 @pytest.mark.parametrize("flows", FLOWS)
 @FEW
+@example(case=gs.fold_start_from(**FOLD_START_AT_ORIGIN))
 @given(case=gs.fold_starts())
 def test_a_start_at_a_fold_leaves_or_slides_as_the_fold_says(flows, case):
     """A start on H where F_+ (F_-) is tangent. Visible fold: the orbit leaves into that
