@@ -309,17 +309,18 @@ def unit(draw, n, name="unit"):
 
 
 @st.composite
-def matrix(draw, n, rotations=True):
+def matrix(draw, n, rotations=True, rotate_first=False):
     """(A, V, re, im): A = V B V^-1 with B real-block-diagonal, |re| in [0.15, 1.2] for a
     real eigenvalue (A invertible: an equilibrium z* for the flow's formula), im in
-    [0.3, 1.2] for a rotation block; V = I + a perturbation with cond(V) <= 20."""
+    [0.3, 1.2] for a rotation block (``rotate_first``: the first block is one); V = I + a
+    perturbation with cond(V) <= 20."""
     re = np.array(draw(st.lists(st.floats(0.15, 1.2), min_size=n, max_size=n)))
     re *= np.array(draw(st.lists(st.sampled_from([-1.0, 1.0]), min_size=n, max_size=n)))
     im = np.zeros(n)
     B = np.diag(re)
     i = 0
     while i + 1 < n and rotations:
-        if draw(st.booleans(), label="rotation block"):
+        if (rotate_first and i == 0) or draw(st.booleans(), label="rotation block"):
             w = draw(st.floats(0.3, 1.2))
             re[i + 1] = re[i]
             im[i], im[i + 1] = w, -w
@@ -616,3 +617,479 @@ def relay_from(lam, amplitude, gamma):
     rest = np.delete(mu, one)
     rest = rest[np.argsort(-np.abs(rest), kind="stable")]
     return Relay(g, x0, 2 * T, dP, np.concatenate([[mu[one]], rest]))
+
+
+# ----------------------------------------------------------------------------- folds, starts
+# Issue 28's remaining classes: orbits that pass a fold of F_+ or F_- close to H without
+# touching it (and ones that dip across it between samples), starts at a fold (a normal
+# speed 0 on H: a tangency, visible or invisible), starts on the section itself, and
+# sliding on a curved H (a nonlinear sliding field: an integrated reference).
+def _dh(g: Generated, side: Affine):
+    """dh/dt along the flow of ``side`` (the normal speed, at any state)."""
+    return lambda z: float(g.grad_h(z) @ side.f(z))
+
+
+def _section_side(g: Generated, sigma: float) -> Generated:
+    """g with the section h = sigma (the dynamics do not depend on it)."""
+    p = g.p.copy()
+    p[layout(g.n)["sigma"]] = sigma
+    return dataclasses.replace(g, sigma=float(sigma), p=p)
+
+
+def _leave_to_section(g: Generated, side: Affine, z, direction: int, t_start=0.0):
+    """The flow of ``side`` from z to the section h = sigma met in ``direction``: (tau, P),
+    or None unless h stays on the region's side of H (by >= 0 on a grid of 201 points past
+    t_start) and the section is crossed at a rate >= RATE."""
+    tau = root_along(side, z, g.s, t_start=t_start)
+    if tau is None:
+        return None
+    P = side.flow(z, tau)
+    if direction * _dh(g, side)(P) < RATE:
+        return None
+    hs = np.array([g.h(w) for w in side.grid(z, tau, 201)[1][1:]])
+    if (direction > 0 and hs.min() <= 0) or (direction < 0 and hs.max() >= 0):
+        return None
+    return tau, P
+
+
+@dataclasses.dataclass
+class Graze:
+    """An orbit of one region's field that dips toward H: h has an extremum hm at tm
+    (plus: a minimum, hm = gap > 0; minus: a maximum, hm = -gap): it passes the fold of
+    that field (visible from its side) at a distance gap, no switch, and goes on to the
+    section h = sigma met in ``direction`` (+1 above H, -1 below). ``gap`` < 0 (plus
+    only, planar H, a common matrix A): the dip crosses H at t1 where F_- points up --
+    attracting sliding, the slide ends at the visible fold of F_+ nearby at t1 + ts, then
+    F_+ to the section; the dip lasts ~2 sqrt(2 |gap| / h''), down to a sample step."""
+
+    g: Generated
+    z0: np.ndarray
+    side: str
+    gap: float
+    tm: float
+    direction: int
+    t1: float           # nan without a switch
+    ts: float           # 0 without sliding
+    time: float
+    P: np.ndarray
+    dP: np.ndarray
+    scale: float
+
+
+@st.composite
+def grazes(draw, dims=DIMS):
+    n = draw(st.sampled_from(dims), label="n")
+    side = draw(st.sampled_from(["plus", "minus"]), label="side")
+    c = unit(draw, n, "c")
+    gap = draw(st.sampled_from([1.0, 1e-1, 1e-2, 1e-3]), label="|gap|") \
+        * draw(st.floats(1.0, 9.0), label="gap mantissa")
+    dips = side == "plus" and draw(st.booleans(), label="dips across H")
+    if dips:
+        gap = -gap / 10.0
+    curved = not dips and draw(st.booleans(), label="curved H")
+    e = orthogonal_unit(draw, n, c) if curved else np.zeros(n)
+    k = draw(st.floats(-0.4, 0.4), label="k") if curved else 0.0
+    A, V, re, im = draw(matrix(n), label="A")
+    z0 = vector(draw, n, -1.0, 1.0)
+    sgn = 1 if side == "plus" else -1   # the region's side of H
+    # b's part along c sets dh/dt at z0 (grad h . c = 1): heading toward H
+    b = vector(draw, n)
+    grad0 = c + 2 * k * (e @ z0) * e
+    b = b + c * (-sgn * draw(st.floats(0.3, 2.0), label="|dh/dt| at z0") - grad0 @ (A @ z0 + b))
+    sides = [(A, b, V, re, im), (A, b, V, re, im)]
+    if dips:   # F_- = F_+ - D, with a = c.F_- = b_+ + gD: F_- points up near the dip
+        gD = draw(st.floats(0.5, 3.0), label="c.D")
+        D = vector(draw, n)
+        D = D + c * (-gD - c @ D)
+        sides[0] = (A, b + D, V, re, im)
+    g = build(n, sides, c, 0.0, k, e, 0.0)
+    me = g.plus if side == "plus" else g.minus
+    dh = _dh(g, me)
+    # the first extremum toward H (plus: dh/dt rises through 0; minus: falls through 0)
+    assume(sgn * dh(z0) <= -RATE)
+    tm = root_along(me, z0, dh)
+    assume(tm is not None and tm >= 0.1)
+    zm = me.flow(z0, tm)
+    # its sharpness |h''| >= RATE: the extremum is well defined
+    assume(sgn * float(g.grad_h(zm) @ me.A @ me.f(zm) + 2 * k * (g.e @ me.f(zm)) ** 2) >= RATE)
+    # put H where h's extremum lies gap from it (d shifts h and nothing else)
+    d = g.h(zm) - sgn * gap
+    g = dataclasses.replace(g, d=float(d), p=g.p.copy())
+    g.p[layout(n)["d"]] = d
+    assume(sgn * g.h(z0) >= 0.1)   # the start clear of H
+    if not dips:
+        sigma = sgn * (gap + draw(st.floats(0.1, 1.0), label="sigma - gap"))
+        g = _section_side(g, sigma)
+        left = _leave_to_section(g, me, z0, sgn, t_start=tm)
+        assume(left is not None)
+        tau, P = left
+        # h monotone into the extremum and out of it to the section: no other dip
+        ts_, zs = me.grid(z0, tau, 401)
+        rates = np.array([dh(z) for z in zs]) * sgn
+        before, after = rates[ts_ < tm - 0.02], rates[ts_ > tm + 0.02]
+        assume(before.size == 0 or before.max() < 0)
+        assume(after.size == 0 or after.min() > 0)
+        assume(np.abs(P).max() <= GROWTH)
+        factors = [projection(me.f(P), g.grad_h(P)), me.stm(tau)]
+        return Graze(g, z0, side, gap, tm, sgn, np.nan, 0.0, tau, P,
+                     np.linalg.multi_dot(factors), _scale(factors))
+    # the dip across H: F_+ down to H (the first zero of h, before tm)
+    t1 = root_along(g.plus, z0, g.h, t_end=tm)
+    assume(t1 is not None)
+    zc = g.plus.flow(z0, t1)
+    a = lambda z: float(c @ g.minus.f(z))  # noqa: E731
+    bspeed = lambda z: float(c @ g.plus.f(z))  # noqa: E731
+    assume(a(zc) >= RATE and bspeed(zc) < 0)
+    ts_, zs = g.plus.grid(z0, t1, 201)
+    assume(max(dh(z) for z in zs) < 0)   # h falls all the way to H: one crossing
+    D = g.plus.b - g.minus.b
+    Pi = np.eye(n) - np.outer(D, c) / (c @ D)
+    sl = Affine(Pi @ A, Pi @ g.minus.b)
+    ts = root_along(sl, zc, bspeed, t_start=0.0)
+    assume(ts is not None and ts > 0)
+    zx = sl.flow(zc, ts)
+    assume(min(a(z) for z in sl.grid(zc, ts, 201)[1]) >= RATE)
+    assume(c @ A @ sl.f(zx) >= RATE)   # the visible fold, b rising through 0
+    g = _section_side(g, draw(st.floats(0.1, 1.0), label="sigma"))
+    left = _leave_to_section(g, g.plus, zx, +1, t_start=1e-3)
+    assume(left is not None)
+    tau, P = left
+    assume(np.abs(P).max() <= GROWTH)
+    factors = [projection(g.plus.f(P), c), g.plus.stm(tau), expm(sl.A * ts),
+               saltation(g.plus.f(zc), sl.f(zc), c), g.plus.stm(t1)]
+    return Graze(g, z0, side, gap, tm, +1, t1, ts, t1 + ts + tau, P,
+                 np.linalg.multi_dot(factors), _scale(factors))
+
+
+@dataclasses.dataclass
+class FoldStart:
+    """A start on planar H exactly at a fold of F_+ (b = 0, a >= RATE) or of F_-
+    (a = 0, b <= -RATE), up to the rounding of z0 -- a tangency, where the library's
+    decision rests on a normal speed that is rounding noise. A common matrix A, so the
+    sliding field is affine. Visible fold (the tangent field's orbit curves away from H
+    into its own region, |h''| >= RATE): the Filippov solution leaves into that region
+    at once -- no sliding; ``exit`` is that region and ts = 0. Invisible (it curves
+    across H, into the other field's push): the solution slides, away from the fold,
+    until a or b reaches 0 again (a visible fold, at a rate >= RATE) at ts, and leaves
+    into ``exit``. Then to the section h = sigma on the exit's side (+1: sigma > 0
+    crossed upwards; -1: sigma < 0 crossed downwards)."""
+
+    g: Generated
+    z0: np.ndarray
+    field: str          # the tangent field: "plus" (b = 0) or "minus" (a = 0)
+    visible: bool
+    ts: float
+    exit: str           # the region the orbit leaves into
+    direction: int
+    time: float
+    P: np.ndarray
+
+
+def _affine_sliding(g: Generated):
+    """Planar H, a common matrix A: Filippov's sliding field, Pi (A z + b_-)."""
+    c = g.c
+    D = g.plus.b - g.minus.b
+    Pi = np.eye(g.n) - np.outer(D, c) / (c @ D)
+    return Affine(Pi @ g.minus.A, Pi @ g.minus.b)
+
+
+def slide_exit(g: Generated, sl: Affine, z, t_start, clear_from=0.0):
+    """Where a slide from z (on H, a > 0 > b past t_start) ends: (ts, region) at the first
+    zero of a (-> "minus") or of b (-> "plus") after t_start, or None: none by T_SCAN, the
+    speed not crossing 0 at a rate >= RATE (no visible fold), or the other speed within
+    RATE of 0 before it (from ``clear_from`` on; before it only on its side of 0: a start
+    at a fold, moving away from it)."""
+    a = lambda w: float(g.grad_h(w) @ g.minus.f(w))  # noqa: E731
+    b = lambda w: float(g.grad_h(w) @ g.plus.f(w))   # noqa: E731
+    ends = [(t, r) for t, r in ((root_along(sl, z, a, t_start=t_start), "minus"),
+                                (root_along(sl, z, b, t_start=t_start), "plus"))
+            if t is not None]
+    if not ends:
+        return None
+    ts, region = min(ends)
+    zx = sl.flow(z, ts)
+    other = b if region == "minus" else a
+    tg, grid = sl.grid(z, ts, 201)
+    sgn = -1.0 if region == "minus" else 1.0
+    vals = sgn * np.array([other(w) for w in grid])
+    if vals[tg >= clear_from].min(initial=np.inf) < RATE or vals[1:].min() <= 0:
+        return None
+    # the rate of the ending speed along F_s (which equals the tangent field there):
+    # c.A F_s, A the common matrix (not sl.A, whose rows c.Pi = 0)
+    rate = float(g.c @ g.minus.A @ sl.f(zx))
+    if (rate >= RATE) if region == "plus" else (rate <= -RATE):
+        return ts, region
+    return None
+
+
+@st.composite
+def fold_starts(draw, dims=DIMS):
+    n = draw(st.sampled_from(dims), label="n")
+    field = draw(st.sampled_from(["plus", "minus"]), label="tangent field")
+    visible = draw(st.booleans(), label="visible fold")
+    c = unit(draw, n, "c")
+    A, V, re, im = draw(matrix(n), label="A")
+    d = draw(st.floats(-0.5, 0.5), label="d")
+    z0 = vector(draw, n, -0.8, 0.8)
+    z0 = z0 + c * (d - c @ z0)   # on H
+    Az = A @ z0
+    # the tangent field T(z0) = A z0 + b_T: c.b_T = -c.A z0 (tangent), and its tangential
+    # part set so that h'' = c.A T(z0) = kappa (sign: visible for F_+ is h'' > 0, for F_-
+    # h'' < 0)
+    u = c @ A
+    q = u - (u @ c) * c
+    assume(np.linalg.norm(q) >= 0.3)
+    kappa = draw(st.floats(0.3, 1.5), label="|h''|")
+    kappa *= 1 if visible == (field == "plus") else -1
+    bT = vector(draw, n)
+    bT = bT + c * (-(c @ Az) - c @ bT)
+    bT = bT + q * (kappa - u @ (Az + bT)) / (q @ q)
+    # the other field: normal speed >= RATE toward H (a > 0 below, b < 0 above)
+    speed = draw(st.floats(0.5, 2.0), label="other normal speed")
+    bO = vector(draw, n)
+    bO = bO + c * ((speed if field == "plus" else -speed) - c @ Az - c @ bO)
+    bm, bp = (bO, bT) if field == "plus" else (bT, bO)
+    g = build(n, ((A, bm, V, re, im), (A, bp, V, re, im)), c, d, 0.0, np.zeros(n), 0.0)
+    case = fold_answer(g, z0, field, visible, draw(st.floats(0.1, 1.0), label="|sigma|"))
+    assume(case is not None)
+    return case
+
+
+def fold_answer(g: Generated, z0, field, visible, sigma_size):
+    """The FoldStart of a start z0 at the fold of ``field`` (None where the generator's
+    conditions fail); the section h = +-sigma_size on the exit's side."""
+    if visible:
+        ts, region = 0.0, field
+    else:
+        sl = _affine_sliding(g)
+        tangent = g.plus if field == "plus" else g.minus
+        kappa = abs(float(g.c @ tangent.A @ tangent.f(z0)))
+        # leave the fold's neighbourhood first: the tangent speed is 0 at t = 0
+        end = slide_exit(g, sl, z0, t_start=1e-3, clear_from=2 * RATE / kappa)
+        if end is None:
+            return None
+        ts, region = end
+    zx = z0 if ts == 0.0 else _affine_sliding(g).flow(z0, ts)
+    direction = 1 if region == "plus" else -1
+    g = _section_side(g, direction * sigma_size)
+    side = g.plus if region == "plus" else g.minus
+    left = _leave_to_section(g, side, zx, direction, t_start=1e-3)
+    if left is None:
+        return None
+    tau, P = left
+    if np.abs(P).max() > GROWTH:
+        return None
+    return FoldStart(g, z0, field, visible, ts, region, direction, ts + tau, P)
+
+
+def fold_start_from(n, p, z0) -> FoldStart:
+    """A fold start kept as numbers (p, z0): the tangent field is the one whose normal
+    speed is 0 at z0, the fold's kind the sign of h'' = c.A F(z0) along it."""
+    g = from_p(n, p)
+    z0 = np.array(z0, dtype=float)
+    a, b = g.c @ g.minus.f(z0), g.c @ g.plus.f(z0)
+    field = "plus" if abs(b) < abs(a) else "minus"
+    T = g.plus if field == "plus" else g.minus
+    curv = float(g.c @ T.A @ T.f(z0))
+    visible = curv > 0 if field == "plus" else curv < 0
+    return fold_answer(g, z0, field, visible, abs(g.sigma))
+
+
+@dataclasses.dataclass
+class SectionStart:
+    """A start on the section h = sigma itself (up to ``offset`` roundings of z0 along
+    grad h: 0 or +-4), region +, heading up across it: the start is no return (the
+    library's contract: a start on the section up to rounding is not a hit). The orbit
+    of F_+ rises, falls back through the section (downwards: not counted), stays >=
+    margin above H, and returns upwards at ``time``."""
+
+    g: Generated
+    z0: np.ndarray
+    offset: int
+    time: float
+    P: np.ndarray
+
+
+def section_return(g: Generated, z0, level):
+    """From z0 on the level set h = level, crossing it upwards under F_+: the next upward
+    crossing after the orbit has fallen back through it, (time, P), or None (not by
+    T_SCAN, or a crossing at a rate < RATE)."""
+    up = _dh(g, g.plus)
+    if up(z0) < RATE:
+        return None
+    rel = lambda z: g.h(z) - level  # noqa: E731
+    t_down = root_along(g.plus, z0, rel, t_start=1e-3)
+    if t_down is None or up(g.plus.flow(z0, t_down)) > -RATE:
+        return None
+    t_r = root_along(g.plus, z0, rel, t_start=t_down + 1e-3)
+    if t_r is None:
+        return None
+    P = g.plus.flow(z0, t_r)
+    if up(P) < RATE or np.abs(P).max() > GROWTH:
+        return None
+    return t_r, P
+
+
+def from_p(n: int, p) -> Generated:
+    """The Generated system whose parameter array is p (a regression case kept as
+    numbers)."""
+    p = np.array(p, dtype=float)
+    L = layout(n)
+
+    def side(base):
+        return Affine(p[base:base + n * n].reshape(n, n).copy(),
+                      p[base + n * n:base + n * n + n].copy())
+
+    return Generated(n, side(L["minus"]), side(L["plus"]), p[L["c"]:L["c"] + n].copy(),
+                     float(p[L["d"]]), float(p[L["k"]]), p[L["e"]:L["e"] + n].copy(),
+                     float(p[L["sigma"]]), p)
+
+
+def section_start_from(n, p, z0) -> SectionStart:
+    """A start on the section kept as numbers (p, z0), its return by section_return."""
+    g = from_p(n, p)
+    z0 = np.array(z0, dtype=float)
+    time, P = section_return(g, z0, g.sigma)   # the section is the level set h = sigma
+    return SectionStart(g, z0, 0, time, P)
+
+
+@st.composite
+def section_starts(draw, dims=DIMS):
+    n = draw(st.sampled_from(dims), label="n")
+    c = unit(draw, n, "c")
+    curved = draw(st.booleans(), label="curved H")
+    e = orthogonal_unit(draw, n, c) if curved else np.zeros(n)
+    k = draw(st.floats(-0.4, 0.4), label="k") if curved else 0.0
+    # the orbit must rise through the section, fall back and rise again: a rotation
+    A, V, re, im = draw(matrix(n, rotate_first=True), label="A")
+    z0 = vector(draw, n, -1.0, 1.0)
+    # b's part along c sets dh/dt at z0 (grad h . c = 1): upwards across the section
+    b = vector(draw, n)
+    grad0 = c + 2 * k * (e @ z0) * e
+    b = b + c * (draw(st.floats(0.3, 2.0), label="dh/dt at z0") - grad0 @ (A @ z0 + b))
+    side = (A, b, V, re, im)
+    g = build(n, (side, side), c, 0.0, k, e, 0.0)
+    level = g.h(z0)
+    ret = section_return(g, z0, level)
+    assume(ret is not None)
+    t_r, P = ret
+    # H below the orbit's lowest point by margin (d shifts h, nothing else)
+    low = min(g.h(z) for z in g.plus.grid(z0, t_r, 801)[1])
+    margin = draw(st.floats(0.05, 0.5), label="margin")
+    d = low - margin
+    g = dataclasses.replace(g, d=float(d), p=g.p.copy())
+    g.p[layout(n)["d"]] = d
+    g = _section_side(g, level - d)
+    offset = draw(st.sampled_from([0, 4, -4]), label="offset (roundings)")
+    gh = g.grad_h(z0)
+    z0 = z0 + offset * np.finfo(float).eps * np.abs(z0).max() * gh / np.linalg.norm(gh)
+    return SectionStart(g, z0, offset, t_r, P)
+
+
+# ----------------------------------------------------------------------------- curved sliding
+SLIDE_RTOL = 1e-12
+
+
+def sliding_field(g: Generated):
+    """Filippov's convex combination on H: (a F_+ - b F_-) / (a - b), a = grad h . F_-,
+    b = grad h . F_+ (nonlinear in z on a curved H)."""
+    def f(t, z):
+        n = g.grad_h(z)
+        fm, fp = g.minus.f(z), g.plus.f(z)
+        a, b = n @ fm, n @ fp
+        return (a * fp - b * fm) / (a - b)
+    return f
+
+
+def integrated_slide(g: Generated, z):
+    """The slide from z on H by scipy's DOP853 at rtol SLIDE_RTOL, atol 1e-14, to its end
+    where b rises through 0 (the event, located by brentq on the dense output, xtol
+    4 eps): (ts, zx, steps (states along it)), or None (it ends otherwise by T_SCAN:
+    a reaches 0, or never)."""
+    from scipy.integrate import solve_ivp
+
+    def b_ev(t, w):
+        return float(g.grad_h(w) @ g.plus.f(w))
+
+    def a_ev(t, w):
+        return float(g.grad_h(w) @ g.minus.f(w))
+
+    b_ev.terminal, b_ev.direction = True, 1.0
+    a_ev.terminal, a_ev.direction = True, -1.0
+    sol = solve_ivp(sliding_field(g), (0.0, T_SCAN), z, method="DOP853", rtol=SLIDE_RTOL,
+                    atol=1e-14, events=[b_ev, a_ev])
+    if sol.status != 1 or not sol.t_events[0].size:
+        return None
+    return float(sol.t_events[0][0]), sol.y_events[0][0], sol.y.T
+
+
+@dataclasses.dataclass
+class CurvedSlide:
+    """A parabolic H (k != 0), any two affine fields: from z0 below H (or on it) to H at
+    t1 (F_-, closed form), sliding along Filippov's (nonlinear) field -- integrated by
+    scipy -- until b rises through 0 at t1 + ts (a visible fold), then F_+ (closed form)
+    to the section h = sigma."""
+
+    g: Generated
+    z0: np.ndarray
+    on_h: bool
+    t1: float
+    ts: float
+    time: float
+    P: np.ndarray
+
+
+def curved_reference(g: Generated, z0, on_h):
+    """(t1, ts, time, P) of the slide from z0 (see CurvedSlide), or None where the
+    generator's conditions fail (tangencies, no visible exit, no section)."""
+    t1, zc = 0.0, z0
+    if not on_h:
+        t1 = root_along(g.minus, z0, g.h)
+        if t1 is None or rates_along(g.minus, z0, g.grad_h, t1) < RATE:
+            return None
+        zc = g.minus.flow(z0, t1)
+    a = lambda z: float(g.grad_h(z) @ g.minus.f(z))  # noqa: E731
+    b = lambda z: float(g.grad_h(z) @ g.plus.f(z))   # noqa: E731
+    if a(zc) < RATE or b(zc) > -RATE:
+        return None
+    slide = integrated_slide(g, zc)
+    if slide is None:
+        return None
+    ts, zx, steps = slide
+    if min(a(z) for z in steps) < RATE:
+        return None
+    # b's rate at the exit, along F_s = F_+ there: grad h . A_+ F_+ + F_+ . Hess(h) F_+
+    fp = g.plus.f(zx)
+    if g.grad_h(zx) @ g.plus.A @ fp + 2 * g.k * (g.e @ fp) ** 2 < RATE:
+        return None
+    left = _leave_to_section(g, g.plus, zx, +1, t_start=1e-3)
+    if left is None:
+        return None
+    tau, P = left
+    return t1, ts, t1 + ts + tau, P
+
+
+@st.composite
+def curved_slides(draw, dims=DIMS):
+    n = draw(st.sampled_from(dims), label="n")
+    c = unit(draw, n, "c")
+    e = orthogonal_unit(draw, n, c)
+    assume(np.abs(e).max() > 0)
+    k = draw(st.floats(0.15, 0.5), label="|k|") * draw(st.sampled_from([-1.0, 1.0]),
+                                                        label="sign k")
+    sides = []
+    for name, sgn in (("minus", 1.0), ("plus", -1.0)):
+        A, V, re, im = draw(matrix(n), label=f"A_{name}")
+        b = vector(draw, n)
+        speed = draw(st.floats(0.5, 2.0), label=f"|c.b_{name}|")
+        sides.append((A, b + c * (sgn * speed - c @ b), V, re, im))
+    g = build(n, sides, c, draw(st.floats(-0.5, 0.5), label="d"), k, e,
+              draw(st.floats(0.05, 0.5), label="sigma"))
+    on_h = draw(st.booleans(), label="start on H")
+    z0 = _drift_to_h(g, vector(draw, n, -0.5, 0.5),
+                     0.0 if on_h else -draw(st.floats(0.1, 1.0), label="delta"))
+    ref = curved_reference(g, z0, on_h)
+    assume(ref is not None)
+    t1, ts, time, P = ref
+    assume(np.abs(P).max() <= GROWTH)
+    return CurvedSlide(g, z0, on_h, t1, ts, time, P)

@@ -284,9 +284,12 @@ def start_on_switch(H: float, a: float, b: float, sliding: bool) -> tuple[int, b
     wrong side is thereby no switch."""
     if a > 0 and b < 0:
         return (SLIDING if sliding else PLUS), False
-    if a < 0 and b < 0:
+    # a tangent field (a or b exactly 0) whose partner pushes into its region: the partner's
+    # region is no solution (its field points across H at once; tests/test_properties.py
+    # FOLD_START_AT_ORIGIN: a = 0, b < 0 took region + and changed mode twice at t = 1e-323)
+    if a <= 0 and b < 0:
         return MINUS, False
-    if a > 0 and b > 0:
+    if a > 0 and b >= 0:
         return PLUS, False
     if a < 0 < b:
         return PLUS, True
@@ -455,16 +458,26 @@ def same_instant(xtol: float, t: float) -> float:
 START_ULPS = 64
 
 
-def starts_on_section(s0, z0, sr, zr) -> bool:
+def starts_on_section(s0, z0, sr, zr, z_start) -> bool:
     """The start ``z0`` (section value ``s0``) lies on the section up to rounding,
-    given the refined root ``zr`` (section value ``sr``); 1-D float arrays."""
+    given the refined root ``zr`` (section value ``sr``); 1-D float arrays. ``z0`` is
+    the first sample as the stay's stepper gives it -- for an exact flow, the closed
+    form at tau = 0 from the run's start ``z_start`` (else z_start itself) --, whose
+    rounding counts too, as in :func:`exit_band`: a closed form built around another
+    point (z* + V e^{B tau} V^-1 (z - z*)) rounds at the scale of |z*|, not of |z|.
+    Found by tests/test_properties.py: a start at the origin exactly on the section,
+    its flow at tau = 0 read s = -1.1e-16 (|z_flow - z| = 2.2e-16 while |z| = 0), and
+    the crossing back at tau = 5e-16 was taken for the return."""
     # linear interpolation to the crossing; sr is on the far side, so the fraction is <= 1
     frac = min(1.0, abs(s0) / abs(s0 - sr)) if s0 != sr else 1.0
-    size, moved = 0.0, 0.0
+    size, moved, flow = 0.0, 0.0, 0.0
     for k in range(z0.size):
         size = max(size, abs(z0[k]), abs(zr[k]))
         moved = max(moved, abs(zr[k] - z0[k]))
-    return frac * moved <= START_ULPS * _EPS * size
+        flow = max(flow, abs(z0[k] - z_start[k]))
+    # a closed form that misses its start by more than exit_band accepts is no rounding
+    flow = min(flow, EXIT_BAND_FLOW_MAX * max(1.0, size))
+    return frac * moved <= START_ULPS * max(_EPS * size, flow)
 
 
 def band_probe(r: float, step: float, lo: float, clear: bool):

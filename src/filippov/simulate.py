@@ -907,7 +907,8 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
                     continue
                 if (i == 0 and ta == traj.t0
                         and rules.starts_on_section(float(sv[0]), np.asarray(zs[:, 0], dtype=float),
-                                               float(sec.func(zr)), np.asarray(zr, dtype=float))):
+                                               float(sec.func(zr)), np.asarray(zr, dtype=float),
+                                               np.asarray(traj.z0, dtype=float).reshape(-1))):
                     continue
                 best = (r, "section", k)
         if best is not None:

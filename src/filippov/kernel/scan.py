@@ -201,7 +201,8 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
                     at_start = False
                     if ts[i] == 0.0:
                         _zat(ts[i], mode, sg, za, F, y_old, fns, p, wg)
-                        at_start = _starts_on_section(svals[i], wg, _section(fns, wz, p), wz)
+                        at_start = _starts_on_section(svals[i], wg, _section(fns, wz, p), wz,
+                                                      za)
                     if not at_start:
                         best_t, best_w = r, _W_SECTION
         if best_w != _W_NONE:
