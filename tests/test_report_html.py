@@ -355,3 +355,20 @@ def test_html_report_of_the_build(workflow_build, tmp_path):
     assert rep.returncode == 0, rep.stdout[-3000:] + rep.stderr[-3000:]
     assert "ERROR/" not in rep.stderr, rep.stderr[-3000:]
     check_report(out, work, summary(work))
+
+
+def test_a_dataset_names_the_paper_s_numbers_not_its_labels():
+    # scenes.printed: what a reader of the netCDF file sees in titles and long names
+    import xarray as xr
+
+    from filippov.scenes import printed
+
+    ds = xr.Dataset({"image": ((), 1.0, {"long_name": "s from eq:xi1r", "equation": "eq:xi1r",
+                                         "units": "1"})},
+                    attrs={"title": "graph from eq:xi1r (fig:p:xi12)",
+                           "scene_config": '{"description": "eq:xi1r"}'})
+    out = printed(ds, {"eq:xi1r": "Eq. (23)", "fig:p:xi12": "Fig. 6"})
+    assert out.attrs["title"] == "graph from Eq. (23) (Fig. 6)"
+    assert out["image"].attrs["long_name"] == "s from Eq. (23)"
+    assert out["image"].attrs["equation"] == "Eq. (23)"
+    assert out.attrs["scene_config"] == ds.attrs["scene_config"]   # the file as given

@@ -15,6 +15,7 @@ rule compute:
         scene="config/scenes/{scene}.yaml",
         schema=config["schema"],
         script="workflow/scripts/compute_scene.py",
+        labels="paper/paper_labels.tex",  # the paper's numbers in titles (scenes.printed)
     output:
         report("results/{scene}.nc", caption="../report/dataset.rst", category="Datasets",
                labels=dataset_labels),
@@ -61,6 +62,7 @@ rule merge_chunks:
         scene="config/scenes/{scene}.yaml",
         schema=config["schema"],
         script="workflow/scripts/merge_chunks.py",
+        labels="paper/paper_labels.tex",  # the paper's numbers in titles (scenes.printed)
         chunks=lambda wc: [f"results/chunks/{wc.scene}/{i}.nc" for i in range(CHUNKS[wc.scene])],
     output:
         report("results/{scene}.nc", caption="../report/dataset.rst", category="Datasets",

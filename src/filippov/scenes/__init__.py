@@ -63,7 +63,35 @@ def _declared(module, scene, ds):
     ds = describe(ds, getattr(module, "VARIABLE_ATTRS", {}), getattr(module, "LATEX_NAMES", {}))
     declared = module.tolerances(scene) if hasattr(module, "tolerances") else \
         getattr(module, "TOLERANCES", {})
-    return tolerance.annotate(ds, declared)
+    return printed(tolerance.annotate(ds, declared))
+
+
+#: attributes whose text is for readers (the paper's labels in them are replaced);
+#: scene_config stays the scene file as given
+READER_ATTRS = ("title", "long_name", "equation", "comment", "description")
+
+
+def printed(ds, labels: dict | None = None):
+    """``ds`` with the paper's LaTeX labels (``eq:ymm``, ``fig:retmaps``) in its
+    titles, long names and equation attributes replaced by the numbers the paper
+    prints ("Eq. (18)", "Fig. 4"; paper/paper_labels.tex, :mod:`filippov.paper_labels`):
+    a reader of the netCDF file has the paper, not its source."""
+    from ..paper_labels import OUT
+    from ..report_html import cite, printed_labels
+
+    labels = printed_labels(OUT) if labels is None else labels
+    if not labels:
+        return ds
+
+    def fix(attrs):
+        return {k: cite(v, labels) if k in READER_ATTRS and isinstance(v, str) else v
+                for k, v in attrs.items()}
+
+    ds = ds.copy()
+    ds.attrs = fix(ds.attrs)
+    for name in ds.variables:
+        ds[name].attrs = fix(ds[name].attrs)
+    return ds
 
 
 def describe(ds, attrs: dict, latex: dict | None = None):
