@@ -201,30 +201,60 @@ def lyapunov_limit(ds: xr.Dataset, omega: float) -> np.ndarray:
     return out
 
 
+#: an end of the extent of 100 kept points of a chaotic band: within half the band's
+#: width of another orbit's (the sampling error of the extent)
+EXTENT_JUMP_100 = 0.5
+
+
+def extent_jump(n_keep: int) -> float:
+    """Sampling error of an end of the extent of ``n_keep`` points of a chaotic band,
+    as a fraction of its width. At a band edge that is the image of the grazing point,
+    where the return map has its square-root term (u -> a sqrt(u - u_g)), the invariant
+    density vanishes linearly: the mass within d of the edge goes as (d/W)^2, so the
+    extreme of n points falls short by d with probability exp(-c n (d/W)^2). The same
+    probability at every n_keep: d/W ~ 1/sqrt(n), :data:`EXTENT_JUMP_100` at 100."""
+    return EXTENT_JUMP_100 * float(np.sqrt(100.0 / n_keep))
+
+
+def lyapunov_atol(n_keep: int) -> float:
+    """Tolerance of a Lyapunov exponent, a mean of ``n_keep`` correlated log-slopes
+    (standard error ~2/sqrt(n_keep)): two builds compute two independent estimates
+    (two orbits), whose difference has sqrt(2) times that standard error; three of
+    them."""
+    return 3.0 * np.sqrt(2.0) * 2.0 / np.sqrt(n_keep)
+
+
 def chaos_tolerances(scene: dict) -> dict:
     """Cross-machine tolerances where the attractor may be chaotic (filippov.tolerance).
     There a last-bit change is amplified by e^(lambda n) over the n returns of the run
     (lambda up to ~0.6: e^180 after 300): the kept points belong to another orbit on the
     same attractor. Points are therefore compared by each row's extent (rule attractor,
-    to half the width: the sampling error of the extent of ~100 points); the exponent,
+    to its sampling error: half the width at 100 points, extent_jump); the exponent,
     a mean of log-slopes whose logs spread by about one (slopes lambda and lambda s), by
-    three standard errors of that mean; the width to 50%. Periodic rows (width 0) keep
-    the close tolerance of their points, 10 x EVENT_STATE / sigma_min in u. The
+    three standard errors of the difference of two such means (lyapunov_atol); the
+    width (max - min) to the sum of its two ends' tolerances (width_tolerance). Periodic
+    rows (width 0) keep the close tolerance of their points, 10 x EVENT_STATE / sigma_min in u. The
     classifications (period) may change at a few points near a boundary between types
     (at most one in fifty)."""
     p = scene["parameters"]
     sigma = min(limit_map.scale(e, t) for e in eps_list(p) for t in thetas(p))
     u_atol = 10 * tolerance.EVENT_STATE / sigma
     stat = "a sampled statistic of a chaotic orbit (another orbit on another machine)"
+    keep = int(p["n_keep"])
     pts = Tolerance(0.0, u_atol, "a chaotic orbit's points are not reproducible, only "
-                                 "where they lie: each row's extent, to half its width",
-                    rule="attractor", jump=0.5)
+                                 "where they lie: each row's extent, to its sampling error "
+                                 "(extent_jump: half the width at 100 points, "
+                                 "x sqrt(100/n_keep), the "
+                                 "extreme of n points of a band whose density vanishes "
+                                 "linearly at the image of the grazing point)",
+                    rule="attractor", jump=extent_jump(keep))
     lim = Tolerance(0.0, 1e-9, "limit map (numpy): chaotic where lambda s < -1; each row's "
                                "extent, to half its width", rule="attractor", jump=0.5)
-    mean = Tolerance(0.0, 6.0 / np.sqrt(int(p["n_keep"])),
+    mean = Tolerance(0.0, lyapunov_atol(keep),
                      f"{stat}: mean of n_keep correlated log-slopes, standard error "
                      f"~2/sqrt(n_keep) (per-return spread ~1, correlated over a few "
-                     f"returns), three of them: 6/sqrt(n_keep)")
+                     f"returns); two builds' means are independent estimates, their "
+                     f"difference sqrt(2) times that; three of those: 6 sqrt(2)/sqrt(n_keep)")
     n_pts = len(thetas(p)) * len(eps_list(p)) * len(s_grid(p))
     kind = Tolerance(0.0, 0.0, "a classification: points at a boundary of types (or with "
                                "an exponent within sampling error of 0) may change",
@@ -232,6 +262,22 @@ def chaos_tolerances(scene: dict) -> dict:
     return {"period": kind, "period_limit": kind, "period_limit0": kind,
             "u": pts, "u_limit": lim, "u_limit0": lim, "lyapunov": mean,
             "lyapunov_limit": mean,
-            "lyapunov_err": Tolerance(1.0, 6.0 / np.sqrt(int(p["n_keep"])),
+            "lyapunov_err": Tolerance(1.0, lyapunov_atol(keep),
                                       f"{stat}: spread of block means, itself sampled"),
-            "width": Tolerance(0.5, u_atol, f"{stat}: extent of the kept points")}
+            "width": width_tolerance(pts, stat)}
+
+
+def width_tolerance(points: Tolerance, stat: str, atol: float | None = None) -> Tolerance:
+    """The tolerance of a row's width, max - min of its kept points, implied by the
+    ``points``' rule ``attractor``: each end may move by ``points.atol`` plus
+    ``points.jump`` times the width, and the two ends independently (another orbit
+    samples each edge of the band anew), so the width by twice that: rtol 2 jump,
+    atol 2 points.atol (``atol``: instead, in other units, e.g. x2 = u eps^2)."""
+    if points.rule != "attractor":
+        raise ValueError(f"width_tolerance: points compared by rule 'attractor', got "
+                         f"{points.rule!r}")
+    atol = 2 * points.atol if atol is None else atol
+    return Tolerance(2 * points.jump, atol,
+                     f"{stat}: max - min of the kept points, each end within its sampling "
+                     f"error (the points' rule attractor: jump times the width each): "
+                     f"2 jump of the width")
