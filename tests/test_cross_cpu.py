@@ -344,3 +344,98 @@ def test_the_emulated_build_targets_every_scene():
     assert [t for t in got if t.startswith("figures/")] == [
         f"figures/{s}.{ext}" for s in scenes for ext in ("pdf", "png")]
     assert "results/hard_cases.nc" in got
+
+
+# ----------------------------------------------------------------------------- derived tolerances
+def _declared(sid):
+    import importlib
+    scene = load_scene(ROOT / "config" / "scenes" / f"{sid}.yaml",
+                       ROOT / "config" / "schema" / "scene.schema.json")
+    return importlib.import_module(f"filippov.scenes.{sid}").tolerances(scene)
+
+
+@pytest.mark.parametrize("sid,width", [("fig12_period_adding", "width"),
+                                       ("fig14_atlas", "width"),
+                                       ("fig13_small_scale_chaos", "width"),
+                                       ("fig13_small_scale_chaos", "width_x2")])
+def test_a_width_is_declared_as_the_sum_of_its_two_ends_tolerances(sid, width):
+    # width = max - min of a row's kept points; the points are compared by their extent
+    # (rule attractor: each end within atol + jump x width), so the width within twice
+    # that -- not a separate guess (it was 0.5, tighter than its ends: fig12 and fig14
+    # widths then moved by 0.28 of themselves at +-2 ulps, margin 1.76, while u held)
+    tols = _declared(sid)
+    u, w = tols["u"], tols[width]
+    assert u.rule == "attractor" and w.rule == "close"
+    assert w.rtol == 2 * u.jump
+    if width == "width":
+        assert w.atol == 2 * u.atol
+    else:   # in x2: two event-located states
+        assert w.atol == 2 * tolerance.EVENT_STATE
+    # each end at its limit, in opposite directions: the width at its limit
+    ref, moved = 1.0, 1.0 - 2 * (u.jump * 1.0 + u.atol)
+    if width == "width":
+        assert abs(moved - ref) <= w.allowed(ref) * (1 + 1e-12)
+
+
+def test_the_saddle_node_search_history_ends_with_its_converged_sample():
+    # rule trace compares the last finite sample: it must be the correction at the full
+    # rtol (v0_sn_search, x1_sn), not the largest v0 of a sorted history (before: M at
+    # the secant's start v0_guess + 1e-3, at the search rtol 1e-8 and xatol 1e-5, which
+    # moved by 1e-8 at +-2 ulps against its atol 1e-8)
+    from filippov.scenes import fig11_dfo_retmaps as f11
+
+    man = json.loads(manifest.MANIFEST.read_text())["data"]["fig11_dfo_retmaps"]["variables"]
+    final = {n: man[n]["final"] for n in ("sn_branch_v0", "sn_branch_x1", "sn_branch_M")}
+    assert final["sn_branch_v0"] == man["v0_sn_search"]["sample"]
+    assert final["sn_branch_x1"] == man["x1_sn"]["sample"]
+    # the last M is M'(v0) (v0_sn_search - v0_sn): its tolerance the slope bound times
+    # v0_sn_search's tolerance
+    tol = f11.TOLERANCES["sn_branch_M"]
+    assert tol.rule == "trace"
+    assert tol.atol == f11.SN_SLOPE_BOUND * f11.V0_SEARCH_RTOL * f11.SN_V0_BOUND
+    assert f11.TOLERANCES["v0_sn_search"].rtol == f11.V0_SEARCH_RTOL
+    assert max(man["v0_sn"]["sample"]) <= f11.SN_V0_BOUND
+    # the bounds hold for the recorded data: |M'| from the widest pair of samples
+    v = np.array(man["sn_branch_v0"]["sample"], dtype=float).reshape(2, -1)
+    m = np.array(man["sn_branch_M"]["sample"], dtype=float).reshape(2, -1)
+    for vi, mi in zip(v, m):
+        ok = np.isfinite(vi) & np.isfinite(mi)
+        lo, hi = np.argmin(vi[ok]), np.argmax(vi[ok])
+        slope = (mi[ok][hi] - mi[ok][lo]) / (vi[ok][hi] - vi[ok][lo])
+        assert 0.5 < abs(slope) <= f11.SN_SLOPE_BOUND
+    for vs, vn, mf in zip(man["v0_sn_search"]["sample"], man["v0_sn"]["sample"],
+                          final["sn_branch_M"]):
+        assert abs(mf) <= f11.SN_SLOPE_BOUND * abs(vs - vn) + 1e-9
+
+
+def test_the_work_precision_reference_check_is_compared_as_an_error(tmp_path):
+    # the difference of two solves at rtol 1e-13 is an error, re-drawn by step choices:
+    # rule order (as error_map); measured at +-2 ulps: 1.59e-12 -> 9.7e-13
+    from filippov.benchmarks import work_precision as wp
+
+    tol = wp.tolerances()["reference_check"]
+    assert tol.rule == "order" and tol.rtol == wp.tolerances()["error_map"].rtol
+    base = np.array([1.59e-12, 4.6e-14, 2.0e-13, 3.0e-13])
+    moved = base.copy()
+    moved[0] = 9.7e-13
+    assert _verdicts(base, moved, tol, tmp_path) == (True,) * 4
+    moved[0] = 1e-10   # a real loss of the references' agreement
+    assert _verdicts(base, moved, tol, tmp_path) == (False,) * 4
+
+
+@pytest.mark.parametrize("sid", ["fig12_period_adding", "fig13_small_scale_chaos",
+                                 "fig14_atlas"])
+def test_chaotic_statistics_follow_their_sampling_laws(sid):
+    # an end of the extent of the kept points: a sample extreme, within the row's width
+    # (a sampled statistic, no numerics-based bound); the exponent: three standard
+    # errors (2/sqrt(n) each) of the difference of two builds' independent means
+    from filippov.scenes import attractor_common as ac
+
+    scene = load_scene(ROOT / "config" / "scenes" / f"{sid}.yaml",
+                       ROOT / "config" / "schema" / "scene.schema.json")
+    n = int(scene["parameters"]["n_keep"])
+    tols = _declared(sid)
+    assert tols["u"].jump == ac.EXTENT_JUMP == 1.0 and tols["u"].rule == "attractor"
+    assert "sampled statistic" in tols["u"].why
+    assert tols["lyapunov"].atol == pytest.approx(3 * np.sqrt(2) * 2 / np.sqrt(n), rel=1e-15)
+    assert tols["lyapunov_err"].atol == tols["lyapunov"].atol

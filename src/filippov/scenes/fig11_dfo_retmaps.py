@@ -96,6 +96,17 @@ LATEX_NAMES = {
 _ONSET = ("the onset of sticking is a grid point of each panel: whether that orbit "
           "slides is decided at a tangency (onset known to a few 1e-11, x1_onset_step)")
 _FOLD = "at the fold P(x1) - x1 has a flat maximum: its argmax is square-root conditioned"
+#: v0 from the saddle-node search at sn_search_rtol = 1e-8: converged to that rtol; x10
+V0_SEARCH_RTOL = 1e-7
+#: |dM/dv0| at the fold, M(v0) = max_x1 P - x1: 1.46 and 1.56 (eps 0.1, 0.01: the secant's
+#: widest pair of iterates, manifest data), bounded by 2
+SN_SLOPE_BOUND = 2.0
+#: v0 at the fold: 3.32 and 3.17 (v0_sn), bounded by 3.5
+SN_V0_BOUND = 3.5
+#: the last sample of the search history is M at v0_sn_search (full rtol): M'(v0) times
+#: v0_sn_search's offset from the fold, so it moves as v0_sn_search does, times |M'|
+#: (M's own rounding at the full rtol, ~1e-10 as P's, is below that)
+SN_M_ATOL = SN_SLOPE_BOUND * V0_SEARCH_RTOL * SN_V0_BOUND
 #: cross-machine tolerances (filippov.tolerance)
 TOLERANCES = {
     "n_switches": Tolerance(0.0, 0.0, _ONSET + ": one crossing pair more or less",
@@ -115,16 +126,20 @@ TOLERANCES = {
     "sliding_length_sn": Tolerance(1e-9, 1e-4, _FOLD + "; the slide near the fold grows "
                                                        "steeply in x1 (~100 per unit)"),
     "sliding_time_sn": Tolerance(1e-9, 1e-4, "as sliding_length_sn"),
-    "v0_sn_search": Tolerance(1e-7, 1e-12, "secant at sn_search_rtol = 1e-8: converged to "
-                                           "that rtol; x10"),
-    "sn_branch_v0": Tolerance(1e-7, 1e-12, "secant history: only the last iterate is a "
-                                           "result (as v0_sn_search)", rule="trace"),
-    "sn_branch_x1": Tolerance(1e-9, 1e-5, "secant history: only the last iterate is a "
-                                          "result, an argmax at the search's rtol 1e-8 (x1_sn "
-                                          "is then corrected at the full rtol)", rule="trace"),
-    "sn_branch_M": Tolerance(1e-9, 1e-8, "secant history: only the last iterate is a "
-                                         "result, max of P - x1 at the search tolerance 1e-8",
-                             rule="trace"),
+    "v0_sn_search": Tolerance(V0_SEARCH_RTOL, 1e-12, "secant at sn_search_rtol = 1e-8: "
+                                                     "converged to that rtol; x10"),
+    "sn_branch_v0": Tolerance(V0_SEARCH_RTOL, 1e-12, "secant history: only the last sample "
+                                                     "is a result (= v0_sn_search)",
+                              rule="trace"),
+    "sn_branch_x1": Tolerance(1e-9, 1e-5, "secant history: only the last sample is a "
+                                          "result, the argmax of the correction at the full "
+                                          "rtol (= x1_sn, 1e-6); x10", rule="trace"),
+    "sn_branch_M": Tolerance(1e-9, SN_M_ATOL, "secant history: only the last sample is a "
+                                          "result, M at v0_sn_search and the full rtol, "
+                                          "M'(v0) (v0_sn_search - v0_sn): |M'| <= "
+                                          f"{SN_SLOPE_BOUND:g} times the tolerance of "
+                                          f"v0_sn_search ({V0_SEARCH_RTOL:g} of v0 <= "
+                                          f"{SN_V0_BOUND:g})", rule="trace"),
 }
 
 
@@ -292,8 +307,9 @@ def saddle_node(eps, law, x1_lo, x1_hi, v0_guess, *, rtol=1e-12, atol=1e-14,
     ``rtol``: v_sn = v_search - M_full(v_search) / M'(v0) (one Newton step;
     M' from the secant iterates).
 
-    Returns (x1 at the fold, v0 at the fold, samples (v0, M, argmax), v0 from
-    the search tolerance alone).
+    Returns (x1 at the fold, v0 at the fold, samples (v0, M, argmax) in the order
+    they were taken -- the last is the correction's, at v0 from the search and the
+    full rtol --, v0 from the search tolerance alone).
     """
     samples = []
     state = {"x": None}
@@ -327,7 +343,9 @@ def saddle_node(eps, law, x1_lo, x1_hi, v0_guess, *, rtol=1e-12, atol=1e-14,
     # onset of sticking P - x1 is sharply curved (error G'' dx^2 / 2 in M)
     m_full = M(v_search, rtol, win=2e-3, xatol=1e-7)
     v_sn = v_search - m_full / slope
-    return float(samples[-1][2]), float(v_sn), np.array(sorted(samples)), float(v_search)
+    # the samples in the order they were taken: the last one is the correction's
+    # evaluation at the full rtol (the converged value; rule trace compares it alone)
+    return float(samples[-1][2]), float(v_sn), np.array(samples), float(v_search)
 
 
 # --------------------------------------------------------------------------- onset of sticking
@@ -606,12 +624,14 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
          "P_onset": ("panel", [float(np.interp(o[0], x1, m["P"])) for o, m in zip(onsets, maps)], {
              "long_name": "P at the onset of sticking (a grid point)", "units": one}),
          "sn_branch_x1": (("panel", "branch"), br_x1, {
-             "long_name": "saddle-node search iterates: argmax over x1 of P(x1) - x1",
+             "long_name": "saddle-node search samples in the order taken (the last: the "
+                          "correction at the full rtol): argmax over x1 of P(x1) - x1",
              "units": one}),
          "sn_branch_v0": (("panel", "branch"), br_v0, {
-             "long_name": "saddle-node search iterates: v0", "units": one}),
+             "long_name": "saddle-node search samples (as sn_branch_x1): v0", "units": one}),
          "sn_branch_M": (("panel", "branch"), br_M, {
-             "long_name": "saddle-node search iterates: max over x1 of P(x1) - x1",
+             "long_name": "saddle-node search samples (as sn_branch_x1): max over x1 of "
+                          "P(x1) - x1",
              "units": one}),
          "chi_minus": ((), chi, {"long_name": "dh/dx f_- - dh/dx f_+ at the grazing point "
                                  "(eq:chiminus); > 0: case 1 of thm:gen", "units": one}),

@@ -26,7 +26,7 @@ from ..analytic import limit_map
 from ..io import finalize
 from ..tolerance import Tolerance
 from .attractor_common import (CHUNK_AXIS, ENGINES, chunk_grid, T_RETURN,  # noqa: F401
-                               VARIABLE_ATTRS as _COMMON_ATTRS, chaos_tolerances,
+                               VARIABLE_ATTRS as _COMMON_ATTRS, chaos_tolerances, width_tolerance,
                                common_dataset, eps_list, lyapunov_limit, s_grid, sweep, thetas)
 from .attractor_common import validate as _validate_common
 from ..config import SceneError
@@ -73,12 +73,14 @@ VARIABLE_ATTRS.update({
 
 
 def tolerances(scene: dict) -> dict:
-    """attractor_common.chaos_tolerances, and for the derived widths: width_x2 to its
-    sampling error (50%), the width exponent, a log10 ratio of two widths a decade of
-    eps apart, to log10(1.5/0.5) ~ 0.5."""
+    """attractor_common.chaos_tolerances, and for the derived widths: width_x2 as the
+    width (attractor_common.width_tolerance: its two ends' sampling errors); the width
+    exponent, a log10 ratio of two widths a decade of eps apart, to log10(1.5/0.5) ~ 0.5."""
     out = chaos_tolerances(scene)
     stat = "a sampled statistic of a chaotic orbit (another orbit on another machine)"
-    out["width_x2"] = Tolerance(0.5, tolerance.EVENT_STATE, f"{stat}: extent of the points")
+    # width_x2 = width eps^2 (x2 coordinates): the width's rule, its atol that of two
+    # event-located x2 (the ends)
+    out["width_x2"] = width_tolerance(out["u"], stat, atol=2 * tolerance.EVENT_STATE)
     out["width_exponent"] = Tolerance(0.0, 0.5, f"{stat}: slope of log widths over three or "
                                       "more eps, each width to 50% (ln 3 moves the slope by "
                                       "< 0.25 a decade apart)")
