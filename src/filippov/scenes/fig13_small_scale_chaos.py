@@ -81,9 +81,11 @@ def tolerances(scene: dict) -> dict:
     # width_x2 = width eps^2 (x2 coordinates): the width's rule, its atol that of two
     # event-located x2 (the ends)
     out["width_x2"] = width_tolerance(out["u"], stat, atol=2 * tolerance.EVENT_STATE)
-    out["width_exponent"] = Tolerance(0.0, 0.5, f"{stat}: slope of log widths over three or "
-                                      "more eps, each width to 50% (ln 3 moves the slope by "
-                                      "< 0.25 a decade apart)")
+    out["width_exponent"] = Tolerance(0.0, 0.5, f"{stat}: least-squares slope of log10 "
+                                      "width over three or more eps a decade apart, each "
+                                      "width within a factor 3 either way (measured: 0.28 of "
+                                      "itself at most, +-2 ulps); log10 3 = 0.48 at both ends, "
+                                      "opposite ways, moves the slope by at most 0.48")
     out["width_exponent_err"] = Tolerance(0.0, 0.5, f"{stat}: residuals of the same fit")
     out["chaotic"] = out["period"]   # a classification, as the period
     return out
