@@ -346,6 +346,18 @@ def orthogonal_unit(draw, n, c):
     return e / np.linalg.norm(e)
 
 
+def surface(draw, dims):
+    """The dimension and the shape of a switching surface h(z) = c.z - d + k (e.z)^2 (c a
+    unit normal, e orthogonal to it; flat, e = 0 and k = 0, unless a curved one is
+    drawn): (n, c, e, k)."""
+    n = draw(st.sampled_from(dims), label="n")
+    c = unit(draw, n, "c")
+    curved = draw(st.booleans(), label="curved H")
+    e = orthogonal_unit(draw, n, c) if curved else np.zeros(n)
+    k = draw(st.floats(-0.4, 0.4), label="k") if curved else 0.0
+    return n, c, e, k
+
+
 # ----------------------------------------------------------------------------- scanning
 def first_root(g, t0, t1, num=801, scan=None):
     """The first sign change of the scalar g(t) on [t0, t1], by a grid and brentq (xtol
@@ -426,11 +438,7 @@ def saltation(f_before, f_after, grad):
 
 @st.composite
 def crossings(draw, dims=DIMS):
-    n = draw(st.sampled_from(dims), label="n")
-    c = unit(draw, n, "c")
-    curved = draw(st.booleans(), label="curved H")
-    e = orthogonal_unit(draw, n, c) if curved else np.zeros(n)
-    k = draw(st.floats(-0.4, 0.4), label="k") if curved else 0.0
+    n, c, e, k = surface(draw, dims)
     d = draw(st.floats(-0.5, 0.5), label="d")
     start = draw(st.sampled_from(["below", "on H", "repelling"]), label="start")
     sides = []
@@ -955,11 +963,7 @@ def section_start_from(n, p, z0) -> SectionStart:
 
 @st.composite
 def section_starts(draw, dims=DIMS):
-    n = draw(st.sampled_from(dims), label="n")
-    c = unit(draw, n, "c")
-    curved = draw(st.booleans(), label="curved H")
-    e = orthogonal_unit(draw, n, c) if curved else np.zeros(n)
-    k = draw(st.floats(-0.4, 0.4), label="k") if curved else 0.0
+    n, c, e, k = surface(draw, dims)
     # the orbit must rise through the section, fall back and rise again: a rotation
     A, V, re, im = draw(matrix(n, rotate_first=True), label="A")
     z0 = vector(draw, n, -1.0, 1.0)
