@@ -29,8 +29,45 @@ def test_the_compiled_engine_compiles_the_rules_themselves():
                              (kernel._central_step, rules.central_step),
                              (kernel._slides_in_section, rules.slides_in_section),
                              (kernel._carried_age, rules.carried_age),
-                             (kernel._far_side_probe, rules.far_side_probe)):
+                             (kernel._far_side_probe, rules.far_side_probe),
+                             (kernel._section_probe, rules.section_probe),
+                             (kernel._section_noise, rules.section_noise),
+                             (kernel._on_section_by_value, rules.on_section_by_value)):
         assert compiled.py_func is source
+
+
+def _noise_of(values):
+    noise = 0.0
+    for j in range(2, len(values)):
+        noise = rules.section_noise(noise, values[j - 2], values[j - 1], values[j])
+    return noise
+
+
+def test_the_section_s_rounding_is_measured_not_assumed():
+    """A section with terms of 22 against a state of 1 rounds in units of ulp(22): the
+    probes about a start see those steps (a straight line leaves nothing), and a start
+    whose value is within START_ULPS of them is on the section; a start 1e-12 off is not."""
+    z0 = np.array([0.125, -0.375, 1.0])
+    e = np.array([0.0874, 0.6989, 0.7098])
+    d = 22.2
+    s = lambda z: (e @ z + d) - (d + e @ z0)  # noqa: E731  (0 at z0 in exact arithmetic)
+    zr = z0 + 1.5e-14 * e
+    probe = np.empty(3)
+    values = []
+    for j in range(-rules.SECTION_PROBES, rules.SECTION_PROBES + 1):
+        assert rules.section_probe(z0, zr, j, probe)
+        values.append(s(probe))
+    noise = _noise_of(values)
+    ulp22 = np.spacing(22.2 + 0.6)
+    assert 0.25 * ulp22 <= noise <= 2 * ulp22
+    assert rules.on_section_by_value(-ulp22, noise)
+    assert not rules.on_section_by_value(-1e-12, noise)
+    # an exactly straight section measures no rounding
+    assert _noise_of([0.5 * j for j in range(17)]) == 0.0
+    # a crossing beyond the reach is never explained by rounding; NaN is no evidence
+    assert not rules.section_probe(z0, z0 + 1e-3, 1, probe)
+    nan = _noise_of([0.0, 1.0, np.nan, 1.0, 0.0])
+    assert np.isnan(nan) and not rules.on_section_by_value(0.0, nan)
 
 
 def test_an_age_is_carried_only_where_the_region_is_unambiguous():

@@ -480,6 +480,60 @@ def starts_on_section(s0, z0, sr, zr, z_start) -> bool:
     return frac * moved <= START_ULPS * max(_EPS * size, flow)
 
 
+#: Probes each side of the start (2 SECTION_PROBES + 1 points) that measure the section
+#: function's own rounding there: :func:`starts_on_section` judges rounding of the state,
+#: but a section whose terms are large against the state (s = c.z - d with |d| = 22 at
+#: |z| ~ 1: s rounds in units of 3.6e-15) puts a start "on" it a hair below by more than
+#: the state's rounding -- found by tests/test_properties.py: the compiled engine
+#: returned such a start itself at t = 1.5e-14. The section is a black box, so its
+#: rounding is measured, not assumed from |z|.
+SECTION_PROBES = 8
+#: Probes only for a crossing this close to the start (relative to the state): a start
+#: rounding puts below a section whose terms are up to ~1e10 times the state. Over a
+#: span this short s is straight far below its rounding (its curvature term s'' L^2
+#: against s' L at L <= 1e-6), so a genuine crossing's change is never taken for noise.
+SECTION_PROBE_REACH = 1e-6
+
+
+def section_probe(z0, zr, j: int, out) -> bool:
+    """Probe point j (|j| <= SECTION_PROBES) of the section's rounding at the start z0:
+    ``out`` <- z0 + j steps along the straight way to the crossing zr, each step 8
+    rounding units of the state or 1/SECTION_PROBES of the way, whichever is longer (the
+    probes span the crossing, so a section that rounds coarsely against its change per
+    unit of state shows its steps). False (``out`` untouched) when zr is beyond
+    SECTION_PROBE_REACH of z0: then no rounding explains the crossing."""
+    size, dist2 = _TINY, 0.0
+    for k in range(z0.size):
+        size = max(size, abs(z0[k]), abs(zr[k]))
+        dist2 += (zr[k] - z0[k]) * (zr[k] - z0[k])
+    dist = np.sqrt(dist2)
+    if not dist <= SECTION_PROBE_REACH * size:
+        return False
+    step = max(8.0 * _EPS * size, dist / SECTION_PROBES) * j / dist if dist > 0.0 else 0.0
+    for k in range(z0.size):
+        out[k] = z0[k] + step * (zr[k] - z0[k])
+    return True
+
+
+def section_noise(worst: float, s_2: float, s_1: float, s: float) -> float:
+    """One step of the section's rounding measured at consecutive probes (values s_2,
+    s_1, s at probes j-2, j-1, j): the largest half second difference so far. The probes
+    are equally spaced on a line, so s's straight part cancels and, over their span,
+    its curvature is far below rounding: what is left is the steps of its rounding (a
+    coarse staircase: half a unit at each step). Streamed so the compiled engine needs
+    no array for it. A non-finite value makes it NaN."""
+    d = 0.5 * abs(s - 2.0 * s_1 + s_2)
+    return d if (d > worst or d != d) else worst
+
+
+def on_section_by_value(s0: float, noise: float) -> bool:
+    """The start's section value s0 is within START_ULPS of the section's measured
+    rounding (:func:`section_noise` over the probes) of 0: the start is on the section,
+    and a crossing in its first sample interval is the start itself, not a return. A
+    non-finite value is no evidence (False)."""
+    return abs(s0) <= START_ULPS * noise
+
+
 def band_probe(r: float, step: float, lo: float, clear: bool):
     """One step of the walk back from a crossing found while the stay is still inside
     its exit's rounding band (at ``r`` H is beyond the band's far edge: the banded

@@ -777,6 +777,22 @@ def _speed_rates(system, Z, z0):
     return rates
 
 
+def _in_section_rounding(func, s0, z0, zr) -> bool:
+    """rules.on_section_by_value: the start's section value s0 within the section's own
+    rounding, measured at the probes rules.section_probe places about z0 toward the
+    crossing zr (no probes beyond its reach: False)."""
+    probe = np.empty_like(z0)
+    noise, s_2, s_1 = 0.0, 0.0, 0.0
+    for j in range(-rules.SECTION_PROBES, rules.SECTION_PROBES + 1):
+        if not rules.section_probe(z0, zr, j, probe):
+            return False
+        s = float(func(probe.copy()))
+        if j >= 2 - rules.SECTION_PROBES:
+            noise = rules.section_noise(noise, s_2, s_1, s)
+        s_2, s_1 = s_1, s
+    return rules.on_section_by_value(s0, noise)
+
+
 def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xtol, traj,
           band=0.0, unbanded=None):
     """Earliest event in the samples ``ts`` of one segment, or None; and the band still
@@ -905,11 +921,13 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
                 zr = Z(r)
                 if sec.where is not None and not sec.where(zr):
                     continue
-                if (i == 0 and ta == traj.t0
-                        and rules.starts_on_section(float(sv[0]), np.asarray(zs[:, 0], dtype=float),
-                                               float(sec.func(zr)), np.asarray(zr, dtype=float),
-                                               np.asarray(traj.z0, dtype=float).reshape(-1))):
-                    continue
+                if i == 0 and ta == traj.t0:
+                    z_first = np.asarray(zs[:, 0], dtype=float)
+                    z_root = np.asarray(zr, dtype=float).reshape(-1)
+                    if (rules.starts_on_section(float(sv[0]), z_first, float(sec.func(zr)), z_root,
+                                                np.asarray(traj.z0, dtype=float).reshape(-1))
+                            or _in_section_rounding(sec.func, float(sv[0]), z_first, z_root)):
+                        continue
                 best = (r, "section", k)
         if best is not None:
             r, what, k = best

@@ -83,14 +83,15 @@ _jit_inline = njit(cache=True, _nrt=False, inline="always")
  _slides_in_section, _starts_on_section, _same_instant, _start_side, _start_on_switch,
  _next_mode, _accumulates, _exit_shift, _dips_and_returns, _exact_window, _onto_switch,
  _exit_drift, _carried_age, _far_side_probe, _exit_band, _banded_shift, _clears_band,
- _band_probe, _speed_extremum_between, _speed_graze, _rate_step, _flow_consistent) = (
+ _band_probe, _speed_extremum_between, _speed_graze, _rate_step, _flow_consistent,
+ _section_probe, _section_noise, _on_section_by_value) = (
     _jit_rule(getattr(rules, name)) for name in (
     "after", "crosses", "clamp", "far_side", "extremum_between", "graze", "central_step",
     "slides_in_section", "starts_on_section", "same_instant", "start_side", "start_on_switch",
     "next_mode", "accumulates", "exit_shift", "dips_and_returns", "exact_window",
     "onto_switch", "exit_drift", "carried_age", "far_side_probe", "exit_band",
     "banded_shift", "clears_band", "band_probe", "speed_extremum_between", "speed_graze",
-    "rate_step", "flow_consistent"))
+    "rate_step", "flow_consistent", "section_probe", "section_noise", "on_section_by_value"))
 assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 
 

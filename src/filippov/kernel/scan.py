@@ -10,7 +10,8 @@ from .base import (OK, ROOT_FAILED, _EPS, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, 
                    _TO_NONPOS, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_NONE, _W_SECTION, _W_SWITCH,
                    _after, _band_probe, _clamp, _clears_band, _crosses, _dips_and_returns, _dot, _extremum_between,
                    _flow_consistent, _graze, _jit, _rate_step, _same_instant, _speed_extremum_between, _speed_graze,
-                   _speeds, _starts_on_section, _field_minus,
+                   _speeds, _starts_on_section, _field_minus, _section_probe, _section_noise,
+                   _on_section_by_value,
                    _field_plus, _grad_h, _h, _section, _where)
 from .segment import (_fval, _rates, _zat)
 from .roots import (_brentq, _refine)
@@ -68,6 +69,21 @@ def _flow_follows(za, zb, dt, speed2_a, fb):
         d2 += (zb[c] - za[c]) * (zb[c] - za[c])
         size = max(size, abs(za[c]), abs(zb[c]))
     return _flow_consistent(np.sqrt(d2), dt, np.sqrt(speed2_a), np.sqrt(_dot(fb, fb)), size)
+
+
+@_jit
+def _in_section_rounding(fns, p, s0, z0, zr, probe):
+    """simulate._in_section_rounding: the start's section value s0 within the section's
+    rounding measured at the probes about z0 toward zr (``probe``: scratch)."""
+    noise, s_2, s_1 = 0.0, 0.0, 0.0
+    for j in range(-rules.SECTION_PROBES, rules.SECTION_PROBES + 1):
+        if not _section_probe(z0, zr, j, probe):
+            return False
+        s = _section(fns, probe, p)
+        if j >= 2 - rules.SECTION_PROBES:
+            noise = _section_noise(noise, s_2, s_1, s)
+        s_2, s_1 = s_1, s
+    return _on_section_by_value(s0, noise)
 
 
 @_jit
@@ -201,8 +217,13 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
                     at_start = False
                     if ts[i] == 0.0:
                         _zat(ts[i], mode, sg, za, F, y_old, fns, p, wg)
-                        at_start = _starts_on_section(svals[i], wg, _section(fns, wz, p), wz,
-                                                      za)
+                        # the closed form's start za counts for an exact flow only; a
+                        # dense output (integrated, sliding) starts at wg itself and za is
+                        # stale there (it took crossings within 64 x 1e-10 for the start)
+                        exact = mode != SLIDING and sg[3] == 0.0
+                        at_start = (_starts_on_section(svals[i], wg, _section(fns, wz, p), wz,
+                                                       za if exact else wg)
+                                    or _in_section_rounding(fns, p, svals[i], wg, wz, wf))
                     if not at_start:
                         best_t, best_w = r, _W_SECTION
         if best_w != _W_NONE:
