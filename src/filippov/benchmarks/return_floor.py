@@ -32,6 +32,20 @@ Run ``python -m filippov.benchmarks.return_floor`` (part of ``make bench``). For
   rate along the orbit, the section), a bound no scan at this resolution gets below.
 
 The table says, per case, the CPU time, the evaluations, the floor and the distance.
+
+What the rest is (perf with a symbol map of the kernel, commit 92c2930 on the 2-core
+development machine, share of the CPU time of 2000-return calls): at theta = -0.5,
+eps = 1e-2 the flow of region + is half of a return (flow_plus 15%, and in libm expm1
+21%, sincos 10%, exp 3%), the sample loop's own code 20% (mostly passing the work arrays
+to five pieces a sample at their compiled addresses), root solves (brentq, _fval,
+_refine) 10%, the scan 6%, the driver 6%, the other pieces 7%; at theta = 0.2, eps =
+1e-4 the flow 36%, the sample loop 13%, sliding (DOP853's stages, dense output, the
+Filippov field) 20%, root solves 10%, scan and driver 9%. So the targets of issue 33
+(5 us at theta < 0, 10 us at theta > 0) lie at or below the floor where eps is small:
+at theta < 0 the evaluations alone cost 3.8-6.5 us (eps = 1e-2 .. 1e-6) and the flows
+alone 2.0-3.7 us; at theta > 0, 6-9 us before any DOP853 arithmetic. Fewer samples
+(a coarser declared resolution) or a cheaper flow piece (the model's expm1 and sincos)
+would move the floor, and the datasets with it.
 """
 from __future__ import annotations
 
