@@ -123,3 +123,18 @@ def test_parallel_scaling_table(monkeypatch):
     assert np.all(ds.returns_per_second.values > 0)
     assert np.all(ds.span.values <= ds.cpu_time.values * 1.05)  # one thread's share
     assert "load average" in lines[0] and ds.attrs["load_average_before"] >= 0
+
+
+def test_return_floor_counts_without_changing_returns(monkeypatch):
+    # the counting pieces give the same returns bit for bit (measure raises otherwise);
+    # an exact-flow return evaluates each of flow, h, grad h, field and section at least
+    # once per sample, and the floor is below the time of the return itself
+    from filippov.benchmarks import return_floor as rf
+    monkeypatch.setattr(rf, "CASES", [(-0.5, 1e-2, 1.0)])
+    lines = []
+    ds = rf.run(returns=20, repeat=1, log=lines.append)
+    assert ds.samples.values[0] > 16 and ds.calls_section_where.values[0] == 1.0
+    flows = ds.calls_flow_plus.values[0] + ds.calls_flow_minus.values[0]
+    assert flows == ds.samples.values[0] + ds.root_flows.values[0]
+    assert 0 < ds.flow_floor.values[0] < ds.floor.values[0]
+    assert ds.target.values[0] == 5e-6 and "floor" in lines[0]

@@ -125,6 +125,21 @@ rule bench_attractor_cost:
         "../scripts/bench_attractor_cost.py"
 
 
+# Where one return of the iterated Hopf map goes: CPU time per return, the model
+# evaluations it makes (counted) and their cost alone (the floor), printed as a table.
+rule bench_return_floor:
+    output:
+        "results/bench_return_floor.nc",
+    params:
+        code=library_hash(exclude="plotting"),
+    log:
+        "logs/bench_return_floor.log",
+    conda:
+        "../envs/filippov.yaml"
+    script:
+        "../scripts/bench_return_floor.py"
+
+
 # The cost of one stiff sliding return of the Hopf example per eps (reference
 # driver, Radau IIA with 3 and 5 stages), printed as a table.
 rule bench_sliding_cost:
@@ -177,6 +192,7 @@ rule bench:
         rules.plot_bench.output,
         rules.bench_effect_cost.output,
         rules.bench_attractor_cost.output,
+        rules.bench_return_floor.output,
         rules.bench_sliding_cost.output,
         rules.bench_compile_cost.output,
         rules.bench_parallel_scaling.output,

@@ -33,7 +33,7 @@ from .base import (BAD_START, EVENT_LIMIT, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN
 from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
                      _dop_step, _non_finite_stage)
 from .segment import _zat
-from .scan import (_find, _flow_follows, _sample)
+from .scan import (_carry_sample, _find, _flow_follows, _sample)
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
 
@@ -127,8 +127,12 @@ def _window(mode, ta, tb, frac, first, fns, p, s, w):
     (_GO_ON, tb, _W_NONE) if there is none (the state at tb in w.z), (OK, te, what)
     at an event (its state in w.z), NO_RETURN at t_max, or an error (status, ta)."""
     ns = frac.size
-    ok, speed2_a = _sample(mode, ta, tb, frac, ns, w.sg, w.za, w.F, w.y_old, fns, p, w.ts,
-                           w.vals, w.dvals, w.svals, w.wz, w.wg, w.wf, w.wp, w.ynew)
+    # an exact flow's window after the first of its stay starts at the last one's end
+    k0 = 1 if (mode != SLIDING and w.sg[3] == 0.0 and not first) else 0
+    if k0 == 1:
+        _carry_sample(ns, w.sg, w.ts, w.vals, w.dvals, w.svals)
+    ok, speed2_a = _sample(mode, ta, tb, frac, ns, k0, w.sg, w.za, w.F, w.y_old, fns, p,
+                           w.ts, w.vals, w.dvals, w.svals, w.wz, w.wg, w.wf, w.wp, w.ynew)
     if not ok:
         return NON_FINITE, ta, _W_NONE
     # an exact flow (sg[3] == 0) must follow its field over the window: from the state at
@@ -383,7 +387,7 @@ def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, w
     dvals = np.empty((2, nsmax))
     svals = np.empty(nsmax)
     recent = np.empty(max(s.zeno_count, 1))
-    sg = np.zeros(8)
+    sg = np.zeros(10)
     za, y, f = np.zeros(n), np.zeros(n), np.zeros(n)
     y_old, f_old, ynew, ytmp, scale = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                                        np.zeros(n))

@@ -11,18 +11,27 @@ from .segment import _fval
 @_jit
 def _brentq(sel, xa, xb, xtol, rtol, maxiter, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
     """scipy.optimize.brentq (scipy/optimize/Zeros/brentq.c); returns (root, ok)."""
+    r, _, ok = _brentq_f(sel, xa, xb, xtol, rtol, maxiter, mode, sg, za, F, y_old, fns, p,
+                         wz, wg, wf)
+    return r, ok
+
+
+@_jit
+def _brentq_f(sel, xa, xb, xtol, rtol, maxiter, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
+    """_brentq, returning (root, the function's value there, ok): the value at the root
+    is the one it evaluated last (or at xa), which _refine's far-side probe needs first."""
     xpre, xcur = xa, xb
     xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
     fpre = _fval(sel, xpre, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
     fcur = _fval(sel, xcur, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
     if np.isnan(fpre) or np.isnan(fcur):
-        return xcur, False
+        return xcur, fcur, False
     if fpre == 0.0:
-        return xpre, True
+        return xpre, fpre, True
     if fcur == 0.0:
-        return xcur, True
+        return xcur, fcur, True
     if (fpre < 0.0) == (fcur < 0.0):
-        return xcur, False
+        return xcur, fcur, False
     for _ in range(maxiter):
         if fpre != 0.0 and fcur != 0.0 and ((fpre < 0.0) != (fcur < 0.0)):
             xblk = xpre
@@ -38,7 +47,7 @@ def _brentq(sel, xa, xb, xtol, rtol, maxiter, mode, sg, za, F, y_old, fns, p, wz
         delta = (xtol + rtol * abs(xcur)) / 2.0
         sbis = (xblk - xcur) / 2.0
         if fcur == 0.0 or abs(sbis) < delta:
-            return xcur, True
+            return xcur, fcur, True
         if abs(spre) > delta and abs(fcur) < abs(fpre):
             if xpre == xblk:
                 stry = -fcur * (xcur - xpre) / (fcur - fpre)  # interpolate
@@ -63,8 +72,8 @@ def _brentq(sel, xa, xb, xtol, rtol, maxiter, mode, sg, za, F, y_old, fns, p, wz
             xcur += delta if sbis > 0 else -delta
         fcur = _fval(sel, xcur, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
         if np.isnan(fcur):
-            return xcur, False
-    return xcur, False
+            return xcur, fcur, False
+    return xcur, fcur, False
 
 
 @_jit
@@ -73,19 +82,24 @@ def _refine(sel, pred, ta, tb, va, xtol, mode, sg, za, F, y_old, fns, p, wz, wg,
     pred = _far_side(pred, va)
     if va == 0.0:
         r = ta
+        fr = _fval(sel, r, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
     else:
-        r, ok = _brentq(sel, ta, tb, xtol, 4.0 * _EPS, _MAXITER_EVENT, mode, sg, za, F, y_old, fns, p,
-                        wz, wg, wf)
+        # fr: the value at r, which brentq evaluated last (the same call, bit for bit:
+        # not evaluated again for the first far-side probe)
+        r, fr, ok = _brentq_f(sel, ta, tb, xtol, 4.0 * _EPS, _MAXITER_EVENT, mode, sg, za, F,
+                              y_old, fns, p, wz, wg, wf)
         if not ok:
             # as simulate._refine: no sign change because the start sample of a
             # just-entered mode was clamped inside while the true value is already
             # past the crossing -- the event is at once
-            if _after(pred, _fval(sel, ta, mode, sg, za, F, y_old, fns, p, wz, wg, wf)):
+            fr = _fval(sel, ta, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+            if _after(pred, fr):
                 r = ta
             else:
                 return r, False
     done, step = False, 0.0
     while not done:  # to the far side of the crossing (rules.far_side_probe)
-        done, r, step = _far_side_probe(
-            r, step, tb, _after(pred, _fval(sel, r, mode, sg, za, F, y_old, fns, p, wz, wg, wf)))
+        done, r, step = _far_side_probe(r, step, tb, _after(pred, fr))
+        if not done:
+            fr = _fval(sel, r, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
     return r, True

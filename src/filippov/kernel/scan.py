@@ -18,14 +18,16 @@ from .roots import (_brentq, _refine)
 
 
 @_jit
-def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, svals,
+def _sample(mode, ta, tb, frac, ns, k0, sg, za, F, y_old, fns, p, ts, vals, dvals, svals,
             wz, wg, wf, wp, zlast):
     """Samples of one window: times ts, the leave functions (h, or a and b when
     sliding), their rates (dh/dt; the rates of a and b along the orbit while sliding,
     rules.rate_step: sg[7]) and the section; the last state in zlast. (False: non-finite,
-    |f|^2 at the first sample outside sliding -- the state at ta -- for _flow_follows)."""
-    speed2_a = 0.0
-    for k in range(ns):
+    |f|^2 at the first sample outside sliding -- the state at ta -- for _flow_follows).
+    Samples from k0 on: k0 = 1 when the caller carried sample 0 over (_carry_sample);
+    outside sliding the last sample's h and |f|^2 are kept in sg[8], sg[9] for that."""
+    speed2_a = sg[9] if k0 == 1 else 0.0
+    for k in range(k0, ns):
         tk = ta + frac[k] * (tb - ta) if k < ns - 1 else tb
         ts[k] = tk
         _zat(tk, mode, sg, za, F, y_old, fns, p, wz)
@@ -47,7 +49,8 @@ def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, s
                 dvals[0, k] = da
                 dvals[1, k] = db
         else:
-            vals[0, k] = _h(fns, wz, p) - sg[4]
+            hk = _h(fns, wz, p)
+            vals[0, k] = hk - sg[4]
             _grad_h(fns, wz, p, wg)
             if mode == PLUS:
                 _field_plus(fns, wz, p, wf)
@@ -56,7 +59,22 @@ def _sample(mode, ta, tb, frac, ns, sg, za, F, y_old, fns, p, ts, vals, dvals, s
             dvals[0, k] = _dot(wg, wf)
             if k == 0:
                 speed2_a = _dot(wf, wf)
+            if k == ns - 1:  # for the next window's sample 0 (_carry_sample)
+                sg[8] = hk
+                sg[9] = _dot(wf, wf)
     return True, speed2_a
+
+
+@_jit
+def _carry_sample(ns, sg, ts, vals, dvals, svals):
+    """Sample 0 of an exact flow's window that goes on from the window before in the
+    same stay: the state at its start is that window's last sample (the same flow from
+    the same entry over the same time, bit for bit), so its values are taken over
+    instead of evaluated again (h less the current sg[4], which may have changed)."""
+    ts[0] = ts[ns - 1]
+    vals[0, 0] = sg[8] - sg[4]
+    dvals[0, 0] = dvals[0, ns - 1]
+    svals[0] = svals[ns - 1]
 
 
 @_jit

@@ -14,6 +14,8 @@ from .dop853 import _dense_eval
 # (rules.exit_band, rules.banded_shift; 0 once it is out); sg[6]: the exit_shift alone;
 # sg[7]: while sliding, the step of the central differences that give the rates of a and
 # b along the orbit in the current window (rules.rate_step; 0: none).
+# sg[8], sg[9]: outside sliding, h and |f|^2 at the last sample of the last window (the
+# next window's first sample: scan._carry_sample).
 @_jit
 def _zat(t, mode, sg, za, F, y_old, fns, p, out):
     if mode == SLIDING or sg[3] != 0.0:
