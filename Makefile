@@ -103,11 +103,13 @@ if ! "$(1)/bin/python" -m pip --version >/dev/null 2>&1; then \
 fi
 endef
 
-$(VENV)/.done: requirements.lock pyproject.toml | check-python
+$(VENV)/.done: requirements.lock pyproject.toml workflow/pyproject.toml | check-python
 	@echo "== setting up $(VENV) from requirements.lock"
 	@$(call make_venv,$(VENV))
 	$(PY) -m pip install -r requirements.lock
-	$(PY) -m pip install --no-deps -e .
+	# the library (src/filippov) and the paper's pipeline (workflow/filippov_paper): two
+	# distributions, both editable
+	$(PY) -m pip install --no-deps -e . -e workflow
 	touch $@
 
 venv: $(VENV)/.done
@@ -141,7 +143,7 @@ cross-cpu: $(VENV)/.done
 	$(VENV_PATH) $(PY) tests/crosscpu/cross_cpu.py $(CROSS_CPU_ARGS)
 
 manifest: figures
-	$(VENV_PATH) $(PY) -m filippov.manifest update
+	$(VENV_PATH) $(PY) -m filippov_paper.manifest update
 
 TEX_INSTALL = apt-get install -y --no-install-recommends texlive-publishers texlive-latex-extra texlive-latex-recommended texlive-fonts-recommended latexmk
 report: $(VENV)/.done
@@ -161,7 +163,7 @@ bench: $(VENV)/.done
 # BENCH_ARGS="--every 10" for a quick run).
 BENCH_ARGS ?=
 bench-fig04: $(VENV)/.done
-	$(VENV_PATH) $(PY) -m filippov.benchmarks.fig04_speed $(BENCH_ARGS)
+	$(VENV_PATH) $(PY) -m filippov_paper.benchmarks.fig04_speed $(BENCH_ARGS)
 
 lock: | check-python
 	tmp=$$(mktemp -d); trap 'rm -rf "$$tmp"' EXIT; \
@@ -176,7 +178,7 @@ lock: | check-python
 	  echo "#  $(subst ",,$(LOCK_PKGS))"; \
 	  echo "#  then 'pip freeze'.) Installed by 'make' into $(VENV) with 'pip install -r'."; \
 	  echo "# Resolved with $$("$$tmp/venv/bin/python" -c 'import platform as p; print("Python", p.python_version(), "on", p.system(), p.machine())')."; \
-	  "$$tmp/venv/bin/python" -m pip freeze --exclude-editable --exclude filippov; \
+	  "$$tmp/venv/bin/python" -m pip freeze --exclude-editable --exclude filippov --exclude filippov-paper; \
 	} > requirements.lock.tmp; \
 	mv requirements.lock.tmp requirements.lock; \
 	echo "wrote requirements.lock ($$(grep -c '==' requirements.lock) pins)"

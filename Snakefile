@@ -1,10 +1,11 @@
 # Workflow entry point: scene (config/scenes/<id>.yaml) -> results/<id>.nc
-# -> figures/<id>.{pdf,png}. The workflow knows files only; numerics live in
-# src/filippov and are reached through the thin scripts in workflow/scripts.
+# -> figures/<id>.{pdf,png}. The workflow knows files only; numerics live in the
+# library (src/filippov), the paper's scenes, figures and report in the pipeline package
+# (workflow/filippov_paper), both reached through the thin scripts in workflow/scripts.
 
 import sys
 
-from filippov.config import SceneError, load_workflow_config
+from filippov_paper.config import SceneError, load_workflow_config
 
 # config/config.yaml, validated against its schema (one line naming the file and
 # line/column or field when it is malformed); --config values on the command

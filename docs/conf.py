@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "src"))   # the sources of this tree, installed or not
+sys.path[:0] = [str(ROOT / "src"), str(ROOT / "workflow")]   # this tree's sources, installed or not
 os.environ.setdefault("MPLBACKEND", "Agg")
 
 import filippov  # noqa: E402

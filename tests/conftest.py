@@ -1,6 +1,7 @@
 """Shared paths and the one Snakemake build the workflow tests share.
 
-Makes `src/` importable when the package is not installed.
+Makes `src/` (the library) and `workflow/` (the paper's pipeline, filippov_paper)
+importable from this tree first, installed or not.
 """
 import sys
 import time
@@ -10,8 +11,10 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 SRC = ROOT / "src"
-if str(SRC) not in sys.path:
-    sys.path.insert(0, str(SRC))
+PIPELINE = ROOT / "workflow"   # holds the package filippov_paper
+for _path in (PIPELINE, SRC):
+    if str(_path) not in sys.path:
+        sys.path.insert(0, str(_path))
 
 
 # hypothesis profiles (tests/test_properties.py): "ci", the default, is derandomized (the

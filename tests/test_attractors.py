@@ -6,7 +6,7 @@ import pytest
 from filippov import attractors
 from filippov.fastmap import OK, compute_returns
 from filippov.models import hopf
-from filippov.scenes.fig04_retmaps import section_L1
+from filippov_paper.scenes.fig04_retmaps import section_L1
 from filippov.simulate import simulate
 from filippov.variational import return_jacobian
 

@@ -1,4 +1,4 @@
-"""The benchmarks' timing convention (filippov.benchmarks.timing): a warm-up call that
+"""The benchmarks' timing convention (filippov_paper.benchmarks.timing): a warm-up call that
 is not timed, at least ``min_rounds`` timed rounds, the median shown and the min kept.
 
 No absolute time is asserted (machines are shared and noisy): the helper is tested on
@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from filippov.benchmarks import timing, work_precision as wp
+from filippov_paper.benchmarks import timing, work_precision as wp
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -70,7 +70,7 @@ def test_measure_lets_a_failure_through():
 
 def test_the_report_names_the_statistic_the_benchmarks_show():
     # the captions of the work-precision table and figure say "median" in words: the
-    # statistic of filippov.benchmarks.timing (the sentence with numbers uses macros)
+    # statistic of filippov_paper.benchmarks.timing (the sentence with numbers uses macros)
     assert timing.STATISTIC == "median"
     attrs = timing.describe(min_rounds=4, min_time=0.5)
     assert attrs["timing_statistic"] == "median" and attrs["timing_min_rounds"] == 4

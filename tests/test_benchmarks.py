@@ -6,7 +6,7 @@ Speed is not asserted here (machines are shared and noisy): the numbers live in
 import numpy as np
 import pytest
 
-from filippov.benchmarks import effect_cost, work_precision as wp
+from filippov_paper.benchmarks import effect_cost, work_precision as wp
 
 
 def test_work_precision_smoke(tmp_path):
@@ -99,7 +99,7 @@ def test_chunked_benchmark_parts_merge_in_order():
 
 def test_compile_cost_times_a_cold_and_a_warm_process():
     # one pair of fresh processes (the first compiles the kernel on empty caches, ~20 s)
-    from filippov.benchmarks import compile_cost
+    from filippov_paper.benchmarks import compile_cost
     lines = []
     ds = compile_cost.run(repeat=1, log=lambda *a, **k: lines.append(" ".join(map(str, a))))
     assert list(ds.stage.values) == [s for s, _ in compile_cost.STAGES]
@@ -113,7 +113,7 @@ def test_compile_cost_times_a_cold_and_a_warm_process():
 def test_parallel_scaling_table(monkeypatch):
     # a small batch with 1..N workers: the table has a row per worker count, the results
     # were checked equal across them (run raises otherwise), and the CPU times are there
-    from filippov.benchmarks import parallel_scaling as ps
+    from filippov_paper.benchmarks import parallel_scaling as ps
     monkeypatch.setattr(ps, "MIN_TIME", 0.0)
     monkeypatch.setattr(ps, "cores", lambda: 2)
     lines = []
@@ -129,7 +129,7 @@ def test_return_floor_counts_without_changing_returns(monkeypatch):
     # the counting pieces give the same returns bit for bit (measure raises otherwise);
     # an exact-flow return evaluates each of flow, h, grad h, field and section at least
     # once per sample, and the floor is below the time of the return itself
-    from filippov.benchmarks import return_floor as rf
+    from filippov_paper.benchmarks import return_floor as rf
     monkeypatch.setattr(rf, "CASES", [(-0.5, 1e-2, 1.0)])
     lines = []
     ds = rf.run(returns=20, repeat=1, log=lines.append)

@@ -4,7 +4,7 @@ Every figure of the report (a ``figure`` environment of paper/*.tex) is found by
 file its ``\\includegraphics`` names, drawn by its plotting module from the synthetic
 dataset of tests/synthetic.py (no pipeline), and every colour it draws -- lines,
 markers, line strokes, patches, collections, colour-mesh cells, annotations, legend
-keys -- is named with filippov.plotting.style.colour_name. Each colour word of the
+keys -- is named with filippov_paper.plotting.style.colour_name. Each colour word of the
 caption must be one of those names; where the caption puts a colour in parentheses
 after a legend label ("slow-fast (black)"), the legend key of that label must have it.
 """
@@ -24,13 +24,13 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.text import Annotation
 
-import filippov.plotting as plotting
+import filippov_paper.plotting as plotting
 import synthetic
-from filippov.plotting import style
+from filippov_paper.plotting import style
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = ROOT / "paper"
-PLOTTING = ROOT / "src" / "filippov" / "plotting"
+PLOTTING = ROOT / "workflow" / "filippov_paper" / "plotting"
 
 #: words a caption could use for a colour ("gray" is read as "grey")
 COLOUR_WORDS = {"black", "white", "grey", "gray", "red", "orange", "yellow", "green", "blue",

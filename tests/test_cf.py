@@ -6,7 +6,7 @@ import pytest
 import xarray as xr
 
 from filippov.io import REFERENCE
-from filippov.manifest import data_files
+from filippov_paper.manifest import data_files
 
 
 @pytest.fixture(scope="module")

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from filippov.manifest import data_files
+from filippov_paper.manifest import data_files
 
 SUITE = "cf:1.8"
 

@@ -1,4 +1,4 @@
-"""Chunked sweeps (filippov.scenes.chunking): chunks computed apart and merged give
+"""Chunked sweeps (filippov_paper.scenes.chunking): chunks computed apart and merged give
 exactly the dataset of one unsplit compute -- xarray-identical and the same bytes
 on disk -- for the return maps (fig04, split over x2), the discontinuity maps
 (fig07, fig09, split over xi1), the dry-friction bifurcation diagram (fig10,
@@ -10,12 +10,12 @@ import random
 import numpy as np
 import pytest
 
-pytest.importorskip("filippov.scenes", reason="compute code (filippov.scenes) not importable yet")
+pytest.importorskip("filippov_paper.scenes", reason="compute code (filippov_paper.scenes) not importable yet")
 
 import filippov.io
-import filippov.scenes
-from filippov.config import SceneError, load_scene
-from filippov.scenes import chunking
+import filippov_paper.scenes
+from filippov_paper.config import SceneError, load_scene
+from filippov_paper.scenes import chunking
 
 from conftest import ROOT
 
@@ -65,15 +65,15 @@ def test_bounds_partition_the_grid_like_array_split(size, n):
 @pytest.mark.parametrize("sid", CHUNKED)
 def test_merged_chunks_identical_to_compute(sid, tmp_path):
     scene = small_scene(sid)
-    whole = filippov.scenes.compute(scene)
+    whole = filippov_paper.scenes.compute(scene)
     n = 3
-    parts = [roundtrip(filippov.scenes.compute_chunk(scene, i, n), tmp_path / f"{i}.nc")
+    parts = [roundtrip(filippov_paper.scenes.compute_chunk(scene, i, n), tmp_path / f"{i}.nc")
              for i in range(n)]
     axis = parts[0].attrs["chunk_axis"]
     sizes = [p[axis].size for p in parts]
     assert len(set(sizes)) <= 2 and min(sizes) >= 1  # a real split
     random.Random(0).shuffle(parts)  # merge orders them itself
-    merged = filippov.scenes.merge(scene, parts)
+    merged = filippov_paper.scenes.merge(scene, parts)
     assert merged.identical(whole)
     filippov.io.write_dataset(whole, tmp_path / "whole.nc")
     filippov.io.write_dataset(merged, tmp_path / "merged.nc")
@@ -84,40 +84,40 @@ def test_chunks_key_is_layout_not_data(tmp_path):
     """`chunks` does not enter the dataset: with or without it, same result."""
     scene = small_scene("fig07_pdm_theta_neg")
     with_key = dict(scene, chunks=2)
-    whole = filippov.scenes.compute(scene)
-    assert filippov.scenes.compute(with_key).identical(whole)
-    parts = [roundtrip(filippov.scenes.compute_chunk(with_key, i), tmp_path / f"{i}.nc")
+    whole = filippov_paper.scenes.compute(scene)
+    assert filippov_paper.scenes.compute(with_key).identical(whole)
+    parts = [roundtrip(filippov_paper.scenes.compute_chunk(with_key, i), tmp_path / f"{i}.nc")
              for i in range(2)]  # n from the scene's `chunks`
-    assert filippov.scenes.merge(with_key, parts).identical(whole)
+    assert filippov_paper.scenes.merge(with_key, parts).identical(whole)
     assert "chunks" not in whole.attrs["scene_config"]
 
 
 def test_merge_rejects_incomplete_or_foreign_chunks():
     scene = small_scene("fig07_pdm_theta_neg")
-    parts = [filippov.scenes.compute_chunk(scene, i, 3) for i in range(3)]
+    parts = [filippov_paper.scenes.compute_chunk(scene, i, 3) for i in range(3)]
     with pytest.raises(ValueError, match="chunks 0..2"):
-        filippov.scenes.merge(scene, parts[:2])
+        filippov_paper.scenes.merge(scene, parts[:2])
     with pytest.raises(ValueError, match="chunks 0..2"):
-        filippov.scenes.merge(scene, [parts[0], parts[0], parts[2]])
+        filippov_paper.scenes.merge(scene, [parts[0], parts[0], parts[2]])
     other = small_scene("fig07_pdm_theta_neg")
     other["parameters"]["n_uniform"] = 11
     with pytest.raises(ValueError, match="different scene"):
-        filippov.scenes.merge(other, parts)
-    two = [filippov.scenes.compute_chunk(scene, i, 2) for i in range(2)]
+        filippov_paper.scenes.merge(other, parts)
+    two = [filippov_paper.scenes.compute_chunk(scene, i, 2) for i in range(2)]
     with pytest.raises(ValueError, match="different splits"):
-        filippov.scenes.merge(scene, [parts[0], two[1]])
+        filippov_paper.scenes.merge(scene, [parts[0], two[1]])
 
 
 def test_bad_chunk_requests_fail_clearly():
     scene = small_scene("fig07_pdm_theta_neg")
-    n_points = filippov.scenes._module(scene).chunk_grid(scene).size
+    n_points = filippov_paper.scenes._module(scene).chunk_grid(scene).size
     with pytest.raises(ValueError, match="need 1 <= chunks"):
-        filippov.scenes.compute_chunk(scene, 0, n_points + 1)
+        filippov_paper.scenes.compute_chunk(scene, 0, n_points + 1)
     with pytest.raises(ValueError, match="out of range"):
-        filippov.scenes.compute_chunk(scene, 3, 3)
+        filippov_paper.scenes.compute_chunk(scene, 3, 3)
     sketch = load_scene(ROOT / "config" / "scenes" / "fig08_s0theta.yaml", SCHEMA)
     with pytest.raises(ValueError, match="cannot be split"):
-        filippov.scenes.compute_chunk(sketch, 0, 2)
+        filippov_paper.scenes.compute_chunk(sketch, 0, 2)
     with pytest.raises(ValueError, match="integer >= 1"):
         chunking.n_chunks({"id": "x", "chunks": 0})
 

@@ -3,7 +3,7 @@ from pathlib import Path
 
 import pytest
 
-from filippov.config import SceneError, load_scene
+from filippov_paper.config import SceneError, load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "config" / "schema" / "scene.schema.json"
@@ -79,9 +79,9 @@ def test_s0_range_must_be_ordered(tmp_path):
 
 def test_a_scene_brings_its_own_parameter_block(tmp_path, monkeypatch):
     # fig04's parameters are closed by PARAMETERS_SCHEMA in its module
-    # (filippov.scenes.fig04_retmaps), not by a block in the shared schema: a typo there
+    # (filippov_paper.scenes.fig04_retmaps), not by a block in the shared schema: a typo there
     # is named, and a block that is not a literal is named as such
-    import filippov.config as config
+    import filippov_paper.config as config
     text = (ROOT / "config" / "scenes" / "fig04_retmaps.yaml").read_text()
     assert "closest:" in text
     path = _write(tmp_path, text.replace("closest:", "closets:"), "fig04_retmaps")
@@ -105,12 +105,12 @@ def test_every_scene_module_declares_a_readable_block():
     # imported module holds
     import importlib
 
-    from filippov.config import scene_schema_block
-    from filippov.scenes import known_scenes
+    from filippov_paper.config import scene_schema_block
+    from filippov_paper.scenes import known_scenes
     blocks = 0
     for sid in known_scenes():
         block = scene_schema_block(sid)
-        module = importlib.import_module(f"filippov.scenes.{sid}")
+        module = importlib.import_module(f"filippov_paper.scenes.{sid}")
         assert block == getattr(module, "PARAMETERS_SCHEMA", None), sid
         blocks += block is not None
     assert blocks >= 10
@@ -142,8 +142,8 @@ def test_the_compute_hash_leaves_out_exactly_the_report_part():
     # the hash would miss code it runs)
     import ast
 
-    from filippov.config import SCENE_MODULES, is_report_part, without_report_part
-    from filippov.scenes import known_scenes
+    from filippov_paper.config import SCENE_MODULES, is_report_part, without_report_part
+    from filippov_paper.scenes import known_scenes
     for sid in known_scenes():
         text = (SCENE_MODULES / f"{sid}.py").read_text()
         kept = without_report_part(text)

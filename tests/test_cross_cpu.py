@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from filippov import manifest, scenes, tolerance
-from filippov.config import load_scene, scene_files
+from filippov_paper import manifest, scenes, tolerance
+from filippov_paper.config import load_scene, scene_files
 from filippov.io import write_dataset
-from filippov.tolerance import Tolerance
+from filippov_paper.tolerance import Tolerance
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "tests" / "crosscpu"))
@@ -119,7 +119,7 @@ def test_work_precision_errors_agree_whichever_build_wrote_the_manifest(tmp_path
     # the manifest check (against 2.45e-8) while its spread against the native build
     # failed: the verdict depended on which machine wrote the reference. The rule of
     # an error must be symmetric, and must hold for what a last-bit change does.
-    from filippov.benchmarks import work_precision as wp
+    from filippov_paper.benchmarks import work_precision as wp
 
     tol = wp.tolerances()["error_switch"]
     base = np.array([3.4e-5, 2.5e-6, 1.4e-9, 1.3e-12, 4.6e-6, 1.4e-7, 1.9e-9, 2.3e-11])
@@ -272,7 +272,7 @@ def test_runs_are_the_seeds_and_one_with_every_result_moved():
 
 
 def test_environment_fingerprint_tracks_the_arithmetic(shim):
-    code = "from filippov import manifest; print(manifest.environment())"
+    code = "from filippov_paper import manifest; print(manifest.environment())"
 
     def fingerprint(extra):
         env = dict(os.environ, **extra)
@@ -351,7 +351,7 @@ def _declared(sid):
     import importlib
     scene = load_scene(ROOT / "config" / "scenes" / f"{sid}.yaml",
                        ROOT / "config" / "schema" / "scene.schema.json")
-    return importlib.import_module(f"filippov.scenes.{sid}").tolerances(scene)
+    return importlib.import_module(f"filippov_paper.scenes.{sid}").tolerances(scene)
 
 
 @pytest.mark.parametrize("sid,width", [("fig12_period_adding", "width"),
@@ -382,7 +382,7 @@ def test_the_saddle_node_search_history_ends_with_its_converged_sample():
     # rtol (v0_sn_search, x1_sn), not the largest v0 of a sorted history (before: M at
     # the secant's start v0_guess + 1e-3, at the search rtol 1e-8 and xatol 1e-5, which
     # moved by 1e-8 at +-2 ulps against its atol 1e-8)
-    from filippov.scenes import fig11_dfo_retmaps as f11
+    from filippov_paper.scenes import fig11_dfo_retmaps as f11
 
     man = json.loads(manifest.MANIFEST.read_text())["data"]["fig11_dfo_retmaps"]["variables"]
     final = {n: man[n]["final"] for n in ("sn_branch_v0", "sn_branch_x1", "sn_branch_M")}
@@ -411,7 +411,7 @@ def test_the_saddle_node_search_history_ends_with_its_converged_sample():
 def test_the_work_precision_reference_check_is_compared_as_an_error(tmp_path):
     # the difference of two solves at rtol 1e-13 is an error, re-drawn by step choices:
     # rule order (as error_map); measured at +-2 ulps: 1.59e-12 -> 9.7e-13
-    from filippov.benchmarks import work_precision as wp
+    from filippov_paper.benchmarks import work_precision as wp
 
     tol = wp.tolerances()["reference_check"]
     assert tol.rule == "order" and tol.rtol == wp.tolerances()["error_map"].rtol
@@ -429,7 +429,7 @@ def test_chaotic_statistics_follow_their_sampling_laws(sid):
     # an end of the extent of the kept points: a sample extreme, within the row's width
     # (a sampled statistic, no numerics-based bound); the exponent: three standard
     # errors (2/sqrt(n) each) of the difference of two builds' independent means
-    from filippov.scenes import attractor_common as ac
+    from filippov_paper.scenes import attractor_common as ac
 
     scene = load_scene(ROOT / "config" / "scenes" / f"{sid}.yaml",
                        ROOT / "config" / "schema" / "scene.schema.json")

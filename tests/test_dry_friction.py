@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from filippov.models import dry_friction as df
-from filippov.scenes import fig10_dfo as f10
-from filippov.scenes import fig11_dfo_retmaps as f11
+from filippov_paper.scenes import fig10_dfo as f10
+from filippov_paper.scenes import fig11_dfo_retmaps as f11
 from filippov.simulate import Section, simulate
 
 LAW = {"f0": -2.0, "fv": 0.3, "fc": 2.5, "convention": "stribeck"}

@@ -84,7 +84,7 @@ def test_a_shallow_crossing_is_followed_past_the_rounding_of_h(engine):
     from filippov.fastmap import compute_returns
     from filippov.models import hopf
     from filippov.poincare import first_returns as returns
-    from filippov.scenes.fig04_retmaps import section_L1
+    from filippov_paper.scenes.fig04_retmaps import section_L1
 
     eps, theta, mu = 1e-2, 0.2, 1 + 3e-4
     noisy = np.array([[-2.374618293487855e-15, 1.0000380794232673, -2.374618293487855e-15]])

@@ -111,7 +111,8 @@ def test_example_uses_the_public_api_only(name):
 @pytest.mark.parametrize("name", SCRIPTS)
 def test_example_runs_as_a_program(name):
     env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT / "src"), env.get("PYTHONPATH")]))
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT / "src"), str(ROOT / "workflow"),
+                                                      env.get("PYTHONPATH")]))
     t0 = time.perf_counter()
     run = subprocess.run([sys.executable, str(EXAMPLES / f"{name}.py")], cwd=ROOT, env=env,
                          capture_output=True, text=True, timeout=60)

@@ -12,7 +12,7 @@ from filippov import EventLimitError, SimulationError, ZenoError, simulate
 from filippov import fastmap
 from filippov.models import hopf, pseudo_equilibrium
 from filippov.poincare import Returns
-from filippov.scenes.fig04_retmaps import return_map
+from filippov_paper.scenes.fig04_retmaps import return_map
 
 EPS, MU, OMEGA = 0.01, 1.0, 8 * np.pi
 OPTS = {"rtol": 1e-12, "atol": 1e-14}
@@ -120,7 +120,7 @@ def _python_integrated(system, z0s, t_max, section, **opts):
 @pytest.mark.parametrize("eps,v0", [(0.1, 3.32), (0.01, 3.1)])
 def test_dry_friction_compiled_integration_agrees_with_the_python_driver(eps, v0):
     from filippov.models import dry_friction as df
-    from filippov.scenes.fig11_dfo_retmaps import section_L
+    from filippov_paper.scenes.fig11_dfo_retmaps import section_L
 
     law = dict(gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck")
     x1 = np.linspace(4.15, 4.6, 10)
@@ -169,7 +169,7 @@ def test_hopf_with_integrated_regions_agrees_with_the_python_driver(theta):
     """The Hopf model with its flows switched off: the kernel integrates all modes."""
     import dataclasses
 
-    from filippov.scenes.fig04_retmaps import section_L1
+    from filippov_paper.scenes.fig04_retmaps import section_L1
 
     x2 = np.array([0.97, 0.999, 1.001, 1.01, 1.03])
     cm = dataclasses.replace(hopf.compiled(EPS, theta, MU, OMEGA), exact=False)

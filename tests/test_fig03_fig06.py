@@ -9,10 +9,10 @@ import pytest
 from scipy.optimize import brentq
 
 from filippov.analytic import sgraph
-from filippov.config import SceneError, load_scene
+from filippov_paper.config import SceneError, load_scene
 from filippov.models import hopf
-from filippov.scenes import compute
-from filippov.scenes.fig03_grazingsketch import x_l_tangency
+from filippov_paper.scenes import compute
+from filippov_paper.scenes.fig03_grazingsketch import x_l_tangency
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "config" / "schema" / "scene.schema.json"

@@ -6,7 +6,7 @@ import pytest
 from filippov.analytic.s0 import s0_lambert
 from filippov.models import hopf
 from filippov.poincare import fixed_points
-from filippov.scenes.fig04_retmaps import return_map, sigma_minus, x2_grid
+from filippov_paper.scenes.fig04_retmaps import return_map, sigma_minus, x2_grid
 
 OMEGA, MU = 8 * np.pi, 1.0
 OPTS = {"rtol": 1e-12, "atol": 1e-14}
@@ -110,24 +110,24 @@ def test_fixed_points_of_the_map():
 
 
 def test_engine_is_checked_per_scene():
-    import filippov.scenes
-    from filippov.scenes.common import engine
+    import filippov_paper.scenes
+    from filippov_paper.scenes.common import engine
     scene = {"id": "fig04_retmaps", "ingredients": {"flow": "integrate"},
              "solver": {"engine": "compiled"}}
     assert engine(scene) == "compiled"   # fig04 runs both flows on both engines
-    assert filippov.scenes._module(scene).ENGINES == ("python", "compiled")
+    assert filippov_paper.scenes._module(scene).ENGINES == ("python", "compiled")
     assert engine({"id": "x", "ingredients": {"flow": "exact"}}) == "python"
     # a scene without a compiled engine says so, naming the field
     other = {"id": "fig08_s0theta", "ingredients": {"flow": "exact"},
              "solver": {"engine": "compiled"}}
     with pytest.raises(ValueError, match="solver.engine: 'compiled' not available"):
-        filippov.scenes.compute(other)
+        filippov_paper.scenes.compute(other)
 
 
 def test_compiled_engine_integrates_when_asked():
     """flow: integrate on the compiled engine: DOP853 inside the kernel, the same
     map as the reference driver's integration and, to the tolerance, as the exact flows."""
-    from filippov.scenes.fig04_retmaps import return_map
+    from filippov_paper.scenes.fig04_retmaps import return_map
     x2 = np.array([0.97, 0.999, 1.001, 1.03])
     model = hopf.model(0.01, 0.5, 1.0, OMEGA)
     opts = {"rtol": 1e-12, "atol": 1e-14}
@@ -145,7 +145,7 @@ def test_scene_engines_agree():
     (theta < 0: P ~ sqrt(x2 - 1)) a rounding u of a crossing moves P by u |dP/dx2|
     (dP/dx2 from the compiled engine's derivative; 64 roundings; none at the touch)."""
     from filippov.fastmap import compute_returns
-    from filippov.scenes.fig04_retmaps import return_map
+    from filippov_paper.scenes.fig04_retmaps import return_map
     x2 = np.array([0.97, 0.999, 1.0, 1.0 + 1e-9, 1.001, 1.03])
     starts = np.stack([np.zeros_like(x2), x2, np.zeros_like(x2)], axis=1)
     for theta in (-0.5, 0.5):

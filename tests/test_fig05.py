@@ -13,13 +13,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import filippov.plotting as plotting
+import filippov_paper.plotting as plotting
 import synthetic
 from filippov import simulate
-from filippov.config import load_scene
+from filippov_paper.config import load_scene
 from filippov.models import hopf
-from filippov.scenes import compute
-from filippov.scenes import fig05_thetalt0mfs as fig05
+from filippov_paper.scenes import compute
+from filippov_paper.scenes import fig05_thetalt0mfs as fig05
 from filippov.system import MINUS, PLUS
 
 ROOT = Path(__file__).resolve().parents[1]

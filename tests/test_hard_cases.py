@@ -8,7 +8,8 @@ drift cannot pass. Speed is measured in `make bench`, not here.
 import numpy as np
 import pytest
 
-from filippov import SLIDING, ZenoError, fastmap, hard_cases, simulate
+from filippov import SLIDING, ZenoError, fastmap, simulate
+from filippov_paper import hard_cases
 from filippov.analytic import chatter
 from filippov.models import hopf, pseudo_equilibrium
 
@@ -28,14 +29,14 @@ def hopf_map(eps, theta, x2, mu=MU, **opts):
 
 
 # ----------------------------------------------------------------------- eps to 1e-6
-# The eps sweep is a workflow product (results/hard_cases.nc, filippov.hard_cases);
+# The eps sweep is a workflow product (results/hard_cases.nc, filippov_paper.hard_cases);
 # these tests assert on the same library code, run here over the same eps values.
 EPS_SWEEP = [1e-2, 1e-3, 1e-4, 1e-5, 1e-6]
 
 
 @pytest.fixture(scope="module")
 def eps_sweep():
-    """filippov.hard_cases.sweep over EPS_SWEEP: what results/hard_cases.nc holds."""
+    """filippov_paper.hard_cases.sweep over EPS_SWEEP: what results/hard_cases.nc holds."""
     ds = hard_cases.sweep(EPS_SWEEP)
     np.testing.assert_array_equal(ds.eps.values, EPS_SWEEP)
     return ds
@@ -317,7 +318,7 @@ def test_slow_windows_change_the_cost_not_the_result(theta, eps):
     """The Hopf map with and without the slow windows: same switches, same returns."""
     import dataclasses
 
-    from filippov.scenes.fig04_retmaps import section_L1
+    from filippov_paper.scenes.fig04_retmaps import section_L1
 
     fast_only = dataclasses.replace(hopf.model(eps, theta, MU, OMEGA).full(),
                                     slow_sample_step=np.nan)
@@ -344,7 +345,7 @@ def test_stiff_sliding_does_not_depend_on_the_blas_thread_count():
     import os
     import subprocess
     import sys
-    code = ("from filippov import hard_cases; r = hard_cases.sliding_return(1e-4); "
+    code = ("from filippov_paper import hard_cases; r = hard_cases.sliding_return(1e-4); "
             "print(repr(r['return_P']), r['return_steps'], r['return_stiff'])")
     out = set()
     for threads in ("1", "2"):

@@ -1,4 +1,4 @@
-"""The hard-case eps sweep as a workflow product (filippov.hard_cases,
+"""The hard-case eps sweep as a workflow product (filippov_paper.hard_cases,
 workflow/rules/hard_cases.smk): chunks merged give the unsplit sweep byte for
 byte, the merge refuses chunks that do not belong together, a bad `hard_cases:`
 block fails with the field named, and the workflow plans one job per chunk."""
@@ -11,7 +11,7 @@ import xarray as xr
 import yaml
 
 import filippov.io
-from filippov import hard_cases
+from filippov_paper import hard_cases
 
 from conftest import ROOT, copy_project, run_snakemake
 

@@ -6,7 +6,7 @@ import pytest
 
 from filippov import attractors, branches
 from filippov.fastmap import compute_returns
-from filippov.scenes import fig12_period_adding as fig12
+from filippov_paper.scenes import fig12_period_adding as fig12
 from filippov.analytic import limit_map
 from filippov.models import hopf
 
@@ -204,7 +204,7 @@ def test_the_chaos_ends_at_smaller_s_as_eps_shrinks():
 
 
 def test_width_exponents_are_fitted_over_three_eps_with_their_error():
-    from filippov.scenes.fig13_small_scale_chaos import width_exponents
+    from filippov_paper.scenes.fig13_small_scale_chaos import width_exponents
     eps = np.array([1e-2, 1e-3, 1e-4, 1e-5])
     fitted = eps <= 1e-3
     w = np.array([3.0, 2.0, 1.0])[None, None, :] * eps[None, :, None] ** 2

@@ -13,7 +13,7 @@ import pytest
 from filippov import attractors
 from filippov.analytic import limit_map
 from filippov.models import hopf
-from filippov.scenes.fig14_atlas import FLIP_ONE, FLIP_STEP, FLIP_TWO_OUTSIDE, slow_fast_flip
+from filippov_paper.scenes.fig14_atlas import FLIP_ONE, FLIP_STEP, FLIP_TWO_OUTSIDE, slow_fast_flip
 
 OMEGA = 8 * np.pi
 LAM = limit_map.multiplier(1.0, OMEGA)

@@ -7,7 +7,7 @@ import shutil
 import numpy as np
 import xarray as xr
 
-from filippov import manifest, tolerance
+from filippov_paper import manifest, tolerance
 from filippov.io import write_dataset
 
 

@@ -1,6 +1,6 @@
 """The Snakemake workflow end to end in a scratch copy of the project.
 
-Skipped only while the compute package `filippov.scenes` cannot be imported.
+Skipped only while the compute package `filippov_paper.scenes` cannot be imported.
 """
 import re
 import shutil
@@ -9,10 +9,10 @@ from pathlib import Path
 import pytest
 import yaml
 
-pytest.importorskip("filippov.scenes", reason="compute code (filippov.scenes) not importable yet")
+pytest.importorskip("filippov_paper.scenes", reason="compute code (filippov_paper.scenes) not importable yet")
 
 from conftest import copy_project, run_snakemake
-from filippov.config import scene_files
+from filippov_paper.config import scene_files
 
 
 def _project(tmp_path) -> Path:
@@ -109,8 +109,8 @@ def test_editing_a_workflow_script_reruns_its_rule_only(workflow_build, tmp_path
 
 def test_build_holds_the_hard_case_sweep_of_the_configured_eps(workflow_build):
     """results/hard_cases.nc of the build (chunk jobs, merged) is the sweep of
-    filippov.hard_cases over the configured eps in one process."""
-    from filippov import hard_cases
+    filippov_paper.hard_cases over the configured eps in one process."""
+    from filippov_paper import hard_cases
     from filippov.io import read_dataset
 
     work, run = workflow_build["work"], workflow_build["run"]

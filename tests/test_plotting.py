@@ -1,7 +1,7 @@
 """Every figure draws from a synthetic dataset and saves byte-reproducibly."""
 import pytest
 
-import filippov.plotting as plotting
+import filippov_paper.plotting as plotting
 import synthetic
 
 CASES = {"fig01_slidesketch": synthetic.fig01, "fig02_cases": synthetic.fig02, "fig03_grazingsketch": synthetic.fig03, "fig04_retmaps": synthetic.fig04, "fig05_thetalt0mfs": synthetic.fig05, "fig06_sgraph": synthetic.fig06,

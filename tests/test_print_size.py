@@ -20,9 +20,9 @@ import matplotlib.text
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-import filippov.plotting as plotting
+import filippov_paper.plotting as plotting
 import synthetic
-from filippov.plotting import style
+from filippov_paper.plotting import style
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = ROOT / "paper"
@@ -184,7 +184,7 @@ def test_no_font_size_below_the_minimum_in_the_code():
         if key == "font.size" or key.endswith(("labelsize", "titlesize", "fontsize")):
             assert isinstance(value, (int, float)) and value >= MIN_PT, (key, value)
     pattern = re.compile(r"\b(fontsize|labelsize|title_fontsize)\s*=\s*([^,)\s]+)")
-    for path in sorted((ROOT / "src" / "filippov" / "plotting").glob("*.py")):
+    for path in sorted((ROOT / "workflow" / "filippov_paper" / "plotting").glob("*.py")):
         for m in pattern.finditer(path.read_text(encoding="utf-8")):
             where, value = f"{path.name}: {m.group(0)}", m.group(2)
             if value.startswith("st.") or value.startswith("style."):

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 import yaml
 
-from filippov import EventLimitError, SimulationError, scenes, simulate
-from filippov.config import SceneError, check_limits, limits, load_scene
+from filippov import EventLimitError, SimulationError, simulate
+from filippov_paper import scenes
+from filippov_paper.config import SceneError, check_limits, limits, load_scene
 from filippov.models import hopf, pseudo_equilibrium
 from filippov.simulate import Section
 
@@ -119,7 +120,7 @@ def test_stiff_sliding_at_tiny_eps_is_cheap_and_leaves_at_its_tangential_exit(ep
     # slide. Before: at eps = 1e-7 Radau chased the field's rounding noise (11072
     # steps, 11 s); at eps = 1e-9 the exit point, one rounding below H, read as a
     # crossing back and the driver cycled slide_end/slide_start into a ZenoError.
-    from filippov.scenes.fig04_retmaps import section_L1
+    from filippov_paper.scenes.fig04_retmaps import section_L1
     model = hopf.model(eps, 0.5)
     traj = simulate(model.full(), [0.0, 1.2, 0.0], 1.0, sections=[section_L1()], dense=False)
     reduced = simulate(model.reduced(), [0.0, 1.2], 1.0, sections=[section_L1()], dense=False)
@@ -233,7 +234,7 @@ def test_malformed_config_names_file_line_and_column(project):
 def test_the_scenes_are_the_scene_files(project):
     # no list to keep: every config/scenes/*.yaml is built; a list in config.yaml picks
     # some, and an id without its file is named
-    from filippov.config import load_workflow_config
+    from filippov_paper.config import load_workflow_config
     cfg = project / "config/config.yaml"
     schema = project / "config/schema/config.schema.json"
     every = sorted(p.stem for p in (project / "config/scenes").glob("*.yaml"))
@@ -263,7 +264,7 @@ def test_engine_error_from_the_compute_job_is_one_line(project):
 
 
 def test_manifest_check_defaults_to_the_working_directory(tmp_path, monkeypatch):
-    from filippov import manifest
+    from filippov_paper import manifest
 
     monkeypatch.chdir(tmp_path)
     (tmp_path / "results").mkdir()

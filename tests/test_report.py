@@ -18,8 +18,8 @@ import xarray as xr
 import yaml
 
 from conftest import run_snakemake
-from filippov import report, scenes
-from filippov.config import scene_files
+from filippov_paper import report, scenes
+from filippov_paper.config import scene_files
 
 ROOT = Path(__file__).resolve().parents[1]
 TEX_PACKAGES = ("texlive-publishers texlive-latex-extra texlive-latex-recommended "
@@ -38,7 +38,7 @@ def test_number_formatting_round_trips():
 
 
 def test_absent_optional_results_say_not_yet_computed():
-    from filippov.scenes import fig10_dfo, fig11_dfo_retmaps
+    from filippov_paper.scenes import fig10_dfo, fig11_dfo_retmaps
     m = report.Macros()
     t10, t11 = fig10_dfo.report(None, m), fig11_dfo_retmaps.report(None, m)
     tb = report.bench(None, m)
@@ -53,7 +53,7 @@ def test_absent_optional_results_say_not_yet_computed():
 
 
 def test_the_compile_cost_is_quoted_when_measured():
-    from filippov.benchmarks.compile_cost import STAGES
+    from filippov_paper.benchmarks.compile_cost import STAGES
     names = [s for s, _ in STAGES]
     cc = xr.Dataset({"cold": ("stage", [0.9, 13.0, 1.9, 0.01, 11.6]),
                      "warm": ("stage", [0.7, 0.04, 0.48, 0.0, 0.05])}, coords={"stage": names})
@@ -74,7 +74,7 @@ def test_the_compile_cost_is_quoted_when_measured():
 def test_optional_tables_show_whatever_the_datasets_hold():
     ds = xr.Dataset({"v_hopf": ((), 2.5, {"long_name": "Hopf point"}),
                      "v_gs": ((), 3.25, {"long_name": "grazing-sliding point"})})
-    from filippov.scenes import fig10_dfo
+    from filippov_paper.scenes import fig10_dfo
     m = report.Macros()
     t10 = fig10_dfo.report(ds, m)
     assert "v\\_hopf" in t10 and "2.5" in t10 and report.NOT_YET not in t10
@@ -118,8 +118,8 @@ def test_no_number_typed_in_the_figure_prose():
 
 def test_the_paper_is_cited_by_its_printed_numbers():
     # every citation of the paper goes through paper/paper_labels.tex (derived from the
-    # paper's source by filippov.paper_labels): no raw label text, no unknown label
-    from filippov.paper_labels import read_tex
+    # paper's source by filippov_paper.paper_labels): no raw label text, no unknown label
+    from filippov_paper.paper_labels import read_tex
 
     known = read_tex((ROOT / "paper" / "paper_labels.tex").read_text())
     cited = set()
@@ -335,8 +335,8 @@ def test_html_report_links_every_figure_to_its_rule(workflow_build, tmp_path):
     # the physical parameters (not only a code hash)
     from html import escape as html_escape
 
-    from filippov.paper_labels import read_tex
-    from filippov.report_html import cite, printed_labels
+    from filippov_paper.paper_labels import read_tex
+    from filippov_paper.report_html import cite, printed_labels
 
     printed = read_tex((ROOT / "paper" / "paper_labels.tex").read_text())
     # the text a reader sees (docutils splits a literal such as ``eps = 1e-13`` at "-")
@@ -358,11 +358,11 @@ def test_html_report_links_every_figure_to_its_rule(workflow_build, tmp_path):
 
 
 def test_every_scene_declares_its_report_part():
-    # no list of scenes in filippov.report: each report part brings its own, and
+    # no list of scenes in filippov_paper.report: each report part brings its own, and
     # the report refuses to go on without a scene that does not declare itself optional
     import importlib
     for sid in scenes.known_scenes():
-        module = importlib.import_module(f"filippov.scenes.{sid}")
+        module = importlib.import_module(f"filippov_paper.scenes.{sid}")
         assert callable(module.report), sid
     with pytest.raises(ValueError, match="report needs the datasets of fig01_slidesketch"):
         report.generate({})

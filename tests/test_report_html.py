@@ -1,4 +1,4 @@
-"""Snakemake's HTML report (report.html, `make report-html`; filippov.report_html,
+"""Snakemake's HTML report (report.html, `make report-html`; filippov_paper.report_html,
 workflow/rules/report_html.smk, the caption templates workflow/report/*.rst).
 
 What the report must do: no docutils error ("System Message") in any caption; every
@@ -30,9 +30,9 @@ from docutils.core import publish_parts
 from jinja2 import Environment
 
 from conftest import ROOT, copy_project, run_snakemake
-from filippov import report_html
-from filippov.config import scene_files
-from filippov.paper_labels import read_tex
+from filippov_paper import report_html
+from filippov_paper.config import scene_files
+from filippov_paper.paper_labels import read_tex
 
 REPORT = ROOT / "workflow" / "report"
 LABELS = ROOT / "paper" / "paper_labels.tex"
@@ -361,7 +361,7 @@ def test_a_dataset_names_the_paper_s_numbers_not_its_labels():
     # scenes.printed: what a reader of the netCDF file sees in titles and long names
     import xarray as xr
 
-    from filippov.scenes import printed
+    from filippov_paper.scenes import printed
 
     ds = xr.Dataset({"image": ((), 1.0, {"long_name": "s from eq:xi1r", "equation": "eq:xi1r",
                                          "units": "1"})},

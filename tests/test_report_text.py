@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import synthetic
-from filippov import report
+from filippov_paper import report
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -118,7 +118,7 @@ def test_formulas_refuse_what_they_cannot_read(bad):
 
 
 def test_fig01_fields_are_math_not_code():
-    from filippov.scenes import fig01_slidesketch
+    from filippov_paper.scenes import fig01_slidesketch
     ds = synthetic.fig01().assign_attrs(
         crossing_fields="f_- = (1, 1 + x1/2), f_+ = (1, 1/2)",
         sliding_fields="f_- = (1, 1), f_+ = (1, -1 - x1^2/4)", switching_function="h = x2")

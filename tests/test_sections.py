@@ -16,7 +16,7 @@ import pytest
 from filippov import MINUS, PLUS, PiecewiseSystem, Section, SimulationError, fastmap, simulate
 from filippov.models import hopf
 from filippov.poincare import first_returns
-from filippov.scenes.fig04_retmaps import section_L1
+from filippov_paper.scenes.fig04_retmaps import section_L1
 
 # --------------------------------------------------------------------------- a planar crossing
 # Region + (x1 >= 0) turns about the origin, region - about (-C, 0); both fields

@@ -195,7 +195,7 @@ def test_sliding_excluded_is_said_in_the_systems_words():
 
 
 def test_the_scene_layer_adds_its_own_words():
-    from filippov import scenes
+    from filippov_paper import scenes
 
     system = pseudo_equilibrium.model(0.02, 0.4).full(sliding=False)
     scene = {"id": "fig05_thetalt0mfs", "ingredients": {"sliding": False}}

@@ -5,7 +5,7 @@ import pytest
 
 from filippov import simulate
 from filippov.models import hopf
-from filippov.scenes.fig04_retmaps import section_L1
+from filippov_paper.scenes.fig04_retmaps import section_L1
 from filippov.variational import VariationalError, return_jacobian, transition_matrix
 
 T_MAX = 4 * 2 * np.pi / (8 * np.pi)   # four rotation periods: one return to L1

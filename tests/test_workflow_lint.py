@@ -86,7 +86,7 @@ bar.step(); bar.step()
 print("a table line")
 sys.exit("error: fig99_test: something wrong")
 """
-    env = dict(os.environ, PYTHONPATH=str(ROOT / "src"))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(ROOT / "workflow")]))
     run = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True,
                          timeout=300, env=env)
     assert run.returncode == 1

@@ -274,7 +274,7 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     It agrees with :func:`filippov.variational.return_jacobian` and with finite
     differences of P (tests/test_return_jacobian.py). It costs little on exact flows
     and about 7 field evaluations per one on integrated stays (benchmark:
-    ``filippov.benchmarks.attractor_cost``). NaN where P is not
+    ``filippov_paper.benchmarks.attractor_cost``). NaN where P is not
     differentiable: a switch or section met tangentially, an orbit that touches H
     (``touch_tol``: the kink of P at grazing), a start that slides.
 

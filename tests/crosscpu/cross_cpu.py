@@ -55,14 +55,14 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
-sys.path.insert(0, str(ROOT / "src"))
+sys.path[:0] = [str(ROOT / "src"), str(ROOT / "workflow")]
 sys.path.insert(0, str(ROOT / "workflow" / "scripts"))
 
 from verify import copy_project, run_snakemake  # noqa: E402
 
-from filippov import manifest  # noqa: E402
+from filippov_paper import manifest  # noqa: E402
 from filippov.io import read_dataset  # noqa: E402
-from filippov.tolerance import spread  # noqa: E402
+from filippov_paper.tolerance import spread  # noqa: E402
 
 #: datasets whose numbers never pass through a transcendental function: the
 #: emulation cannot move them, and they are not required to move
@@ -106,7 +106,7 @@ SWEEPS = ("hard_cases", "work_precision")
 def targets(only: list[str] | None = None) -> list[str]:
     """What the workflow builds (every scene file's figures, unless config.yaml picks
     some, and the sweeps); ``only``: just these scene ids and sweeps."""
-    from filippov.config import load_workflow_config
+    from filippov_paper.config import load_workflow_config
 
     scenes = load_workflow_config(ROOT / "config" / "config.yaml",
                                   ROOT / "config" / "schema" / "config.schema.json")["scenes"]
@@ -141,7 +141,7 @@ def build(work: Path, env: dict | None, label: str, only: list[str] | None = Non
 
 
 def compare_builds(native: Path, emulated: Path) -> dict:
-    """{dataset: {variable: spread dict}} over full arrays (see filippov.tolerance.spread)."""
+    """{dataset: {variable: spread dict}} over full arrays (see filippov_paper.tolerance.spread)."""
     out = {}
     for nc in manifest.data_files(native / "results"):
         a, b = read_dataset(nc), read_dataset(emulated / "results" / nc.name)

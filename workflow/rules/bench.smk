@@ -1,6 +1,6 @@
 # The default build's work-precision sweep (part of `all`, about a minute): the
 # fig04 and fig11 maps on subgrids, the project's modes against solve_ivp RK45 and
-# DOP853 (preset "build" of filippov.benchmarks.work_precision). Its wall times
+# DOP853 (preset "build" of filippov_paper.benchmarks.work_precision). Its wall times
 # differ between any two runs (tolerance rule "measured"); its errors are
 # reproducible.
 rule work_precision:

@@ -16,12 +16,12 @@ from pathlib import Path
 
 import yaml
 
-from filippov.config import (DEFAULT_RESOLUTION, SceneError, apply_resolution, check_limits,
+from filippov_paper.config import (DEFAULT_RESOLUTION, SceneError, apply_resolution, check_limits,
                              limits)
 
 # Library parts no scene computation imports: editing them must not recompute data.
 # (hard_cases.py is the hard-case sweep's own module: rule hard_cases hashes it.)
-# The report part of each scene module (filippov.config.is_report_part) is left out of
+# The report part of each scene module (filippov_paper.config.is_report_part) is left out of
 # their hash as well (strip_reports=True).
 NOT_COMPUTE = ("plotting/", "benchmarks/", "report.py", "manifest.py",
                "hard_cases.py", "paper_labels.py", "report_html.py")
@@ -36,20 +36,25 @@ def library_hash(include="", exclude=(), strip_reports=False):
 
 @functools.lru_cache(maxsize=None)
 def _library_hash(include, exclude, strip_reports):
-    """sha256 over filippov's *.py files under `include`, minus the paths in
-    `exclude` (a folder "name/" or a file "name.py", relative to the package); with
-    `strip_reports`, the scene modules without their report part."""
-    from filippov.config import without_report_part
+    """sha256 over the *.py files of the library (filippov) and of the paper's pipeline
+    (filippov_paper) under `include`, minus the paths in `exclude` (a folder "name/" or a
+    file "name.py", relative to the package that holds it: the two packages share no
+    name, so "plotting" or "report.py" is the pipeline's); with `strip_reports`, the
+    scene modules without their report part."""
+    from filippov_paper.config import without_report_part
 
-    spec = importlib.util.find_spec("filippov")  # locates without importing numerics
-    if spec is None or not spec.origin:
-        return "filippov-not-found"
-    root = Path(spec.origin).parent
+    files = []
+    for package in ("filippov", "filippov_paper"):
+        spec = importlib.util.find_spec(package)  # locates without importing numerics
+        if spec is None or not spec.origin:
+            return f"{package}-not-found"
+        root = Path(spec.origin).parent
+        files += [(path.relative_to(root).as_posix(), path)
+                  for path in (root / include).rglob("*.py")]
     # a bare name is a folder ("plotting" == "plotting/"); join(e, "") adds the slash
     exclude = tuple(e if e.endswith(".py") else posixpath.join(e, "") for e in exclude)
     digest = hashlib.sha256()
-    for path in sorted((root / include).rglob("*.py")):
-        rel = path.relative_to(root).as_posix()
+    for rel, path in sorted(files):
         if any(rel == e or (e.endswith("/") and rel.startswith(e)) for e in exclude):
             continue
         text = path.read_bytes()
@@ -66,7 +71,7 @@ def fail(message):
     sys.exit(1)
 
 
-# (the HTML report's captions: report_html.smk and filippov.report_html)
+# (the HTML report's captions: report_html.smk and filippov_paper.report_html)
 
 
 # ----------------------------------------------------------------------------- scenes

@@ -32,7 +32,7 @@ rule compute:
 
 
 # A scene with `chunks: N` is computed as N jobs, each on a contiguous part of
-# the scene's grid (filippov.scenes.chunking), and merged into results/<id>.nc
+# the scene's grid (filippov_paper.scenes.chunking), and merged into results/<id>.nc
 # by one job that also computes what depends on the whole grid (fixed points,
 # errors, rates). The merged file is byte-identical to the one rule `compute`
 # writes. The chunk files are temporary: removed once the merge has succeeded.

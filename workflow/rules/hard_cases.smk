@@ -1,4 +1,4 @@
-# The hard-case sweep over eps (filippov.hard_cases): config["hard_cases"] lists
+# The hard-case sweep over eps (filippov_paper.hard_cases): config["hard_cases"] lists
 # the eps values and how many jobs share them (`chunks`). Each job measures a
 # contiguous part of the list (results/chunks/hard_cases/<i>.nc, temporary); one
 # local job merges them into results/hard_cases.nc, byte-identical to a sweep in
@@ -9,7 +9,7 @@
 import json
 
 HARD_CASES_SETTINGS = json.dumps(config.get("hard_cases"), sort_keys=True)
-# the compute code (as for the scenes) and filippov/hard_cases.py itself
+# the compute code (as for the scenes) and workflow/filippov_paper/hard_cases.py itself
 HARD_CASES_CODE = library_hash(exclude=[e for e in NOT_COMPUTE if e != "hard_cases.py"],
                                strip_reports=True)
 

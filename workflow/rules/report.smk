@@ -10,7 +10,7 @@
 # (results/hard_cases.nc, rule hard_cases) is an input: it takes seconds.
 # The helpers (tex_available, report_data, report_figures, bench_stamps) are in
 # common.smk.
-from filippov.config import scene_files
+from filippov_paper.config import scene_files
 
 report: "../report/workflow.rst"
 
@@ -18,7 +18,7 @@ report: "../report/workflow.rst"
 # module; a comment when it has none), for every scene file in config/scenes, so
 # that a scene left out of config["scenes"] gets its "not yet computed" text
 # instead of a stale table. Which scenes the report cannot do without is the
-# scenes' own declaration (REPORT_OPTIONAL in filippov.scenes.<id>).
+# scenes' own declaration (REPORT_OPTIONAL in filippov_paper.scenes.<id>).
 SCENE_FILES = scene_files("config/scenes")
 REPORT_GENERATED = ["macros.tex", *[f"{s}.tex" for s in SCENE_FILES], "tab_bench.tex",
                     "tab_hard_cases.tex", "tab_hard_return.tex"]
@@ -35,7 +35,7 @@ rule report_tables:
     output:
         [f"paper/generated/{name}" for name in REPORT_GENERATED],
     params:
-        code=library_hash(exclude="plotting"),  # filippov.report, the scenes' report parts, ...
+        code=library_hash(exclude="plotting"),  # filippov_paper.report, the scenes' report parts, ...
         bench=bench_stamps(),
     log:
         "logs/report_tables.log",

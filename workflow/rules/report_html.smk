@@ -1,6 +1,6 @@
 # Snakemake's HTML report (`snakemake --report report.html`, `make report-html`): the
 # captions of the files the rules mark with report(...) and the report's rule graph.
-# The values of the captions (workflow/report/*.rst) come from filippov.report_html:
+# The values of the captions (workflow/report/*.rst) come from filippov_paper.report_html:
 # escaped for reStructuredText, the paper cited by its printed numbers, a dataset's
 # format read from the file.
 #
@@ -9,7 +9,7 @@
 # leaves it out of its params rerun trigger, so editing a caption, a template or
 # paper/paper_labels.tex recomputes nothing. A Caption reads nothing before the report
 # asks (when the workflow is planned the files need not exist).
-from filippov import report_html
+from filippov_paper import report_html
 
 
 def dataset_caption(wildcards, output):

@@ -4,6 +4,6 @@ import joblog
 
 joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, logs/)
 
-import filippov.benchmarks.compile_cost as cc  # noqa: E402
+import filippov_paper.benchmarks.compile_cost as cc  # noqa: E402
 
 cc.main(["--repeat", "1", "--out", snakemake.output[0]])  # noqa: F821

@@ -4,6 +4,6 @@ import joblog
 
 joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, logs/)
 
-import filippov.benchmarks.effect_cost as ec  # noqa: E402
+import filippov_paper.benchmarks.effect_cost as ec  # noqa: E402
 
 ec.main(["--out", snakemake.output[0]])  # noqa: F821

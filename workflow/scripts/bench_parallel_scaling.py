@@ -4,6 +4,6 @@ import joblog
 
 joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, logs/)
 
-import filippov.benchmarks.parallel_scaling as ps  # noqa: E402
+import filippov_paper.benchmarks.parallel_scaling as ps  # noqa: E402
 
 ps.main(["--out", snakemake.output[0]])  # noqa: F821

@@ -4,6 +4,6 @@ import joblog
 
 joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, logs/)
 
-import filippov.benchmarks.return_floor as rf  # noqa: E402
+import filippov_paper.benchmarks.return_floor as rf  # noqa: E402
 
 rf.main(["--out", snakemake.output[0]])  # noqa: F821

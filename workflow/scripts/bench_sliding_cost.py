@@ -4,6 +4,6 @@ import joblog
 
 joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, logs/)
 
-import filippov.benchmarks.sliding_cost as sc  # noqa: E402
+import filippov_paper.benchmarks.sliding_cost as sc  # noqa: E402
 
 sc.main(["--out", snakemake.output[0]])  # noqa: F821

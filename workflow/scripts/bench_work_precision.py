@@ -5,7 +5,7 @@ import joblog
 
 joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, logs/)
 
-import filippov.benchmarks.work_precision as wp  # noqa: E402
+import filippov_paper.benchmarks.work_precision as wp  # noqa: E402
 
 if snakemake.rule == "work_precision":  # noqa: F821
     wp.main(["--preset", "build", "--out", snakemake.output[0]])  # noqa: F821

@@ -1,4 +1,4 @@
-"""Thin: scene file + chunk index -> filippov.scenes.compute_chunk -> results/chunks/<id>/<i>.nc."""
+"""Thin: scene file + chunk index -> filippov_paper.scenes.compute_chunk -> results/chunks/<id>/<i>.nc."""
 
 import joblog
 
@@ -7,16 +7,16 @@ joblog.tee(snakemake)  # noqa: F821  (stdout and stderr also to the rule's log, 
 import sys  # noqa: E402
 
 import filippov.io  # noqa: E402
-import filippov.scenes  # noqa: E402
-from filippov.config import SceneError, limits, load_scene  # noqa: E402
+import filippov_paper.scenes  # noqa: E402
+from filippov_paper.config import SceneError, limits, load_scene  # noqa: E402
 
 try:
     scene = load_scene(snakemake.input.scene, snakemake.input.schema,  # noqa: F821
                        limits(snakemake.config),
                        resolution=snakemake.params.resolution)  # noqa: F821
-    filippov.scenes.check(scene)  # the engine it asks for, the size of its grid
+    filippov_paper.scenes.check(scene)  # the engine it asks for, the size of its grid
 except SceneError as exc:
     sys.exit(f"error: {exc}")
 index = int(snakemake.wildcards.chunk)  # noqa: F821; the count is the scene's `chunks`
-ds = filippov.scenes.compute_chunk(scene, index, progress=True)
+ds = filippov_paper.scenes.compute_chunk(scene, index, progress=True)
 filippov.io.write_dataset(ds, snakemake.output[0])  # noqa: F821

@@ -1,4 +1,4 @@
-"""Thin: results/chunks/hard_cases/*.nc -> filippov.hard_cases.merge
+"""Thin: results/chunks/hard_cases/*.nc -> filippov_paper.hard_cases.merge
 -> results/hard_cases.nc (no numerics here)."""
 
 import joblog
@@ -9,7 +9,7 @@ import json  # noqa: E402
 import sys  # noqa: E402
 
 import filippov.io  # noqa: E402
-from filippov import hard_cases  # noqa: E402
+from filippov_paper import hard_cases  # noqa: E402
 
 try:
     settings = hard_cases.check_config(json.loads(snakemake.params.settings))  # noqa: F821

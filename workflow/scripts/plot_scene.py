@@ -1,6 +1,6 @@
-"""Thin: results/<id>.nc -> filippov.plotting -> figures/<id>.{pdf,png}.
+"""Thin: results/<id>.nc -> filippov_paper.plotting -> figures/<id>.{pdf,png}.
 
-filippov.plotting builds pyplot-free Figures, so no GUI backend is involved.
+filippov_paper.plotting builds pyplot-free Figures, so no GUI backend is involved.
 """
 
 import joblog
@@ -11,7 +11,7 @@ import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import filippov.io  # noqa: E402
-import filippov.plotting  # noqa: E402
+import filippov_paper.plotting  # noqa: E402
 
 # the figure's id is its file name: figures/<id>.pdf (scenes and benchmarks alike)
 fid = Path(snakemake.output.pdf).stem  # noqa: F821
@@ -21,5 +21,5 @@ try:
                                   scene_id=fid if fid.startswith("fig") else None)
 except filippov.io.DatasetError as exc:
     sys.exit(f"error: {exc}")
-fig = filippov.plotting.draw(fid, ds)
-filippov.plotting.save(fig, snakemake.output.pdf, snakemake.output.png)  # noqa: F821
+fig = filippov_paper.plotting.draw(fid, ds)
+filippov_paper.plotting.save(fig, snakemake.output.pdf, snakemake.output.png)  # noqa: F821

@@ -1,4 +1,4 @@
-"""Thin: results/*.nc -> filippov.report.generate -> paper/generated/*.tex."""
+"""Thin: results/*.nc -> filippov_paper.report.generate -> paper/generated/*.tex."""
 
 import joblog
 
@@ -8,7 +8,7 @@ import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import filippov.io  # noqa: E402
-import filippov.report  # noqa: E402
+import filippov_paper.report  # noqa: E402
 
 datasets = {}
 # the scenes' datasets, the hard-case and work-precision sweeps (inputs), and the
@@ -20,7 +20,7 @@ try:
         datasets[Path(path).stem] = filippov.io.read_dataset(path)
 except filippov.io.DatasetError as exc:
     sys.exit(f"error: {exc}")
-texts = filippov.report.generate(datasets)
+texts = filippov_paper.report.generate(datasets)
 for out in snakemake.output:  # noqa: F821
     out = Path(out)
     tmp = out.with_suffix(".tmp")

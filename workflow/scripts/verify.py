@@ -9,7 +9,7 @@
    build a's measurement, so that everything made from it must match; the
    measurement's reproducible part (its errors) is checked by the manifest.
 3. The first build is compared with the committed manifest
-   (tests/reference/manifest.json, see filippov.manifest).
+   (tests/reference/manifest.json, see filippov_paper.manifest).
 
 Run by make, not by a Snakemake rule. tests/conftest.py reuses copy_project and
 run_snakemake from here.
@@ -48,7 +48,8 @@ def run_snakemake(work: Path, *args, cores: str = "1", timeout: float = 3000, ca
                   env: dict | None = None):
     """`snakemake` in ``work`` with the project's library; ``env`` adds variables."""
     env = dict(os.environ, MPLBACKEND="Agg", SOURCE_DATE_EPOCH="0", **(env or {}))
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT / "src"), env.get("PYTHONPATH")]))
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT / "src"), str(ROOT / "workflow"),
+                                                      env.get("PYTHONPATH")]))
     env["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), env.get("PATH", "")])
     cmd = [sys.executable, "-m", "snakemake", "--cores", cores, "--directory", str(work), *args]
     return subprocess.run(cmd, cwd=work, env=env, capture_output=capture, text=True,
@@ -77,8 +78,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--keep", action="store_true", help="keep the build directories")
     args = ap.parse_args(argv)
-    sys.path.insert(0, str(ROOT / "src"))
-    from filippov import manifest
+    sys.path[:0] = [str(ROOT / "src"), str(ROOT / "workflow")]
+    from filippov_paper import manifest
 
     tmp = Path(tempfile.mkdtemp(prefix="filippov-verify-"))
     try:

@@ -5,7 +5,7 @@ compilation with the on-disk cache kept in step with the sources.
 The kernel comes in two builds of this one source: with the dP/dz code (_batch) and
 without it (_batch_plain, what returns without derivatives run on). The dP/dz code is
 40% of the kernel's machine code; a user who never asks for dP/dz should not wait for it
-to compile (13 s instead of 18 s cold on 2 cores, filippov.benchmarks.compile_cost).
+to compile (13 s instead of 18 s cold on 2 cores, filippov_paper.benchmarks.compile_cost).
 
 The batch kernel releases the GIL (nogil) and keeps no state between calls but its
 arguments: each call allocates its own work arrays, and start i writes row i of the

@@ -1,0 +1,120 @@
+"""What the compiled engine costs before its first return: compile and load times.
+
+Run ``python -m filippov_paper.benchmarks.compile_cost`` (part of ``make bench``). Each run is
+a fresh Python process with its own empty caches (numba's, ``NUMBA_CACHE_DIR``, and the
+generated model pieces', ``FILIPPOV_CACHE_DIR``): it imports the engine, compiles the
+kernel (:func:`filippov.fastmap.compile_kernel`: the build without the dP/dz code), builds
+the Hopf model's compiled pieces, makes one batch call of first returns, then compiles the
+kernel's build with the dP/dz code (what ``jacobian=True`` runs on; the helpers both builds
+share are compiled by then). A second process on the same caches does the same: the loads
+a user sees from the second session on. Each stage is timed on its own
+(wall time, median over ``--repeat`` pairs of processes); the kernel is one numba
+compilation, so a second core does not help it.
+"""
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+
+import xarray as xr
+
+from filippov_paper.benchmarks import command_line
+from filippov.io import finalize
+
+#: the stages one process times, in order (name, what it is)
+STAGES = [("import", "import filippov.fastmap (numba, the rule book, the kernel's types)"),
+          ("kernel", "compile_kernel(): the kernel, compiled or loaded from numba's cache"),
+          ("model", "hopf.compiled(...): the model's pieces, generated and compiled or loaded"),
+          ("first_call", "one batch of 8 first returns, the first call of the process"),
+          ("kernel_dpdz", "compile_kernel(derivatives=True): the build with the dP/dz code, "
+                          "on top of the helpers already compiled")]
+
+_PROBE = """
+import json, time
+t0 = time.perf_counter()
+from filippov.fastmap import compile_kernel, compute_returns
+t1 = time.perf_counter()
+loaded = compile_kernel()
+t2 = time.perf_counter()
+import numpy as np
+from filippov.models import hopf
+cm = hopf.compiled(1e-2, -0.5, 1.0 + 1e-2)
+t3 = time.perf_counter()
+starts = np.column_stack([np.zeros(8), np.linspace(0.9, 1.1, 8), np.zeros(8)])
+out = compute_returns(cm, starts, 5.0)
+t4 = time.perf_counter()
+from filippov.kernel import derivative
+# helpers of the dP/dz code compiled so far (none: the returns did not ask for dP/dz)
+dpdz = sum(len(f.signatures) for f in vars(derivative).values()
+           if getattr(getattr(f, "py_func", None), "__module__", None) == derivative.__name__)
+compile_kernel(derivatives=True)
+t5 = time.perf_counter()
+print(json.dumps({"import": t1 - t0, "kernel": t2 - t1, "model": t3 - t2,
+                  "first_call": t4 - t3, "kernel_dpdz": t5 - t4, "loaded": loaded,
+                  "dpdz_before": dpdz, "ok": int((out.status == 0).sum())}))
+"""
+
+
+def _process(cache: str) -> dict:
+    env = dict(os.environ, NUMBA_CACHE_DIR=os.path.join(cache, "numba"),
+               FILIPPOV_CACHE_DIR=os.path.join(cache, "generated"))
+    run = subprocess.run([sys.executable, "-c", _PROBE], env=env, capture_output=True,
+                         text=True, check=False)
+    if run.returncode != 0:
+        raise RuntimeError(f"compile_cost probe failed:\n{run.stderr[-3000:]}")
+    return json.loads(run.stdout.strip().splitlines()[-1])
+
+
+def measure(repeat: int = 3, log=print) -> dict:
+    """{"cold": {stage: s}, "warm": {stage: s}}: medians over ``repeat`` pairs of
+    processes (the first on empty caches, the second on what the first left)."""
+    runs = {"cold": [], "warm": []}
+    for k in range(repeat):
+        with tempfile.TemporaryDirectory(prefix="filippov-compile-cost-") as cache:
+            cold, warm = _process(cache), _process(cache)
+        if cold["ok"] != 8 or warm["ok"] != 8:
+            raise RuntimeError("compile_cost: a first return of the probe failed")
+        if cold["dpdz_before"]:
+            raise RuntimeError("compile_cost: returns without dP/dz compiled "
+                               f"{cold['dpdz_before']} functions of the dP/dz code")
+        if cold["loaded"] or not warm["loaded"]:
+            raise RuntimeError("compile_cost: the first process loaded a cached kernel or "
+                               "the second compiled it again (a cache outside NUMBA_CACHE_DIR?)")
+        runs["cold"].append(cold)
+        runs["warm"].append(warm)
+        log(f"  pair {k + 1}/{repeat}: kernel {cold['kernel']:.1f} s cold, "
+            f"{warm['kernel']:.2f} s warm; with dP/dz +{cold['kernel_dpdz']:.1f} s cold",
+            flush=True)
+    return {kind: {s: statistics.median(r[s] for r in rows) for s, _ in STAGES}
+            for kind, rows in runs.items()}
+
+
+def run(repeat: int = 3, log=print) -> xr.Dataset:
+    m = measure(repeat, log)
+    names = [s for s, _ in STAGES]
+    ds = xr.Dataset(
+        {"cold": ("stage", [m["cold"][s] for s in names],
+                  {"long_name": "wall time, empty caches (median)", "units": "s"}),
+         "warm": ("stage", [m["warm"][s] for s in names],
+                  {"long_name": "wall time, caches written by an earlier process (median)",
+                   "units": "s"}),
+         "description": ("stage", [d for _, d in STAGES], {"long_name": "what the stage does"})},
+        coords={"stage": ("stage", names, {"long_name": "stage of a process's first return"})})
+    log(f"{'stage':12s} {'cold [s]':>9s} {'warm [s]':>9s}  what")
+    for s, d in STAGES:
+        log(f"{s:12s} {m['cold'][s]:9.2f} {m['warm'][s]:9.2f}  {d}")
+    log(f"{'total':12s} {sum(m['cold'].values()):9.2f} {sum(m['warm'].values()):9.2f}")
+    return finalize(ds, None, repeat=repeat, cpu_count=os.cpu_count() or 0,
+                    title="compile and load times of the compiled engine")
+
+
+def main(argv=None) -> None:
+    command_line(__doc__, run, argv, repeat=3)
+
+
+if __name__ == "__main__":
+    main()

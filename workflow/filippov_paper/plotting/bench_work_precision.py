@@ -1,0 +1,62 @@
+"""Work-precision diagram: error of the return map against wall time, log-log,
+one panel per problem, one line per method swept over its tolerance."""
+from __future__ import annotations
+
+import numpy as np
+
+from filippov_paper.plotting import style as st
+
+VARS = ["error_map", "wall_time", "status", "reference_check"]
+# the project's modes solid, scipy's dashed; markers tell the families apart
+LOOK = {"project compiled exact": ("o", "-", "black"),
+        "project python exact": ("s", "-", "0.45"),
+        "project compiled DOP853": ("d", "-", "#e7298a"),
+        "project DOP853": ("D", "-", st.C_PLUS),
+        "solve_ivp RK45": ("^", "--", st.C_MINUS),
+        "solve_ivp DOP853": ("v", "--", "#7b3294"),
+        "solve_ivp Radau": ("P", "--", "#1b9e77"),
+        "solve_ivp LSODA": ("X", "--", "#d95f02")}
+FLOOR = 1e-16  # an error of exactly zero is drawn here
+
+
+def draw(ds):
+    st.require(ds, "bench_work_precision", VARS)
+    n = ds.sizes["problem"]
+    ncols = min(n, 2)
+    nrows = -(-n // ncols)
+    fig = st.new_figure(st.TEXT_WIDTH, 2.4 * nrows)
+    axes = np.atleast_1d(fig.subplots(nrows, ncols, squeeze=False).ravel())
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    axes = axes[:n]
+    methods = list(dict.fromkeys(str(m) for m in ds.method.values))
+    for i, ax in enumerate(axes):
+        for fam in methods:
+            sel = np.flatnonzero(ds.method.values == fam)
+            err = np.maximum(ds.error_map.values[i, sel], FLOOR)
+            t = ds.wall_time.values[i, sel]
+            ok = np.isfinite(err) & np.isfinite(t)
+            marker, ls, color = LOOK.get(fam, (".", ":", "0.3"))
+            if ok.any():
+                order = np.argsort(t[ok])
+                ax.plot(t[ok][order], err[ok][order], marker=marker, ls=ls, color=color,
+                        ms=4, lw=1.0, label=fam)
+        check = max(float(ds.reference_check.values[i]), FLOOR)
+        ax.axhline(check, color=st.C_AUX, lw=0.8, ls=":", label="reference check")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        # the statistic the sweep shows (filippov_paper.benchmarks.timing; older sweeps: median)
+        ax.set_xlabel(f"{ds.attrs.get('timing_statistic', 'median')} wall time of one map [s]")
+        name = str(ds.problem.values[i]).replace("theta=", r"$\theta=$").replace(
+            "eps=", r"$\varepsilon=$")   # the paper's symbols
+        st.panel_label(ax, f"({'abcd'[i]}) {name}, {int(ds.n_points.values[i])} points")
+    for ax in axes[::ncols]:
+        ax.set_ylabel(r"max $|P - P_{\mathrm{ref}}|$")
+    # one legend for all panels, below them
+    handles = {}
+    for ax in axes:
+        for h, label in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(label, h)
+    fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncol=3,
+               frameon=False)
+    return fig

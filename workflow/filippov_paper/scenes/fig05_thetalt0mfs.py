@@ -1,0 +1,287 @@
+"""fig:thetalt0mfs: the invariant manifolds near the grazing point p_g = (-1, 0, -1)
+of the slow-fast Hopf example (eq:exslow2, eq:exfast2) for theta < 0, mu = 1.
+
+What is computed, and how:
+
+* the grazing periodic orbit: the solver run from (0, 1, 0) on L1 for one
+  period; it lies in M_+ = {y = x1} (eq:ymp) and only touches H_s at p_g;
+* M_-, the slow manifold of the region-minus flow E_-, computed numerically
+  without the closed form: trajectories of E_- (x1' = 1, x2' = 0,
+  eps y' = g(x, y)) are integrated with DOP853 for ``settle`` * eps time units
+  into each grid point, from y = x1 (on M_+). Off-manifold parts decay like
+  exp(-t/eps), so what arrives is M_- to ~exp(-settle). The result is stored
+  next to the exact cubic (hopf.slow_manifold_minus), the O(eps) expansion
+  eq:ymm and the differences, plus the invariance residual of the exact cubic;
+* one switching trajectory from L1 slightly outside the grazing orbit, run by
+  the solver with the exact flows until it returns to L1: it crosses H_s into
+  region - (E_+ -> E_-), crosses back (E_- -> E_+) and relaxes onto M_+; the
+  rate of that relaxation is measured from the samples.
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+from scipy.integrate import solve_ivp
+
+from filippov import simulate
+from filippov.io import finalize
+from filippov.models import hopf
+from filippov.simulate import Section
+from filippov.system import MINUS, PLUS
+from filippov_paper.scenes.common import require, solver_options
+from filippov_paper.report import Macros, var
+
+#: this scene's block of the scene schema: filippov_paper.config.load_scene adds it to
+#: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it
+#: from this file without importing it (a literal: JSON with Python's True/False/None)
+PARAMETERS_SCHEMA = {
+  "properties": {
+    "parameters": {
+      "required": ["eps", "mu", "omega", "theta", "start_x2", "x1_range", "x2_range",
+                   "n_grid", "settle", "rate_window", "n_samples"],
+      "additionalProperties": False,
+      "properties": {
+        "eps": {"$ref": "#/$defs/positive"},
+        "mu": {"const": 1.0},
+        "omega": True,
+        "theta": {"type": "number", "exclusiveMaximum": 0},
+        "start_x2": {"type": "number", "exclusiveMinimum": 1},
+        "x1_range": {"$ref": "#/$defs/point2"},
+        "x2_range": {"$ref": "#/$defs/point2"},
+        "n_grid": {"type": "integer", "minimum": 2},
+        "settle": {"type": "number", "minimum": 10},
+        "rate_window": {"$ref": "#/$defs/positive"},
+        "n_samples": {"$ref": "#/$defs/n_samples"}
+      }
+    }
+  }
+}
+
+#: names and units of the variables without them below (checked by filippov_paper.scenes)
+VARIABLE_ATTRS = {
+    "mode": ("field followed: -1 region -, 0 sliding, 1 region +", "1"),
+    "switch_from": ("mode before the switch: -1 region -, 0 sliding, 1 region +", "1"),
+    "switch_to": ("mode after the switch: -1 region -, 0 sliding, 1 region +", "1"),
+    "switch": ("switch index along the switching trajectory", "1"),
+}
+
+P_G = np.array([-1.0, 0.0, -1.0])  # grazing point at mu = 1
+
+
+def section_L1() -> Section:
+    return Section("L1", lambda z: z[0], direction=-1, where=lambda z: z[1] > 0, terminal=1)
+
+
+def expansion_minus(x1, x2, eps, mu, omega):
+    """eq:ymm without its O(eps^2) remainder."""
+    return x1 + eps * (mu * x1 - omega * x2 - (x1 * x1 + x2 * x2) * x1 - 1.0)
+
+
+def numeric_slow_manifold_minus(model, x1, x2, settle: float = 40.0,
+                                rtol: float = 1e-12, atol: float = 1e-14):
+    """M_- at the points (x1, x2) from integrated E_- trajectories (no closed form).
+
+    Each trajectory starts ``settle * eps`` time units upstream, at
+    (x1 - settle eps, x2, y = x1 - settle eps), i.e. on M_+, and is integrated
+    with the model's own f_- and g_- fields. Returns (y, t, dev) with ``dev``
+    the largest distance to the final surface along the way, sampled at ``t``
+    (for showing the convergence; it is measured against the exact cubic).
+    """
+    eps = model.eps
+    x1 = np.asarray(x1, dtype=float)
+    x2 = np.asarray(x2, dtype=float)
+    shape = x1.shape
+    a1, a2 = x1.ravel(), x2.ravel()
+    T = settle * eps
+    mu, omega = model.parameters["mu"], model.parameters["omega"]
+
+    def rhs(s, y):
+        x = np.stack([a1 - T + s, a2])
+        # slow part of E_- is f_- (x1' = 1, x2' = 0): checked, not assumed
+        return model.g_minus(x, y[None])[0] / eps
+
+    f = model.f_minus(np.stack([a1, a2]), a1[None])
+    if not (np.all(f[0] == 1.0) and np.all(f[1] == 0.0)):
+        raise ValueError("numeric_slow_manifold_minus expects f_- = (1, 0)")
+    t_eval = np.linspace(0.0, T, 41)
+    sol = solve_ivp(rhs, (0.0, T), a1 - T, method="DOP853", rtol=rtol, atol=atol,
+                    t_eval=t_eval)
+    if not sol.success:
+        raise RuntimeError(f"E_- integration failed: {sol.message}")
+    xs = a1[:, None] - T + sol.t[None, :]
+    exact = hopf.slow_manifold_minus(xs, a2[:, None], eps, mu, omega)
+    dev = np.max(np.abs(sol.y - exact), axis=0)
+    return sol.y[:, -1].reshape(shape), sol.t - T, dev
+
+
+def invariance_residual(x1, x2, eps, mu, omega, step: float = 1e-20):
+    """eps * D y_m- . f_- - g_-(x, y_m-) for the exact cubic, by complex-step
+    differentiation along f_- = (1, 0): zero on an invariant graph."""
+    d = hopf.slow_manifold_minus(x1 + 1j * step, x2, eps, mu, omega).imag / step
+    y = hopf.slow_manifold_minus(x1, x2, eps, mu, omega)
+    g = eps * hopf.hopf_rhs(x1, x2, mu, omega)[0] + x1 - y
+    return eps * d - g
+
+
+def relaxation_rate(t, z, t_from: float, t_to: float, floor: float = 1e-9):
+    """Least-squares rate lambda of |y - x1| ~ exp(-lambda t) on [t_from, t_to]."""
+    dev = np.abs(z[2] - z[0])
+    sel = (t > t_from) & (t <= t_to) & (dev > floor)
+    if sel.sum() < 3:
+        raise RuntimeError("too few samples to measure the relaxation rate")
+    slope = np.polyfit(t[sel] - t_from, np.log(dev[sel]), 1)[0]
+    return -slope
+
+
+def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    kind = require(scene, "system", {"slow_fast"})
+    p = scene["parameters"]
+    opts = solver_options(scene)
+    eps, theta = float(p["eps"]), float(p["theta"])
+    mu, omega = float(p["mu"]), float(p["omega"])
+    if not theta < 0:
+        raise ValueError(f"{scene['id']}: parameters.theta must be < 0 (case 2), got {theta}")
+    if mu != 1.0:
+        raise ValueError(f"{scene['id']}: parameters.mu must be 1 (grazing at p_g), got {mu}")
+    model = hopf.model(eps, theta, mu, omega)
+    system = model.system(kind, sliding=scene["ingredients"]["sliding"],
+                          exact=opts["method"] == "exact")
+    n = int(p["n_samples"])
+
+    # --- the grazing periodic orbit, from the solver: one period from L1
+    orbit = simulate(system, [0.0, 1.0, 0.0], 2.0 * 2 * np.pi / abs(omega),
+                     sections=[section_L1()], **opts)
+    if orbit.switches():
+        raise RuntimeError("the grazing orbit switched: it should only touch H_s")
+    touches = [e for e in orbit.events if e.kind == "touch"]
+    t_orb, z_orb, _ = orbit.sample(np.linspace(0.0, orbit.t, n), include_events=False)
+
+    # --- the switching trajectory, L1 -> L1
+    traj = simulate(system, [0.0, float(p["start_x2"]), 0.0], 4.0 * 2 * np.pi / abs(omega),
+                    sections=[section_L1()], **opts)
+    sw = traj.switches()
+    if any(e.kind != "crossing" for e in sw):
+        raise RuntimeError(f"{scene['id']}: expected crossings only, got "
+                           f"{[e.kind for e in sw]}")
+    if [(e.mode_before, e.mode_after) for e in sw] != [(PLUS, MINUS), (MINUS, PLUS)]:
+        raise RuntimeError(f"{scene['id']}: expected E+ -> E- -> E+, got "
+                           f"{[(e.mode_before, e.mode_after) for e in sw]}")
+    t, z, mode = traj.sample(np.linspace(0.0, traj.t, n))
+    t_back = sw[1].t
+    span = float(p["rate_window"]) * eps
+    t_fit = np.linspace(t_back, min(t_back + span, traj.t), 401)
+    tf, zf, mf = traj.sample(t_fit, include_events=False)
+    if np.any(mf[1:] != PLUS):  # the sample at t_back itself closes the E_- segment
+        raise RuntimeError("relaxation window left region +")
+    rate = relaxation_rate(tf, zf, t_back, tf[-1])
+
+    # --- surfaces on the zoom window
+    g1 = np.linspace(*map(float, p["x1_range"]), int(p["n_grid"]))
+    g2 = np.linspace(*map(float, p["x2_range"]), int(p["n_grid"]))
+    X1, X2 = np.meshgrid(g1, g2, indexing="ij")
+    settle = float(p["settle"])
+    y_num, t_conv, dev_conv = numeric_slow_manifold_minus(model, X1, X2, settle, **{
+        k: opts[k] for k in ("rtol", "atol")})
+    y_exact = hopf.slow_manifold_minus(X1, X2, eps, mu, omega)
+    y_exp = expansion_minus(X1, X2, eps, mu, omega)
+    y_hs = (-1.0 - theta * X1) / (1.0 - theta)
+    resid = invariance_residual(X1, X2, eps, mu, omega)
+    y_pg_num, _, _ = numeric_slow_manifold_minus(model, P_G[:1], P_G[1:2], settle, **{
+        k: opts[k] for k in ("rtol", "atol")})
+    gap_pg = float(P_G[0] - y_pg_num[0])  # y_m+ - y_m- at x = (-1, 0)
+
+    one = lambda v, ln, **kw: ((), float(v), {"long_name": ln, "units": "1", **kw})
+    grid = ("x1_grid", "x2_grid")
+    ev = lambda k: np.array([e.state[k] for e in sw])
+    ds = xr.Dataset(
+        {
+            "x1": ("t", z[0], {"long_name": "switching trajectory x1", "units": "1"}),
+            "x2": ("t", z[1], {"long_name": "switching trajectory x2", "units": "1"}),
+            "y": ("t", z[2], {"long_name": "switching trajectory y (fast)", "units": "1"}),
+            "mode": ("t", mode.astype(np.int8),
+                     {"long_name": "flow followed", "flag_values": np.array([-1, 0, 1], np.int8),
+                      "flag_meanings": "minus sliding plus"}),
+            "orbit_x1": ("t_orbit", z_orb[0], {"long_name": "grazing periodic orbit x1",
+                                               "units": "1"}),
+            "orbit_x2": ("t_orbit", z_orb[1], {"long_name": "grazing periodic orbit x2",
+                                               "units": "1"}),
+            "orbit_y": ("t_orbit", z_orb[2], {"long_name": "grazing periodic orbit y",
+                                              "units": "1"}),
+            "switch_t": ("switch", [e.t for e in sw], {"long_name": "switch time", "units": "1"}),
+            "switch_x1": ("switch", ev(0), {"long_name": "x1 at the switch", "units": "1"}),
+            "switch_x2": ("switch", ev(1), {"long_name": "x2 at the switch", "units": "1"}),
+            "switch_y": ("switch", ev(2), {"long_name": "y at the switch", "units": "1"}),
+            "switch_from": ("switch", np.array([e.mode_before for e in sw], np.int8),
+                            {"long_name": "mode before the switch"}),
+            "switch_to": ("switch", np.array([e.mode_after for e in sw], np.int8),
+                          {"long_name": "mode after the switch"}),
+            "y_M_plus": (grid, X1.copy(), {"long_name": "M_+ (eq:ymp): y = x1", "units": "1"}),
+            "y_M_minus": (grid, y_num, {
+                "long_name": "M_-: y from E_- trajectories integrated (DOP853) onto the grid",
+                "units": "1", "settle_over_eps": settle}),
+            "y_M_minus_exact": (grid, y_exact, {
+                "long_name": "M_-: exact cubic (hopf.slow_manifold_minus)", "units": "1"}),
+            "y_M_minus_expansion": (grid, y_exp, {
+                "long_name": "M_-: O(eps) expansion eq:ymm", "units": "1"}),
+            "M_minus_error": (grid, y_num - y_exact, {
+                "long_name": "numerical M_- minus exact cubic", "units": "1"}),
+            "M_minus_expansion_error": (grid, y_exact - y_exp, {
+                "long_name": "exact M_- minus expansion eq:ymm (O(eps^2))", "units": "1"}),
+            "M_minus_invariance_residual": (grid, resid, {
+                "long_name": "eps dy/dx . f_- - g_- on the exact cubic (complex step)",
+                "units": "1"}),
+            "y_H_s": (grid, y_hs, {"long_name": "H_s: theta x1 + (1 - theta) y = -1",
+                                   "units": "1"}),
+            "convergence": ("t_settle", dev_conv, {
+                "long_name": "max over the grid of |y - y_m-| along the E_- trajectories",
+                "units": "1"}),
+            "decay_rate": one(rate, "measured rate of |y - x1| ~ exp(-rate t) after the "
+                                    "return to region +", expected=1.0 / eps),
+            "decay_rate_rel_error": one(rate * eps - 1.0, "decay_rate * eps - 1"),
+            "gap_pg": one(gap_pg, "y_m+ - y_m- at x = (-1, 0) from the numerical M_-"),
+            "gap_pg_exact": one(eps - 2 * eps ** 2 - 6 * eps ** 3 - 6 * eps ** 4,
+                                "y_m+ - y_m- at x = (-1, 0) from the exact cubic"),
+            "M_minus_max_error": one(np.max(np.abs(y_num - y_exact)),
+                                     "max |numerical M_- - exact cubic| on the grid"),
+            "M_minus_max_expansion_error": one(np.max(np.abs(y_exact - y_exp)),
+                                               "max |exact M_- - eq:ymm| on the grid"),
+            "orbit_touch_t": one(touches[0].t if touches else np.nan,
+                                 "time of the grazing orbit's touch of H_s"),
+            "orbit_min_x1": one(z_orb[0].min(), "min x1 on the grazing orbit"),
+        },
+        coords={
+            "t": ("t", t, {"long_name": "time", "units": "1"}),
+            "t_orbit": ("t_orbit", t_orb, {"long_name": "time on the grazing orbit",
+                                           "units": "1"}),
+            "switch": ("switch", np.arange(len(sw))),
+            "x1_grid": ("x1_grid", g1, {"long_name": "x1", "units": "1"}),
+            "x2_grid": ("x2_grid", g2, {"long_name": "x2", "units": "1"}),
+            "t_settle": ("t_settle", t_conv, {"long_name": "time before reaching the grid",
+                                              "units": "1"}),
+        })
+    return finalize(ds, scene, title="manifolds near the grazing point, theta < 0 "
+                    "(eq:exslow2/eq:exfast2)", p_g=P_G.tolist(),
+                    t_return=float(traj.t), x2_return=float(traj.z[1]))
+
+
+# ============================================================================= report
+# What the reproduction report quotes from this scene's dataset (filippov_paper.report calls
+# `report`). This part -- report, REPORT_OPTIONAL and the _report_* / _REPORT_* names --
+# is left out of the code hash of the compute jobs: editing it rebuilds the report only.
+def report(ds, m: Macros) -> str | None:
+    """The report's macros from this scene's dataset; returns its table (None: none)."""
+    sid = "fig05_thetalt0mfs"
+    m.add("rpFiveEps", float(ds.attrs["eps"]), f"{sid}:attrs.eps")
+    m.add("rpFiveTheta", float(ds.attrs["theta"]), f"{sid}:attrs.theta")
+    m.add("rpFiveStart", float(ds.attrs["start_x2"]), f"{sid}:attrs.start_x2", 6)
+    m.add("rpFiveSettle", float(ds.attrs["settle"]), f"{sid}:attrs.settle")
+    m.add("rpFiveReturn", float(ds.attrs["x2_return"]), f"{sid}:attrs.x2_return", 6)
+    var(m, "rpFiveGap", ds, sid, "gap_pg", sig=6)
+    var(m, "rpFiveDecay", ds, sid, "decay_rate", sig=8)
+    var(m, "rpFiveDecayErr", ds, sid, "decay_rate_rel_error", sig=2)
+    var(m, "rpFiveMminusErr", ds, sid, "M_minus_max_error", sig=2)
+    var(m, "rpFiveExpansionErr", ds, sid, "M_minus_max_expansion_error", sig=3)
+    var(m, "rpFiveSwitchTwoXone", ds, sid, "switch_x1", sig=5, switch=1)
+    var(m, "rpFiveSwitchTwoY", ds, sid, "switch_y", sig=5, switch=1)
+    var(m, "rpFiveSwitchXtwo", ds, sid, "switch_x2", sig=4, switch=0)
+    return None

@@ -1,0 +1,253 @@
+"""Small-scale chaos (theta > 0): the attractor of the return map to L1 of the slow-fast
+Hopf example across mu = 1 for several theta and eps, with its largest Lyapunov
+exponent and width, beside the limit map.
+
+Orbit diagrams in s = (mu - 1)/eps^2, u = (x2 - 1)/eps^2 (attractor_common), on a
+uniform grid around grazing and a geometric one beyond it (where the attractor ends).
+On top of the shared sweep:
+
+* the one-sided slope of P_DM at grazing, s(theta, 0, 0) = (theta - 1)/theta (the
+  paper's chaos condition is s < -1), and the slope of the whole return there,
+  lambda s (lambda the cycle's multiplier per turn): the fixed point on the sliding
+  branch loses stability where lambda s < -1;
+* the Lyapunov exponent of the limit map along its attractor (central differences of
+  the map), beside the slow-fast one;
+* the width in x2 (width u times eps^2) and its scaling exponent k per (theta, s):
+  the least-squares slope of log width against log eps over eps <= ``fit_eps_max``,
+  where the attractor is not a point at any of them.
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from filippov import attractors
+from filippov_paper import tolerance
+from filippov.analytic import limit_map
+from filippov.io import finalize
+from filippov_paper.tolerance import Tolerance
+from filippov_paper.scenes.attractor_common import (CHUNK_AXIS, ENGINES, chunk_grid, T_RETURN,  # noqa: F401
+                               VARIABLE_ATTRS as _COMMON_ATTRS, chaos_tolerances, width_tolerance,
+                               common_dataset, eps_list, lyapunov_limit, s_grid, sweep, thetas)
+from filippov_paper.scenes.attractor_common import validate as _validate_common
+from filippov_paper.config import SceneError
+from filippov_paper.report import Macros, eps_tex, head, num, source, tabular, value
+
+#: this scene's block of the scene schema: filippov_paper.config.load_scene adds it to
+#: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it
+#: from this file without importing it (a literal: JSON with Python's True/False/None)
+PARAMETERS_SCHEMA = {
+  "properties": {
+    "parameters": {
+      "required": ["eps", "theta", "omega", "s_min", "s_max", "n_mu", "n_geo", "s_geo_max",
+                   "n_transient", "n_keep", "max_period", "window", "lyapunov", "fit_eps_max"],
+      "$ref": "#/$defs/attractor_sweep",
+      "propertyNames": {"enum": [
+        "eps", "theta", "omega", "s_min", "s_max", "n_mu", "n_geo", "s_geo_max", "n_transient",
+        "n_keep", "max_period", "window", "lyapunov", "fit_eps_max"
+      ]},
+      "properties": {
+        "eps": {"type": "array", "minItems": 1, "items": {"type": "number", "exclusiveMinimum": 0, "maximum": 0.1}},
+        "theta": {"type": "array", "minItems": 1, "items": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1}},
+        "s_max": {"type": "number", "exclusiveMinimum": 0},
+        "n_geo": {"type": "integer", "minimum": 0},
+        "s_geo_max": {"type": "number", "exclusiveMinimum": 0},
+        "fit_eps_max": {"type": "number", "exclusiveMinimum": 0}
+      }
+    }
+  }
+}
+
+VARIABLE_ATTRS = dict(_COMMON_ATTRS)
+VARIABLE_ATTRS.update({
+    "slope_pdm": ("one-sided slope s(theta,0,0) = (theta - 1)/theta of P_DM at grazing", "1"),
+    "slope_return": ("lambda s(theta,0,0): slope of the return map on the sliding side", "1"),
+    "lyapunov_limit": ("Lyapunov exponent of the limit map along its attractor", "1"),
+    "width_x2": ("width of the attractor in x2 (width times eps^2)", "1"),
+    "width_exponent": ("k of width_x2 ~ eps^k: least-squares slope of log width against "
+                       "log eps over eps <= fit_eps_max (three or more), where the attractor "
+                       "is chaotic at each of them (NaN elsewhere)", "1"),
+    "width_exponent_err": ("standard error of width_exponent (residuals, n - 2 degrees of "
+                           "freedom)", "1"),
+    "chaotic": ("1: chaotic (no confirmed period, exponent above three standard errors)", "1"),
+})
+
+
+def tolerances(scene: dict) -> dict:
+    """attractor_common.chaos_tolerances, and for the derived widths: width_x2 as the
+    width (attractor_common.width_tolerance: its two ends' sampling errors); the width
+    exponent, a log10 ratio of two widths a decade of eps apart, to log10(1.5/0.5) ~ 0.5."""
+    out = chaos_tolerances(scene)
+    stat = "a sampled statistic of a chaotic orbit (another orbit on another machine)"
+    # width_x2 = width eps^2 (x2 coordinates): the width's rule, its atol that of two
+    # event-located x2 (the ends)
+    out["width_x2"] = width_tolerance(out["u"], stat, atol=2 * tolerance.EVENT_STATE)
+    out["width_exponent"] = Tolerance(0.0, 0.5, f"{stat}: least-squares slope of log10 "
+                                      "width over three or more eps a decade apart, each "
+                                      "width within a factor 3 either way (measured: 0.28 of "
+                                      "itself at most, +-2 ulps); log10 3 = 0.48 at both ends, "
+                                      "opposite ways, moves the slope by at most 0.48")
+    out["width_exponent_err"] = Tolerance(0.0, 0.5, f"{stat}: residuals of the same fit")
+    out["chaotic"] = out["period"]   # a classification, as the period
+    return out
+
+
+def validate(scene: dict) -> None:
+    _validate_common(scene)
+    if any(not 0 < t < 1 for t in thetas(scene["parameters"])):
+        raise SceneError(f"{scene['id']}: parameters.theta: each theta must lie in (0, 1) "
+                         "(the sliding case)")
+
+
+def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    return assemble(scene, sweep(scene, chunk_grid(scene), progress=progress))
+
+
+def chaotic(ds) -> np.ndarray:
+    """1 where the attractor is chaotic: no confirmed period and a Lyapunov exponent
+    above attractors.LYAPUNOV_SIGMAS standard errors (0 elsewhere)."""
+    return ((ds.period.values == 0) & (ds.status.values == 0) &
+            (ds.lyapunov.values > attractors.LYAPUNOV_SIGMAS * ds.lyapunov_err.values)
+            ).astype(np.int32)
+
+
+def width_exponents(wx: np.ndarray, chaos: np.ndarray, fitted: np.ndarray, eps: np.ndarray):
+    """k and its standard error per (theta, s): the least-squares slope of log width
+    against log eps over the ``fitted`` eps (at least three), where the attractor is
+    chaotic at every one of them (a periodic attractor's width is its orbit's extent,
+    which need not scale like a chaotic band's); NaN elsewhere. The error is the slope's
+    standard error from the residuals (n - 2 degrees of freedom)."""
+    le = np.log(eps[fitted])
+    n = le.size
+    k, err = np.full(wx.shape[::2], np.nan), np.full(wx.shape[::2], np.nan)
+    if n < 3:
+        return k, err
+    sxx = float(np.sum((le - le.mean()) ** 2))
+    for i in range(wx.shape[0]):
+        for m in range(wx.shape[2]):
+            w = wx[i, fitted, m]
+            if not (np.all(chaos[i, fitted, m] == 1) and np.all(np.isfinite(w) & (w > 0))):
+                continue
+            slope, icpt = np.polyfit(le, np.log(w), 1)
+            res = np.log(w) - (icpt + slope * le)
+            k[i, m] = slope
+            err[i, m] = float(np.sqrt(np.sum(res ** 2) / (n - 2) / sxx))
+    return k, err
+
+
+def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
+    p = scene["parameters"]
+    ds = common_dataset(scene, raw)
+    th, eps = np.array(thetas(p)), np.array(eps_list(p))
+    lam = limit_map.multiplier(1.0, float(p["omega"]))
+    ds["slope_pdm"] = ("theta", (th - 1.0) / th)
+    ds["slope_return"] = ("theta", lam * (th - 1.0) / th)
+    ds["lyapunov_limit"] = (("theta", "eps", "s"), lyapunov_limit(ds, float(p["omega"])))
+    wx = ds.width.values * (eps ** 2)[None, :, None]
+    ds["width_x2"] = (("theta", "eps", "s"), wx)
+    ds["chaotic"] = (("theta", "eps", "s"), chaotic(ds))
+    k, k_err = width_exponents(wx, ds.chaotic.values, eps <= float(p["fit_eps_max"]), eps)
+    ds["width_exponent"] = (("theta", "s"), k)
+    ds["width_exponent_err"] = (("theta", "s"), k_err)
+    return finalize(ds, scene, engine="compiled", method="exact",
+                    title="small-scale chaos of the slow-fast Hopf example, theta > 0")
+
+
+# ============================================================================= report
+# What the reproduction report quotes from this scene's dataset (filippov_paper.report calls
+# `report`). This part -- report, REPORT_OPTIONAL and the _report_* / _REPORT_* names --
+# is left out of the code hash of the compute jobs: editing it rebuilds the report only.
+_REPORT_WORD = {0.7: "Seven", 0.5: "Half", 0.4: "Four", 0.3: "Three", 0.2: "Two", 0.1: "One"}
+
+
+def _report_near(s, ds) -> np.ndarray:
+    """The uniform grid's part above grazing: 0 < s <= s_max."""
+    return (s > 0) & (s <= float(ds.attrs["s_max"]) + 1e-12)
+
+
+def _report_table(ds) -> str:
+    """Per theta: the largest Lyapunov exponent on 0 < s <= s_max at each eps, and its
+    median distance to the limit map's at each eps."""
+    s = ds.s.values
+    near = _report_near(s, ds)
+    eps = [float(e) for e in ds.eps.values]
+    rows = []
+    for i, t in enumerate(ds.theta.values):
+        ly = ds.lyapunov.values[i][:, near]
+        gap = np.abs(ly - ds.lyapunov_limit.values[i][:, near])
+        cells = [f"${float(t):g}$", f"${num(float(ds.slope_pdm.values[i]), 3)}$"]
+        cells += [f"${num(float(np.max(r)), 2)}$" for r in ly]
+        cells += [f"${num(float(np.median(g)), 1)}$" for g in gap]
+        rows.append(" & ".join(cells) + r" \\")
+    e_head = [f"${eps_tex(e)}$" for e in eps]
+    top = " & ".join(["", "", rf"\multicolumn{{{len(eps)}}}{{c}}{{largest exponent}}",
+                      rf"\multicolumn{{{len(eps)}}}{{c}}{{gap to the limit map}}"]) + r" \\"
+    # two columns per eps: narrower column gaps keep four eps within the text width
+    return r"\setlength{\tabcolsep}{3.5pt}" + "\n" + tabular("rr" + "r" * 2 * len(eps),
+                   [top, head(r"$\theta$", r"$s(\theta,0,0)$", *e_head, *e_head)], rows)
+
+
+def report(ds, m: Macros) -> str | None:
+    sid = "fig13_small_scale_chaos"
+    eps = [float(e) for e in ds.eps.values]
+    s = ds.s.values
+    near = _report_near(s, ds)
+    m.add("rpThirteenEpsMax", eps[0], f"{sid}:eps[0]")
+    m.add("rpThirteenEpsMin", eps[-1], f"{sid}:eps[-1]")
+    m.add("rpThirteenSMin", float(ds.attrs["s_min"]), f"{sid}:attrs.s_min")
+    m.add("rpThirteenSMax", float(ds.attrs["s_max"]), f"{sid}:attrs.s_max")
+    m.add("rpThirteenSGeoMax", float(ds.attrs["s_geo_max"]), f"{sid}:attrs.s_geo_max")
+    m.add("rpThirteenFitEpsMax", float(ds.attrs["fit_eps_max"]), f"{sid}:attrs.fit_eps_max", 1)
+    lam = value(ds, "multiplier")
+    m.add("rpThirteenMultiplier", lam, source(sid, "multiplier"), 4)
+    m.add("rpThirteenThetaCrit", lam / (1.0 + lam), "derived: lambda/(1 + lambda), where "
+          "lambda s(theta,0,0) = -1", 3)
+    j = len(eps) - 1
+    for i, t in enumerate(ds.theta.values):
+        w = _REPORT_WORD.get(round(float(t), 6))
+        if not w:
+            continue
+        m.add(f"rpThirteenTheta{w}", float(t), source(sid, "theta", theta=float(t)))
+        m.add(f"rpThirteenSlope{w}", float(ds.slope_pdm.values[i]),
+              source(sid, "slope_pdm", theta=float(t)), 3)
+        m.add(f"rpThirteenSlopeReturn{w}", float(ds.slope_return.values[i]),
+              source(sid, "slope_return", theta=float(t)), 3)
+        ly = ds.lyapunov.values[i][:, near]
+        small = np.array(eps) <= float(ds.attrs["fit_eps_max"])
+        m.add(f"rpThirteenLyapMax{w}", float(np.max(ly[small])),
+              "derived: max lyapunov over eps <= fit_eps_max and 0 < s <= s_max", 2)
+        m.add(f"rpThirteenLyapMaxAll{w}", float(np.max(ly)),
+              "derived: max lyapunov over all eps and 0 < s <= s_max", 2)
+        m.add(f"rpThirteenLyapMin{w}", float(np.min(ly)),
+              "derived: min lyapunov over all eps and 0 < s <= s_max", 2)
+        per = ds.period.values[i, j]
+        ends = [s[np.flatnonzero((s > 0) & (ds.chaotic.values[i, jj] == 1))]
+                for jj in range(len(eps))]
+        if all(e.size for e in ends):
+            m.add(f"rpThirteenChaosEnd{w}", float(ends[-1][-1]),
+                  "derived: largest s where chaotic == 1 at the smallest eps", 3)
+            m.add(f"rpThirteenChaosEndFirst{w}", float(ends[0][-1]),
+                  "derived: largest s where chaotic == 1 at the largest eps", 3)
+            last = np.array([e[-1] for e in ends])
+            m.add(f"rpThirteenChaosEndSpread{w}", float(last.max() / last.min()),
+                  "derived: max/min over eps of the largest s where chaotic == 1", 3)
+            # on the geometric grid, the ends' indices: how many grid steps apart
+            idx = np.array([int(np.flatnonzero(s == v)[0]) for v in last])
+            m.add(f"rpThirteenChaosEndSteps{w}", float(idx.max() - idx.min()),
+                  "derived: grid steps between the largest and smallest chaos end over eps", 1)
+        k = ds.width_exponent.values[i][near]
+        if np.isfinite(k).any():
+            m.add(f"rpThirteenK{w}", float(np.nanmedian(k)),
+                  "derived: median width_exponent over 0 < s <= s_max", 3)
+            m.add(f"rpThirteenKMax{w}", float(np.nanmax(np.abs(k - 2.0))),
+                  "derived: max |width_exponent - 2| over 0 < s <= s_max", 2)
+            ke = ds.width_exponent_err.values[i][near]
+            m.add(f"rpThirteenKErr{w}", float(np.nanmedian(ke)),
+                  "derived: median width_exponent_err over 0 < s <= s_max", 2)
+            m.add(f"rpThirteenKN{w}", float(np.isfinite(k).sum()),
+                  "derived: number of s in 0 < s <= s_max with a width exponent", 2)
+        m.add(f"rpThirteenPeriodTwoShare{w}", float(np.mean(per[near] == 2)),
+              "derived: share of 0 < s <= s_max with period == 2 at the smallest eps", 2)
+        m.add(f"rpThirteenPeriodOne{w}", float(np.all(per[near] == 1)),
+              "derived: 1 if period == 1 on 0 < s <= s_max at the smallest eps", 1)
+    return _report_table(ds)
