@@ -132,6 +132,8 @@ test-deep: $(VENV)/.done
 # scripts in examples/ run by sphinx-gallery (a few seconds each). -W --keep-going: every
 # warning is reported, and any fails the build.
 docs: $(VENV)/.done
+	# autosummary's pages are regenerated each build: stale ones of moved modules would fail -W
+	rm -rf docs/generated
 	$(VENV_PATH) $(PY) -m sphinx -W --keep-going -q -b html -d docs/_build/doctrees docs docs/_build/html
 	@echo "wrote docs/_build/html/index.html"
 

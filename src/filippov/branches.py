@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+from .errors import BranchError  # noqa: F401  (re-exported)
 
 FLIP, BORDER, FOLD, TORUS, BEYOND = -1, 0, 1, 3, 2
 KINDS = {FLIP: "period doubling (multiplier -1)", BORDER: "border collision (grazing)",
@@ -36,10 +37,6 @@ KINDS = {FLIP: "period doubling (multiplier -1)", BORDER: "border collision (gra
 #: 1 - c sqrt(xtol) ~ 1 - 3e-5 c at xtol = 1e-9, while at a border collision it stays
 #: where the smooth part of the map puts it (O(lambda^n), far from 1)
 FOLD_NEAR = 1e-2
-
-
-class BranchError(RuntimeError):
-    """The orbit to follow is not there, or not stable, at the start."""
 
 
 @dataclass(frozen=True)

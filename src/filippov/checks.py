@@ -20,6 +20,7 @@ import weakref
 import numpy as np
 
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
+from .errors import SystemContractError  # noqa: F401  (re-exported)
 
 FLOW_NAMES = {MINUS: "flows[MINUS]", PLUS: "flows[PLUS]", SLIDING: "flows[SLIDING]"}
 FIELD_NAMES = {MINUS: "field_minus", PLUS: "field_plus"}
@@ -43,10 +44,6 @@ PROBE_RTOL = 1e-8
 #: GRAD_STEPS: the check fails only if no step agrees.
 GRAD_RTOL = 1e-3
 GRAD_STEPS = (1.0, 1e-2, 1e-4)
-
-
-class SystemContractError(ValueError):
-    """A piece of a :class:`~filippov.system.PiecewiseSystem` breaks its contract."""
 
 
 # (id(system), exact flows checked) -> weak reference to a system that passed; the

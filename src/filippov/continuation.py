@@ -36,10 +36,7 @@ from .progress import Progress
 # importable from here, where the continuation code and its users reach for them
 from .variational import (VariationalError, fd_jacobian, saltation,  # noqa: F401
                           switch_matrix, transition_matrix)
-
-
-class ContinuationError(RuntimeError):
-    """Newton failed to converge or the step size collapsed."""
+from .errors import ContinuationError  # noqa: F401  (re-exported)
 
 
 def _null_vector(J: np.ndarray) -> np.ndarray:

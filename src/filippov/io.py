@@ -26,14 +26,10 @@ import numpy as np
 import xarray as xr
 
 from . import __version__
+from .errors import DatasetError  # noqa: F401  (re-exported)
 
 NETCDF_FORMAT = "NETCDF3_64BIT"
 CHECKSUM_ATTR = "checksum_sha256"
-
-
-class DatasetError(ValueError):
-    """A file that is not a sound dataset of this project (unreadable, damaged,
-    truncated, written by something else, or of another scene)."""
 
 
 @lru_cache(maxsize=1)

@@ -15,13 +15,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from .errors import PeriodicOrbitError  # noqa: F401  (re-exported)
 
 ENGINES = ("compiled", "python")
-
-
-class PeriodicOrbitError(RuntimeError):
-    """Newton's method did not converge, a return failed, or the derivative at the
-    fixed point does not annihilate the flow direction."""
 
 
 @dataclass(frozen=True)

@@ -33,22 +33,7 @@ from scipy.optimize import brentq
 from . import checks, options, rules, variational
 from .radau_iia import RadauIIA
 from .system import MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
-
-
-class SimulationError(RuntimeError):
-    """A trajectory could not be continued (non-finite state, bad input, ...)."""
-
-
-class EventLimitError(SimulationError):
-    """The bound on events or steps was hit (typically rapid switching)."""
-
-
-class ZenoError(SimulationError):
-    """Switching times accumulate: infinitely many switches in finite time."""
-
-
-class SlidingNotBuiltError(SimulationError):
-    """Attracting sliding reached by a system built with ``sliding=False``."""
+from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
 
 
 @dataclass(frozen=True)

@@ -32,12 +32,9 @@ import sympy as sp
 from . import codegen
 from .abi import CompiledModel, no_flow
 from .compiled_system import FilippovSystem, _scalar_piece, _where_piece
+from .errors import SymbolicError  # noqa: F401  (re-exported)
 
 MODES = ("minus", "plus")
-
-
-class SymbolicError(ValueError):
-    """A symbolic definition that cannot be turned into a system (names the piece)."""
 
 
 def _symbols(seq, what: str) -> tuple:

@@ -26,11 +26,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .system import SLIDING
-
-
-class VariationalError(RuntimeError):
-    """The variational equations could not be integrated, or a switch or section
-    is met tangentially (the derivative does not exist there)."""
+from .errors import VariationalError  # noqa: F401  (re-exported)
 
 
 def fd_jacobian(fun: Callable[[np.ndarray], np.ndarray], u: np.ndarray,

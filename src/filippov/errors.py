@@ -1,0 +1,63 @@
+"""Every error the library raises of its own, in one place, for both engines.
+
+The reference driver (:func:`filippov.simulate.simulate`) and the compiled engine
+(:mod:`filippov.fastmap`: a failed start's status code becomes one of these, with the
+same meaning) raise the same classes, so a caller catches one name whatever engine ran.
+The modules that raise them re-export them (``filippov.simulate.ZenoError`` is this
+``ZenoError``).
+
+- :class:`SystemContractError`: a piece of the system breaks its contract (a wrong shape,
+  a non-finite value at the start, a gradient that disagrees with its function).
+- :class:`SimulationError` and its kinds: an orbit that cannot be continued.
+- :class:`VariationalError`, :class:`PeriodicOrbitError`, :class:`ContinuationError`,
+  :class:`BranchError`: the analyses on top (dP/dz, periodic orbits, continuation).
+- :class:`SymbolicError`: a symbolic definition that cannot become a system.
+- :class:`DatasetError`: a file that is not a sound dataset.
+"""
+
+
+class SystemContractError(ValueError):
+    """A piece of a :class:`~filippov.system.PiecewiseSystem` breaks its contract."""
+
+
+class SimulationError(RuntimeError):
+    """A trajectory could not be continued (non-finite state, bad input, ...)."""
+
+
+class EventLimitError(SimulationError):
+    """The bound on events or steps was hit (typically rapid switching)."""
+
+
+class ZenoError(SimulationError):
+    """Switching times accumulate: infinitely many switches in finite time."""
+
+
+class SlidingNotBuiltError(SimulationError):
+    """Attracting sliding reached by a system built with ``sliding=False``."""
+
+
+class VariationalError(RuntimeError):
+    """The variational equations could not be integrated, or a switch or section
+    is met tangentially (the derivative does not exist there)."""
+
+
+class PeriodicOrbitError(RuntimeError):
+    """Newton's method did not converge, a return failed, or the derivative at the
+    fixed point does not annihilate the flow direction."""
+
+
+class ContinuationError(RuntimeError):
+    """Newton failed to converge or the step size collapsed."""
+
+
+class BranchError(RuntimeError):
+    """The orbit to follow is not there, or not stable, at the start."""
+
+
+class SymbolicError(ValueError):
+    """A symbolic definition that cannot be turned into a system (names the piece)."""
+
+
+class DatasetError(ValueError):
+    """A file that is not a sound dataset of this project (unreadable, damaged,
+    truncated, written by something else, or of another scene)."""
