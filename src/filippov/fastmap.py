@@ -50,10 +50,11 @@ is compiled once -- about 13 s on 2 cores, 10 s more for its build with the dP/d
 -- cached on disk by numba, and serves every model), plus a parameter vector ``params`` handed to every piece. See
 :func:`filippov.models.hopf.compiled`.
 
-One deliberate difference from :func:`filippov.poincare.first_returns`: a start
-point that begins in sliding has that first sliding stretch counted in
-``sliding_time`` (the reference's event bookkeeping skips it). Touches are not
-recorded (they change nothing in a return).
+A start point that begins in sliding has that first sliding stretch counted in
+``sliding_time`` (the reference's event bookkeeping skips it: a defect of the
+reference's, left for now). Touches are not recorded (they change nothing in a return).
+Every difference between the engines, with its reason and its test:
+:mod:`filippov.engines`.
 """
 from __future__ import annotations
 

@@ -437,6 +437,11 @@ def accumulates(oldest: float, newest: float, zeno_span: float) -> bool:
     return newest - oldest <= zeno_span * max(1.0, abs(newest))
 
 
+#: the iteration bound of Brent's method on both engines, for an event's root and for the
+#: extremum of h (or of a normal speed) between two samples alike
+BRENT_MAXITER = 200
+
+
 def same_instant(xtol: float, t: float) -> float:
     """Events closer than this are one instant to the solver: each root is located
     to xtol + 4 eps |t| (brentq's tolerance) and then stepped to its far side."""

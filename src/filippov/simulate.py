@@ -307,12 +307,12 @@ def _brent(fun, ta, tb, fa, fb, xtol):
     has lost the sign change the samples saw, the bracket keeps the sampled end values
     (the interior is ``fun``'s), so a change the scan decided on is never dropped."""
     try:
-        return brentq(fun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=200)
+        return brentq(fun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=rules.BRENT_MAXITER)
     except ValueError:
         if not (fa * fb <= 0 and (fa != 0 or fb != 0)):
             raise
     pinned = lambda t: fa if t == ta else fb if t == tb else fun(t)  # noqa: E731
-    return brentq(pinned, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=200)
+    return brentq(pinned, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=rules.BRENT_MAXITER)
 
 
 def _refine(fun, pred, ta, tb, va, vb, xtol):
@@ -322,7 +322,7 @@ def _refine(fun, pred, ta, tb, va, vb, xtol):
         r = ta
     else:
         try:
-            r = brentq(fun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=200)
+            r = brentq(fun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=rules.BRENT_MAXITER)
         except ValueError:
             # no sign change between fun(ta) and fun(tb): the start sample of a
             # just-entered mode is clamped inside, while rounding put the true

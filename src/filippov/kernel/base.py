@@ -52,9 +52,9 @@ _TO_NEG, _TO_NONNEG, _TO_NONPOS, _EITHER = (
 # the orbit (forward differences on the segment, step sg[7]: rules.rate_step), whose
 # zeros are their extrema while sliding
 _S_H, _S_A, _S_B, _S_SEC, _S_DA, _S_DB = (np.int64(c) for c in range(6))
-# brentq's iteration bounds: the reference driver's for an event, scipy's default for the
-# extremum of h between two samples
-_MAXITER_EVENT, _MAXITER_EXTREMUM = np.int64(200), np.int64(100)
+# brentq's iteration bounds, the reference driver's (rules.BRENT_MAXITER): for an event,
+# and for the extremum of h or of a normal speed between two samples
+_MAXITER_EVENT = _MAXITER_EXTREMUM = np.int64(rules.BRENT_MAXITER)
 # what an event is
 _W_NONE, _W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_SECTION = -1, 0, 1, 2, 3
 

@@ -226,7 +226,7 @@ def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y
                             fns, p, wz, wg, wf)
             if not ok:
                 return ROOT_FAILED, r, _W_NONE
-            # simulate._scan: min_time; a tie with a switch (simulate._same_instant)
+            # simulate._scan: min_time; a tie with a switch (rules.same_instant)
             # goes to the section; a start on the section up to rounding is no hit
             if r >= min_time and (best_w == _W_NONE
                                   or r <= best_t + _same_instant(xtol, best_t)):

@@ -12,7 +12,7 @@ from .dop853 import _dense_eval
 # sg[4]: what the stay subtracts from H (rules.exit_shift; 0 but after a slide), moved by
 # sg[5], the rounding band of the exit the stay began at, while the orbit is inside it
 # (rules.exit_band, rules.banded_shift; 0 once it is out); sg[6]: the exit_shift alone;
-# sg[7]: while sliding, the step of the central differences that give the rates of a and
+# sg[7]: while sliding, the step of the forward differences that give the rates of a and
 # b along the orbit in the current window (rules.rate_step; 0: none).
 # sg[8], sg[9]: outside sliding, h and |f|^2 at the last sample of the last window (the
 # next window's first sample: scan._carry_sample).

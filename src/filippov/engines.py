@@ -1,0 +1,98 @@
+"""What differs between the engines, and why.
+
+The reference driver (:mod:`filippov.simulate`) and the compiled engine
+(:mod:`filippov.fastmap`, :mod:`filippov.kernel`) take every decision from one rule book
+(:mod:`filippov.rules`) and ask its questions in the same order: in a sample interval,
+the crossing of H (or of a or b while sliding), the end of sliding hidden between the
+samples, then a hidden extremum of H, then the section, whose root at the instant of a
+switch wins the tie (``rules.same_instant``); the hard bounds ``max_events`` (switches)
+and ``max_steps`` (integration steps, or exact-flow windows), counted alike and checked
+before the Zeno ring (``rules.accumulates`` over the last ``zeno_count`` switches); the
+start mode (``rules.start_side``, ``rules.start_on_switch``); the refusal to slide inside
+a section, at the start and at each arrival on H; a start on the section up to rounding
+(``rules.starts_on_section``, the probes of ``rules.section_probe``); the fold exit
+(``rules.exit_drift``, ``onto_switch``, ``exit_band``); the exact-flow check
+(``rules.flow_consistent``); non-finite states and fields (an error, or a status);
+the options (:mod:`filippov.options`, one check for both). What remains different is
+listed here, each entry with its reason and the test that pins it; a change of either
+engine that moves one of these makes its test fail.
+
+1. **Samples of an exact flow.** The compiled engine samples an exact-flow window
+   once per ``sample_step`` (the model's declared resolution); the reference
+   ``samples_per_step`` times more densely, since its samples are also the stored
+   trajectory. Deliberate (cost: the kernel's work is its samples); results agree to
+   rounding, not bit for bit. ``samples_per_step`` counts the samples of an
+   integration step only on the compiled engine.
+   Test: tests/test_engine_asymmetries.py::test_the_compiled_engine_scans_exact_flows_once_per_sample_step
+
+2. **The event budget projected from the switching rate.** At each switch past the
+   Zeno ring's ``zeno_count``, the reference projects the rate of the last ones to
+   ``t_end`` and stops (EventLimitError, "switching every ...") when it would exceed
+   ``max_events``; the compiled engine has the hard bound only. Deliberate: the
+   projection saves minutes of a Python run that will hit the bound anyway; the kernel
+   gets there in milliseconds, and a return ends at the section, often long before
+   ``t_max``, where a projection to ``t_max`` refuses a return that would have come.
+   Test: tests/test_engine_asymmetries.py::test_the_event_budget_is_projected_by_the_reference_engine_only
+
+3. **The step budget projected from the mean step.** After ``PROJECT_AFTER`` steps of
+   one stepper the reference projects its mean step to ``t_end`` and stops when the
+   steps would exceed ``max_steps``; the compiled engine has the hard bound only
+   (status STEP_LIMIT). Deliberate, as 2.
+   Test: tests/test_engine_asymmetries.py::test_the_step_budget_is_projected_by_the_reference_engine_only
+
+4. **Stiff stays.** The reference continues an integrated stay whose DOP853 steps are
+   bounded by stability with the implicit Radau IIA (``stiff=True``, every
+   ``STIFF_AFTER`` steps; its atol kept above the field's noise); the kernel has DOP853
+   only (no ``stiff`` option), so a stiff stay costs steps up to ``max_steps``.
+   Deliberate: the implicit method is not ported to the kernel (exact flows carry the
+   stiff regions of the paper's models).
+   Tests: tests/test_engine_asymmetries.py::test_the_compiled_engine_has_no_stiff_switch,
+   tests/test_reliability.py::test_integrating_a_stiff_field_switches_to_radau_with_a_note
+
+5. **The pinned-bracket fallback.** The reference samples with array evaluations
+   (numpy's loops) and refines with scalar ones, which may round differently: where the
+   scalar ends lost the sign change the samples saw, ``simulate._brent`` keeps the
+   sampled end values. The kernel samples and refines through the same compiled scalar
+   code (``kernel.scan._sample`` and ``kernel.segment._fval``), so its ends agree with
+   its samples bit for bit and it has no fallback: a bracket that fails is status
+   ROOT_FAILED (a SimulationError), and the re-refinement after the band probe or at
+   the dip after an entry keeps the first root where it fails. Deliberate (nothing to
+   pin on the kernel side but the one code path).
+   Test: tests/test_solver_events.py::test_a_sign_change_the_samples_saw_survives_refinement
+
+6. **Brent's iteration bound (fixed).** The kernel bounded the extremum's bracket at 100
+   iterations (scipy's default) where the reference's ``_brent`` allows 200, under a
+   comment that called 100 the reference's. A defect: both now take
+   ``rules.BRENT_MAXITER``.
+   Test: tests/test_engine_asymmetries.py::test_both_engines_give_brent_the_same_iteration_bound
+
+7. **Sliding time of a start that slides (defect, left).** The compiled engine counts
+   the slide a start on H begins in; the reference's ``poincare.sliding_time`` opens a
+   stretch at a ``slide_start`` event only, so it reports 0 for it (fastmap's docstring
+   called this deliberate; no reason holds: the orbit slides). Left because the fix (a
+   start event in sliding opens a stretch) may change the paper's datasets and needs the
+   manifest check; the test is xfail(strict=True).
+   Test: tests/test_engine_asymmetries.py::test_a_start_that_slides_counts_its_first_slide_on_both_engines
+
+8. **Iterated returns and sections.** The reference follows several sections, counts
+   non-terminal hits and goes on in the same mode after one, and logs every event
+   (touches, starts) in a Trajectory; the compiled engine has one terminal section and
+   returns only, and an iterated return (``iterations``) starts from the last hit as a
+   start does (``rules.start_side``/``start_on_switch``), carrying its time in the
+   region (``rules.carried_age``, ``start_age``), where the reference's
+   ``first_returns`` starts each return's exact-flow windows afresh. Deliberate (the
+   kernel computes return maps; results agree to rounding).
+   Tests: tests/test_attractors.py::test_iterating_in_one_call_is_chaining_first_returns,
+   tests/test_attractors.py::test_a_carried_age_skips_only_the_scan_of_a_transient_that_has_decayed
+
+9. **Exact sliding flows.** Under ``method="exact"`` the reference uses a system's
+   ``flows[SLIDING]`` if it has one; the compiled model has no sliding flow piece
+   (:data:`filippov.abi.PIECES`) and integrates every slide. Deliberate (a piece the
+   kernel's one signature would have to carry for every model).
+   Test: tests/test_engine_asymmetries.py::test_the_compiled_model_has_no_sliding_flow
+
+10. **Failures.** The reference raises where a run fails; the compiled engine gives each
+    start a status and goes on with the batch, and its wrapper raises the same error
+    classes for the first failure. Deliberate (one failing start must not lose a batch).
+    Test: tests/test_errors.py::test_the_compiled_engine_s_failures_are_the_reference_driver_s_classes
+"""
