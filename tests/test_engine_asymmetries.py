@@ -105,15 +105,7 @@ def test_both_engines_give_brent_the_same_iteration_bound():
 
 
 # ------------------------------------------------------------------ bookkeeping
-_SLIDING_TIME_DEFECT = pytest.mark.xfail(strict=True, reason=(
-    "defect left (filippov.engines): poincare.sliding_time opens a sliding stretch at a "
-    "slide_start event only, so the reference counts 0 for a start that slides; the "
-    "compiled engine counts it. The fix (a start event in sliding opens a stretch) may "
-    "change the paper's datasets and needs the manifest check"))
-
-
-@pytest.mark.parametrize("engine", ["compiled",
-                                    pytest.param("python", marks=_SLIDING_TIME_DEFECT)])
+@pytest.mark.parametrize("engine", ["compiled", "python"])
 def test_a_start_that_slides_counts_its_first_slide_on_both_engines(engine):
     # f_- = (1, 1), f_+ = (1, x1), h = x2: from (-1, 0) on H (a = 1, b = -1) the orbit
     # slides to x1 = 0 (t = 1), leaves into region +, and meets x1 = 1 at t = 2

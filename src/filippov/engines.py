@@ -66,12 +66,11 @@ engine that moves one of these makes its test fail.
    ``rules.BRENT_MAXITER``.
    Test: tests/test_engine_asymmetries.py::test_both_engines_give_brent_the_same_iteration_bound
 
-7. **Sliding time of a start that slides (defect, left).** The compiled engine counts
-   the slide a start on H begins in; the reference's ``poincare.sliding_time`` opens a
-   stretch at a ``slide_start`` event only, so it reports 0 for it (fastmap's docstring
-   called this deliberate; no reason holds: the orbit slides). Left because the fix (a
-   start event in sliding opens a stretch) may change the paper's datasets and needs the
-   manifest check; the test is xfail(strict=True).
+7. **Sliding time of a start that slides (a defect, fixed).** The compiled engine
+   counted the slide a start on H begins in; the reference's ``poincare.sliding_time``
+   opened a stretch at a ``slide_start`` event only and reported 0. A ``start`` event in
+   sliding now opens one too: both count it (fig11, the one dataset that uses it, is
+   unchanged bit for bit: its returns never start sliding).
    Test: tests/test_engine_asymmetries.py::test_a_start_that_slides_counts_its_first_slide_on_both_engines
 
 8. **Iterated returns and sections.** The reference follows several sections, counts

@@ -51,8 +51,7 @@ is compiled once -- about 13 s on 2 cores, 10 s more for its build with the dP/d
 :func:`filippov.models.hopf.compiled`.
 
 A start point that begins in sliding has that first sliding stretch counted in
-``sliding_time`` (the reference's event bookkeeping skips it: a defect of the
-reference's, left for now). Touches are not recorded (they change nothing in a return).
+``sliding_time``, as the reference's :func:`filippov.poincare.sliding_time` does. Touches are not recorded (they change nothing in a return).
 Every difference between the engines, with its reason and its test:
 :mod:`filippov.engines`.
 """

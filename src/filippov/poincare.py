@@ -64,10 +64,11 @@ def first_returns(system: PiecewiseSystem, starts, section: Section, t_max: floa
 
 
 def sliding_time(events) -> float:
-    """Time spent sliding along an event log (a stretch still open at the end counts)."""
+    """Time spent sliding along an event log (a stretch open at the start -- a run that
+    starts sliding -- or still open at the end counts), as the compiled engine counts."""
     total, since = 0.0, None
     for e in events:
-        if e.mode_after == SLIDING and e.mode_before != SLIDING:
+        if e.mode_after == SLIDING and (e.mode_before != SLIDING or e.kind == "start"):
             since = e.t
         elif e.mode_before == SLIDING and e.mode_after != SLIDING and since is not None:
             total += e.t - since
