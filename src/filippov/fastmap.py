@@ -139,16 +139,18 @@ def _address(piece, sig) -> int:
     """The address of ``piece``'s compiled code for ``sig`` (numba's own lookup when it
     hands a compiled function to another as a first-class function), memoized: the
     kernel is handed addresses (kernel.base._PIECE_ADDRS), so that a call costs no
-    lookup. The address stays valid while ``piece`` lives (the caller's model holds it)."""
+    lookup. The memo holds the compiled code it points into (alive while ``piece``
+    lives) and is looked up again if that code is no longer the piece's (a recompile)."""
     known = _ADDRESSES.setdefault(piece, {})
     key = tuple(sig.args)
-    if key not in known:
+    cres, addr = known.get(key, (None, 0))
+    if cres is None or piece.overloads.get(key) is not cres:
         cres = piece.get_compile_result(sig)
         addr = cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name)
         if not (isinstance(addr, int) and addr > 0):
             raise RuntimeError(f"no compiled address for {piece!r} with {sig}")
-        known[key] = addr
-    return known[key]
+        known[key] = (cres, addr)
+    return addr
 
 
 def _pieces(cmodel: CompiledModel) -> tuple:
