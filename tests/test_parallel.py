@@ -2,6 +2,7 @@
 number of threads, every output array; the threads really split the batch; and the
 default number of workers follows FILIPPOV_WORKERS."""
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -35,6 +36,11 @@ def split_small(monkeypatch):
         def call(*args):
             with lock:
                 calls.append((threading.get_ident(), args[-3].shape[0]))
+            # a slice of a few returns takes microseconds: without a pause the thread that
+            # took the first slice could be done with it before the pool starts another
+            # (ThreadPoolExecutor starts a thread per task only while none is idle), and
+            # the batch ran on one thread however many were allowed (seen under load)
+            time.sleep(0.01)
             return batch(*args)
         return call
 
