@@ -45,7 +45,7 @@ codes and rules, DOP853, segments, root finding, event scan, dP/dz, driver loop)
 this module is its Python side: the batch call, its options and its errors.
 
 A model enters as a :class:`CompiledModel`: numba-compiled pieces with the
-signatures below (passed to the kernel as first-class functions, so the kernel
+signatures below (passed to the kernel as their compiled addresses, so the kernel
 is compiled once -- about 13 s on 2 cores, 10 s more for its build with the dP/dz code
 -- cached on disk by numba, and serves every model), plus a parameter vector ``params`` handed to every piece. See
 :func:`filippov.models.hopf.compiled`.
@@ -58,6 +58,7 @@ Every difference between the engines, with its reason and its test:
 from __future__ import annotations
 
 import os
+import weakref
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -130,11 +131,33 @@ def _checked_starts(cmodel: CompiledModel, starts, start_age):
     return starts, ages
 
 
+#: each piece's compiled address, looked up once per piece (the entry goes with the piece)
+_ADDRESSES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _address(piece, sig) -> int:
+    """The address of ``piece``'s compiled code for ``sig`` (numba's own lookup when it
+    hands a compiled function to another as a first-class function), memoized: the
+    kernel is handed addresses (kernel.base._PIECE_ADDRS), so that a call costs no
+    lookup. The memo holds the compiled code it points into (alive while ``piece``
+    lives) and is looked up again if that code is no longer the piece's (a recompile)."""
+    known = _ADDRESSES.setdefault(piece, {})
+    key = tuple(sig.args)
+    cres, addr = known.get(key, (None, 0))
+    if cres is None or piece.overloads.get(key) is not cres:
+        cres = piece.get_compile_result(sig)
+        addr = cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name)
+        if not (isinstance(addr, int) and addr > 0):
+            raise RuntimeError(f"no compiled address for {piece!r} with {sig}")
+        known[key] = (cres, addr)
+    return addr
+
+
 def _pieces(cmodel: CompiledModel) -> tuple:
-    """The model's pieces in the kernel's order (filippov.abi.PIECES), each a numba-compiled
-    function with its signature: the kernel calls them at their compiled address
-    (kernel.base._piece), which anything else lacks. A model without Jacobians hands
-    :func:`no_jacobian`."""
+    """The compiled addresses of the model's pieces in the kernel's order
+    (filippov.abi.PIECES), each piece a numba-compiled function with its signature: the
+    kernel calls them at their address (kernel.base._piece), which anything else lacks.
+    A model without Jacobians hands :func:`no_jacobian`."""
     pieces = []
     for name, sig in PIECES:
         piece = getattr(cmodel, name)
@@ -145,7 +168,7 @@ def _pieces(cmodel: CompiledModel) -> tuple:
                 f"CompiledModel.{name}: expected a numba njit function compiled with the "
                 f"signature {sig} (filippov.abi; compile_system and SymbolicSystem build "
                 f"them), got {piece!r}")
-        pieces.append(piece)
+        pieces.append(_address(piece, sig))
     return tuple(pieces)
 
 
@@ -170,8 +193,8 @@ def _check_options(cmodel, t_max, iterations, keep, min_time) -> None:
 #: oversubscribe the cores)
 WORKERS_ENV = "FILIPPOV_WORKERS"
 #: returns (starts x iterations) a slice of a batch must hold at least: each call of the
-#: kernel costs ~0.3 ms of Python (numba unboxing the model's nine first-class functions,
-#: GIL held), the work of ~20-30 returns of the Hopf example; 256 keep that under ~10%
+#: kernel costs some Python (unboxing its arguments, GIL held; ~0.3 ms when the model's
+#: nine pieces were handed over as first-class functions, less since they are addresses)
 MIN_RETURNS_PER_SLICE = 256
 #: slices per worker: starts differ in cost (a sliding return, a failure), so a large
 #: batch is cut finer than one slice per thread and a thread takes the next slice when done
@@ -224,12 +247,12 @@ def _run_batch(batch, pieces, params, starts, ages, settings, out, workers: int)
     ``workers``, bit for bit (tests/test_parallel.py)."""
     slices = _slices(starts.shape[0], settings.iterations, workers)
     if len(slices) == 1:
-        batch(*pieces, params, starts, ages, settings, out)
+        batch(pieces, params, starts, ages, settings, out)
         return
 
     def run(lo_hi):  # views of the rows lo:hi: C-contiguous, as the kernel's signature
         lo, hi = lo_hi
-        batch(*pieces, params, starts[lo:hi], ages[lo:hi], settings,
+        batch(pieces, params, starts[lo:hi], ages[lo:hi], settings,
               Outputs(*(a[lo:hi] for a in out)))
 
     with ThreadPoolExecutor(max_workers=min(workers, len(slices))) as pool:
@@ -287,7 +310,7 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     """
     workers = _checked_workers(workers)
     starts, ages = _checked_starts(cmodel, starts, start_age)
-    pieces = _pieces(cmodel)
+    pieces = _pieces(cmodel)  # their addresses
     if starts.shape[0]:
         check_compiled(cmodel, starts[0])  # the reference driver's start check, once a model
     options.check(rtol=rtol, atol=atol, max_step=max_step, max_events=max_events,

@@ -96,20 +96,26 @@ assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MIN
 
 
 # ============================================================================= model pieces
-# The model's pieces are a tuple of numba first-class functions (the order of _batch's
-# arguments). numba's own call of one (fns[k](...)) also carries a path that takes the
-# GIL and asks Python for the piece's address when it is missing: ~150 lines of IR at
-# each of the 34 call sites, compiled into every helper (1-2 s of the cold compile).
-# The address is never missing here (fastmap.compute_returns accepts numba-compiled
-# pieces only), so the pieces are called straight at their compiled address.
+# The model's pieces reach the kernel as their compiled addresses: a tuple of integers
+# (_PIECE_ADDRS, in the order of filippov.abi.PIECES; fastmap.compute_returns takes them
+# from numba-compiled pieces only, once per piece: fastmap._address). Handed over as
+# numba first-class functions instead, each call of the kernel had numba look up both
+# addresses of all nine pieces again in Python (get_compile_result, a pickled signature
+# loaded, LLVM's symbol lookup): 0.3-0.9 ms a call, most of the time of the attractor
+# sweeps, whose calls hold few returns each (fig12 chunk: 8544 calls, 7 of its 8 s). And
+# numba's own call of a first-class function (fns[k](...)) carries a path that takes the
+# GIL and asks Python for a missing address: ~150 lines of IR at each of the 34 call
+# sites (1-2 s of the cold compile). So each piece is called straight at its address,
+# with its signature from PIECES.
+_PIECE_ADDRS = types.UniTuple(types.intp, len(PIECES))
+
+
 def _call_piece_codegen(index):
     def codegen(context, builder, signature, args):
-        fty = signature.args[0][index]
-        sig = fty.signature
-        piece = cgutils.create_struct_proxy(fty)(
-            context, builder, value=builder.extract_value(args[0], index))
-        fnptr = builder.bitcast(piece.jit_addr, context.call_conv.get_function_type(
-            sig.return_type, sig.args).as_pointer())
+        sig = _PIECE_TYPES[index].signature
+        fnptr = builder.inttoptr(builder.extract_value(args[0], index),
+                                 context.call_conv.get_function_type(
+                                     sig.return_type, sig.args).as_pointer())
         status, res = context.call_conv.call_function(builder, fnptr, sig.return_type,
                                                       sig.args, args[1:])
         with cgutils.if_unlikely(builder, status.is_error):
@@ -120,13 +126,13 @@ def _call_piece_codegen(index):
 
 def _piece(name):
     """An intrinsic ``piece(fns, *args)``: calls the piece ``name`` of filippov.abi.PIECES
-    (fns[its index]) with its signature's arguments (numba's intrinsics take no ``*args``:
+    at its address fns[its index] (_PIECE_ADDRS) with its signature's arguments (numba's intrinsics take no ``*args``:
     one typing function per arity)."""
     index = [n for n, _ in PIECES].index(name)
     arity = len(PIECES[index][1].args)
 
     def typed(fns):
-        sig = fns[index].signature
+        sig = _PIECE_TYPES[index].signature
         return sig.return_type(fns, *sig.args), _call_piece_codegen(index)
     by_arity = {2: lambda typingctx, fns, a, b: typed(fns),
                 3: lambda typingctx, fns, a, b, c: typed(fns),
@@ -134,7 +140,7 @@ def _piece(name):
     return intrinsic(by_arity[arity])
 
 
-# fns[k] by name: (z0, tau, p, out), (z, p, out), (z, p) -> float or bool, (mode, z, p, out)
+# the piece at fns[k] by name: (z0, tau, p, out), (z, p, out), (z, p) -> float or bool, (mode, z, p, out)
 (_flow_plus, _flow_minus, _field_plus, _field_minus, _h, _grad_h, _section, _where,
  _jacobian) = (_piece(name) for name, _ in PIECES)
 

@@ -25,7 +25,7 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from ..system import PLUS, SLIDING
 from .base import (BAD_START, EVENT_LIMIT, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
-                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO, _PIECE_TYPES, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
+                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO, _PIECE_ADDRS, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
                    _banded_shift, _clears_band, _exit_band, _exit_drift, _exit_shift,
                    _flow_minus, _flow_plus, _jit, _jit_inline, _next_mode, _onto_switch,
                    _slides_in_section, _speeds, _start_on_switch, _start_side, _vec, _h,
@@ -78,9 +78,9 @@ def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
     return mode
 
 
-# The kernel's ABI: _batch(*pieces, params, starts, ages, settings, out): the model's nine
-# pieces (filippov.abi.PIECES; numba converts a compiled function handed over on its own
-# to a first-class function, not one inside a tuple), arrays and two named tuples;
+# The kernel's ABI: _batch(fns, params, starts, ages, settings, out): the compiled
+# addresses of the model's nine pieces (a tuple of integers in the order of
+# filippov.abi.PIECES: base._PIECE_ADDRS), arrays and two named tuples;
 # fastmap.compute_returns builds them (_KERNEL_SIG: their types).
 
 #: what a batch runs with: t_max per return; exact flows in regions + and - (else DOP853)
@@ -360,7 +360,7 @@ def _one(z0, age0, fns, p, s, w):
 
 _f8, _i8, _b1 = types.float64, types.int64, types.boolean
 _KERNEL_SIG = types.void(
-    *_PIECE_TYPES,              # the model (filippov.abi.PIECES)
+    _PIECE_ADDRS,               # the model: its pieces' addresses (filippov.abi.PIECES)
     _vec,                       # params
     types.float64[:, ::1],      # starts (m, n)
     _vec,                       # their ages in their regions (rules.carried_age)
@@ -373,13 +373,11 @@ _KERNEL_SIG = types.void(
 
 
 @njit(cache=True, nogil=True)
-def _batch(flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, jacobian,
-           p, starts, ages, s, out):
+def _batch(fns, p, starts, ages, s, out):
     """Each start is mapped s.iterations times by the first-return map, each return
     starting from the last one's state; the outputs describe the last return made
     (or where it stopped) and out.orbit[i] holds the last keep returns (with s.jac:
     out.jacobian and out.orbit_jacobian their derivatives dP/dz, NaN where not made)."""
-    fns = (flow_plus, flow_minus, field_plus, field_minus, h, grad_h, section, where, jacobian)
     m, n = starts.shape
     nsmax = max(s.frac_ex.size, s.frac_in.size)
     ts = np.empty(nsmax)
