@@ -58,7 +58,7 @@ from numba import njit, types
 
 from filippov.abi import FIELD_SIG, FLOW_SIG, JAC_SIG, PIECES, SCALAR_SIG, WHERE_SIG
 from filippov.analytic import limit_map
-from filippov.fastmap import OK, _pieces, compute_returns
+from filippov.fastmap import OK, compute_returns, no_jacobian
 from filippov.io import finalize
 from filippov.models import hopf
 from filippov_paper.benchmarks import command_line
@@ -67,6 +67,13 @@ from filippov_paper.benchmarks.attractor_cost import CASES, OMEGA
 NAMES = [name for name, _ in PIECES]
 #: the issue-33 targets per return on one core (theta < 0, theta > 0), seconds
 TARGET = {False: 5e-6, True: 10e-6}
+
+
+def _functions(cm) -> dict:
+    """The model's compiled pieces by name (abi.PIECES order; no_jacobian where the model
+    has none) -- the functions themselves, which the kernel is handed as addresses."""
+    return {name: (no_jacobian if name == "jacobian" and cm.jacobian is None
+                   else getattr(cm, name)) for name in NAMES}
 
 
 def _counted_piece(f, sig, slot):
@@ -94,7 +101,7 @@ def counted_model(cm):
     """``cm`` with every piece counting its calls into ``params[base + k]`` (k the piece's
     index in abi.PIECES); (model, base)."""
     base = cm.params.size
-    pieces = dict(zip(NAMES, _pieces(cm)))
+    pieces = _functions(cm)
     new = {name: _counted_piece(pieces[name], sig, base + k)
            for k, (name, sig) in enumerate(PIECES)
            if not (name == "jacobian" and cm.jacobian is None)}
@@ -159,7 +166,7 @@ def piece_costs(cm, states, window, reps: int = 100, repeat: int = 21) -> dict:
     taus = np.random.default_rng(0).uniform(0.0, window, zs.shape[0])
     p = np.ascontiguousarray(cm.params, dtype=float)
     z, out = np.zeros(zs.shape[1]), np.zeros(zs.shape[1])
-    pieces = dict(zip(NAMES, _pieces(cm)))
+    pieces = _functions(cm)
     costs = {}
     for name, sig in PIECES:
         f = pieces[name]
