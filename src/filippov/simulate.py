@@ -872,7 +872,8 @@ class _Scan:
             best = self._event_in(i)
             if best is not None:
                 r, what, k = best
-                return (r, np.asarray(self.Z(r), dtype=float).reshape(-1).copy(), what, k), self.band
+                z = np.asarray(self.Z(r), dtype=float).reshape(-1).copy()
+                return (r, z, what, k), self.band
         return None, self.band
 
     def _unband(self, i):

@@ -156,7 +156,7 @@ class _LabelScan:
         self.stack: list[_Env] = []
         self.section: tuple[str, bool, bool] | None = None  # (command, starred, in appendix)
         self.appendix = False
-        self.subfig_end = -1                                 # inside \subfigure[...]{...} up to here
+        self.subfig_end = -1        # inside \subfigure[...]{...} up to here
 
     def run(self) -> dict[str, str]:
         start = self.text.find(r"\begin{document}")
@@ -272,7 +272,8 @@ class _LabelScan:
     def _decide(self, label: str, pos: int) -> None:
         line = self._line_of(pos)
         if label in self.seen:
-            self.errors.append(f"{label} (line {line}): defined twice (also line {self.seen[label]})")
+            self.errors.append(f"{label} (line {line}): defined twice "
+                               f"(also line {self.seen[label]})")
             return
         self.seen[label] = line
         if pos < self.subfig_end:
