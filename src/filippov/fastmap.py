@@ -260,6 +260,45 @@ def _run_batch(batch, pieces, params, starts, ages, settings, out, workers: int)
             pass  # the kernel raises nothing itself; map re-raises what a thread did
 
 
+def _settings(cmodel: CompiledModel, t_max, *, rtol, atol, max_step, max_events, max_steps,
+              samples_per_step, touch_tol, event_xtol, zeno_count, zeno_span, min_time,
+              iterations, jacobian) -> Settings:
+    """The kernel's settings of one :func:`compute_returns` call (its options already
+    checked there)."""
+    hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max) if cmodel.exact else np.inf
+    hwin_slow = slow_window(cmodel.slow_sample_step, hwin, max_step, t_max)
+    # an exact flow: one sample per sample step (the model's declared resolution);
+    # samples_per_step is for integration steps, whose length error control sets
+    frac_ex = np.linspace(0.0, 1.0, EXACT_BLOCK + 1)
+    frac_in = np.linspace(0.0, 1.0, samples_per_step + 1)
+    # dP/dz: 0 none, 1 Jacobian-vector products by differences, 2 the model's Jacobians
+    jac_mode = (2 if cmodel.jacobian is not None else 1) if jacobian else 0
+    # the kernel's ABI (kernel.driver: abi.PIECES, Settings, Outputs; their numba types are
+    # the kernel's one signature: Python floats, ints and bools as such)
+    return Settings(
+        t_max=float(t_max), exact=bool(cmodel.exact), hwin=float(hwin),
+        hwin_slow=float(hwin_slow), transient=float(cmodel.transient_time),
+        sec_pred=int(_section_pred(cmodel.section_direction)), sliding=bool(cmodel.sliding),
+        frac_ex=frac_ex, frac_in=frac_in, rtol=float(rtol), atol=float(atol),
+        touch_tol=float(touch_tol), xtol=float(event_xtol), zeno_span=float(zeno_span),
+        max_step=float(max_step), min_time=float(min_time), max_events=int(max_events),
+        max_steps=int(max_steps), zeno_count=int(zeno_count), jac=jac_mode,
+        iterations=int(iterations))
+
+
+def _outputs(starts, keep: int, jacobian: bool) -> Outputs:
+    """The kernel's output arrays for the batch ``starts`` (orbit rows NaN until filled)."""
+    m, n = starts.shape
+    return Outputs(state=np.empty_like(starts), time=np.empty(m),
+                     n_switches=np.empty(m, dtype=np.int64), sliding_time=np.empty(m),
+                     status=np.empty(m, dtype=np.int64), first_switch=np.empty(m),
+                     sliding_displacement=np.empty_like(starts),
+                     orbit=np.full((m, keep, n), np.nan),
+                     returns_done=np.empty(m, dtype=np.int64), jacobian=np.empty((m, n, n)),
+                     orbit_jacobian=np.full((m, keep if jacobian else 0, n, n), np.nan),
+                     age=np.empty(m), mode=np.empty(m, dtype=np.int64))
+
+
 def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float = 1e-12,
                     atol: float = 1e-14, max_step: float = np.inf, max_events: int = 100_000,
                     max_steps: int = 5_000_000, samples_per_step: int = 4,
@@ -317,34 +356,12 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
                   max_steps=max_steps, samples_per_step=samples_per_step, touch_tol=touch_tol,
                   event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span)
     _check_options(cmodel, t_max, iterations, keep, min_time)
-    hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max) if cmodel.exact else np.inf
-    hwin_slow = slow_window(cmodel.slow_sample_step, hwin, max_step, t_max)
-    # an exact flow: one sample per sample step (the model's declared resolution);
-    # samples_per_step is for integration steps, whose length error control sets
-    frac_ex = np.linspace(0.0, 1.0, EXACT_BLOCK + 1)
-    frac_in = np.linspace(0.0, 1.0, samples_per_step + 1)
-    # dP/dz: 0 none, 1 Jacobian-vector products by differences, 2 the model's Jacobians
-    jac_mode = (2 if cmodel.jacobian is not None else 1) if jacobian else 0
-    # the kernel's ABI (kernel.driver: abi.PIECES, Settings, Outputs; their numba types are
-    # the kernel's one signature: Python floats, ints and bools as such)
-    settings = Settings(
-        t_max=float(t_max), exact=bool(cmodel.exact), hwin=float(hwin),
-        hwin_slow=float(hwin_slow), transient=float(cmodel.transient_time),
-        sec_pred=int(_section_pred(cmodel.section_direction)), sliding=bool(cmodel.sliding),
-        frac_ex=frac_ex, frac_in=frac_in, rtol=float(rtol), atol=float(atol),
-        touch_tol=float(touch_tol), xtol=float(event_xtol), zeno_span=float(zeno_span),
-        max_step=float(max_step), min_time=float(min_time), max_events=int(max_events),
-        max_steps=int(max_steps), zeno_count=int(zeno_count), jac=jac_mode,
-        iterations=int(iterations))
-    m, n = starts.shape
-    out = Outputs(state=np.empty_like(starts), time=np.empty(m),
-                  n_switches=np.empty(m, dtype=np.int64), sliding_time=np.empty(m),
-                  status=np.empty(m, dtype=np.int64), first_switch=np.empty(m),
-                  sliding_displacement=np.empty_like(starts),
-                  orbit=np.full((m, keep, n), np.nan), returns_done=np.empty(m, dtype=np.int64),
-                  jacobian=np.empty((m, n, n)),
-                  orbit_jacobian=np.full((m, keep if jacobian else 0, n, n), np.nan),
-                  age=np.empty(m), mode=np.empty(m, dtype=np.int64))
+    settings = _settings(cmodel, t_max, rtol=rtol, atol=atol, max_step=max_step,
+                         max_events=max_events, max_steps=max_steps,
+                         samples_per_step=samples_per_step, touch_tol=touch_tol,
+                         event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span,
+                         min_time=min_time, iterations=iterations, jacobian=jacobian)
+    out = _outputs(starts, keep, jacobian)
     params = np.ascontiguousarray(cmodel.params, dtype=float)
     # the build without the dP/dz code unless it is asked for (kernel.driver)
     _run_batch(kernel(derivatives=bool(jacobian)), pieces, params, starts, ages, settings,

@@ -785,136 +785,204 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
     at, while the orbit is inside it (rules.exit_band, rules.graze; ``leave`` then
     measures H from the band's edge, ``unbanded`` from the exit shift alone): it ends at
     the first sample interval examined whose start is out of the band (rules.clears_band)."""
-    vals = []
-    for func, pred, what in leave:
-        v = np.asarray(func(zs), dtype=float)
-        if first:  # just entered this mode: its start is inside by construction
-            v = v.copy()
-            v[0] = rules.clamp(pred, v[0])
-        vals.append(v)
-    if mode != SLIDING:
-        D = np.asarray(system.speed_of_switch(mode, zs), dtype=float)
-    svals = [np.asarray(s.func(zs), dtype=float) for s in sections]
+    return _Scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xtol,
+                 traj, band, unbanded).earliest()
 
-    def scalar(func):
+
+class _Scan:
+    """One segment as :func:`_scan` examines it: the values at the samples of the
+    functions whose sign change leaves the mode (``leave``), of dH/dt (in a region) or
+    of the rates of the sliding speeds a and b (sliding), and of the sections; the
+    exit's band while in force."""
+
+    def __init__(self, system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol,
+                 xtol, traj, band, unbanded):
+        self.system, self.mode, self.Z, self.ts, self.zs = system, mode, Z, ts, zs
+        self.leave, self.sections, self.preds, self.first = leave, sections, preds, first
+        self.touch_tol, self.xtol, self.traj = touch_tol, xtol, traj
+        self.band, self.unbanded = band, unbanded
+        self.vals = []
+        for func, pred, what in leave:
+            v = np.asarray(func(zs), dtype=float)
+            if first:  # just entered this mode: its start is inside by construction
+                v = v.copy()
+                v[0] = rules.clamp(pred, v[0])
+            self.vals.append(v)
+        self.D = None
+        if mode != SLIDING:  # dH/dt along the mode's field: extrema of H are its roots
+            self.D = np.asarray(system.speed_of_switch(mode, zs), dtype=float)
+        self.svals = [np.asarray(s.func(zs), dtype=float) for s in sections]
+        self.rates = self.R = None
+        if mode == SLIDING:  # the rates of a and b along the orbit: their extrema are roots (rules)
+            self.rates = _speed_rates(system, Z, np.asarray(zs[:, 0], dtype=float))
+            if self.rates is not None:
+                self.R = self.rates(ts)
+
+    def _along(self, func):
+        """``func`` of the state as a function of time on the segment."""
+        Z = self.Z
         return lambda tt: float(func(Z(tt)))
 
-    if mode != SLIDING:  # dH/dt along the mode's field: extrema of H are its roots
-        dfun = scalar(lambda zz: system.speed_of_switch(mode, zz))
-        rates = None
-    else:  # the rates of a and b along the orbit: their extrema are roots (rules)
-        rates = _speed_rates(system, Z, np.asarray(zs[:, 0], dtype=float))
-        if rates is not None:
-            R = rates(ts)
+    def _dH(self, tt):
+        return float(self.system.speed_of_switch(self.mode, self.Z(tt)))
 
-    # Sample intervals that may hold an event, found with array operations; only
-    # those are examined one by one (a scan of many samples costs a few numpy calls).
-    cand = np.zeros(ts.size - 1, dtype=bool)
-    for (_, pred, _), v in zip(leave, vals):
-        cand |= rules.crosses(pred, v[:-1], v[1:])
-    if mode != SLIDING:
-        cand |= rules.extremum_between(mode, D[:-1], D[1:])
-    elif rates is not None:
-        for (_, pred, _), Dv in zip(leave, R):
-            cand |= rules.speed_extremum_between(pred, Dv[:-1], Dv[1:])
-    for pred, sv in zip(preds, svals):
-        cand |= rules.crosses(pred, sv[:-1], sv[1:])
+    def _touch(self, tm):
+        """A touch of H at tm: no event for the orbit, a kink of P (recorded)."""
+        self.traj.events.append(Event(tm, "touch", self.Z(tm).copy(), self.mode, self.mode))
 
-    order, pos = np.flatnonzero(cand), 0
-    while pos < order.size:
-        i = int(order[pos])
-        pos += 1
-        if band > 0.0 and rules.clears_band(mode, vals[0][i], band):
-            # out of the exit's rounding band at ts[i]: H unbiased from there on, so a
-            # return across H is refined at H = 0 (as the compiled engine's _find)
-            band, leave = 0.0, unbanded
-            vals[0] = np.asarray(leave[0][0](zs), dtype=float)
-            again = rules.crosses(leave[0][1], vals[0][:-1], vals[0][1:])
-            again |= rules.extremum_between(mode, D[:-1], D[1:])
-            for pred, sv in zip(preds, svals):
-                again |= rules.crosses(pred, sv[:-1], sv[1:])
-            again[:i] = False
-            order, pos = np.flatnonzero(again), 0
-            continue
-        best = None  # (t, z, what, idx)
-        ta, tb = ts[i], ts[i + 1]
-        for (func, pred, what), v in zip(leave, vals):
-            if rules.crosses(pred, v[i], v[i + 1]):
-                lo, vlo = ta, v[i]
-                if (mode != SLIDING and first and i == 0
-                        and rules.dips_and_returns(mode, D[0], D[1])):
-                    # refine beyond the dip: next to the entry H is noise (rules)
-                    tm = _brent(dfun, ta, tb, D[0], D[1], xtol)
-                    hm = float(func(Z(tm)))
-                    if not rules.after(pred, hm):
-                        lo, vlo = tm, hm
-                r = _refine(scalar(func), pred, lo, tb, vlo, v[i + 1], xtol)
-                if band > 0.0 and what == "switch":
-                    # found beyond the exit's band: again on H itself (rules.band_probe)
-                    h = scalar(unbanded[0][0])
-                    tq, step, done, clear = r, 0.0, False, False
-                    while not done:
-                        clear = rules.clears_band(mode, float(func(Z(tq))), band)
-                        done, tq, step = rules.band_probe(tq, step, lo, clear)
-                    if clear:
-                        r = _refine(h, pred, tq, r, h(tq), h(r), xtol)
+    def candidates(self):
+        """Sample intervals that may hold an event, found with array operations; only
+        those are examined one by one (a scan of many samples costs a few numpy calls)."""
+        cand = np.zeros(self.ts.size - 1, dtype=bool)
+        for (_, pred, _), v in zip(self.leave, self.vals):
+            cand |= rules.crosses(pred, v[:-1], v[1:])
+        if self.mode != SLIDING:
+            cand |= rules.extremum_between(self.mode, self.D[:-1], self.D[1:])
+        elif self.rates is not None:
+            for (_, pred, _), Dv in zip(self.leave, self.R):
+                cand |= rules.speed_extremum_between(pred, Dv[:-1], Dv[1:])
+        for pred, sv in zip(self.preds, self.svals):
+            cand |= rules.crosses(pred, sv[:-1], sv[1:])
+        return cand
+
+    def earliest(self):
+        """(t, z, what, section index) of the earliest event, or None; the band after it."""
+        order, pos = np.flatnonzero(self.candidates()), 0
+        while pos < order.size:
+            i = int(order[pos])
+            pos += 1
+            if self.band > 0.0 and rules.clears_band(self.mode, self.vals[0][i], self.band):
+                order, pos = self._unband(i), 0
+                continue
+            best = self._event_in(i)
+            if best is not None:
+                r, what, k = best
+                z = np.asarray(self.Z(r), dtype=float).reshape(-1).copy()
+                return (r, z, what, k), self.band
+        return None, self.band
+
+    def _unband(self, i):
+        """Out of the exit's rounding band at ts[i]: H unbiased from there on, so a
+        return across H is refined at H = 0 (as the compiled engine's _find). The
+        candidate intervals from i on, again."""
+        self.band, self.leave = 0.0, self.unbanded
+        self.vals[0] = np.asarray(self.leave[0][0](self.zs), dtype=float)
+        again = rules.crosses(self.leave[0][1], self.vals[0][:-1], self.vals[0][1:])
+        again |= rules.extremum_between(self.mode, self.D[:-1], self.D[1:])
+        for pred, sv in zip(self.preds, self.svals):
+            again |= rules.crosses(pred, sv[:-1], sv[1:])
+        again[:i] = False
+        return np.flatnonzero(again)
+
+    def _event_in(self, i):
+        """The earliest event in the sample interval i as (t, what, section index), or
+        None: a crossing of a leave function, else a graze hidden between the samples;
+        then a section hit that comes first (or at the same instant)."""
+        ta, tb = self.ts[i], self.ts[i + 1]
+        best = self._leave_crossing(i, ta, tb)
+        if self.mode == SLIDING and best is None and self.rates is not None:
+            best = self._hidden_slide_end(i, ta, tb)
+        if self.mode != SLIDING and best is None:
+            best = self._hidden_extremum(i, ta, tb)
+        return self._section_hit(i, ta, tb, best)
+
+    def _leave_crossing(self, i, ta, tb):
+        best = None  # (t, what, section index)
+        for (func, pred, what), v in zip(self.leave, self.vals):
+            if not rules.crosses(pred, v[i], v[i + 1]):
+                continue
+            lo, vlo = ta, v[i]
+            if (self.mode != SLIDING and self.first and i == 0
+                    and rules.dips_and_returns(self.mode, self.D[0], self.D[1])):
+                # refine beyond the dip: next to the entry H is noise (rules)
+                tm = _brent(self._dH, ta, tb, self.D[0], self.D[1], self.xtol)
+                hm = float(func(self.Z(tm)))
+                if not rules.after(pred, hm):
+                    lo, vlo = tm, hm
+            r = _refine(self._along(func), pred, lo, tb, vlo, v[i + 1], self.xtol)
+            if self.band > 0.0 and what == "switch":
+                r = self._past_band(func, pred, lo, r)
+            if best is None or r < best[0]:
+                best = (r, what, -1)
+        return best
+
+    def _past_band(self, func, pred, lo, r):
+        """A switch found beyond the exit's band: again on H itself (rules.band_probe)."""
+        h = self._along(self.unbanded[0][0])
+        tq, step, done, clear = r, 0.0, False, False
+        while not done:
+            clear = rules.clears_band(self.mode, float(func(self.Z(tq))), self.band)
+            done, tq, step = rules.band_probe(tq, step, lo, clear)
+        if clear:
+            r = _refine(h, pred, tq, r, h(tq), h(r), self.xtol)
+        return r
+
+    def _hidden_slide_end(self, i, ta, tb):
+        """The end of sliding hidden between the samples (rules.speed_graze): refined
+        at the extremum of a or b, an exit at the speed's root before it."""
+        best, touches = None, []
+        for j, ((func, pred, what), v, Dv) in enumerate(zip(self.leave, self.vals, self.R)):
+            if not rules.speed_extremum_between(pred, Dv[i], Dv[i + 1]):
+                continue
+            tm = _brent(lambda tt, j=j: float(self.rates(tt)[j]), ta, tb, Dv[i], Dv[i + 1],
+                        self.xtol)
+            vm = float(func(self.Z(tm)))
+            kind = rules.speed_graze(pred, vm, Dv[i], Dv[i + 1], tb - ta, self.touch_tol)
+            if kind == rules.GRAZE_CROSSES:
+                r = _refine(self._along(func), pred, ta, tm, v[i], vm, self.xtol)
                 if best is None or r < best[0]:
                     best = (r, what, -1)
-        if mode == SLIDING and best is None and rates is not None:
-            # the end of sliding hidden between the samples (rules.speed_graze): refined
-            # at the extremum of a or b, an exit at the speed's root before it
-            touches = []
-            for j, ((func, pred, what), v, Dv) in enumerate(zip(leave, vals, R)):
-                if not rules.speed_extremum_between(pred, Dv[i], Dv[i + 1]):
-                    continue
-                tm = _brent(lambda tt, j=j: float(rates(tt)[j]), ta, tb, Dv[i], Dv[i + 1],
-                            xtol)
-                vm = float(func(Z(tm)))
-                kind = rules.speed_graze(pred, vm, Dv[i], Dv[i + 1], tb - ta, touch_tol)
-                if kind == rules.GRAZE_CROSSES:
-                    r = _refine(scalar(func), pred, ta, tm, v[i], vm, xtol)
-                    if best is None or r < best[0]:
-                        best = (r, what, -1)
-                elif kind == rules.GRAZE_TOUCHES:
-                    touches.append(tm)
-            for tm in sorted(touches):  # a touch before any exit: P has a kink there
-                if best is None or tm < best[0]:
-                    traj.events.append(Event(tm, "touch", Z(tm).copy(), mode, mode))
-        if mode != SLIDING and best is None:
-            # a minimum (in +) or maximum (in -) of H hidden between samples
-            H = vals[0]
-            if rules.extremum_between(mode, D[i], D[i + 1]):
-                tm = _brent(dfun, ta, tb, D[i], D[i + 1], xtol)
-                Hm = float(leave[0][0](Z(tm)))
-                pred = leave[0][1]
-                kind = rules.graze(mode, Hm, touch_tol, band)
-                if kind == rules.GRAZE_CROSSES:
-                    r = _refine(scalar(leave[0][0]), pred, ta, tm, H[i], Hm, xtol)
-                    best = (r, "switch", -1)
-                elif kind == rules.GRAZE_TOUCHES:
-                    traj.events.append(Event(tm, "touch", Z(tm).copy(), mode, mode))
-        for k, (sec, pred, sv) in enumerate(zip(sections, preds, svals)):
-            if rules.crosses(pred, sv[i], sv[i + 1]):
-                r = _refine(scalar(sec.func), pred, ta, tb, sv[i], sv[i + 1], xtol)
-                if r < traj.t0 + sec.min_time:
-                    continue
-                # a section root at the instant of a switch (a section on H) is hit
-                # there, before the switch: the switch then follows at once on restart
-                if not (best is None or r < best[0]
-                        or (best[1] != "section" and r <= best[0] + rules.same_instant(xtol, best[0]))):
-                    continue
-                zr = Z(r)
-                if sec.where is not None and not sec.where(zr):
-                    continue
-                if i == 0 and ta == traj.t0:
-                    z_first = np.asarray(zs[:, 0], dtype=float)
-                    z_root = np.asarray(zr, dtype=float).reshape(-1)
-                    if (rules.starts_on_section(float(sv[0]), z_first, float(sec.func(zr)), z_root,
-                                                np.asarray(traj.z0, dtype=float).reshape(-1))
-                            or _in_section_rounding(sec.func, float(sv[0]), z_first, z_root)):
-                        continue
-                best = (r, "section", k)
-        if best is not None:
-            r, what, k = best
-            return (r, np.asarray(Z(r), dtype=float).reshape(-1).copy(), what, k), band
-    return None, band
+            elif kind == rules.GRAZE_TOUCHES:
+                touches.append(tm)
+        for tm in sorted(touches):  # a touch before any exit: P has a kink there
+            if best is None or tm < best[0]:
+                self._touch(tm)
+        return best
+
+    def _hidden_extremum(self, i, ta, tb):
+        """A minimum (in +) or maximum (in -) of H hidden between the samples: a switch
+        if H changes sign there (rules.graze), a touch if it just reaches it."""
+        if not rules.extremum_between(self.mode, self.D[i], self.D[i + 1]):
+            return None
+        func, pred, _ = self.leave[0]
+        tm = _brent(self._dH, ta, tb, self.D[i], self.D[i + 1], self.xtol)
+        Hm = float(func(self.Z(tm)))
+        kind = rules.graze(self.mode, Hm, self.touch_tol, self.band)
+        if kind == rules.GRAZE_CROSSES:
+            return (_refine(self._along(func), pred, ta, tm, self.vals[0][i], Hm, self.xtol),
+                    "switch", -1)
+        if kind == rules.GRAZE_TOUCHES:
+            self._touch(tm)
+        return None
+
+    def _section_hit(self, i, ta, tb, best):
+        """``best`` or a section hit in the interval that comes first; a section root at
+        the instant of a switch (a section on H) is hit there, before the switch: the
+        switch then follows at once on restart."""
+        traj = self.traj
+        for k, (sec, pred, sv) in enumerate(zip(self.sections, self.preds, self.svals)):
+            if not rules.crosses(pred, sv[i], sv[i + 1]):
+                continue
+            r = _refine(self._along(sec.func), pred, ta, tb, sv[i], sv[i + 1], self.xtol)
+            if r < traj.t0 + sec.min_time:
+                continue
+            if not (best is None or r < best[0]
+                    or (best[1] != "section"
+                        and r <= best[0] + rules.same_instant(self.xtol, best[0]))):
+                continue
+            zr = self.Z(r)
+            if sec.where is not None and not sec.where(zr):
+                continue
+            if i == 0 and ta == traj.t0 and self._starts_on(sec, sv, zr):
+                continue
+            best = (r, "section", k)
+        return best
+
+    def _starts_on(self, sec, sv, zr) -> bool:
+        """The start on the section, up to its rounding (rules.starts_on_section,
+        rules.on_section_by_value): no hit."""
+        z_first = np.asarray(self.zs[:, 0], dtype=float)
+        z_root = np.asarray(zr, dtype=float).reshape(-1)
+        return (rules.starts_on_section(float(sv[0]), z_first, float(sec.func(zr)), z_root,
+                                        np.asarray(self.traj.z0, dtype=float).reshape(-1))
+                or _in_section_rounding(sec.func, float(sv[0]), z_first, z_root))

@@ -40,6 +40,7 @@ NO_GRAPHICS = r"\AtBeginDocument{\renewcommand{\includegraphics}[2][]{\fbox{grap
 EQ_SINGLE = {"equation", "multline"}
 EQ_MULTI = {"align", "eqnarray", "gather", "flalign", "alignat", "xalignat"}
 EQ_UNNUMBERED = {"displaymath", "math"}
+EQ_ALL = EQ_SINGLE | EQ_MULTI | EQ_UNNUMBERED
 FLOATS = {"figure": "Fig.", "subfigure": "Fig.", "table": "Table", "subtable": "Table"}
 # environments that do not step a counter: a \label inside refers to the enclosing one
 TRANSPARENT = {
@@ -136,150 +137,202 @@ def kinds(source_text: str) -> dict[str, str]:
     \\section*, in an unknown environment) or that is defined twice raises
     ValueError naming it: the numbers are only trusted where the kind is certain.
     """
-    theorems = theorem_names(source_text)
-    text = strip_comments(source_text)
-    start = text.find(r"\begin{document}")
-    start = 0 if start < 0 else start
-    has_chapters = re.search(r"\\chapter\b", text) is not None
+    return _LabelScan(source_text).run()
 
-    result: dict[str, str] = {}
-    errors: list[str] = []
-    seen: dict[str, int] = {}
-    stack: list[_Env] = []
-    section: tuple[str, bool, bool] | None = None   # (command, starred, in appendix)
-    appendix = False
-    subfig_end = -1                                  # inside \subfigure[...]{...} up to here
 
-    def line_of(pos: int) -> int:
-        return text.count("\n", 0, pos) + 1
 
-    def nearest(names) -> _Env | None:
-        return next((e for e in reversed(stack) if e.base in names), None)
+class _LabelScan:
+    """One pass over the source's control sequences from \\begin{document}: the open
+    environments, the current sectioning command and every \\label's kind (or the
+    reason it has none)."""
 
-    def close_row(env: _Env) -> None:
-        for label, line in env.row:
-            if env.starred or env.base in EQ_UNNUMBERED:
-                if env.tag:
-                    result[label] = "Eq."
-                else:
-                    errors.append(f"{label} (line {line}): in the unnumbered {env.name}")
-            elif env.nonumber and not env.tag:
-                errors.append(f"{label} (line {line}): in a \\nonumber row of {env.name}")
-            else:
-                result[label] = "Eq."
-        env.row, env.nonumber, env.tag = [], False, False
+    def __init__(self, source_text: str):
+        self.theorems = theorem_names(source_text)
+        self.text = strip_comments(source_text)
+        self.has_chapters = re.search(r"\\chapter\b", self.text) is not None
+        self.result: dict[str, str] = {}
+        self.errors: list[str] = []
+        self.seen: dict[str, int] = {}
+        self.stack: list[_Env] = []
+        self.section: tuple[str, bool, bool] | None = None  # (command, starred, in appendix)
+        self.appendix = False
+        self.subfig_end = -1        # inside \subfigure[...]{...} up to here
 
-    def decide(label: str, pos: int) -> None:
-        line = line_of(pos)
-        if label in seen:
-            errors.append(f"{label} (line {line}): defined twice (also line {seen[label]})")
-            return
-        seen[label] = line
-        if pos < subfig_end:
-            result[label] = "Fig."
-            return
-        for env in reversed(stack):
-            b = env.base
-            if b in TRANSPARENT:
-                continue
-            if b in EQ_SINGLE | EQ_MULTI | EQ_UNNUMBERED:
-                env.row.append((label, line))
-            elif b in FLOATS:
-                if env.captioned:
-                    result[label] = FLOATS[b]
-                else:
-                    errors.append(f"{label} (line {line}): in {env.name} before its \\caption")
-            elif b == "enumerate":
-                if env.itemed:
-                    result[label] = "Item"
-                else:
-                    errors.append(f"{label} (line {line}): in enumerate before its first \\item")
-            elif b in theorems:
-                if theorems[b] is None:
-                    errors.append(f"{label} (line {line}): in the unnumbered {b}")
-                else:
-                    result[label] = theorems[b]
-            elif b == "document":
+    def run(self) -> dict[str, str]:
+        start = self.text.find(r"\begin{document}")
+        pos = 0 if start < 0 else start
+        while (m := _CS.search(self.text, pos)) is not None:
+            pos = self._command(m)
+            if pos is None:       # \end{document}: what follows is not printed
                 break
-            else:
-                errors.append(f"{label} (line {line}): in environment {env.name}, "
-                              "kind unknown")
-            return
-        if section is None:
-            errors.append(f"{label} (line {line}): no sectioning command before it")
-        elif section[1]:
-            errors.append(f"{label} (line {line}): after the unnumbered \\{section[0]}*")
-        else:
-            # after \appendix every sectioning label is cited "Appendix B.1", as the
-            # paper itself does (Elsevier style), not "Sec. B.1"
-            if section[2] and (not has_chapters or section[0] == "chapter"):
-                result[label] = "Appendix"
-            elif section[0] == "chapter":
-                result[label] = "Chapter"
-            elif section[0] == "part":
-                result[label] = "Part"
-            else:
-                result[label] = "Sec."
+        if self.errors:
+            raise ValueError("paper labels whose printed kind cannot be decided: "
+                             + "; ".join(self.errors))
+        return self.result
 
-    pos = start
-    while (m := _CS.search(text, pos)) is not None:
+    # -- helpers
+    def _line_of(self, pos: int) -> int:
+        return self.text.count("\n", 0, pos) + 1
+
+    def _nearest(self, names) -> _Env | None:
+        return next((e for e in reversed(self.stack) if e.base in names), None)
+
+    # -- one control sequence: the position to scan on from, None at \end{document}
+    def _command(self, m: re.Match) -> int | None:
         pos = m.end()
         word, star, symbol = m[1], m[2], m[3]
         if symbol is not None:
-            if symbol == "\\" and stack and stack[-1].base in EQ_MULTI:
-                close_row(stack[-1])
-            elif symbol == "[":
-                stack.append(_Env("displaymath", line_of(m.start())))
-            elif symbol == "]" and stack and stack[-1].name == "displaymath":
-                close_row(stack.pop())
-            continue
-        if word in ("begin", "end"):
-            g = _group(text, pos)
-            if g is None:
-                continue
-            name, pos = g[0].strip(), g[1]
-            if word == "begin":
-                stack.append(_Env(name, line_of(m.start())))
-                continue
-            if not stack or stack[-1].name != name:
-                open_ = f"\\begin{{{stack[-1].name}}} of line {stack[-1].line}" if stack else "nothing"
-                raise ValueError(f"cannot follow the environments: \\end{{{name}}} on line "
-                                 f"{line_of(m.start())} closes {open_}")
-            env = stack.pop()
-            if env.base in EQ_SINGLE | EQ_MULTI | EQ_UNNUMBERED:
-                close_row(env)
-            if name == "document":
-                break
+            self._symbol(symbol, m.start())
+        elif word in ("begin", "end"):
+            return self._begin_end(word, m)
         elif word == "label":
-            g = _group(text, pos)
-            if g is not None:
-                decide(g[0].strip(), m.start())
-                pos = g[1]
-        elif word in SECTIONS:
-            section = (word, bool(star), appendix)
+            return self._label(m)
+        elif word in ("subfigure", "subfloat"):
+            self._subfigure(pos)
+        else:
+            self._marker(word, star)
+        return pos
+
+    def _symbol(self, symbol: str, at: int) -> None:
+        """\\\\ ends a row of a multi-row display; \\[ ... \\] is an unnumbered display."""
+        if symbol == "\\" and self.stack and self.stack[-1].base in EQ_MULTI:
+            self._close_row(self.stack[-1])
+        elif symbol == "[":
+            self.stack.append(_Env("displaymath", self._line_of(at)))
+        elif symbol == "]" and self.stack and self.stack[-1].name == "displaymath":
+            self._close_row(self.stack.pop())
+
+    def _begin_end(self, word: str, m: re.Match) -> int | None:
+        g = _group(self.text, m.end())
+        if g is None:
+            return m.end()
+        name, pos = g[0].strip(), g[1]
+        if word == "begin":
+            self.stack.append(_Env(name, self._line_of(m.start())))
+            return pos
+        if not self.stack or self.stack[-1].name != name:
+            top = self.stack[-1] if self.stack else None
+            open_ = f"\\begin{{{top.name}}} of line {top.line}" if top else "nothing"
+            raise ValueError(f"cannot follow the environments: \\end{{{name}}} on line "
+                             f"{self._line_of(m.start())} closes {open_}")
+        env = self.stack.pop()
+        if env.base in EQ_ALL:
+            self._close_row(env)
+        return None if name == "document" else pos
+
+    def _label(self, m: re.Match) -> int:
+        g = _group(self.text, m.end())
+        if g is None:
+            return m.end()
+        self._decide(g[0].strip(), m.start())
+        return g[1]
+
+    def _subfigure(self, pos: int) -> None:
+        """A \\subfigure[...]{...} panel: labels up to its closing brace are figures."""
+        j = pos
+        while (g := _group(self.text, j, "[", "]")) is not None:
+            j = g[1]
+        g = _group(self.text, j)
+        self.subfig_end = max(self.subfig_end, g[1] if g else j)
+
+    def _marker(self, word: str, star: str) -> None:
+        """Commands that change how a later \\label is counted."""
+        if word in SECTIONS:
+            self.section = (word, bool(star), self.appendix)
         elif word == "appendix":
-            appendix = True
+            self.appendix = True
         elif word == "caption":
-            env = nearest(FLOATS)
+            env = self._nearest(FLOATS)
             if env is not None:
                 env.captioned = True
         elif word == "item":
-            if stack and stack[-1].base == "enumerate":
-                stack[-1].itemed = True
+            if self.stack and self.stack[-1].base == "enumerate":
+                self.stack[-1].itemed = True
         elif word in ("nonumber", "notag", "tag"):
-            env = nearest(EQ_SINGLE | EQ_MULTI | EQ_UNNUMBERED)
+            env = self._nearest(EQ_ALL)
             if env is not None:
                 setattr(env, "tag" if word == "tag" else "nonumber", True)
-        elif word in ("subfigure", "subfloat"):
-            j = pos
-            while (g := _group(text, j, "[", "]")) is not None:
-                j = g[1]
-            g = _group(text, j)
-            subfig_end = max(subfig_end, g[1] if g else j)
-    if errors:
-        raise ValueError("paper labels whose printed kind cannot be decided: "
-                         + "; ".join(errors))
-    return result
+
+    # -- deciding a label's kind
+    def _close_row(self, env: _Env) -> None:
+        """The labels of a finished display row: numbered unless the row or the
+        display is unnumbered (a \\tag numbers it anyway)."""
+        for label, line in env.row:
+            if env.starred or env.base in EQ_UNNUMBERED:
+                if env.tag:
+                    self.result[label] = "Eq."
+                else:
+                    self.errors.append(f"{label} (line {line}): in the unnumbered {env.name}")
+            elif env.nonumber and not env.tag:
+                self.errors.append(f"{label} (line {line}): in a \\nonumber row of {env.name}")
+            else:
+                self.result[label] = "Eq."
+        env.row, env.nonumber, env.tag = [], False, False
+
+    def _decide(self, label: str, pos: int) -> None:
+        line = self._line_of(pos)
+        if label in self.seen:
+            self.errors.append(f"{label} (line {line}): defined twice "
+                               f"(also line {self.seen[label]})")
+            return
+        self.seen[label] = line
+        if pos < self.subfig_end:
+            self.result[label] = "Fig."
+            return
+        env = self._counting_env()
+        if env is None:
+            self._in_section(label, line)
+        else:
+            self._in_env(env, label, line)
+
+    def _counting_env(self) -> _Env | None:
+        """The innermost environment that steps a counter; None in the document's body."""
+        for env in reversed(self.stack):
+            if env.base in TRANSPARENT:
+                continue
+            return None if env.base == "document" else env
+        return None
+
+    def _in_env(self, env: _Env, label: str, line: int) -> None:
+        b = env.base
+        if b in EQ_ALL:
+            env.row.append((label, line))   # decided when the row closes
+        elif b in FLOATS:
+            if env.captioned:
+                self.result[label] = FLOATS[b]
+            else:
+                self.errors.append(f"{label} (line {line}): in {env.name} before its \\caption")
+        elif b == "enumerate":
+            if env.itemed:
+                self.result[label] = "Item"
+            else:
+                self.errors.append(f"{label} (line {line}): in enumerate before its first \\item")
+        elif b in self.theorems:
+            if self.theorems[b] is None:
+                self.errors.append(f"{label} (line {line}): in the unnumbered {b}")
+            else:
+                self.result[label] = self.theorems[b]
+        else:
+            self.errors.append(f"{label} (line {line}): in environment {env.name}, "
+                               "kind unknown")
+
+    def _in_section(self, label: str, line: int) -> None:
+        if self.section is None:
+            self.errors.append(f"{label} (line {line}): no sectioning command before it")
+            return
+        command, starred, in_appendix = self.section
+        if starred:
+            self.errors.append(f"{label} (line {line}): after the unnumbered \\{command}*")
+        # after \appendix every sectioning label is cited "Appendix B.1", as the
+        # paper itself does (Elsevier style), not "Sec. B.1"
+        elif in_appendix and (not self.has_chapters or command == "chapter"):
+            self.result[label] = "Appendix"
+        elif command == "chapter":
+            self.result[label] = "Chapter"
+        elif command == "part":
+            self.result[label] = "Part"
+        else:
+            self.result[label] = "Sec."
 
 
 # ----------------------------------------------------------------------------- compiling

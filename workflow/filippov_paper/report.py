@@ -437,16 +437,7 @@ def bench(ds, m: Macros, effects=None, returns=None, compile_cost=None) -> str:
     ingredient when results/bench_effect_cost.nc is there and the cost of one iterated
     return when results/bench_attractor_cost.nc is (`make bench`); the compile and load
     times of the compiled engine (macros only) when results/bench_compile_cost.nc is."""
-    quoted = (("kernel", "Kernel"), ("kernel_dpdz", "KernelDpdz"), ("model", "Model"))
-    if compile_cost is not None and not {s for s, _ in quoted} <= set(compile_cost.stage.values):
-        compile_cost = None  # measured by an older benchmark: measured again by make bench
-    m.flag("rpHaveCompileCost", compile_cost is not None)
-    if compile_cost is not None:
-        for stage, tag in quoted:
-            for kind in ("cold", "warm"):
-                var(m, f"rpCompile{tag}{kind.title()}", compile_cost, "bench_compile_cost",
-                    kind, sig=2, stage=stage)
-    sid = "work_precision"
+    _compile_cost_macros(m, compile_cost)
     missing = absent(m, "rpHaveBench", ds, "Work--precision sweep", "results/work_precision.nc")
     m.flag("rpHaveBenchTiming", False)  # set by _bench_timing when the sweep says how it timed
     # the blocks of `make bench` (set below when measured): defined for every build, as
@@ -463,6 +454,34 @@ def bench(ds, m: Macros, effects=None, returns=None, compile_cost=None) -> str:
         probs = [i for i, p in enumerate(names) if p.startswith(prefix)]
         if probs:
             lines += ([r"\medskip", ""] if lines else []) + _bench_tabular(ds, probs)
+    _bench_problem_macros(ds, m, names)
+    _bench_timing(ds, m)
+    m.flag("rpHaveEffects", effects is not None)
+    if effects is not None:
+        lines += _effects_tabular(effects)
+    m.flag("rpHaveReturnCost", returns is not None)
+    if returns is not None:
+        lines += _return_cost_tabular(returns)
+    return "\n".join(lines)
+
+
+def _compile_cost_macros(m: Macros, compile_cost) -> None:
+    """The compiled engine's cold and warm compile/load times of the quoted stages."""
+    quoted = (("kernel", "Kernel"), ("kernel_dpdz", "KernelDpdz"), ("model", "Model"))
+    if compile_cost is not None and not {s for s, _ in quoted} <= set(compile_cost.stage.values):
+        compile_cost = None  # measured by an older benchmark: measured again by make bench
+    m.flag("rpHaveCompileCost", compile_cost is not None)
+    if compile_cost is not None:
+        for stage, tag in quoted:
+            for kind in ("cold", "warm"):
+                var(m, f"rpCompile{tag}{kind.title()}", compile_cost, "bench_compile_cost",
+                    kind, sig=2, stage=stage)
+
+
+def _bench_problem_macros(ds, m: Macros, names) -> None:
+    """Per problem (the first four: A-D) the speed-up, the reference floor, the points,
+    and what solve_ivp's RK45 and DOP853 miss; then the failed configurations."""
+    sid = "work_precision"
     fam = np.array([str(f) for f in ds.method.values])
     for i, p in enumerate(names[:4]):
         key = "ABCD"[i]
@@ -488,37 +507,39 @@ def bench(ds, m: Macros, effects=None, returns=None, compile_cost=None) -> str:
           "derived: configurations of work_precision:status that failed",
           text=failed_sentence(failed))
     m.add("rpBenchConfigs", float(ds.sizes["config"]), "work_precision:config (size)", 4)
-    _bench_timing(ds, m)
-    m.flag("rpHaveEffects", effects is not None)
-    if effects is not None:
-        lines += [r"\medskip", "", r"\begin{tabular}{llrrl}", r"\toprule",
-                  r"scene & ingredient switched & time [s] & $\times$ declared & outcome \\",
-                  r"\midrule"]
-        for k in range(effects.sizes["variant"]):
-            status = str(effects.status.values[k])
-            outcome = "ok" if status == "ok" else status.split(":")[0]
-            lines.append(" & ".join([
-                r"\texttt{" + tex_escape(str(effects.scene.values[k])) + "}",
-                tex_escape(str(effects.change.values[k])).replace("->", r"$\to$"),
-                f"${num(float(effects.seconds.values[k]), 3)}$",
-                f"${num(float(effects.relative.values[k]), 3)}$",
-                r"\emph{" + tex_escape(outcome) + "}"]) + r" \\")
-        lines += [r"\bottomrule", r"\end{tabular}", ""]
-    m.flag("rpHaveReturnCost", returns is not None)
-    if returns is not None:
-        lines += [r"\medskip", "", r"\begin{tabular}{rrrrrr}", r"\toprule",
-                  r"$\theta$ & $\epsilon$ & $s$ & $\mu$s/return & with $DP$ & "
-                  r"switches/return \\", r"\midrule"]
-        for k in range(returns.sizes["case"]):
-            lines.append(" & ".join([
-                f"${num(float(returns.theta.values[k]), 2)}$",
-                f"${num(float(returns.eps.values[k]), 1)}$",
-                f"${num(float(returns.s.values[k]), 2)}$",
-                f"${num(1e6 * float(returns.time_per_return.values[k]), 3)}$",
-                f"${num(1e6 * float(returns.time_per_return_jacobian.values[k]), 3)}$",
-                f"${num(float(returns.switches_per_return.values[k]), 3)}$"]) + r" \\")
-        lines += [r"\bottomrule", r"\end{tabular}", ""]
-    return "\n".join(lines)
+
+
+def _effects_tabular(effects) -> list[str]:
+    """The cost of each model ingredient (results/bench_effect_cost.nc)."""
+    lines = [r"\medskip", "", r"\begin{tabular}{llrrl}", r"\toprule",
+             r"scene & ingredient switched & time [s] & $\times$ declared & outcome \\",
+             r"\midrule"]
+    for k in range(effects.sizes["variant"]):
+        status = str(effects.status.values[k])
+        outcome = "ok" if status == "ok" else status.split(":")[0]
+        lines.append(" & ".join([
+            r"\texttt{" + tex_escape(str(effects.scene.values[k])) + "}",
+            tex_escape(str(effects.change.values[k])).replace("->", r"$\to$"),
+            f"${num(float(effects.seconds.values[k]), 3)}$",
+            f"${num(float(effects.relative.values[k]), 3)}$",
+            r"\emph{" + tex_escape(outcome) + "}"]) + r" \\")
+    return lines + [r"\bottomrule", r"\end{tabular}", ""]
+
+
+def _return_cost_tabular(returns) -> list[str]:
+    """The cost of one iterated return (results/bench_attractor_cost.nc)."""
+    lines = [r"\medskip", "", r"\begin{tabular}{rrrrrr}", r"\toprule",
+             r"$\theta$ & $\epsilon$ & $s$ & $\mu$s/return & with $DP$ & "
+             r"switches/return \\", r"\midrule"]
+    for k in range(returns.sizes["case"]):
+        lines.append(" & ".join([
+            f"${num(float(returns.theta.values[k]), 2)}$",
+            f"${num(float(returns.eps.values[k]), 1)}$",
+            f"${num(float(returns.s.values[k]), 2)}$",
+            f"${num(1e6 * float(returns.time_per_return.values[k]), 3)}$",
+            f"${num(1e6 * float(returns.time_per_return_jacobian.values[k]), 3)}$",
+            f"${num(float(returns.switches_per_return.values[k]), 3)}$"]) + r" \\")
+    return lines + [r"\bottomrule", r"\end{tabular}", ""]
 
 
 def hard_cases(ds, m: Macros) -> str:

@@ -195,71 +195,94 @@ def slow_manifold_plus(x1, x2, eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5,
     x2 = np.atleast_1d(np.asarray(x2, dtype=float)) + 0.0 * x1
     if eps <= 0:
         return v0 + gamma * x2, np.zeros_like(x2)
-    Fp0, dFp0 = friction_branches(f0, fv, fc, convention)[:2]
-    F0, dF0 = float(Fp0(0.0)), float(dFp0(0.0))
+    flow = _PlusRelaxation(eps, v0, gamma, friction_branches(f0, fv, fc, convention)[:2],
+                           x1.size)
+    T = min(relax * eps, t_max)
+    w = flow.solve(x1, x2, T, newton_tol, max_iter)
+    w_long = flow.solve(x1, x2, 1.5 * T, newton_tol, max_iter)
+    return w, np.abs(w - w_long)
 
-    def Fp(nu):
-        return np.where(nu <= 0, Fp0(np.minimum(nu, 0.0)), F0 + dF0 * nu)
 
-    def dFp(nu):
-        return np.where(nu <= 0, dFp0(np.minimum(nu, 0.0)), dF0)
+class _PlusRelaxation:
+    """The region-+ field of eq:dfo-sf for a batch of ``m`` points (states stacked as
+    (x1, x2, w) blocks), the second-order expansion w2 of M_+, and the relaxation onto
+    M_+ that :func:`slow_manifold_plus` solves for."""
 
-    g1 = 1.0 + gamma
-    m = x1.size
+    def __init__(self, eps, v0, gamma, branches, m: int):
+        self.Fp0, self.dFp0 = branches
+        self.F0, self.dF0 = float(self.Fp0(0.0)), float(self.dFp0(0.0))
+        self.eps, self.v0, self.gamma, self.m = eps, v0, gamma, m
+        self.g1 = 1.0 + gamma
+        # Fixed DOP853 steps (first_step = max_step, loose tolerances so every step is
+        # accepted): the map x_s -> x(T) is then a smooth function of x_s, which
+        # Newton needs; adaptive steps make it jitter at the 1e-10 level.
+        self.h_fix = min(eps / 8, 0.0125)
 
-    def w2(a, b):
-        F = Fp(b - v0)
-        return v0 + gamma * b + eps * gamma * F + eps ** 2 * gamma * dFp(b - v0) * (a + (1 - gamma) * F)
+    # F_plus for nu <= 0; beyond, its tangent at nu = 0 (the analytic branch runs away)
+    def Fp(self, nu):
+        return np.where(nu <= 0, self.Fp0(np.minimum(nu, 0.0)), self.F0 + self.dF0 * nu)
 
-    def rhs(t, z):
+    def dFp(self, nu):
+        return np.where(nu <= 0, self.dFp0(np.minimum(nu, 0.0)), self.dF0)
+
+    def w2(self, a, b):
+        """w on the second-order expansion of M_+ above (a, b)."""
+        eps, v0, gamma = self.eps, self.v0, self.gamma
+        F = self.Fp(b - v0)
+        return v0 + gamma * b + eps * gamma * F + eps ** 2 * gamma * self.dFp(b - v0) * (a + (1 - gamma) * F)
+
+    def rhs(self, t, z):
+        eps, v0, gamma = self.eps, self.v0, self.gamma
         a, b, w = z.reshape(3, -1)
-        return np.concatenate([b, -a - Fp(g1 * b - w), (-w + v0 + gamma * b - eps * gamma * a) / eps])
+        return np.concatenate([b, -a - self.Fp(self.g1 * b - w), (-w + v0 + gamma * b - eps * gamma * a) / eps])
 
-    # Fixed DOP853 steps (first_step = max_step, loose tolerances so every step is
-    # accepted): the map x_s -> x(T) is then a smooth function of x_s, which
-    # Newton needs; adaptive steps make it jitter at the 1e-10 level.
-    h_fix = min(eps / 8, 0.0125)
+    def back(self, t, z):
+        """The slow flow on the expansion w2, backward in time ((x1, x2) blocks)."""
+        m = self.m
+        return -np.concatenate([z[m:], -z[:m] - self.Fp(self.g1 * z[m:] - self.w2(z[:m], z[m:]))])
 
-    def forward(xs1, xs2, T):
-        z0 = np.concatenate([xs1, xs2, w2(xs1, xs2)])
-        sol = solve_ivp(rhs, (0.0, T), z0, method="DOP853", rtol=1e-3, atol=1e3,
-                        first_step=h_fix, max_step=h_fix)
+    def forward(self, xs1, xs2, T):
+        """The states at time T from (xs1, xs2) on the expansion: rows x1, x2, w."""
+        z0 = np.concatenate([xs1, xs2, self.w2(xs1, xs2)])
+        sol = solve_ivp(self.rhs, (0.0, T), z0, method="DOP853", rtol=1e-3, atol=1e3,
+                        first_step=self.h_fix, max_step=self.h_fix)
         if not sol.success:
             raise RuntimeError(f"slow-manifold relaxation failed: {sol.message}")
-        return sol.y[:, -1].reshape(3, m)
+        return sol.y[:, -1].reshape(3, self.m)
 
-    def solve(T):
-        # backward slow flow on the expansion: the Newton start
-        back = lambda t, z: -np.concatenate([z[m:], -z[:m] - Fp(g1 * z[m:] - w2(z[:m], z[m:]))])
+    def newton_start(self, x1, x2, T):
+        """Where the backward slow flow on the expansion is at time T: the start of
+        the Newton iteration for x_s."""
+        m = self.m
         # fixed steps here too: an adaptive step size depends on an error norm over
         # the whole batch, a BLAS dot product whose last bit depends on where the
         # array sits in memory; the Newton start (and so, at its tolerance, the
         # result) would then differ between two runs of the same build
-        s = solve_ivp(back, (0.0, T), np.concatenate([x1, x2]), method="DOP853",
-                      rtol=1e-3, atol=1e3, first_step=h_fix, max_step=h_fix).y[:, -1]
-        a, b = s[:m].copy(), s[m:].copy()
+        s = solve_ivp(self.back, (0.0, T), np.concatenate([x1, x2]), method="DOP853",
+                      rtol=1e-3, atol=1e3, first_step=self.h_fix, max_step=self.h_fix).y[:, -1]
+        return s[:m].copy(), s[m:].copy()
+
+    def solve(self, x1, x2, T, newton_tol, max_iter):
+        """w at (x1, x2) after relaxing for T: Newton (all points at once, Jacobian by
+        forward differences) for the start x_s with x(T) = (x1, x2)."""
+        a, b = self.newton_start(x1, x2, T)
         d = 1e-6
         for _ in range(max_iter):
-            z = forward(a, b, T)
+            z = self.forward(a, b, T)
             r1, r2 = z[0] - x1, z[1] - x2
             if np.max(np.abs(np.concatenate([r1, r2]))) <= newton_tol * max(1.0, np.max(np.abs(x1))):
                 return z[2]
-            za = forward(a + d, b, T)
-            zb = forward(a, b + d, T)
+            za = self.forward(a + d, b, T)
+            zb = self.forward(a, b + d, T)
             J11, J21 = (za[0] - z[0]) / d, (za[1] - z[1]) / d
             J12, J22 = (zb[0] - z[0]) / d, (zb[1] - z[1]) / d
             det = J11 * J22 - J12 * J21
             a = a - (J22 * r1 - J12 * r2) / det
             b = b - (-J21 * r1 + J11 * r2) / det
-        z = forward(a, b, T)
+        z = self.forward(a, b, T)
         if np.max(np.abs(z[:2] - np.stack([x1, x2]))) > 1e-11:
             raise RuntimeError("slow-manifold Newton iteration did not converge")
         return z[2]
-
-    T = min(relax * eps, t_max)
-    w = solve(T)
-    w_long = solve(1.5 * T)
-    return w, np.abs(w - w_long)
 
 
 # --------------------------------------------------------------------------- fast forms

@@ -337,76 +337,134 @@ def run(problems, families, repeat: int, time_cap: float, log=print,
     least ``repeat`` timed runs per configuration, more until ``min_time`` s were timed;
     ``wall_time`` is their median, ``wall_time_min`` their min."""
     configs = [(fam, tol) for fam, tols in families for tol in tols]
-    shape = (len(problems), len(configs))
-    err_map, err_sw, wall = np.full(shape, np.nan), np.full(shape, np.nan), np.full(shape, np.nan)
-    wall_min = np.full(shape, np.nan)
-    runs, missed = np.zeros(shape, dtype=np.int32), np.zeros(shape, dtype=np.int32)
-    status = np.full(shape, "ok", dtype=object)
+    res = _Results.empty(len(problems), len(configs))
     ref_check = np.empty(len(problems))
     ref_names = []
     for i, prob in enumerate(problems):
-        (ref_fam, ref_tol), (chk_fam, chk_tol) = prob.reference
-        ref_p, ref_sw = runner(prob, ref_fam, ref_tol, np.inf)()
-        chk_p, chk_sw = runner(prob, chk_fam, chk_tol, np.inf)()
-        ref_check[i] = max_dev(chk_p, ref_p, prob.scored)[0]
-        ref_names.append(f"{ref_fam} rtol {ref_tol:g} vs {chk_fam} rtol {chk_tol:g}")
+        ref, chk, ref_check[i], name = _reference(prob)
+        ref_names.append(name)
         log(f"{prob.name}: {prob.x2.size} start points; reference check "
             f"({ref_names[-1]}): {ref_check[i]:.2e}")
         warmed = set()  # families run once untimed on this problem
         for j, (fam, tol) in enumerate(configs):
             # the reference's own method is scored against the independent check
-            want_p, want_sw = (chk_p, chk_sw) if prob.scored_by_check(fam) else (ref_p, ref_sw)
-            try:
-                t = timed(runner(prob, fam, tol, time_cap), repeat, min_time,
-                          warmup=0 if fam in warmed else 1)
-                warmed.add(fam)
-                wall[i, j], wall_min[i, j], runs[i, j] = t.median, t.min, t.rounds
-                got_p, got_sw = t.value
-            except NotApplicable:
-                status[i, j] = "n/a"
-            except baseline.TimeCapExceeded as exc:
-                status[i, j] = f"time cap: {exc}"
-            except Exception as exc:  # listed, not dropped
-                status[i, j] = f"failed: {type(exc).__name__}: {exc}"[:200]
-            else:
-                err_map[i, j] = max_dev(got_p, want_p, prob.scored)[0]
-                err_sw[i, j], missed[i, j] = max_dev(got_sw, want_sw, prob.scored)
-            log(f"  {fam:24s} rtol {tol:7.0e}  {wall[i, j]:9.4f} s (min {wall_min[i, j]:9.4f} s, "
-                f"{runs[i, j]:4d} runs; {1e6 * wall[i, j] / prob.x2.size:8.1f} us/return)  "
-                f"map err {err_map[i, j]:9.2e}"
-                f"  switch err {err_sw[i, j]:9.2e} ({missed[i, j]} missed)  {status[i, j] if status[i, j] != 'ok' else ''}")
+            want = chk if prob.scored_by_check(fam) else ref
+            res.measure(i, j, prob, fam, tol, want, repeat=repeat, min_time=min_time,
+                        time_cap=time_cap, warmed=warmed)
+            log(res.line(i, j, fam, tol, prob.x2.size))
     fam_of = np.array([c[0] for c in configs])
-    ratio = np.full(len(problems), np.nan)
-    t_ours, t_rk45 = np.full(len(problems), np.nan), np.full(len(problems), np.nan)
-    for i in range(len(problems)):
+    t_ours, t_rk45, ratio = _at_target(fam_of, res.err_map, res.wall)
+    ds = _dataset(problems, configs, fam_of, res, ref_check, ref_names, t_ours, t_rk45, ratio)
+    from filippov_paper.tolerance import annotate
+
+    ds = annotate(ds, tolerances())
+    return finalize(ds, None, target_error=TARGET_ERROR, time_cap=time_cap, repeat=repeat,
+                    grazing_gap=GRAZING_GAP, min_time=min_time, **settings,
+                    **timing.describe(min_rounds=repeat, min_time=min_time),
+                    title="work-precision of the fig04 and fig11 return maps: project vs solve_ivp")
+
+
+def _reference(prob: Problem):
+    """The problem's reference (P, switch times), its independent check, their max
+    deviation and the pair's description."""
+    (ref_fam, ref_tol), (chk_fam, chk_tol) = prob.reference
+    ref = runner(prob, ref_fam, ref_tol, np.inf)()
+    chk = runner(prob, chk_fam, chk_tol, np.inf)()
+    check = max_dev(chk[0], ref[0], prob.scored)[0]
+    return ref, chk, check, f"{ref_fam} rtol {ref_tol:g} vs {chk_fam} rtol {chk_tol:g}"
+
+
+@dataclass
+class _Results:
+    """Per (problem, configuration): errors, wall times, timed runs and status."""
+    err_map: np.ndarray
+    err_sw: np.ndarray
+    wall: np.ndarray
+    wall_min: np.ndarray
+    runs: np.ndarray
+    missed: np.ndarray
+    status: np.ndarray
+
+    @classmethod
+    def empty(cls, n_problems: int, n_configs: int) -> "_Results":
+        shape = (n_problems, n_configs)
+        return cls(err_map=np.full(shape, np.nan), err_sw=np.full(shape, np.nan),
+                   wall=np.full(shape, np.nan), wall_min=np.full(shape, np.nan),
+                   runs=np.zeros(shape, dtype=np.int32), missed=np.zeros(shape, dtype=np.int32),
+                   status=np.full(shape, "ok", dtype=object))
+
+    def measure(self, i, j, prob, fam, tol, want, *, repeat, min_time, time_cap, warmed):
+        """Time configuration j on problem i and score it against ``want``; a failure
+        is listed in ``status``, not dropped."""
+        want_p, want_sw = want
+        try:
+            t = timed(runner(prob, fam, tol, time_cap), repeat, min_time,
+                      warmup=0 if fam in warmed else 1)
+            warmed.add(fam)
+            self.wall[i, j], self.wall_min[i, j], self.runs[i, j] = t.median, t.min, t.rounds
+            got_p, got_sw = t.value
+        except NotApplicable:
+            self.status[i, j] = "n/a"
+        except baseline.TimeCapExceeded as exc:
+            self.status[i, j] = f"time cap: {exc}"
+        except Exception as exc:  # listed, not dropped
+            self.status[i, j] = f"failed: {type(exc).__name__}: {exc}"[:200]
+        else:
+            self.err_map[i, j] = max_dev(got_p, want_p, prob.scored)[0]
+            self.err_sw[i, j], self.missed[i, j] = max_dev(got_sw, want_sw, prob.scored)
+
+    def line(self, i, j, fam, tol, n_points) -> str:
+        """The log line of configuration j on problem i."""
+        wall, status = self.wall[i, j], self.status[i, j]
+        return (f"  {fam:24s} rtol {tol:7.0e}  {wall:9.4f} s (min {self.wall_min[i, j]:9.4f} s, "
+                f"{self.runs[i, j]:4d} runs; {1e6 * wall / n_points:8.1f} us/return)  "
+                f"map err {self.err_map[i, j]:9.2e}"
+                f"  switch err {self.err_sw[i, j]:9.2e} ({self.missed[i, j]} missed)  "
+                f"{status if status != 'ok' else ''}")
+
+
+def _at_target(fam_of, err_map, wall):
+    """Per problem: the fastest project configuration within TARGET_ERROR, RK45's time
+    at that error, and their ratio."""
+    n = err_map.shape[0]
+    ratio = np.full(n, np.nan)
+    t_ours, t_rk45 = np.full(n, np.nan), np.full(n, np.nan)
+    for i in range(n):
         ours = np.array([f.startswith("project") for f in fam_of])
         ok = ours & (err_map[i] <= TARGET_ERROR)
         t_ours[i] = wall[i, ok].min() if ok.any() else np.nan
         rk = fam_of == "solve_ivp RK45"
         t_rk45[i] = time_at_error(err_map[i, rk], wall[i, rk], TARGET_ERROR)
         ratio[i] = t_rk45[i] / t_ours[i]
+    return t_ours, t_rk45, ratio
+
+
+def _dataset(problems, configs, fam_of, res: _Results, ref_check, ref_names,
+             t_ours, t_rk45, ratio) -> xr.Dataset:
     dims = ("problem", "config")
     n_points = np.array([p.x2.size for p in problems], dtype=np.int32)
-    ds = xr.Dataset(
-        {"error_map": (dims, err_map, {"long_name": "max |P - P_ref| over the grid", "units": "1"}),
-         "error_switch": (dims, err_sw, {
+    return xr.Dataset(
+        {"error_map": (dims, res.err_map, {"long_name": "max |P - P_ref| over the grid",
+                                           "units": "1"}),
+         "error_switch": (dims, res.err_sw, {
              "long_name": "max error of the first switching time (points where both switch)",
              "units": "1"}),
-         "missed_switches": (dims, missed, {
+         "missed_switches": (dims, res.missed, {
              "long_name": "start points where only one of method and reference switches "
                           "(a grazing excursion missed or invented)", "units": "1"}),
-         "wall_time": (dims, wall, {
+         "wall_time": (dims, res.wall, {
              "long_name": "median wall time of one map (timed runs after a warm-up run)",
              "units": "s", "statistic": timing.STATISTIC}),
-         "wall_time_min": (dims, wall_min, {
+         "wall_time_min": (dims, res.wall_min, {
              "long_name": "min wall time of one map (the fastest timed run)", "units": "s",
              "statistic": "min"}),
-         "time_per_return": (dims, wall / n_points[:, None], {
+         "time_per_return": (dims, res.wall / n_points[:, None], {
              "long_name": "cost of one return: median wall time of the map over its start "
                           "points", "units": "s", "statistic": timing.STATISTIC}),
-         "runs": (dims, runs, {"long_name": "timed runs the median and min are taken over "
-                                            "(the warm-up run not counted)", "units": "1"}),
-         "status": (dims, status.astype(str), {"long_name": "ok, failed: ..., or time cap: ..."}),
+         "runs": (dims, res.runs, {"long_name": "timed runs the median and min are taken over "
+                                                "(the warm-up run not counted)", "units": "1"}),
+         "status": (dims, res.status.astype(str),
+                    {"long_name": "ok, failed: ..., or time cap: ..."}),
          "reference_check": ("problem", ref_check, {
              "long_name": "max |P_reference - P_check| (see reference_pair)", "units": "1"}),
          "reference_pair": ("problem", np.array(ref_names, dtype=str), {
@@ -426,13 +484,6 @@ def run(problems, families, repeat: int, time_cap: float, log=print,
                 "tolerance": ("config", [c[1] for c in configs],
                               {"long_name": "relative tolerance rtol (atol = rtol/100)",
                                "units": "1"})})
-    from filippov_paper.tolerance import annotate
-
-    ds = annotate(ds, tolerances())
-    return finalize(ds, None, target_error=TARGET_ERROR, time_cap=time_cap, repeat=repeat,
-                    grazing_gap=GRAZING_GAP, min_time=min_time, **settings,
-                    **timing.describe(min_rounds=repeat, min_time=min_time),
-                    title="work-precision of the fig04 and fig11 return maps: project vs solve_ivp")
 
 
 def merge(parts: list[xr.Dataset]) -> xr.Dataset:

@@ -134,6 +134,36 @@ def relaxation_rate(t, z, t_from: float, t_to: float, floor: float = 1e-9):
 
 
 def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    model, system, opts = _model_and_system(scene)
+    p = scene["parameters"]
+    n, omega, eps = int(p["n_samples"]), float(p["omega"]), float(p["eps"])
+    t_orb, z_orb, touches = grazing_orbit(system, omega, n, opts)
+    traj, sw = switching_trajectory(system, omega, float(p["start_x2"]), opts, scene["id"])
+    t, z, mode = traj.sample(np.linspace(0.0, traj.t, n))
+    rate = relaxation_after_return(traj, sw, float(p["rate_window"]) * eps)
+    s = surfaces(model, p, opts)
+    ds = xr.Dataset(
+        # one dict in the dataset's variable order: trajectories, surfaces, numbers
+        {**_trajectory_vars(z, mode, z_orb, sw), **_surface_vars(s),
+         **_number_vars(eps, rate, s, touches, z_orb)},
+        coords={
+            "t": ("t", t, {"long_name": "time", "units": "1"}),
+            "t_orbit": ("t_orbit", t_orb, {"long_name": "time on the grazing orbit",
+                                           "units": "1"}),
+            "switch": ("switch", np.arange(len(sw))),
+            "x1_grid": ("x1_grid", s["g1"], {"long_name": "x1", "units": "1"}),
+            "x2_grid": ("x2_grid", s["g2"], {"long_name": "x2", "units": "1"}),
+            "t_settle": ("t_settle", s["t_conv"], {"long_name": "time before reaching the grid",
+                                                   "units": "1"}),
+        })
+    return finalize(ds, scene, title="manifolds near the grazing point, theta < 0 "
+                    "(eq:exslow2/eq:exfast2)", p_g=P_G.tolist(),
+                    t_return=float(traj.t), x2_return=float(traj.z[1]))
+
+
+def _model_and_system(scene: dict):
+    """The scene's Hopf model, its system and the solver options; theta < 0 and mu = 1
+    are required (case 2, grazing at p_g)."""
     kind = require(scene, "system", {"slow_fast"})
     p = scene["parameters"]
     opts = solver_options(scene)
@@ -146,122 +176,141 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     model = hopf.model(eps, theta, mu, omega)
     system = model.system(kind, sliding=scene["ingredients"]["sliding"],
                           exact=opts["method"] == "exact")
-    n = int(p["n_samples"])
+    return model, system, opts
 
-    # --- the grazing periodic orbit, from the solver: one period from L1
+
+def grazing_orbit(system, omega: float, n: int, opts: dict):
+    """The grazing periodic orbit from the solver, one period from L1 (it may only
+    touch H_s): ``n`` sample times, the states there and the touch events."""
     orbit = simulate(system, [0.0, 1.0, 0.0], 2.0 * 2 * np.pi / abs(omega),
                      sections=[section_L1()], **opts)
     if orbit.switches():
         raise RuntimeError("the grazing orbit switched: it should only touch H_s")
     touches = [e for e in orbit.events if e.kind == "touch"]
     t_orb, z_orb, _ = orbit.sample(np.linspace(0.0, orbit.t, n), include_events=False)
+    return t_orb, z_orb, touches
 
-    # --- the switching trajectory, L1 -> L1
-    traj = simulate(system, [0.0, float(p["start_x2"]), 0.0], 4.0 * 2 * np.pi / abs(omega),
+
+def switching_trajectory(system, omega: float, start_x2: float, opts: dict, scene_id: str):
+    """The run from (0, start_x2, 0) on L1 back to L1 and its switches, which must be
+    two crossings E+ -> E- -> E+."""
+    traj = simulate(system, [0.0, start_x2, 0.0], 4.0 * 2 * np.pi / abs(omega),
                     sections=[section_L1()], **opts)
     sw = traj.switches()
     if any(e.kind != "crossing" for e in sw):
-        raise RuntimeError(f"{scene['id']}: expected crossings only, got "
+        raise RuntimeError(f"{scene_id}: expected crossings only, got "
                            f"{[e.kind for e in sw]}")
     if [(e.mode_before, e.mode_after) for e in sw] != [(PLUS, MINUS), (MINUS, PLUS)]:
-        raise RuntimeError(f"{scene['id']}: expected E+ -> E- -> E+, got "
+        raise RuntimeError(f"{scene_id}: expected E+ -> E- -> E+, got "
                            f"{[(e.mode_before, e.mode_after) for e in sw]}")
-    t, z, mode = traj.sample(np.linspace(0.0, traj.t, n))
+    return traj, sw
+
+
+def relaxation_after_return(traj, sw, span: float) -> float:
+    """The rate of the relaxation onto M_+ over ``span`` after the crossing back into
+    region + (the second switch)."""
     t_back = sw[1].t
-    span = float(p["rate_window"]) * eps
     t_fit = np.linspace(t_back, min(t_back + span, traj.t), 401)
     tf, zf, mf = traj.sample(t_fit, include_events=False)
     if np.any(mf[1:] != PLUS):  # the sample at t_back itself closes the E_- segment
         raise RuntimeError("relaxation window left region +")
-    rate = relaxation_rate(tf, zf, t_back, tf[-1])
+    return relaxation_rate(tf, zf, t_back, tf[-1])
 
-    # --- surfaces on the zoom window
+
+def surfaces(model, p: dict, opts: dict) -> dict:
+    """M_- (numerical, exact, expanded), M_+'s gap to it at p_g, H_s and the invariance
+    residual on the zoom window's grid."""
+    eps, theta = float(p["eps"]), float(p["theta"])
+    mu, omega = float(p["mu"]), float(p["omega"])
     g1 = np.linspace(*map(float, p["x1_range"]), int(p["n_grid"]))
     g2 = np.linspace(*map(float, p["x2_range"]), int(p["n_grid"]))
     X1, X2 = np.meshgrid(g1, g2, indexing="ij")
     settle = float(p["settle"])
-    y_num, t_conv, dev_conv = numeric_slow_manifold_minus(model, X1, X2, settle, **{
-        k: opts[k] for k in ("rtol", "atol")})
+    tol = {k: opts[k] for k in ("rtol", "atol")}
+    y_num, t_conv, dev_conv = numeric_slow_manifold_minus(model, X1, X2, settle, **tol)
     y_exact = hopf.slow_manifold_minus(X1, X2, eps, mu, omega)
     y_exp = expansion_minus(X1, X2, eps, mu, omega)
     y_hs = (-1.0 - theta * X1) / (1.0 - theta)
     resid = invariance_residual(X1, X2, eps, mu, omega)
-    y_pg_num, _, _ = numeric_slow_manifold_minus(model, P_G[:1], P_G[1:2], settle, **{
-        k: opts[k] for k in ("rtol", "atol")})
+    y_pg_num, _, _ = numeric_slow_manifold_minus(model, P_G[:1], P_G[1:2], settle, **tol)
     gap_pg = float(P_G[0] - y_pg_num[0])  # y_m+ - y_m- at x = (-1, 0)
+    return dict(g1=g1, g2=g2, X1=X1, settle=settle, y_num=y_num, t_conv=t_conv,
+                dev_conv=dev_conv, y_exact=y_exact, y_exp=y_exp, y_hs=y_hs, resid=resid,
+                gap_pg=gap_pg)
 
-    one = lambda v, ln, **kw: ((), float(v), {"long_name": ln, "units": "1", **kw})
-    grid = ("x1_grid", "x2_grid")
+
+def _trajectory_vars(z, mode, z_orb, sw) -> dict:
+    """The switching trajectory, the grazing orbit and the switches."""
     ev = lambda k: np.array([e.state[k] for e in sw])
-    ds = xr.Dataset(
-        {
-            "x1": ("t", z[0], {"long_name": "switching trajectory x1", "units": "1"}),
-            "x2": ("t", z[1], {"long_name": "switching trajectory x2", "units": "1"}),
-            "y": ("t", z[2], {"long_name": "switching trajectory y (fast)", "units": "1"}),
-            "mode": ("t", mode.astype(np.int8),
-                     {"long_name": "flow followed", "flag_values": np.array([-1, 0, 1], np.int8),
-                      "flag_meanings": "minus sliding plus"}),
-            "orbit_x1": ("t_orbit", z_orb[0], {"long_name": "grazing periodic orbit x1",
-                                               "units": "1"}),
-            "orbit_x2": ("t_orbit", z_orb[1], {"long_name": "grazing periodic orbit x2",
-                                               "units": "1"}),
-            "orbit_y": ("t_orbit", z_orb[2], {"long_name": "grazing periodic orbit y",
-                                              "units": "1"}),
-            "switch_t": ("switch", [e.t for e in sw], {"long_name": "switch time", "units": "1"}),
-            "switch_x1": ("switch", ev(0), {"long_name": "x1 at the switch", "units": "1"}),
-            "switch_x2": ("switch", ev(1), {"long_name": "x2 at the switch", "units": "1"}),
-            "switch_y": ("switch", ev(2), {"long_name": "y at the switch", "units": "1"}),
-            "switch_from": ("switch", np.array([e.mode_before for e in sw], np.int8),
-                            {"long_name": "mode before the switch"}),
-            "switch_to": ("switch", np.array([e.mode_after for e in sw], np.int8),
-                          {"long_name": "mode after the switch"}),
-            "y_M_plus": (grid, X1.copy(), {"long_name": "M_+ (eq:ymp): y = x1", "units": "1"}),
-            "y_M_minus": (grid, y_num, {
-                "long_name": "M_-: y from E_- trajectories integrated (DOP853) onto the grid",
-                "units": "1", "settle_over_eps": settle}),
-            "y_M_minus_exact": (grid, y_exact, {
-                "long_name": "M_-: exact cubic (hopf.slow_manifold_minus)", "units": "1"}),
-            "y_M_minus_expansion": (grid, y_exp, {
-                "long_name": "M_-: O(eps) expansion eq:ymm", "units": "1"}),
-            "M_minus_error": (grid, y_num - y_exact, {
-                "long_name": "numerical M_- minus exact cubic", "units": "1"}),
-            "M_minus_expansion_error": (grid, y_exact - y_exp, {
-                "long_name": "exact M_- minus expansion eq:ymm (O(eps^2))", "units": "1"}),
-            "M_minus_invariance_residual": (grid, resid, {
-                "long_name": "eps dy/dx . f_- - g_- on the exact cubic (complex step)",
-                "units": "1"}),
-            "y_H_s": (grid, y_hs, {"long_name": "H_s: theta x1 + (1 - theta) y = -1",
-                                   "units": "1"}),
-            "convergence": ("t_settle", dev_conv, {
-                "long_name": "max over the grid of |y - y_m-| along the E_- trajectories",
-                "units": "1"}),
-            "decay_rate": one(rate, "measured rate of |y - x1| ~ exp(-rate t) after the "
-                                    "return to region +", expected=1.0 / eps),
-            "decay_rate_rel_error": one(rate * eps - 1.0, "decay_rate * eps - 1"),
-            "gap_pg": one(gap_pg, "y_m+ - y_m- at x = (-1, 0) from the numerical M_-"),
-            "gap_pg_exact": one(eps - 2 * eps ** 2 - 6 * eps ** 3 - 6 * eps ** 4,
-                                "y_m+ - y_m- at x = (-1, 0) from the exact cubic"),
-            "M_minus_max_error": one(np.max(np.abs(y_num - y_exact)),
-                                     "max |numerical M_- - exact cubic| on the grid"),
-            "M_minus_max_expansion_error": one(np.max(np.abs(y_exact - y_exp)),
-                                               "max |exact M_- - eq:ymm| on the grid"),
-            "orbit_touch_t": one(touches[0].t if touches else np.nan,
-                                 "time of the grazing orbit's touch of H_s"),
-            "orbit_min_x1": one(z_orb[0].min(), "min x1 on the grazing orbit"),
-        },
-        coords={
-            "t": ("t", t, {"long_name": "time", "units": "1"}),
-            "t_orbit": ("t_orbit", t_orb, {"long_name": "time on the grazing orbit",
+    return {
+        "x1": ("t", z[0], {"long_name": "switching trajectory x1", "units": "1"}),
+        "x2": ("t", z[1], {"long_name": "switching trajectory x2", "units": "1"}),
+        "y": ("t", z[2], {"long_name": "switching trajectory y (fast)", "units": "1"}),
+        "mode": ("t", mode.astype(np.int8),
+                 {"long_name": "flow followed", "flag_values": np.array([-1, 0, 1], np.int8),
+                  "flag_meanings": "minus sliding plus"}),
+        "orbit_x1": ("t_orbit", z_orb[0], {"long_name": "grazing periodic orbit x1",
                                            "units": "1"}),
-            "switch": ("switch", np.arange(len(sw))),
-            "x1_grid": ("x1_grid", g1, {"long_name": "x1", "units": "1"}),
-            "x2_grid": ("x2_grid", g2, {"long_name": "x2", "units": "1"}),
-            "t_settle": ("t_settle", t_conv, {"long_name": "time before reaching the grid",
-                                              "units": "1"}),
-        })
-    return finalize(ds, scene, title="manifolds near the grazing point, theta < 0 "
-                    "(eq:exslow2/eq:exfast2)", p_g=P_G.tolist(),
-                    t_return=float(traj.t), x2_return=float(traj.z[1]))
+        "orbit_x2": ("t_orbit", z_orb[1], {"long_name": "grazing periodic orbit x2",
+                                           "units": "1"}),
+        "orbit_y": ("t_orbit", z_orb[2], {"long_name": "grazing periodic orbit y",
+                                          "units": "1"}),
+        "switch_t": ("switch", [e.t for e in sw], {"long_name": "switch time", "units": "1"}),
+        "switch_x1": ("switch", ev(0), {"long_name": "x1 at the switch", "units": "1"}),
+        "switch_x2": ("switch", ev(1), {"long_name": "x2 at the switch", "units": "1"}),
+        "switch_y": ("switch", ev(2), {"long_name": "y at the switch", "units": "1"}),
+        "switch_from": ("switch", np.array([e.mode_before for e in sw], np.int8),
+                        {"long_name": "mode before the switch"}),
+        "switch_to": ("switch", np.array([e.mode_after for e in sw], np.int8),
+                      {"long_name": "mode after the switch"}),
+    }
+
+
+def _surface_vars(s: dict) -> dict:
+    """The surfaces of :func:`surfaces` on the grid and the convergence of M_-."""
+    grid = ("x1_grid", "x2_grid")
+    return {
+        "y_M_plus": (grid, s["X1"].copy(), {"long_name": "M_+ (eq:ymp): y = x1", "units": "1"}),
+        "y_M_minus": (grid, s["y_num"], {
+            "long_name": "M_-: y from E_- trajectories integrated (DOP853) onto the grid",
+            "units": "1", "settle_over_eps": s["settle"]}),
+        "y_M_minus_exact": (grid, s["y_exact"], {
+            "long_name": "M_-: exact cubic (hopf.slow_manifold_minus)", "units": "1"}),
+        "y_M_minus_expansion": (grid, s["y_exp"], {
+            "long_name": "M_-: O(eps) expansion eq:ymm", "units": "1"}),
+        "M_minus_error": (grid, s["y_num"] - s["y_exact"], {
+            "long_name": "numerical M_- minus exact cubic", "units": "1"}),
+        "M_minus_expansion_error": (grid, s["y_exact"] - s["y_exp"], {
+            "long_name": "exact M_- minus expansion eq:ymm (O(eps^2))", "units": "1"}),
+        "M_minus_invariance_residual": (grid, s["resid"], {
+            "long_name": "eps dy/dx . f_- - g_- on the exact cubic (complex step)",
+            "units": "1"}),
+        "y_H_s": (grid, s["y_hs"], {"long_name": "H_s: theta x1 + (1 - theta) y = -1",
+                                    "units": "1"}),
+        "convergence": ("t_settle", s["dev_conv"], {
+            "long_name": "max over the grid of |y - y_m-| along the E_- trajectories",
+            "units": "1"}),
+    }
+
+
+def _number_vars(eps: float, rate: float, s: dict, touches, z_orb) -> dict:
+    """The scalars the report quotes: decay rate, gap at p_g, surface errors, orbit."""
+    one = lambda v, ln, **kw: ((), float(v), {"long_name": ln, "units": "1", **kw})
+    return {
+        "decay_rate": one(rate, "measured rate of |y - x1| ~ exp(-rate t) after the "
+                                "return to region +", expected=1.0 / eps),
+        "decay_rate_rel_error": one(rate * eps - 1.0, "decay_rate * eps - 1"),
+        "gap_pg": one(s["gap_pg"], "y_m+ - y_m- at x = (-1, 0) from the numerical M_-"),
+        "gap_pg_exact": one(eps - 2 * eps ** 2 - 6 * eps ** 3 - 6 * eps ** 4,
+                            "y_m+ - y_m- at x = (-1, 0) from the exact cubic"),
+        "M_minus_max_error": one(np.max(np.abs(s["y_num"] - s["y_exact"])),
+                                 "max |numerical M_- - exact cubic| on the grid"),
+        "M_minus_max_expansion_error": one(np.max(np.abs(s["y_exact"] - s["y_exp"])),
+                                           "max |exact M_- - eq:ymm| on the grid"),
+        "orbit_touch_t": one(touches[0].t if touches else np.nan,
+                             "time of the grazing orbit's touch of H_s"),
+        "orbit_min_x1": one(z_orb[0].min(), "min x1 on the grazing orbit"),
+    }
 
 
 # ============================================================================= report

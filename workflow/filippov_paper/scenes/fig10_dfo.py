@@ -390,11 +390,27 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
 def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     p = _checked(scene)
     law, v_hopf, v_gs = _special_speeds(scene)
-    v_min, v_max = float(p["v_min"]), float(p["v_max"])
     v_hopf_num = hopf_numeric(law, (0.5 * v_hopf, 1.5 * v_hopf))
+    br, po_mult, u_gs, n_folds = unstable_cycles(raw)
+    ds = xr.Dataset(
+        # one dict in the dataset's variable order
+        {**_point_vars(law, v_hopf, v_hopf_num, v_gs, u_gs, n_folds),
+         **_equilibrium_vars(law, p, v_hopf),
+         **_cycle_vars(br, po_mult),
+         **_stick_slip_vars(_stick_slip_rows(raw)),
+         **_friction_vars(law, p)},
+    )
+    return finalize(ds, scene, method="integrate", friction_convention=law["convention"],
+                    title="dry-friction oscillator eq:dfo1: friction law and bifurcation "
+                          "diagram (fig:dfo)")
+
+
+def unstable_cycles(raw: xr.Dataset):
+    """The unstable cycles born at H from the two continuation tasks: towards H
+    (ordered by v), then towards GS; their multipliers, the grazing cycle (x1, period,
+    v) and the number of folds."""
     kind = raw["kind"].values
 
-    # unstable cycles born at H: towards H (ordered by v), then towards GS
     def rows(which):
         j = int(np.flatnonzero(kind == which)[0])
         n = int(raw["br_rows"].values[j])
@@ -404,81 +420,102 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     br, po_mult = np.vstack([low, high]), np.concatenate([m_low, m_high])
     u_gs = raw["u_gs"].values[j_high]
     n_folds = int(raw["br_folds"].values[j_low] + raw["br_folds"].values[j_high])
+    return br, po_mult, u_gs, n_folds
 
-    sel = kind == STICK_SLIP
-    ss = {name[3:]: raw[name].values[sel] for name in raw.data_vars if name.startswith("ss_")}
-    vs = ss["v"]
-    ss_stable = ss["multiplier"] < 1
 
-    ve = np.linspace(v_min, v_max, 401)
+def _stick_slip_rows(raw: xr.Dataset) -> dict:
+    """The stick-slip tasks' scalars, by name without the ss_ prefix."""
+    sel = raw["kind"].values == STICK_SLIP
+    return {name[3:]: raw[name].values[sel] for name in raw.data_vars if name.startswith("ss_")}
+
+
+def _point_vars(law, v_hopf, v_hopf_num, v_gs, u_gs, n_folds) -> dict:
+    """The special points: Hopf, grazing-sliding, the exit of sticking."""
+    return {
+        "v_hopf": ((), v_hopf, {"long_name": "Hopf point: belt speed with F_c'(-v) = 0, ln(fc/fv)",
+                                "units": "1"}),
+        "v_hopf_numeric": ((), v_hopf_num, {"long_name": "Hopf point from the eigenvalues of a "
+                                            "finite-difference Jacobian", "units": "1"}),
+        "v_gs": ((), v_gs, {"long_name": "grazing-sliding point GS (orbit through the sticking "
+                            "exit point closes)", "units": "1"}),
+        "v_gs_branch": ((), float(u_gs[2]), {"long_name": "grazing point of the continued branch "
+                                          "of unstable cycles", "units": "1"}),
+        "x1_gs": ((), float(u_gs[0]), {"long_name": "max x1 of the grazing orbit", "units": "1"}),
+        "period_gs": ((), float(u_gs[1]), {"long_name": "period of the grazing orbit", "units": "1"}),
+        "x1_exit": ((), exit_point(law), {"long_name": "x1 where sticking ends (-F_c(0-))",
+                                          "units": "1"}),
+        "n_folds_hopf_branch": ((), n_folds, {"long_name": "folds on the unstable branch",
+                                                  "units": "1"}),
+    }
+
+
+def _equilibrium_vars(law, p: dict, v_hopf: float) -> dict:
+    """The equilibrium over [v_min, v_max] with the Hopf point on the grid."""
+    ve = np.linspace(float(p["v_min"]), float(p["v_max"]), 401)
     veq = np.unique(np.concatenate([ve, [v_hopf]]))
     x_eq = df.equilibrium(veq, **law)[0]
+    return {
+        "eq_v": ("eq", veq, {"long_name": "belt speed v", "units": "1"}),
+        "eq_x1": ("eq", x_eq, {"long_name": "x1 of the equilibrium, -F_c(-v)", "units": "1"}),
+        "eq_stable": ("eq", (veq > v_hopf).astype(np.int8),
+                      {"long_name": "1 if the equilibrium is asymptotically stable", "units": "1"}),
+    }
+
+
+def _cycle_vars(br, po_mult) -> dict:
+    """The unstable cycles in region + (rows of :func:`unstable_cycles`)."""
+    return {
+        "po_v": ("po", br[:, 2], {"long_name": "belt speed v", "units": "1"}),
+        "po_x1": ("po", br[:, 0], {"long_name": "max x1 along the cycle", "units": "1"}),
+        "po_period": ("po", br[:, 1], {"long_name": "period", "units": "1"}),
+        "po_multiplier": ("po", po_mult,
+                          {"long_name": "nontrivial Floquet multiplier (modulus)", "units": "1"}),
+        "po_stable": ("po", (po_mult < 1).astype(np.int8),
+                      {"long_name": "1 if the cycle is stable", "units": "1"}),
+    }
+
+
+def _stick_slip_vars(ss: dict) -> dict:
+    """The stick-slip orbits, one per belt speed of the sweep."""
+    return {
+        "ss_v": ("ss", ss["v"], {"long_name": "belt speed v", "units": "1"}),
+        "ss_x1": ("ss", ss["x1"], {"long_name": "max x1 along the orbit",
+                                   "units": "1"}),
+        "ss_period": ("ss", ss["period"], {"long_name": "period", "units": "1"}),
+        "ss_stick_time": ("ss", ss["stick_time"],
+                          {"long_name": "time spent sticking (sliding on x2 = v)", "units": "1"}),
+        "ss_stick_length": ("ss", ss["stick_length"],
+                            {"long_name": "x1 distance travelled while sticking", "units": "1"}),
+        "ss_multiplier": ("ss", ss["multiplier"],
+                          {"long_name": "nontrivial Floquet multiplier (modulus), with saltation",
+                           "units": "1"}),
+        "ss_trivial_multiplier": ("ss", ss["trivial_multiplier"],
+                                  {"long_name": "trivial Floquet multiplier (should be 1)",
+                                   "units": "1"}),
+        "ss_closure": ("ss", ss["closure"],
+                       {"long_name": "|x1 after one period - x1 at start|", "units": "1"}),
+        "ss_stable": ("ss", (ss["multiplier"] < 1).astype(np.int8),
+                      {"long_name": "1 if the orbit is stable (multipliers)", "units": "1"}),
+    }
+
+
+def _friction_vars(law, p: dict) -> dict:
+    """The friction law over the relative velocity, as adopted and as printed."""
     nu = np.linspace(-float(p["nu_max"]), float(p["nu_max"]), 801)
+    # both sides of the jump at 0, not 0 itself (F_c is set-valued there)
     nu = np.unique(np.concatenate([nu, [-1e-12, 1e-12]]))
     nu = nu[nu != 0]
     F = df.friction(nu, **law)
-    lit = dict(law, convention="literal")
-    F_lit = df.friction(nu, **lit)
-    Fp, _, Fm, _ = df.friction_branches(**law)
-
-    ds = xr.Dataset(
-        {"v_hopf": ((), v_hopf, {"long_name": "Hopf point: belt speed with F_c'(-v) = 0, ln(fc/fv)",
-                                 "units": "1"}),
-         "v_hopf_numeric": ((), v_hopf_num, {"long_name": "Hopf point from the eigenvalues of a "
-                                             "finite-difference Jacobian", "units": "1"}),
-         "v_gs": ((), v_gs, {"long_name": "grazing-sliding point GS (orbit through the sticking "
-                             "exit point closes)", "units": "1"}),
-         "v_gs_branch": ((), float(u_gs[2]), {"long_name": "grazing point of the continued branch "
-                                           "of unstable cycles", "units": "1"}),
-         "x1_gs": ((), float(u_gs[0]), {"long_name": "max x1 of the grazing orbit", "units": "1"}),
-         "period_gs": ((), float(u_gs[1]), {"long_name": "period of the grazing orbit", "units": "1"}),
-         "x1_exit": ((), exit_point(law), {"long_name": "x1 where sticking ends (-F_c(0-))",
-                                           "units": "1"}),
-         "n_folds_hopf_branch": ((), n_folds, {"long_name": "folds on the unstable branch",
-                                                   "units": "1"}),
-         # equilibrium
-         "eq_v": ("eq", veq, {"long_name": "belt speed v", "units": "1"}),
-         "eq_x1": ("eq", x_eq, {"long_name": "x1 of the equilibrium, -F_c(-v)", "units": "1"}),
-         "eq_stable": ("eq", (veq > v_hopf).astype(np.int8),
-                       {"long_name": "1 if the equilibrium is asymptotically stable", "units": "1"}),
-         # unstable cycles in region +
-         "po_v": ("po", br[:, 2], {"long_name": "belt speed v", "units": "1"}),
-         "po_x1": ("po", br[:, 0], {"long_name": "max x1 along the cycle", "units": "1"}),
-         "po_period": ("po", br[:, 1], {"long_name": "period", "units": "1"}),
-         "po_multiplier": ("po", po_mult,
-                           {"long_name": "nontrivial Floquet multiplier (modulus)", "units": "1"}),
-         "po_stable": ("po", (po_mult < 1).astype(np.int8),
-                       {"long_name": "1 if the cycle is stable", "units": "1"}),
-         # stick-slip orbits
-         "ss_v": ("ss", vs, {"long_name": "belt speed v", "units": "1"}),
-         "ss_x1": ("ss", ss["x1"], {"long_name": "max x1 along the orbit",
-                                                   "units": "1"}),
-         "ss_period": ("ss", ss["period"], {"long_name": "period", "units": "1"}),
-         "ss_stick_time": ("ss", ss["stick_time"],
-                           {"long_name": "time spent sticking (sliding on x2 = v)", "units": "1"}),
-         "ss_stick_length": ("ss", ss["stick_length"],
-                             {"long_name": "x1 distance travelled while sticking", "units": "1"}),
-         "ss_multiplier": ("ss", ss["multiplier"],
-                           {"long_name": "nontrivial Floquet multiplier (modulus), with saltation",
-                            "units": "1"}),
-         "ss_trivial_multiplier": ("ss", ss["trivial_multiplier"],
-                                   {"long_name": "trivial Floquet multiplier (should be 1)",
-                                    "units": "1"}),
-         "ss_closure": ("ss", ss["closure"],
-                        {"long_name": "|x1 after one period - x1 at start|", "units": "1"}),
-         "ss_stable": ("ss", ss_stable.astype(np.int8),
-                       {"long_name": "1 if the orbit is stable (multipliers)", "units": "1"}),
-         # friction law
-         "nu": ("nu", nu, {"long_name": "relative velocity x2 - v", "units": "1"}),
-         "F_c": ("nu", F, {"long_name": "friction force F_c (adopted convention)", "units": "1"}),
-         "F_c_literal": ("nu", F_lit, {"long_name": "friction force, printed law read literally",
-                                       "units": "1"}),
-         "F_c_static": ((), float(Fm(0.0)), {"long_name": "F_c(0+), the static friction level",
-                                             "units": "1"})},
-    )
-    return finalize(ds, scene, method="integrate", friction_convention=law["convention"],
-                    title="dry-friction oscillator eq:dfo1: friction law and bifurcation "
-                          "diagram (fig:dfo)")
+    F_lit = df.friction(nu, **dict(law, convention="literal"))
+    _, _, Fm, _ = df.friction_branches(**law)
+    return {
+        "nu": ("nu", nu, {"long_name": "relative velocity x2 - v", "units": "1"}),
+        "F_c": ("nu", F, {"long_name": "friction force F_c (adopted convention)", "units": "1"}),
+        "F_c_literal": ("nu", F_lit, {"long_name": "friction force, printed law read literally",
+                                      "units": "1"}),
+        "F_c_static": ((), float(Fm(0.0)), {"long_name": "F_c(0+), the static friction level",
+                                            "units": "1"}),
+    }
 
 
 # ============================================================================= report

@@ -30,6 +30,8 @@ literally, together with the solver's normal speeds at a point of H_s.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import xarray as xr
 from scipy.integrate import solve_ivp
@@ -509,13 +511,65 @@ def lemma_quantity(law, v, x0=None):
 
 
 def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
+    c = _settings(scene)
+    bar = Progress(scene["id"], len(c.eps) * (2 * c.n + 60), progress)
+    panels = list(zip(c.eps, c.v0))
+    # start points on M_+ over the grid and over the returns, one relaxation per panel
+    span = (min(c.lo, c.x1_return_min), c.hi)
+    starts = [df.slow_manifold_plus_on_L(*span, eps, v0, **c.model_law, rtol=c.rtol,
+                                         atol=c.atol)
+              for eps, v0 in panels]
+    maps, onsets = refined_return_maps(np.linspace(c.lo, c.hi, c.n), panels, c.law,
+                                       rtol=c.rtol, atol=c.atol, dP_max=c.dP_max,
+                                       max_rounds=c.rounds, bar=bar, starts=starts,
+                                       engine=c.kernel)
+    x1 = maps[0]["x1"]
+    fps, sns = [], []
+    for (eps, v0), r, st in zip(panels, maps, starts):
+        fp, sn = _panel_analysis(c, eps, v0, r, st, x1, bar)
+        fps.append(fp)
+        sns.append(sn)
+    ds = xr.Dataset(
+        # one dict in the dataset's variable order: maps, panels, lemma thm:gen
+        {**_map_vars(maps, fps, x1), **_panel_vars(c, sns, onsets, maps, x1),
+         **_lemma_vars(c)},
+        coords={"panel": ("panel", np.arange(len(c.eps)), {"long_name": "0: (a), 1: (b)",
+                                                            "units": "1"}),
+                "x1": ("x1", x1, {"long_name": "x1 of the start point on L", "units": "1"})})
+    return finalize(ds, scene, method="integrate", friction_convention=c.law["convention"],
+                    title="return maps of the slow-fast dry-friction oscillator (fig:dfo-retmap)")
+
+
+@dataclass(frozen=True)
+class _Settings:
+    """The scene's parameters and solver options as :func:`compute` uses them."""
+    rtol: float
+    atol: float
+    kernel: str                 # the engine
+    law: dict                   # the friction law (_law)
+    model_law: dict             # the law's keys that df.slow_manifold_plus_on_L takes
+    eps: list                   # one per panel
+    v0: list                    # one per panel
+    lo: float                   # the uniform x1 grid
+    hi: float
+    n: int
+    dP_max: float               # grid refinement
+    rounds: int
+    search_rtol: float          # saddle-node search
+    v_gs: float
+    c_gs: float
+    sn_lo: float
+    sn_hi: float
+    x1_return_min: float
+
+
+def _settings(scene: dict) -> _Settings:
     require(scene, "system", {"slow_fast"})
     require(scene, "flow", {"integrate"})
     if not scene["ingredients"]["sliding"]:
         raise ValueError(f"{scene['id']}: ingredients.sliding must be true (sticking is sliding)")
     p = scene["parameters"]
     opts = solver_options(scene)
-    rtol, atol = float(opts["rtol"]), float(opts["atol"])
     kernel = engine(scene)
     law = _law(p)
     eps_list = [float(e) for e in p["eps"]]
@@ -523,129 +577,138 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     if len(eps_list) != len(v0_list):
         raise ValueError(f"{scene['id']}: parameters.v0: need one v0 per eps "
                          f"({len(v0_list)} != {len(eps_list)})")
-    lo, hi, n = float(p["x1_min"]), float(p["x1_max"]), int(p["n_x1"])
-    dP_max, rounds = float(p.get("refine_dP", 0.03)), int(p.get("refine_rounds", 5))
-    search_rtol = float(p.get("sn_search_rtol", 1e-10))
     vgs, cgs = (float(v) for v in p.get("sn_v0_guess", [3.15625, 1.7]))
-    ml = {k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")}
-    bar = Progress(scene["id"], len(eps_list) * (2 * n + 60), progress)
+    return _Settings(
+        rtol=float(opts["rtol"]), atol=float(opts["atol"]), kernel=kernel, law=law,
+        model_law={k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")},
+        eps=eps_list, v0=v0_list,
+        lo=float(p["x1_min"]), hi=float(p["x1_max"]), n=int(p["n_x1"]),
+        dP_max=float(p.get("refine_dP", 0.03)), rounds=int(p.get("refine_rounds", 5)),
+        search_rtol=float(p.get("sn_search_rtol", 1e-10)), v_gs=vgs, c_gs=cgs,
+        sn_lo=float(p["sn_x1_range"][0]), sn_hi=float(p["sn_x1_range"][1]),
+        x1_return_min=float(p.get("x1_return_min", 3.3)))
 
-    panels = list(zip(eps_list, v0_list))
-    # start points on M_+ over the grid and over the returns, one relaxation per panel
-    span = (min(lo, float(p.get("x1_return_min", 3.3))), hi)
-    starts = [df.slow_manifold_plus_on_L(*span, eps, v0, **ml, rtol=rtol, atol=atol)
-              for eps, v0 in panels]
-    maps, onsets = refined_return_maps(np.linspace(lo, hi, n), panels, law, rtol=rtol,
-                                       atol=atol, dP_max=dP_max, max_rounds=rounds, bar=bar,
-                                       starts=starts, engine=kernel)
-    x1 = maps[0]["x1"]
-    fps, sns = [], []
-    for (eps, v0), r, st in zip(panels, maps, starts):
-        # distance of the returned points to M_+ (relaxation since the last switch)
-        r["return_residual"] = np.abs(r["w"] - st(r["P"])[0])
-        # fixed points of the same map (same start points), Brent in each sign change
-        Pm = lambda x, e=eps, v=v0, s_=st: float(return_map(
-            [x], e, v, law, rtol=rtol, atol=atol, with_residual=False, start=s_,
-            engine=kernel)["P"][0])
-        fps.append(np.asarray(fixed_points(x1, r["P"], refine=Pm, xtol=1e-12)))
-        # saddle-node of the stick-slip orbits; first guess: reduced GS + c eps
-        xs, vs, br, v_search = saddle_node(eps, law, float(p["sn_x1_range"][0]),
-                                           float(p["sn_x1_range"][1]), vgs + cgs * eps,
-                                           rtol=rtol, atol=atol, search_rtol=search_rtol,
-                                           progress=bar, engine=kernel)
-        at = return_map([xs], eps, vs, law, rtol=rtol, atol=atol, with_residual=False,
-                        engine=kernel)
-        sns.append({"x1": xs, "v0": vs, "v0_search": v_search,
-                    "slide_length": float(at["slide_length"][0]),
-                    "slide_time": float(at["slide_time"][0]), "branch": br})
 
+def _panel_analysis(c: _Settings, eps: float, v0: float, r: dict, st, x1, bar):
+    """One panel's return residual (into ``r``), the fixed points of its map and the
+    saddle-node of its stick-slip orbits."""
+    law, rtol, atol, kernel = c.law, c.rtol, c.atol, c.kernel
+    # distance of the returned points to M_+ (relaxation since the last switch)
+    r["return_residual"] = np.abs(r["w"] - st(r["P"])[0])
+    # fixed points of the same map (same start points), Brent in each sign change
+    Pm = lambda x, e=eps, v=v0, s_=st: float(return_map(
+        [x], e, v, law, rtol=rtol, atol=atol, with_residual=False, start=s_,
+        engine=kernel)["P"][0])
+    fp = np.asarray(fixed_points(x1, r["P"], refine=Pm, xtol=1e-12))
+    # saddle-node of the stick-slip orbits; first guess: reduced GS + c eps
+    xs, vs, br, v_search = saddle_node(eps, law, c.sn_lo, c.sn_hi, c.v_gs + c.c_gs * eps,
+                                       rtol=rtol, atol=atol, search_rtol=c.search_rtol,
+                                       progress=bar, engine=kernel)
+    at = return_map([xs], eps, vs, law, rtol=rtol, atol=atol, with_residual=False,
+                    engine=kernel)
+    return fp, {"x1": xs, "v0": vs, "v0_search": v_search,
+                "slide_length": float(at["slide_length"][0]),
+                "slide_time": float(at["slide_time"][0]), "branch": br}
+
+
+def _padded(rows, width: int) -> np.ndarray:
+    """Rows of different lengths as one array, NaN after each row's end."""
+    out = np.full((len(rows), width), np.nan)
+    for i, row in enumerate(rows):
+        out[i, :len(row)] = row
+    return out
+
+
+def _map_vars(maps, fps, x1) -> dict:
+    """The return maps over the x1 grid and their fixed points."""
     n_fp = max(max(len(f) for f in fps), 1)
-    fp_arr = np.full((len(eps_list), n_fp), np.nan)
-    fp_slide = np.full((len(eps_list), n_fp), np.nan)
-    for i, f in enumerate(fps):
-        fp_arr[i, :len(f)] = f
-        fp_slide[i, :len(f)] = np.interp(f, x1, maps[i]["slide_length"]) if len(f) else []
-    nb = max(len(s["branch"]) for s in sns)
-    br_x1 = np.full((len(eps_list), nb), np.nan)
-    br_v0 = np.full((len(eps_list), nb), np.nan)
-    br_M = np.full((len(eps_list), nb), np.nan)
-    for i, s in enumerate(sns):
-        br_x1[i, :len(s["branch"])] = s["branch"][:, 2]
-        br_v0[i, :len(s["branch"])] = s["branch"][:, 0]
-        br_M[i, :len(s["branch"])] = s["branch"][:, 1]
-
-    chi, a, b = lemma_quantity({k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")},
-                               float(np.mean(v0_list)))
-    lit = dict(law, convention="literal")
-    chi_l, a_l, b_l = lemma_quantity(lit, float(np.mean(v0_list)))
-
+    fp_arr = _padded(fps, n_fp)
+    fp_slide = _padded([np.interp(f, x1, m["slide_length"]) if len(f) else []
+                        for f, m in zip(fps, maps)], n_fp)
     d2 = ("panel", "x1")
     st = lambda key: np.array([m[key] for m in maps])
     one = "1"
-    ds = xr.Dataset(
-        {"P": (d2, st("P"), {"long_name": "x1 at the first return to L", "units": one}),
-         "w_return": (d2, st("w"), {"long_name": "w at the return", "units": one}),
-         "start_residual": (d2, st("start_residual"), {
-             "long_name": "distance of the start point to M_+ (change of w when the "
-                          "relaxation is lengthened by half)", "units": one}),
-         "return_residual": (d2, st("return_residual"), {
-             "long_name": "|w - w_+(x)| at the return (distance to M_+)", "units": one}),
-         "return_time": (d2, st("time"), {"long_name": "time of flight to L", "units": one}),
-         "sliding_time": (d2, st("slide_time"), {"long_name": "time spent sliding (sticking)",
-                                                  "units": one}),
-         "sliding_length": (d2, st("slide_length"), {
-             "long_name": "x1 distance travelled while sliding (sticking)", "units": one}),
-         "n_switches": (d2, st("n_switches"), {"long_name": "mode changes on the way",
-                                               "units": one}),
-         "fixed_point": (("panel", "fixed"), fp_arr, {
-             "long_name": "fixed points of P (NaN: none)", "units": one}),
-         "fixed_point_sliding_length": (("panel", "fixed"), fp_slide, {
-             "long_name": "sliding length at the fixed point (interpolated)", "units": one}),
-         "eps": ("panel", eps_list, {"long_name": "singular perturbation parameter", "units": one}),
-         "v0": ("panel", v0_list, {"long_name": "target belt speed v0", "units": one}),
-         "v0_sn": ("panel", [s["v0"] for s in sns], {
-             "long_name": "saddle-node of stick-slip orbits: v0 at the fold", "units": one}),
-         "x1_sn": ("panel", [s["x1"] for s in sns], {
-             "long_name": "fixed point x1 at the saddle-node", "units": one}),
-         "sliding_length_sn": ("panel", [s["slide_length"] for s in sns], {
-             "long_name": "x1 distance slid by the orbit at the saddle-node", "units": one}),
-         "sliding_time_sn": ("panel", [s["slide_time"] for s in sns], {
-             "long_name": "time spent sliding by the orbit at the saddle-node", "units": one}),
-         "v0_sn_search": ("panel", [s["v0_search"] for s in sns], {
-             "long_name": "v0 at the fold from the search at rtol sn_search_rtol alone "
-                          "(v0_sn: corrected by one evaluation at the full rtol)",
-             "units": one}),
-         "x1_onset": ("panel", [o[0] for o in onsets], {
-             "long_name": "x1 on L where sticking begins (root of the minimum of h along "
-                          "the region-+ orbit)", "units": one}),
-         "x1_onset_step": ("panel", [o[1] for o in onsets], {
-             "long_name": "last correction of the onset iteration (noise floor at "
-                          "rtol 1e-12: a few 1e-11)", "units": one}),
-         "P_onset": ("panel", [float(np.interp(o[0], x1, m["P"])) for o, m in zip(onsets, maps)], {
-             "long_name": "P at the onset of sticking (a grid point)", "units": one}),
-         "sn_branch_x1": (("panel", "branch"), br_x1, {
-             "long_name": "saddle-node search samples in the order taken (the last: the "
-                          "correction at the full rtol): argmax over x1 of P(x1) - x1",
-             "units": one}),
-         "sn_branch_v0": (("panel", "branch"), br_v0, {
-             "long_name": "saddle-node search samples (as sn_branch_x1): v0", "units": one}),
-         "sn_branch_M": (("panel", "branch"), br_M, {
-             "long_name": "saddle-node search samples (as sn_branch_x1): max over x1 of "
-                          "P(x1) - x1",
-             "units": one}),
-         "chi_minus": ((), chi, {"long_name": "dh/dx f_- - dh/dx f_+ at the grazing point "
-                                 "(eq:chiminus); > 0: case 1 of thm:gen", "units": one}),
-         "chi_minus_literal": ((), chi_l, {"long_name": "eq:chiminus for the printed law "
-                                           "read literally", "units": one}),
-         "sticking_a": ((), a, {"long_name": "dh/dt along f_- at (0, v0), reduced", "units": one}),
-         "sticking_b": ((), b, {"long_name": "dh/dt along f_+ at (0, v0), reduced", "units": one}),
-         "sticking_a_literal": ((), a_l, {"long_name": "as sticking_a, literal law", "units": one}),
-         "sticking_b_literal": ((), b_l, {"long_name": "as sticking_b, literal law", "units": one})},
-        coords={"panel": ("panel", np.arange(len(eps_list)), {"long_name": "0: (a), 1: (b)",
-                                                               "units": one}),
-                "x1": ("x1", x1, {"long_name": "x1 of the start point on L", "units": one})})
-    return finalize(ds, scene, method="integrate", friction_convention=law["convention"],
-                    title="return maps of the slow-fast dry-friction oscillator (fig:dfo-retmap)")
+    return {
+        "P": (d2, st("P"), {"long_name": "x1 at the first return to L", "units": one}),
+        "w_return": (d2, st("w"), {"long_name": "w at the return", "units": one}),
+        "start_residual": (d2, st("start_residual"), {
+            "long_name": "distance of the start point to M_+ (change of w when the "
+                         "relaxation is lengthened by half)", "units": one}),
+        "return_residual": (d2, st("return_residual"), {
+            "long_name": "|w - w_+(x)| at the return (distance to M_+)", "units": one}),
+        "return_time": (d2, st("time"), {"long_name": "time of flight to L", "units": one}),
+        "sliding_time": (d2, st("slide_time"), {"long_name": "time spent sliding (sticking)",
+                                                 "units": one}),
+        "sliding_length": (d2, st("slide_length"), {
+            "long_name": "x1 distance travelled while sliding (sticking)", "units": one}),
+        "n_switches": (d2, st("n_switches"), {"long_name": "mode changes on the way",
+                                              "units": one}),
+        "fixed_point": (("panel", "fixed"), fp_arr, {
+            "long_name": "fixed points of P (NaN: none)", "units": one}),
+        "fixed_point_sliding_length": (("panel", "fixed"), fp_slide, {
+            "long_name": "sliding length at the fixed point (interpolated)", "units": one}),
+    }
+
+
+def _panel_vars(c: _Settings, sns, onsets, maps, x1) -> dict:
+    """Per panel: its parameters, the saddle-node and its search, the onset of sticking."""
+    nb = max(len(s["branch"]) for s in sns)
+    # the search samples' columns: (v0, M, x1)
+    branch = lambda col: _padded([s["branch"][:, col] for s in sns], nb)
+    one = "1"
+    return {
+        "eps": ("panel", c.eps, {"long_name": "singular perturbation parameter", "units": one}),
+        "v0": ("panel", c.v0, {"long_name": "target belt speed v0", "units": one}),
+        "v0_sn": ("panel", [s["v0"] for s in sns], {
+            "long_name": "saddle-node of stick-slip orbits: v0 at the fold", "units": one}),
+        "x1_sn": ("panel", [s["x1"] for s in sns], {
+            "long_name": "fixed point x1 at the saddle-node", "units": one}),
+        "sliding_length_sn": ("panel", [s["slide_length"] for s in sns], {
+            "long_name": "x1 distance slid by the orbit at the saddle-node", "units": one}),
+        "sliding_time_sn": ("panel", [s["slide_time"] for s in sns], {
+            "long_name": "time spent sliding by the orbit at the saddle-node", "units": one}),
+        "v0_sn_search": ("panel", [s["v0_search"] for s in sns], {
+            "long_name": "v0 at the fold from the search at rtol sn_search_rtol alone "
+                         "(v0_sn: corrected by one evaluation at the full rtol)",
+            "units": one}),
+        "x1_onset": ("panel", [o[0] for o in onsets], {
+            "long_name": "x1 on L where sticking begins (root of the minimum of h along "
+                         "the region-+ orbit)", "units": one}),
+        "x1_onset_step": ("panel", [o[1] for o in onsets], {
+            "long_name": "last correction of the onset iteration (noise floor at "
+                         "rtol 1e-12: a few 1e-11)", "units": one}),
+        "P_onset": ("panel", [float(np.interp(o[0], x1, m["P"])) for o, m in zip(onsets, maps)], {
+            "long_name": "P at the onset of sticking (a grid point)", "units": one}),
+        "sn_branch_x1": (("panel", "branch"), branch(2), {
+            "long_name": "saddle-node search samples in the order taken (the last: the "
+                         "correction at the full rtol): argmax over x1 of P(x1) - x1",
+            "units": one}),
+        "sn_branch_v0": (("panel", "branch"), branch(0), {
+            "long_name": "saddle-node search samples (as sn_branch_x1): v0", "units": one}),
+        "sn_branch_M": (("panel", "branch"), branch(1), {
+            "long_name": "saddle-node search samples (as sn_branch_x1): max over x1 of "
+                         "P(x1) - x1",
+            "units": one}),
+    }
+
+
+def _lemma_vars(c: _Settings) -> dict:
+    """The case of lemma thm:gen (eq:chiminus) and the reduced sticking speeds, for the
+    law as used and as printed (literal), at the panels' mean v0."""
+    chi, a, b = lemma_quantity(c.model_law, float(np.mean(c.v0)))
+    lit = dict(c.law, convention="literal")
+    chi_l, a_l, b_l = lemma_quantity(lit, float(np.mean(c.v0)))
+    one = "1"
+    return {
+        "chi_minus": ((), chi, {"long_name": "dh/dx f_- - dh/dx f_+ at the grazing point "
+                                "(eq:chiminus); > 0: case 1 of thm:gen", "units": one}),
+        "chi_minus_literal": ((), chi_l, {"long_name": "eq:chiminus for the printed law "
+                                          "read literally", "units": one}),
+        "sticking_a": ((), a, {"long_name": "dh/dt along f_- at (0, v0), reduced", "units": one}),
+        "sticking_b": ((), b, {"long_name": "dh/dt along f_+ at (0, v0), reduced", "units": one}),
+        "sticking_a_literal": ((), a_l, {"long_name": "as sticking_a, literal law", "units": one}),
+        "sticking_b_literal": ((), b_l, {"long_name": "as sticking_b, literal law", "units": one}),
+    }
 
 
 # ============================================================================= report
