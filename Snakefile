@@ -26,7 +26,6 @@ wildcard_constraints:
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/report_html.smk"  # the HTML report's captions and rule graph
-include: "workflow/rules/kernel.smk"  # compiled once, before the jobs that run it
 include: "workflow/rules/compute.smk"
 include: "workflow/rules/hard_cases.smk"
 include: "workflow/rules/plot.smk"

@@ -4,8 +4,6 @@
 # differ between any two runs (tolerance rule "measured"); its errors are
 # reproducible.
 rule work_precision:
-    input:
-        kernel=KERNEL_COMPILED,  # compiled once per build (kernel.smk)
     output:
         report("results/work_precision.nc", caption="../report/work_precision.rst",
                category="Datasets", labels=dataset_labels),

@@ -93,24 +93,6 @@ def scene_resolution(scene):
     return apply_resolution(data, RESOLUTION).get("resolution", DEFAULT_RESOLUTION)
 
 
-@functools.lru_cache(maxsize=None)
-def scene_engine(scene):
-    """The engine scene `scene` asks for (its `solver: engine:`, at the run's resolution;
-    default python), so that only the jobs of compiled-engine scenes wait for the
-    kernel's compile (kernel.smk); a malformed file is left to the job, which names it."""
-    try:
-        data = yaml.safe_load(Path(f"config/scenes/{scene}.yaml").read_text(encoding="utf-8"))
-        data = apply_resolution(data, RESOLUTION)
-        return data.get("solver", {}).get("engine", "python")
-    except Exception:  # noqa: BLE001  (malformed: the job's schema check names the field)
-        return "python"
-
-
-def kernel_for(wildcards):
-    """[the kernel's compile marker] for a scene on the compiled engine, else []."""
-    return [KERNEL_COMPILED] if scene_engine(wildcards.scene) == "compiled" else []
-
-
 def scene_chunks():
     """{id: N} for the scene files with a top-level `chunks: N` (N >= 1).
 

@@ -16,7 +16,6 @@ rule compute:
         schema=config["schema"],
         script="workflow/scripts/compute_scene.py",
         labels="paper/paper_labels.tex",  # the paper's numbers in titles (scenes.printed)
-        kernel=kernel_for,  # compiled once per build for compiled-engine scenes (kernel.smk)
     output:
         report("results/{scene}.nc", caption="../report/dataset.rst", category="Datasets",
                labels=dataset_labels),
@@ -42,7 +41,6 @@ rule compute_chunk:
         scene="config/scenes/{scene}.yaml",
         schema=config["schema"],
         script="workflow/scripts/compute_chunk.py",
-        kernel=kernel_for,  # compiled once per build for compiled-engine scenes (kernel.smk)
     output:
         temp("results/chunks/{scene}/{chunk}.nc"),
     wildcard_constraints:

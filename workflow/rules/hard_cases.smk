@@ -17,7 +17,6 @@ HARD_CASES_CODE = library_hash(exclude=[e for e in NOT_COMPUTE if e != "hard_cas
 rule hard_cases_part:
     input:
         script="workflow/scripts/hard_cases_part.py",
-        kernel=KERNEL_COMPILED,  # compiled once per build (kernel.smk)
     output:
         temp("results/chunks/hard_cases/{i}.nc"),
     wildcard_constraints:
