@@ -93,6 +93,26 @@ def test_changing_one_scene_reruns_only_its_chain(workflow_build, tmp_path):
     assert set(jobs) <= {"report_tables", "paper"}, jobs
 
 
+def test_changing_a_compiled_engine_scene_reruns_only_its_chain(workflow_build, tmp_path):
+    """As above for a scene on the compiled engine (chunked): no job it shares with the
+    other compiled-engine scenes, the hard cases or the work-precision sweep (a shared
+    input regenerated for it -- a kernel-compiled marker was tried -- would rerun them
+    all: 'input files updated by another job')."""
+    work = _copy_of_build(workflow_build, tmp_path)
+    assert _planned(work) == {}
+    scene = work / "config" / "scenes" / "fig04_retmaps.yaml"
+    text = scene.read_text()
+    assert "n_geometric: 100" in text
+    scene.write_text(text.replace("n_geometric: 100", "n_geometric: 101"))
+    jobs = _planned(work)
+    assert jobs.pop("compute_chunk") == {"fig04_retmaps"}
+    assert jobs.pop("merge_chunks") == {"fig04_retmaps"}
+    assert jobs.pop("plot") == {"fig04_retmaps"}
+    jobs.pop("all", None)
+    assert jobs.pop("publish_scene", {"fig04_retmaps"}) == {"fig04_retmaps"}
+    assert set(jobs) <= {"report_tables", "paper"}, jobs
+
+
 def test_editing_a_workflow_script_reruns_its_rule_only(workflow_build, tmp_path):
     work = _copy_of_build(workflow_build, tmp_path)
     script = work / "workflow" / "scripts" / "plot_scene.py"
