@@ -28,6 +28,16 @@ OMEGA = 8 * np.pi
 MIN_TIME = 0.2
 
 
+def case_coords(cases) -> dict:
+    """The coordinates of (theta, eps, s) cases along a dimension "case", for the
+    datasets of every benchmark that runs such cases."""
+    return {"theta": ("case", [c[0] for c in cases], {"units": "1"}),
+            "eps": ("case", [c[1] for c in cases], {"units": "1"}),
+            "s": ("case", [c[2] for c in cases],
+                  {"long_name": "(mu - 1)/eps (theta < 0), /eps^2 (theta > 0)",
+                   "units": "1"})}
+
+
 def measure(theta: float, eps: float, s: float, returns: int, repeat: int) -> dict:
     mu = 1.0 + s * limit_map.scale(eps, theta)
     cm = hopf.compiled(eps, theta, mu, OMEGA, sliding=theta > 0)
@@ -77,11 +87,7 @@ def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
                             "units": "1"}),
          "switches_per_return": ("case", [r["switches"] for r in rows],
                                  {"long_name": "mean mode changes per return", "units": "1"})},
-        coords={"theta": ("case", [c[0] for c in CASES], {"units": "1"}),
-                "eps": ("case", [c[1] for c in CASES], {"units": "1"}),
-                "s": ("case", [c[2] for c in CASES],
-                      {"long_name": "(mu - 1)/eps (theta < 0), /eps^2 (theta > 0)",
-                       "units": "1"})})
+        coords=case_coords(CASES))
     log(f"{'theta':>6} {'eps':>7} {'s':>4} {'us/return':>10} {'with dP/dz':>11} "
         f"{'ratio':>6} {'switches':>9}")
     for (t, e, s), r in zip(CASES, rows):

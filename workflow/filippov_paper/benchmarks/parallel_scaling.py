@@ -38,6 +38,7 @@ from filippov.fastmap import OK, compute_returns
 from filippov.io import finalize
 from filippov.models import hopf
 from filippov_paper.benchmarks import command_line, timing
+from filippov_paper.benchmarks.attractor_cost import case_coords
 
 #: (theta, eps, s): the cascade (theta < 0, exact flows) and the chaos (theta > 0,
 #: sliding integrated), as in filippov_paper.benchmarks.attractor_cost
@@ -143,12 +144,7 @@ def run(starts: int = 2000, returns: int = 10, repeat: int = 3, log=print) -> xr
                                  "units": "s"},),
          "runs": var("rounds") + ({"long_name": "timed calls (after a warm-up call)",
                                    "units": "1"},)},
-        coords={"workers": ("workers", workers, {"units": "1"}),
-                "theta": ("case", [c[0] for c in CASES], {"units": "1"}),
-                "eps": ("case", [c[1] for c in CASES], {"units": "1"}),
-                "s": ("case", [c[2] for c in CASES],
-                      {"long_name": "(mu - 1)/eps (theta < 0), /eps^2 (theta > 0)",
-                       "units": "1"})})
+        coords={"workers": ("workers", workers, {"units": "1"}), **case_coords(CASES)})
     log(f"batch: {starts} starts x {returns} returns; load average "
         f"{load_before[0]:.2f} before, {load_after[0]:.2f} after, on {os.cpu_count()} CPUs "
         f"({cores()} usable)")

@@ -62,7 +62,7 @@ from filippov.fastmap import OK, compute_returns, no_jacobian
 from filippov.io import finalize
 from filippov.models import hopf
 from filippov_paper.benchmarks import command_line
-from filippov_paper.benchmarks.attractor_cost import CASES, OMEGA
+from filippov_paper.benchmarks.attractor_cost import CASES, OMEGA, case_coords
 
 NAMES = [name for name, _ in PIECES]
 #: the issue-33 targets per return on one core (theta < 0, theta > 0), seconds
@@ -278,11 +278,7 @@ def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
          **{f"cost_{name}": ("case", [r["costs"].get(name, np.nan) for r in rows],
                              {"long_name": f"time per call of {name} alone", "units": "s"})
             for name in NAMES}},
-        coords={"theta": ("case", [c[0] for c in CASES], {"units": "1"}),
-                "eps": ("case", [c[1] for c in CASES], {"units": "1"}),
-                "s": ("case", [c[2] for c in CASES],
-                      {"long_name": "(mu - 1)/eps (theta < 0), /eps^2 (theta > 0)",
-                       "units": "1"})})
+        coords=case_coords(CASES))
     log(f"{'theta':>6} {'eps':>7} {'us/ret':>7} {'dP/dz':>6} {'target':>6} {'floor':>6} "
         f"{'x floor':>7} {'over':>6} {'flows':>6} | {'flows':>6} {'fields':>6} {'h,sec':>6} "
         f"{'samples':>7} {'root':>5}")
