@@ -30,3 +30,23 @@ def test_the_readme_says_what_comes_out_and_where_to_read_more():
     # every link points to a file or folder of the repository
     for target in re.findall(r"\]\(([^)#]+)\)", TEXT):
         assert (ROOT / target).exists(), target
+
+
+def _short(x: float) -> str:
+    """1e-09 -> 1e-9: a power of ten as the README writes it."""
+    mantissa, exponent = f"{x:.0e}".split("e")
+    return f"{mantissa}e{int(exponent)}"
+
+
+def test_the_readme_s_property_suite_numbers_are_the_suite_s():
+    """The README quotes the property suite's tolerances and deep sample size: they are
+    the constants the suite runs with (tests/test_properties.py, tests/conftest.py)."""
+    import test_properties as tp
+    from hypothesis import settings
+
+    text = " ".join((Path(__file__).resolve().parents[1] / "README.md").read_text().split())
+    assert (f"times to {_short(tp.TOL['exact'])} (exact flows) and "
+            f"{_short(tp.TOL['integrate'])} (integrated)") in text
+    assert f"dP/dz to {_short(tp.TOL_JAC)} relative" in text
+    deep = settings.get_profile("deep").max_examples
+    assert re.search(rf"`make test-deep` {deep} random systems per test", text)
