@@ -89,7 +89,7 @@ def colour_words(caption: str) -> list[str]:
 # --- the colours a figure draws ------------------------------------------------------------
 
 def dataset(fid: str):
-    return getattr(synthetic, "work_precision" if fid == "work_precision" else fid.split("_")[0])()
+    return synthetic.dataset(fid)
 
 
 def _rgba(colours) -> list:
@@ -245,7 +245,7 @@ def _boundary_look(line: Line2D):
 
 
 def test_atlas_boundary_lines_look_the_same_in_the_legend():
-    fig = plotting.draw("fig14_atlas", synthetic.fig14())
+    fig = plotting.draw("fig14_atlas", synthetic.dataset("fig14_atlas"))
     drawn(fig)
     on_axes = {_boundary_look(ln) for ax in fig.axes for ln in ax.lines
                if ln.get_path_effects() and len(ln.get_xdata())}

@@ -5,6 +5,7 @@ on disk -- for the return maps (fig04, split over x2), the discontinuity maps
 split over tasks: the two continuation directions and the stick-slip orbits) and the
 orbit diagrams of the instabilities (fig12, fig13, split over the scaled mu).
 Small grids keep it quick."""
+import importlib
 import random
 
 import numpy as np
@@ -14,39 +15,34 @@ pytest.importorskip("filippov_paper.scenes", reason="compute code (filippov_pape
 
 import filippov.io
 import filippov_paper.scenes
+from filippov_paper import product
 from filippov_paper.config import SceneError, load_scene
 from filippov_paper.scenes import chunking
 
 from conftest import ROOT
 
 SCHEMA = ROOT / "config" / "schema" / "scene.schema.json"
-CHUNKED = ("fig04_retmaps", "fig07_pdm_theta_neg", "fig09_pdm_theta_pos", "fig10_dfo",
-           "fig12_period_adding", "fig13_small_scale_chaos", "fig14_atlas")
+
+def _module(sid: str):
+    return importlib.import_module(f"filippov_paper.scenes.{sid}")
+
+
+#: every scene that can be split into chunks (its module has the chunk hooks)
+CHUNKED = tuple(sid for sid in filippov_paper.scenes.known_scenes()
+                if product.chunkable(_module(sid)))
 
 
 def small_scene(sid: str) -> dict:
-    """The scene file with a short grid (and two eps for the P_DM scenes)."""
+    """The scene file on the short grid its module declares (TEST_SMALL)."""
     scene = load_scene(ROOT / "config" / "scenes" / f"{sid}.yaml", SCHEMA)
-    p = scene["parameters"]
-    if sid == "fig04_retmaps":
-        p.update(n_uniform=21, n_geometric=6)
-    elif sid == "fig10_dfo":
-        p.update(n_stick_slip=8, ds=0.2)
-    elif sid in ("fig12_period_adding", "fig13_small_scale_chaos", "fig14_atlas"):
-        p.update(n_mu=7, n_transient=40, n_keep=20, max_period=10)
-        p["eps"] = p["eps"][:2]
-        if "theta" in p and isinstance(p["theta"], list):
-            p["theta"] = p["theta"][:1] + p["theta"][-2:]
-        if "n_geo" in p:
-            p["n_geo"] = 2
-        if "boundary_s" in p:   # fig14's flips: one s, one eps (each costs ~0.3 s)
-            p.update(boundary_s=[1.0], boundary_eps=[1e-3])
-    else:
-        p.update(n_uniform=9, n_geometric=4)
-        p["eps"] = p["eps"][:2]
-        if "n_core" in p:
-            p["n_core"] = 5
+    scene["parameters"].update(product.hook(_module(sid), "TEST_SMALL"))
     return scene
+
+
+def test_the_chunked_scenes_are_found():
+    # the return maps, both discontinuity maps, dry friction and the instabilities
+    assert {"fig04_retmaps", "fig07_pdm_theta_neg", "fig10_dfo", "fig14_atlas"} <= set(CHUNKED)
+    assert "fig08_s0theta" not in CHUNKED
 
 
 def roundtrip(ds, path):

@@ -1,6 +1,7 @@
 """Cross-machine reproducibility: the tolerance model, the emulation of another
 CPU (tests/crosscpu/lastbit.c), the environment fingerprint, and that the
 manifest still catches a real change of every scene."""
+import importlib
 import json
 import os
 import shutil
@@ -12,7 +13,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from filippov_paper import manifest, scenes, tolerance
+from filippov_paper import manifest, product, scenes, tolerance
 from filippov_paper.config import load_scene, scene_files
 from filippov.io import write_dataset
 from filippov_paper.tolerance import Tolerance
@@ -289,18 +290,18 @@ def test_environment_fingerprint_tracks_the_arithmetic(shim):
 
 
 # ----------------------------------------------------------------------------- real changes
-#: one physical parameter per scene, changed by one percent
-PARAMETER = {"fig01_slidesketch": "t_end", "fig02_cases": "eps", "fig03_grazingsketch": "omega",
-             "fig04_retmaps": "eps", "fig05_thetalt0mfs": "eps", "fig06_sgraph": "omega",
-             "fig07_pdm_theta_neg": "theta", "fig08_s0theta": "theta_min",
-             "fig09_pdm_theta_pos": "theta", "fig10_dfo": "fv", "fig11_dfo_retmaps": "fv",
-             "fig12_period_adding": "theta", "fig13_small_scale_chaos": "theta",
-             "fig14_atlas": "theta"}
+#: one physical parameter per scene, changed by one percent (its module's TEST_PERTURB)
+PARAMETER = {sid: product.hook(importlib.import_module(f"filippov_paper.scenes.{sid}"),
+                               "TEST_PERTURB") for sid in scenes.known_scenes()}
 
 
 def test_every_scene_has_a_parameter_to_change():
     listed = scene_files(ROOT / "config" / "scenes")
     assert sorted(PARAMETER) == sorted(listed)
+    for sid, name in PARAMETER.items():
+        scene = load_scene(ROOT / "config" / "scenes" / f"{sid}.yaml",
+                           ROOT / "config" / "schema" / "scene.schema.json")
+        assert name in scene["parameters"], f"{sid}: TEST_PERTURB {name!r} is no parameter"
 
 
 @pytest.mark.parametrize("sid", sorted(PARAMETER))

@@ -155,7 +155,7 @@ def test_positive_theta_is_rejected():
         compute(_scene(theta=0.5))
 
 
-@pytest.mark.parametrize("make", [synthetic.fig05, lambda: compute(SCENE)],
+@pytest.mark.parametrize("make", [lambda: synthetic.dataset("fig05_thetalt0mfs"), lambda: compute(SCENE)],
                          ids=["synthetic", "computed"])
 def test_draw_and_save_is_deterministic(tmp_path, make):
     ds = make()
@@ -170,4 +170,4 @@ def test_draw_and_save_is_deterministic(tmp_path, make):
 
 def test_missing_variable_is_named():
     with pytest.raises(KeyError, match="y_M_minus"):
-        plotting.draw("fig05_thetalt0mfs", synthetic.fig05().drop_vars("y_M_minus"))
+        plotting.draw("fig05_thetalt0mfs", synthetic.dataset("fig05_thetalt0mfs").drop_vars("y_M_minus"))

@@ -77,9 +77,9 @@ def test_the_plot_step_refuses_a_truncated_dataset(tmp_path):
 
     work = copy_project(tmp_path / "p")
     synthetic = tmp_path / "s.nc"
-    from synthetic import fig08  # a small, valid dataset of the scene
+    from synthetic import dataset  # a small, valid dataset of the scene
 
-    write_dataset(fig08().assign_attrs(scene_id="fig08_s0theta"), synthetic)
+    write_dataset(dataset("fig08_s0theta").assign_attrs(scene_id="fig08_s0theta"), synthetic)
     (work / "results").mkdir()
     data = synthetic.read_bytes()
     (work / "results" / "fig08_s0theta.nc").write_bytes(data[: len(data) // 2])

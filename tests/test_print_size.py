@@ -4,12 +4,13 @@ r"""Figures at the size they are printed (issue 31): no text of a figure prints 
 LaTeX scales a figure to the width it is included at, so a font of size f in a figure
 drawn w inches wide and included w' inches wide prints at f * w'/w. The included widths
 are read from paper/main.tex and the files it \inputs; the drawn widths and the fonts
-come from figures built from the synthetic datasets of tests/synthetic.py (no pipeline:
+come from figures built from the figure modules' synthetic datasets (tests/synthetic.py) (no pipeline:
 this runs on a clean checkout), and, where a build has left them, from the PDFs in
 figures/ (MediaBox and the font sizes of their text).
 """
 from __future__ import annotations
 
+import functools
 import re
 import shutil
 import subprocess
@@ -31,14 +32,8 @@ MIN_PT = 7.0
 DOCUMENTCLASS = r"\documentclass[preprint,11pt,a4paper]{elsarticle}"
 TEX_PT_PER_IN = 72.27  # TeX points; PDF and matplotlib sizes are in big points (72/in)
 
-CASES = {"fig01_slidesketch": synthetic.fig01, "fig02_cases": synthetic.fig02,
-         "fig03_grazingsketch": synthetic.fig03, "fig04_retmaps": synthetic.fig04,
-         "fig05_thetalt0mfs": synthetic.fig05, "fig06_sgraph": synthetic.fig06,
-         "fig07_pdm_theta_neg": synthetic.fig07, "fig08_s0theta": synthetic.fig08,
-         "fig09_pdm_theta_pos": synthetic.fig09, "fig10_dfo": synthetic.fig10,
-         "fig11_dfo_retmaps": synthetic.fig11, "fig12_period_adding": synthetic.fig12,
-         "fig13_small_scale_chaos": synthetic.fig13, "fig14_atlas": synthetic.fig14,
-         "work_precision": synthetic.work_precision}
+#: every figure of the report: {id: its stand-in dataset's maker}
+CASES = {fid: functools.partial(synthetic.dataset, fid) for fid in plotting.figure_ids()}
 
 
 # --- how the report includes the figures -----------------------------------------------
@@ -133,7 +128,7 @@ def test_text_width_from_latex(tmp_path):
 def test_every_included_figure_is_checked():
     assert INCLUDED, "no \\includegraphics found in paper/main.tex"
     assert set(INCLUDED) == set(CASES), (
-        "a figure in the report needs a synthetic dataset here (tests/synthetic.py)")
+        "every figure in the report, and only those, has a figure module (plotting.figure_ids)")
 
 
 def drawn_fonts(fig, monkeypatch) -> list[tuple[float, str]]:

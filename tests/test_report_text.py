@@ -61,7 +61,7 @@ def test_failed_sentence_says_zero_naturally():
 
 
 def _bench_dataset(failed: int):
-    ds = synthetic.work_precision()
+    ds = synthetic.dataset("work_precision")
     status = np.full(ds.status.shape, "ok", dtype=object)
     status.flat[:failed] = "failed: step size underflow"
     return ds.assign(status=(ds.status.dims, status),
@@ -119,7 +119,7 @@ def test_formulas_refuse_what_they_cannot_read(bad):
 
 def test_fig01_fields_are_math_not_code():
     from filippov_paper.scenes import fig01_slidesketch
-    ds = synthetic.fig01().assign_attrs(
+    ds = synthetic.dataset("fig01_slidesketch").assign_attrs(
         crossing_fields="f_- = (1, 1 + x1/2), f_+ = (1, 1/2)",
         sliding_fields="f_- = (1, 1), f_+ = (1, -1 - x1^2/4)", switching_function="h = x2")
     m = report.Macros()

@@ -198,25 +198,24 @@ def scene_schema_block(scene_id: str) -> dict | None:
     all), read from the module's source without importing it (no numerics load to
     check a scene file). It is one more ``allOf`` entry of the scene schema, so
     ``#/$defs/...`` refer there."""
+    from filippov_paper.product import literal
+
     path = SCENE_MODULES / f"{scene_id}.py"
     try:
-        tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+        block = literal(path, "PARAMETERS_SCHEMA")
     except FileNotFoundError:
         return None  # an unknown id: filippov_paper.scenes names the known ones
     except (OSError, UnicodeDecodeError, SyntaxError) as exc:
         raise SceneError(f"{path}: cannot read the scene module: {exc}") from exc
-    for node in tree.body:
-        if isinstance(node, ast.Assign) and any(
-                isinstance(t, ast.Name) and t.id == "PARAMETERS_SCHEMA" for t in node.targets):
-            try:
-                block = ast.literal_eval(node.value)
-            except ValueError:
-                block = None
-            if not isinstance(block, dict):
-                raise SceneError(f"{path}: PARAMETERS_SCHEMA (line {node.lineno}): must be a "
-                                 "literal dict (JSON written with True/False/None)")
-            return block
-    return None
+    except ValueError as exc:  # names file and line
+        raise SceneError(str(exc)) from None
+    return block
+
+
+def is_test_knob(name: str) -> bool:
+    """A top-level name of a scene module that only the tests read (``TEST_*``, see
+    :mod:`filippov_paper.product`): left out of the compute jobs' code hash too."""
+    return name.startswith("TEST_")
 
 
 def is_report_part(name: str) -> bool:
@@ -228,8 +227,9 @@ def is_report_part(name: str) -> bool:
 
 def without_report_part(source: str) -> str:
     """A scene module's source with the statements that define its report part (see
-    :func:`is_report_part`) and blank lines taken out: what the workflow hashes for the
-    compute jobs, so that editing the report rebuilds the report only."""
+    :func:`is_report_part`), its test knobs (:func:`is_test_knob`) and blank lines taken
+    out: what the workflow hashes for the compute jobs, so that editing the report
+    rebuilds the report only, and editing a test knob nothing."""
     tree = ast.parse(source)
     lines = source.splitlines(keepends=True)
     drop = set()
@@ -243,7 +243,7 @@ def without_report_part(source: str) -> str:
                 continue
         else:
             continue
-        if names and all(is_report_part(n) for n in names):
+        if names and all(is_report_part(n) or is_test_knob(n) for n in names):
             first = min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])])
             drop.update(range(first - 1, node.end_lineno))
     # blank lines go too: those between two parts taken out would otherwise remain

@@ -251,15 +251,13 @@ def image_tolerance(scene_id: str) -> float:
     """The tolerated thumbnail RMS of a figure: :data:`IMAGE_RMS`, or what its plotting
     module declares (``IMAGE_RMS``, with its reason there) when its pixels follow data
     that is reproducible only within a tolerance wider than a line (chaotic orbits)."""
-    import importlib
-
-    from filippov_paper.plotting import _module_name
+    from filippov_paper import plotting, product
 
     try:
-        module = importlib.import_module(f".plotting.{_module_name(scene_id)}", __package__)
+        module = plotting.module(scene_id)
     except ValueError:
         return IMAGE_RMS
-    return float(getattr(module, "IMAGE_RMS", IMAGE_RMS))
+    return float(product.hook(module, "IMAGE_RMS", IMAGE_RMS))
 
 
 def compare_image(png: Path, ref: Path, limit: float = IMAGE_RMS) -> str | None:

@@ -36,6 +36,8 @@ from typing import Mapping, Optional
 import numpy as np
 import xarray as xr
 
+from filippov_paper import product
+
 NOT_YET = "not yet computed"
 
 
@@ -639,6 +641,7 @@ def _scene_modules() -> list:
     import importlib
 
     from filippov_paper.scenes import known_scenes
+
     return [(sid, importlib.import_module(f".scenes.{sid}", __package__))
             for sid in known_scenes()]
 
@@ -648,7 +651,7 @@ def generate(datasets: Mapping[str, Optional[xr.Dataset]]) -> dict[str, str]:
     not declare ``REPORT_OPTIONAL`` are required."""
     modules = _scene_modules()
     missing = [sid for sid, mod in modules
-               if datasets.get(sid) is None and not getattr(mod, "REPORT_OPTIONAL", False)]
+               if datasets.get(sid) is None and not product.hook(mod, "REPORT_OPTIONAL", False)]
     if missing:
         raise ValueError(f"report needs the datasets of {', '.join(missing)}")
     m = Macros()

@@ -33,10 +33,21 @@ PNG_METADATA = {"Software": None}
 PNG_DPI = 200
 
 
+def figure_ids() -> list[str]:
+    """The ids of every figure: the scenes' and the aliased ones (work_precision)."""
+    inverse = {v: k for k, v in ALIASES.items()}
+    return sorted(inverse.get(m.name, m.name) for m in pkgutil.iter_modules(__path__)
+                  if re.fullmatch(r"fig[0-9]{2}_[a-z0-9_]+|bench_[a-z0-9_]+", m.name))
+
+
+def module(scene_id: str):
+    """The figure module of dataset ``scene_id`` (hooks: filippov_paper.product.FIGURE)."""
+    return importlib.import_module(f".{_module_name(scene_id)}", __name__)
+
+
 def draw(scene_id: str, ds):
-    module = importlib.import_module(f".{_module_name(scene_id)}", __name__)
     with style.context():
-        return module.draw(ds)
+        return module(scene_id).draw(ds)
 
 
 def _atomic_savefig(fig, path, fmt: str, **kw) -> None:

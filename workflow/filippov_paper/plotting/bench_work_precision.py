@@ -3,6 +3,7 @@ one panel per problem, one line per method swept over its tolerance."""
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 
 from filippov_paper.plotting import style as st
 
@@ -60,3 +61,19 @@ def draw(ds):
     fig.legend(list(handles.values()), list(handles), loc="outside lower center", ncol=3,
                frameon=False)
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_dataset() -> xr.Dataset:
+    """Two problems, two methods at three tolerances each."""
+    method = ["project compiled exact"] * 3 + ["solve_ivp RK45"] * 3
+    err = np.array([[1e-12, 1e-11, 1e-10, 1e-3, 1e-5, 1e-7]] * 2)
+    wall = np.array([[1e-3, 1.2e-3, 1.5e-3, 0.1, 0.3, 1.0]] * 2)
+    return xr.Dataset(
+        {"error_map": (("problem", "config"), err), "wall_time": (("problem", "config"), wall),
+         "status": (("problem", "config"), np.full(err.shape, "ok", dtype=object)),
+         "reference_check": ("problem", [1e-13, 1e-13]), "n_points": ("problem", [60, 9])},
+        coords={"problem": ["fig04 theta=-0.5", "fig11 (a) eps=0.1"],
+                "method": ("config", method), "tolerance": ("config", [1e-6, 1e-8, 1e-10] * 2)})

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 
 from filippov_paper.plotting import style as st
 from filippov_paper.plotting.lines import arrowhead, runs, unit_arrows
@@ -63,3 +64,26 @@ def draw(ds):
         _panel(ax, ds.sel(case=case))
         st.panel_label(ax, f"({tag}) {case}")
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_dataset(n: int = 201) -> xr.Dataset:
+    t = np.linspace(0.0, 2.5, n)
+    x1 = np.stack([-1.0 + t, -1.0 + t])
+    cross = np.where(t < 1.0, -1.0 + t, 0.5 * (t - 1.0))   # crosses x2 = 0 at t = 1
+    slide = np.minimum(-1.0 + t, 0.0)                     # reaches x2 = 0, then slides
+    x2 = np.stack([cross, slide])
+    mode = np.stack([np.where(t < 1.0, -1, 1), np.where(t < 1.0, -1, 0)]).astype("int8")
+    gx, gy = np.meshgrid(np.linspace(-0.8, 1.2, 4), [-0.6, 0.3])
+    ax1, ax2 = gx.ravel(), gy.ravel()
+    u = np.ones((2, ax1.size))
+    v = np.stack([np.where(ax2 < 0, 1.0, 0.5), np.where(ax2 < 0, 1.0, -1.0)])
+    return xr.Dataset(
+        {"x1": (("case", "t"), x1), "x2": (("case", "t"), x2), "mode": (("case", "t"), mode),
+         "hit_x1": ("case", [0.0, 0.0]), "hit_x2": ("case", [0.0, 0.0]),
+         "arrow_x1": (("case", "arrow"), np.stack([ax1, ax1])),
+         "arrow_x2": (("case", "arrow"), np.stack([ax2, ax2])),
+         "arrow_u": (("case", "arrow"), u), "arrow_v": (("case", "arrow"), v)},
+        coords={"case": ["crossing", "sliding"], "t": t})

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import xarray as xr
 from matplotlib.ticker import FuncFormatter, MultipleLocator
 
 from filippov_paper.plotting import style as st
@@ -104,3 +105,39 @@ def draw(ds):
                   arrowprops=dict(arrowstyle="-", lw=0.5, color="k", shrinkA=0, shrinkB=3))
     st.panel_label(ax_b, rf"(b) $\theta={neg:g}$, period $={float(ds.period) / eps:.3g}\,\varepsilon$")
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def _simulate(theta, eps, start, t):
+    """Fixed-step exact flow of x' = -sign(h), eps y' = x - y (chatters at dt when sliding)."""
+    dt = t[1] - t[0]
+    x, y = np.empty_like(t), np.empty_like(t)
+    x[0], y[0] = start
+    for k in range(t.size - 1):
+        c = -1.0 if theta * x[k] + (1 - theta) * y[k] >= 0 else 1.0
+        x[k + 1] = x[k] + c * dt
+        y[k + 1] = x[k + 1] - c * eps + (y[k] - x[k] + c * eps) * np.exp(-dt / eps)
+    return x, y
+
+
+def synthetic_dataset(n: int = 1501, eps: float = 0.1) -> xr.Dataset:
+    thetas = np.array([0.5, -0.5])
+    t = np.linspace(0.0, 3.0, n)
+    xs, ys, modes = [], [], []
+    for th in thetas:
+        x, y = _simulate(th, eps, (0.6, 0.3), t)
+        h = th * x + (1 - th) * y
+        mode = np.where(np.abs(h) < 2 * (t[1] - t[0]), 0, np.sign(h))
+        xs.append(x); ys.append(y); modes.append(mode.astype("int8"))
+    h = thetas[1] * xs[1] + (1 - thetas[1]) * ys[1]
+    up = np.flatnonzero((h[:-1] < 0) & (h[1:] >= 0)) + 1   # f- -> f+ switches
+    a, b = up[-2], up[-1]
+    return xr.Dataset(
+        {"x": (("theta", "t"), np.stack(xs)), "y": (("theta", "t"), np.stack(ys)),
+         "mode": (("theta", "t"), np.stack(modes)),
+         "period": t[b] - t[a], "x_switch": xs[1][b], "y_switch": ys[1][b],
+         "sliding_x_min": -eps * thetas[0], "sliding_x_max": eps * thetas[0],
+         "x_cycle": ("cycle", xs[1][a:b + 1]), "y_cycle": ("cycle", ys[1][a:b + 1])},
+        coords={"theta": thetas, "t": t}, attrs={"eps": eps, "theta": -0.5})

@@ -4,6 +4,7 @@ with the switching line H_s^0 = {x1 = -1} and the section L1."""
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 
 from filippov_paper.plotting import style as st
 from filippov_paper.plotting.lines import arrowhead, runs
@@ -78,3 +79,24 @@ def draw(ds):
             _point(ax, xl, r"$x_l$", (-4, -2), "right", "top")
     axes[0].set_ylabel(st.X2)
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_dataset(n: int = 300, omega: float = 8 * np.pi) -> xr.Dataset:
+    """Circles of radius sqrt(mu), clipped at x1 = -1 (a crude stand-in for sliding)."""
+    mus = np.array([0.8, 1.0, 1.2])
+    phi = np.linspace(np.pi / 2, np.pi / 2 + 2 * np.pi, n)
+    x1 = np.sqrt(mus)[:, None] * np.cos(phi)
+    x2 = np.sqrt(mus)[:, None] * np.sin(phi)
+    mode = np.where(x1 < -1.0, 0, 1).astype("int8")
+    x1 = np.maximum(x1, -1.0)
+    nan2 = [np.nan, np.nan]
+    return xr.Dataset(
+        {"x1": (("mu", "sample"), x1), "x2": (("mu", "sample"), x2),
+         "mode": (("mu", "sample"), mode), "fixed_x2": ("mu", np.sqrt(mus)),
+         "x_g": ("component", [-1.0, 0.0]),
+         "x_h": (("mu", "component"), [nan2, nan2, [-1.0, np.sqrt(0.2)]]),
+         "x_l": (("mu", "component"), [nan2, nan2, [-1.0, -np.sqrt(0.2)]])},
+        coords={"mu": mus, "component": ["x1", "x2"]}, attrs={"omega": omega})

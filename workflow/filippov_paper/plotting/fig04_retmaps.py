@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 
 from filippov_paper.plotting import style as st
 
@@ -37,3 +38,19 @@ def draw(ds):
                            f"$\\varepsilon={float(ds.attrs['eps']):g}$, $\\mu={float(ds.attrs['mu']):g}$")
         ax.legend(loc="upper left")
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_dataset(n: int = 81) -> xr.Dataset:
+    """A return map with the right shape: smooth slope below 1, a jump (theta<0) or kink above."""
+    x2 = np.linspace(0.96, 1.04, n)
+    k = np.exp(-0.5)
+    P = np.array([np.where(x2 <= 1, 1 + k * (x2 - 1), 0.994 - 0.3 * np.sqrt(np.abs(x2 - 1))),
+                  np.where(x2 <= 1, 1 + k * (x2 - 1), 1 - 0.01 * np.tanh(60 * (x2 - 1)))])
+    return xr.Dataset(
+        {"P": (("theta", "x2"), P), "residual": (("theta", "x2"), np.zeros_like(P)),
+         "n_switches": (("theta", "x2"), (P != 1 + k * (x2 - 1)).astype(np.int32)),
+         "fixed_point": (("theta", "fixed"), [[1.0], [1.0]])},
+        coords={"theta": [-0.5, 0.5], "x2": x2}, attrs={"eps": 0.01, "mu": 1.0})

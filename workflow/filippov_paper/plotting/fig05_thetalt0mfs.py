@@ -8,6 +8,7 @@ region - and decays like exp(-t/eps) after the return to region +."""
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
 
@@ -143,3 +144,35 @@ def _omega(ds) -> str:
     omega = float(ds.attrs.get("omega", np.nan))
     k = omega / np.pi
     return rf"{k:g}\pi" if np.isfinite(k) and abs(k - round(k)) < 1e-9 else f"{omega:g}"
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_dataset(n: int = 400, eps: float = 0.01, theta: float = -0.5) -> xr.Dataset:
+    """Circle arcs near p_g, a straight E_- leg and a crude exp(-t/eps) relaxation."""
+    omega = 8 * np.pi
+    phi = np.linspace(0.0, 2 * np.pi, n)
+    ox1, ox2 = -np.cos(phi), -np.sin(phi)            # unit circle through p_g at phi = 0
+    t = np.linspace(0.0, 0.3, n)
+    r = np.where(t < 0.1, 1.004, 0.95)
+    ang = np.pi - 0.1 + omega * (t - 0.1) * (t > 0.1)
+    x1, x2 = r * np.cos(ang), r * np.sin(ang)
+    leg = (t > 0.05) & (t <= 0.1)                     # E_-: x1 increases, x2 fixed
+    x1 = np.where(leg, -1.0 + (t - 0.05), x1)
+    x2 = np.where(leg, 0.1, x2)
+    y = x1 - 3 * eps * np.where(t > 0.05, np.exp(-np.clip(t - 0.1, 0, None) / eps), 0.0)
+    mode = np.where(leg, -1, 1).astype("int8")
+    g1, g2 = np.linspace(-1.04, -0.9, 8), np.linspace(-0.4, 0.3, 9)
+    X1, X2 = np.meshgrid(g1, g2, indexing="ij")
+    ym = X1 + eps * (X1 - omega * X2 - (X1 ** 2 + X2 ** 2) * X1 - 1.0)
+    return xr.Dataset(
+        {"x1": ("t", x1), "x2": ("t", x2), "y": ("t", y), "mode": ("t", mode),
+         "orbit_x1": ("t_orbit", ox1), "orbit_x2": ("t_orbit", ox2),
+         "orbit_y": ("t_orbit", ox1),
+         "switch_t": ("switch", [0.05, 0.1]), "switch_x1": ("switch", [-1.0, -0.95]),
+         "switch_x2": ("switch", [0.1, 0.1]), "switch_y": ("switch", [-1.0, -0.98]),
+         "y_M_plus": (("x1_grid", "x2_grid"), X1), "y_M_minus": (("x1_grid", "x2_grid"), ym),
+         "y_H_s": (("x1_grid", "x2_grid"), (-1.0 - theta * X1) / (1.0 - theta))},
+        coords={"t": t, "x1_grid": g1, "x2_grid": g2},
+        attrs={"eps": eps, "theta": theta, "mu": 1.0, "omega": omega})

@@ -9,6 +9,7 @@ omega^2 (1 - theta) (dotted), i.e. slope s -> 0 as in the reduced model;
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 from matplotlib.patches import Rectangle
 
 from filippov_paper.plotting import style as st
@@ -76,3 +77,19 @@ def draw(ds):
     ax.add_patch(Rectangle((box[0][0], box[1][0]), box[0][1] - box[0][0], box[1][1] - box[1][0],
                            fill=False, ec="k", lw=st.LW_THIN, zorder=6))
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_dataset(n: int = 200, theta: float = 0.5, omega: float = 8 * np.pi) -> xr.Dataset:
+    """eq:xi1r evaluated naively (no care for cancellation: t_s >= 1e-3 only)."""
+    t = np.geomspace(1e-3, 5.0, n)
+    e = np.exp(-t / theta)
+    d = theta + (1 - theta) * e
+    xi1 = -0.5 * omega ** 2 * theta ** 2 * (((1 - theta) * (1 - e) + t) / d) ** 2
+    img = omega ** 2 * (1 - theta) * (theta - (theta + t) * e) / d
+    return xr.Dataset(
+        {"xi1": ("t_s", xi1), "image": ("t_s", img), "s": ("t_s", img / xi1),
+         "slope_at_zero": (theta - 1) / theta, "image_limit": omega ** 2 * (1 - theta)},
+        coords={"t_s": t}, attrs={"theta": theta, "omega": omega})

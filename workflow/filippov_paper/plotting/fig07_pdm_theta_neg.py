@@ -4,6 +4,7 @@ the first-order expansion for each eps (dashed) and its limit xi1 + s0 (black);
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 from matplotlib import colormaps
 
 from filippov_paper.plotting import style as st
@@ -107,3 +108,38 @@ def draw(ds):
     st.panel_label(bx, "(b) deviation from the expansions")
     fig.legend(*bx.get_legend_handles_labels(), loc="outside lower right")  # under (b)
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_pdm_common(xi, eps, P, extra):
+    """Variables both discontinuity-map figures read, on dims (eps, xi1)."""
+    d2 = ("eps", "xi1")
+    data = {"P_DM": (d2, P), "P_flow": (d2, P.copy())}
+    data.update(extra)
+    return xr.Dataset(data, coords={"eps": eps, "xi1": xi}, attrs={"theta": 0.0})
+
+
+def synthetic_dataset(n: int = 81, theta: float = -0.5, omega: float = 8 * np.pi) -> xr.Dataset:
+    # the corrected expansion plus a made-up O(eps) remainder
+    from filippov.analytic import pdm as a
+    from filippov.analytic.s0 import s0_lambert
+
+    eps = np.array([1e-2, 1e-3, 1e-4])
+    xi = np.linspace(-2.5, 1.5, n)
+    e = eps[:, None]
+    first = a.pdm_theta_neg(xi, theta, omega, e)
+    P = first + np.where(xi < 0, 5 * e * xi ** 2, 0.0)
+    P[-1, xi < -2] -= 3.0  # a stretch where the true flow re-crosses H_s
+    err = np.abs(P - first).max(axis=1)
+    d2 = ("eps", "xi1")
+    ds = synthetic_pdm_common(xi, eps, P, {
+        "P_first_order": (d2, first), "P_zero_order": (d2, np.broadcast_to(a.pdm_theta_neg(xi, theta, omega, e, order=0),
+                                             P.shape).copy()),
+        "P_printed": (d2, a.pdm_theta_neg_printed(xi, theta, omega, e)),
+        "s0": float(s0_lambert(theta)), "theta": theta,
+        "error_first_order": ("eps", err), "error_zero_order": ("eps", 3 * np.sqrt(eps)),
+        "error_printed": ("eps", 2.5 + 0 * eps), "left_limit_error": ("eps", 0.2 * eps)})
+    ds["P_flow"].values[-1, xi < -2] += 1.0
+    return ds

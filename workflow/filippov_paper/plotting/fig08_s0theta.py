@@ -3,6 +3,7 @@ s0 = -theta dashed: the paper states s0 > -theta."""
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 
 from filippov_paper.plotting import style as st
 
@@ -27,3 +28,15 @@ def draw(ds):
     ax.set_ylabel(r"$s_0$")
     ax.legend(loc="upper right")
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_dataset(n: int = 60) -> xr.Dataset:
+    # Parametrise by s0 (eq:s0def solved for theta), as the paper suggests.
+    s = np.linspace(0.02, 6.0, n)
+    theta = (1 - s - np.exp(-s)) / (1 - np.exp(-s))
+    order = np.argsort(theta)
+    return xr.Dataset({"s0": ("theta", s[order]), "s0_root": ("theta", s[order])},
+                      coords={"theta": theta[order]})

@@ -5,9 +5,11 @@ the grazing point with the linear map eq:p:pdm of slope (theta-1)/theta;
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 
 from filippov_paper.plotting import style as st
-from filippov_paper.plotting.fig07_pdm_theta_neg import eps_colours, eps_label, reference_slope
+from filippov_paper.plotting.fig07_pdm_theta_neg import (eps_colours, eps_label, reference_slope,
+                                                           synthetic_pdm_common)
 
 VARS = ["P_DM", "P_zero_order", "P_printed", "P_linear", "P_reduced", "slope_theory",
         "error", "error_core", "error_printed"]
@@ -73,3 +75,26 @@ def draw(ds):
     st.panel_label(bx, "(c) deviation from\nzero order")
     fig.legend(*bx.get_legend_handles_labels(), loc="outside lower right")
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_dataset(n: int = 121, theta: float = 0.5, omega: float = 8 * np.pi) -> xr.Dataset:
+    from filippov.analytic import pdm as a
+
+    eps = np.array([1e-2, 1e-3, 1e-4])
+    xi = np.unique(np.concatenate([np.linspace(-600, 60, n), np.linspace(-5, 0, 21)]))
+    zero = a.pdm_theta_pos(xi, theta, omega)
+    P = zero[None, :] * (1 + 10 * eps[:, None])
+    d2 = ("eps", "xi1")
+    ds = synthetic_pdm_common(xi, eps, P, {
+        "P_zero_order": (d2, np.broadcast_to(zero, P.shape).copy()),
+        "P_printed": (d2, np.broadcast_to(a.pdm_theta_pos(xi, theta, omega, printed=True),
+                                          P.shape).copy()),
+        "P_linear": ("xi1", a.pdm_theta_pos_linear(xi, theta)),
+        "P_reduced": ("xi1", a.pdm_reduced(xi)), "slope_theory": (theta - 1) / theta,
+        "theta": theta, "error": ("eps", np.abs(P - zero).max(axis=1)),
+        "error_core": ("eps", 30 * eps), "error_printed": ("eps", 20 + 0 * eps)})
+    ds.attrs["core"] = 5.0
+    return ds

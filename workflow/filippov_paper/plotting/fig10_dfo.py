@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 from matplotlib.patches import Circle, FancyArrowPatch, Rectangle
 
 from filippov_paper.plotting import style as st
@@ -92,3 +93,25 @@ def draw(ds):
     st.legend_below(ax_c)
     st.panel_label(ax_c, "(c) bifurcation diagram")
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_dataset(n: int = 40) -> xr.Dataset:
+    """Rough shapes: equilibrium line, a square-root Hopf branch, a stick-slip line."""
+    vh, vgs = 2.12, 3.156
+    ev = np.linspace(0.5, 3.6, n)
+    pv = np.linspace(vh + 0.01, vgs, n)
+    sv = np.linspace(0.5, vgs, n)
+    nu = np.linspace(-6, 6, 121)
+    nu = nu[nu != 0]
+    F = np.sign(nu) * (2 - 2.5 * (1 - np.exp(-np.abs(nu)))) + 0.3 * nu
+    return xr.Dataset(
+        {"v_hopf": vh, "v_gs": vgs, "x1_gs": 4.52, "F_c_static": 2.0,
+         "eq_v": ("eq", ev), "eq_x1": ("eq", 0.4 + 0.05 * ev),
+         "eq_stable": ("eq", (ev > vh).astype(np.int8)),
+         "po_v": ("po", pv), "po_x1": ("po", 0.5 + 4 * np.sqrt((pv - vh) / (vgs - vh))),
+         "po_stable": ("po", np.zeros(n, np.int8)),
+         "ss_v": ("ss", sv), "ss_x1": ("ss", 2.5 + 0.6 * sv), "ss_stable": ("ss", np.ones(n, np.int8)),
+         "nu": ("nu", nu), "F_c": ("nu", F), "F_c_literal": ("nu", -F)})

@@ -10,6 +10,7 @@ data are covered.
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 
 from filippov_paper.plotting import style as st
 
@@ -78,3 +79,19 @@ def draw(ds):
     fig.legend(hs, [h.get_label() for h in hs], loc="outside lower center", ncol=3,
                frameon=False)
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_dataset(n: int = 41) -> xr.Dataset:
+    x1 = np.linspace(4.15, 4.6, n)
+    P = np.array([np.where(x1 < 4.3, x1 + 2 * (x1 - 4.29), 4.43 - 0.1 * (x1 - 4.3)),
+                  np.where(x1 < 4.3, x1 + 2 * (x1 - 4.29), 4.43 + 0 * x1)])
+    sl = np.where(x1 < 4.3, 0.0, x1 - 4.3)
+    return xr.Dataset(
+        {"P": (("panel", "x1"), P), "sliding_length": (("panel", "x1"), np.stack([sl, sl])),
+         "fixed_point": (("panel", "fixed"), [[4.29, 4.43], [4.29, 4.43]]),
+         "eps": ("panel", [0.1, 0.01]), "v0": ("panel", [3.32, 3.1]),
+         "v0_sn": ("panel", [3.3228, 3.1721])},
+        coords={"panel": [0, 1], "x1": x1})

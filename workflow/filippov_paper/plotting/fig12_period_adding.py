@@ -3,6 +3,7 @@ the limit map beside them, the period against s, and how the window edges conver
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 
 from filippov_paper.plotting import style as st
 
@@ -90,3 +91,28 @@ def draw(ds):
     fig.legend(*ax.get_legend_handles_labels(), loc="outside lower right")  # under (f)
     st.panel_label(ax, "(f) window edges:\nleft o, right \u25a1")
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_dataset(n_s: int = 19, k: int = 6) -> xr.Dataset:
+    """Orbit diagrams of made-up period-n windows; edges converging like eps."""
+    s = np.linspace(-0.5, 4.0, n_s)
+    eps = np.array([1e-2, 1e-3, 1e-4])
+    per = np.where(s < 0, 1, 2 + (np.floor(s) % 3)).astype(np.int32)
+    u0 = 0.1 * s[:, None] - 0.2 * (np.arange(k)[None, :] % per[:, None])
+    u = np.broadcast_to(u0, (1, eps.size, n_s, k)) + 0.01 * eps[None, :, None, None]
+    n = np.array([2, 3])
+    edge0 = np.array([[1.0, 1.6], [0.5, 0.8]])
+    return xr.Dataset(
+        {"u": (("theta", "eps", "s", "k"), u.copy()), "u_limit": (("theta", "eps", "s", "k"), u.copy()),
+         "u_limit0": (("theta", "s", "k"), u0[None]),
+         "period": (("theta", "eps", "s"), np.broadcast_to(per, (1, eps.size, n_s)).copy()),
+         "period_limit0": (("theta", "s"), per[None]),
+         "edge": (("eps", "n", "side"), edge0[None] + eps[:, None, None]),
+         "edge_limit0": (("n", "side"), edge0), "edge_gap": ("eps", 2 * eps),
+         "edge_kind": (("eps", "n", "side"),
+                       np.broadcast_to(np.array([-1, 0], dtype=np.int32), (eps.size, 2, 2)).copy())},
+        coords={"theta": [-0.5], "eps": eps, "s": s, "k": np.arange(k), "n": n, "side": [0, 1]},
+        attrs={"theta": -0.5, "s_max": 4.0})

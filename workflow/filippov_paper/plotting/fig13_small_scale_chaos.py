@@ -3,6 +3,7 @@ exponent against s for every theta, and the eps^2 scaling of the attractor's wid
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 
 from filippov_paper.plotting import style as st
 
@@ -83,3 +84,31 @@ def draw(ds):
     ax.legend(loc="lower left")
     st.panel_label(ax, "(f) scaling exponent\nof the width")
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_dataset(k: int = 5) -> xr.Dataset:
+    """Fans of made-up chaotic returns; widths ~ eps^2 (mu - 1)."""
+    theta = np.array([0.5, 0.2, 0.1])
+    eps = np.array([1e-2, 1e-3])
+    s = np.concatenate([np.linspace(-1.0, 5.0, 13), [20.0, 100.0]])
+    shape = (theta.size, eps.size, s.size)
+    fan = np.maximum(s, 0)[None, None, :, None] * np.linspace(-0.3, 0.1, k)
+    u = np.broadcast_to(fan, shape + (k,)).copy()
+    lyap = np.broadcast_to(np.where(s > 0, 0.3, -0.5), shape).copy()
+    width = np.broadcast_to(np.maximum(s, 0) * eps[None, :, None] ** 2 + 1e-12, shape).copy()
+    return xr.Dataset(
+        {"u": (("theta", "eps", "s", "k"), u), "u_limit": (("theta", "eps", "s", "k"), u),
+         "lyapunov": (("theta", "eps", "s"), lyap), "lyapunov_limit": (("theta", "eps", "s"), lyap),
+         "width_x2": (("theta", "eps", "s"), width),
+         "chaotic": (("theta", "eps", "s"), (lyap > 0).astype(np.int32)),
+         "width_exponent_err": (("theta", "s"), np.full((theta.size, s.size), 0.01)),
+         "width_exponent": (("theta", "s"), np.broadcast_to(np.where(s > 0, 2.0, np.nan),
+                                                           (theta.size, s.size)).copy()),
+         "slope_pdm": ("theta", (theta - 1) / theta),
+         "period": (("theta", "eps", "s"), np.where(np.broadcast_to(s, shape) > 0, 0, 1)
+                    .astype(np.int32))},
+        coords={"theta": theta, "eps": eps, "s": s, "k": np.arange(k)},
+        attrs={"s_max": 5.0})

@@ -6,6 +6,7 @@ from __future__ import annotations
 import matplotlib.colors as mcolors
 import matplotlib.patheffects as pe
 import numpy as np
+import xarray as xr
 
 from filippov_paper.plotting import style as st
 
@@ -71,3 +72,23 @@ def draw(ds):
                              mew=0.6, label="multiplier $-1$ of\nperiod one, two", **_LINE)[0]]
     fig.legend(handles=handles, loc="outside right center", frameon=False)
     return fig
+
+
+# ----------------------------------------------------------------------------- test knob
+# (filippov_paper.product) a crude stand-in for the real dataset: its names, shapes and
+# rough geometry, for the plotting tests; no solver, no event location
+def synthetic_dataset() -> xr.Dataset:
+    """Every attractor class once or more on a coarse (theta, s) grid."""
+    theta = np.linspace(-1.0, 0.8, 7)
+    s = np.linspace(-1.0, 5.0, 7)
+    kind = (np.add.outer(np.arange(theta.size), np.arange(s.size)) % 10 - 2).astype(np.int32)
+    sb, eb = np.array([0.5, 1.0, 2.0]), np.array([1e-2, 1e-3])
+    flip = 0.38 + 0.01 * sb
+    return xr.Dataset(
+        {"attractor_type": (("theta", "eps", "s"), kind[:, None, :]),
+         "attractor_type_limit": (("theta", "eps", "s"), kind[::-1, None, :].copy()),
+         "theta_critical": 0.3775, "theta_chaos": 0.2689,
+         "theta_flip": (("eps_boundary", "s_boundary"), np.stack([flip, flip])),
+         "theta_chaos_flip": (("eps_boundary", "s_boundary"), np.stack([flip, flip]) - 0.1),
+         "theta_flip_limit": ("s_boundary", flip), "theta_chaos_limit": ("s_boundary", flip - 0.1)},
+        coords={"theta": theta, "eps": [1e-3], "s": s, "s_boundary": sb, "eps_boundary": eb})

@@ -9,7 +9,7 @@ import contextlib
 import importlib
 import pkgutil
 
-from filippov_paper import tolerance
+from filippov_paper import product, tolerance
 from filippov_paper.config import SCENE_ID, SceneError
 from filippov.simulate import SlidingNotBuiltError
 from filippov_paper.scenes import chunking
@@ -30,7 +30,7 @@ def _module(scene: dict):
     module = importlib.import_module(f".{sid}", __name__)
     # solver.engine: a scene runs on the engines its module lists (default: the reference driver)
     name = scene.get("solver", {}).get("engine", "python")
-    available = getattr(module, "ENGINES", ("python",))
+    available = product.hook(module, "ENGINES", ("python",))
     if name not in available:
         raise SceneError(f"{sid}: solver.engine: {name!r} not available for this scene; "
                          f"expected one of {list(available)}")
@@ -42,7 +42,7 @@ def check(scene: dict) -> None:
     offers the engine the scene asks for, and that ``chunks`` does not exceed its
     grid. Raises :class:`~filippov_paper.config.SceneError` naming the field."""
     module = _module(scene)
-    if hasattr(module, "validate"):
+    if product.has(module, "validate"):
         module.validate(chunking.without_layout(scene))
     if scene.get("chunks") is None:
         return
@@ -60,9 +60,10 @@ def _declared(module, scene, ds):
     end up with a long_name, every numeric one with units) and cross-machine
     tolerances (``tolerances(scene)`` when they follow the scene's eps or grid,
     else ``TOLERANCES``; see :mod:`filippov_paper.tolerance`)."""
-    ds = describe(ds, getattr(module, "VARIABLE_ATTRS", {}), getattr(module, "LATEX_NAMES", {}))
-    declared = module.tolerances(scene) if hasattr(module, "tolerances") else \
-        getattr(module, "TOLERANCES", {})
+    ds = describe(ds, product.hook(module, "VARIABLE_ATTRS", {}),
+                  product.hook(module, "LATEX_NAMES", {}))
+    declared = module.tolerances(scene) if product.has(module, "tolerances") else \
+        product.hook(module, "TOLERANCES", {})
     return printed(tolerance.annotate(ds, declared))
 
 

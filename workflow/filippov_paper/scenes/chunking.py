@@ -60,8 +60,10 @@ def bounds(size: int, i: int, n: int) -> tuple[int, int]:
 
 
 def supports_chunks(module) -> bool:
-    return all(hasattr(module, name) for name in ("CHUNK_AXIS", "chunk_grid", "sweep",
-                                                  "assemble"))
+    """Whether the scene module has the four chunk hooks (filippov_paper.product)."""
+    from filippov_paper import product
+
+    return product.chunkable(module)
 
 
 def compute_chunk(module, scene: dict, i: int, n: int, *, progress: bool = False) -> xr.Dataset:

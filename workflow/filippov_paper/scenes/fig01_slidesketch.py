@@ -88,3 +88,9 @@ def report(ds, m: Macros) -> str | None:
     m.add("rpOneSwitching", None, f"{sid}:attrs.switching_function",
           text=formulas_tex(ds.attrs["switching_function"]))
     return None
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "t_end"

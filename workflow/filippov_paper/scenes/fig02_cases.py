@@ -152,3 +152,9 @@ def report(ds, m: Macros) -> str | None:
     m.add("rpTwoMinusThetaTanh", -float(ds.attrs["theta"]) * math.tanh(T / 2),
           "derived: -theta tanh(T_half/2)", 4)
     return None
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "eps"

@@ -248,3 +248,9 @@ def report(ds, m: Macros) -> str | None:
           "derived: |x_l - x_l_formula| at mu above 1", 2)
     m.add("rpThreeSqrtMuBelow", math.sqrt(mus[0]), "derived: sqrt(mu below 1)", 6)
     return None
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "omega"

@@ -261,3 +261,12 @@ def report(ds, m: Macros) -> str | None:
     for th, word in ((-0.5, "Neg"), (0.5, "Pos")):
         var(m, f"rpFourSigma{word}", ds, sid, "sigma_minus", sig=3, theta=th)
     return None
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "eps"
+#: parameters for a grid small enough that computing it in chunks takes seconds
+#: (tests/test_chunks.py)
+TEST_SMALL = {"n_uniform": 21, "n_geometric": 6}

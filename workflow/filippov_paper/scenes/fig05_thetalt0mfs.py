@@ -334,3 +334,9 @@ def report(ds, m: Macros) -> str | None:
     var(m, "rpFiveSwitchTwoY", ds, sid, "switch_y", sig=5, switch=1)
     var(m, "rpFiveSwitchXtwo", ds, sid, "switch_x2", sig=4, switch=0)
     return None
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "eps"

@@ -64,3 +64,9 @@ def report(ds, m: Macros) -> str | None:
     m.add("rpSixTsMax", float(ds.t_s.values[-1]), "fig06_sgraph:t_s[-1]", 2)
     m.add("rpSixXiMin", float(ds.xi1.values[-1]), "fig06_sgraph:xi1[-1]", 4)
     return None
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "omega"

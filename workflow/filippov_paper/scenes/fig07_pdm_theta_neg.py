@@ -186,3 +186,12 @@ def report(ds, m: Macros) -> str | None:
     m.add("rpSevenIdentityErr", float(ds.identity_error_x1.max()),
           "derived: max identity_error_x1 over eps", 2)
     return _report_table(ds)
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "theta"
+#: parameters for a grid small enough that computing it in chunks takes seconds
+#: (tests/test_chunks.py)
+TEST_SMALL = {"eps": [0.01, 0.001], "n_uniform": 9, "n_geometric": 4}

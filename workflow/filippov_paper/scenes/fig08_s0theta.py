@@ -65,3 +65,9 @@ def report(ds, m: Macros) -> str | None:
     m.add("rpEightSmallRatio", float(ds.s0.values[-1] / (-2 * th[-1] / (1 - th[-1]))),
           "derived: s0 / (-2 theta/(1-theta)) at theta[-1]", 5)
     return None
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "theta_min"

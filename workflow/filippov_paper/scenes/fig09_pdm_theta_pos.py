@@ -190,3 +190,12 @@ def report(ds, m: Macros) -> str | None:
         var(m, f"rpNine{name}Min", ds, sid, name_var, sig=4 if name_var == "slope_left" else 3, eps=eps[-1])
     var(m, "rpNineSlideLimitMax", ds, sid, "sliding_limit_xi2", eps=eps[0])
     return _report_table(ds)
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "theta"
+#: parameters for a grid small enough that computing it in chunks takes seconds
+#: (tests/test_chunks.py)
+TEST_SMALL = {"eps": [0.01, 0.001], "n_uniform": 9, "n_geometric": 4, "n_core": 5}

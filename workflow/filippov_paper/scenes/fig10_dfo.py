@@ -548,3 +548,12 @@ def report(ds, m: Macros) -> str:
         m.add("rpTenPOMultMin", float(np.nanmin(ds.po_multiplier.values)),
               "derived:min(fig10_dfo:po_multiplier)", 5)
     return scalar_table(ds)
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "fv"
+#: parameters for a grid small enough that computing it in chunks takes seconds
+#: (tests/test_chunks.py)
+TEST_SMALL = {"n_stick_slip": 8, "ds": 0.2}

@@ -740,3 +740,9 @@ def report(ds, m: Macros) -> str:
             if name_var in ds:
                 var(m, f"rpEleven{name}{key}", ds, "fig11_dfo_retmaps", name_var, sig, panel=k)
     return scalar_table(ds)
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "fv"

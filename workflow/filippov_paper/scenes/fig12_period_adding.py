@@ -492,3 +492,13 @@ def _report_bifurcations(ds, m: Macros, sid: str) -> None:
     m.add("rpTwelveCoexistTwoThree", float(c[j, 0]),
           source(sid, "coexistence", eps=float(eps[j]), n=int(ds.n.values[0])), 2)
     m.add("rpTwelveCoexistTwoThreeEps", float(eps[j]), f"derived: eps of max coexistence[n=0]", 2)
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "theta"
+#: parameters for a grid small enough that computing it in chunks takes seconds
+#: (tests/test_chunks.py)
+TEST_SMALL = {"eps": [0.01, 0.001], "n_mu": 7, "n_transient": 40, "n_keep": 20,
+              "max_period": 10}

@@ -251,3 +251,13 @@ def report(ds, m: Macros) -> str | None:
         m.add(f"rpThirteenPeriodOne{w}", float(np.all(per[near] == 1)),
               "derived: 1 if period == 1 on 0 < s <= s_max at the smallest eps", 1)
     return _report_table(ds)
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "theta"
+#: parameters for a grid small enough that computing it in chunks takes seconds
+#: (tests/test_chunks.py)
+TEST_SMALL = {"eps": [0.01, 0.001], "theta": [0.7, 0.2, 0.1], "n_mu": 7, "n_geo": 2,
+              "n_transient": 40, "n_keep": 20, "max_period": 10}

@@ -259,3 +259,13 @@ def _report_flip_exponents(ds) -> np.ndarray:
         gap = np.abs(ds[sf].values - ds[lim].values[None, :])
         out += [np.polyfit(le, np.log(gap[:, j]), 1)[0] for j in range(gap.shape[1])]
     return np.array(out)
+
+
+# ----------------------------------------------------------------------------- test knobs
+# (filippov_paper.product; left out of the compute jobs' code hash)
+#: a physical parameter whose 1% change the manifest must notice (tests/test_cross_cpu.py)
+TEST_PERTURB = "theta"
+#: parameters for a grid small enough that computing it in chunks takes seconds
+#: (tests/test_chunks.py)
+TEST_SMALL = {"theta": [-1.0, 0.6, 0.8], "n_mu": 7, "n_transient": 40, "n_keep": 20,
+              "max_period": 10, "boundary_eps": [0.001], "boundary_s": [1.0]}
