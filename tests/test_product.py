@@ -108,3 +108,19 @@ def test_a_new_figure_is_three_files():
         text = f.read_text(encoding="utf-8")
         named = {sid for sid in every if f'"{sid}"' in text or f"'{sid}'" in text}
         assert named != every, f"{f.name} names every scene: a per-figure list to keep"
+
+
+def test_make_bench_rules_come_from_the_benchmark_modules(monkeypatch, tmp_path):
+    declared = product.workflow_benchmarks()
+    # the six benchmarks of `make bench` besides work-precision (which has its own rules)
+    assert sorted(declared) == ["attractor_cost", "compile_cost", "effect_cost",
+                                "parallel_scaling", "return_floor", "sliding_cost"]
+    assert declared["parallel_scaling"]["threads"] == "all"
+    assert declared["compile_cost"]["args"] == ["--repeat", "1"]
+    # a malformed declaration names its file and the expected form
+    (tmp_path / "benchmarks").mkdir()
+    (tmp_path / "benchmarks" / "odd.py").write_text(
+        "WORKFLOW = {'args': [], 'threads': 'many'}\ndef main(argv=None): pass\n")
+    monkeypatch.setattr(product, "PACKAGE", tmp_path)
+    with pytest.raises(ValueError, match=r"odd.py: WORKFLOW: expected .*'many'"):
+        product.workflow_benchmarks()

@@ -97,102 +97,35 @@ rule plot_bench:
         "../scripts/plot_scene.py"
 
 
-rule bench_effect_cost:
-    output:
-        "results/bench_effect_cost.nc",
-    params:
-        code=library_hash(exclude="plotting"),
-    log:
-        "logs/bench_effect_cost.log",
-    conda:
-        "../envs/filippov.yaml"
-    script:
-        "../scripts/bench_effect_cost.py"
+# The other benchmarks of `make bench`, one rule each, generated from the benchmark modules
+# that declare WORKFLOW (filippov_paper.product.workflow_benchmarks, read from their source):
+# rule bench_<name> runs the module's main(WORKFLOW["args"] + --out) through the one script
+# workflow/scripts/bench.py and writes results/bench_<name>.nc; "threads": "all" takes every
+# core (parallel_scaling: no other job beside it). A new benchmark is its module.
+# What each measures is its module's docstring (and the table it prints).
+BENCHMARKS = workflow_benchmarks()
 
+for _name, _spec in BENCHMARKS.items():
 
-# The cost of one return of the iterated Hopf map (the instability scenes' kernel):
-# median wall time per return, printed as a table.
-rule bench_attractor_cost:
-    output:
-        "results/bench_attractor_cost.nc",
-    params:
-        code=library_hash(exclude="plotting"),
-    log:
-        "logs/bench_attractor_cost.log",
-    conda:
-        "../envs/filippov.yaml"
-    script:
-        "../scripts/bench_attractor_cost.py"
-
-
-# Where one return of the iterated Hopf map goes: CPU time per return, the model
-# evaluations it makes (counted) and their cost alone (the floor), printed as a table.
-rule bench_return_floor:
-    output:
-        "results/bench_return_floor.nc",
-    params:
-        code=library_hash(exclude="plotting"),
-    log:
-        "logs/bench_return_floor.log",
-    conda:
-        "../envs/filippov.yaml"
-    script:
-        "../scripts/bench_return_floor.py"
-
-
-# The cost of one stiff sliding return of the Hopf example per eps (reference
-# driver, Radau IIA with 3 and 5 stages), printed as a table.
-rule bench_sliding_cost:
-    output:
-        "results/bench_sliding_cost.nc",
-    params:
-        code=library_hash(exclude="plotting"),
-    log:
-        "logs/bench_sliding_cost.log",
-    conda:
-        "../envs/filippov.yaml"
-    script:
-        "../scripts/bench_sliding_cost.py"
-
-
-# What the compiled engine costs before its first return: the kernel's compile on empty
-# caches and its load afterwards (fresh processes), printed as a table.
-rule bench_compile_cost:
-    output:
-        "results/bench_compile_cost.nc",
-    params:
-        code=library_hash(exclude="plotting"),
-    log:
-        "logs/bench_compile_cost.log",
-    conda:
-        "../envs/filippov.yaml"
-    script:
-        "../scripts/bench_compile_cost.py"
-
-
-# Returns per second of a batch of iterated Hopf returns with 1, 2, ... workers up to the
-# cores (compute_returns(workers=)), with CPU times and the load average, printed as a
-# table. It takes every core (threads), so no other job runs beside it.
-rule bench_parallel_scaling:
-    output:
-        "results/bench_parallel_scaling.nc",
-    params:
-        code=library_hash(exclude="plotting"),
-    threads: workflow.cores
-    log:
-        "logs/bench_parallel_scaling.log",
-    conda:
-        "../envs/filippov.yaml"
-    script:
-        "../scripts/bench_parallel_scaling.py"
+    rule:
+        name:
+            f"bench_{_name}"
+        output:
+            f"results/bench_{_name}.nc",
+        params:
+            code=library_hash(exclude="plotting"),
+            benchmark=_name,
+            args=_spec["args"],
+        threads: workflow.cores if _spec["threads"] == "all" else 1
+        log:
+            f"logs/bench_{_name}.log",
+        conda:
+            "../envs/filippov.yaml"
+        script:
+            "../scripts/bench.py"
 
 
 rule bench:
     input:
         rules.plot_bench.output,
-        rules.bench_effect_cost.output,
-        rules.bench_attractor_cost.output,
-        rules.bench_return_floor.output,
-        rules.bench_sliding_cost.output,
-        rules.bench_compile_cost.output,
-        rules.bench_parallel_scaling.output,
+        expand("results/bench_{name}.nc", name=BENCHMARKS),

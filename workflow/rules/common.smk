@@ -164,6 +164,18 @@ BENCH_OUTPUTS = ["results/bench_effect_cost.nc", "results/bench_attractor_cost.n
                  "results/bench_compile_cost.nc"]
 
 
+def workflow_benchmarks():
+    """{name: WORKFLOW} of the benchmarks of `make bench` that bench.smk makes a rule for
+    (filippov_paper.product; read from the modules' source). A malformed WORKFLOW stops
+    the run with one line naming the file."""
+    from filippov_paper.product import workflow_benchmarks as declared
+
+    try:
+        return declared()
+    except (ValueError, SyntaxError) as exc:
+        fail(exc)
+
+
 def bench_stamps():
     return {p: Path(p).stat().st_mtime_ns for p in BENCH_OUTPUTS if Path(p).exists()}
 

@@ -99,6 +99,10 @@ def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
                     title="cost per return of the iterated Hopf return map (compiled engine)")
 
 
+#: part of `make bench` (filippov_paper.product): rule bench_attractor_cost runs main(args + ['--out', 'results/bench_attractor_cost.nc'])
+WORKFLOW = {"args": []}
+
+
 def main(argv=None) -> None:
     command_line(__doc__, run, argv, returns=2000, repeat=5)
 

@@ -112,6 +112,10 @@ def run(repeat: int = 3, log=print) -> xr.Dataset:
                     title="compile and load times of the compiled engine")
 
 
+#: part of `make bench` (filippov_paper.product): rule bench_compile_cost runs main(args + ['--out', 'results/bench_compile_cost.nc'])
+WORKFLOW = {"args": ["--repeat", "1"]}  # fresh processes: one round is enough for the table
+
+
 def main(argv=None) -> None:
     command_line(__doc__, run, argv, repeat=3)
 

@@ -113,6 +113,10 @@ def measure(scene_ids, cap: float, log=print, repeat: int = timing.MIN_ROUNDS,
                     title="cost of each model ingredient per scene")
 
 
+#: part of `make bench` (filippov_paper.product): rule bench_effect_cost runs main(args + ['--out', 'results/bench_effect_cost.nc'])
+WORKFLOW = {"args": []}
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("scenes", nargs="*", default=DEFAULT_SCENES)

@@ -168,6 +168,10 @@ def run(starts: int = 2000, returns: int = 10, repeat: int = 3, log=print) -> xr
                           "(iterated Hopf return map, compiled engine)")
 
 
+#: part of `make bench` (filippov_paper.product): rule bench_parallel_scaling runs main(args + ['--out', 'results/bench_parallel_scaling.nc'])
+WORKFLOW = {"args": [], "threads": "all"}  # every core: no other job beside it
+
+
 def main(argv=None) -> None:
     command_line(__doc__, run, argv, starts=2000, returns=10, repeat=3)
 

@@ -306,6 +306,10 @@ def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
                           "(compiled engine)")
 
 
+#: part of `make bench` (filippov_paper.product): rule bench_return_floor runs main(args + ['--out', 'results/bench_return_floor.nc'])
+WORKFLOW = {"args": []}
+
+
 def main(argv=None) -> None:
     command_line(__doc__, run, argv, returns=2000, repeat=5)
 

@@ -86,6 +86,10 @@ def run(repeat: int = 5, log=print) -> xr.Dataset:
                           "(reference driver)")
 
 
+#: part of `make bench` (filippov_paper.product): rule bench_sliding_cost runs main(args + ['--out', 'results/bench_sliding_cost.nc'])
+WORKFLOW = {"args": []}
+
+
 def main(argv=None) -> None:
     command_line(__doc__, run, argv, repeat=5)
 
