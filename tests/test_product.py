@@ -124,3 +124,20 @@ def test_make_bench_rules_come_from_the_benchmark_modules(monkeypatch, tmp_path)
     monkeypatch.setattr(product, "PACKAGE", tmp_path)
     with pytest.raises(ValueError, match=r"odd.py: WORKFLOW: expected .*'many'"):
         product.workflow_benchmarks()
+
+
+def test_test_knobs_are_not_part_of_the_compute_hash():
+    # editing a test knob reruns no computation: the compute jobs hash the scene module
+    # without them (filippov_paper.config.without_report_part)
+    from filippov_paper.config import without_report_part
+
+    path = ROOT / "workflow" / "filippov_paper" / "scenes" / "fig14_atlas.py"
+    source = path.read_text(encoding="utf-8")
+    edited = source.replace('TEST_PERTURB = "theta"', 'TEST_PERTURB = "eps"')
+    edited = edited.replace('"n_mu": 7,', '"n_mu": 9,')
+    assert edited.count("TEST_") == source.count("TEST_") and edited != source
+    assert without_report_part(edited) == without_report_part(source)
+    assert "TEST_SMALL" not in without_report_part(source)
+    # a change of what is computed still shows
+    assert without_report_part(source.replace("def ", "def x", 1)) != \
+        without_report_part(source)
