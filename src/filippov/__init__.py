@@ -25,7 +25,7 @@ from .periodic import periodic_orbit, PeriodicOrbit, PeriodicOrbitError
 _COMPILED = {"compile_system": "compiled_system", "with_section": "compiled_system",
              "FilippovSystem": "compiled_system",
              "SymbolicSystem": "symbolic", "SymbolicSlowFast": "symbolic",
-             "CompiledModel": "abi", "compute_returns": "fastmap",
+             "CompiledModel": "abi", "compute_returns": "fastmap", "sweep_returns": "fastmap",
              "first_returns_compiled": "fastmap"}
 
 
@@ -44,5 +44,5 @@ __all__ = [
     "transition_matrix", "return_jacobian", "VariationalError",
     "periodic_orbit", "PeriodicOrbit", "PeriodicOrbitError",
     "FilippovSystem", "SymbolicSystem", "SymbolicSlowFast", "compile_system", "with_section", "CompiledModel", "compute_returns",
-    "first_returns_compiled", "MINUS", "PLUS", "SLIDING", "__version__",
+    "sweep_returns", "first_returns_compiled", "MINUS", "PLUS", "SLIDING", "__version__",
 ]

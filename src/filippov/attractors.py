@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .abi import CompiledModel
-from .fastmap import OK, STATUS, compute_returns
+from .fastmap import OK, STATUS, BatchReturns, compute_returns, sweep_returns
 
 _UNIT = float(np.spacing(1.0))
 #: status of a run whose kept returns left the watched window (beyond the engine's
@@ -110,6 +110,24 @@ def iterate(cmodel: CompiledModel, start, *, transient: int, keep: int, t_max: f
         raise ValueError(f"need transient >= 0 and keep >= 1, got {transient}, {keep}")
     return compute_returns(cmodel, np.atleast_2d(start), t_max, iterations=transient + keep,
                            keep=keep, jacobian=jacobian, **options)
+
+
+def iterate_sweep(cmodels, starts, *, transient: int, keep: int, t_max: float,
+                  jacobian: bool = False, **options) -> BatchReturns:
+    """:func:`iterate` from ``starts[i]`` under ``cmodels[i]`` for every i, in one compiled
+    call (:func:`filippov.fastmap.sweep_returns`: one model at different parameter
+    values); row i of each output is what :func:`iterate` returns for that point, bit for
+    bit (:func:`row` takes it out)."""
+    if transient < 0 or keep < 1:
+        raise ValueError(f"need transient >= 0 and keep >= 1, got {transient}, {keep}")
+    return sweep_returns(cmodels, starts, t_max, iterations=transient + keep, keep=keep,
+                         jacobian=jacobian, **options)
+
+
+def row(batch: BatchReturns, i: int) -> BatchReturns:
+    """Start i of a batch as a batch of its own (views of row i)."""
+    return BatchReturns(**{name: None if value is None else value[i:i + 1]
+                           for name, value in vars(batch).items()})
 
 
 def lyapunov_exponent(jacobians: np.ndarray, coordinate: int) -> float:
@@ -368,9 +386,22 @@ def _periodic(cmodel, states, age, coordinate, scale, max_period, t_max, options
                      cycle=cycle), period
 
 
+def _check_first(first: BatchReturns, transient: int, keep: int, lyapunov: bool) -> None:
+    """``first`` must be the run settle would make: one start, ``keep`` kept returns
+    (with their dP/dz when ``lyapunov``), ``transient + keep`` made unless it failed."""
+    made = int(first.returns_done[0]) if first.returns_done.shape == (1,) else -1
+    if (first.orbit.shape[:2] != (1, keep) or (lyapunov and first.orbit_jacobian is None)
+            or (first.status[0] == OK and made != transient + keep)):
+        raise ValueError(
+            f"first: expected the run of one start with {transient} + {keep} returns "
+            f"(keep {keep}{', with jacobian=True' if lyapunov else ''}), got orbit "
+            f"{first.orbit.shape}, {made} returns made")
+
+
 def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, keep: int,
            t_max: float, scale: float, max_period: int, window: tuple[float, float],
-           lyapunov: bool = False, **options) -> Attractor:
+           lyapunov: bool = False, first: BatchReturns | None = None,
+           **options) -> Attractor:
     """Iterate, classify, and (``lyapunov``) the Lyapunov exponent from the engine's
     dP/dz along the kept returns. A scale too small to resolve is refused first
     (:func:`check_resolvable`).
@@ -381,10 +412,17 @@ def settle(cmodel: CompiledModel, start, *, coordinate: int, transient: int, kee
     so far exceeds LYAPUNOV_SIGMAS standard errors: an orbit that converges slowly (a
     multiplier near one in modulus) or lingers near a saddle cycle -- whose exponent
     over a short window can look positive -- is then found, whatever the fixed
-    transient was."""
+    transient was.
+
+    ``first``: the first ``transient + keep`` returns already made (a row of
+    :func:`iterate_sweep`, which makes them for many points in one call), instead of
+    iterating here."""
     check_resolvable(scale)
-    run = iterate(cmodel, start, transient=transient, keep=keep, t_max=t_max,
-                  jacobian=lyapunov, **options)
+    if first is not None:
+        _check_first(first, transient, keep, lyapunov)
+    run = first if first is not None else iterate(cmodel, start, transient=transient,
+                                                  keep=keep, t_max=t_max,
+                                                  jacobian=lyapunov, **options)
     states = run.orbit[0]
     values = states[:, coordinate]
     escaped = _escape(run, values, window)

@@ -57,6 +57,7 @@ Every difference between the engines, with its reason and its test:
 """
 from __future__ import annotations
 
+import inspect
 import os
 import weakref
 from concurrent.futures import ThreadPoolExecutor
@@ -252,8 +253,8 @@ def _run_batch(batch, pieces, params, starts, ages, settings, out, workers: int)
 
     def run(lo_hi):  # views of the rows lo:hi: C-contiguous, as the kernel's signature
         lo, hi = lo_hi
-        batch(pieces, params, starts[lo:hi], ages[lo:hi], settings,
-              Outputs(*(a[lo:hi] for a in out)))
+        batch(pieces, params[lo:hi] if params.shape[0] > 1 else params, starts[lo:hi],
+              ages[lo:hi], settings, Outputs(*(a[lo:hi] for a in out)))
 
     with ThreadPoolExecutor(max_workers=min(workers, len(slices))) as pool:
         for _ in pool.map(run, slices):
@@ -347,11 +348,94 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     few returns (starts x iterations, :data:`MIN_RETURNS_PER_SLICE` a slice) uses
     fewer threads, down to the calling thread alone.
     """
-    workers = _checked_workers(workers)
     starts, ages = _checked_starts(cmodel, starts, start_age)
-    pieces = _pieces(cmodel)  # their addresses
     if starts.shape[0]:
         check_compiled(cmodel, starts[0])  # the reference driver's start check, once a model
+    params = np.ascontiguousarray(np.atleast_2d(np.asarray(cmodel.params, dtype=float)))
+    return _returns(cmodel, params, starts, ages, t_max, rtol=rtol, atol=atol,
+                    max_step=max_step, max_events=max_events, max_steps=max_steps,
+                    samples_per_step=samples_per_step, touch_tol=touch_tol,
+                    event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span,
+                    min_time=min_time, iterations=iterations, keep=keep, jacobian=jacobian,
+                    workers=workers)
+
+
+#: what the models of one sweep must share (all but their parameter values): the pieces
+#: (the same compiled functions), the section's direction and the settings they set
+SWEEP_SHARED = ("names", "flow_plus", "flow_minus", "field_plus", "field_minus", "h", "grad_h",
+                "section", "section_where", "jacobian", "section_direction", "sample_step",
+                "sliding", "exact", "slow_sample_step", "transient_time")
+
+
+def _same(a, b) -> bool:
+    if callable(a) or callable(b) or a is None or b is None:
+        return a is b  # a piece: the same compiled function
+    if isinstance(a, float) and isinstance(b, float) and np.isnan(a) and np.isnan(b):
+        return True
+    return a == b
+
+
+def _sweep_params(cmodels) -> np.ndarray:
+    """The models' parameters, one row a model, once every model was checked to differ
+    from the first in its parameter values only (else the error naming the field)."""
+    cmodels = list(cmodels)
+    if not cmodels or not all(isinstance(c, CompiledModel) for c in cmodels):
+        raise TypeError("cmodels must be a non-empty sequence of CompiledModel, one per "
+                        "start point")
+    first = cmodels[0]
+    k = np.asarray(first.params).size
+    for i, c in enumerate(cmodels[1:], start=1):
+        for name in SWEEP_SHARED:
+            if not _same(getattr(c, name), getattr(first, name)):
+                raise ValueError(
+                    f"cmodels[{i}].{name} = {getattr(c, name)!r} differs from cmodels[0]."
+                    f"{name} = {getattr(first, name)!r}: the models of one sweep may differ "
+                    "in their parameter values only (group the points by what else they "
+                    "change and sweep each group)")
+        if np.asarray(c.params).size != k:
+            raise ValueError(f"cmodels[{i}].params has {np.asarray(c.params).size} values, "
+                             f"cmodels[0].params {k}")
+    params = np.array([np.asarray(c.params, dtype=float).reshape(-1) for c in cmodels])
+    if k == 0:  # a model without parameters: the kernel still takes a (1, 0) row
+        params = np.zeros((1, 0))
+    return np.ascontiguousarray(params)
+
+
+def sweep_returns(cmodels, starts, t_max: float, *, start_age=0.0, workers=None,
+                  **options) -> BatchReturns:
+    """:func:`compute_returns` of start i under model ``cmodels[i]``: a parameter sweep in
+    one compiled call. The models must be one model at different parameter values (the
+    same pieces, section and sampling: :data:`SWEEP_SHARED`), as a model's constructor
+    builds them (its checks of the parameters apply); each start's returns are those of
+    :func:`compute_returns` with its own model, bit for bit, whatever ``workers``.
+    ``options`` as there."""
+    params = _sweep_params(cmodels)
+    cmodels = list(cmodels)
+    first = cmodels[0]
+    starts, ages = _checked_starts(first, starts, start_age)
+    if starts.shape[0] != len(cmodels):
+        raise ValueError(f"starts: one start point per model, got {starts.shape[0]} starts "
+                         f"for {len(cmodels)} cmodels")
+    for i, c in enumerate(cmodels):  # once a model object (checks.check_compiled)
+        check_compiled(c, starts[i])
+    defaults = {name: par.default for name, par in
+                inspect.signature(compute_returns).parameters.items()
+                if par.kind is par.KEYWORD_ONLY and name not in ("start_age", "workers")}
+    unknown = set(options) - set(defaults)
+    if unknown:
+        raise TypeError(f"sweep_returns() got unexpected options {sorted(unknown)}")
+    return _returns(first, params, starts, ages, t_max, workers=workers,
+                    **{**defaults, **options})
+
+
+def _returns(cmodel: CompiledModel, params, starts, ages, t_max, *, rtol, atol, max_step,
+             max_events, max_steps, samples_per_step, touch_tol, event_xtol, zeno_count,
+             zeno_span, min_time, iterations, keep, jacobian, workers) -> BatchReturns:
+    """compute_returns and sweep_returns after their own checks of the starts: the
+    options checked, one kernel call over the batch (``params``: one row for all the
+    starts, or one row a start)."""
+    workers = _checked_workers(workers)
+    pieces = _pieces(cmodel)  # their addresses
     options.check(rtol=rtol, atol=atol, max_step=max_step, max_events=max_events,
                   max_steps=max_steps, samples_per_step=samples_per_step, touch_tol=touch_tol,
                   event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span)
@@ -362,7 +446,6 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
                          event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span,
                          min_time=min_time, iterations=iterations, jacobian=jacobian)
     out = _outputs(starts, keep, jacobian)
-    params = np.ascontiguousarray(cmodel.params, dtype=float)
     # the build without the dP/dz code unless it is asked for (kernel.driver)
     _run_batch(kernel(derivatives=bool(jacobian)), pieces, params, starts, ages, settings,
                out, workers)

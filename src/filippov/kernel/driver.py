@@ -361,7 +361,7 @@ def _one(z0, age0, fns, p, s, w):
 _f8, _i8, _b1 = types.float64, types.int64, types.boolean
 _KERNEL_SIG = types.void(
     _PIECE_ADDRS,               # the model: its pieces' addresses (filippov.abi.PIECES)
-    _vec,                       # params
+    types.float64[:, ::1],      # params: one row for every start, or one row a start
     types.float64[:, ::1],      # starts (m, n)
     _vec,                       # their ages in their regions (rules.carried_age)
     types.NamedTuple([_f8, _b1, _f8, _f8, _f8, _i8, _b1, _vec, _vec, _f8, _f8, _f8, _f8, _f8,
@@ -373,12 +373,14 @@ _KERNEL_SIG = types.void(
 
 
 @njit(cache=True, nogil=True)
-def _batch(fns, p, starts, ages, s, out):
+def _batch(fns, params, starts, ages, s, out):
     """Each start is mapped s.iterations times by the first-return map, each return
     starting from the last one's state; the outputs describe the last return made
     (or where it stopped) and out.orbit[i] holds the last keep returns (with s.jac:
-    out.jacobian and out.orbit_jacobian their derivatives dP/dz, NaN where not made)."""
+    out.jacobian and out.orbit_jacobian their derivatives dP/dz, NaN where not made).
+    ``params``: one row for the whole batch, or row i for start i (a parameter sweep)."""
     m, n = starts.shape
+    per_start = params.shape[0] > 1
     nsmax = max(s.frac_ex.size, s.frac_in.size)
     ts = np.empty(nsmax)
     vals = np.empty((2, nsmax))
@@ -407,6 +409,7 @@ def _batch(fns, p, starts, ages, s, out):
             zin[c] = starts[i, c]
         done = 0
         age = ages[i]
+        p = params[i] if per_start else params[0]  # a C-contiguous row, as pieces take
         while True:
             first[0] = np.nan
             st, t, nsw, sl, mode = _one(zin, age, fns, p, s, w)

@@ -73,15 +73,33 @@ def validate(scene: dict) -> None:
                          "between the two cases (no scale)")
 
 
-def _settle(p, theta, eps, s, options, lyapunov):
-    sigma = limit_map.scale(eps, theta)
-    mu = 1.0 + s * sigma
+def _model(p, theta, eps, s):
+    """The compiled model at the sweep point s of (theta, eps) and the start there."""
+    mu = 1.0 + s * limit_map.scale(eps, theta)
     cm = hopf.compiled(eps, theta, mu, float(p["omega"]), sliding=theta > 0)
+    return cm, [0.0, np.sqrt(mu), 0.0]
+
+
+def _settle(p, theta, eps, s, options, lyapunov, point=None, first=None):
+    """The attractor at the sweep point s (``point``, ``first``: its model and start, and
+    its first returns, already made by :func:`_first_returns`)."""
+    cm, start = point if point is not None else _model(p, theta, eps, s)
     w = float(p["window"])
     return attractors.settle(
-        cm, [0.0, np.sqrt(mu), 0.0], coordinate=1, transient=int(p["n_transient"]),
-        keep=int(p["n_keep"]), t_max=T_RETURN, scale=sigma, max_period=int(p["max_period"]),
-        window=(1.0 - w, 1.0 + w), lyapunov=lyapunov, **options)
+        cm, start, coordinate=1, transient=int(p["n_transient"]), keep=int(p["n_keep"]),
+        t_max=T_RETURN, scale=limit_map.scale(eps, theta), max_period=int(p["max_period"]),
+        window=(1.0 - w, 1.0 + w), lyapunov=lyapunov, first=first, **options)
+
+
+def _first_returns(p, theta, eps, s, options, lyapunov):
+    """The models and starts of every point s of (theta, eps), and their first
+    n_transient + n_keep returns in one compiled call (one model at different mu, the start points spread over the cores);
+    row k is what attractors.settle would make for s[k] itself, bit for bit."""
+    attractors.check_resolvable(limit_map.scale(eps, theta))  # settle's refusal, first
+    points = [_model(p, theta, eps, float(sk)) for sk in s]
+    return points, attractors.iterate_sweep(
+        [cm for cm, _ in points], [z for _, z in points], transient=int(p["n_transient"]),
+        keep=int(p["n_keep"]), t_max=T_RETURN, jacobian=lyapunov, **options)
 
 
 def sweep(scene: dict, s: np.ndarray, *, progress: bool = False) -> xr.Dataset:
@@ -102,8 +120,10 @@ def sweep(scene: dict, s: np.ndarray, *, progress: bool = False) -> xr.Dataset:
     for i, theta in enumerate(th):
         for j, eps in enumerate(ep):
             sigma = limit_map.scale(eps, theta)
+            points, first = _first_returns(p, theta, eps, s, opts, lyapunov)
             for k, sk in enumerate(s):
-                at = _settle(p, theta, eps, float(sk), opts, lyapunov)
+                at = _settle(p, theta, eps, float(sk), opts, lyapunov, point=points[k],
+                             first=attractors.row(first, k))
                 u[i, j, k] = (at.values - 1.0) / sigma
                 period[i, j, k] = at.period
                 width[i, j, k] = at.width / sigma
