@@ -125,6 +125,18 @@ def test_parallel_scaling_table(monkeypatch):
     assert "load average" in lines[0] and ds.attrs["load_average_before"] >= 0
 
 
+def test_sweep_cost_table(monkeypatch):
+    # a small sweep three ways (a call per point, one call on 1 thread, on N): the
+    # results were checked equal (run raises otherwise), a row per case and variant
+    from filippov_paper.benchmarks import sweep_cost as sc
+    monkeypatch.setattr(sc, "MIN_TIME", 0.0)
+    lines = []
+    ds = sc.run(points=6, returns=3, repeat=1, log=lines.append)
+    assert list(ds.variant.values) == ["loop", "sweep 1", "sweep N"]
+    assert ds.cpu_time.shape == (len(sc.CASES), 3) and np.all(ds.cpu_time.values > 0)
+    assert ds.threads.values[0, 2] == sc.cores() and "load average" in lines[0]
+
+
 def test_return_floor_counts_without_changing_returns(monkeypatch):
     # the counting pieces give the same returns bit for bit (measure raises otherwise);
     # an exact-flow return evaluates each of flow, h, grad h, field and section at least

@@ -112,10 +112,12 @@ def test_a_new_figure_is_three_files():
 
 def test_make_bench_rules_come_from_the_benchmark_modules(monkeypatch, tmp_path):
     declared = product.workflow_benchmarks()
-    # the six benchmarks of `make bench` besides work-precision (which has its own rules)
+    # the seven benchmarks of `make bench` besides work-precision (which has its own rules)
     assert sorted(declared) == ["attractor_cost", "compile_cost", "effect_cost",
-                                "parallel_scaling", "return_floor", "sliding_cost"]
+                                "parallel_scaling", "return_floor", "sliding_cost",
+                                "sweep_cost"]
     assert declared["parallel_scaling"]["threads"] == "all"
+    assert declared["sweep_cost"]["threads"] == "all"
     assert declared["compile_cost"]["args"] == ["--repeat", "1"]
     # a malformed declaration names its file and the expected form
     (tmp_path / "benchmarks").mkdir()

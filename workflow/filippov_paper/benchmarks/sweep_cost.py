@@ -128,6 +128,10 @@ def run(points: int = 200, returns: int = 40, repeat: int = 3, log=print) -> xr.
                           "against one sweep_returns call (compiled engine)")
 
 
+#: part of `make bench` (filippov_paper.product): rule bench_sweep_cost runs main(args + ['--out', 'results/bench_sweep_cost.nc'])
+WORKFLOW = {"args": [], "threads": "all"}  # "sweep N" takes every core: no other job beside it
+
+
 def main(argv=None) -> None:
     command_line(__doc__, run, argv, points=200, returns=40, repeat=3)
 
