@@ -74,7 +74,8 @@ _jit = njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=Tr
 _jit_rule = njit(cache=True, _nrt=False)
 # the driver's pieces (kernel.driver: _window, _stay_*, _event) are inlined into _one at the
 # IR level: as separate calls they were 4-13% slower on the fig04/fig11 maps, each
-# call passing the named work arrays by value
+# call passing the named work arrays by value; so are the pieces of kernel.scan._find
+# (one function of 142 lines before, the same per-return cost split)
 _jit_inline = njit(cache=True, _nrt=False, inline="always")
 
 
