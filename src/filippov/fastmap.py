@@ -73,8 +73,8 @@ from .abi import (FIELD_SIG, FLOW_SIG, PIECES, SCALAR_SIG, WHERE_SIG,  # noqa: F
 from .kernel.base import (BAD_START, EVENT_LIMIT, FLOW_OFF_FIELD, NO_RETURN,  # noqa: F401
                           NO_SLIDING, NON_FINITE, OK, ROOT_FAILED, SECTION_SLIDING, STATUS, STEP_FAILED,
                           STEP_LIMIT, ZENO)
-from .kernel.driver import (KERNEL_SOURCES, Outputs, Settings,  # noqa: F401
-                            compile_kernel, kernel)
+from .kernel.driver import KERNEL_SOURCES, compile_kernel, kernel  # noqa: F401
+from .kernel.state import Outputs, Settings
 from .checks import check_compiled
 from .system import MINUS, MODE_NAMES, PLUS
 from .poincare import Returns
@@ -274,8 +274,9 @@ def _settings(cmodel: CompiledModel, t_max, *, rtol, atol, max_step, max_events,
     frac_in = np.linspace(0.0, 1.0, samples_per_step + 1)
     # dP/dz: 0 none, 1 Jacobian-vector products by differences, 2 the model's Jacobians
     jac_mode = (2 if cmodel.jacobian is not None else 1) if jacobian else 0
-    # the kernel's ABI (kernel.driver: abi.PIECES, Settings, Outputs; their numba types are
-    # the kernel's one signature: Python floats, ints and bools as such)
+    # the kernel's ABI (abi.PIECES; kernel.state: Settings, Outputs, declared there with
+    # their numba types, from which the kernel's one signature is built: Python floats,
+    # ints and bools as such)
     return Settings(
         t_max=float(t_max), exact=bool(cmodel.exact), hwin=float(hwin),
         hwin_slow=float(hwin_slow), transient=float(cmodel.transient_time),

@@ -49,8 +49,8 @@ STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event lim
 _TO_NEG, _TO_NONNEG, _TO_NONPOS, _EITHER = (
     np.int64(c) for c in (rules.TO_NEG, rules.TO_NONNEG, rules.TO_NONPOS, rules.EITHER))
 # scalar functions of the state whose zeros are events; and the rates of a and b along
-# the orbit (forward differences on the segment, step sg[7]: rules.rate_step), whose
-# zeros are their extrema while sliding
+# the orbit (forward differences on the segment, step w.seg[SEG_RATE_STEP] of
+# kernel.state: rules.rate_step), whose zeros are their extrema while sliding
 _S_H, _S_A, _S_B, _S_SEC, _S_DA, _S_DB = (np.int64(c) for c in range(6))
 # brentq's iteration bounds, the reference driver's (rules.BRENT_MAXITER): for an event,
 # and for the extremum of h or of a normal speed between two samples
@@ -74,7 +74,8 @@ _jit = njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=Tr
 _jit_rule = njit(cache=True, _nrt=False)
 # the driver's pieces (kernel.driver: _window, _stay_*, _event) are inlined into _one at the
 # IR level: as separate calls they were 4-13% slower on the fig04/fig11 maps, each
-# call passing the named work arrays by value
+# call passing the named work arrays by value; so are the pieces of kernel.scan._find
+# (one function of 142 lines before, the same per-return cost split)
 _jit_inline = njit(cache=True, _nrt=False, inline="always")
 
 

@@ -7,6 +7,7 @@ from ..system import PLUS
 from .base import (_central_step, _dot, _flow_minus, _flow_plus, _grad_h, _jacobian, _jit,
                    _section)
 from .dop853 import (_A, _B, _NS, _TRIAL, _checked_field, _stage)
+from .state import Fill, Stages
 
 
 # The derivative of a return, carried in w.M while the orbit runs (Settings.jac), as the
@@ -87,8 +88,8 @@ def _jvp(mode, y, v, out, fns, p, w):
     for k in range(n):
         w.jz1[k] = y[k] + d * v[k]
         w.jz2[k] = y[k] - d * v[k]
-    _checked_field(w.jz1, mode, _TRIAL, fns, p, w.wg, w.wf, w.wp, w.jf1)
-    _checked_field(w.jz2, mode, _TRIAL, fns, p, w.wg, w.wf, w.wp, w.jf2)
+    _checked_field(w.jz1, mode, _TRIAL, fns, p, Fill(w.wg, w.wf, w.wp), w.jf1)
+    _checked_field(w.jz2, mode, _TRIAL, fns, p, Fill(w.wg, w.wf, w.wp), w.jf2)
     for k in range(n):
         out[k] = (w.jf1[k] - w.jf2[k]) / (2.0 * d)
 
@@ -122,7 +123,7 @@ def _var_step(mode, y0, h, fns, p, w, exact):
     step of the state); J exact where the model has it (``exact``)."""
     n = y0.size
     for s in range(_NS):
-        _stage(s, mode, y0, h, w.KV, w.ys, fns, p, w.wg, w.wf, w.wp)
+        _stage(s, mode, y0, h, Stages(w.KV, w.ys), fns, p, Fill(w.wg, w.wf, w.wp))
         for a in range(n):
             for b in range(n):
                 acc = 0.0
@@ -141,8 +142,8 @@ def _var_step(mode, y0, h, fns, p, w, exact):
 @_jit
 def _switch_derivative(mode, new_mode, fns, p, w):
     """w.M <- S w.M, S the saltation matrix of the switch mode -> new_mode at w.z."""
-    _checked_field(w.z, mode, _TRIAL, fns, p, w.wg, w.wf, w.wp, w.jf1)
-    _checked_field(w.z, new_mode, _TRIAL, fns, p, w.wg, w.wf, w.wp, w.jf2)
+    _checked_field(w.z, mode, _TRIAL, fns, p, Fill(w.wg, w.wf, w.wp), w.jf1)
+    _checked_field(w.z, new_mode, _TRIAL, fns, p, Fill(w.wg, w.wf, w.wp), w.jf2)
     _grad_h(fns, w.z, p, w.jz1)
     speed = _dot(w.jz1, w.jf1)
     for k in range(w.z.size):
@@ -155,7 +156,7 @@ def _section_derivative(mode, fns, p, w):
     """w.M <- (I - f g^T / (g . f)) w.M at the section hit w.z: f the field there, g the
     section's gradient (central differences; w.z is restored bit for bit)."""
     z = w.z
-    _checked_field(z, mode, _TRIAL, fns, p, w.wg, w.wf, w.wp, w.jf1)
+    _checked_field(z, mode, _TRIAL, fns, p, Fill(w.wg, w.wf, w.wp), w.jf1)
     for k in range(z.size):
         orig = z[k]
         d = _central_step(max(1.0, abs(orig)), 1.0)

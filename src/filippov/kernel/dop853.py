@@ -8,6 +8,7 @@ import numpy as np
 from .. import dop853_tableau as _dop
 from ..system import MINUS, PLUS
 from .base import (_field_minus, _field_plus, _jit, _speeds)
+from .state import Stages
 
 # ----------------------------------------------------------------------------- DOP853 tableau
 # The coefficients of scipy's DOP853, which the reference driver integrates sliding
@@ -46,12 +47,9 @@ def _dense_eval(t, t_old, hs, y_old, F, out):
         out[k] += y_old[k]
 
 
-# A segment of the current mode: exact flow from za at time sg[0], or the dense
-
-
 @_jit
-def _checked_field(z, mode, first_call, fns, p, wg, wm, wp, out):
-    """The field of ``mode`` (the Filippov field when sliding) with
+def _checked_field(z, mode, first_call, fns, p, fl, out):
+    """The field of ``mode`` (the Filippov field when sliding; fl: state.Fill) with
     simulate._IntegratingStepper's guard: a non-finite value at the first call
     is an error (False), on a trial stage it is 1e300."""
     if mode == PLUS:
@@ -59,9 +57,9 @@ def _checked_field(z, mode, first_call, fns, p, wg, wm, wp, out):
     elif mode == MINUS:
         _field_minus(fns, z, p, out)
     else:
-        a, b = _speeds(z, fns, p, wg, wm, wp)
+        a, b = _speeds(z, fns, p, fl.wg, fl.wm, fl.wp)
         for k in range(z.size):
-            out[k] = (a * wp[k] - b * wm[k]) / (a - b)
+            out[k] = (a * fl.wp[k] - b * fl.wm[k]) / (a - b)
     finite = True
     for k in range(z.size):
         if not np.isfinite(out[k]):
@@ -75,15 +73,16 @@ def _checked_field(z, mode, first_call, fns, p, wg, wm, wp, out):
 
 
 @_jit
-def _stage(s, mode, y0, h, K, ytmp, fns, p, wg, wm, wp):
+def _stage(s, mode, y0, h, st, fns, p, fl):
     """Stage s of the tableau from y0 over h: K[s] = field(y0 + h sum_j<s A[s, j] K[j])
-    (ytmp holds the stage's state)."""
+    (st: state.Stages, K and ytmp, which holds the stage's state)."""
+    K, ytmp = st.K, st.ytmp
     for k in range(y0.size):
         acc = 0.0
         for j in range(s):
             acc += K[j, k] * _A[s, j]
         ytmp[k] = y0[k] + acc * h
-    _checked_field(ytmp, mode, _TRIAL, fns, p, wg, wm, wp, K[s])
+    _checked_field(ytmp, mode, _TRIAL, fns, p, fl, K[s])
 
 
 @_jit
@@ -96,9 +95,11 @@ def _rms(x, scale):
 
 
 @_jit
-def _dop_initial_step(mode, t0, y0, f0, t_bound, max_step, rtol, atol, fns, p, wg, wm, wp,
-                      y1, f1, scale):
-    """scipy.integrate._ivp.common.select_initial_step for DOP853 (order 7)."""
+def _dop_initial_step(mode, t0, ctl, fns, p, fl, d):
+    """scipy.integrate._ivp.common.select_initial_step for DOP853 (order 7) from d.y, its
+    field d.f (ctl: state.Control; d: state.Dop, d.ynew and d.ytmp scratch)."""
+    t_bound, max_step, rtol, atol = ctl.t_bound, ctl.max_step, ctl.rtol, ctl.atol
+    y0, f0, y1, f1, scale = d.y, d.f, d.ynew, d.ytmp, d.scale
     interval = abs(t_bound - t0)
     if interval == 0.0:
         return 0.0
@@ -114,7 +115,7 @@ def _dop_initial_step(mode, t0, y0, f0, t_bound, max_step, rtol, atol, fns, p, w
     h0 = min(h0, interval)
     for k in range(n):
         y1[k] = y0[k] + h0 * f0[k]
-    _checked_field(y1, mode, _TRIAL, fns, p, wg, wm, wp, f1)
+    _checked_field(y1, mode, _TRIAL, fns, p, fl, f1)
     s = 0.0
     for k in range(n):
         q = (f1[k] - f0[k]) / scale[k]
@@ -128,13 +129,16 @@ def _dop_initial_step(mode, t0, y0, f0, t_bound, max_step, rtol, atol, fns, p, w
 
 
 @_jit
-def _dop_step(mode, t, y, f, h_abs, t_bound, max_step, rtol, atol, fns, p, wg, wm, wp,
-              K, ynew, ytmp, scale):
-    """One accepted step of scipy's DOP853 (RungeKutta._step_impl).
+def _dop_step(mode, t, h_abs, ctl, fns, p, fl, d):
+    """One accepted step of scipy's DOP853 (RungeKutta._step_impl) from d.y, its field
+    d.f (ctl: state.Control; d: state.Dop).
 
     Returns (ok, t_new, h, h_abs_next); K holds the stages, ynew the new state,
     K[_NS] the field there. On failure (the step size collapsed): (False, t, the last
     step tried, h_abs), K holding that step's stages (see _non_finite_stage)."""
+    t_bound, max_step, rtol, atol = ctl.t_bound, ctl.max_step, ctl.rtol, ctl.atol
+    y, f, K, ynew, scale = d.y, d.f, d.K, d.ynew, d.scale
+    stages = Stages(K, d.ytmp)
     n = y.size
     h = 0.0
     min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
@@ -156,13 +160,13 @@ def _dop_step(mode, t, y, f, h_abs, t_bound, max_step, rtol, atol, fns, p, wg, w
         for k in range(n):
             K[0, k] = f[k]
         for s in range(1, _NS):
-            _stage(s, mode, y, h, K, ytmp, fns, p, wg, wm, wp)
+            _stage(s, mode, y, h, stages, fns, p, fl)
         for k in range(n):
             acc = 0.0
             for j in range(_NS):
                 acc += K[j, k] * _B[j]
             ynew[k] = y[k] + h * acc
-        _checked_field(ynew, mode, _TRIAL, fns, p, wg, wm, wp, K[_NS])
+        _checked_field(ynew, mode, _TRIAL, fns, p, fl, K[_NS])
         # error norm (DOP853._estimate_error_norm)
         for k in range(n):
             scale[k] = atol + max(abs(y[k]), abs(ynew[k])) * rtol
@@ -216,11 +220,14 @@ def _non_finite_stage(y, h, K, out):
 
 
 @_jit
-def _dop_dense(mode, h, y_old, y, f_old, f, fns, p, wg, wm, wp, K, ytmp, F):
-    """DOP853._dense_output_impl: extra stages and the interpolant F (7, n)."""
+def _dop_dense(mode, h, fns, p, fl, d):
+    """DOP853._dense_output_impl of the step h from d.y_old to d.y: extra stages and the
+    interpolant d.F (7, n)."""
+    y_old, y, f_old, f, K, F = d.y_old, d.y, d.f_old, d.f, d.K, d.F
+    stages = Stages(K, d.ytmp)
     n = y.size
     for s in range(_NS + 1, _NSE):
-        _stage(s, mode, y_old, h, K, ytmp, fns, p, wg, wm, wp)
+        _stage(s, mode, y_old, h, stages, fns, p, fl)
     for k in range(n):
         dy = y[k] - y_old[k]
         F[0, k] = dy

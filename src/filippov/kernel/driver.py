@@ -16,7 +16,6 @@ import hashlib
 import sys
 import types as pytypes
 import warnings
-from collections import namedtuple
 from pathlib import Path
 
 import numpy as np
@@ -34,13 +33,18 @@ from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _d
                      _dop_step, _non_finite_stage)
 from .segment import _zat
 from .scan import (_carry_sample, _find, _flow_follows, _sample)
+from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY,
+                    SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_SHIFT, SEG_SIZE, SEG_STEP_H,
+                    SEG_STEP_T, T_AGE, T_SLID, T_SLIDE_START, TALLY_SIZE, Control, Dop, Fill,
+                    Orbit, Outputs, Samples, Scratch, Settings, Work, kernel_signature)  # noqa: F401
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
 
 
 @_jit
-def _section_rate(z, wm, wp, cm, cp, d, fns, p, wz):
-    """Central difference of the section along the field cm F_- + cp F_+."""
+def _section_rate(z, wm, wp, c, d, fns, p, wz):
+    """Central difference of the section along the field cm F_- + cp F_+, c = (cm, cp)."""
+    cm, cp = c
     for k in range(z.size):
         wz[k] = z[k] + d * (cm * wm[k] + cp * wp[k])
     s1 = _section(fns, wz, p)
@@ -61,9 +65,9 @@ def _slides_in(z, fns, p, wg, wm, wp, wz):
     if d == 0.0:
         return False
     return _slides_in_section(_section(fns, z, p), d,
-                              _section_rate(z, wm, wp, 1.0, 0.0, d, fns, p, wz),
-                              _section_rate(z, wm, wp, 0.0, 1.0, d, fns, p, wz),
-                              _section_rate(z, wm, wp, -b / (a - b), a / (a - b), d, fns, p, wz))
+                              _section_rate(z, wm, wp, (1.0, 0.0), d, fns, p, wz),
+                              _section_rate(z, wm, wp, (0.0, 1.0), d, fns, p, wz),
+                              _section_rate(z, wm, wp, (-b / (a - b), a / (a - b)), d, fns, p, wz))
 
 
 @_jit
@@ -80,38 +84,9 @@ def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
 
 # The kernel's ABI: _batch(fns, params, starts, ages, settings, out): the compiled
 # addresses of the model's nine pieces (a tuple of integers in the order of
-# filippov.abi.PIECES: base._PIECE_ADDRS), arrays and two named tuples;
-# fastmap.compute_returns builds them (_KERNEL_SIG: their types).
-
-#: what a batch runs with: t_max per return; exact flows in regions + and - (else DOP853)
-#: in windows hwin (hwin_slow after the transient time); the section predicate; sliding
-#: declared; sample fractions of an exact window and of an integration step; tolerances and
-#: limits as compute_returns' options; iterations: returns per start; jac: dP/dz (0 none,
-#: 1 Jacobian-vector products by differences, 2 the model's Jacobians)
-Settings = namedtuple("Settings", [
-    "t_max", "exact", "hwin", "hwin_slow", "transient", "sec_pred", "sliding",
-    "frac_ex", "frac_in", "rtol", "atol", "touch_tol", "xtol", "zeno_span", "max_step",
-    "min_time", "max_events", "max_steps", "zeno_count", "jac", "iterations"])
-
-#: what a batch returns, per start (m) -- fastmap.BatchReturns' fields: state (m, n), time,
-#: n_switches, sliding_time, status, first_switch, sliding_displacement (m, n), orbit
-#: (m, keep, n), returns_done, jacobian (m, n, n), orbit_jacobian (m, keep or 0, n, n), age,
-#: mode (the mode at the return, or the one the run stopped in)
-Outputs = namedtuple("Outputs", [
-    "state", "time", "n_switches", "sliding_time", "status", "first_switch",
-    "sliding_displacement", "orbit", "returns_done", "jacobian", "orbit_jacobian", "age",
-    "mode"])
-
-#: the kernel's named work arrays, allocated once per batch by _batch. count: switches,
-#: steps, entries in the Zeno ring; tally: time slid, start of the current slide, time
-#: already spent in the current mode when the current exact stay began (its age: 0 after
-#: an entry; carried from the last hit when a return continues an orbit)
-Work = namedtuple("Work", [
-    "ts", "vals", "dvals", "svals", "recent", "sg", "za", "y", "f", "y_old", "f_old", "K",
-    "ynew", "ytmp", "scale", "F", "wz", "wg", "wf", "wp", "z", "first_sw", "slide_dz",
-    "slide_z0", "count", "tally",
-    # dP/dz (Settings.jac): the derivative so far, workspaces, the variational stages
-    "M", "Mt", "KV", "KP", "ys", "jv", "jo", "jz1", "jz2", "jf1", "jf2", "touched", "Jm"])
+# filippov.abi.PIECES: base._PIECE_ADDRS), arrays and two named tuples (kernel.state:
+# Settings, Outputs; their types and the signature declared there once);
+# fastmap.compute_returns builds them.
 
 _GO_ON = -1  # no event yet / the orbit goes on (never a returned status)
 
@@ -122,28 +97,28 @@ _DERIVATIVES = True
 
 
 @_jit_inline
-def _window(mode, ta, tb, frac, first, fns, p, s, w):
-    """Samples the segment [ta, tb] of the current mode and finds its earliest event:
-    (_GO_ON, tb, _W_NONE) if there is none (the state at tb in w.z), (OK, te, what)
-    at an event (its state in w.z), NO_RETURN at t_max, or an error (status, ta)."""
+def _window(mode, ta, tb, frac, first, o, s, w):
+    """Samples the segment [ta, tb] of the current mode (o: state.Orbit, of w's arrays)
+    and finds its earliest event: (_GO_ON, tb, _W_NONE) if there is none (the state at tb
+    in w.z), (OK, te, what) at an event (its state in w.z), NO_RETURN at t_max, or an
+    error (status, ta)."""
     ns = frac.size
+    sm = Samples(w.ts, w.vals, w.dvals, w.svals, w.ynew, w.touched)
+    sc = Scratch(w.wz, w.wg, w.wf, w.wp)
     # an exact flow's window after the first of its stay starts at the last one's end
-    k0 = 1 if (mode != SLIDING and w.sg[3] == 0.0 and not first) else 0
+    k0 = 1 if (mode != SLIDING and w.seg[SEG_INTEGRATED] == 0.0 and not first) else 0
     if k0 == 1:
-        _carry_sample(ns, w.sg, w.ts, w.vals, w.dvals, w.svals)
-    ok, speed2_a = _sample(mode, ta, tb, frac, ns, k0, w.sg, w.za, w.F, w.y_old, fns, p,
-                           w.ts, w.vals, w.dvals, w.svals, w.wz, w.wg, w.wf, w.wp, w.ynew)
+        _carry_sample(ns, w.seg, sm)
+    ok, speed2_a = _sample(mode, ta, tb, frac, k0, o, sm, sc)
     if not ok:
         return NON_FINITE, ta, _W_NONE
-    # an exact flow (sg[3] == 0) must follow its field over the window: from the state at
-    # ta (w.z) to that at tb (w.ynew), the field at tb left in w.wf by the last sample;
-    # else the run stops at ta (w.z)
-    if mode != SLIDING and w.sg[3] == 0.0 and not _flow_follows(w.z, w.ynew, tb - ta,
-                                                                 speed2_a, w.wf):
+    # an exact flow (SEG_INTEGRATED == 0) must follow its field over the window: from the
+    # state at ta (w.z) to that at tb (w.ynew), the field at tb left in w.wf by the last
+    # sample; else the run stops at ta (w.z)
+    if mode != SLIDING and w.seg[SEG_INTEGRATED] == 0.0 and not _flow_follows(
+            w.z, w.ynew, tb - ta, speed2_a, w.wf):
         return FLOW_OFF_FIELD, ta, _W_NONE
-    st, te, what = _find(mode, w.ts, ns, first, s.sec_pred, s.touch_tol, s.xtol, s.min_time,
-                         w.sg, w.za, w.F, w.y_old, fns, p, w.vals, w.dvals, w.svals, w.wz,
-                         w.wg, w.wf, w.touched)
+    st, te, what = _find(mode, ns, first, s, o, sm, sc)
     # P is not differentiable where the orbit touches H
     if _DERIVATIVES and s.jac and w.touched[0]:
         for i in range(w.z.size):
@@ -154,11 +129,12 @@ def _window(mode, ta, tb, frac, first, fns, p, s, w):
     if what == _W_NONE:
         for c in range(w.z.size):
             w.z[c] = w.ynew[c]
-        if w.sg[5] > 0.0 and _clears_band(mode, w.vals[0, ns - 1], w.sg[5]):
-            w.sg[4] = w.sg[6]  # out of the exit's rounding band: H unbiased from here
-            w.sg[5] = 0.0
+        if w.seg[SEG_BAND] > 0.0 and _clears_band(mode, w.vals[0, ns - 1], w.seg[SEG_BAND]):
+            # out of the exit's rounding band: H unbiased from here
+            w.seg[SEG_SHIFT] = w.seg[SEG_EXIT_SHIFT]
+            w.seg[SEG_BAND] = 0.0
         return (NO_RETURN if tb >= s.t_max else _GO_ON), tb, _W_NONE
-    _zat(te, mode, w.sg, w.za, w.F, w.y_old, fns, p, w.z)
+    _zat(te, mode, o, w.z)
     return OK, te, what
 
 
@@ -169,21 +145,22 @@ def _stay_exact(mode, t, fns, p, s, w):
     transient, then hwin_slow); (status, t, what)."""
     for k in range(w.z.size):
         w.za[k] = w.z[k]
-    w.sg[0] = t
-    w.sg[3] = 0.0
+    w.seg[SEG_ENTRY] = t
+    w.seg[SEG_INTEGRATED] = 0.0
+    o = Orbit(fns, p, w.seg, w.za, w.F, w.y_old, s.xtol)
     ta, first = t, True
     while True:
-        w.count[1] += 1
-        if w.count[1] > s.max_steps:
+        w.count[N_STEPS] += 1
+        if w.count[N_STEPS] > s.max_steps:
             return STEP_LIMIT, ta, _W_NONE
-        tb = min(ta + _exact_window(ta - w.sg[0] + w.tally[2], s.hwin, s.hwin_slow,
-                                    s.transient), s.t_max)
+        age = ta - w.seg[SEG_ENTRY] + w.tally[T_AGE]
+        tb = min(ta + _exact_window(age, s.hwin, s.hwin_slow, s.transient), s.t_max)
         if tb == ta:
             tb = np.nextafter(ta, np.inf)
-        st, t, what = _window(mode, ta, tb, s.frac_ex, first, fns, p, s, w)
+        st, t, what = _window(mode, ta, tb, s.frac_ex, first, o, s, w)
         if st != _GO_ON:
             if _DERIVATIVES and st == OK and s.jac:
-                _flow_jacobian(mode, w.za, t - w.sg[0], fns, p, w.Mt, w.jz1, w.jz2)
+                _flow_jacobian(mode, w.za, t - w.seg[SEG_ENTRY], fns, p, w.Mt, w.jz1, w.jz2)
                 _apply(w.Mt, w.M, w.KP[0])
             return st, t, what
         ta, first = tb, False
@@ -194,21 +171,22 @@ def _stay_integrated(mode, t, fns, p, s, w):
     """A stay integrated by DOP853 with the mode's field (Filippov's when sliding;
     regions + and - of a model without exact flows); (status, t, what)."""
     n = w.z.size
-    w.sg[3] = 1.0
+    w.seg[SEG_INTEGRATED] = 1.0
     for k in range(n):
         w.y[k] = w.z[k]
-    if not _checked_field(w.y, mode, _FIRST_CALL, fns, p, w.wg, w.wf, w.wp, w.f):
+    fl = Fill(w.wg, w.wf, w.wp)
+    d = Dop(w.y, w.f, w.y_old, w.f_old, w.K, w.ynew, w.ytmp, w.scale, w.F)
+    ctl = Control(s.t_max, s.max_step, s.rtol, s.atol)
+    if not _checked_field(w.y, mode, _FIRST_CALL, fns, p, fl, w.f):
         return NON_FINITE, t, _W_NONE
-    h_abs = _dop_initial_step(mode, t, w.y, w.f, s.t_max, s.max_step, s.rtol, s.atol, fns, p,
-                              w.wg, w.wf, w.wp, w.ynew, w.ytmp, w.scale)
+    h_abs = _dop_initial_step(mode, t, ctl, fns, p, fl, d)
+    o = Orbit(fns, p, w.seg, w.za, w.F, w.y_old, s.xtol)
     ta, first = t, True
     while True:
-        w.count[1] += 1
-        if w.count[1] > s.max_steps:
+        w.count[N_STEPS] += 1
+        if w.count[N_STEPS] > s.max_steps:
             return STEP_LIMIT, ta, _W_NONE
-        ok, tb, hstep, h_abs = _dop_step(mode, ta, w.y, w.f, h_abs, s.t_max, s.max_step, s.rtol,
-                                         s.atol, fns, p, w.wg, w.wf, w.wp, w.K, w.ynew, w.ytmp,
-                                         w.scale)
+        ok, tb, hstep, h_abs = _dop_step(mode, ta, h_abs, ctl, fns, p, fl, d)
         if not ok:  # a non-finite field collapses the step too: say which
             return (NON_FINITE if _non_finite_stage(w.y, hstep, w.K, w.z) else STEP_FAILED,
                     ta, _W_NONE)
@@ -217,11 +195,10 @@ def _stay_integrated(mode, t, fns, p, s, w):
             w.f_old[k] = w.f[k]
             w.y[k] = w.ynew[k]
             w.f[k] = w.K[_NS, k]
-        _dop_dense(mode, hstep, w.y_old, w.y, w.f_old, w.f, fns, p, w.wg, w.wf, w.wp, w.K,
-                   w.ytmp, w.F)
-        w.sg[1] = ta
-        w.sg[2] = tb - ta
-        st, t, what = _window(mode, ta, tb, s.frac_in, first, fns, p, s, w)
+        _dop_dense(mode, hstep, fns, p, fl, d)
+        w.seg[SEG_STEP_T] = ta
+        w.seg[SEG_STEP_H] = tb - ta
+        st, t, what = _window(mode, ta, tb, s.frac_in, first, o, s, w)
         if _DERIVATIVES and s.jac and (st == _GO_ON or (st == OK and t > ta)):
             _var_step(mode, w.y_old, (tb if st == _GO_ON else t) - ta, fns, p, w, s.jac == 2)
         if st != _GO_ON:
@@ -232,7 +209,7 @@ def _stay_integrated(mode, t, fns, p, s, w):
 @_jit_inline
 def _end_slide(t, w):
     """Counts the slide that ends at t (time, and change of state)."""
-    w.tally[0] += t - w.tally[1]
+    w.tally[T_SLID] += t - w.tally[T_SLIDE_START]
     for k in range(w.z.size):
         w.slide_dz[k] += w.z[k] - w.slide_z0[k]
 
@@ -245,7 +222,8 @@ def _event(mode, t, what, fns, p, s, w):
     if what == _W_SECTION:
         # the age in this mode at the hit (the next return of an iterated run goes on
         # from it: a hit is no mode entry)
-        w.tally[2] = t - w.sg[0] + w.tally[2] if (mode != SLIDING and s.exact) else 0.0
+        w.tally[T_AGE] = (t - w.seg[SEG_ENTRY] + w.tally[T_AGE] if (mode != SLIDING and s.exact)
+                          else 0.0)
         if mode == SLIDING:
             _end_slide(t, w)
         if _DERIVATIVES and s.jac:
@@ -278,34 +256,34 @@ def _event(mode, t, what, fns, p, s, w):
             band = _exit_band(w.z, w.wz, w.wg)
         _end_slide(t, w)
     if new_mode == SLIDING:
-        w.tally[1] = t
+        w.tally[T_SLIDE_START] = t
         for k in range(w.z.size):
             w.slide_z0[k] = w.z[k]
     if new_mode != mode:
-        w.count[0] += 1
-        if w.count[0] == 1:
+        w.count[N_SWITCHES] += 1
+        if w.count[N_SWITCHES] == 1:
             w.first_sw[0] = t
-    if w.count[0] > s.max_events:
+    if w.count[N_SWITCHES] > s.max_events:
         return EVENT_LIMIT, mode
-    w.recent[w.count[2] % s.zeno_count] = t
-    w.count[2] += 1
-    if w.count[2] >= s.zeno_count and _accumulates(w.recent[w.count[2] % s.zeno_count], t,
+    w.recent[w.count[N_RING] % s.zeno_count] = t
+    w.count[N_RING] += 1
+    if w.count[N_RING] >= s.zeno_count and _accumulates(w.recent[w.count[N_RING] % s.zeno_count], t,
                                                    s.zeno_span):
         return ZENO, mode
-    w.sg[4] = 0.0
-    w.sg[5] = 0.0
-    w.sg[6] = 0.0
+    w.seg[SEG_SHIFT] = 0.0
+    w.seg[SEG_BAND] = 0.0
+    w.seg[SEG_EXIT_SHIFT] = 0.0
     if mode == SLIDING and new_mode != SLIDING:
-        w.sg[6] = _exit_shift(new_mode, h0, s.touch_tol, drift)
-        w.sg[5] = band
-        w.sg[4] = _banded_shift(new_mode, w.sg[6], band) if band > 0.0 else w.sg[6]
+        w.seg[SEG_EXIT_SHIFT] = _exit_shift(new_mode, h0, s.touch_tol, drift)
+        w.seg[SEG_BAND] = band
+        w.seg[SEG_SHIFT] = _banded_shift(new_mode, w.seg[SEG_EXIT_SHIFT], band) if band > 0.0 else w.seg[SEG_EXIT_SHIFT]
     # (the end of sliding: identity)
     if _DERIVATIVES and s.jac and mode != SLIDING and new_mode != mode:
         _switch_derivative(mode, new_mode, fns, p, w)
     if new_mode != mode:
-        w.tally[2] = 0.0  # an entry: the fast transient starts again
+        w.tally[T_AGE] = 0.0  # an entry: the fast transient starts again
     elif mode != SLIDING and s.exact:
-        w.tally[2] += t - w.sg[0]  # the stay goes on from here
+        w.tally[T_AGE] += t - w.seg[SEG_ENTRY]  # the stay goes on from here
     return _GO_ON, new_mode
 
 
@@ -315,7 +293,7 @@ def _one(z0, age0, fns, p, s, w):
     (status, t, n_switches, sliding_time, mode at the return or where the run stopped). w.first_sw[0]: time of the first change of
     mode (left untouched if there is none); w.slide_dz: the change of state summed
     over the sliding stretches (counted like sliding_time); age0: the time already spent
-    in the start's region (rules.carried_age), w.tally[2] the same at the return."""
+    in the start's region (rules.carried_age), w.tally[T_AGE] the same at the return."""
     n = z0.size
     for k in range(n):
         w.slide_dz[k] = 0.0
@@ -334,20 +312,20 @@ def _one(z0, age0, fns, p, s, w):
                 w.M[i, j] = np.nan if mode == SLIDING else (1.0 if i == j else 0.0)
     for k in range(n):
         w.slide_z0[k] = w.z[k]
-    for k in range(3):
+    for k in range(COUNT_SIZE):
         w.count[k] = 0
-    w.tally[0] = 0.0
-    w.tally[1] = 0.0
-    w.tally[2] = 0.0 if mode == SLIDING else _carried_age(_h(fns, w.z, p), s.touch_tol, age0)
-    w.sg[4] = 0.0
-    w.sg[5] = 0.0
-    w.sg[6] = 0.0
+    w.tally[T_SLID] = 0.0
+    w.tally[T_SLIDE_START] = 0.0
+    w.tally[T_AGE] = 0.0 if mode == SLIDING else _carried_age(_h(fns, w.z, p), s.touch_tol, age0)
+    w.seg[SEG_SHIFT] = 0.0
+    w.seg[SEG_BAND] = 0.0
+    w.seg[SEG_EXIT_SHIFT] = 0.0
     t = 0.0
     while True:
         if t >= s.t_max:
-            return NO_RETURN, t, w.count[0], w.tally[0], mode
+            return NO_RETURN, t, w.count[N_SWITCHES], w.tally[T_SLID], mode
         if mode == SLIDING and not s.sliding:
-            return NO_SLIDING, t, w.count[0], w.tally[0], mode
+            return NO_SLIDING, t, w.count[N_SWITCHES], w.tally[T_SLID], mode
         if mode != SLIDING and s.exact:
             st, t, what = _stay_exact(mode, t, fns, p, s, w)
         else:
@@ -355,21 +333,10 @@ def _one(z0, age0, fns, p, s, w):
         if st == OK:
             st, mode = _event(mode, t, what, fns, p, s, w)
         if st != _GO_ON:  # _event hands back the mode it was asked about unless it goes on
-            return st, t, w.count[0], w.tally[0], mode
+            return st, t, w.count[N_SWITCHES], w.tally[T_SLID], mode
 
 
-_f8, _i8, _b1 = types.float64, types.int64, types.boolean
-_KERNEL_SIG = types.void(
-    _PIECE_ADDRS,               # the model: its pieces' addresses (filippov.abi.PIECES)
-    types.float64[:, ::1],      # params: one row for every start, or one row a start
-    types.float64[:, ::1],      # starts (m, n)
-    _vec,                       # their ages in their regions (rules.carried_age)
-    types.NamedTuple([_f8, _b1, _f8, _f8, _f8, _i8, _b1, _vec, _vec, _f8, _f8, _f8, _f8, _f8,
-                      _f8, _f8, _i8, _i8, _i8, _i8, _i8], Settings),
-    types.NamedTuple([types.float64[:, ::1], _vec, types.int64[::1], _vec, types.int64[::1],
-                      _vec, types.float64[:, ::1], types.float64[:, :, ::1], types.int64[::1],
-                      types.float64[:, :, ::1], types.float64[:, :, :, ::1], _vec,
-                      types.int64[::1]], Outputs))
+_KERNEL_SIG = kernel_signature()
 
 
 @njit(cache=True, nogil=True)
@@ -387,7 +354,7 @@ def _batch(fns, params, starts, ages, s, out):
     dvals = np.empty((2, nsmax))
     svals = np.empty(nsmax)
     recent = np.empty(max(s.zeno_count, 1))
-    sg = np.zeros(10)
+    seg = np.zeros(SEG_SIZE)
     za, y, f = np.zeros(n), np.zeros(n), np.zeros(n)
     y_old, f_old, ynew, ytmp, scale = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                                        np.zeros(n))
@@ -395,9 +362,9 @@ def _batch(fns, params, starts, ages, s, out):
     K = np.zeros((_NSE, n))
     F = np.zeros((_NI, n))
     first = np.zeros(1)
-    w = Work(ts, vals, dvals, svals, recent, sg, za, y, f, y_old, f_old, K, ynew, ytmp, scale,
+    w = Work(ts, vals, dvals, svals, recent, seg, za, y, f, y_old, f_old, K, ynew, ytmp, scale,
              F, wz, wg, wf, wp, np.zeros(n), first, np.zeros(n), np.zeros(n),
-             np.zeros(3, dtype=np.int64), np.zeros(3),
+             np.zeros(COUNT_SIZE, dtype=np.int64), np.zeros(TALLY_SIZE),
              np.zeros((n, n)), np.zeros((n, n)), np.zeros((_NS, n)), np.zeros((_NS, n, n)),
              np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
              np.zeros(n), np.zeros(1, dtype=np.bool_), np.zeros(n * n))
@@ -428,9 +395,9 @@ def _batch(fns, params, starts, ages, s, out):
                 break
             for c in range(n):
                 zin[c] = w.z[c]
-            age = w.tally[2]
+            age = w.tally[T_AGE]
         out.returns_done[i] = done
-        out.age[i] = w.tally[2]
+        out.age[i] = w.tally[T_AGE]
         out.first_switch[i] = first[0]
         for c in range(n):
             out.state[i, c] = w.z[c]

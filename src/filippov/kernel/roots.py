@@ -7,23 +7,28 @@ import numpy as np
 from .base import (_EPS, _MAXITER_EVENT, _after, _far_side, _far_side_probe, _jit)
 from .segment import _fval
 
+# brentq's relative tolerance: scipy's default (4 eps), the reference driver's
+_RTOL = 4.0 * _EPS
+
 
 @_jit
-def _brentq(sel, xa, xb, xtol, rtol, maxiter, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
-    """scipy.optimize.brentq (scipy/optimize/Zeros/brentq.c); returns (root, ok)."""
-    r, _, ok = _brentq_f(sel, xa, xb, xtol, rtol, maxiter, mode, sg, za, F, y_old, fns, p,
-                         wz, wg, wf)
+def _brentq(sel, xa, xb, maxiter, mode, o, sc):
+    """scipy.optimize.brentq (scipy/optimize/Zeros/brentq.c) of the event function sel
+    on the segment o (state.Orbit), to xtol o.xtol and rtol 4 eps (scipy's default);
+    returns (root, ok)."""
+    r, _, ok = _brentq_f(sel, xa, xb, maxiter, mode, o, sc)
     return r, ok
 
 
 @_jit
-def _brentq_f(sel, xa, xb, xtol, rtol, maxiter, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
+def _brentq_f(sel, xa, xb, maxiter, mode, o, sc):
     """_brentq, returning (root, the function's value there, ok): the value at the root
     is the one it evaluated last (or at xa), which _refine's far-side probe needs first."""
+    xtol, rtol = o.xtol, _RTOL
     xpre, xcur = xa, xb
     xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
-    fpre = _fval(sel, xpre, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
-    fcur = _fval(sel, xcur, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+    fpre = _fval(sel, xpre, mode, o, sc)
+    fcur = _fval(sel, xcur, mode, o, sc)
     if np.isnan(fpre) or np.isnan(fcur):
         return xcur, fcur, False
     if fpre == 0.0:
@@ -70,29 +75,29 @@ def _brentq_f(sel, xa, xb, xtol, rtol, maxiter, mode, sg, za, F, y_old, fns, p, 
             xcur += scur
         else:
             xcur += delta if sbis > 0 else -delta
-        fcur = _fval(sel, xcur, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+        fcur = _fval(sel, xcur, mode, o, sc)
         if np.isnan(fcur):
             return xcur, fcur, False
     return xcur, fcur, False
 
 
 @_jit
-def _refine(sel, pred, ta, tb, va, xtol, mode, sg, za, F, y_old, fns, p, wz, wg, wf):
-    """simulate._refine: root in [ta, tb] on the far side of the crossing; (t, ok)."""
+def _refine(sel, pred, ta, tb, va, mode, o, sc):
+    """simulate._refine: root in [ta, tb] on the far side of the crossing (va: the value
+    at ta), to o.xtol; (t, ok)."""
     pred = _far_side(pred, va)
     if va == 0.0:
         r = ta
-        fr = _fval(sel, r, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+        fr = _fval(sel, r, mode, o, sc)
     else:
         # fr: the value at r, which brentq evaluated last (the same call, bit for bit:
         # not evaluated again for the first far-side probe)
-        r, fr, ok = _brentq_f(sel, ta, tb, xtol, 4.0 * _EPS, _MAXITER_EVENT, mode, sg, za, F,
-                              y_old, fns, p, wz, wg, wf)
+        r, fr, ok = _brentq_f(sel, ta, tb, _MAXITER_EVENT, mode, o, sc)
         if not ok:
             # as simulate._refine: no sign change because the start sample of a
             # just-entered mode was clamped inside while the true value is already
             # past the crossing -- the event is at once
-            fr = _fval(sel, ta, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+            fr = _fval(sel, ta, mode, o, sc)
             if _after(pred, fr):
                 r = ta
             else:
@@ -101,5 +106,5 @@ def _refine(sel, pred, ta, tb, va, xtol, mode, sg, za, F, y_old, fns, p, wz, wg,
     while not done:  # to the far side of the crossing (rules.far_side_probe)
         done, r, step = _far_side_probe(r, step, tb, _after(pred, fr))
         if not done:
-            fr = _fval(sel, r, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
+            fr = _fval(sel, r, mode, o, sc)
     return r, True

@@ -2,6 +2,8 @@
 filippov.simulate._scan)."""
 from __future__ import annotations
 
+from collections import namedtuple
+
 import numpy as np
 
 from .. import rules
@@ -9,48 +11,54 @@ from ..system import MINUS, PLUS, SLIDING
 from .base import (OK, ROOT_FAILED, _EPS, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB, _S_H, _S_SEC, _TO_NEG, _TO_NONNEG,
                    _TO_NONPOS, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_NONE, _W_SECTION, _W_SWITCH,
                    _after, _band_probe, _clamp, _clears_band, _crosses, _dips_and_returns, _dot, _extremum_between,
-                   _flow_consistent, _graze, _jit, _rate_step, _same_instant, _speed_extremum_between, _speed_graze,
+                   _flow_consistent, _graze, _jit, _jit_inline, _rate_step, _same_instant, _speed_extremum_between, _speed_graze,
                    _speeds, _starts_on_section, _field_minus, _section_probe, _section_noise,
                    _on_section_by_value,
                    _field_plus, _grad_h, _h, _section, _where)
 from .segment import (_fval, _rates, _zat)
+from .state import (SEG_BAND, SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_LAST_H, SEG_LAST_SPEED2,
+                    SEG_RATE_STEP, SEG_SHIFT)
 from .roots import (_brentq, _refine)
 
 
 @_jit
-def _sample(mode, ta, tb, frac, ns, k0, sg, za, F, y_old, fns, p, ts, vals, dvals, svals,
-            wz, wg, wf, wp, zlast):
-    """Samples of one window: times ts, the leave functions (h, or a and b when
-    sliding), their rates (dh/dt; the rates of a and b along the orbit while sliding,
-    rules.rate_step: sg[7]) and the section; the last state in zlast. (False: non-finite,
-    |f|^2 at the first sample outside sliding -- the state at ta -- for _flow_follows).
-    Samples from k0 on: k0 = 1 when the caller carried sample 0 over (_carry_sample);
-    outside sliding the last sample's h and |f|^2 are kept in sg[8], sg[9] for that."""
-    speed2_a = sg[9] if k0 == 1 else 0.0
+def _sample(mode, ta, tb, frac, k0, o, sm, sc):
+    """Samples of one window at the fractions frac of [ta, tb] (sm: state.Samples): times
+    ts, the leave functions (h, or a and b when sliding), their rates (dh/dt; the rates of
+    a and b along the orbit while sliding, rules.rate_step: SEG_RATE_STEP) and the section;
+    the last state in sm.end. (False: non-finite, |f|^2 at the first sample outside
+    sliding -- the state at ta -- for _flow_follows). Samples from k0 on: k0 = 1 when the
+    caller carried sample 0 over (_carry_sample); outside sliding the last sample's h and
+    |f|^2 are kept in SEG_LAST_H, SEG_LAST_SPEED2 for that."""
+    ns = frac.size
+    sg, wz, wg, wf, wp = o.seg, sc.wz, sc.wg, sc.wf, sc.wp
+    ts, vals, dvals, svals = sm.ts, sm.vals, sm.dvals, sm.svals
+    fns, p = o.fns, o.p
+    speed2_a = sg[SEG_LAST_SPEED2] if k0 == 1 else 0.0
     for k in range(k0, ns):
         tk = ta + frac[k] * (tb - ta) if k < ns - 1 else tb
         ts[k] = tk
-        _zat(tk, mode, sg, za, F, y_old, fns, p, wz)
+        _zat(tk, mode, o, wz)
         for c in range(wz.size):
             if not np.isfinite(wz[c]):
                 return False, speed2_a
         svals[k] = _section(fns, wz, p)
         if k == ns - 1:
             for c in range(wz.size):
-                zlast[c] = wz[c]
+                sm.end[c] = wz[c]
         if mode == SLIDING:
             a, b = _speeds(wz, fns, p, wg, wf, wp)
             vals[0, k] = a
             vals[1, k] = b
             if k == 0:  # one difference step for the window (wf, wp: F_-, F_+ at wz)
-                sg[7] = _rate_step(wz, wf, wp, a, b)
-            if sg[7] > 0.0:  # (overwrites wz)
-                da, db = _rates(tk, a, b, mode, sg, za, F, y_old, fns, p, wz, wg, wf, wp)
+                sg[SEG_RATE_STEP] = _rate_step(wz, wf, wp, a, b)
+            if sg[SEG_RATE_STEP] > 0.0:  # (overwrites wz)
+                da, db = _rates(tk, a, b, mode, o, sc)
                 dvals[0, k] = da
                 dvals[1, k] = db
         else:
             hk = _h(fns, wz, p)
-            vals[0, k] = hk - sg[4]
+            vals[0, k] = hk - sg[SEG_SHIFT]
             _grad_h(fns, wz, p, wg)
             if mode == PLUS:
                 _field_plus(fns, wz, p, wf)
@@ -60,21 +68,21 @@ def _sample(mode, ta, tb, frac, ns, k0, sg, za, F, y_old, fns, p, ts, vals, dval
             if k == 0:
                 speed2_a = _dot(wf, wf)
             if k == ns - 1:  # for the next window's sample 0 (_carry_sample)
-                sg[8] = hk
-                sg[9] = _dot(wf, wf)
+                sg[SEG_LAST_H] = hk
+                sg[SEG_LAST_SPEED2] = _dot(wf, wf)
     return True, speed2_a
 
 
 @_jit
-def _carry_sample(ns, sg, ts, vals, dvals, svals):
+def _carry_sample(ns, seg, sm):
     """Sample 0 of an exact flow's window that goes on from the window before in the
     same stay: the state at its start is that window's last sample (the same flow from
     the same entry over the same time, bit for bit), so its values are taken over
-    instead of evaluated again (h less the current sg[4], which may have changed)."""
-    ts[0] = ts[ns - 1]
-    vals[0, 0] = sg[8] - sg[4]
-    dvals[0, 0] = dvals[0, ns - 1]
-    svals[0] = svals[ns - 1]
+    instead of evaluated again (h less the current SEG_SHIFT, which may have changed)."""
+    sm.ts[0] = sm.ts[ns - 1]
+    sm.vals[0, 0] = seg[SEG_LAST_H] - seg[SEG_SHIFT]
+    sm.dvals[0, 0] = sm.dvals[0, ns - 1]
+    sm.svals[0] = sm.svals[ns - 1]
 
 
 @_jit
@@ -104,146 +112,199 @@ def _in_section_rounding(fns, p, s0, z0, zr, probe):
     return _on_section_by_value(s0, noise)
 
 
-@_jit
-def _find(mode, ts, ns, first, sec_pred, touch_tol, xtol, min_time, sg, za, F, y_old, fns,
-          p, vals, dvals, svals, wz, wg, wf, touched):
-    """simulate._scan on the samples: the earliest event; (status, t, what). A touch of
-    H on the way (no event) sets touched[0]."""
+#: how an orbit leaves its mode: through n leave functions (1: h; 2 while sliding: a and
+#: b), the first of them ``sel`` crossing by ``pred`` (the event ``what``), and the rate
+#: ``sel_d`` whose zero is the first one's extremum
+_Leave = namedtuple("_Leave", ["n", "sel", "pred", "what", "sel_d"])
+
+
+@_jit_inline
+def _leave_of(mode):
     if mode == PLUS:
-        nleave, sel0, pred0, what0, sel_d = 1, _S_H, _TO_NEG, _W_SWITCH, _S_B
-    elif mode == MINUS:
-        nleave, sel0, pred0, what0, sel_d = 1, _S_H, _TO_NONNEG, _W_SWITCH, _S_A
-    else:
-        nleave, sel0, pred0, what0, sel_d = 2, _S_A, _TO_NONPOS, _W_EXIT_MINUS, _S_A
+        return _Leave(1, _S_H, _TO_NEG, _W_SWITCH, _S_B)
+    if mode == MINUS:
+        return _Leave(1, _S_H, _TO_NONNEG, _W_SWITCH, _S_A)
+    return _Leave(2, _S_A, _TO_NONPOS, _W_EXIT_MINUS, _S_A)
+
+
+@_jit_inline
+def _unband(i, ns, mode, o, sm, sc):
+    """The orbit is out of its exit's rounding band at ts[i]: from there H is unbiased
+    (rules.clears_band), so a return across H is refined at H = 0: the shift dropped and
+    h sampled again from ts[i] on."""
+    o.seg[SEG_SHIFT] = o.seg[SEG_EXIT_SHIFT]
+    o.seg[SEG_BAND] = 0.0
+    for k in range(i, ns):
+        sm.vals[0, k] = _fval(_S_H, sm.ts[k], mode, o, sc)
+
+
+@_jit_inline
+def _band_root(r, lo, mode, lv, o, sc):
+    """A crossing of H found at r beyond the exit's band, refined again on H itself
+    (rules.band_probe) where the orbit has cleared the band before r; (r, ok)."""
+    sg = o.seg
+    tq, step, done, clear = r, 0.0, False, False
+    while not done:
+        clear = _clears_band(mode, _fval(_S_H, tq, mode, o, sc), sg[SEG_BAND])
+        done, tq, step = _band_probe(tq, step, lo, clear)
+    if clear:
+        banded = sg[SEG_SHIFT]
+        sg[SEG_SHIFT] = sg[SEG_EXIT_SHIFT]
+        r2, ok = _refine(lv.sel, lv.pred, tq, r, _fval(_S_H, tq, mode, o, sc), mode, o, sc)
+        sg[SEG_SHIFT] = banded
+        if ok:
+            r = r2
+    return r
+
+
+@_jit_inline
+def _leave_root(i, mode, first, lv, o, sm, sc):
+    """The crossing of the first leave function between samples i and i + 1; (t, ok)."""
+    ta, tb = sm.ts[i], sm.ts[i + 1]
+    lo, vlo = ta, sm.vals[0, i]
+    if (first and i == 0 and mode != SLIDING
+            and _dips_and_returns(mode, sm.dvals[0, 0], sm.dvals[0, 1])):
+        tm, ok = _brentq(lv.sel_d, ta, tb, _MAXITER_EXTREMUM, mode, o, sc)
+        hm = _fval(_S_H, tm, mode, o, sc)
+        if ok and not _after(lv.pred, hm):  # refine beyond the dip (rules)
+            lo, vlo = tm, hm
+    r, ok = _refine(lv.sel, lv.pred, lo, tb, vlo, mode, o, sc)
+    if not ok:
+        return r, False
+    if o.seg[SEG_BAND] > 0.0:  # found beyond the exit's band: again on H itself
+        r = _band_root(r, lo, mode, lv, o, sc)
+    return r, True
+
+
+@_jit_inline
+def _speed_exit(i, mode, ha, hb, touch_tol, o, sm, sc):
+    """The end of sliding hidden between samples i and i + 1 (rules.speed_graze): refined
+    at the extremum of a (ha) or b (hb), an exit at the speed's root before it;
+    (status, t, what), (OK, inf, _W_NONE) if none."""
+    ta, tb = sm.ts[i], sm.ts[i + 1]
+    best_t, best_w = np.inf, _W_NONE
+    touch_t = np.inf
+    for q in range(2):
+        if not (ha if q == 0 else hb):
+            continue
+        sel_v, sel_r = (_S_A, _S_DA) if q == 0 else (_S_B, _S_DB)
+        pred = _TO_NONPOS if q == 0 else _TO_NONNEG
+        tm, ok = _brentq(sel_r, ta, tb, _MAXITER_EXTREMUM, mode, o, sc)
+        if not ok:
+            return ROOT_FAILED, tm, _W_NONE
+        vm = _fval(sel_v, tm, mode, o, sc)
+        kind = _speed_graze(pred, vm, sm.dvals[q, i], sm.dvals[q, i + 1], tb - ta, touch_tol)
+        if kind == rules.GRAZE_CROSSES:
+            r, ok = _refine(sel_v, pred, ta, tm, sm.vals[q, i], mode, o, sc)
+            if not ok:
+                return ROOT_FAILED, r, _W_NONE
+            if best_w == _W_NONE or r < best_t:
+                best_t, best_w = r, (_W_EXIT_MINUS if q == 0 else _W_EXIT_PLUS)
+        elif kind == rules.GRAZE_TOUCHES:
+            touch_t = min(touch_t, tm)
+    if touch_t < best_t:
+        sm.touched[0] = True  # a touch before any exit: P has a kink here
+    return OK, best_t, best_w
+
+
+@_jit_inline
+def _h_extremum(i, mode, lv, touch_tol, o, sm, sc):
+    """A minimum (in +) or maximum (in -) of h hidden between samples i and i + 1: a
+    switch at h's root before it, or a touch (no event); (status, t, what)."""
+    ta, tb = sm.ts[i], sm.ts[i + 1]
+    tm, ok = _brentq(lv.sel_d, ta, tb, _MAXITER_EXTREMUM, mode, o, sc)
+    if not ok:
+        return ROOT_FAILED, tm, _W_NONE
+    hm = _fval(_S_H, tm, mode, o, sc)
+    kind = _graze(mode, hm, touch_tol, o.seg[SEG_BAND])  # the exit's band (rules)
+    if kind == rules.GRAZE_CROSSES:
+        r, ok = _refine(_S_H, lv.pred, ta, tm, sm.vals[0, i], mode, o, sc)
+        if not ok:
+            return ROOT_FAILED, r, _W_NONE
+        return OK, r, _W_SWITCH
+    if kind == rules.GRAZE_TOUCHES:
+        # |hm| <= touch_tol: a touch, not an event; P has a kink here
+        sm.touched[0] = True
+    return OK, np.inf, _W_NONE
+
+
+@_jit_inline
+def _section_hit(i, mode, best_t, best_w, s, o, sm, sc):
+    """The section crossed between samples i and i + 1: the hit unless an earlier event
+    (best_t, best_w) comes first; (status, t, what)."""
+    r, ok = _refine(_S_SEC, s.sec_pred, sm.ts[i], sm.ts[i + 1], sm.svals[i], mode, o, sc)
+    if not ok:
+        return ROOT_FAILED, r, _W_NONE
+    # simulate._scan: min_time; a tie with a switch (rules.same_instant)
+    # goes to the section; a start on the section up to rounding is no hit
+    if r >= s.min_time and (best_w == _W_NONE
+                            or r <= best_t + _same_instant(o.xtol, best_t)):
+        wz, wg = sc.wz, sc.wg
+        _zat(r, mode, o, wz)
+        if _where(o.fns, wz, o.p):
+            at_start = False
+            if sm.ts[i] == 0.0:
+                _zat(sm.ts[i], mode, o, wg)
+                # the closed form's start za counts for an exact flow only; a
+                # dense output (integrated, sliding) starts at wg itself and za is
+                # stale there (it took crossings within 64 x 1e-10 for the start)
+                exact = mode != SLIDING and o.seg[SEG_INTEGRATED] == 0.0
+                at_start = (_starts_on_section(sm.svals[i], wg, _section(o.fns, wz, o.p), wz,
+                                               o.za if exact else wg)
+                            or _in_section_rounding(o.fns, o.p, sm.svals[i], wg, wz, sc.wf))
+            if not at_start:
+                return OK, r, _W_SECTION
+    return OK, best_t, best_w
+
+
+@_jit
+def _find(mode, ns, first, s, o, sm, sc):
+    """simulate._scan on the samples: the earliest event; (status, t, what). A touch of
+    H on the way (no event) sets sm.touched[0]."""
+    lv = _leave_of(mode)
+    vals, dvals, svals, sg = sm.vals, sm.dvals, sm.svals, o.seg
     if first:  # just entered this mode: its start is inside by construction
-        vals[0, 0] = _clamp(pred0, vals[0, 0])
-        if nleave == 2:
+        vals[0, 0] = _clamp(lv.pred, vals[0, 0])
+        if lv.n == 2:
             vals[1, 0] = _clamp(_TO_NONNEG, vals[1, 0])
     for i in range(ns - 1):
-        c0 = _crosses(pred0, vals[0, i], vals[0, i + 1])
-        c1 = nleave == 2 and _crosses(_TO_NONNEG, vals[1, i], vals[1, i + 1])
+        c0 = _crosses(lv.pred, vals[0, i], vals[0, i + 1])
+        c1 = lv.n == 2 and _crosses(_TO_NONNEG, vals[1, i], vals[1, i + 1])
         cd = mode != SLIDING and _extremum_between(mode, dvals[0, i], dvals[0, i + 1])
-        cs = _crosses(sec_pred, svals[i], svals[i + 1])
+        cs = _crosses(s.sec_pred, svals[i], svals[i + 1])
         # while sliding: a minimum of a, a maximum of b between the samples (rules)
-        ha = nleave == 2 and sg[7] > 0.0 and _speed_extremum_between(
+        ha = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and _speed_extremum_between(
             _TO_NONPOS, dvals[0, i], dvals[0, i + 1])
-        hb = nleave == 2 and sg[7] > 0.0 and _speed_extremum_between(
+        hb = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and _speed_extremum_between(
             _TO_NONNEG, dvals[1, i], dvals[1, i + 1])
         if not (c0 or c1 or cd or cs or ha or hb):
             continue
-        if sg[5] > 0.0 and _clears_band(mode, vals[0, i], sg[5]):
-            # the orbit is out of its exit's rounding band at ts[i]: from there H is
-            # unbiased (rules.clears_band), so a return across H is refined at H = 0
-            sg[4] = sg[6]
-            sg[5] = 0.0
-            for k in range(i, ns):
-                vals[0, k] = _fval(_S_H, ts[k], mode, sg, za, F, y_old, fns, p, wz, wg, wf)
-            c0 = _crosses(pred0, vals[0, i], vals[0, i + 1])
+        if sg[SEG_BAND] > 0.0 and _clears_band(mode, vals[0, i], sg[SEG_BAND]):
+            _unband(i, ns, mode, o, sm, sc)
+            c0 = _crosses(lv.pred, vals[0, i], vals[0, i + 1])
             if not (c0 or c1 or cd or cs):
                 continue
-        ta, tb = ts[i], ts[i + 1]
         best_t, best_w = np.inf, _W_NONE
         if c0:
-            lo, vlo = ta, vals[0, i]
-            if first and i == 0 and mode != SLIDING and _dips_and_returns(mode, dvals[0, 0], dvals[0, 1]):
-                tm, ok = _brentq(sel_d, ta, tb, xtol, 4.0 * _EPS, _MAXITER_EXTREMUM, mode, sg, za, F, y_old,
-                                 fns, p, wz, wg, wf)
-                hm = _fval(_S_H, tm, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
-                if ok and not _after(pred0, hm):  # refine beyond the dip (rules)
-                    lo, vlo = tm, hm
-            r, ok = _refine(sel0, pred0, lo, tb, vlo, xtol, mode, sg, za, F, y_old,
-                            fns, p, wz, wg, wf)
+            r, ok = _leave_root(i, mode, first, lv, o, sm, sc)
             if not ok:
                 return ROOT_FAILED, r, _W_NONE
-            if sg[5] > 0.0:  # found beyond the exit's band: again on H itself (rules.band_probe)
-                tq, step, done, clear = r, 0.0, False, False
-                while not done:
-                    clear = _clears_band(mode, _fval(_S_H, tq, mode, sg, za, F, y_old, fns, p,
-                                                     wz, wg, wf), sg[5])
-                    done, tq, step = _band_probe(tq, step, lo, clear)
-                if clear:
-                    banded = sg[4]
-                    sg[4] = sg[6]
-                    r2, ok = _refine(sel0, pred0, tq, r, _fval(_S_H, tq, mode, sg, za, F, y_old,
-                                                               fns, p, wz, wg, wf),
-                                     xtol, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
-                    sg[4] = banded
-                    if ok:
-                        r = r2
-            best_t, best_w = r, what0
+            best_t, best_w = r, lv.what
         if c1:
-            r, ok = _refine(_S_B, _TO_NONNEG, ta, tb, vals[1, i], xtol, mode, sg, za, F,
-                            y_old, fns, p, wz, wg, wf)
+            r, ok = _refine(_S_B, _TO_NONNEG, sm.ts[i], sm.ts[i + 1], vals[1, i], mode, o, sc)
             if not ok:
                 return ROOT_FAILED, r, _W_NONE
             if best_w == _W_NONE or r < best_t:
                 best_t, best_w = r, _W_EXIT_PLUS
+        st = OK
         if best_w == _W_NONE and (ha or hb):
-            # the end of sliding hidden between the samples (rules.speed_graze): refined
-            # at the extremum of a or b, an exit at the speed's root before it
-            touch_t = np.inf
-            for q in range(2):
-                if not (ha if q == 0 else hb):
-                    continue
-                sel_v, sel_r = (_S_A, _S_DA) if q == 0 else (_S_B, _S_DB)
-                pred = _TO_NONPOS if q == 0 else _TO_NONNEG
-                tm, ok = _brentq(sel_r, ta, tb, xtol, 4.0 * _EPS, _MAXITER_EXTREMUM, mode, sg,
-                                 za, F, y_old, fns, p, wz, wg, wf)
-                if not ok:
-                    return ROOT_FAILED, tm, _W_NONE
-                vm = _fval(sel_v, tm, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
-                kind = _speed_graze(pred, vm, dvals[q, i], dvals[q, i + 1], tb - ta, touch_tol)
-                if kind == rules.GRAZE_CROSSES:
-                    r, ok = _refine(sel_v, pred, ta, tm, vals[q, i], xtol, mode, sg, za, F,
-                                    y_old, fns, p, wz, wg, wf)
-                    if not ok:
-                        return ROOT_FAILED, r, _W_NONE
-                    if best_w == _W_NONE or r < best_t:
-                        best_t, best_w = r, (_W_EXIT_MINUS if q == 0 else _W_EXIT_PLUS)
-                elif kind == rules.GRAZE_TOUCHES:
-                    touch_t = min(touch_t, tm)
-            if touch_t < best_t:
-                touched[0] = True  # a touch before any exit: P has a kink here
-        if mode != SLIDING and best_w == _W_NONE and cd:
-            # a minimum (in +) or maximum (in -) of h hidden between samples
-            tm, ok = _brentq(sel_d, ta, tb, xtol, 4.0 * _EPS, _MAXITER_EXTREMUM, mode, sg, za, F, y_old,
-                             fns, p, wz, wg, wf)
-            if not ok:
-                return ROOT_FAILED, tm, _W_NONE
-            hm = _fval(_S_H, tm, mode, sg, za, F, y_old, fns, p, wz, wg, wf)
-            kind = _graze(mode, hm, touch_tol, sg[5])  # sg[5]: the exit's band (rules)
-            if kind == rules.GRAZE_CROSSES:
-                r, ok = _refine(_S_H, pred0, ta, tm, vals[0, i], xtol, mode, sg, za, F,
-                                y_old, fns, p, wz, wg, wf)
-                if not ok:
-                    return ROOT_FAILED, r, _W_NONE
-                best_t, best_w = r, _W_SWITCH
-            elif kind == rules.GRAZE_TOUCHES:
-                # |hm| <= touch_tol: a touch, not an event; P has a kink here
-                touched[0] = True
-        if cs:
-            r, ok = _refine(_S_SEC, sec_pred, ta, tb, svals[i], xtol, mode, sg, za, F, y_old,
-                            fns, p, wz, wg, wf)
-            if not ok:
-                return ROOT_FAILED, r, _W_NONE
-            # simulate._scan: min_time; a tie with a switch (rules.same_instant)
-            # goes to the section; a start on the section up to rounding is no hit
-            if r >= min_time and (best_w == _W_NONE
-                                  or r <= best_t + _same_instant(xtol, best_t)):
-                _zat(r, mode, sg, za, F, y_old, fns, p, wz)
-                if _where(fns, wz, p):
-                    at_start = False
-                    if ts[i] == 0.0:
-                        _zat(ts[i], mode, sg, za, F, y_old, fns, p, wg)
-                        # the closed form's start za counts for an exact flow only; a
-                        # dense output (integrated, sliding) starts at wg itself and za is
-                        # stale there (it took crossings within 64 x 1e-10 for the start)
-                        exact = mode != SLIDING and sg[3] == 0.0
-                        at_start = (_starts_on_section(svals[i], wg, _section(fns, wz, p), wz,
-                                                       za if exact else wg)
-                                    or _in_section_rounding(fns, p, svals[i], wg, wz, wf))
-                    if not at_start:
-                        best_t, best_w = r, _W_SECTION
+            st, best_t, best_w = _speed_exit(i, mode, ha, hb, s.touch_tol, o, sm, sc)
+        if st == OK and mode != SLIDING and best_w == _W_NONE and cd:
+            st, best_t, best_w = _h_extremum(i, mode, lv, s.touch_tol, o, sm, sc)
+        if st == OK and cs:
+            st, best_t, best_w = _section_hit(i, mode, best_t, best_w, s, o, sm, sc)
+        if st != OK:
+            return st, best_t, best_w
         if best_w != _W_NONE:
             return OK, best_t, best_w
     return OK, np.inf, _W_NONE
