@@ -37,7 +37,7 @@ Failures never raise inside the compiled code and never hang: each start point
 gets a status code (:data:`STATUS`) -- event or step bound hit, accumulation of
 switches (Zeno), non-finite state, an exact flow that does not follow its field
 (``rules.flow_consistent``, as the reference driver), no return within ``t_max``,
-...; the wrapper :func:`first_returns_compiled` turns a failure into the same
+...; the front door :func:`filippov.first_returns` (``engine="compiled"``) turns a failure into the same
 exception types as the reference driver.
 
 The kernel itself lives in :mod:`filippov.kernel`, split along its seams (shared
@@ -64,7 +64,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import options, rules
+from . import engines, options, rules
 # what a model hands the engine (its pieces' signatures, CompiledModel), re-exported here
 from .abi import (FIELD_SIG, FLOW_SIG, PIECES, SCALAR_SIG, WHERE_SIG,  # noqa: F401
                   CompiledModel, no_flow, no_jacobian)
@@ -443,15 +443,26 @@ _ERRORS = {EVENT_LIMIT: EventLimitError, STEP_LIMIT: EventLimitError, ZENO: Zeno
 
 def first_returns_compiled(cmodel: CompiledModel, starts, t_max: float, *,
                            progress: Progress | None = None, **options) -> Returns:
-    """:func:`filippov.poincare.first_returns` on the compiled path.
+    """Replaced by the front door ``first_returns(cmodel, starts, None, t_max,
+    engine="compiled")`` (:func:`filippov.first_returns`); kept for its callers."""
+    from .poincare import first_returns
 
-    ``options`` go to :func:`compute_returns`; ``progress`` is stepped once by
-    the number of start points, after the batch. A start point that does not return
-    is an error naming it (the first one, with its status), raised as the
-    reference driver would: :class:`EventLimitError` for the event and step
-    bounds, :class:`ZenoError`, :class:`SimulationError` for a numerical
-    failure, RuntimeError for no return within ``t_max``.
+    return first_returns(cmodel, starts, None, t_max, engine="compiled", progress=progress,
+                         **options)
+
+
+def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
+                   where=None, progress: Progress | None = None, **options) -> Returns:
+    """:func:`filippov.first_returns` on the compiled engine: one batch call of
+    :func:`compute_returns`; ``progress`` is stepped once by the number of start points,
+    after the batch. A start point that does not return is an error naming it (the
+    first one, with its status), raised as the reference driver would:
+    :class:`EventLimitError` for the event and step bounds, :class:`ZenoError`,
+    :class:`SimulationError` for a numerical failure, RuntimeError for no return within
+    ``t_max``.
     """
+    cmodel = engines.compiled_model(system, "first_returns", section, direction=direction,
+                                    where=where)
     out = compute_returns(cmodel, starts, t_max, **options)
     if progress is not None:
         progress.step(out.status.size)
