@@ -389,7 +389,7 @@ class _Pieces:
         return self._vector(self.cm.field_plus, z)
 
     def switch_grad(self, z):
-        return self._vector(self.cm.grad_h, z)
+        return self._vector(self.cm.switch_grad, z)
 
 
 def failure(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:

@@ -201,9 +201,9 @@ def breakdown(counts: dict, sliding: bool) -> dict:
     told apart from them, so ``samples`` counts both there."""
     flows = counts["flow_plus"] + counts["flow_minus"]
     if not sliding:
-        samples = counts["grad_h"] - min(counts["field_minus"], counts["field_plus"])
+        samples = counts["switch_grad"] - min(counts["field_minus"], counts["field_plus"])
     else:
-        samples = counts["h"]
+        samples = counts["switch"]
     return {"samples": samples, "root": max(flows - samples, 0.0),
             "stage_fields": (counts["field_minus"] + counts["field_plus"] - 2 * samples
                              if not sliding else counts["field_minus"])}

@@ -108,7 +108,7 @@ def sigma_minus(model) -> tuple[float, float]:
     pg = np.array([-1.0, 0.0, -1.0])
     a, _ = system.normal_speeds(pg)
     x, y = pg[:2], pg[2:]
-    hx, _ = model.h_grad(x, y)
+    hx, _ = model.switch_grad(x, y)
     chi = float(hx @ model.f_minus(x, y) - hx @ model.f_plus(x, y))
     return float(a), chi
 

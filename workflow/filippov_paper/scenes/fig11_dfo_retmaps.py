@@ -504,7 +504,7 @@ def lemma_quantity(law, v, x0=None):
     xe = -df.friction_branches(law["f0"], law["fv"], law["fc"], law["convention"])[0](0.0)
     x = np.array([xe, v]) if x0 is None else np.asarray(x0, float)
     y = m.y0(x)
-    hx, _ = m.h_grad(x, y)
+    hx, _ = m.switch_grad(x, y)
     chi = float(hx @ m.f_minus(x, y) - hx @ m.f_plus(x, y))
     a, b = m.reduced().normal_speeds(np.array([0.0, v]))
     return chi, float(a), float(b)
