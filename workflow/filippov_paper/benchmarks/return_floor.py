@@ -291,8 +291,8 @@ def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
             f"{r['per_return'] / r['floor']:7.2f} {1e6 * (r['per_return'] - r['floor']):6.2f} "
             f"{1e6 * r['flow_floor']:6.2f} | "
             f"{c['flow_plus'] + c['flow_minus']:6.1f} "
-            f"{c['field_plus'] + c['field_minus'] + c['grad_h']:6.1f} "
-            f"{c['h'] + c['section']:6.1f} {r['samples']:7.1f} {r['root']:5.1f}")
+            f"{c['field_plus'] + c['field_minus'] + c['switch_grad']:6.1f} "
+            f"{c['switch'] + c['section']:6.1f} {r['samples']:7.1f} {r['root']:5.1f}")
     costs = rows[0]["costs"]
     log("times in us per return; floor (eval): every model evaluation the return makes, "
         "each at its cost alone; flows only: the flow evaluations alone (the states at the "
