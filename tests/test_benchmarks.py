@@ -65,11 +65,11 @@ def test_effect_variants_switch_one_ingredient_each():
              "solver": {"rtol": 1e-12, "engine": "compiled"}}
     labels = [label for label, _ in effect_cost.variants(scene)]
     assert labels == ["as declared", "system: slow_fast -> reduced", "flow: exact -> integrate",
-                      "sliding: True -> False", "engine: compiled -> python"]
+                      "sliding: True -> False", "engine: compiled -> reference"]
     by = dict(effect_cost.variants(scene))
     # the same engine with the other flow: the cost of the ingredient alone
     assert by["flow: exact -> integrate"]["solver"]["engine"] == "compiled"
-    assert by["engine: compiled -> python"]["ingredients"]["flow"] == "exact"
+    assert by["engine: compiled -> reference"]["ingredients"]["flow"] == "exact"
     assert scene["ingredients"]["flow"] == "exact"                    # the original untouched
 
 

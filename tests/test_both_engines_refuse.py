@@ -28,7 +28,7 @@ from filippov.fastmap import (FLOW_OFF_FIELD, NON_FINITE, compute_returns, failu
 from filippov.system import MINUS, MODE_NAMES
 
 ZETA, V, K = -0.05, 0.5, 1.0
-ENGINES = ("compiled", "python")
+ENGINES = ("compiled", "reference")
 A = np.array([[0.0, 1.0, 0.0], [-1.0, -2 * ZETA, 0.0], [1.0, 0.0, -K]])
 
 
@@ -186,7 +186,7 @@ def test_jacobians_of_the_two_fields_give_the_sliding_one():
     # the sliding field here is (u, 0, -k w + x): its Jacobian in closed form
     want = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 0.0], [1.0, 0.0, -K]])
     np.testing.assert_allclose(system.jacobian(0, z), want, rtol=0, atol=1e-12)
-    orbit = periodic_orbit(system, [1.0, -0.5, 1.0], _section, direction=-1, engine="python",
+    orbit = periodic_orbit(system, [1.0, -0.5, 1.0], _section, direction=-1, engine="reference",
                            t_max=50.0)
     assert orbit.multipliers[1] == pytest.approx(np.exp(-K * orbit.period), rel=1e-6)
 

@@ -143,7 +143,7 @@ def test_one_definition_with_exact_flows_and_sliding():
 
 @pytest.mark.parametrize("piece,value,match", [
     ("field_plus", lambda z, p, out: None, r"CompiledModel\.field_plus: expected a numba njit"),
-    ("h", "njit-lazy", r"CompiledModel\.h: expected a numba njit function compiled with"),
+    ("switch", "njit-lazy", r"CompiledModel\.switch: expected a numba njit function compiled with"),
     ("section", "cfunc", r"CompiledModel\.section: expected a numba njit"),
 ])
 def test_a_piece_the_kernel_cannot_call_is_refused(piece, value, match):

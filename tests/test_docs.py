@@ -124,8 +124,8 @@ def test_one_definition_and_the_symbolic_system_find_the_orbit_on_both_engines(t
                                                                                 relay):
     scope, out = tutorial
     want = relay.closed_form()
-    assert abs(scope["po"].period - want["period"]) < 1e-12       # the last engine: python
+    assert abs(scope["po"].period - want["period"]) < 1e-12       # the last engine: reference
     np.testing.assert_allclose(scope["po"].multipliers, want["multipliers"], atol=1e-9)
     assert np.array_equal(np.asarray(scope["relay_sym"].jacobians["plus"], dtype=float),
                           relay.A)
-    assert out.count("compiled 3.67975067086") == 2 and out.count("python 3.67975067086") == 2
+    assert out.count("compiled 3.67975067086") == 2 and out.count("reference 3.67975067086") == 2

@@ -105,14 +105,14 @@ def test_both_engines_give_brent_the_same_iteration_bound():
 
 
 # ------------------------------------------------------------------ bookkeeping
-@pytest.mark.parametrize("engine", ["compiled", "python"])
+@pytest.mark.parametrize("engine", ["compiled", "reference"])
 def test_a_start_that_slides_counts_its_first_slide_on_both_engines(engine):
     # f_- = (1, 1), f_+ = (1, x1), h = x2: from (-1, 0) on H (a = 1, b = -1) the orbit
     # slides to x1 = 0 (t = 1), leaves into region +, and meets x1 = 1 at t = 2
     system = FilippovSystem(("x1", "x2"), lambda z, p: np.array([1.0, 1.0]),
                             lambda z, p: np.array([1.0, z[0]]), switch=lambda z, p: z[1],
                             switch_grad=lambda z, p: np.array([0.0, 1.0]))
-    if engine == "python":
+    if engine == "reference":
         out = first_returns(system.python(), [[-1.0, 0.0]],
                             Section("s", lambda z: z[0] - 1.0, 1), 5.0, method="integrate")
     else:

@@ -1,23 +1,22 @@
 """Known answers on both engines through the public API: one definition of each system
-(filippov.FilippovSystem), the reference driver (first_returns) and the compiled engine
-(first_returns_compiled) asked for the same first return, each checked against the
-closed form -- not only against each other."""
+(filippov.FilippovSystem), asked through the one front door (first_returns(engine=...))
+for the same first return on the reference driver and on the compiled engine, each
+checked against the closed form -- not only against each other."""
 import numpy as np
 import pytest
 
-from filippov import FilippovSystem, Section, first_returns, first_returns_compiled
+from filippov import FilippovSystem, first_returns
 
-ENGINES = ("python", "compiled")
+ENGINES = ("reference", "compiled")
 
 
 def _returns(system, engine, start, section, direction, t_max, method="exact", **options):
     """``method``: the reference driver's; the compiled engine integrates a system
     without exact flows and uses the flows of one that has them, by construction."""
-    if engine == "python":
-        sec = Section("s", lambda z: section(z, None), direction=direction)
-        return first_returns(system.python(), [start], sec, t_max, method=method, **options)
-    return first_returns_compiled(system.compiled(section, direction=direction), [start], t_max,
-                                  **options)
+    if engine == "reference":
+        options["method"] = method
+    return first_returns(system, [start], section, t_max, engine=engine, direction=direction,
+                         **options)
 
 
 def _planar(field_minus, field_plus, **kw):
@@ -91,7 +90,7 @@ def test_a_shallow_crossing_is_followed_past_the_rounding_of_h(engine):
     clean = np.array([[0.0, 1.0000380794232673, 0.0]])
     out = []
     for z in (noisy, clean):
-        if engine == "python":
+        if engine == "reference":
             r = returns(hopf.model(eps, theta, mu).full(), z, section_L1(), 1.0)
         else:
             r = compute_returns(hopf.compiled(eps, theta, mu), z, 1.0)
@@ -113,7 +112,7 @@ def _run(system, engine, start, t_max, **options):
     from filippov.poincare import sliding_time
 
     never = lambda z, p: z[0] - 1e6  # noqa: E731 -- a section no orbit here reaches
-    if engine == "python":
+    if engine == "reference":
         traj = simulate(system.python(), start, t_max, dense=False, **options)
         sw = traj.switches()
         return (sw[0].t if sw else np.nan), len(sw), sliding_time(traj.events), traj.z

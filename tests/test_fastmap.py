@@ -95,8 +95,8 @@ def test_compiled_hopf_pieces_are_the_model_formulas():
         np.testing.assert_allclose(out, system.field_plus(z), rtol=1e-15, atol=1e-13)
         cm.field_minus(z, cm.params, out)
         np.testing.assert_allclose(out, system.field_minus(z), rtol=1e-15, atol=1e-13)
-        assert cm.h(z, cm.params) == pytest.approx(float(system.switch(z)), abs=1e-15)
-        cm.grad_h(z, cm.params, out)
+        assert cm.switch(z, cm.params) == pytest.approx(float(system.switch(z)), abs=1e-15)
+        cm.switch_grad(z, cm.params, out)
         np.testing.assert_array_equal(out, system.switch_grad(z))
 
 
@@ -159,8 +159,8 @@ def test_compiled_dry_friction_pieces_are_the_model_formulas():
             np.testing.assert_allclose(out, system.field_plus(z), rtol=1e-14, atol=1e-13)
             cm.field_minus(z, cm.params, out)
             np.testing.assert_allclose(out, system.field_minus(z), rtol=1e-14, atol=1e-13)
-            assert cm.h(z, cm.params) == float(system.switch(z))
-            cm.grad_h(z, cm.params, out)
+            assert cm.switch(z, cm.params) == float(system.switch(z))
+            cm.switch_grad(z, cm.params, out)
             np.testing.assert_array_equal(out, system.switch_grad(z))
 
 

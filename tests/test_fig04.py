@@ -115,8 +115,8 @@ def test_engine_is_checked_per_scene():
     scene = {"id": "fig04_retmaps", "ingredients": {"flow": "integrate"},
              "solver": {"engine": "compiled"}}
     assert engine(scene) == "compiled"   # fig04 runs both flows on both engines
-    assert filippov_paper.scenes._module(scene).ENGINES == ("python", "compiled")
-    assert engine({"id": "x", "ingredients": {"flow": "exact"}}) == "python"
+    assert filippov_paper.scenes._module(scene).ENGINES == ("reference", "compiled")
+    assert engine({"id": "x", "ingredients": {"flow": "exact"}}) == "reference"
     # a scene without a compiled engine says so, naming the field
     other = {"id": "fig08_s0theta", "ingredients": {"flow": "exact"},
              "solver": {"engine": "compiled"}}

@@ -167,7 +167,7 @@ def _run(engine, flows, c, L):
 
 
 @pytest.mark.parametrize("flows", ["exact", "integrate"])
-@pytest.mark.parametrize("engine", ["compiled", "python"])
+@pytest.mark.parametrize("engine", ["compiled", "reference"])
 @pytest.mark.parametrize("c, L", CASES)
 def test_a_return_across_h_soon_after_a_fold_exit_is_found(engine, flows, c, L):
     want = _case(c, L)[2]
@@ -187,7 +187,7 @@ def test_a_return_across_h_soon_after_a_fold_exit_is_found(engine, flows, c, L):
     np.testing.assert_allclose(P, want["P"], atol=1e-9)
 
 
-@pytest.mark.parametrize("engine", ["compiled", "python"])
+@pytest.mark.parametrize("engine", ["compiled", "reference"])
 def test_the_return_in_the_exits_first_window_is_located_at_h_zero(engine):
     """The return 0.015 after the exit lies in the stay's first window, where the exit's
     band is still in force (the compiled engine: in the first sample interval, from the

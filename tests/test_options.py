@@ -35,7 +35,7 @@ def _python(**opts):
     return simulate(system, [0.0, 1.0, 0.0], 0.1, **opts)
 
 
-@pytest.mark.parametrize("engine", [_compiled, _python], ids=["compiled", "python"])
+@pytest.mark.parametrize("engine", [_compiled, _python], ids=["compiled", "reference"])
 @pytest.mark.parametrize("name,value,words", BAD)
 def test_both_engines_refuse_the_same_option_with_its_name(engine, name, value, words):
     with pytest.raises(ValueError) as exc:
@@ -48,6 +48,6 @@ def test_an_unknown_option_is_no_silent_default():
         options.check(rtoll=1e-9)
 
 
-@pytest.mark.parametrize("engine", [_compiled, _python], ids=["compiled", "python"])
+@pytest.mark.parametrize("engine", [_compiled, _python], ids=["compiled", "reference"])
 def test_the_smallest_allowed_values_pass(engine):
     engine(zeno_count=2, touch_tol=0.0, zeno_span=0.0, max_events=1_000, samples_per_step=1)

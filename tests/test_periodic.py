@@ -11,7 +11,7 @@ from filippov import FilippovSystem, PeriodicOrbitError, periodic_orbit
 from filippov.periodic import floquet_from_return
 
 ROOT = Path(__file__).resolve().parents[1]
-ENGINES = ("compiled", "python")
+ENGINES = ("compiled", "reference")
 
 
 def _example(name):

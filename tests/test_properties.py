@@ -31,7 +31,7 @@ import generated_systems as gs
 from filippov import return_jacobian, simulate
 from filippov.poincare import sliding_time
 
-ENGINES = ("compiled", "python")
+ENGINES = ("compiled", "reference")
 FLOWS = ("exact", "integrate")
 
 # Tolerances (absolute, on O(1) states and times: the generators keep |z| <~ 3, t <~ 16).

@@ -217,7 +217,7 @@ def test_compiled_min_time():
 def _on_h(theta, direction):
     """The compiled Hopf model with its section moved onto the switching surface."""
     cm = hopf.compiled(EPS, theta, MU, OMEGA)
-    return dataclasses.replace(cm, section=cm.h, section_direction=direction)
+    return dataclasses.replace(cm, section=cm.switch, section_direction=direction)
 
 
 X2 = np.array([1.005, 1.01, 1.0125, 1.0175, 1.02])

@@ -159,7 +159,7 @@ SHORT = [(40.0, 40.0 * 0.01 ** 2 / 8), (40.0, 40.0 * 1e-3 ** 2 / 8)]
 
 
 @pytest.mark.parametrize("flows", ["exact", "integrate"])
-@pytest.mark.parametrize("engine", ["compiled", "python"])
+@pytest.mark.parametrize("engine", ["compiled", "reference"])
 @pytest.mark.parametrize("c, m", SHORT)
 def test_a_short_exit_window_inside_one_step_ends_the_slide(engine, flows, c, m):
     want = _case(c, m)[2]
@@ -180,7 +180,7 @@ WIDE = [(2.0, 2.0 * 0.5 ** 2 / 8), (1.5, 1.5 * 1.0 ** 2 / 8)]
 
 
 @pytest.mark.parametrize("flows", ["exact", "integrate"])
-@pytest.mark.parametrize("engine", ["compiled", "python"])
+@pytest.mark.parametrize("engine", ["compiled", "reference"])
 @pytest.mark.parametrize("c, m", WIDE)
 def test_an_exit_seen_at_the_samples_is_unchanged(engine, flows, c, m):
     want = _case(c, m)[2]
@@ -194,7 +194,7 @@ def test_an_exit_seen_at_the_samples_is_unchanged(engine, flows, c, m):
 
 
 @pytest.mark.parametrize("flows", ["exact", "integrate"])
-@pytest.mark.parametrize("engine", ["compiled", "python"])
+@pytest.mark.parametrize("engine", ["compiled", "reference"])
 @pytest.mark.parametrize("m", [-0.05, -1e-4])
 def test_a_slide_whose_b_peaks_below_zero_goes_on(engine, flows, m):
     """b has its maximum m < 0 between two samples (the hidden-extremum check refines it
@@ -211,7 +211,7 @@ def test_a_slide_whose_b_peaks_below_zero_goes_on(engine, flows, m):
 
 
 @pytest.mark.parametrize("flows", ["exact", "integrate"])
-@pytest.mark.parametrize("engine", ["compiled", "python"])
+@pytest.mark.parametrize("engine", ["compiled", "reference"])
 def test_b_touching_zero_between_samples_is_a_touch(engine, flows):
     """m = 0: F_+ turns tangent to H at t* and back (b's maximum is 0 up to rounding):
     the orbit would leave H by nothing (rules.speed_graze: the excursion is far within
@@ -242,7 +242,7 @@ def test_the_fold_exit_cases_at_the_default_samples(monkeypatch):
         sys.path.insert(0, here)
     fold = importlib.import_module("test_fold_exit")
     monkeypatch.setattr(fold, "SAMPLES", 4)
-    for engine in ("compiled", "python"):
+    for engine in ("compiled", "reference"):
         for flows in ("exact", "integrate"):
             for c, L in fold.CASES:
                 fold.test_a_return_across_h_soon_after_a_fold_exit_is_found(engine, flows, c, L)

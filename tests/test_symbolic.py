@@ -63,7 +63,7 @@ def test_generated_derivatives_of_the_relay():
         system.jacobian(SLIDING, z)
 
 
-@pytest.mark.parametrize("engine", ["python", "compiled"])
+@pytest.mark.parametrize("engine", ["reference", "compiled"])
 def test_relay_periodic_orbit_from_the_symbolic_definition(engine):
     want = _relay_example().closed_form()
     orbit = periodic_orbit(relay().system(), [0.0, 0.5, -0.2], lambda z, p: z[0],

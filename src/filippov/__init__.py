@@ -37,12 +37,17 @@ def __getattr__(name):
     raise AttributeError(f"module 'filippov' has no attribute {name!r}")
 
 
+# the public system types: PiecewiseSystem (the reference engine's own), FilippovSystem
+# (one numeric definition for both engines) and its symbolic front-ends. SlowFastModel
+# (filippov.model) and CompiledModel (filippov.abi) are what a symbolic slow-fast model
+# and FilippovSystem.compiled() build for an engine: still importable, not exported.
 __all__ = [
-    "PiecewiseSystem", "SlowFastModel", "simulate", "Section",
+    "PiecewiseSystem", "simulate", "Section",
     "SimulationError", "ZenoError", "EventLimitError", "SystemContractError",
     "first_returns", "fixed_points", "monodromy", "floquet_multipliers", "ContinuationError",
     "transition_matrix", "return_jacobian", "VariationalError",
     "periodic_orbit", "PeriodicOrbit", "PeriodicOrbitError",
-    "FilippovSystem", "SymbolicSystem", "SymbolicSlowFast", "compile_system", "with_section", "CompiledModel", "compute_returns",
-    "sweep_returns", "first_returns_compiled", "MINUS", "PLUS", "SLIDING", "__version__",
+    "FilippovSystem", "SymbolicSystem", "SymbolicSlowFast", "compile_system", "with_section",
+    "compute_returns", "sweep_returns",
+    "first_returns_compiled", "MINUS", "PLUS", "SLIDING", "__version__",
 ]

@@ -13,12 +13,14 @@ from typing import Any, Mapping
 import numpy as np
 from numba import njit, types
 
+from .spelling import one_spelling
+
 _vec = types.float64[::1]
 #: ``flow(z0, tau, params, out)``: the exact flow of a region from ``z0`` over ``tau``.
 FLOW_SIG = types.void(_vec, types.float64, _vec, _vec)
 #: ``field(z, params, out)`` (also ``grad_h``).
 FIELD_SIG = types.void(_vec, _vec, _vec)
-#: ``h(z, params)`` and ``section(z, params)``.
+#: ``switch(z, params)`` and ``section(z, params)``.
 SCALAR_SIG = types.float64(_vec, _vec)
 #: ``where(z, params)``: the condition a section hit must satisfy.
 WHERE_SIG = types.boolean(_vec, _vec)
@@ -30,7 +32,7 @@ JAC_SIG = types.void(types.int64, _vec, _vec, _vec)
 #: the pieces of a :class:`CompiledModel` with their signatures, in the order the
 #: compiled engine takes them (its kernel's arguments, and the index it calls each by)
 PIECES = (("flow_plus", FLOW_SIG), ("flow_minus", FLOW_SIG), ("field_plus", FIELD_SIG),
-          ("field_minus", FIELD_SIG), ("h", SCALAR_SIG), ("grad_h", FIELD_SIG),
+          ("field_minus", FIELD_SIG), ("switch", SCALAR_SIG), ("switch_grad", FIELD_SIG),
           ("section", SCALAR_SIG), ("section_where", WHERE_SIG), ("jacobian", JAC_SIG))
 
 
@@ -55,15 +57,16 @@ def always(z, p):
     return True
 
 
+@one_spelling
 @dataclass(frozen=True)
 class CompiledModel:
-    """A piecewise system (region + is ``h >= 0``) and a section, as numba-compiled
+    """A piecewise system (region + is ``switch >= 0``) and a section, as numba-compiled
     functions with the module's signatures; with exact flows in both regions
     (``exact=True``), or integrated there with DOP853 like sliding (``exact=False``,
     the flows are then :func:`no_flow`).
 
     ``flow_plus``/``flow_minus``: :data:`FLOW_SIG`; ``field_plus``/``field_minus``/
-    ``grad_h``: :data:`FIELD_SIG`; ``h``/``section``: :data:`SCALAR_SIG`;
+    ``switch_grad``: :data:`FIELD_SIG`; ``switch``/``section``: :data:`SCALAR_SIG`;
     ``section_where``: :data:`WHERE_SIG`. Every piece receives ``params``.
     ``section_direction`` -1 counts decreasing crossings of ``section(z) = 0``,
     +1 increasing, 0 both. ``sample_step`` is the longest time between samples
@@ -80,8 +83,8 @@ class CompiledModel:
     flow_minus: Any
     field_plus: Any
     field_minus: Any
-    h: Any
-    grad_h: Any
+    switch: Any
+    switch_grad: Any
     section: Any
     section_where: Any
     section_direction: int

@@ -269,10 +269,10 @@ def check_compiled(cmodel, z0: np.ndarray) -> None:
     p = cmodel.params
     g = np.full(z0.size, np.nan)
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-        cmodel.grad_h(z0, p, g)
+        cmodel.switch_grad(z0, p, g)
 
         def switch_at(Z):
-            return np.array([cmodel.h(np.ascontiguousarray(Z[:, j]), p)
+            return np.array([cmodel.switch(np.ascontiguousarray(Z[:, j]), p)
                              for j in range(Z.shape[1])])
 
         gradient_check(switch_at, g, z0)  # the user's names (compile_system's arguments)

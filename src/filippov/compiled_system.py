@@ -19,6 +19,7 @@ from numba import njit
 from numba.core.errors import NumbaError
 
 from .checks import SystemContractError
+from .spelling import one_spelling
 from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, always, no_flow
 
 _DOC_PIECE = ("write it for one state z (1-D float array) and the parameter array p, "
@@ -108,8 +109,8 @@ def _check_shapes(cm: CompiledModel, probe: np.ndarray) -> None:
             return out
         return value
 
-    pieces = {_USER_NAME[k]: vector(getattr(cm, k)) for k in ("field_minus", "field_plus", "grad_h")}
-    pieces.update({_USER_NAME[k]: (lambda z, fn=getattr(cm, k): fn(z, p)) for k in ("h", "section")})
+    pieces = {k: vector(getattr(cm, k)) for k in ("field_minus", "field_plus", "switch_grad")}
+    pieces.update({k: (lambda z, fn=getattr(cm, k): fn(z, p)) for k in ("switch", "section")})
     _probe(pieces, cm.names, probe)
 
 
@@ -159,10 +160,9 @@ def _probe_state(probe, n: int) -> np.ndarray:
 
 
 _SCALARS = ("switch", "section")
-_USER_NAME = {"field_minus": "field_minus", "field_plus": "field_plus", "grad_h": "switch_grad",
-              "h": "switch", "section": "section"}
 
 
+@one_spelling
 def compile_system(names, field_minus, field_plus, switch, switch_grad, *, section,
                    section_direction: int = 0, section_where: Optional[Callable] = None,
                    params=(), flow_minus: Optional[Callable] = None,
@@ -177,9 +177,9 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
     field_minus, field_plus : callable
         ``f(z, p) -> array (n,)``: the fields of the regions ``switch < 0`` and ``>= 0``.
     switch : callable
-        ``h(z, p) -> float``, the switching function.
+        ``switch(z, p) -> float``, the switching function.
     switch_grad : callable
-        ``grad_h(z, p) -> array (n,)``.
+        ``switch_grad(z, p) -> array (n,)``, its gradient.
     section : callable
         ``s(z, p) -> float``: returns are hits of ``s = 0``.
     section_direction : int
@@ -228,7 +228,8 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
         flow_minus=_flow_piece(flow_minus, "flow_minus", n) if exact else no_flow,
         field_plus=_vector_piece(field_plus, "field_plus", n),
         field_minus=_vector_piece(field_minus, "field_minus", n),
-        h=_scalar_piece(switch, "switch"), grad_h=_vector_piece(switch_grad, "switch_grad", n),
+        switch=_scalar_piece(switch, "switch"),
+        switch_grad=_vector_piece(switch_grad, "switch_grad", n),
         section=_scalar_piece(section, "section"),
         section_where=_where_piece(section_where, "section_where"),
         section_direction=int(section_direction), sample_step=float(sample_step),
@@ -308,6 +309,7 @@ def _states(z, n):
 _JAC_MODES = ("minus", "sliding", "plus")   # filippov.system.MODE_NAMES
 
 
+@one_spelling
 class FilippovSystem:
     """One definition of a Filippov system, run by both engines.
 

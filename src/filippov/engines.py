@@ -1,4 +1,19 @@
-"""What differs between the engines, and why.
+"""Which engine runs what, and what differs between the engines, and why.
+
+**The choice.** The front doors :func:`filippov.simulate`, :func:`filippov.first_returns`
+and :func:`filippov.periodic_orbit` take a system and ``engine=``: ``"reference"`` (the
+Python driver, :mod:`filippov.simulate`) or ``"compiled"`` (numba: :mod:`filippov.fastmap`,
+:mod:`filippov.kernel`). This module is the one place that maps them to what runs:
+:data:`RUNS` (capability x engine -> function, or None with its reason in :data:`LACKS`:
+the compiled engine has no trajectory output), :func:`runner`, and the system each engine
+runs -- :func:`reference_system` (a PiecewiseSystem, or the ``python()`` view of a
+system defined once) and :func:`compiled_model` (a CompiledModel, or the ``compiled()``
+view with the caller's section). A PiecewiseSystem asked for the compiled engine, a
+CompiledModel for the reference one, or an unknown engine is an error naming the field.
+Each front door keeps its default engine (simulate and first_returns: reference;
+periodic_orbit: compiled).
+
+**The differences.**
 
 The reference driver (:mod:`filippov.simulate`) and the compiled engine
 (:mod:`filippov.fastmap`, :mod:`filippov.kernel`) take every decision from one rule book
@@ -95,3 +110,112 @@ engine that moves one of these makes its test fail.
     classes for the first failure. Deliberate (one failing start must not lose a batch).
     Test: tests/test_errors.py::test_the_compiled_engine_s_failures_are_the_reference_driver_s_classes
 """
+from __future__ import annotations
+
+import importlib
+import sys
+
+#: the engines, by the name the front doors' ``engine=`` takes
+REFERENCE, COMPILED = "reference", "compiled"
+ENGINES = (REFERENCE, COMPILED)
+
+#: what runs each front door on each engine: ``"module:function"`` of this package, or
+#: None where the engine lacks that output (the reason is in :data:`LACKS`)
+RUNS = {
+    "simulate": {REFERENCE: "simulate:_simulate", COMPILED: None},
+    "first_returns": {REFERENCE: "poincare:_first_returns", COMPILED: "fastmap:_first_returns"},
+    "periodic_orbit": {REFERENCE: "periodic:_reference_return",
+                       COMPILED: "periodic:_compiled_return"},
+}
+
+LACKS = {
+    ("simulate", COMPILED): (
+        "the compiled engine has no trajectory output: it computes returns to a section "
+        "(state, time, switches, sliding time), not the events, samples and dense output "
+        "of a Trajectory; use engine='reference' for a trajectory, or "
+        "first_returns(..., engine='compiled') for returns"),
+}
+
+_HOW_TO_COMPILE = (
+    "build a filippov.FilippovSystem from plain functions of (z, p) (or a "
+    "filippov.SymbolicSystem from SymPy expressions), which runs on both engines")
+
+
+def checked(engine) -> str:
+    """``engine`` if it names an engine, else a ValueError naming ``engine``."""
+    if not (isinstance(engine, str) and engine in ENGINES):
+        raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
+    return engine
+
+
+def runner(capability: str, engine):
+    """The function that runs ``capability`` (a key of :data:`RUNS`) on ``engine``: the
+    one place where the engine is chosen."""
+    target = RUNS[capability][checked(engine)]
+    if target is None:
+        raise ValueError(f"engine={engine!r}: {capability} is not available on this "
+                         f"engine: {LACKS[capability, engine]}")
+    module, name = target.split(":")
+    return getattr(importlib.import_module(f".{module}", __package__), name)
+
+
+def _is_compiled_model(system) -> bool:
+    abi = sys.modules.get(f"{__package__}.abi")  # no CompiledModel without it imported
+    return abi is not None and isinstance(system, abi.CompiledModel)
+
+
+def reference_system(system, capability: str):
+    """The :class:`~filippov.system.PiecewiseSystem` the reference driver runs for
+    ``system``: itself, or the ``python()`` view of a system defined once
+    (:class:`~filippov.FilippovSystem`, :class:`~filippov.SymbolicSystem`)."""
+    from .system import PiecewiseSystem
+
+    if isinstance(system, PiecewiseSystem):
+        return system
+    if _is_compiled_model(system):
+        raise TypeError(f"system: {capability}(engine='reference') cannot run a "
+                        "CompiledModel (numba pieces for the compiled engine only); "
+                        f"use engine='compiled', or {_HOW_TO_COMPILE}")
+    view = getattr(system, "python", None)
+    if callable(view):
+        return view()
+    raise TypeError(f"system: {capability} expected a PiecewiseSystem, a FilippovSystem "
+                    f"or a SymbolicSystem, got {type(system).__name__}")
+
+
+def compiled_model(system, capability: str, section=None, *, direction: int = 0,
+                   where=None):
+    """The :class:`~filippov.abi.CompiledModel` the compiled engine runs for ``system``
+    with the section ``section(z, p) = 0`` (None: a CompiledModel's own section)."""
+    from .system import PiecewiseSystem
+
+    if isinstance(system, PiecewiseSystem):
+        raise TypeError(f"system: {capability}(engine='compiled') cannot run a "
+                        "PiecewiseSystem (Python functions the compiled kernel cannot "
+                        f"call); {_HOW_TO_COMPILE}, or use engine='reference'")
+    if _is_compiled_model(system):
+        if section is None:
+            return system
+        from .compiled_system import with_section
+
+        return with_section(system, _section_function(section, capability),
+                            direction=direction, where=where)
+    build = getattr(system, "compiled", None)
+    if not callable(build):
+        raise TypeError(f"system: {capability}(engine='compiled') expected a "
+                        f"FilippovSystem, a SymbolicSystem or a CompiledModel, got "
+                        f"{type(system).__name__}")
+    if section is None:
+        raise TypeError(f"section: {capability}(engine='compiled') of a "
+                        f"{type(system).__name__} needs a section s(z, p) -> float")
+    return build(_section_function(section, capability), direction=direction, where=where)
+
+
+def _section_function(section, capability: str):
+    from .simulate import Section
+
+    if isinstance(section, Section):
+        raise TypeError(f"section: {capability}(engine='compiled') takes the section as "
+                        f"a function s(z, p) -> float (compiled with the system's "
+                        f"pieces), not a Section of the reference driver")
+    return section

@@ -37,7 +37,7 @@ Failures never raise inside the compiled code and never hang: each start point
 gets a status code (:data:`STATUS`) -- event or step bound hit, accumulation of
 switches (Zeno), non-finite state, an exact flow that does not follow its field
 (``rules.flow_consistent``, as the reference driver), no return within ``t_max``,
-...; the wrapper :func:`first_returns_compiled` turns a failure into the same
+...; the front door :func:`filippov.first_returns` (``engine="compiled"``) turns a failure into the same
 exception types as the reference driver.
 
 The kernel itself lives in :mod:`filippov.kernel`, split along its seams (shared
@@ -65,7 +65,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import options, rules
+from . import engines, options, rules
 # what a model hands the engine (its pieces' signatures, CompiledModel), re-exported here
 from .abi import (FIELD_SIG, FLOW_SIG, PIECES, SCALAR_SIG, WHERE_SIG,  # noqa: F401
                   CompiledModel, no_flow, no_jacobian)
@@ -363,9 +363,9 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
 
 #: what the models of one sweep must share (all but their parameter values): the pieces
 #: (the same compiled functions), the section's direction and the settings they set
-SWEEP_SHARED = ("names", "flow_plus", "flow_minus", "field_plus", "field_minus", "h", "grad_h",
-                "section", "section_where", "jacobian", "section_direction", "sample_step",
-                "sliding", "exact", "slow_sample_step", "transient_time")
+SWEEP_SHARED = ("names", "flow_plus", "flow_minus", "field_plus", "field_minus", "switch",
+                "switch_grad", "section", "section_where", "jacobian", "section_direction",
+                "sample_step", "sliding", "exact", "slow_sample_step", "transient_time")
 
 
 def _same(a, b) -> bool:
@@ -473,7 +473,7 @@ class _Pieces:
         return self._vector(self.cm.field_plus, z)
 
     def switch_grad(self, z):
-        return self._vector(self.cm.grad_h, z)
+        return self._vector(self.cm.switch_grad, z)
 
 
 def failure(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:
@@ -527,15 +527,26 @@ _ERRORS = {EVENT_LIMIT: EventLimitError, STEP_LIMIT: EventLimitError, ZENO: Zeno
 
 def first_returns_compiled(cmodel: CompiledModel, starts, t_max: float, *,
                            progress: Progress | None = None, **options) -> Returns:
-    """:func:`filippov.poincare.first_returns` on the compiled path.
+    """Replaced by the front door ``first_returns(cmodel, starts, None, t_max,
+    engine="compiled")`` (:func:`filippov.first_returns`); kept for its callers."""
+    from .poincare import first_returns
 
-    ``options`` go to :func:`compute_returns`; ``progress`` is stepped once by
-    the number of start points, after the batch. A start point that does not return
-    is an error naming it (the first one, with its status), raised as the
-    reference driver would: :class:`EventLimitError` for the event and step
-    bounds, :class:`ZenoError`, :class:`SimulationError` for a numerical
-    failure, RuntimeError for no return within ``t_max``.
+    return first_returns(cmodel, starts, None, t_max, engine="compiled", progress=progress,
+                         **options)
+
+
+def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
+                   where=None, progress: Progress | None = None, **options) -> Returns:
+    """:func:`filippov.first_returns` on the compiled engine: one batch call of
+    :func:`compute_returns`; ``progress`` is stepped once by the number of start points,
+    after the batch. A start point that does not return is an error naming it (the
+    first one, with its status), raised as the reference driver would:
+    :class:`EventLimitError` for the event and step bounds, :class:`ZenoError`,
+    :class:`SimulationError` for a numerical failure, RuntimeError for no return within
+    ``t_max``.
     """
+    cmodel = engines.compiled_model(system, "first_returns", section, direction=direction,
+                                    where=where)
     out = compute_returns(cmodel, starts, t_max, **options)
     if progress is not None:
         progress.step(out.status.size)

@@ -19,6 +19,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from .spelling import one_spelling
 from .system import PiecewiseSystem
 
 Fn = Callable[..., np.ndarray]
@@ -29,11 +30,13 @@ Fn = Callable[..., np.ndarray]
 TRANSIENT = 40.0
 
 
+@one_spelling
 @dataclass(frozen=True)
 class SlowFastModel:
     """Components take ``x`` with shape ``(nx, ...)`` and ``y`` with ``(ny, ...)``.
 
-    ``h_grad(x, y)`` returns ``(dh/dx, dh/dy)``; ``y0_jac(x)`` returns
+    ``switch(x, y)`` is the switching function h, ``switch_grad(x, y)`` returns
+    ``(dh/dx, dh/dy)``; ``y0_jac(x)`` returns
     ``dy0/dx`` with shape ``(ny, nx, ...)``. Exact flows are optional, per
     system kind ("full", "reduced") and per mode.
     """
@@ -43,8 +46,8 @@ class SlowFastModel:
     fast_names: tuple[str, ...]
     f_minus: Fn
     f_plus: Fn
-    h: Fn
-    h_grad: Fn
+    switch: Fn
+    switch_grad: Fn
     g_minus: Fn
     g_plus: Fn
     eps: float
@@ -88,11 +91,11 @@ class SlowFastModel:
 
         def H(z):
             x, y = split(z)
-            return self.h(x, y)
+            return self.switch(x, y)
 
         def dH(z):
             x, y = split(z)
-            hx, hy = self.h_grad(x, y)
+            hx, hy = self.switch_grad(x, y)
             return np.concatenate([hx, hy])
 
         flows = dict(self.exact_flows.get("full", {})) if exact else {}
@@ -113,11 +116,11 @@ class SlowFastModel:
             return self.f_plus(x, self.y0(x))
 
         def H(x):
-            return self.h(x, self.y0(x))
+            return self.switch(x, self.y0(x))
 
         def dH(x):
             y = self.y0(x)
-            hx, hy = self.h_grad(x, y)
+            hx, hy = self.switch_grad(x, y)
             # chain rule: dh/dx + (dy0/dx)^T dh/dy
             return hx + np.einsum("j...,ji...->i...", hy, self.y0_jac(x))
 

@@ -15,9 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from . import engines
 from .errors import PeriodicOrbitError  # noqa: F401  (re-exported)
-
-ENGINES = ("compiled", "python")
 
 
 @dataclass(frozen=True)
@@ -32,41 +31,54 @@ class PeriodicOrbit:
     residual: float            # max |P(z) - z| at the point
 
 
+def _compiled_return(system, section, direction: int, where, t_max: float, options: dict):
+    """(z, age -> (P(z), its time, dP/dz, age at the return), z -> section value) on the
+    compiled engine, dP/dz carried along the return; the time spent in the region is
+    carried across a hit, as an iterated run does."""
+    from .fastmap import OK, compute_returns, failure
+
+    cm = engines.compiled_model(system, "periodic_orbit", section, direction=direction,
+                                where=where)
+
+    def single(z, age):
+        out = compute_returns(cm, [z], t_max, jacobian=True, start_age=age, **options)
+        if out.status[0] != OK:
+            raise PeriodicOrbitError(f"no return from {np.asarray(z).tolist()}: "
+                                     f"{failure(cm, out, 0)}")
+        return out.state[0], float(out.time[0]), out.jacobian[0], float(out.age[0])
+    value = lambda z: float(cm.section(np.ascontiguousarray(z, dtype=float), cm.params))  # noqa: E731
+    return single, value
+
+
+def _reference_return(system, section, direction: int, where, t_max: float, options: dict):
+    """As :func:`_compiled_return` on the reference driver, dP/dz from the variational
+    equations afterwards (each return starts afresh: age 0)."""
+    from .simulate import simulate
+    from .variational import return_jacobian
+
+    python = engines.reference_system(system, "periodic_orbit")
+    sec = system.python_section(section, direction=direction, where=where)
+    # exact field Jacobians where the system has them (filippov.symbolic), else differences
+    jac = system.jacobian if getattr(system, "has_jacobians", False) else None
+
+    def single(z, age):
+        traj = simulate(python, z, t_max, sections=[sec], dense=False, **options)
+        if traj.status != f"section:{sec.name}":
+            raise PeriodicOrbitError(f"no return from {np.asarray(z).tolist()} within "
+                                     f"t_max={t_max!r} (status {traj.status})")
+        J = return_jacobian(python, traj, sec, jacobian=jac)
+        return np.asarray(traj.z, dtype=float), float(traj.t - traj.t0), J, 0.0
+    value = lambda z: float(np.asarray(sec.func(z)).reshape(()))  # noqa: E731
+    return single, value
+
+
 def _returns(system, section, direction: int, where, engine: str, t_max: float, returns: int,
              options: dict):
-    """(z -> (P^returns(z), its time, its dP/dz), z -> section value) on the chosen engine:
-    ``returns`` single returns, each from the last one's state (the compiled engine
-    carries the time spent in the region across a hit, as an iterated run does), their
-    derivatives multiplied."""
-    if engine == "compiled":
-        from .fastmap import OK, compute_returns, failure
-
-        cm = system.compiled(section, direction=direction, where=where)
-
-        def single(z, age):
-            out = compute_returns(cm, [z], t_max, jacobian=True, start_age=age, **options)
-            if out.status[0] != OK:
-                raise PeriodicOrbitError(f"no return from {np.asarray(z).tolist()}: "
-                                         f"{failure(cm, out, 0)}")
-            return out.state[0], float(out.time[0]), out.jacobian[0], float(out.age[0])
-        value = lambda z: float(cm.section(np.ascontiguousarray(z, dtype=float), cm.params))  # noqa: E731
-    else:
-        from .simulate import simulate
-        from .variational import return_jacobian
-
-        python = system.python()
-        sec = system.python_section(section, direction=direction, where=where)
-        # exact field Jacobians where the system has them (filippov.symbolic), else differences
-        jac = system.jacobian if getattr(system, "has_jacobians", False) else None
-
-        def single(z, age):
-            traj = simulate(python, z, t_max, sections=[sec], dense=False, **options)
-            if traj.status != f"section:{sec.name}":
-                raise PeriodicOrbitError(f"no return from {np.asarray(z).tolist()} within "
-                                         f"t_max={t_max!r} (status {traj.status})")
-            J = return_jacobian(python, traj, sec, jacobian=jac)
-            return np.asarray(traj.z, dtype=float), float(traj.t - traj.t0), J, 0.0
-        value = lambda z: float(np.asarray(sec.func(z)).reshape(()))  # noqa: E731
+    """(z -> (P^returns(z), its time, its dP/dz), z -> section value) on the chosen engine
+    (:func:`filippov.engines.runner`): ``returns`` single returns, each from the last
+    one's state, their derivatives multiplied."""
+    single, value = engines.runner("periodic_orbit", engine)(system, section, direction,
+                                                              where, t_max, options)
 
     def one(z):
         total, D, age = 0.0, np.eye(z.size), 0.0
@@ -199,7 +211,9 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
     Parameters
     ----------
     system : FilippovSystem
-        The system, defined once (:class:`filippov.FilippovSystem`).
+        The system, defined once (:class:`filippov.FilippovSystem` or
+        :class:`filippov.SymbolicSystem`): both engines' views and the field at the
+        fixed point.
     guess : array (n,)
         A start near the orbit (on the section or not).
     section : callable
@@ -212,9 +226,10 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
     returns : int
         n: the orbit's period is n returns to the section (its point is a fixed point
         of P^n; ``period`` is the time of all n, ``jacobian`` d(P^n)/dz).
-    engine : {"compiled", "python"}
+    engine : {"compiled", "reference"}
         The compiled engine (numba, dP/dz carried along the return) or the reference
-        driver (dP/dz from the variational equations afterwards).
+        driver (dP/dz from the variational equations afterwards); chosen by
+        :func:`filippov.engines.runner`.
     t_max : float
         Longest time a return may take.
     tol : float
@@ -237,8 +252,11 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
         return is the start itself (a path shorter than ``SHORTEST_PATH`` of the state's
         size: the start a hair before the section by rounding).
     """
-    if engine not in ENGINES:
-        raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
+    engines.checked(engine)
+    if not callable(getattr(system, "python_section", None)):
+        raise TypeError(f"system: periodic_orbit expected a FilippovSystem or a "
+                        f"SymbolicSystem (a system defined once: both engines' views), "
+                        f"got {type(system).__name__}")
     z = np.array(guess, dtype=float).reshape(-1)
     if z.size != len(system.names) or not np.all(np.isfinite(z)):
         raise ValueError(f"guess: expected {len(system.names)} finite values "
@@ -251,7 +269,7 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
         Pz, period, J = ret(z)
         residual = float(np.abs(Pz - z).max())
         if residual <= tol * (1.0 + np.abs(z).max()):
-            f = _field_at(system.python(), z, options.get("touch_tol", 1e-15))
+            f = _field_at(engines.reference_system(system, "periodic_orbit"), z, options.get("touch_tol", 1e-15))
             _refuse_the_start_itself(z, period, f)
             mult = floquet_from_return(J, f, normal=_section_normal(section_value, z))
             return PeriodicOrbit(z, period, mult, J, it - 1, residual)

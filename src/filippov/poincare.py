@@ -12,9 +12,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import engines
 from .progress import Progress
 from .simulate import Section, simulate
-from .system import PiecewiseSystem, SLIDING
+from .system import SLIDING
 
 
 @dataclass(frozen=True)
@@ -28,18 +29,56 @@ class Returns:
     first_switch: np.ndarray  # (m,) time of the first change of mode (NaN: none)
 
 
-def first_returns(system: PiecewiseSystem, starts, section: Section, t_max: float, *,
-                  progress: Progress | None = None, **options) -> Returns:
+def first_returns(system, starts, section, t_max: float, *, engine: str = "reference",
+                  direction: int = 0, where=None, progress: Progress | None = None,
+                  **options) -> Returns:
     """Follow each start point until it first hits ``section`` (within ``t_max``).
 
-    ``options`` go to :func:`simulate`. A start point that does not return within
+    ``system``: a :class:`~filippov.system.PiecewiseSystem` (reference engine), a system
+    defined once (:class:`~filippov.FilippovSystem`, :class:`~filippov.SymbolicSystem`:
+    either engine) or a :class:`~filippov.abi.CompiledModel` (compiled engine).
+    ``section``: a :class:`~filippov.simulate.Section` (reference engine), or a function
+    ``s(z, p) -> float`` of a system defined once, with ``direction`` (-1, 0, +1) and
+    ``where(z, p) -> bool``; None: a CompiledModel's own section.
+    ``engine``: "reference" (:func:`simulate` once per start) or "compiled" (one batch
+    call of :func:`filippov.fastmap.compute_returns`), chosen by
+    :func:`filippov.engines.runner`.
+
+    ``options`` go to the engine. A start point that does not return within
     ``t_max`` is an error naming it: a return map with holes is not a return map.
     A start on the section (up to rounding) returns at its next crossing;
-    ``section.min_time`` skips crossings closer to the start than that.
+    ``min_time`` (a Section's, or an option) skips crossings closer to the start than
+    that. ``progress`` is stepped once per start point.
     """
+    return engines.runner("first_returns", engine)(system, starts, section, t_max,
+                                                   direction=direction, where=where,
+                                                   progress=progress, **options)
+
+
+def _reference_section(system, section, direction: int, where, options: dict) -> Section:
+    """``section`` as the reference driver's terminal Section (a function s(z, p) of a
+    system defined once compiled like its pieces; ``min_time`` taken from ``options``)."""
+    if isinstance(section, Section):
+        if direction != 0 or where is not None:
+            raise ValueError("direction, where: a Section carries its own; give them to "
+                             "the Section")
+        return section if section.terminal == 1 else dataclasses.replace(section, terminal=1)
+    build = getattr(system, "python_section", None)
+    if section is None or not callable(build):
+        raise TypeError(f"section: first_returns(engine='reference') of a "
+                        f"{type(system).__name__} expected a filippov.Section, got "
+                        f"{type(section).__name__}")
+    return build(section, direction=direction, where=where,
+                 min_time=options.pop("min_time", 0.0))
+
+
+def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
+                   where=None, progress: Progress | None = None, **options) -> Returns:
+    """:func:`first_returns` on the reference driver."""
+    python = engines.reference_system(system, "first_returns")
+    section = _reference_section(system, section, direction, where, options)
+    system = python
     starts = np.atleast_2d(np.asarray(starts, dtype=float))
-    if section.terminal != 1:
-        section = dataclasses.replace(section, terminal=1)
     m = starts.shape[0]
     state = np.empty_like(starts)
     time = np.empty(m)

@@ -30,7 +30,7 @@ import numpy as np
 from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
-from . import checks, options, rules, variational
+from . import checks, engines, options, rules, variational
 from .radau_iia import RadauIIA
 from .system import MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
@@ -397,7 +397,7 @@ def slow_window(slow_sample_step, h, max_step, span):
 
 
 @_quiet_floating_point
-def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
+def simulate(system, z0, t_end: float, *, engine: str = "reference", t0: float = 0.0,
              method: str = "exact", rtol: float = 1e-12, atol: float = 1e-14,
              max_step: float = np.inf, sections: Sequence[Section] = (),
              max_events: int = 100_000, max_steps: int = 5_000_000,
@@ -405,6 +405,11 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
              event_xtol: float = 1e-15, zeno_count: int = 64,
              zeno_span: float = 1e-10, stiff: bool = True) -> Trajectory:
     """Integrate ``system`` from ``z0`` at ``t0`` to ``t_end`` (or a terminal section).
+
+    ``system`` is a :class:`~filippov.system.PiecewiseSystem` or a system defined once
+    (:class:`~filippov.FilippovSystem`, :class:`~filippov.SymbolicSystem`: its
+    ``python()`` view). ``engine``: "reference" (this driver; the only engine with a
+    trajectory output -- "compiled" is refused, see :mod:`filippov.engines`).
 
     ``method="exact"`` uses the system's exact flows where it has them (modes
     without one are integrated, listed in ``Trajectory.integrated_modes``);
@@ -418,6 +423,17 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
     tolerance is kept above the field's rounding noise (``NOISE_STEPS``; where that
     lifted it above ``atol``, ``Trajectory.atol_raised`` says by how much).
     """
+    run = engines.runner("simulate", engine)
+    opts = dict(t0=t0, t_end=t_end, method=method, rtol=rtol, atol=atol, max_step=max_step,
+                max_events=max_events, max_steps=max_steps, dense=dense,
+                samples_per_step=samples_per_step, touch_tol=touch_tol, event_xtol=event_xtol,
+                zeno_count=zeno_count, zeno_span=zeno_span, stiff=stiff)
+    return run(engines.reference_system(system, "simulate"), z0, sections, opts)
+
+
+def _simulate(system: PiecewiseSystem, z0, sections: Sequence[Section], opts: dict) -> Trajectory:
+    """The reference driver's run of :func:`simulate` (``opts``: its options by name)."""
+    method, t0, t_end = opts["method"], opts["t0"], opts["t_end"]
     if method not in ("exact", "integrate"):
         raise ValueError(f"method must be 'exact' or 'integrate', got {method!r}")
     z = np.array(z0, dtype=float).reshape(-1)
@@ -428,20 +444,14 @@ def simulate(system: PiecewiseSystem, z0, t_end: float, *, t0: float = 0.0,
         raise ValueError(f"initial state must be finite, got {z.tolist()}")
     if not (np.isfinite(t0) and np.isfinite(t_end) and t_end >= t0):
         raise ValueError(f"need finite t0 <= t_end, got t0={t0!r}, t_end={t_end!r}")
-    options.check(rtol=rtol, atol=atol, max_step=max_step, max_events=max_events,
-                  max_steps=max_steps, samples_per_step=samples_per_step,
-                  touch_tol=touch_tol, event_xtol=event_xtol, zeno_count=zeno_count,
-                  zeno_span=zeno_span, stiff=stiff)
+    options.check(**{k: v for k, v in opts.items() if k not in ("t0", "t_end", "method",
+                                                                   "dense")})
     for k, sec in enumerate(sections):
         if not isinstance(sec, Section):
             raise TypeError(f"sections[{k}]: expected a filippov.simulate.Section, got "
                             f"{type(sec).__name__}")
     checks.check_system(system, z, method=method)  # the pieces keep the class's contract
 
-    opts = dict(t0=t0, t_end=t_end, method=method, rtol=rtol, atol=atol, max_step=max_step,
-                max_events=max_events, max_steps=max_steps, dense=dense,
-                samples_per_step=samples_per_step, touch_tol=touch_tol, event_xtol=event_xtol,
-                zeno_count=zeno_count, zeno_span=zeno_span, stiff=stiff)
     return _Run(system, z, list(sections), opts).go()
 
 

@@ -33,6 +33,7 @@ from . import codegen
 from .abi import CompiledModel, no_flow
 from .compiled_system import FilippovSystem, _scalar_piece, _where_piece
 from .errors import SymbolicError  # noqa: F401  (re-exported)
+from .spelling import one_spelling
 
 MODES = ("minus", "plus")
 
@@ -77,6 +78,7 @@ _OPTIONS = {"sample_step": float, "slow_sample_step": float, "transient_time": f
             "sliding": bool}
 
 
+@one_spelling
 class SymbolicSystem:
     """A Filippov system ``z' = F_-(z)`` if ``h(z) < 0`` else ``F_+(z)``, in SymPy.
 
@@ -319,8 +321,8 @@ class GeneratedSystem(FilippovSystem):
             name=self.name, names=self.names, params=self.params,
             flow_plus=m.flow_plus if exact else no_flow,
             flow_minus=m.flow_minus if exact else no_flow,
-            field_plus=m.field_plus, field_minus=m.field_minus, h=m.switch,
-            grad_h=m.switch_grad, section=sec, section_where=wh or always,
+            field_plus=m.field_plus, field_minus=m.field_minus, switch=m.switch,
+            switch_grad=m.switch_grad, section=sec, section_where=wh or always,
             section_direction=int(direction), sample_step=self.sample_step,
             slow_sample_step=self.slow_sample_step, transient_time=self.transient_time,
             sliding=self.sliding, exact=exact, jacobian=m.jacobian,
@@ -349,6 +351,7 @@ def _regions(flows):
     return None if not flows else {m: flows[m] for m in MODES}
 
 
+@one_spelling
 class SymbolicSlowFast:
     """A slow-fast Filippov model (the paper's eq:sgfilipslow, eq:sgfilipfast) in SymPy.
 
@@ -518,7 +521,7 @@ class SymbolicSlowFast:
         return SlowFastModel(
             name=self.name, slow_names=tuple(map(str, self.slow)),
             fast_names=tuple(map(str, self.fast)), f_minus=bind(mod.f_minus),
-            f_plus=bind(mod.f_plus), h=bind(mod.h), h_grad=h_grad, g_minus=bind(mod.g_minus),
+            f_plus=bind(mod.f_plus), switch=bind(mod.h), switch_grad=h_grad, g_minus=bind(mod.g_minus),
             g_plus=bind(mod.g_plus), eps=params[self.eps], y0=bind(mod.y0),
             y0_jac=bind(mod.y0_jac), exact_flows=flows,
             parameters={str(k): v for k, v in params.items()}, **options)

@@ -19,6 +19,8 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from .spelling import one_spelling
+
 MINUS, SLIDING, PLUS = -1, 0, 1
 MODE_NAMES = {MINUS: "minus", SLIDING: "sliding", PLUS: "plus"}
 
@@ -26,6 +28,7 @@ Field = Callable[[np.ndarray], np.ndarray]
 Flow = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
+@one_spelling
 @dataclass(frozen=True)
 class PiecewiseSystem:
     """A Filippov system ``dz/dt = F_-(z)`` if ``H(z) < 0`` else ``F_+(z)``.

@@ -64,7 +64,7 @@ SCENE = (
        "the report part: adds the scene's LaTeX macros, returns its table (or None)"),
     _v("REPORT_OPTIONAL", False, bool, "bool (default False)",
        "the report is built without this scene's dataset"),
-    _v("ENGINES", False, tuple, "tuple[str, ...] (default ('python',))",
+    _v("ENGINES", False, tuple, "tuple[str, ...] (default ('reference',))",
        "the solver engines a scene file may choose (solver.engine)"),
     _f("validate", False, "validate(scene: dict) -> None",
        "checks only the module can make before computing; raises SceneError naming the field"),

@@ -1,6 +1,6 @@
 """What each model ingredient costs: every scene timed as declared and with one
 ingredient switched (reduced <-> slow-fast, exact <-> integrated flows, sliding
-on <-> off, compiled <-> python engine).
+on <-> off, compiled <-> reference engine).
 
 Run ``python -m filippov_paper.benchmarks.effect_cost [scene ...]``. Each variant runs
 in its own process (with a time cap over all its calls), timing only the scene's
@@ -62,8 +62,8 @@ def variants(scene: dict) -> list[tuple[str, dict]]:
     engine = scene.get("solver", {}).get("engine")
     if engine == "compiled":
         v = copy.deepcopy(scene)
-        v["solver"]["engine"] = "python"
-        out.append(("engine: compiled -> python", v))
+        v["solver"]["engine"] = "reference"
+        out.append(("engine: compiled -> reference", v))
     return out
 
 

@@ -201,9 +201,9 @@ def breakdown(counts: dict, sliding: bool) -> dict:
     told apart from them, so ``samples`` counts both there."""
     flows = counts["flow_plus"] + counts["flow_minus"]
     if not sliding:
-        samples = counts["grad_h"] - min(counts["field_minus"], counts["field_plus"])
+        samples = counts["switch_grad"] - min(counts["field_minus"], counts["field_plus"])
     else:
-        samples = counts["h"]
+        samples = counts["switch"]
     return {"samples": samples, "root": max(flows - samples, 0.0),
             "stage_fields": (counts["field_minus"] + counts["field_plus"] - 2 * samples
                              if not sliding else counts["field_minus"])}
@@ -291,8 +291,8 @@ def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
             f"{r['per_return'] / r['floor']:7.2f} {1e6 * (r['per_return'] - r['floor']):6.2f} "
             f"{1e6 * r['flow_floor']:6.2f} | "
             f"{c['flow_plus'] + c['flow_minus']:6.1f} "
-            f"{c['field_plus'] + c['field_minus'] + c['grad_h']:6.1f} "
-            f"{c['h'] + c['section']:6.1f} {r['samples']:7.1f} {r['root']:5.1f}")
+            f"{c['field_plus'] + c['field_minus'] + c['switch_grad']:6.1f} "
+            f"{c['switch'] + c['section']:6.1f} {r['samples']:7.1f} {r['root']:5.1f}")
     costs = rows[0]["costs"]
     log("times in us per return; floor (eval): every model evaluation the return makes, "
         "each at its cost alone; flows only: the flow evaluations alone (the states at the "

@@ -50,7 +50,7 @@ import numpy as np
 import xarray as xr
 import yaml
 
-from filippov import fastmap
+from filippov.poincare import first_returns
 from filippov.io import finalize, write_dataset
 from filippov.models import dry_friction
 from filippov.models import hopf
@@ -250,8 +250,8 @@ def _fig11_project(problem: Problem, rtol: float, atol: float, time_cap: float):
 def _fig11_compiled(problem: Problem, rtol: float, atol: float):
     """fig11 on the compiled kernel (every mode integrated by DOP853), sampled as
     the scene runs it: one sample per step."""
-    ret = fastmap.first_returns_compiled(problem.compiled, problem.starts, T_MAX11, rtol=rtol,
-                                         atol=atol, samples_per_step=1)
+    ret = first_returns(problem.compiled, problem.starts, None, T_MAX11, engine="compiled",
+                        rtol=rtol, atol=atol, samples_per_step=1)
     return ret.state[:, 0], ret.first_switch
 
 
@@ -275,7 +275,7 @@ def runner(problem: Problem, family: str, tol: float, time_cap: float) -> Callab
         return run11
     if family.startswith("project"):
         method = "integrate" if "DOP853" in family else "exact"
-        engine = "compiled" if "compiled" in family else "python"
+        engine = "compiled" if "compiled" in family else "reference"
 
         def run():
             px2, _, ret = return_map(problem.model, problem.x2, method, opts, engine=engine)

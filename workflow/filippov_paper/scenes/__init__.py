@@ -29,8 +29,8 @@ def _module(scene: dict):
         raise SceneError(f"id: unknown scene {sid!r}; known scenes: {', '.join(known)}")
     module = importlib.import_module(f".{sid}", __name__)
     # solver.engine: a scene runs on the engines its module lists (default: the reference driver)
-    name = scene.get("solver", {}).get("engine", "python")
-    available = product.hook(module, "ENGINES", ("python",))
+    name = scene.get("solver", {}).get("engine", "reference")
+    available = product.hook(module, "ENGINES", ("reference",))
     if name not in available:
         raise SceneError(f"{sid}: solver.engine: {name!r} not available for this scene; "
                          f"expected one of {list(available)}")

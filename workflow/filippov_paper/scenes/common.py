@@ -14,12 +14,12 @@ def solver_options(scene: dict) -> dict:
 
 
 def engine(scene: dict) -> str:
-    """``solver.engine``: "python" (the reference driver, default) or "compiled"
+    """``solver.engine``: "reference" (the reference driver, default) or "compiled"
     (the numba kernel of :mod:`filippov.fastmap`: exact flows where the scene
     asks for them, DOP853 inside the kernel where it asks for integration).
     Only scene modules that list "compiled" in their ``ENGINES`` accept it
     (checked by :func:`filippov_paper.scenes.compute`)."""
-    return scene.get("solver", {}).get("engine", "python")
+    return scene.get("solver", {}).get("engine", "reference")
 
 
 def require(scene: dict, field: str, allowed) -> str:

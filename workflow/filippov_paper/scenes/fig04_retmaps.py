@@ -20,7 +20,6 @@ from filippov.models import hopf
 from filippov.poincare import first_returns, fixed_points
 from filippov.progress import Progress
 from filippov.simulate import Section
-from filippov.fastmap import first_returns_compiled
 from filippov_paper.scenes.common import engine, require, solver_options
 from filippov_paper.tolerance import Tolerance, sqrt_law
 import math
@@ -73,7 +72,7 @@ def x2_grid(p: dict) -> np.ndarray:
 
 
 def return_map(model, x2, method: str, options: dict, progress=None, sliding=True,
-               engine: str = "python"):
+               engine: str = "reference"):
     """P on L1 for the start values ``x2``: (returned x2, residual |y - x1|, Returns).
 
     ``engine="compiled"`` runs the numba kernel of :mod:`filippov.fastmap` (exact
@@ -82,17 +81,24 @@ def return_map(model, x2, method: str, options: dict, progress=None, sliding=Tru
     """
     starts = np.stack([np.zeros_like(x2), x2, np.zeros_like(x2)], axis=1)
     t_max = 4.0 * 2 * np.pi / abs(model.parameters["omega"])
+    # the model's view for each engine (hopf.compiled carries the section L1; method
+    # "integrate": regions + and - integrated, by the kernel's DOP853 on the compiled
+    # engine); one front door runs either (filippov.engines)
+    system, section, options = _on_engine(model, method, options, sliding, engine)
+    ret = first_returns(system, starts, section, t_max, engine=engine, progress=progress,
+                        **options)
+    return ret.state[:, 1], np.abs(ret.state[:, 2] - ret.state[:, 0]), ret
+
+
+def _on_engine(model, method: str, options: dict, sliding: bool, engine: str):
+    """(system, section, options) of the Hopf model for ``engine``: the compiled model
+    with its section L1, or the reference driver's system, section_L1() and method."""
+    exact = method == "exact"
     if engine == "compiled":
         par = model.parameters
-        # method "integrate": regions + and - integrated with the kernel's DOP853
-        cmodel = hopf.compiled(par["eps"], par["theta"], par["mu"], par["omega"],
-                               sliding=sliding, exact=method == "exact")
-        ret = first_returns_compiled(cmodel, starts, t_max, progress=progress, **options)
-    else:
-        system = model.full(sliding=sliding, exact=method == "exact")
-        ret = first_returns(system, starts, section_L1(), t_max, progress=progress,
-                            method=method, **options)
-    return ret.state[:, 1], np.abs(ret.state[:, 2] - ret.state[:, 0]), ret
+        return (hopf.compiled(par["eps"], par["theta"], par["mu"], par["omega"],
+                              sliding=sliding, exact=exact), None, options)
+    return model.full(sliding=sliding, exact=exact), section_L1(), dict(options, method=method)
 
 
 def sigma_minus(model) -> tuple[float, float]:
@@ -102,7 +108,7 @@ def sigma_minus(model) -> tuple[float, float]:
     pg = np.array([-1.0, 0.0, -1.0])
     a, _ = system.normal_speeds(pg)
     x, y = pg[:2], pg[2:]
-    hx, _ = model.h_grad(x, y)
+    hx, _ = model.switch_grad(x, y)
     chi = float(hx @ model.f_minus(x, y) - hx @ model.f_plus(x, y))
     return float(a), chi
 
@@ -113,7 +119,7 @@ def sigma_minus(model) -> tuple[float, float]:
 # grid -- the fixed points and everything else derived from the whole map are
 # computed there, so compute() and a merge of chunks give identical datasets.
 CHUNK_AXIS = "x2"
-ENGINES = ("python", "compiled")
+ENGINES = ("reference", "compiled")
 VARIABLE_ATTRS = {"theta": ("theta, weight of the fast variable in the switching function",
                             "1")}
 

@@ -146,7 +146,7 @@ TOLERANCES = {
 
 
 T_RETURN = 200.0  # time bound of one return to L
-ENGINES = ("python", "compiled")
+ENGINES = ("reference", "compiled")
 
 
 def section_L() -> Section:
@@ -187,11 +187,11 @@ def compiled_returns(z0s, eps, v0, law, rtol, atol):
 
 
 def return_map(x1, eps, v0, law, *, rtol=1e-12, atol=1e-14, progress=None,
-               with_residual=True, start=None, engine="python"):
+               with_residual=True, start=None, engine="reference"):
     """P(x1) on L for start points on M_+. Returns a dict of arrays.
     ``start``: optional ``x1 -> (w, estimate)`` on M_+
     (:func:`filippov.models.dry_friction.slow_manifold_plus_on_L`), else the
-    relaxation is run for these points. ``engine``: "python" (the reference
+    relaxation is run for these points. ``engine``: "reference" (the reference
     driver, one orbit at a time) or "compiled" (:func:`compiled_returns`)."""
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     ml = {k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")}
@@ -252,7 +252,7 @@ def near_manifold_start(x1, eps, v0, law, t_pull=0.5):
     return np.array([zs[0], zs[1], w2(zs[0], zs[1])])
 
 
-def P_pair(x1, v0, eps, law, rtol, atol, engine="python"):
+def P_pair(x1, v0, eps, law, rtol, atol, engine="reference"):
     """(x1 at the first hit of L, x1 at the next): a return of a point that
     reaches L on M_+ (to about exp(-30) for eps = 0.01; for eps = 0.1 the
     deviation decays by exp(-t/eps) long before the orbit reaches H_s).
@@ -273,7 +273,7 @@ def P_pair(x1, v0, eps, law, rtol, atol, engine="python"):
     return float(hits[0].state[0]), float(hits[1].state[0])
 
 
-def P_scalar(x1, v0, eps, law, rtol, atol, engine="python"):
+def P_scalar(x1, v0, eps, law, rtol, atol, engine="reference"):
     """P(x1) - x1 measured on the pair of hits of :func:`P_pair` (so the start
     abscissa is the actual first hit, a hair away from x1)."""
     a, b = P_pair(x1, v0, eps, law, rtol, atol, engine)
@@ -291,7 +291,7 @@ def fixed_point_near(x1_guess, v0, eps, law, rtol, atol, width=0.05):
 
 
 def saddle_node(eps, law, x1_lo, x1_hi, v0_guess, *, rtol=1e-12, atol=1e-14,
-                search_rtol=1e-10, window=0.02, progress=None, engine="python"):
+                search_rtol=1e-10, window=0.02, progress=None, engine="reference"):
     """The fold of the stick-slip fixed points of P in v0.
 
     M(v0) = max over x1 of P(x1; v0) - x1 is positive while the stable and
@@ -430,7 +430,7 @@ def _merge(maps, new):
 
 
 def refined_return_maps(x_base, panels, law, *, rtol, atol, dP_max, max_rounds, bar=None,
-                        starts=None, engine="python"):
+                        starts=None, engine="reference"):
     """P on one x1 grid shared by all panels: the uniform ``x_base``, plus the
     onset of sticking of each panel, plus points subdividing every interval
     where |Delta P| > ``dP_max`` in some panel (:func:`_subdivide`, repeated
@@ -504,7 +504,7 @@ def lemma_quantity(law, v, x0=None):
     xe = -df.friction_branches(law["f0"], law["fv"], law["fc"], law["convention"])[0](0.0)
     x = np.array([xe, v]) if x0 is None else np.asarray(x0, float)
     y = m.y0(x)
-    hx, _ = m.h_grad(x, y)
+    hx, _ = m.switch_grad(x, y)
     chi = float(hx @ m.f_minus(x, y) - hx @ m.f_plus(x, y))
     a, b = m.reduced().normal_speeds(np.array([0.0, v]))
     return chi, float(a), float(b)
