@@ -4,6 +4,8 @@ formulas of the datasets' plain-text attributes in the paper's notation."""
 from __future__ import annotations
 
 import re
+import shutil
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -140,3 +142,27 @@ def test_the_extension_budget_in_the_text_is_the_code_s():
     text = " ".join((ROOT / "paper" / "sec_instabilities.tex").read_text().split())
     assert f"goes on for {words[attractors.EXTEND]} times as many returns" in text
     assert f"up to {words[attractors.MAX_EXTENSIONS]} times" in text
+
+
+@pytest.mark.skipif(shutil.which("pdflatex") is None, reason="needs TeX (the report's tests)")
+def test_the_bench_table_fits_the_line_whatever_the_timings(tmp_path):
+    """The table of measured times prints numbers as wide as the machine was slow (a run
+    under load: 12 s a cell, 1.2x10^4 ms): it must still fit the report's line width (an
+    overfull box of 23 pt was seen when the suite built the report under load)."""
+    ds = _bench_dataset(0)
+    # two problems of one figure side by side, the longest method name, every cell 12 s
+    slow = ds.assign(wall_time=ds.wall_time * 0 + 12.3456, error_map=ds.error_map * 0 + 1.23e-12)
+    slow = slow.assign_coords(problem=["fig04 theta=-0.5", "fig04 theta=0.5"])
+    slow["method"] = ("config", ["compiled, exact flows"] * slow.sizes["config"])
+    m = report.Macros()
+    table = report.bench(slow, m)
+    assert table.count(report.FIT_BEGIN) == table.count(r"\begin{tabular}") >= 1
+    (tmp_path / "t.tex").write_text(
+        "\\documentclass[preprint,11pt,a4paper]{elsarticle}\n\\usepackage{amsmath,booktabs}\n"
+        "\\usepackage[export]{adjustbox}\n\\begin{document}\n\\begin{table}\n"
+        "\\centering\\footnotesize\\setlength{\\tabcolsep}{4pt}\n" + table +
+        "\\end{table}\n\\end{document}\n")
+    subprocess.run(["pdflatex", "-interaction=nonstopmode", "-halt-on-error", "t.tex"],
+                   cwd=tmp_path, capture_output=True, check=True, timeout=300)
+    log = (tmp_path / "t.log").read_text(errors="replace")
+    assert "Overfull \\hbox" not in log, re.findall(r"Overfull \\hbox \([\d.]+pt too wide\)", log)

@@ -355,6 +355,12 @@ METHOD_TEX = {"project compiled exact": "compiled, exact flows",
               "solve_ivp LSODA": "scipy LSODA"}
 
 
+#: around each table of measured times: the widths of their numbers follow the machine's
+#: speed and load (a slow run's "12345" ms), so a table is shrunk to the line width where
+#: it would overrun it (adjustbox's max width; a table that fits is left as it is)
+FIT_BEGIN, FIT_END = r"\begin{adjustbox}{max width=\linewidth}", r"\end{adjustbox}"
+
+
 def _bench_tabular(ds, probs: list[int]) -> list[str]:
     """One tabular: a row per method and tolerance, error / time / missed switches
     for each problem in ``probs``; a configuration that failed says so in its cells."""
@@ -362,7 +368,7 @@ def _bench_tabular(ds, probs: list[int]) -> list[str]:
                       for i in probs)
     rules = "".join(rf"\cmidrule(lr){{{3 + 3 * k}-{5 + 3 * k}}}" for k in range(len(probs)))
     sub = " & ".join(["error & ms & missed"] * len(probs))
-    lines = [r"\begin{tabular}{@{}ll" + "rrr" * len(probs) + "@{}}", r"\toprule",
+    lines = [FIT_BEGIN, r"\begin{tabular}{@{}ll" + "rrr" * len(probs) + "@{}}", r"\toprule",
              rf"method & rtol & {head} \\", rules, rf" & & {sub} \\", r"\midrule"]
     rows = [j for j in range(ds.sizes["config"])
             if any(str(ds.status.values[i, j]) != "n/a" for i in probs)]
@@ -378,7 +384,7 @@ def _bench_tabular(ds, probs: list[int]) -> list[str]:
                       f"${num(1e3 * float(ds.wall_time.values[i, j]), 2)}$",
                       str(int(ds.missed_switches.values[i, j]))]
         lines.append(" & ".join(cells) + r" \\")
-    return lines + [r"\bottomrule", r"\end{tabular}", ""]
+    return lines + [r"\bottomrule", r"\end{tabular}", FIT_END, ""]
 
 
 def _problem_tex(name: str) -> str:
@@ -513,7 +519,7 @@ def _bench_problem_macros(ds, m: Macros, names) -> None:
 
 def _effects_tabular(effects) -> list[str]:
     """The cost of each model ingredient (results/bench_effect_cost.nc)."""
-    lines = [r"\medskip", "", r"\begin{tabular}{llrrl}", r"\toprule",
+    lines = [r"\medskip", "", FIT_BEGIN, r"\begin{tabular}{llrrl}", r"\toprule",
              r"scene & ingredient switched & time [s] & $\times$ declared & outcome \\",
              r"\midrule"]
     for k in range(effects.sizes["variant"]):
@@ -525,12 +531,12 @@ def _effects_tabular(effects) -> list[str]:
             f"${num(float(effects.seconds.values[k]), 3)}$",
             f"${num(float(effects.relative.values[k]), 3)}$",
             r"\emph{" + tex_escape(outcome) + "}"]) + r" \\")
-    return lines + [r"\bottomrule", r"\end{tabular}", ""]
+    return lines + [r"\bottomrule", r"\end{tabular}", FIT_END, ""]
 
 
 def _return_cost_tabular(returns) -> list[str]:
     """The cost of one iterated return (results/bench_attractor_cost.nc)."""
-    lines = [r"\medskip", "", r"\begin{tabular}{rrrrrr}", r"\toprule",
+    lines = [r"\medskip", "", FIT_BEGIN, r"\begin{tabular}{rrrrrr}", r"\toprule",
              r"$\theta$ & $\epsilon$ & $s$ & $\mu$s/return & with $DP$ & "
              r"switches/return \\", r"\midrule"]
     for k in range(returns.sizes["case"]):
@@ -541,7 +547,7 @@ def _return_cost_tabular(returns) -> list[str]:
             f"${num(1e6 * float(returns.time_per_return.values[k]), 3)}$",
             f"${num(1e6 * float(returns.time_per_return_jacobian.values[k]), 3)}$",
             f"${num(float(returns.switches_per_return.values[k]), 3)}$"]) + r" \\")
-    return lines + [r"\bottomrule", r"\end{tabular}", ""]
+    return lines + [r"\bottomrule", r"\end{tabular}", FIT_END, ""]
 
 
 def hard_cases(ds, m: Macros) -> str:
