@@ -225,6 +225,12 @@ def _reduced_plus():
     return tuple(codegen.lambdify_written((x1, x2, v0, s0, sc, fv), p, calls) for p in pieces)
 
 
+def _values(eps, v0, gamma, f0, fv, fc, convention) -> dict:
+    check_parameters(eps, v0, gamma, f0, fv, fc, convention)
+    a, c = _coefficients(f0, fc, convention)
+    return {"eps": eps, "v0": v0, "gamma": gamma, "s0": a, "sc": c, "fv": fv}
+
+
 def model(eps: float, v0: float, gamma: float = 2.0, f0: float = -2.0, fv: float = 0.3,
           fc: float = 2.5, convention: str = "stribeck") -> SlowFastModel:
     """The reference driver's model (slow-fast and reduced), from :data:`DEFINITION`."""
