@@ -49,6 +49,9 @@ from ..symbolic import SymbolicSlowFast
 
 CONVENTIONS = ("stribeck", "literal")
 
+#: the model's name in the registry (filippov.models.get) and in a scene's ``model:`` key
+NAME = 'dry_friction'
+
 
 def check_parameters(eps, v0, gamma, f0, fv, fc, convention) -> None:
     for name, val in (("eps", eps), ("v0", v0), ("gamma", gamma), ("f0", f0), ("fv", fv),
