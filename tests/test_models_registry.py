@@ -30,8 +30,11 @@ def test_unknown_model_names_the_field_and_the_choices():
 
 @pytest.mark.parametrize("path", SCENES, ids=lambda p: p.stem)
 def test_every_scene_model_resolves(path):
+    from filippov_paper import scenes
+
     scene = load_scene(path, SCHEMA)
     assert models.get(scene["model"]).NAME == scene["model"]
+    scenes.check(scene)     # and it is the model the scene's module computes with
 
 
 def test_scene_with_unknown_model_is_refused(tmp_path):
@@ -42,3 +45,19 @@ def test_scene_with_unknown_model_is_refused(tmp_path):
     bad.write_text(yaml.safe_dump(data))
     with pytest.raises(SceneError, match=r"model: unknown model 'hopff'; expected one of .*hopf"):
         load_scene(bad, SCHEMA)
+
+
+def test_scene_module_computes_with_the_scene_model():
+    """The dispatcher refuses a scene whose model is not the one its module computes with,
+    and an unknown model, naming ``model``."""
+    from filippov_paper import scenes
+
+    scene = load_scene(ROOT / "config" / "scenes" / "fig10_dfo.yaml", SCHEMA)
+    scenes.check(scene)        # dry_friction: the module's own
+    with pytest.raises(SceneError, match=r"fig10_dfo: model: 'hopf', but the scene computes with dry_friction"):
+        scenes.check(dict(scene, model="hopf"))
+    with pytest.raises(SceneError, match=r"fig10_dfo: model: unknown model 'nope'"):
+        scenes.check(dict(scene, model="nope"))
+    # a module taking its model from the scene follows the key
+    two = load_scene(ROOT / "config" / "scenes" / "fig02_cases.yaml", SCHEMA)
+    scenes.check(two)

@@ -16,12 +16,12 @@ import numpy as np
 import xarray as xr
 
 from filippov.io import finalize
-from filippov.models import hopf
+from filippov import models
 from filippov.poincare import first_returns, fixed_points
 from filippov.progress import Progress
 from filippov.simulate import Section
 from filippov.fastmap import first_returns_compiled
-from filippov_paper.scenes.common import engine, require, solver_options
+from filippov_paper.scenes.common import engine, registered_model, require, solver_options
 from filippov_paper.tolerance import Tolerance, sqrt_law
 import math
 from filippov_paper.report import Macros, source, value, var
@@ -85,7 +85,7 @@ def return_map(model, x2, method: str, options: dict, progress=None, sliding=Tru
     if engine == "compiled":
         par = model.parameters
         # method "integrate": regions + and - integrated with the kernel's DOP853
-        cmodel = hopf.compiled(par["eps"], par["theta"], par["mu"], par["omega"],
+        cmodel = models.get(model.name).compiled(par["eps"], par["theta"], par["mu"], par["omega"],
                                sliding=sliding, exact=method == "exact")
         ret = first_returns_compiled(cmodel, starts, t_max, progress=progress, **options)
     else:
@@ -136,7 +136,7 @@ def sweep(scene: dict, x2: np.ndarray, *, progress: bool = False) -> xr.Dataset:
     bar = Progress(scene["id"], len(thetas) * x2.size, progress)
     P, res, tof, nsw, slide, first = [], [], [], [], [], []
     for theta in thetas:
-        model = hopf.model(eps, theta, mu, omega)
+        model = registered_model(scene).model(eps, theta, mu, omega)
         px2, r, ret = return_map(model, x2, method, opts, bar, scene["ingredients"]["sliding"],
                                  kernel)
         P.append(px2), res.append(r), tof.append(ret.time)
@@ -168,7 +168,7 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     slide, first = raw["sliding_time"].values, raw["first_switch_time"].values
     sig, chi, fps = [], [], []
     for theta, px2 in zip(thetas, P):
-        model = hopf.model(eps, theta, mu, omega)
+        model = registered_model(scene).model(eps, theta, mu, omega)
         s, c = sigma_minus(model)
         sig.append(s), chi.append(c)
         fps.append(fixed_points(x2, px2))
