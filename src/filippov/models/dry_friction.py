@@ -31,8 +31,13 @@ Each region's friction is a smooth (analytic) branch defined for all nu,
 across H_s, as the slow-manifold construction needs.
 
 No region has a closed-form flow: every mode is integrated (DOP853). The model is
-written once (:data:`DEFINITION`, SymPy); the reference driver's and the compiled
-engine's pieces and the Jacobians are generated from it.
+written once, in SymPy: the friction law (:data:`FRICTION`), the fields (:data:`SLOW`,
+:data:`FAST`) and the second-order slow manifold (:data:`W2_PLUS`), as text kept in its
+written order. :data:`DEFINITION` (canonical) gives the reference driver's and the
+compiled engine's pieces and the Jacobians; the NumPy helpers here (friction branches,
+the reduced region-+ field for shooting, the relaxation onto M_+) are printed from the
+same pieces in written order (:func:`filippov.codegen.lambdify_written`), so they round
+exactly as that text does in NumPy (tests/test_dry_friction.py).
 """
 from __future__ import annotations
 
@@ -217,6 +222,12 @@ REGION_PLUS = {"analytic": _region_plus(*_BRANCHES["plus"]),
 
 
 @functools.lru_cache(maxsize=None)
+def _quasi_static():
+    """y0(x2, v0, gamma): w on the slow manifold at eps = 0, solved from the definition."""
+    return codegen.lambdify_written((x2, v0, gamma), DEFINITION.quasi_static()[w])
+
+
+@functools.lru_cache(maxsize=None)
 def _reduced_plus():
     """(f, df/dx, df/dv) of the reduced region-+ field (x2, x2') in NumPy, functions of
     (x1, x2, v0, s0, sc, fv): w = y0(x), so nu simplifies to x2 - v0."""
@@ -282,7 +293,7 @@ def slow_manifold_plus(x1, x2, eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5,
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     x2 = np.atleast_1d(np.asarray(x2, dtype=float)) + 0.0 * x1
     if eps <= 0:
-        return v0 + gamma * x2, np.zeros_like(x2)
+        return _quasi_static()(x2, v0, gamma), np.zeros_like(x2)   # M_+ is y0(x) at eps = 0
     flow = _PlusRelaxation(eps, v0, gamma, law_coefficients(f0, fv, fc, convention), x1.size)
     T = min(relax * eps, t_max)
     w = flow.solve(x1, x2, T, newton_tol, max_iter)
