@@ -55,7 +55,7 @@ from ..symbolic import SymbolicSlowFast
 CONVENTIONS = ("stribeck", "literal")
 
 #: the model's name in the registry (filippov.models.get) and in a scene's ``model:`` key
-NAME = 'dry_friction'
+NAME = "dry_friction"
 
 
 def check_parameters(eps, v0, gamma, f0, fv, fc, convention) -> None:
@@ -161,7 +161,7 @@ def _defined(expr):
 #: eq:dfo-sf written once; the friction law enters through (s0, sc) (see :func:`_coefficients`)
 DEFINITION = SymbolicSlowFast(
     (x1, x2), (w,), f_minus=(x2, _defined(SLOW["minus"])), f_plus=(x2, _defined(SLOW["plus"])),
-    g_minus=(_defined(FAST),), g_plus=(_defined(FAST),), switch=w - (1 + gamma) * x2, eps=eps,
+    g_minus=(_defined(FAST),), g_plus=(_defined(FAST),), switch=-NU.doit(), eps=eps,
     params={eps: 0.01, v0: 1.0, gamma: 2.0, s0: 2.0, sc: -2.5, fv: 0.3}, name="dry_friction")
 
 #: the section L of fig:dfo-retmap: x2 = 0 crossed downward with x1 > 0 (the caller's choice)

@@ -42,7 +42,7 @@ from ..model import TRANSIENT, SlowFastModel
 from ..symbolic import SymbolicSlowFast
 
 #: the model's name in the registry (filippov.models.get) and in a scene's ``model:`` key
-NAME = 'hopf'
+NAME = "hopf"
 
 
 # ----------------------------------------------------------------- the definition

@@ -15,7 +15,7 @@ import numpy as np
 from ..system import MINUS, PLUS, SLIDING, PiecewiseSystem
 
 #: the model's name in the registry (filippov.models.get) and in a scene's ``model:`` key
-NAME = 'planar_sketch'
+NAME = "planar_sketch"
 
 
 def _h(z):

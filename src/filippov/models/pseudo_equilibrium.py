@@ -19,7 +19,7 @@ from ..symbolic import SymbolicSlowFast
 from ..system import SLIDING
 
 #: the model's name in the registry (filippov.models.get) and in a scene's ``model:`` key
-NAME = 'pseudo_equilibrium'
+NAME = "pseudo_equilibrium"
 
 
 def _check(eps: float, theta: float) -> None:
