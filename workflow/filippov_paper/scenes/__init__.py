@@ -47,8 +47,10 @@ def _check_model(scene: dict, module) -> None:
 
     from filippov import models
 
+    if "model" not in scene:   # a partial scene (the schema requires one of every scene file)
+        return
     try:
-        chosen = models.get(scene.get("model"))
+        chosen = models.get(scene["model"])
     except ValueError as exc:
         raise SceneError(f"{scene.get('id')}: {exc}") from None
     held = {v.NAME for v in vars(module).values() if isinstance(v, types.ModuleType)
