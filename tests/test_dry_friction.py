@@ -196,3 +196,60 @@ def test_the_reduced_jacobian_first_then_the_slow_fast_system():
     jac = df.reduced_jacobian(1.0)
     assert callable(jac)
     assert df.system(0.1, 3.32).names
+
+
+def test_numpy_helpers_are_the_definition_printed_in_written_order():
+    """The helpers come from the SymPy definition: they agree with its canonical form to
+    rounding, and (printed in written order) round exactly like the NumPy text they were
+    written as -- which is what keeps the datasets bit-identical."""
+    import sympy as sp
+
+    rng = np.random.default_rng(7)
+    nu = rng.uniform(-6, 6, 5000)
+    x = rng.uniform(-5, 5, (2, 5000))
+    for law in (LAW, dict(LAW, convention="literal")):
+        a, c, fv = df.law_coefficients(**law)
+        Fp, dFp, Fm, dFm = df.friction_branches(**law)
+        canon = {m: sp.lambdify(df.nu, df.FRICTION[m].doit().subs({df.s0: a, df.sc: c, df.fv: fv}))
+                 for m in ("plus", "minus")}
+        np.testing.assert_allclose(Fp(nu), canon["plus"](nu), rtol=1e-13, atol=1e-13)
+        np.testing.assert_allclose(Fm(nu), canon["minus"](nu), rtol=1e-13, atol=1e-13)
+        # bit for bit the NumPy text the law is written as
+        assert np.array_equal(Fp(nu), -a - c * (1 - np.exp(nu)) + fv * nu)
+        assert np.array_equal(Fm(nu), a + c * (1 - np.exp(-nu)) + fv * nu)
+        assert np.array_equal(dFp(nu), c * np.exp(nu) + fv)
+        f, jac, dv = df.plus_field_reduced(3.1, **law)
+        for z in x.T[:200]:
+            assert np.array_equal(f(z), [z[1], -z[0] - Fp(z[1] - 3.1)])
+            assert np.array_equal(jac(z), [[0.0, 1.0], [-1.0, -dFp(z[1] - 3.1)]])
+            assert np.array_equal(dv(z), [0.0, dFp(z[1] - 3.1)])
+
+
+def test_second_order_manifold_solves_the_invariance_equation():
+    """W2_PLUS (used by the relaxation and by fig11) is M_+ of the model's region-+ field to
+    O(eps^2): eps u' = -u + eps gamma F(x2 - v0 - u), u = w - v0 - gamma x2, leaves O(eps^3)."""
+    import sympy as sp
+
+    x1, x2, eps, v0, gamma = df.x1, df.x2, df.eps, df.v0, df.gamma
+    F = sp.Function("F")
+    a = x2 - v0
+    w2 = df.W2_PLUS.doit().subs({df._F: F(a), df._dF: sp.Derivative(F(a), x2)}).doit()
+    nu = df.NU.doit().subs(df.w, w2)
+    slow = (x2, -x1 - F(nu))                               # SLOW["plus"], the branch kept generic
+    assert sp.simplify(df.SLOW["plus"].doit().subs(df.nu, nu).replace(
+        lambda e: isinstance(e, df._Branch), lambda e: F(e.args[0])) - slow[1]) == 0
+    w_dot = sp.diff(w2, x1) * slow[0] + sp.diff(w2, x2) * slow[1]
+    residual = eps * w_dot - df.FAST.doit().subs(df.w, w2)  # eps w' - (eps w')_field on W2
+    series = sp.series(residual, eps, 0, 3).removeO()
+    assert sp.simplify(series) == 0
+
+
+def test_definition_is_the_written_pieces():
+    """DEFINITION's fields are the written pieces, evaluated (one definition)."""
+    import sympy as sp
+
+    law = {df.F_plus: df.FRICTION["plus"].doit()}
+    want = df.SLOW["plus"].doit().replace(lambda e: isinstance(e, df.F_plus),
+                                          lambda e: law[df.F_plus].subs(df.nu, e.args[0]))
+    assert sp.simplify(df.DEFINITION.f_plus[1] - want.subs(df.nu, df.NU.doit())) == 0
+    assert sp.simplify(df.DEFINITION.g_plus[0] - df.FAST.doit()) == 0

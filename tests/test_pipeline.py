@@ -141,3 +141,16 @@ def test_build_holds_the_hard_case_sweep_of_the_configured_eps(workflow_build):
     # code_version names the commit at the time of writing; everything else is equal
     built.attrs.pop("code_version"), whole.attrs.pop("code_version")
     assert built.identical(whole)
+
+
+def test_unknown_model_fails_cleanly(tmp_path):
+    """A scene naming a model the registry does not have is refused, naming ``model`` and
+    the choices, before anything is written."""
+    work = _project(tmp_path)
+    scene = work / "config" / "scenes" / "fig02_cases.yaml"
+    scene.write_text(scene.read_text().replace("model: pseudo_equilibrium", "model: pseudo_equilibrum"))
+    run = _snakemake(work, "results/fig02_cases.nc")
+    assert run.returncode != 0
+    out = run.stdout + run.stderr
+    assert "model: unknown model 'pseudo_equilibrum'" in out and "pseudo_equilibrium" in out
+    assert not (work / "results" / "fig02_cases.nc").exists()

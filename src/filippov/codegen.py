@@ -265,3 +265,34 @@ def load_numpy(src: str):
         exec(compile(src, f"<{module.__name__}>", "exec"), module.__dict__)
         _LOADED[key] = module
     return _LOADED[key]
+
+
+# ------------------------------------------------------------------ NumPy, as written
+class _WrittenOrderPrinter(_NumPyPrinter):
+    """NumPy with the terms and factors in the order of the expression's tree (no
+    canonical reordering): an expression kept unevaluated (``parse_expr(...,
+    evaluate=False)``) is printed with the same operations, in the same order, as
+    the text it was parsed from, so it rounds like a hand-written NumPy form of that
+    text. Functions SymPy does not know are printed as calls (see :func:`lambdify_written`)."""
+
+    def __init__(self):
+        NumPyPrinter.__init__(self, {"fully_qualified_modules": True, "order": "none",
+                                     "allow_unknown_functions": True})
+
+
+def lambdify_written(args: Sequence, expr, functions: dict | None = None):
+    """A NumPy function of ``args`` computing ``expr`` (an expression or a list),
+    printed in written order (:class:`_WrittenOrderPrinter`), without common
+    subexpressions; ``functions`` names the Python callables of the undefined
+    functions in ``expr`` (e.g. a friction branch chosen by the caller)."""
+    return sp.lambdify(args, expr, modules=[dict(functions or {}), "numpy"],
+                       printer=_WrittenOrderPrinter(), cse=False)
+
+
+def parse_written(text: str, names: dict):
+    """``text`` as a SymPy expression kept in its written order (unevaluated: ``a - b +
+    c`` stays ``(a - b) + c``), the names read from ``names``; ``.doit()`` gives the
+    canonical expression."""
+    from sympy.parsing.sympy_parser import parse_expr
+
+    return parse_expr(text, local_dict=dict(names), evaluate=False)

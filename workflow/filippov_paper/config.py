@@ -7,8 +7,10 @@ No Snakemake here: the workflow's scripts call `load_scene`.
 from __future__ import annotations
 
 import ast
+import importlib.util
 import json
 import math
+import pkgutil
 import re
 from pathlib import Path
 
@@ -274,6 +276,28 @@ def apply_resolution(scene: dict, resolution: str | None) -> dict:
     return out
 
 
+def model_names() -> list[str]:
+    """The models of the registry :mod:`filippov.models` (its modules, as
+    ``filippov.models.names()`` lists them), found without importing the library: checking
+    a scene file loads no numerics."""
+    spec = importlib.util.find_spec("filippov")
+    if spec is None or not spec.submodule_search_locations:
+        raise SceneError("model: the library filippov is not installed; cannot list its models")
+    folder = Path(list(spec.submodule_search_locations)[0]) / "models"
+    return sorted(m.name for m in pkgutil.iter_modules([str(folder)]) if not m.name.startswith("_"))
+
+
+def check_model(scene: dict, path) -> None:
+    """The scene's ``model`` names a registered model (else SceneError naming the field
+    and the choices); a missing key is the schema's to report."""
+    if "model" not in scene:
+        return
+    known = model_names()
+    if scene["model"] not in known:
+        raise SceneError(f"{path}: model: unknown model {scene['model']!r}; expected one of "
+                         f"{', '.join(known)}")
+
+
 def load_scene(path, schema_path, lim: dict | None = None,
                resolution: str | None = None) -> dict:
     """Read a scene, validate it against the JSON schema and the limits (``lim``,
@@ -290,6 +314,7 @@ def load_scene(path, schema_path, lim: dict | None = None,
         got = "an empty file" if scene is None else f"a {type(scene).__name__}"
         raise SceneError(f"{path}: a scene must be a YAML mapping, got {got}")
 
+    check_model(scene, path)
     schema = json.loads(Path(schema_path).read_text(encoding="utf-8"))
     sid = scene.get("id")
     if isinstance(sid, str) and SCENE_ID.fullmatch(sid):  # the scene's own block, if any

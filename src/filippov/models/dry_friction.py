@@ -31,21 +31,31 @@ Each region's friction is a smooth (analytic) branch defined for all nu,
 across H_s, as the slow-manifold construction needs.
 
 No region has a closed-form flow: every mode is integrated (DOP853). The model is
-written once (:data:`DEFINITION`, SymPy); the reference driver's and the compiled
-engine's pieces and the Jacobians are generated from it.
+written once, in SymPy: the friction law (:data:`FRICTION`), the fields (:data:`SLOW`,
+:data:`FAST`) and the second-order slow manifold (:data:`W2_PLUS`), as text kept in its
+written order. :data:`DEFINITION` (canonical) gives the reference driver's and the
+compiled engine's pieces and the Jacobians; the NumPy helpers here (friction branches,
+the reduced region-+ field for shooting, the relaxation onto M_+) are printed from the
+same pieces in written order (:func:`filippov.codegen.lambdify_written`), so they round
+exactly as that text does in NumPy (tests/test_dry_friction.py).
 """
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
 import sympy as sp
 from scipy.integrate import solve_ivp
 
+from .. import codegen
 from ..model import SlowFastModel
 from ..symbolic import SymbolicSlowFast
 
 CONVENTIONS = ("stribeck", "literal")
+
+#: the model's name in the registry (filippov.models.get) and in a scene's ``model:`` key
+NAME = "dry_friction"
 
 
 def check_parameters(eps, v0, gamma, f0, fv, fc, convention) -> None:
@@ -65,27 +75,11 @@ def check_parameters(eps, v0, gamma, f0, fv, fc, convention) -> None:
 
 def friction_branches(f0=-2.0, fv=0.3, fc=2.5, convention="stribeck"):
     """``(F_plus, dF_plus, F_minus, dF_minus)``: the smooth branches of F_c for
-    nu < 0 (region +) and nu > 0 (region -), each extended to all nu."""
-    if convention == "stribeck":
-        s0, sc = -f0, -fc   # sgn(nu) [-f0 - fc (1 - e^{-|nu|})]
-    elif convention == "literal":
-        s0, sc = f0, fc     # sgn(nu) [f0 + fc (1 - e^{-|nu|})]
-    else:
-        raise ValueError(f"convention must be one of {CONVENTIONS}, got {convention!r}")
-
-    def F_plus(nu):   # sgn = -1, |nu| = -nu
-        return -s0 - sc * (1.0 - np.exp(nu)) + fv * nu
-
-    def dF_plus(nu):
-        return sc * np.exp(nu) + fv
-
-    def F_minus(nu):  # sgn = +1
-        return s0 + sc * (1.0 - np.exp(-nu)) + fv * nu
-
-    def dF_minus(nu):
-        return sc * np.exp(-nu) + fv
-
-    return F_plus, dF_plus, F_minus, dF_minus
+    nu < 0 (region +) and nu > 0 (region -), each extended to all nu; printed from
+    :data:`FRICTION` (the slopes differentiated from it)."""
+    a, c = _coefficients(f0, fc, convention)
+    return tuple((lambda nu, fn=fn: fn(nu, a, c, fv)) for mode in ("plus", "minus")
+                 for fn in _BRANCHES[mode])
 
 
 def friction(nu, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck"):
@@ -111,27 +105,138 @@ def equilibrium(v, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck"):
 
 
 # ----------------------------------------------------------------- the definition
-x1, x2, w, eps, v0, gamma, s0, sc, fv = sp.symbols("x1 x2 w eps v0 gamma s0 sc fv")
-_nu = (1 + gamma) * x2 - w
-# the friction branches with coefficients (s0, sc) of friction_branches: region + (nu < 0)
-# and region - (nu > 0), each extended to all nu
-_F_PLUS = -s0 - sc * (1 - sp.exp(_nu)) + fv * _nu
-_F_MINUS = s0 + sc * (1 - sp.exp(-_nu)) + fv * _nu
-_G = -w + v0 + gamma * x2 - eps * gamma * x1
+x1, x2, w, eps, v0, gamma, s0, sc, fv, nu = sp.symbols("x1 x2 w eps v0 gamma s0 sc fv nu")
+_F, _dF = sp.symbols("F dF")     # a friction branch's value and slope (in W2_PLUS)
+
+
+class _Branch(sp.Function):
+    """A friction branch F(nu, s0, sc, fv) left as a call (the NumPy helpers are told
+    which function it is, e.g. continued by its tangent); d/dnu is ``slope``."""
+    nargs = 4
+    slope = None
+
+    def fdiff(self, argindex=1):
+        if argindex != 1:
+            raise sp.ArgumentIndexError(self, argindex)
+        return self.slope(*self.args)
+
+
+F_plus = type("F_plus", (_Branch,), {"slope": sp.Function("dF_plus")})
+F_minus = type("F_minus", (_Branch,), {"slope": sp.Function("dF_minus")})
+_NAMES = {**{str(s): s for s in (x1, x2, w, eps, v0, gamma, s0, sc, fv, nu, _F, _dF)},
+          "F_plus": F_plus, "F_minus": F_minus, "exp": sp.exp}
+
+
+def _written(text: str):
+    """``text`` in SymPy, unevaluated: the NumPy helpers print it with the same operations
+    in the same order, so they round as that text does in NumPy (``.doit()``: canonical)."""
+    return codegen.parse_written(text, _NAMES)
+
+
+#: F_c(nu) = sgn(nu) [s0 + sc (1 - e^{-|nu|})] + fv nu (coefficients: :func:`_coefficients`):
+#: its smooth branches for nu < 0 (region +) and nu > 0 (region -), each extended to all nu
+FRICTION = {"plus": _written("-s0 - sc * (1 - exp(nu)) + fv * nu"),
+            "minus": _written("s0 + sc * (1 - exp(-nu)) + fv * nu")}
+#: nu = (1 + gamma) x2 - w, the block's velocity relative to the belt
+NU = _written("(1 + gamma) * x2 - w")
+#: x2' of regions + and -, the friction branch at nu (x1' = x2)
+SLOW = {"plus": _written("-x1 - F_plus(nu, s0, sc, fv)"),
+        "minus": _written("-x1 - F_minus(nu, s0, sc, fv)")}
+#: eps w', the same in both regions
+FAST = _written("-w + v0 + gamma * x2 - eps * gamma * x1")
+#: w on the second-order expansion of the slow manifold M_+, F and dF being F_plus and its
+#: slope at x2 - v0: the solution of the invariance equation of u = w - v0 - gamma x2,
+#: eps u' = -u + eps gamma F(x2 - v0 - u), to O(eps^2) (tests/test_dry_friction.py)
+W2_PLUS = _written("v0 + gamma * x2 + eps * gamma * F + eps ** 2 * gamma * dF * (x1 + (1 - gamma) * F)")
+
+
+def _defined(expr):
+    """``expr`` canonical, nu = :data:`NU` and the branches replaced by :data:`FRICTION`."""
+    law = {F_plus: FRICTION["plus"].doit(), F_minus: FRICTION["minus"].doit()}
+    out = expr.doit().replace(lambda e: isinstance(e, _Branch),
+                              lambda e: law[type(e)].subs(nu, e.args[0]))
+    return out.subs(nu, NU.doit())
+
 
 #: eq:dfo-sf written once; the friction law enters through (s0, sc) (see :func:`_coefficients`)
 DEFINITION = SymbolicSlowFast(
-    (x1, x2), (w,), f_minus=(x2, -x1 - _F_MINUS), f_plus=(x2, -x1 - _F_PLUS),
-    g_minus=(_G,), g_plus=(_G,), switch=w - (1 + gamma) * x2, eps=eps,
+    (x1, x2), (w,), f_minus=(x2, _defined(SLOW["minus"])), f_plus=(x2, _defined(SLOW["plus"])),
+    g_minus=(_defined(FAST),), g_plus=(_defined(FAST),), switch=-NU.doit(), eps=eps,
     params={eps: 0.01, v0: 1.0, gamma: 2.0, s0: 2.0, sc: -2.5, fv: 0.3}, name="dry_friction")
 
 #: the section L of fig:dfo-retmap: x2 = 0 crossed downward with x1 > 0 (the caller's choice)
 L = {"section": x2, "direction": -1, "where": x1 > 0}
 
 
+def law_coefficients(f0=-2.0, fv=0.3, fc=2.5, convention="stribeck") -> tuple:
+    """(s0, sc, fv): the parameters of :data:`FRICTION` for a friction law."""
+    return (*_coefficients(f0, fc, convention), fv)
+
+
 def _coefficients(f0, fc, convention) -> tuple:
     """(s0, sc) of the branches: F_c(nu) = sgn(nu) [s0 + sc (1 - e^{-|nu|})] + fv nu."""
+    if convention not in CONVENTIONS:
+        raise ValueError(f"convention must be one of {CONVENTIONS}, got {convention!r}")
     return (-f0, -fc) if convention == "stribeck" else (f0, fc)
+
+
+# ------------------------------------------------------------------ NumPy helpers, printed
+#: mode -> (F(nu, s0, sc, fv), dF(nu, s0, sc, fv)): the branches printed from FRICTION
+_BRANCHES = {mode: (codegen.lambdify_written((nu, s0, sc, fv), law),
+                    codegen.lambdify_written((nu, s0, sc, fv), sp.diff(law.doit(), nu)))
+             for mode, law in FRICTION.items()}
+_W2_PLUS = codegen.lambdify_written((x1, x2, _F, _dF, eps, v0, gamma), W2_PLUS)
+
+
+def _tangent_branch(nu, s0_, sc_, fv_):
+    """F_plus for nu <= 0, beyond its tangent at nu = 0 (the analytic branch runs away
+    like exp(nu)): what the relaxation onto M_+ follows (see :func:`slow_manifold_plus`)."""
+    F, dF = _BRANCHES["plus"]
+    F0, dF0 = float(F(0.0, s0_, sc_, fv_)), float(dF(0.0, s0_, sc_, fv_))
+    return np.where(nu <= 0, F(np.minimum(nu, 0.0), s0_, sc_, fv_), F0 + dF0 * nu)
+
+
+def _tangent_slope(nu, s0_, sc_, fv_):
+    dF = _BRANCHES["plus"][1]
+    return np.where(nu <= 0, dF(np.minimum(nu, 0.0), s0_, sc_, fv_), float(dF(0.0, s0_, sc_, fv_)))
+
+
+def _region_plus(F, dF) -> dict:
+    """Region +'s pieces in NumPy with the branch (F, dF) of F_plus: ``slow(x1, x2, w,
+    gamma, s0, sc, fv)`` (x2'), ``fast(x1, x2, w, eps, v0, gamma)`` (w') and ``w2(x1,
+    x2, eps, v0, gamma, s0, sc, fv)`` (:data:`W2_PLUS`), printed from the definition."""
+    slow = codegen.lambdify_written((x1, x2, w, gamma, s0, sc, fv),
+                                    SLOW["plus"].xreplace({nu: NU}), {"F_plus": F})
+    fast = codegen.lambdify_written((x1, x2, w, eps, v0, gamma),
+                                    codegen.parse_written("g / eps", {"g": FAST, "eps": eps}))
+
+    def w2(a, b, eps_, v0_, gamma_, *law):
+        return _W2_PLUS(a, b, F(b - v0_, *law), dF(b - v0_, *law), eps_, v0_, gamma_)
+
+    return {"slow": slow, "fast": fast, "w2": w2}
+
+
+#: region +'s pieces with the analytic branch F_plus, and with it continued by its tangent
+REGION_PLUS = {"analytic": _region_plus(*_BRANCHES["plus"]),
+               "tangent": _region_plus(_tangent_branch, _tangent_slope)}
+
+
+@functools.lru_cache(maxsize=None)
+def _quasi_static():
+    """y0(x2, v0, gamma): w on the slow manifold at eps = 0, solved from the definition."""
+    return codegen.lambdify_written((x2, v0, gamma), DEFINITION.quasi_static()[w])
+
+
+@functools.lru_cache(maxsize=None)
+def _reduced_plus():
+    """(f, df/dx, df/dv) of the reduced region-+ field (x2, x2') in NumPy, functions of
+    (x1, x2, v0, s0, sc, fv): w = y0(x), so nu simplifies to x2 - v0."""
+    nu_reduced = sp.simplify(NU.doit().subs(DEFINITION.quasi_static()))
+    f = [x2, SLOW["plus"].xreplace({nu: nu_reduced})]
+    pieces = (f, [[sp.diff(fi.doit(), u) for u in (x1, x2)] for fi in f],
+              [sp.diff(fi.doit(), v0) for fi in f])
+    calls = {"F_plus": _BRANCHES["plus"][0], "dF_plus": _BRANCHES["plus"][1]}
+    return tuple(codegen.lambdify_written((x1, x2, v0, s0, sc, fv), p, calls) for p in pieces)
 
 
 def _values(eps, v0, gamma, f0, fv, fc, convention) -> dict:
@@ -172,13 +277,7 @@ def slow_manifold_plus(x1, x2, eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5,
     """w on the slow manifold M_+ of eq:dfo-sf above the points (x1, x2).
 
     M_+ attracts at rate 1/eps, so it is reached by relaxation: start at x_s
-    with w on the second-order expansion of M_+ (derived from the invariance
-    equation for u = w - v0 - gamma x2, i.e. eps u' = -u + eps gamma F(x2 - v0 - u)):
-
-        w2(x) = v0 + gamma x2 + eps gamma F + eps^2 gamma F' (x1 + (1 - gamma) F),
-        F = F_plus(x2 - v0),
-
-    follow the region-+ field for a time T = min(relax * eps, t_max) and solve (Newton, all
+    with w on the second-order expansion :data:`W2_PLUS` of M_+, follow the region-+ field for a time T = min(relax * eps, t_max) and solve (Newton, all
     points at once) for x_s such that x(T) = (x1, x2). The deviation from M_+
     shrinks by exp(-T/eps) (T is capped: for eps = 0.1 a longer history would
     run through the sticking region, where the smooth region-+ field is fiction
@@ -194,9 +293,8 @@ def slow_manifold_plus(x1, x2, eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5,
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     x2 = np.atleast_1d(np.asarray(x2, dtype=float)) + 0.0 * x1
     if eps <= 0:
-        return v0 + gamma * x2, np.zeros_like(x2)
-    flow = _PlusRelaxation(eps, v0, gamma, friction_branches(f0, fv, fc, convention)[:2],
-                           x1.size)
+        return _quasi_static()(x2, v0, gamma), np.zeros_like(x2)   # M_+ is y0(x) at eps = 0
+    flow = _PlusRelaxation(eps, v0, gamma, law_coefficients(f0, fv, fc, convention), x1.size)
     T = min(relax * eps, t_max)
     w = flow.solve(x1, x2, T, newton_tol, max_iter)
     w_long = flow.solve(x1, x2, 1.5 * T, newton_tol, max_iter)
@@ -205,41 +303,32 @@ def slow_manifold_plus(x1, x2, eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5,
 
 class _PlusRelaxation:
     """The region-+ field of eq:dfo-sf for a batch of ``m`` points (states stacked as
-    (x1, x2, w) blocks), the second-order expansion w2 of M_+, and the relaxation onto
-    M_+ that :func:`slow_manifold_plus` solves for."""
+    (x1, x2, w) blocks), F_plus continued by its tangent beyond nu = 0
+    (:data:`REGION_PLUS`), the second-order expansion w2 of M_+, and the relaxation onto
+    M_+ that :func:`slow_manifold_plus` solves for; ``law`` = (s0, sc, fv)."""
 
-    def __init__(self, eps, v0, gamma, branches, m: int):
-        self.Fp0, self.dFp0 = branches
-        self.F0, self.dF0 = float(self.Fp0(0.0)), float(self.dFp0(0.0))
-        self.eps, self.v0, self.gamma, self.m = eps, v0, gamma, m
-        self.g1 = 1.0 + gamma
+    def __init__(self, eps, v0, gamma, law, m: int):
+        self.eps, self.v0, self.gamma, self.law, self.m = eps, v0, gamma, tuple(law), m
+        self.pieces = REGION_PLUS["tangent"]
         # Fixed DOP853 steps (first_step = max_step, loose tolerances so every step is
         # accepted): the map x_s -> x(T) is then a smooth function of x_s, which
         # Newton needs; adaptive steps make it jitter at the 1e-10 level.
         self.h_fix = min(eps / 8, 0.0125)
 
-    # F_plus for nu <= 0; beyond, its tangent at nu = 0 (the analytic branch runs away)
-    def Fp(self, nu):
-        return np.where(nu <= 0, self.Fp0(np.minimum(nu, 0.0)), self.F0 + self.dF0 * nu)
-
-    def dFp(self, nu):
-        return np.where(nu <= 0, self.dFp0(np.minimum(nu, 0.0)), self.dF0)
-
     def w2(self, a, b):
         """w on the second-order expansion of M_+ above (a, b)."""
-        eps, v0, gamma = self.eps, self.v0, self.gamma
-        F = self.Fp(b - v0)
-        return v0 + gamma * b + eps * gamma * F + eps ** 2 * gamma * self.dFp(b - v0) * (a + (1 - gamma) * F)
+        return self.pieces["w2"](a, b, self.eps, self.v0, self.gamma, *self.law)
 
     def rhs(self, t, z):
-        eps, v0, gamma = self.eps, self.v0, self.gamma
         a, b, w = z.reshape(3, -1)
-        return np.concatenate([b, -a - self.Fp(self.g1 * b - w), (-w + v0 + gamma * b - eps * gamma * a) / eps])
+        return np.concatenate([b, self.pieces["slow"](a, b, w, self.gamma, *self.law),
+                               self.pieces["fast"](a, b, w, self.eps, self.v0, self.gamma)])
 
     def back(self, t, z):
         """The slow flow on the expansion w2, backward in time ((x1, x2) blocks)."""
-        m = self.m
-        return -np.concatenate([z[m:], -z[:m] - self.Fp(self.g1 * z[m:] - self.w2(z[:m], z[m:]))])
+        a, b = z[:self.m], z[self.m:]
+        return -np.concatenate([b, self.pieces["slow"](a, b, self.w2(a, b), self.gamma,
+                                                       *self.law)])
 
     def forward(self, xs1, xs2, T):
         """The states at time T from (xs1, xs2) on the expansion: rows x1, x2, w."""
@@ -288,19 +377,21 @@ class _PlusRelaxation:
 # --------------------------------------------------------------------------- fast forms
 def plus_field_reduced(v, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck"):
     """(f, df/dx, df/dv) of eq:dfo1 in region + (friction branch F_plus, extended
-    smoothly to x2 > v): for shooting and the variational equations."""
-    Fp, dFp = friction_branches(f0, fv, fc, convention)[:2]
+    smoothly to x2 > v): for shooting and the variational equations; printed from
+    :data:`DEFINITION` (:func:`_reduced_plus`)."""
+    law = law_coefficients(f0, fv, fc, convention)
+    f, dfdx, dfdv = _reduced_plus()
 
-    def f(x):
-        return np.array([x[1], -x[0] - Fp(x[1] - v)])
+    def field(x):
+        return np.array(f(x[0], x[1], v, *law), dtype=float)
 
-    def dfdx(x):
-        return np.array([[0.0, 1.0], [-1.0, -dFp(x[1] - v)]])
+    def jac(x):
+        return np.array(dfdx(x[0], x[1], v, *law), dtype=float)
 
-    def dfdv(x):
-        return np.array([0.0, dFp(x[1] - v)])
+    def dv(x):
+        return np.array(dfdv(x[0], x[1], v, *law), dtype=float)
 
-    return f, dfdx, dfdv
+    return field, jac, dv
 
 
 def reduced_jacobian(v, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck"):

@@ -41,6 +41,9 @@ from sympy.codegen.cfunctions import expm1
 from ..model import TRANSIENT, SlowFastModel
 from ..symbolic import SymbolicSlowFast
 
+#: the model's name in the registry (filippov.models.get) and in a scene's ``model:`` key
+NAME = "hopf"
+
 
 # ----------------------------------------------------------------- the definition
 x1, x2, y, eps, theta, mu, omega, t = sp.symbols("x1 x2 y eps theta mu omega t")

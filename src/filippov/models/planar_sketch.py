@@ -14,6 +14,9 @@ import numpy as np
 
 from ..system import MINUS, PLUS, SLIDING, PiecewiseSystem
 
+#: the model's name in the registry (filippov.models.get) and in a scene's ``model:`` key
+NAME = "planar_sketch"
+
 
 def _h(z):
     return z[1]

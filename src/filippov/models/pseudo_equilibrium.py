@@ -18,6 +18,9 @@ from ..model import TRANSIENT, SlowFastModel
 from ..symbolic import SymbolicSlowFast
 from ..system import SLIDING
 
+#: the model's name in the registry (filippov.models.get) and in a scene's ``model:`` key
+NAME = "pseudo_equilibrium"
+
 
 def _check(eps: float, theta: float) -> None:
     if not np.isfinite(theta) or theta >= 1:

@@ -28,6 +28,7 @@ def _module(scene: dict):
     if sid not in known:
         raise SceneError(f"id: unknown scene {sid!r}; known scenes: {', '.join(known)}")
     module = importlib.import_module(f".{sid}", __name__)
+    _check_model(scene, module)
     # solver.engine: a scene runs on the engines its module lists (default: the reference driver)
     name = scene.get("solver", {}).get("engine", "reference")
     available = product.hook(module, "ENGINES", ("reference",))
@@ -35,6 +36,28 @@ def _module(scene: dict):
         raise SceneError(f"{sid}: solver.engine: {name!r} not available for this scene; "
                          f"expected one of {list(available)}")
     return module
+
+
+def _check_model(scene: dict, module) -> None:
+    """The scene's ``model`` is a registered model (:func:`filippov.models.get`) and the one
+    its module computes with: a model module the scene module holds must be that one
+    (modules that take it from the scene, :func:`~filippov_paper.scenes.common.registered_model`,
+    hold none)."""
+    import types
+
+    from filippov import models
+
+    if "model" not in scene:   # a partial scene (the schema requires one of every scene file)
+        return
+    try:
+        chosen = models.get(scene["model"])
+    except ValueError as exc:
+        raise SceneError(f"{scene.get('id')}: {exc}") from None
+    held = {v.NAME for v in vars(module).values() if isinstance(v, types.ModuleType)
+            and v.__name__.startswith("filippov.models.") and hasattr(v, "NAME")}
+    if held - {chosen.NAME}:
+        raise SceneError(f"{scene.get('id')}: model: {chosen.NAME!r}, but the scene computes "
+                         f"with {', '.join(sorted(held))}")
 
 
 def check(scene: dict) -> None:

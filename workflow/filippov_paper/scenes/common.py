@@ -29,3 +29,11 @@ def require(scene: dict, field: str, allowed) -> str:
         raise ValueError(f"{scene['id']}: ingredients.{field}: {value!r} not supported here; "
                          f"expected one of {sorted(map(str, allowed))}")
     return value
+
+
+def registered_model(scene: dict):
+    """The scene's model, from the registry by its ``model`` key (:func:`filippov.models.get`;
+    an unknown name raises ValueError naming ``model`` and the choices)."""
+    from filippov import models
+
+    return models.get(scene["model"])

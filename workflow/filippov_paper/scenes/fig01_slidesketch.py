@@ -6,9 +6,8 @@ import xarray as xr
 
 from filippov import simulate
 from filippov.io import finalize
-from filippov.models import planar_sketch
 from filippov.progress import Progress
-from filippov_paper.scenes.common import require, solver_options
+from filippov_paper.scenes.common import registered_model, require, solver_options
 from filippov_paper.report import Macros, tex_escape, var
 
 CASES = ("crossing", "sliding")
@@ -39,7 +38,7 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     out = {k: [] for k in ("x1", "x2", "mode", "hit_x1", "hit_x2", "u", "v")}
     bar = Progress(scene["id"], len(CASES), progress)
     for case in CASES:
-        sys_ = planar_sketch.system(case)
+        sys_ = registered_model(scene).system(case)
         traj = simulate(sys_, p["start"], p["t_end"], **opts)
         _, z, mode = traj.sample(t, include_events=False)
         hit = next(e for e in traj.events if e.kind in ("crossing", "slide_start"))

@@ -7,11 +7,10 @@ import xarray as xr
 from filippov import simulate
 from filippov.analytic import chatter
 from filippov.io import finalize
-from filippov.models import pseudo_equilibrium
 from filippov.progress import Progress
 from filippov.sliding import attracting_intervals
 from filippov.system import PLUS
-from filippov_paper.scenes.common import require, solver_options
+from filippov_paper.scenes.common import registered_model, require, solver_options
 import math
 from filippov_paper.report import Macros, value, var
 
@@ -30,6 +29,7 @@ SETTLE_PERIODS = 40  # the orbit contracts by ~0.03 a period (theta=-0.5): ample
 
 def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     kind = require(scene, "system", {"slow_fast"})
+    scene_model = registered_model(scene)
     p = scene["parameters"]
     eps, thetas = float(p["eps"]), [float(v) for v in p["theta"]]
     if sorted(np.sign(thetas)) != [-1.0, 1.0] or len(thetas) != 2:
@@ -39,7 +39,7 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     bar = Progress(scene["id"], len(thetas), progress)
     tracks, scalars, extra = {}, {}, {}
     for theta in thetas:
-        model = pseudo_equilibrium.model(eps, theta)
+        model = scene_model.model(eps, theta)
         system = model.system(kind, sliding=scene["ingredients"]["sliding"],
                               exact=opts["method"] == "exact")
         traj = simulate(system, p["start"], p["t_end"], **opts)

@@ -31,11 +31,10 @@ from scipy.optimize import brentq
 
 from filippov import simulate
 from filippov.io import finalize
-from filippov.models import hopf
 from filippov.progress import Progress
 from filippov.simulate import Section
 from filippov_paper.tolerance import Tolerance
-from filippov_paper.scenes.common import require, solver_options
+from filippov_paper.scenes.common import registered_model, require, solver_options
 import math
 from filippov_paper.report import Macros, source, value, var
 
@@ -155,6 +154,7 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     out = {k: [] for k in ("t", "x1", "x2", "mode", "period", "fixed_x2", "settle", "n_periods",
                            "x_h", "x_l", "x_l_formula", "left", "sliding_time")}
     bar = Progress(scene["id"], len(mus), progress)
+    hopf = registered_model(scene)   # the reduced Hopf example, from the registry
     for mu in mus:
         # theta and eps do not enter the reduced system: h0 = x1 + 1 for every theta
         system = hopf.model(0.0, 0.0, mu, omega).reduced(sliding=True, exact=opts["method"] == "exact")

@@ -16,11 +16,11 @@ import numpy as np
 import xarray as xr
 
 from filippov.io import finalize
-from filippov.models import hopf
+from filippov import models
 from filippov.poincare import first_returns, fixed_points
 from filippov.progress import Progress
 from filippov.simulate import Section
-from filippov_paper.scenes.common import engine, require, solver_options
+from filippov_paper.scenes.common import engine, registered_model, require, solver_options
 from filippov_paper.tolerance import Tolerance, sqrt_law
 import math
 from filippov_paper.report import Macros, source, value, var
@@ -81,7 +81,7 @@ def return_map(model, x2, method: str, options: dict, progress=None, sliding=Tru
     """
     starts = np.stack([np.zeros_like(x2), x2, np.zeros_like(x2)], axis=1)
     t_max = 4.0 * 2 * np.pi / abs(model.parameters["omega"])
-    # the model's view for each engine (hopf.compiled carries the section L1; method
+    # the model's view for each engine (the compiled model carries the section L1; method
     # "integrate": regions + and - integrated, by the kernel's DOP853 on the compiled
     # engine); one front door runs either (filippov.engines)
     system, section, options = _on_engine(model, method, options, sliding, engine)
@@ -96,8 +96,9 @@ def _on_engine(model, method: str, options: dict, sliding: bool, engine: str):
     exact = method == "exact"
     if engine == "compiled":
         par = model.parameters
-        return (hopf.compiled(par["eps"], par["theta"], par["mu"], par["omega"],
-                              sliding=sliding, exact=exact), None, options)
+        return (models.get(model.name).compiled(par["eps"], par["theta"], par["mu"],
+                                                par["omega"], sliding=sliding, exact=exact),
+                None, options)
     return model.full(sliding=sliding, exact=exact), section_L1(), dict(options, method=method)
 
 
@@ -142,7 +143,7 @@ def sweep(scene: dict, x2: np.ndarray, *, progress: bool = False) -> xr.Dataset:
     bar = Progress(scene["id"], len(thetas) * x2.size, progress)
     P, res, tof, nsw, slide, first = [], [], [], [], [], []
     for theta in thetas:
-        model = hopf.model(eps, theta, mu, omega)
+        model = registered_model(scene).model(eps, theta, mu, omega)
         px2, r, ret = return_map(model, x2, method, opts, bar, scene["ingredients"]["sliding"],
                                  kernel)
         P.append(px2), res.append(r), tof.append(ret.time)
@@ -174,7 +175,7 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     slide, first = raw["sliding_time"].values, raw["first_switch_time"].values
     sig, chi, fps = [], [], []
     for theta, px2 in zip(thetas, P):
-        model = hopf.model(eps, theta, mu, omega)
+        model = registered_model(scene).model(eps, theta, mu, omega)
         s, c = sigma_minus(model)
         sig.append(s), chi.append(c)
         fps.append(fixed_points(x2, px2))

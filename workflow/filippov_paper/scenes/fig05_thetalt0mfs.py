@@ -28,7 +28,7 @@ from filippov.io import finalize
 from filippov.models import hopf
 from filippov.simulate import Section
 from filippov.system import MINUS, PLUS
-from filippov_paper.scenes.common import require, solver_options
+from filippov_paper.scenes.common import registered_model, require, solver_options
 from filippov_paper.report import Macros, var
 
 #: this scene's block of the scene schema: filippov_paper.config.load_scene adds it to
@@ -173,7 +173,7 @@ def _model_and_system(scene: dict):
         raise ValueError(f"{scene['id']}: parameters.theta must be < 0 (case 2), got {theta}")
     if mu != 1.0:
         raise ValueError(f"{scene['id']}: parameters.mu must be 1 (grazing at p_g), got {mu}")
-    model = hopf.model(eps, theta, mu, omega)
+    model = registered_model(scene).model(eps, theta, mu, omega)
     system = model.system(kind, sliding=scene["ingredients"]["sliding"],
                           exact=opts["method"] == "exact")
     return model, system, opts

@@ -5,9 +5,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from filippov.analytic import sgraph
 from filippov.io import finalize
-from filippov_paper.scenes.common import require
+from filippov_paper.scenes.common import registered_model, require
 from filippov_paper.report import Macros, source, var
 
 
@@ -27,6 +26,7 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
         raise ValueError(f"{scene['id']}: 0 < parameters.t_min < parameters.t_max required, "
                          f"got {p['t_min']!r}, {p['t_max']!r}")
     theta, omega = float(p["theta"]), float(p["omega"])
+    sgraph = registered_model(scene)   # the closed forms of filippov.analytic.sgraph
     t = t_grid(p)
     xi1 = sgraph.xi1(t, theta, omega)
     img = sgraph.image(t, theta, omega)

@@ -4,9 +4,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from filippov.analytic import s0
 from filippov.io import finalize
-from filippov_paper.scenes.common import require
+from filippov_paper.scenes.common import registered_model, require
 from filippov_paper.report import Macros
 
 VARIABLE_ATTRS = {"residual": ("left side of eq:s0def at the closed-form s0", "1")}
@@ -25,6 +24,7 @@ def tolerances(scene: dict) -> dict:
 def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     require(scene, "system", {"none"})
     require(scene, "flow", {"closed_form"})
+    s0 = registered_model(scene)   # the closed form and root finding of filippov.analytic.s0
     p = scene["parameters"]
     lo, hi, n = p["theta_min"], p["theta_max"], p["n_theta"]
     if not lo < hi < 0:

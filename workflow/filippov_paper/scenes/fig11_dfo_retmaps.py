@@ -236,17 +236,13 @@ def return_map(x1, eps, v0, law, *, rtol=1e-12, atol=1e-14, progress=None,
 def near_manifold_start(x1, eps, v0, law, t_pull=0.5):
     """A start point that is on M_+ up to about exp(-T/eps) by the time it
     reaches L: (x1, 0) pulled back along the slow flow on the second-order
-    expansion w2 for T = min(30 eps, t_pull) (short enough to stay below H_s)."""
-    ml = {k: law[k] for k in ("f0", "fv", "fc", "convention")}
+    expansion w2 of the model (:data:`filippov.models.dry_friction.W2_PLUS`, analytic
+    branch) for T = min(30 eps, t_pull) (short enough to stay below H_s)."""
     gamma = law["gamma"]
-    Fp, dFp = df.friction_branches(**ml)[:2]
-    g1 = 1.0 + gamma
-
-    def w2(a, b):
-        F = Fp(b - v0)
-        return v0 + gamma * b + eps * gamma * F + eps ** 2 * gamma * dFp(b - v0) * (a + (1 - gamma) * F)
-
-    back = lambda t, z: -np.array([z[1], -z[0] - Fp(g1 * z[1] - w2(z[0], z[1]))])
+    coef = df.law_coefficients(law["f0"], law["fv"], law["fc"], law["convention"])
+    plus = df.REGION_PLUS["analytic"]
+    w2 = lambda a, b: plus["w2"](a, b, eps, v0, gamma, *coef)  # noqa: E731
+    back = lambda t, z: -np.array([z[1], plus["slow"](z[0], z[1], w2(z[0], z[1]), gamma, *coef)])
     T = min(30 * eps, t_pull)
     zs = solve_ivp(back, (0.0, T), [x1, 0.0], method="DOP853", rtol=1e-12, atol=1e-14).y[:, -1]
     return np.array([zs[0], zs[1], w2(zs[0], zs[1])])

@@ -6,10 +6,9 @@ import numpy as np
 import xarray as xr
 
 from filippov_paper.config import SceneError
-from filippov.models import hopf
 from filippov.pdm import discontinuity_map, scale_for
 from filippov.progress import Progress
-from filippov_paper.scenes.common import require, solver_options
+from filippov_paper.scenes.common import registered_model, require, solver_options
 
 
 def xi1_grid(p: dict) -> np.ndarray:
@@ -47,7 +46,7 @@ def pdm_fields(scene: dict, theta: float, xi: np.ndarray,
     bar = Progress(scene["id"], eps.size * xi.size, progress)
     rows = []
     for e in eps:
-        model = hopf.model(float(e), theta, mu, omega)
+        model = registered_model(scene).model(float(e), theta, mu, omega)
         rows.append(discontinuity_map(model, xi, scale=scale_for(float(e), theta),
                                       sliding=scene["ingredients"]["sliding"], method=method,
                                       progress=bar, **opts))
