@@ -15,6 +15,7 @@ from filippov.kernel import driver, state
 from filippov.models import hopf
 
 KERNEL_DIR = Path(driver.__file__).parent
+ROOT = Path(__file__).resolve().parent.parent
 
 
 @pytest.mark.parametrize("names, prefix, size", [
@@ -98,4 +99,17 @@ def test_no_kernel_helper_takes_more_than_8_arguments_or_runs_over_80_lines():
     long = [(f, n.name, len(n.args.args), n.end_lineno - n.lineno + 1)
             for f, n in _functions()
             if len(n.args.args) > 8 or n.end_lineno - n.lineno + 1 > 80]
+    assert not long, long
+
+
+def test_no_function_of_the_library_or_the_pipeline_runs_over_80_lines():
+    # issue 32: the largest function fits on a screen (docstring included)
+    long = []
+    for folder in (ROOT / "src" / "filippov", ROOT / "workflow" / "filippov_paper"):
+        for path in sorted(folder.rglob("*.py")):
+            for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+                if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                    lines = node.end_lineno - node.lineno + 1
+                    if lines > 80:
+                        long.append(f"{path.relative_to(ROOT)}:{node.name} ({lines})")
     assert not long, long

@@ -202,6 +202,22 @@ def _refuse_the_start_itself(z, period, f) -> None:
             "a guess off the section, or make the exact flow's rounding smaller")
 
 
+def _checked_start(system, guess, returns, engine) -> np.ndarray:
+    """periodic_orbit's arguments checked (each refused naming it); the guess as a vector."""
+    engines.checked(engine)
+    if not callable(getattr(system, "python_section", None)):
+        raise TypeError(f"system: periodic_orbit expected a FilippovSystem or a "
+                        f"SymbolicSystem (a system defined once: both engines' views), "
+                        f"got {type(system).__name__}")
+    z = np.array(guess, dtype=float).reshape(-1)
+    if z.size != len(system.names) or not np.all(np.isfinite(z)):
+        raise ValueError(f"guess: expected {len(system.names)} finite values "
+                         f"({', '.join(system.names)}), got {np.asarray(guess).tolist()}")
+    if not (isinstance(returns, (int, np.integer)) and returns >= 1):
+        raise ValueError(f"returns must be an integer >= 1, got {returns!r}")
+    return z
+
+
 def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
                    returns: int = 1, engine: str = "compiled", t_max: float,
                    tol: float = 1e-12, max_iter: int = 20, **options) -> PeriodicOrbit:
@@ -252,24 +268,15 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
         return is the start itself (a path shorter than ``SHORTEST_PATH`` of the state's
         size: the start a hair before the section by rounding).
     """
-    engines.checked(engine)
-    if not callable(getattr(system, "python_section", None)):
-        raise TypeError(f"system: periodic_orbit expected a FilippovSystem or a "
-                        f"SymbolicSystem (a system defined once: both engines' views), "
-                        f"got {type(system).__name__}")
-    z = np.array(guess, dtype=float).reshape(-1)
-    if z.size != len(system.names) or not np.all(np.isfinite(z)):
-        raise ValueError(f"guess: expected {len(system.names)} finite values "
-                         f"({', '.join(system.names)}), got {np.asarray(guess).tolist()}")
-    if not (isinstance(returns, (int, np.integer)) and returns >= 1):
-        raise ValueError(f"returns must be an integer >= 1, got {returns!r}")
+    z = _checked_start(system, guess, returns, engine)
     ret, section_value = _returns(system, section, direction, where, engine, t_max,
                                   int(returns), options)
     for it in range(1, max_iter + 1):
         Pz, period, J = ret(z)
         residual = float(np.abs(Pz - z).max())
         if residual <= tol * (1.0 + np.abs(z).max()):
-            f = _field_at(engines.reference_system(system, "periodic_orbit"), z, options.get("touch_tol", 1e-15))
+            f = _field_at(engines.reference_system(system, "periodic_orbit"), z,
+                          options.get("touch_tol", 1e-15))
             _refuse_the_start_itself(z, period, f)
             mult = floquet_from_return(J, f, normal=_section_normal(section_value, z))
             return PeriodicOrbit(z, period, mult, J, it - 1, residual)
