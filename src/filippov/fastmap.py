@@ -350,6 +350,9 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     fewer threads, down to the calling thread alone.
     """
     starts, ages = _checked_starts(cmodel, starts, start_age)
+    # the pieces checked before anything calls them: check_compiled's Python call would
+    # compile a lazy njit piece (one the kernel cannot call at an address) on the spot
+    _pieces(cmodel)
     if starts.shape[0]:
         check_compiled(cmodel, starts[0])  # the reference driver's start check, once a model
     params = np.ascontiguousarray(np.atleast_2d(np.asarray(cmodel.params, dtype=float)))
@@ -417,6 +420,7 @@ def sweep_returns(cmodels, starts, t_max: float, *, start_age=0.0, workers=None,
     if starts.shape[0] != len(cmodels):
         raise ValueError(f"starts: one start point per model, got {starts.shape[0]} starts "
                          f"for {len(cmodels)} cmodels")
+    _pieces(first)  # before check_compiled calls them (see compute_returns)
     for i, c in enumerate(cmodels):  # once a model object (checks.check_compiled)
         check_compiled(c, starts[i])
     defaults = {name: par.default for name, par in
