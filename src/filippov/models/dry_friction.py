@@ -133,7 +133,7 @@ def _written(text: str):
     return codegen.parse_written(text, _NAMES)
 
 
-#: F_c(nu) = sgn(nu) [s0 + sc (1 - e^{-|nu|})] + fv nu (coefficients: :func:`_coefficients`):
+#: ``F_c(nu) = sgn(nu) [s0 + sc (1 - e^{-|nu|})] + fv nu`` (coefficients: :func:`_coefficients`):
 #: its smooth branches for nu < 0 (region +) and nu > 0 (region -), each extended to all nu
 FRICTION = {"plus": _written("-s0 - sc * (1 - exp(nu)) + fv * nu"),
             "minus": _written("s0 + sc * (1 - exp(-nu)) + fv * nu")}
