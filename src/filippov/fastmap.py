@@ -352,11 +352,11 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     starts, ages = _checked_starts(cmodel, starts, start_age)
     # the pieces checked before anything calls them: check_compiled's Python call would
     # compile a lazy njit piece (one the kernel cannot call at an address) on the spot
-    _pieces(cmodel)
+    pieces = _pieces(cmodel)
     if starts.shape[0]:
         check_compiled(cmodel, starts[0])  # the reference driver's start check, once a model
     params = np.ascontiguousarray(np.atleast_2d(np.asarray(cmodel.params, dtype=float)))
-    return _returns(cmodel, params, starts, ages, t_max, rtol=rtol, atol=atol,
+    return _returns(cmodel, pieces, params, starts, ages, t_max, rtol=rtol, atol=atol,
                     max_step=max_step, max_events=max_events, max_steps=max_steps,
                     samples_per_step=samples_per_step, touch_tol=touch_tol,
                     event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span,
@@ -420,7 +420,7 @@ def sweep_returns(cmodels, starts, t_max: float, *, start_age=0.0, workers=None,
     if starts.shape[0] != len(cmodels):
         raise ValueError(f"starts: one start point per model, got {starts.shape[0]} starts "
                          f"for {len(cmodels)} cmodels")
-    _pieces(first)  # before check_compiled calls them (see compute_returns)
+    pieces = _pieces(first)  # before check_compiled calls them (see compute_returns)
     for i, c in enumerate(cmodels):  # once a model object (checks.check_compiled)
         check_compiled(c, starts[i])
     defaults = {name: par.default for name, par in
@@ -429,18 +429,18 @@ def sweep_returns(cmodels, starts, t_max: float, *, start_age=0.0, workers=None,
     unknown = set(options) - set(defaults)
     if unknown:
         raise TypeError(f"sweep_returns() got unexpected options {sorted(unknown)}")
-    return _returns(first, params, starts, ages, t_max, workers=workers,
+    return _returns(first, pieces, params, starts, ages, t_max, workers=workers,
                     **{**defaults, **options})
 
 
-def _returns(cmodel: CompiledModel, params, starts, ages, t_max, *, rtol, atol, max_step,
-             max_events, max_steps, samples_per_step, touch_tol, event_xtol, zeno_count,
-             zeno_span, min_time, iterations, keep, jacobian, workers) -> BatchReturns:
+def _returns(cmodel: CompiledModel, pieces, params, starts, ages, t_max, *, rtol, atol,
+             max_step, max_events, max_steps, samples_per_step, touch_tol, event_xtol,
+             zeno_count, zeno_span, min_time, iterations, keep, jacobian,
+             workers) -> BatchReturns:
     """compute_returns and sweep_returns after their own checks of the starts: the
-    options checked, one kernel call over the batch (``params``: one row for all the
-    starts, or one row a start)."""
+    options checked, one kernel call over the batch (``pieces``: the model's addresses,
+    :func:`_pieces`; ``params``: one row for all the starts, or one row a start)."""
     workers = _checked_workers(workers)
-    pieces = _pieces(cmodel)  # their addresses
     options.check(rtol=rtol, atol=atol, max_step=max_step, max_events=max_events,
                   max_steps=max_steps, samples_per_step=samples_per_step, touch_tol=touch_tol,
                   event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span)

@@ -161,8 +161,7 @@ def run(starts: int = 2000, returns: int = 10, repeat: int = 3, log=print) -> xr
                 f"{span_speed:12.2f} "
                 f"{span_speed / n:9.2f}")
     return finalize(ds, None, starts=starts, returns=returns, repeat=repeat,
-                    load_average_before=float(load_before[0]),
-                    load_average_after=float(load_after[0]), cpus=os.cpu_count() or 1,
+                    **timing.load_attrs(load_before, load_after),
                     **timing.describe(min_rounds=repeat, min_time=MIN_TIME),
                     title="returns per second of compute_returns with 1..N workers "
                           "(iterated Hopf return map, compiled engine)")

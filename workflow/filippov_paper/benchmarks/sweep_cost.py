@@ -121,8 +121,7 @@ def run(points: int = 200, returns: int = 40, repeat: int = 3, log=print) -> xr.
                 f"{1e6 * r['cpu'] / points:12.1f} {loop['cpu'] / r['cpu']:13.2f} "
                 f"{loop['wall'] / r['wall']:14.2f}")
     return finalize(ds, None, points=points, returns=returns, repeat=repeat,
-                    load_average_before=float(load_before[0]),
-                    load_average_after=float(load_after[0]), cpus=os.cpu_count() or 1,
+                    **timing.load_attrs(load_before, load_after),
                     **timing.describe(min_rounds=repeat, min_time=MIN_TIME),
                     title="a parameter sweep of the Hopf return map: one call per point "
                           "against one sweep_returns call (compiled engine)")

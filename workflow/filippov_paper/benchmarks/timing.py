@@ -20,6 +20,7 @@ A per-call time cap is the caller's business (the work-precision runners raise
 """
 from __future__ import annotations
 
+import os
 import statistics
 import time
 from dataclasses import dataclass, field
@@ -76,3 +77,10 @@ def describe(*, warmup: int = WARMUP, min_rounds: int = MIN_ROUNDS, min_time: fl
             "timing": f"{STATISTIC} of at least {min_rounds} timed rounds (more until "
                       f"{min_time:g} s were timed, at most {max_rounds}) after {warmup} "
                       f"untimed warm-up call(s); the min is stored as well"}
+
+
+def load_attrs(load_before, load_after) -> dict:
+    """The dataset attributes that say how loaded the machine was while a benchmark ran
+    (``os.getloadavg()`` before and after it) and how many CPUs it has."""
+    return {"load_average_before": float(load_before[0]),
+            "load_average_after": float(load_after[0]), "cpus": os.cpu_count() or 1}
