@@ -76,14 +76,21 @@ def _planned(work: Path) -> dict[str, set]:
     return jobs
 
 
-def test_changing_one_scene_reruns_only_its_chain(workflow_build, tmp_path):
+def _planned_after_edit(workflow_build, tmp_path, scene_id: str, old: str, new: str) -> dict:
+    """The jobs a copy of the finished build plans (none before) after ``old`` is
+    replaced by ``new`` in the scene file ``scene_id``."""
     work = _copy_of_build(workflow_build, tmp_path)
     assert _planned(work) == {}
-    scene = work / "config" / "scenes" / "fig08_s0theta.yaml"
+    scene = work / "config" / "scenes" / f"{scene_id}.yaml"
     text = scene.read_text()
-    assert "n_theta: 400" in text
-    scene.write_text(text.replace("n_theta: 400", "n_theta: 401"))
-    jobs = _planned(work)
+    assert old in text
+    scene.write_text(text.replace(old, new))
+    return _planned(work)
+
+
+def test_changing_one_scene_reruns_only_its_chain(workflow_build, tmp_path):
+    jobs = _planned_after_edit(workflow_build, tmp_path, "fig08_s0theta", "n_theta: 400",
+                               "n_theta: 401")
     assert jobs.pop("compute") == {"fig08_s0theta"}
     assert jobs.pop("plot") == {"fig08_s0theta"}
     jobs.pop("all", None)
@@ -98,13 +105,8 @@ def test_changing_a_compiled_engine_scene_reruns_only_its_chain(workflow_build, 
     other compiled-engine scenes, the hard cases or the work-precision sweep (a shared
     input regenerated for it -- a kernel-compiled marker was tried -- would rerun them
     all: 'input files updated by another job')."""
-    work = _copy_of_build(workflow_build, tmp_path)
-    assert _planned(work) == {}
-    scene = work / "config" / "scenes" / "fig04_retmaps.yaml"
-    text = scene.read_text()
-    assert "n_geometric: 100" in text
-    scene.write_text(text.replace("n_geometric: 100", "n_geometric: 101"))
-    jobs = _planned(work)
+    jobs = _planned_after_edit(workflow_build, tmp_path, "fig04_retmaps", "n_geometric: 100",
+                               "n_geometric: 101")
     assert jobs.pop("compute_chunk") == {"fig04_retmaps"}
     assert jobs.pop("merge_chunks") == {"fig04_retmaps"}
     assert jobs.pop("plot") == {"fig04_retmaps"}
