@@ -1,0 +1,11 @@
+"""The event loop's structure, written once for both engines.
+
+:mod:`filippov.rules` holds each decision (which side, which mode, which tie); this
+package holds the order in which the loop asks them -- in a sample interval, at an
+event, against the budgets -- as plain scalar Python built from the engine's own
+operations (how it steps, samples, refines and stores). The reference driver
+(:mod:`filippov.simulate`) runs these functions as they are, with its Python
+operations; the compiled kernel (:mod:`filippov.kernel`) compiles the same functions
+with numba, with its compiled operations. What still differs between the engines is
+listed, each with its reason and its test, in :mod:`filippov.engines`.
+"""
