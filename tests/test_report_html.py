@@ -167,6 +167,8 @@ def test_scene_captions_render_without_errors_or_labels(scene, tmp_path):
         assert f"<strong>{PRINTED[data['paper_figure']]}</strong>" in figure
     else:
         assert "Beyond the paper" in figure
+    # the template says where a figure stands; the scene's description does not repeat it
+    assert len(re.findall(r"Beyond the (paper|figures)", figure)) <= 1, figure
     assert "netCDF-3 64-bit offset" in dataset and "netCDF4" not in dataset
     assert f"{PRINTED['eq:ymm']} (Fig. 5), M_+ and P_DM" in dataset
     shown = re.sub(r"<[^>]+>", "", figure)  # docutils splits a literal at "-" into spans
