@@ -18,15 +18,18 @@ import numpy as np
 from scipy.linalg import expm
 from scipy.optimize import brentq
 
-from filippov import PLUS, PiecewiseSystem, floquet_multipliers, monodromy, simulate
+from filippov import PLUS, FilippovSystem, floquet_multipliers, monodromy, simulate
 
 A = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, -3.0, -3.0]])  # (s + 1)^3
 b, c = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
 RTOL = 1e-12  # DOP853's relative tolerance, for the orbit and its variational equations
-col = lambda v, z: v.reshape((-1,) + (1,) * (np.ndim(z) - 1))  # v against z (n,) or (n, m)
-SYSTEM = PiecewiseSystem(("x1", "x2", "x3"), lambda z: A @ z + col(b, z),
-                         lambda z: A @ z - col(b, z), lambda z: c @ z,
-                         lambda z: np.broadcast_to(col(c, z), np.shape(z)).copy())
+# A x + b u for one state (compiled pieces); u = -sign(x1): +1 in region -, -1 in +
+SYSTEM = FilippovSystem(
+    ("x1", "x2", "x3"),
+    field_minus=lambda z, p: np.array([z[1], z[2], -z[0] - 3.0 * z[1] - 3.0 * z[2] + 1.0]),
+    field_plus=lambda z, p: np.array([z[1], z[2], -z[0] - 3.0 * z[1] - 3.0 * z[2] - 1.0]),
+    switch=lambda z, p: z[0], switch_grad=lambda z, p: np.array([1.0, 0.0, 0.0]),
+    jacobians={"minus": lambda z, p: A.copy(), "plus": lambda z, p: A.copy()})
 
 
 def start_point(h):
@@ -47,10 +50,10 @@ def computed(periods=20, rtol=RTOL):
     up = [e for e in sw if e.mode_after == PLUS]  # crossings into c^T x > 0
     down = [e for e in sw if e.mode_after != PLUS and e.t > up[-2].t]
     one = simulate(SYSTEM, up[-1].state, up[-1].t - up[-2].t, method="integrate", rtol=rtol)
-    opts = {"jacobian": lambda mode, z: A, "rtol": rtol}  # both fields are linear
+    # both fields are linear: the system carries their Jacobian A (jacobians=)
     return {"half_period": down[0].t - up[-2].t, "period": up[-1].t - up[-2].t,
-            "x0": up[-1].state, "monodromy": monodromy(SYSTEM, one, **opts)[0],
-            "multipliers": floquet_multipliers(SYSTEM, one, **opts)}
+            "x0": up[-1].state, "monodromy": monodromy(SYSTEM, one, rtol=rtol)[0],
+            "multipliers": floquet_multipliers(SYSTEM, one, rtol=rtol)}
 
 
 def main():

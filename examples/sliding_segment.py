@@ -20,18 +20,18 @@ Run: python examples/sliding_segment.py   (filippov installed, or PYTHONPATH=src
 """
 import numpy as np
 
-from filippov import MINUS, PLUS, SLIDING, PiecewiseSystem, simulate
+from filippov import MINUS, SLIDING, FilippovSystem, simulate
 
 Z0, T_END = (-2.0, 0.5), 4.0
 
-SYSTEM = PiecewiseSystem(
+SYSTEM = FilippovSystem(
     ("x", "y"),
-    field_minus=lambda z: np.stack([np.ones_like(z[0]), 1.0 - z[0]]),
-    field_plus=lambda z: np.stack([np.full_like(z[0], 2.0), np.full_like(z[0], -1.0)]),
-    switch=lambda z: z[1],
-    switch_grad=lambda z: np.stack([np.zeros_like(z[1]), np.ones_like(z[1])]),
-    flows={PLUS: lambda z0, s: np.stack([z0[0] + 2.0 * s, z0[1] - s]),
-           MINUS: lambda z0, s: np.stack([z0[0] + s, z0[1] + (1.0 - z0[0]) * s - s * s / 2])},
+    field_minus=lambda z, p: np.array([1.0, 1.0 - z[0]]),
+    field_plus=lambda z, p: np.array([2.0, -1.0]),
+    switch=lambda z, p: z[1],
+    switch_grad=lambda z, p: np.array([0.0, 1.0]),
+    flow_plus=lambda z0, s, p: np.array([z0[0] + 2.0 * s, z0[1] - s]),
+    flow_minus=lambda z0, s, p: np.array([z0[0] + s, z0[1] + (1.0 - z0[0]) * s - s * s / 2]),
     sample_step=0.05)  # scan step of the exact flows: H varies on the scale of 1
 
 

@@ -21,15 +21,15 @@ Run: python examples/stick_slip.py   (filippov installed, or PYTHONPATH=src)
 import numpy as np
 from scipy.optimize import brentq
 
-from filippov import (PiecewiseSystem, Section, first_returns, fixed_points,
+from filippov import (FilippovSystem, Section, first_returns, fixed_points,
                       floquet_multipliers, simulate)
 
 F, V, D = 1.0, 0.5, 0.2
-slip = lambda friction: lambda z: np.stack([z[1], -z[0] + friction + D * (z[1] - V)])
 # H = v - x' < 0 (faster than the belt): friction -F; H >= 0 (slower): +F
-SYSTEM = PiecewiseSystem(("x", "x'"), field_minus=slip(-F), field_plus=slip(F),
-                         switch=lambda z: V - z[1],
-                         switch_grad=lambda z: np.stack([0.0 * z[1], -np.ones_like(z[1])]))
+SYSTEM = FilippovSystem(
+    ("x", "x'"), field_minus=lambda z, p: np.array([z[1], -z[0] - F + D * (z[1] - V)]),
+    field_plus=lambda z, p: np.array([z[1], -z[0] + F + D * (z[1] - V)]),
+    switch=lambda z, p: V - z[1], switch_grad=lambda z, p: np.array([0.0, -1.0]))
 SECTION = Section("x' = 0 downwards", lambda z: z[1], direction=-1)
 
 

@@ -155,3 +155,48 @@ def test_the_engine_is_compared_in_one_module_of_src_only():
              if _CHOICE.search(p.read_text())}
     assert where <= {"engines.py"}, where
     assert _CHOICE.search("if engine == 'compiled':")  # the pattern catches the old form
+
+
+def test_two_public_system_types():
+    """A numeric system and its symbolic front-end; what the engines run is built from
+    them (importable below the front doors, not exported)."""
+    import inspect
+
+    import filippov
+
+    types = {n for n in filippov.__all__ if inspect.isclass(getattr(filippov, n))
+             and n.endswith("System")}
+    assert types == {"FilippovSystem", "SymbolicSystem"}
+    for name in ("PiecewiseSystem", "compile_system", "SymbolicSlowFast", "CompiledModel",
+                 "first_returns_compiled"):
+        assert name not in filippov.__all__ and getattr(filippov, name) is not None
+
+
+def test_the_analysis_functions_take_the_system_the_front_doors_take():
+    """transition_matrix, return_jacobian, monodromy and floquet_multipliers take a
+    FilippovSystem as simulate does (its reference view), and its own Jacobians where it
+    has them: the same numbers as the reference view with the Jacobian passed."""
+    from filippov import (floquet_multipliers, monodromy, return_jacobian,
+                          transition_matrix)
+
+    A = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, -3.0, -3.0]])
+    relay = FilippovSystem(
+        ("x1", "x2", "x3"),
+        lambda z, p: np.array([z[1], z[2], -z[0] - 3.0 * z[1] - 3.0 * z[2] + 1.0]),
+        lambda z, p: np.array([z[1], z[2], -z[0] - 3.0 * z[1] - 3.0 * z[2] - 1.0]),
+        switch=lambda z, p: z[0], switch_grad=lambda z, p: np.array([1.0, 0.0, 0.0]),
+        jacobians={"minus": lambda z, p: A.copy(), "plus": lambda z, p: A.copy()})
+    up = Section("up", lambda z: z[0], direction=1, terminal=1)
+    orbit = simulate(relay, [0.0, 0.29063092, 0.14460608], 20.0, sections=[up],
+                     method="integrate")
+    view, jac = relay.python(), (lambda mode, z: A)
+    assert isinstance(view, PiecewiseSystem)
+    for fn, args in ((transition_matrix, ()), (return_jacobian, (up,))):
+        np.testing.assert_array_equal(fn(relay, orbit, *args),
+                                      fn(view, orbit, *args, jacobian=jac))
+    np.testing.assert_array_equal(monodromy(relay, orbit)[0],
+                                  monodromy(view, orbit, jacobian=jac)[0])
+    np.testing.assert_array_equal(floquet_multipliers(relay, orbit),
+                                  floquet_multipliers(view, orbit, jacobian=jac))
+    with pytest.raises(TypeError, match="system: monodromy expected"):
+        monodromy(object(), orbit)

@@ -37,17 +37,19 @@ def __getattr__(name):
     raise AttributeError(f"module 'filippov' has no attribute {name!r}")
 
 
-# the public system types: PiecewiseSystem (the reference engine's own), FilippovSystem
-# (one numeric definition for both engines) and its symbolic front-ends. SlowFastModel
-# (filippov.model) and CompiledModel (filippov.abi) are what a symbolic slow-fast model
-# and FilippovSystem.compiled() build for an engine: still importable, not exported.
+# the public system types: FilippovSystem (one numeric definition, both engines) and
+# its symbolic front-end SymbolicSystem (SymbolicSystem.slow_fast for a slow-fast model).
+# What the engines run is built from them and stays importable, not exported:
+# PiecewiseSystem (filippov.system, the reference driver's batch form, also written by
+# hand for the reference engine alone), SlowFastModel (filippov.model), CompiledModel,
+# compile_system and with_section (filippov.abi, filippov.compiled_system: the kernel's
+# model with its section), SymbolicSlowFast (filippov.symbolic).
 __all__ = [
-    "PiecewiseSystem", "simulate", "Section",
-    "SimulationError", "ZenoError", "EventLimitError", "SystemContractError",
-    "first_returns", "fixed_points", "monodromy", "floquet_multipliers", "ContinuationError",
-    "transition_matrix", "return_jacobian", "VariationalError",
-    "periodic_orbit", "PeriodicOrbit", "PeriodicOrbitError",
-    "FilippovSystem", "SymbolicSystem", "SymbolicSlowFast", "compile_system", "with_section",
+    "FilippovSystem", "SymbolicSystem",
+    "simulate", "Section", "first_returns", "fixed_points", "periodic_orbit", "PeriodicOrbit",
     "compute_returns", "sweep_returns",
-    "first_returns_compiled", "MINUS", "PLUS", "SLIDING", "__version__",
+    "transition_matrix", "return_jacobian", "monodromy", "floquet_multipliers",
+    "SimulationError", "ZenoError", "EventLimitError", "SystemContractError",
+    "ContinuationError", "VariationalError", "PeriodicOrbitError",
+    "MINUS", "PLUS", "SLIDING", "__version__",
 ]

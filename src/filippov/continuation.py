@@ -34,7 +34,7 @@ from scipy.optimize import minimize_scalar
 from .progress import Progress
 # the derivatives live in filippov.variational; fd_jacobian and saltation stay
 # importable from here, where the continuation code and its users reach for them
-from .variational import (VariationalError, fd_jacobian, saltation,  # noqa: F401
+from .variational import (VariationalError, fd_jacobian, reference_view, saltation,  # noqa: F401
                           switch_matrix, transition_matrix)
 from .errors import ContinuationError  # noqa: F401  (re-exported)
 
@@ -247,7 +247,9 @@ def monodromy(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None):
       it started in: that switch is applied once, at the end, so the result
       does not depend on where on the orbit the period starts.
 
-    Returns (M, multipliers sorted by modulus, descending)."""
+    Returns (M, multipliers sorted by modulus, descending). ``system`` and ``jacobian``
+    as for :func:`filippov.variational.transition_matrix`."""
+    system, jacobian = reference_view(system, jacobian, "monodromy")
     try:
         M = transition_matrix(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
         # simulate logs a start on H = 0 as 'start' in the mode it leaves in, and the
@@ -288,6 +290,7 @@ def floquet_multipliers(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None,
       maps f(z0) to f(z_T), so the trivial multiplier is off by that much.
 
     A missing saltation matrix shifts it by O(1)."""
+    system, jacobian = reference_view(system, jacobian, "floquet_multipliers")
     M, _ = monodromy(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
     lam, wl, vr = scipy.linalg.eig(M, left=True, right=True)
     order = np.argsort(-np.abs(lam))

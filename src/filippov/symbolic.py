@@ -263,6 +263,15 @@ class SymbolicSystem:
         other._system = None
         return other
 
+    @staticmethod
+    def slow_fast(slow, fast, f_minus, f_plus, g_minus, g_plus, switch, *, eps, params,
+                  time=None, flows=None, name: str = "user") -> "SymbolicSlowFast":
+        """A slow-fast model ``x' = f(x, y)``, ``eps y' = g(x, y)`` in SymPy: its
+        ``full()`` and ``reduced()`` systems are SymbolicSystems (see
+        :class:`SymbolicSlowFast` for the arguments)."""
+        return SymbolicSlowFast(slow, fast, f_minus, f_plus, g_minus, g_plus, switch,
+                                eps=eps, params=params, time=time, flows=flows, name=name)
+
 
 class GeneratedSystem(FilippovSystem):
     """A :class:`FilippovSystem` whose pieces are generated from a :class:`SymbolicSystem`:

@@ -60,6 +60,19 @@ def saltation(f_before, f_after, grad):
     return np.eye(f_before.size) + np.outer(f_after - f_before, grad) / speed
 
 
+def reference_view(system, jacobian, capability: str):
+    """The :class:`~filippov.system.PiecewiseSystem` the reference driver ran for
+    ``system`` (any system the front doors take: :func:`filippov.engines.reference_system`)
+    and the Jacobian to use: the caller's ``jacobian``, else the system's own (a
+    FilippovSystem or SymbolicSystem that has its fields' Jacobians), else None
+    (central differences)."""
+    from . import engines
+
+    if jacobian is None and getattr(system, "has_jacobians", False):
+        jacobian = system.jacobian
+    return engines.reference_system(system, capability), jacobian
+
+
 def switch_matrix(system, before: int, after: int, z: np.ndarray):
     """Saltation matrix of a switch from mode ``before`` to ``after`` at ``z``; None
     when there is none: no switch, or the end of sliding (identity)."""
@@ -76,7 +89,7 @@ def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
 
     Parameters
     ----------
-    system : PiecewiseSystem
+    system : FilippovSystem, SymbolicSystem or PiecewiseSystem
         The system ``traj`` was computed with.
     traj : Trajectory
         Its events (``traj.events``) and end (``traj.t``, ``traj.z``) are used.
@@ -87,12 +100,14 @@ def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
         at rtol 1e-12 and 0.2 s at 1e-10).
     jacobian : callable, optional
         ``jacobian(mode, z)`` -> (n, n) Jacobian of the field of ``mode``;
-        default: central differences (:func:`field_jacobian`).
+        default: the system's own Jacobians where it has them, else central
+        differences (:func:`field_jacobian`).
 
     Returns
     -------
     ndarray, shape (n, n)
     """
+    system, jacobian = reference_view(system, jacobian, "transition_matrix")
     n = system.dim
     jac = jacobian or (lambda mode, z: field_jacobian(system, mode, z))
     M = np.eye(n)
@@ -149,6 +164,7 @@ def return_jacobian(system, traj, section, *, rtol: float = 1e-10, atol: float =
     if traj.status != f"section:{section.name}":
         raise VariationalError(f"the trajectory ended with status {traj.status!r}, not at a "
                                f"hit of section {section.name!r}")
+    system, jacobian = reference_view(system, jacobian, "return_jacobian")
     Phi = transition_matrix(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
     z = np.asarray(traj.z, dtype=float)
     grad = (np.asarray(section_grad(z), dtype=float) if section_grad is not None else
