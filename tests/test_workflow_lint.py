@@ -111,6 +111,12 @@ sys.exit("error: fig99_test: something wrong")
     for line in ("[fig99_test] 1/2", "[fig99_test] 2/2", "error: fig99_test: something wrong"):
         assert line in run.stderr and line in logged, (line, run.stderr, logged)
     assert "a table line" in run.stdout and "a table line" in logged
+    # the job's CPU, last line of the log only (filippov_paper.benchmarks.build_cost)
+    last = logged.rstrip("\n").splitlines()[-1]
+    assert last.startswith("joblog: CPU ") and "joblog: CPU" not in run.stderr + run.stdout
+    from filippov_paper.benchmarks.build_cost import job_cpu
+    total, before = job_cpu(logged)
+    assert 0.0 < before < total
 
 
 def test_joblog_without_a_log_changes_nothing():

@@ -4,6 +4,8 @@ The library knows numerics only: models, the event-driven solver, return maps,
 the paper's closed forms, and datasets with provenance. It knows nothing of
 Snakemake; the workflow calls it through thin scripts.
 """
+import sys
+import types
 from importlib.metadata import PackageNotFoundError, version as _version
 
 try:
@@ -11,29 +13,36 @@ try:
 except PackageNotFoundError:  # running from a source tree without install
     __version__ = "0.1.0"
 
-from .system import PiecewiseSystem, MINUS, PLUS, SLIDING
-from .model import SlowFastModel
-from .simulate import simulate, Section, SimulationError, ZenoError, EventLimitError
-from .checks import SystemContractError
-from .poincare import first_returns, fixed_points
-from .continuation import monodromy, floquet_multipliers, ContinuationError
-from .variational import transition_matrix, return_jacobian, VariationalError
-from .periodic import periodic_orbit, PeriodicOrbit, PeriodicOrbitError
-
-# the compiled engine (numba) and the symbolic front-end (sympy) are imported on first
-# use, not by `import filippov`
-_COMPILED = {"compile_system": "compiled_system", "with_section": "compiled_system",
-             "FilippovSystem": "compiled_system",
-             "SymbolicSystem": "symbolic", "SymbolicSlowFast": "symbolic",
-             "CompiledModel": "abi", "compute_returns": "fastmap", "sweep_returns": "fastmap",
-             "first_returns_compiled": "fastmap"}
+# Every name is imported on first use, not by `import filippov`: a job that only reads a
+# dataset (filippov.io) or draws one does not pay for scipy's integrators (0.4 s of CPU a
+# process), nor for the compiled engine (numba) and the symbolic front-end (SymPy)
+_LAZY = {
+    "PiecewiseSystem": "system", "MINUS": "system", "PLUS": "system", "SLIDING": "system",
+    "SlowFastModel": "model",
+    "Section": "simulate", "SimulationError": "simulate",
+    "ZenoError": "simulate", "EventLimitError": "simulate",
+    "SystemContractError": "checks",
+    "first_returns": "poincare", "fixed_points": "poincare",
+    "monodromy": "continuation", "floquet_multipliers": "continuation",
+    "ContinuationError": "continuation",
+    "transition_matrix": "variational", "return_jacobian": "variational",
+    "VariationalError": "variational",
+    "periodic_orbit": "periodic", "PeriodicOrbit": "periodic",
+    "PeriodicOrbitError": "periodic",
+    "compile_system": "compiled_system", "with_section": "compiled_system",
+    "FilippovSystem": "compiled_system",
+    "SymbolicSystem": "symbolic", "SymbolicSlowFast": "symbolic",
+    "CompiledModel": "abi", "compute_returns": "fastmap", "sweep_returns": "fastmap",
+    "first_returns_compiled": "fastmap"}
 
 
 def __getattr__(name):
-    if name in _COMPILED:
+    if name in _LAZY:
         import importlib
 
-        return getattr(importlib.import_module(f".{_COMPILED[name]}", __name__), name)
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value   # looked up once
+        return value
     raise AttributeError(f"module 'filippov' has no attribute {name!r}")
 
 
@@ -53,3 +62,26 @@ __all__ = [
     "ContinuationError", "VariationalError", "PeriodicOrbitError",
     "MINUS", "PLUS", "SLIDING", "__version__",
 ]
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY) | {"simulate"})
+
+
+class _Package(types.ModuleType):
+    """The package, whose ``simulate`` is the function: the submodule of the same name,
+    once imported, is bound here by the import system (which set it after ``from
+    .simulate import simulate`` ran when that was eager); it stays in sys.modules."""
+
+    @property
+    def simulate(self):
+        from .simulate import simulate
+
+        return simulate
+
+    @simulate.setter
+    def simulate(self, value):
+        pass
+
+
+sys.modules[__name__].__class__ = _Package

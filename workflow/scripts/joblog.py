@@ -18,7 +18,9 @@ Imported from workflow/scripts, which Snakemake puts on the path of every script
 """
 from __future__ import annotations
 
+import atexit
 import os
+import resource
 import sys
 
 
@@ -55,3 +57,25 @@ def tee(smk) -> None:
     log = open(smk.log[0], "w", encoding="utf-8", buffering=1)
     sys.stdout = _Tee(sys.stdout, log)
     sys.stderr = _Tee(sys.stderr, log)
+    atexit.register(_cpu_line, log, _cpu())
+
+
+def _cpu() -> float:
+    """CPU seconds (user + system) of this process and the children it waited for."""
+    own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(
+        resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+def _cpu_line(log, at_start: float) -> None:
+    """The job's CPU, last line of its log (read by filippov_paper.benchmarks.build_cost):
+    all of it, and the part before tee() (the interpreter and Snakemake's preamble)."""
+    try:
+        log.write(f"{CPU_TAG} {_cpu():.3f} s (before the script: {at_start:.3f} s)\n")
+        log.flush()
+    except (OSError, ValueError):
+        pass  # a closed log: the job's output is complete without this line
+
+
+#: how the CPU line of a job's log begins
+CPU_TAG = "joblog: CPU"
