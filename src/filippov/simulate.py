@@ -246,30 +246,17 @@ PROJECT_AFTER = 1000  # steps before the step budget is projected from the mean 
 #: accuracy (a fast variable slaved to a slow manifold, e.g. sliding of a slow-fast
 #: system at small eps), and the rest of the stay is integrated by the implicit
 #: Radau IIA method (:mod:`filippov.radau_iia`, STIFF_STAGES stages; listed in
-#: Trajectory.stiff_modes). When to switch is a rent-or-buy choice, since the
-#: length of the stay is unknown. Measured on one sliding return of the Hopf
-#: example (theta = 0.5, rtol 1e-12, 5 stages; seconds at eps = 1e-3, 1e-4, 1e-5,
-#: 1e-6, 1e-7): 100 -> 0.16, 0.17, 0.22, 0.15, 0.17; 50 -> 0.09, 0.09, 0.12, 0.07,
-#: 0.13; 25 -> 0.07, 0.08, 0.07, 0.05, 0.05 (eps = 1e-2 is not stiff: 64 DOP853
-#: steps, 0.04 s, at every choice). With scipy's 3-stage Radau the best was 250.
+#: Trajectory.stiff_modes). Why 25: docs/decisions.md#stiff-switch
 STIFF_AFTER = 25
 
-#: stages of the Radau IIA method that takes over a stiff stay (order 2 s - 1).
-#: The same return at eps = 1e-6 took 1427 steps with scipy's 3-stage Radau
-#: (error estimate of order 3; STIFF_AFTER 250), 124 with 5 stages and 197 with 7
-#: (STIFF_AFTER 25); 7 stages are faster at eps >= 1e-5 but the noise floor
-#: holds them back below (eps = 1e-9: 1195 steps against 83).
+#: stages of the Radau IIA method that takes over a stiff stay (order 2 s - 1; why 5:
+#: docs/decisions.md#stiff-switch)
 STIFF_STAGES = 5
 
-#: A stiff field amplifies the rounding of the state: at eps = 1e-6 the Hopf
-#: example's sliding field moves by ~1e-8 when x1 moves by one ulp (its Jacobian
-#: has entries ~1/eps). The implicit method's error estimate and Newton iteration
-#: cannot settle below h times that noise, so its absolute tolerance is kept at
-#: least NOISE_STEPS * h * field_noise (per component, h the last step). Without
-#: the floor the steps collapsed (scipy's Radau, eps = 1e-7: 11072 steps, 10.8 s,
-#: with it 785 steps; 5-stage Radau IIA at eps = 1e-9: 16425 steps without, 83
-#: with NOISE_STEPS = 10; 1 and 3 left eps <= 1e-8 at 900-2000 steps). The
-#: return P moved by a few ulps at most (tests/test_reliability.py).
+#: A stiff field amplifies the rounding of the state, and the implicit method cannot
+#: settle below h times that noise: its absolute tolerance is kept at least
+#: NOISE_STEPS * h * field_noise (per component, h the last step;
+#: docs/decisions.md#stiff-noise-floor)
 NOISE_STEPS = 10.0
 
 

@@ -3,9 +3,8 @@ to the section (_one), the batch kernel over many start points (_batch), and its
 compilation with the on-disk cache kept in step with the sources.
 
 The kernel comes in two builds of this one source: with the dP/dz code (_batch) and
-without it (_batch_plain, what returns without derivatives run on). The dP/dz code is
-40% of the kernel's machine code; a user who never asks for dP/dz should not wait for it
-to compile (13 s instead of 18 s cold on 2 cores, filippov_paper.benchmarks.compile_cost).
+without it (_batch_plain, what returns without derivatives run on; why:
+docs/decisions.md#kernel-two-builds).
 
 The batch kernel releases the GIL (nogil) and keeps no state between calls but its
 arguments: each call allocates its own work arrays, and start i writes row i of the
@@ -388,7 +387,7 @@ def _batch(fns, params, starts, ages, s, out):
                 for c in range(n):
                     out.orbit[i, j, c] = w.z[c]
                 if keep_jac > 0:  # element by element: a slice assignment compiles
-                    for a in range(n):   # numba's shape-error path (~3 s of compile)
+                    for a in range(n):   # docs/decisions.md#kernel-elementwise-copy
                         for b in range(n):
                             out.orbit_jacobian[i, j, a, b] = w.M[a, b]
             if done >= n_iter:
