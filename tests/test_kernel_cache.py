@@ -53,3 +53,17 @@ def test_the_kernel_can_be_cached():
         if not driver.compile_kernel(derivatives):
             batch = driver.kernel(derivatives)
             assert not batch.overloads[batch.signatures[0]].library.has_dynamic_globals
+
+
+def test_processes_that_start_together_compile_the_kernel_once(tmp_path):
+    """Jobs that start at once (a workflow's first jobs, one per core) share one compile:
+    the one that takes the compile lock compiles and caches, the others wait and load
+    (without the lock each compiled the same kernel: 19-40 s of CPU each)."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path),
+               PYTHONPATH=SRC + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    code = "from filippov.kernel import driver; print(driver.compile_kernel(False))"
+    procs = [subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,
+                              text=True) for _ in range(2)]
+    hits = sorted(p.communicate(timeout=900)[0].strip() for p in procs)
+    assert all(p.returncode == 0 for p in procs)
+    assert hits == ["False", "True"]      # one compiled, the other loaded its cache
