@@ -32,7 +32,8 @@ def test_the_compiled_engine_compiles_the_rules_themselves():
                              (kernel._far_side_probe, rules.far_side_probe),
                              (kernel._section_probe, rules.section_probe),
                              (kernel._section_noise, rules.section_noise),
-                             (kernel._on_section_by_value, rules.on_section_by_value)):
+                             (kernel._on_section_by_value, rules.on_section_by_value),
+                             (kernel._section_first, rules.section_first)):
         assert compiled.py_func is source
 
 
@@ -153,6 +154,27 @@ def test_zeno_span_is_relative_beyond_t_of_one():
     assert not rules.accumulates(0.0, 2e-10, 1e-10)
     assert rules.accumulates(1e6 - 1e-5, 1e6, 1e-10)     # 1e-5 <= 1e-10 * 1e6
     assert not np.isnan(rules.same_instant(1e-15, 1.0))
+
+
+@pytest.mark.parametrize("first", (rules.section_first, kernel._section_first))
+def test_a_section_hit_comes_first_before_or_at_the_instant_of_a_switch(first):
+    """rules.section_first, in Python and as the kernel compiles it (which calls the
+    compiled same_instant): a hit before min_time never counts; with no event so far (inf)
+    every other hit does; against a switch the hit wins up to same_instant after it, not
+    beyond; against another section's hit only a strictly earlier one wins."""
+    xtol, t = 1e-15, 2.0
+    tie = rules.same_instant(xtol, t)
+    assert first(1.0, 0.0, np.inf, False, xtol)
+    assert not first(1.0, 1.5, np.inf, False, xtol)          # before min_time
+    assert first(1.5, 1.5, np.inf, False, xtol)              # at min_time
+    assert first(t - 1e-9, 0.0, t, False, xtol)              # before the switch
+    assert first(t + 0.5 * tie, 0.0, t, False, xtol)         # at its instant: the section
+    assert first(t + tie, 0.0, t, False, xtol)
+    assert not first(t + 2.0 * tie, 0.0, t, False, xtol)     # after it
+    assert first(t - 1e-9, 0.0, t, True, xtol)               # before another section's hit
+    assert not first(t, 0.0, t, True, xtol)                  # at it: the first found stays
+    assert not first(t + 0.5 * tie, 0.0, t, True, xtol)
+    assert not first(np.nan, 0.0, np.inf, False, xtol)       # no root: no hit
 
 
 def test_crossing_predicates_are_the_same_on_scalars_arrays_and_compiled():

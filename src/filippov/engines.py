@@ -17,10 +17,13 @@ periodic_orbit: compiled).
 
 The reference driver (:mod:`filippov.simulate`) and the compiled engine
 (:mod:`filippov.fastmap`, :mod:`filippov.kernel`) take every decision from one rule book
-(:mod:`filippov.rules`) and ask its questions in the same order: in a sample interval,
-the crossing of H (or of a or b while sliding), the end of sliding hidden between the
-samples, then a hidden extremum of H, then the section, whose root at the instant of a
-switch wins the tie (``rules.same_instant``); the hard bounds ``max_events`` (switches)
+(:mod:`filippov.rules`). In a sample interval both run one event search,
+:mod:`filippov.loop.interval` (written once, compiled into the kernel, run as Python by
+the reference), which asks in one order -- the crossing of H (or of a or b while
+sliding), the end of sliding hidden between the samples, then a hidden extremum of H,
+then each section, whose root at the instant of a switch wins the tie
+(``rules.section_first``) -- each engine answering with its own samples and
+refinements. Both keep the hard bounds ``max_events`` (switches)
 and ``max_steps`` (integration steps, or exact-flow windows), counted alike and checked
 before the Zeno ring (``rules.accumulates`` over the last ``zeno_count`` switches); the
 start mode (``rules.start_side``, ``rules.start_on_switch``); the refusal to slide inside

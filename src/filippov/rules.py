@@ -448,6 +448,19 @@ def same_instant(xtol: float, t: float) -> float:
     return 4.0 * (xtol + 4.0 * _EPS * abs(t))
 
 
+def section_first(r: float, t_min: float, best_t: float, best_is_section: bool,
+                  xtol: float) -> bool:
+    """A section's root ``r`` in a sample interval comes first: not before ``t_min`` (the
+    run's start plus the section's min_time), and before the event found so far in the
+    interval (at ``best_t``; inf: none) -- or at its instant (:func:`same_instant`) when
+    that event is a switch or an exit: a section on H is hit where the orbit arrives on
+    H, before the switch, which follows at once on restart. Of two sections' hits at one
+    instant the one found first stays (``best_is_section``)."""
+    if r < t_min:
+        return False
+    return r < best_t or (not best_is_section and r <= best_t + same_instant(xtol, best_t))
+
+
 #: A section crossing in the first sample interval of a run that lies within
 #: START_ULPS rounding errors (eps times the largest component of the state) of
 #: the start point is the start itself, put a hair before the section by rounding:

@@ -31,6 +31,7 @@ from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
 from . import checks, engines, options, rules, variational
+from .loop import interval
 from .radau_iia import RadauIIA
 from .system import MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
@@ -823,10 +824,6 @@ class _Scan:
     def _dH(self, tt):
         return float(self.system.speed_of_switch(self.mode, self.Z(tt)))
 
-    def _touch(self, tm):
-        """A touch of H at tm: no event for the orbit, a kink of P (recorded)."""
-        self.traj.events.append(Event(tm, "touch", self.Z(tm).copy(), self.mode, self.mode))
-
     def candidates(self):
         """Sample intervals that may hold an event, found with array operations; only
         those are examined one by one (a scan of many samples costs a few numpy calls)."""
@@ -851,11 +848,10 @@ class _Scan:
             if self.band > 0.0 and rules.clears_band(self.mode, self.vals[0][i], self.band):
                 order, pos = self._unband(i), 0
                 continue
-            best = self._event_in(i)
-            if best is not None:
-                r, what, k = best
+            _, r, what, k = _interval_event(self, i, self.mode)
+            if what != interval.NONE:
                 z = np.asarray(self.Z(r), dtype=float).reshape(-1).copy()
-                return (r, z, what, k), self.band
+                return (r, z, _WHAT[what], k), self.band
         return None, self.band
 
     def _unband(self, i):
@@ -871,37 +867,33 @@ class _Scan:
         again[:i] = False
         return np.flatnonzero(again)
 
-    def _event_in(self, i):
-        """The earliest event in the sample interval i as (t, what, section index), or
-        None: a crossing of a leave function, else a graze hidden between the samples;
-        then a section hit that comes first (or at the same instant)."""
-        ta, tb = self.ts[i], self.ts[i + 1]
-        best = self._leave_crossing(i, ta, tb)
-        if self.mode == SLIDING and best is None and self.rates is not None:
-            best = self._hidden_slide_end(i, ta, tb)
-        if self.mode != SLIDING and best is None:
-            best = self._hidden_extremum(i, ta, tb)
-        return self._section_hit(i, ta, tb, best)
+    # -------------------------------------------- the event search's operations on it
+    # The order of the questions in one sample interval and its ties are the one event
+    # search (filippov.loop.interval, _interval_event below); these methods are how this
+    # engine answers each, on its samples and its dense output Z. Its failures raise, so
+    # each returns the status OK.
 
-    def _leave_crossing(self, i, ta, tb):
-        best = None  # (t, what, section index)
-        for (func, pred, what), v in zip(self.leave, self.vals):
-            if not rules.crosses(pred, v[i], v[i + 1]):
-                continue
-            lo, vlo = ta, v[i]
-            if (self.mode != SLIDING and self.first and i == 0
-                    and rules.dips_and_returns(self.mode, self.D[0], self.D[1])):
-                # refine beyond the dip: next to the entry H is noise (rules)
-                tm = _brent(self._dH, ta, tb, self.D[0], self.D[1], self.xtol)
-                hm = float(func(self.Z(tm)))
-                if not rules.after(pred, hm):
-                    lo, vlo = tm, hm
-            r = _refine(self._along(func), pred, lo, tb, vlo, v[i + 1], self.xtol)
-            if self.band > 0.0 and what == "switch":
-                r = self._past_band(func, pred, lo, r)
-            if best is None or r < best[0]:
-                best = (r, what, -1)
-        return best
+    def _leave_crosses(self, q, i):
+        v = self.vals[q]
+        return bool(rules.crosses(self.leave[q][1], v[i], v[i + 1]))
+
+    def _leave_root(self, q, i, mode):
+        """The root of leave function q between the samples (beyond the dip after an
+        entry; again on H itself when found beyond the exit's band)."""
+        func, pred, what = self.leave[q]
+        ta, tb, v = self.ts[i], self.ts[i + 1], self.vals[q]
+        lo, vlo = ta, v[i]
+        if (mode != SLIDING and self.first and i == 0
+                and rules.dips_and_returns(mode, self.D[0], self.D[1])):
+            # refine beyond the dip: next to the entry H is noise (rules)
+            tm = _brent(self._dH, ta, tb, self.D[0], self.D[1], self.xtol)
+            hm = float(func(self.Z(tm)))
+            if not rules.after(pred, hm):
+                lo, vlo = tm, hm
+        r = _refine(self._along(func), pred, lo, tb, vlo, v[i + 1], self.xtol)
+        if self.band > 0.0 and what == "switch":
+            r = self._past_band(func, pred, lo, r)
+        return interval.OK, r
 
     def _past_band(self, func, pred, lo, r):
         """A switch found beyond the exit's band: again on H itself (rules.band_probe)."""
@@ -914,66 +906,67 @@ class _Scan:
             r = _refine(h, pred, tq, r, h(tq), h(r), self.xtol)
         return r
 
-    def _hidden_slide_end(self, i, ta, tb):
-        """The end of sliding hidden between the samples (rules.speed_graze): refined
-        at the extremum of a or b, an exit at the speed's root before it."""
-        best, touches = None, []
-        for j, ((func, pred, what), v, Dv) in enumerate(zip(self.leave, self.vals, self.R)):
-            if not rules.speed_extremum_between(pred, Dv[i], Dv[i + 1]):
-                continue
-            tm = _brent(lambda tt, j=j: float(self.rates(tt)[j]), ta, tb, Dv[i], Dv[i + 1],
-                        self.xtol)
-            vm = float(func(self.Z(tm)))
-            kind = rules.speed_graze(pred, vm, Dv[i], Dv[i + 1], tb - ta, self.touch_tol)
-            if kind == rules.GRAZE_CROSSES:
-                r = _refine(self._along(func), pred, ta, tm, v[i], vm, self.xtol)
-                if best is None or r < best[0]:
-                    best = (r, what, -1)
-            elif kind == rules.GRAZE_TOUCHES:
-                touches.append(tm)
-        for tm in sorted(touches):  # a touch before any exit: P has a kink there
-            if best is None or tm < best[0]:
-                self._touch(tm)
-        return best
+    def _slide_end_between(self, q, i):
+        Dv = self.R[q] if self.rates is not None else None
+        return Dv is not None and bool(
+            rules.speed_extremum_between(self.leave[q][1], Dv[i], Dv[i + 1]))
 
-    def _hidden_extremum(self, i, ta, tb):
-        """A minimum (in +) or maximum (in -) of H hidden between the samples: a switch
-        if H changes sign there (rules.graze), a touch if it just reaches it."""
-        if not rules.extremum_between(self.mode, self.D[i], self.D[i + 1]):
-            return None
+    def _hidden_slide_end(self, q, i, mode):
+        """The extremum of a (q = 0) or b hidden between the samples, judged by
+        rules.speed_graze: the speed's root before it (an exit), or its time (a touch)."""
+        func, pred, _ = self.leave[q]
+        ta, tb, Dv = self.ts[i], self.ts[i + 1], self.R[q]
+        tm = _brent(lambda tt: float(self.rates(tt)[q]), ta, tb, Dv[i], Dv[i + 1], self.xtol)
+        vm = float(func(self.Z(tm)))
+        kind = rules.speed_graze(pred, vm, Dv[i], Dv[i + 1], tb - ta, self.touch_tol)
+        if kind == rules.GRAZE_CROSSES:
+            return (interval.OK, _refine(self._along(func), pred, ta, tm, self.vals[q][i], vm,
+                                         self.xtol), kind)
+        return interval.OK, tm, kind
+
+    def _extremum_between(self, i):
+        return bool(rules.extremum_between(self.mode, self.D[i], self.D[i + 1]))
+
+    def _hidden_extremum(self, i, mode):
+        """A minimum (in +) or maximum (in -) of H hidden between the samples, judged by
+        rules.graze: H's root before it (a switch), or its time (a touch)."""
         func, pred, _ = self.leave[0]
+        ta, tb = self.ts[i], self.ts[i + 1]
         tm = _brent(self._dH, ta, tb, self.D[i], self.D[i + 1], self.xtol)
         Hm = float(func(self.Z(tm)))
-        kind = rules.graze(self.mode, Hm, self.touch_tol, self.band)
+        kind = rules.graze(mode, Hm, self.touch_tol, self.band)
         if kind == rules.GRAZE_CROSSES:
-            return (_refine(self._along(func), pred, ta, tm, self.vals[0][i], Hm, self.xtol),
-                    "switch", -1)
-        if kind == rules.GRAZE_TOUCHES:
-            self._touch(tm)
-        return None
+            return (interval.OK, _refine(self._along(func), pred, ta, tm, self.vals[0][i], Hm,
+                                         self.xtol), kind)
+        return interval.OK, tm, kind
 
-    def _section_hit(self, i, ta, tb, best):
-        """``best`` or a section hit in the interval that comes first; a section root at
-        the instant of a switch (a section on H) is hit there, before the switch: the
-        switch then follows at once on restart."""
-        traj = self.traj
-        for k, (sec, pred, sv) in enumerate(zip(self.sections, self.preds, self.svals)):
-            if not rules.crosses(pred, sv[i], sv[i + 1]):
-                continue
-            r = _refine(self._along(sec.func), pred, ta, tb, sv[i], sv[i + 1], self.xtol)
-            if r < traj.t0 + sec.min_time:
-                continue
-            if not (best is None or r < best[0]
-                    or (best[1] != "section"
-                        and r <= best[0] + rules.same_instant(self.xtol, best[0]))):
-                continue
-            zr = self.Z(r)
-            if sec.where is not None and not sec.where(zr):
-                continue
-            if i == 0 and ta == traj.t0 and self._starts_on(sec, sv, zr):
-                continue
-            best = (r, "section", k)
-        return best
+    def _touch(self, tm, mode):
+        """A touch of H at tm: no event for the orbit, a kink of P (recorded)."""
+        self.traj.events.append(Event(tm, "touch", self.Z(tm).copy(), mode, mode))
+
+    def _n_sections(self):
+        return len(self.sections)
+
+    def _section_crosses(self, k, i):
+        sv = self.svals[k]
+        return bool(rules.crosses(self.preds[k], sv[i], sv[i + 1]))
+
+    def _section_root(self, k, i, mode):
+        sv = self.svals[k]
+        return interval.OK, _refine(self._along(self.sections[k].func), self.preds[k],
+                                    self.ts[i], self.ts[i + 1], sv[i], sv[i + 1], self.xtol)
+
+    def _section_bounds(self, k):
+        return self.traj.t0 + self.sections[k].min_time, self.xtol
+
+    def _section_counts(self, k, i, r, mode):
+        """The crossing of section k at r is a hit: ``where`` holds there, and it is not
+        the run's start on the section up to rounding."""
+        sec, zr = self.sections[k], self.Z(r)
+        if sec.where is not None and not sec.where(zr):
+            return False
+        return not (i == 0 and self.ts[i] == self.traj.t0
+                    and self._starts_on(sec, self.svals[k], zr))
 
     def _starts_on(self, sec, sv, zr) -> bool:
         """The start on the section, up to its rounding (rules.starts_on_section,
@@ -983,3 +976,16 @@ class _Scan:
         return (rules.starts_on_section(float(sv[0]), z_first, float(sec.func(zr)), z_root,
                                         np.asarray(self.traj.z0, dtype=float).reshape(-1))
                 or _in_section_rounding(sec.func, float(sv[0]), z_first, z_root))
+
+
+#: the one event search of a sample interval (filippov.loop.interval), asked through this
+#: engine's operations
+_interval_event = interval.make_interval_event(
+    _Scan._leave_crosses, _Scan._leave_root, _Scan._slide_end_between,
+    _Scan._hidden_slide_end, _Scan._extremum_between, _Scan._hidden_extremum, _Scan._touch,
+    _Scan._n_sections, _Scan._section_crosses, _Scan._section_root, _Scan._section_bounds,
+    _Scan._section_counts, rules.section_first)
+
+#: the event codes of the search, as this driver's events name them
+_WHAT = {rules.SWITCH: "switch", rules.EXIT_MINUS: "exit_minus",
+         rules.EXIT_PLUS: "exit_plus", interval.SECTION: "section"}

@@ -9,7 +9,8 @@
 * :mod:`.dop853` -- scipy's DOP853 (step, initial step, dense output);
 * :mod:`.segment` -- the state on the current segment (exact flow or dense output);
 * :mod:`.roots` -- brentq and the far-side refinement of a crossing;
-* :mod:`.scan` -- the samples of one window and its earliest event;
+* :mod:`.scan` -- the samples of one window and its earliest event (asked in the order
+  of :mod:`filippov.loop.interval`, compiled in);
 * :mod:`.derivative` -- dP/dz carried along a return;
 * :mod:`.driver` -- one start point (_one), the batch (_batch), compilation and cache;
   two builds of one source: with the dP/dz code and without it (:func:`.driver.kernel`).

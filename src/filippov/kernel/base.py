@@ -6,10 +6,11 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, types
 from numba.core import cgutils
-from numba.extending import intrinsic
+from numba.extending import intrinsic, register_jitable
 
 from .. import rules
 from ..abi import PIECES
+from ..loop import interval
 
 
 # ----------------------------------------------------------------------------- signatures
@@ -79,21 +80,28 @@ _jit_rule = njit(cache=True, _nrt=False)
 _jit_inline = njit(cache=True, _nrt=False, inline="always")
 
 
+# a rule that another rule calls (section_first: same_instant) is compiled into its caller
+register_jitable(rules.same_instant)
+
 # every decision and crossing predicate, compiled from its one source (filippov.rules)
 (_after, _crosses, _clamp, _far_side, _extremum_between, _graze, _central_step,
  _slides_in_section, _starts_on_section, _same_instant, _start_side, _start_on_switch,
  _next_mode, _accumulates, _exit_shift, _dips_and_returns, _exact_window, _onto_switch,
  _exit_drift, _carried_age, _far_side_probe, _exit_band, _banded_shift, _clears_band,
  _band_probe, _speed_extremum_between, _speed_graze, _rate_step, _flow_consistent,
- _section_probe, _section_noise, _on_section_by_value) = (
+ _section_probe, _section_noise, _on_section_by_value, _section_first) = (
     _jit_rule(getattr(rules, name)) for name in (
     "after", "crosses", "clamp", "far_side", "extremum_between", "graze", "central_step",
     "slides_in_section", "starts_on_section", "same_instant", "start_side", "start_on_switch",
     "next_mode", "accumulates", "exit_shift", "dips_and_returns", "exact_window",
     "onto_switch", "exit_drift", "carried_age", "far_side_probe", "exit_band",
     "banded_shift", "clears_band", "band_probe", "speed_extremum_between", "speed_graze",
-    "rate_step", "flow_consistent", "section_probe", "section_noise", "on_section_by_value"))
-assert (_W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS) == (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
+    "rate_step", "flow_consistent", "section_probe", "section_noise", "on_section_by_value",
+    "section_first"))
+# the codes the one event search (filippov.loop.interval) hands back
+assert (_W_NONE, _W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_SECTION) == (
+    interval.NONE, rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS, interval.SECTION)
+assert OK == interval.OK
 
 
 # ============================================================================= model pieces

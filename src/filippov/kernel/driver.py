@@ -413,12 +413,14 @@ def _batch(fns, params, starts, ages, s, out):
         out.mode[i] = mode
 
 
-#: the files whose code the kernel contains: every module of this package and the
-#: library modules it compiles or reads. numba's on-disk cache checks only the file of
-#: each cached function, not those of the functions it calls (a kernel cached before an
-#: edit of rules.py would go on running the old rules: seen, and numba's documented
-#: limit), so the kernel's cache carries a stamp of all of them (_fresh_cache)
-KERNEL_SOURCES = tuple(sorted(f"kernel/{p.name}" for p in Path(__file__).parent.glob("*.py"))
+#: the files whose code the kernel contains: every module of this package and of the
+#: event loop's orchestration (filippov.loop, compiled in), and the library modules it
+#: compiles or reads. numba's on-disk cache checks only the file of each cached function,
+#: not those of the functions it calls (a kernel cached before an edit of rules.py would
+#: go on running the old rules: seen, and numba's documented limit), so the kernel's cache
+#: carries a stamp of all of them (_fresh_cache)
+KERNEL_SOURCES = tuple(sorted(f"{package}/{p.name}" for package in ("kernel", "loop")
+                              for p in (Path(__file__).parents[1] / package).glob("*.py"))
                        ) + ("rules.py", "dop853_tableau.py", "abi.py", "system.py")
 
 

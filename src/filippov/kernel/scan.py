@@ -1,5 +1,5 @@
-"""The event scan of one window: its samples, and the earliest event among them (as
-filippov.simulate._scan)."""
+"""The event scan of one window: its samples, and the earliest event among them (the
+order of the questions in a sample interval: filippov.loop.interval)."""
 from __future__ import annotations
 
 from collections import namedtuple
@@ -7,11 +7,12 @@ from collections import namedtuple
 import numpy as np
 
 from .. import rules
+from ..loop.interval import make_interval_event
 from ..system import MINUS, PLUS, SLIDING
 from .base import (OK, ROOT_FAILED, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB, _S_H, _S_SEC, _TO_NEG, _TO_NONNEG,
-                   _TO_NONPOS, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_NONE, _W_SECTION, _W_SWITCH,
+                   _TO_NONPOS, _W_NONE,
                    _after, _band_probe, _clamp, _clears_band, _crosses, _dips_and_returns, _dot, _extremum_between,
-                   _flow_consistent, _graze, _jit, _jit_inline, _rate_step, _same_instant, _speed_extremum_between, _speed_graze,
+                   _flow_consistent, _graze, _jit, _jit_inline, _rate_step, _section_first, _speed_extremum_between, _speed_graze,
                    _speeds, _starts_on_section, _field_minus, _section_probe, _section_noise,
                    _on_section_by_value,
                    _field_plus, _grad_h, _h, _section, _where)
@@ -113,18 +114,18 @@ def _in_section_rounding(fns, p, s0, z0, zr, probe):
 
 
 #: how an orbit leaves its mode: through n leave functions (1: h; 2 while sliding: a and
-#: b), the first of them ``sel`` crossing by ``pred`` (the event ``what``), and the rate
-#: ``sel_d`` whose zero is the first one's extremum
-_Leave = namedtuple("_Leave", ["n", "sel", "pred", "what", "sel_d"])
+#: b), the first of them ``sel`` crossing by ``pred``, and the rate ``sel_d`` whose zero
+#: is the first one's extremum (which event a crossing is: loop.interval)
+_Leave = namedtuple("_Leave", ["n", "sel", "pred", "sel_d"])
 
 
 @_jit_inline
 def _leave_of(mode):
     if mode == PLUS:
-        return _Leave(1, _S_H, _TO_NEG, _W_SWITCH, _S_B)
+        return _Leave(1, _S_H, _TO_NEG, _S_B)
     if mode == MINUS:
-        return _Leave(1, _S_H, _TO_NONNEG, _W_SWITCH, _S_A)
-    return _Leave(2, _S_A, _TO_NONPOS, _W_EXIT_MINUS, _S_A)
+        return _Leave(1, _S_H, _TO_NONNEG, _S_A)
+    return _Leave(2, _S_A, _TO_NONPOS, _S_A)
 
 
 @_jit_inline
@@ -176,91 +177,135 @@ def _leave_root(i, mode, first, lv, o, sm, sc):
     return r, True
 
 
+# ------------------------------------------------------------------ the event search
+# The order of the questions in one sample interval and its ties are the one event search
+# (filippov.loop.interval); what follows is how the kernel answers each, on its samples
+# (sm) and its segment (o). Its state ``ctx`` is the tuple (first, lv, s, o, sm, sc, c0,
+# c1, cd, cs, ha, hb): the window's records and the sign changes _find saw in the interval.
+
 @_jit_inline
-def _speed_exit(i, mode, ha, hb, touch_tol, o, sm, sc):
-    """The end of sliding hidden between samples i and i + 1 (rules.speed_graze): refined
-    at the extremum of a (ha) or b (hb), an exit at the speed's root before it;
-    (status, t, what), (OK, inf, _W_NONE) if none."""
+def _leave_crosses(ctx, q, i):
+    return ctx[6] if q == 0 else ctx[7]
+
+
+@_jit_inline
+def _leave_root_at(ctx, q, i, mode):
+    """The root of leave function q (h or a; b) between samples i and i + 1."""
+    first, lv, s, o, sm, sc = ctx[0], ctx[1], ctx[2], ctx[3], ctx[4], ctx[5]
+    if q == 0:
+        r, ok = _leave_root(i, mode, first, lv, o, sm, sc)
+    else:
+        r, ok = _refine(_S_B, _TO_NONNEG, sm.ts[i], sm.ts[i + 1], sm.vals[1, i], mode, o, sc)
+    return (OK if ok else ROOT_FAILED), r
+
+
+@_jit_inline
+def _slide_end_between(ctx, q, i):
+    return ctx[10] if q == 0 else ctx[11]
+
+
+@_jit_inline
+def _speed_exit(ctx, q, i, mode):
+    """The extremum of a (q = 0) or b hidden between samples i and i + 1, judged by
+    rules.speed_graze: (status, the speed's root before it, GRAZE_CROSSES), (status, its
+    time, GRAZE_TOUCHES) or GRAZE_NONE."""
+    s, o, sm, sc = ctx[2], ctx[3], ctx[4], ctx[5]
     ta, tb = sm.ts[i], sm.ts[i + 1]
-    best_t, best_w = np.inf, _W_NONE
-    touch_t = np.inf
-    for q in range(2):
-        if not (ha if q == 0 else hb):
-            continue
-        sel_v, sel_r = (_S_A, _S_DA) if q == 0 else (_S_B, _S_DB)
-        pred = _TO_NONPOS if q == 0 else _TO_NONNEG
-        tm, ok = _brentq(sel_r, ta, tb, _MAXITER_EXTREMUM, mode, o, sc)
-        if not ok:
-            return ROOT_FAILED, tm, _W_NONE
-        vm = _fval(sel_v, tm, mode, o, sc)
-        kind = _speed_graze(pred, vm, sm.dvals[q, i], sm.dvals[q, i + 1], tb - ta, touch_tol)
-        if kind == rules.GRAZE_CROSSES:
-            r, ok = _refine(sel_v, pred, ta, tm, sm.vals[q, i], mode, o, sc)
-            if not ok:
-                return ROOT_FAILED, r, _W_NONE
-            if best_w == _W_NONE or r < best_t:
-                best_t, best_w = r, (_W_EXIT_MINUS if q == 0 else _W_EXIT_PLUS)
-        elif kind == rules.GRAZE_TOUCHES:
-            touch_t = min(touch_t, tm)
-    if touch_t < best_t:
-        sm.touched[0] = True  # a touch before any exit: P has a kink here
-    return OK, best_t, best_w
+    sel_v, sel_r = (_S_A, _S_DA) if q == 0 else (_S_B, _S_DB)
+    pred = _TO_NONPOS if q == 0 else _TO_NONNEG
+    tm, ok = _brentq(sel_r, ta, tb, _MAXITER_EXTREMUM, mode, o, sc)
+    if not ok:
+        return ROOT_FAILED, tm, rules.GRAZE_NONE
+    vm = _fval(sel_v, tm, mode, o, sc)
+    kind = _speed_graze(pred, vm, sm.dvals[q, i], sm.dvals[q, i + 1], tb - ta, s.touch_tol)
+    if kind == rules.GRAZE_CROSSES:
+        r, ok = _refine(sel_v, pred, ta, tm, sm.vals[q, i], mode, o, sc)
+        return (OK if ok else ROOT_FAILED), r, kind
+    return OK, tm, kind
 
 
 @_jit_inline
-def _h_extremum(i, mode, lv, touch_tol, o, sm, sc):
-    """A minimum (in +) or maximum (in -) of h hidden between samples i and i + 1: a
-    switch at h's root before it, or a touch (no event); (status, t, what)."""
+def _extremum_between_at(ctx, i):
+    return ctx[8]
+
+
+@_jit_inline
+def _h_extremum(ctx, i, mode):
+    """A minimum (in +) or maximum (in -) of h hidden between samples i and i + 1, judged
+    by rules.graze (the exit's band): (status, h's root before it, GRAZE_CROSSES),
+    (status, its time, GRAZE_TOUCHES) or GRAZE_NONE."""
+    lv, s, o, sm, sc = ctx[1], ctx[2], ctx[3], ctx[4], ctx[5]
     ta, tb = sm.ts[i], sm.ts[i + 1]
     tm, ok = _brentq(lv.sel_d, ta, tb, _MAXITER_EXTREMUM, mode, o, sc)
     if not ok:
-        return ROOT_FAILED, tm, _W_NONE
+        return ROOT_FAILED, tm, rules.GRAZE_NONE
     hm = _fval(_S_H, tm, mode, o, sc)
-    kind = _graze(mode, hm, touch_tol, o.seg[SEG_BAND])  # the exit's band (rules)
+    kind = _graze(mode, hm, s.touch_tol, o.seg[SEG_BAND])
     if kind == rules.GRAZE_CROSSES:
         r, ok = _refine(_S_H, lv.pred, ta, tm, sm.vals[0, i], mode, o, sc)
-        if not ok:
-            return ROOT_FAILED, r, _W_NONE
-        return OK, r, _W_SWITCH
-    if kind == rules.GRAZE_TOUCHES:
-        # |hm| <= touch_tol: a touch, not an event; P has a kink here
-        sm.touched[0] = True
-    return OK, np.inf, _W_NONE
+        return (OK if ok else ROOT_FAILED), r, kind
+    return OK, tm, kind
 
 
 @_jit_inline
-def _section_hit(i, mode, best_t, best_w, s, o, sm, sc):
-    """The section crossed between samples i and i + 1: the hit unless an earlier event
-    (best_t, best_w) comes first; (status, t, what)."""
+def _touch(ctx, t, mode):
+    ctx[4].touched[0] = True  # no event; P has a kink here
+
+
+@_jit_inline
+def _n_sections(ctx):
+    return 1
+
+
+@_jit_inline
+def _section_crosses(ctx, k, i):
+    return ctx[9]
+
+
+@_jit_inline
+def _section_root(ctx, k, i, mode):
+    s, o, sm, sc = ctx[2], ctx[3], ctx[4], ctx[5]
     r, ok = _refine(_S_SEC, s.sec_pred, sm.ts[i], sm.ts[i + 1], sm.svals[i], mode, o, sc)
-    if not ok:
-        return ROOT_FAILED, r, _W_NONE
-    # simulate._scan: min_time; a tie with a switch (rules.same_instant)
-    # goes to the section; a start on the section up to rounding is no hit
-    if r >= s.min_time and (best_w == _W_NONE
-                            or r <= best_t + _same_instant(o.xtol, best_t)):
-        wz, wg = sc.wz, sc.wg
-        _zat(r, mode, o, wz)
-        if _where(o.fns, wz, o.p):
-            at_start = False
-            if sm.ts[i] == 0.0:
-                _zat(sm.ts[i], mode, o, wg)
-                # the closed form's start za counts for an exact flow only; a
-                # dense output (integrated, sliding) starts at wg itself and za is
-                # stale there (it took crossings within 64 x 1e-10 for the start)
-                exact = mode != SLIDING and o.seg[SEG_INTEGRATED] == 0.0
-                at_start = (_starts_on_section(sm.svals[i], wg, _section(o.fns, wz, o.p), wz,
-                                               o.za if exact else wg)
-                            or _in_section_rounding(o.fns, o.p, sm.svals[i], wg, wz, sc.wf))
-            if not at_start:
-                return OK, r, _W_SECTION
-    return OK, best_t, best_w
+    return (OK if ok else ROOT_FAILED), r
+
+
+@_jit_inline
+def _section_bounds(ctx, k):
+    return ctx[2].min_time, ctx[3].xtol  # the run starts at t = 0
+
+
+@_jit_inline
+def _section_counts(ctx, k, i, r, mode):
+    """The section's crossing at r is a hit: ``where`` holds there, and it is not the
+    start on the section up to rounding."""
+    o, sm, sc = ctx[3], ctx[4], ctx[5]
+    wz, wg = sc.wz, sc.wg
+    _zat(r, mode, o, wz)
+    if not _where(o.fns, wz, o.p):
+        return False
+    if sm.ts[i] != 0.0:
+        return True
+    _zat(sm.ts[i], mode, o, wg)
+    # the closed form's start za counts for an exact flow only; a dense output
+    # (integrated, sliding) starts at wg itself and za is stale there (it took
+    # crossings within 64 x 1e-10 for the start)
+    exact = mode != SLIDING and o.seg[SEG_INTEGRATED] == 0.0
+    return not (_starts_on_section(sm.svals[i], wg, _section(o.fns, wz, o.p), wz,
+                                   o.za if exact else wg)
+                or _in_section_rounding(o.fns, o.p, sm.svals[i], wg, wz, sc.wf))
+
+
+_interval_event = _jit_inline(make_interval_event(
+    _leave_crosses, _leave_root_at, _slide_end_between, _speed_exit, _extremum_between_at,
+    _h_extremum, _touch, _n_sections, _section_crosses, _section_root, _section_bounds,
+    _section_counts, _section_first))
 
 
 @_jit
 def _find(mode, ns, first, s, o, sm, sc):
-    """simulate._scan on the samples: the earliest event; (status, t, what). A touch of
-    H on the way (no event) sets sm.touched[0]."""
+    """The earliest event on the samples (the one event search of loop.interval, asked in
+    each interval where a sign change shows); (status, t, what). A touch of H on the way
+    (no event) sets sm.touched[0]."""
     lv = _leave_of(mode)
     vals, dvals, svals, sg = sm.vals, sm.dvals, sm.svals, o.seg
     if first:  # just entered this mode: its start is inside by construction
@@ -284,27 +329,8 @@ def _find(mode, ns, first, s, o, sm, sc):
             c0 = _crosses(lv.pred, vals[0, i], vals[0, i + 1])
             if not (c0 or c1 or cd or cs):
                 continue
-        best_t, best_w = np.inf, _W_NONE
-        if c0:
-            r, ok = _leave_root(i, mode, first, lv, o, sm, sc)
-            if not ok:
-                return ROOT_FAILED, r, _W_NONE
-            best_t, best_w = r, lv.what
-        if c1:
-            r, ok = _refine(_S_B, _TO_NONNEG, sm.ts[i], sm.ts[i + 1], vals[1, i], mode, o, sc)
-            if not ok:
-                return ROOT_FAILED, r, _W_NONE
-            if best_w == _W_NONE or r < best_t:
-                best_t, best_w = r, _W_EXIT_PLUS
-        st = OK
-        if best_w == _W_NONE and (ha or hb):
-            st, best_t, best_w = _speed_exit(i, mode, ha, hb, s.touch_tol, o, sm, sc)
-        if st == OK and mode != SLIDING and best_w == _W_NONE and cd:
-            st, best_t, best_w = _h_extremum(i, mode, lv, s.touch_tol, o, sm, sc)
-        if st == OK and cs:
-            st, best_t, best_w = _section_hit(i, mode, best_t, best_w, s, o, sm, sc)
-        if st != OK:
-            return st, best_t, best_w
-        if best_w != _W_NONE:
-            return OK, best_t, best_w
+        st, t, what, _ = _interval_event((first, lv, s, o, sm, sc, c0, c1, cd, cs, ha, hb),
+                                         i, mode)
+        if st != OK or what != _W_NONE:
+            return st, t, what
     return OK, np.inf, _W_NONE

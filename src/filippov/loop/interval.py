@@ -1,0 +1,125 @@
+"""The event search of one sample interval, written once for both engines.
+
+Between two samples of a stay the scan asks, in this order:
+
+1. does a leave function change sign (h: a switch; while sliding, a or b: an exit into
+   region - or +)? Its root, refined; the earliest of them is the event so far;
+2. none, and sliding: has a or b an extremum toward its sign change hidden between the
+   samples (``rules.speed_extremum_between``)? The engine refines it and
+   ``rules.speed_graze`` tells an exit (the earliest wins) from a touch, which is
+   recorded when it comes before any exit;
+3. none, and in a region: has h an extremum hidden between the samples
+   (``rules.extremum_between``)? ``rules.graze``: a switch at h's root before it, or a
+   touch (recorded);
+4. each section that changes sign, in order: its root is the event when it comes first
+   (``rules.section_first``: not before its min_time; before the event so far, or at its
+   instant when that is a switch or an exit -- a section on H is hit where the orbit
+   arrives on H) and the engine counts it there (``where`` holds, and it is not the run's
+   start on the section up to rounding).
+
+:func:`make_interval_event` builds this from the engine's own operations -- how it tests
+its samples, refines a root, finds a hidden extremum, records a touch --, each a
+function of the engine's state ``ctx`` first. The reference driver
+(:class:`filippov.simulate._Scan`) passes its Python methods and runs the result as it
+is; the compiled kernel (:mod:`filippov.kernel.scan`) passes its compiled pieces and
+compiles the result with numba (``inline="always"``), so this module is plain scalar
+Python in the subset numba compiles.
+
+An event is ``(status, t, what, k)``: ``status`` OK or the engine's failure code (the
+reference raises instead, so its operations always return OK); ``what`` one of
+:data:`NONE`, ``rules.SWITCH``, ``rules.EXIT_MINUS``, ``rules.EXIT_PLUS``,
+:data:`SECTION` (the kernel's codes); ``k`` the index of the section hit (-1 for any
+other event).
+"""
+from __future__ import annotations
+
+import math
+
+from ..rules import (EXIT_MINUS, EXIT_PLUS, GRAZE_CROSSES, GRAZE_TOUCHES, SWITCH)
+from ..system import SLIDING
+
+#: the status of an operation that succeeded (the kernel's OK)
+OK = 0
+#: what an event is besides the ends of a stay (rules.SWITCH, EXIT_MINUS, EXIT_PLUS):
+#: nothing in the interval, or a section hit
+NONE, SECTION = -1, 3
+
+
+def make_interval_event(leave_crosses, leave_root, slide_end_between, hidden_slide_end,
+                        extremum_between, hidden_extremum, touch, n_sections,
+                        section_crosses, section_root, section_bounds, section_counts,
+                        section_first):
+    """``interval_event(ctx, i, mode) -> (status, t, what, k)``: the earliest event between
+    samples i and i + 1 of a stay in ``mode``, asked in the order of this module's
+    docstring, from the engine's operations on its state ``ctx``:
+
+    * ``leave_crosses(ctx, q, i)``: leave function q (0: h, or a while sliding; 1: b)
+      changes sign; ``leave_root(ctx, q, i, mode) -> (status, t)``: its root;
+    * ``slide_end_between(ctx, q, i)``: while sliding, speed q has an extremum toward its
+      sign change; ``hidden_slide_end(ctx, q, i, mode) -> (status, t, kind)``: judged by
+      rules.speed_graze, GRAZE_CROSSES with the speed's root before it, GRAZE_TOUCHES
+      with the extremum's time, or GRAZE_NONE; ``extremum_between(ctx, i)``,
+      ``hidden_extremum(ctx, i, mode)``: the same for h in a region (rules.graze);
+    * ``touch(ctx, t, mode)``: a touch of H at t (no event; the return map has a kink);
+    * ``n_sections(ctx)``, ``section_crosses(ctx, k, i)``, ``section_root(ctx, k, i,
+      mode) -> (status, t)``, ``section_bounds(ctx, k) -> (t_min, xtol)``,
+      ``section_counts(ctx, k, i, t, mode)``: the crossing at t is a hit (where holds, not
+      the start itself); ``section_first``: the rule as the engine calls it (compiled).
+    """
+
+    def interval_event(ctx, i, mode):
+        best_t, best_w = math.inf, NONE
+        # 1. the leave functions' crossings: the earliest
+        for q in range(2 if mode == SLIDING else 1):
+            if leave_crosses(ctx, q, i):
+                st, r = leave_root(ctx, q, i, mode)
+                if st != OK:
+                    return st, r, NONE, -1
+                if best_w == NONE or r < best_t:
+                    best_t, best_w = r, (SWITCH if mode != SLIDING
+                                         else (EXIT_MINUS if q == 0 else EXIT_PLUS))
+        # 2. none while sliding: the end of sliding hidden between the samples
+        if mode == SLIDING and best_w == NONE:
+            touch_a, touch_b = math.inf, math.inf
+            for q in range(2):
+                if not slide_end_between(ctx, q, i):
+                    continue
+                st, r, kind = hidden_slide_end(ctx, q, i, mode)
+                if st != OK:
+                    return st, r, NONE, -1
+                if kind == GRAZE_CROSSES:
+                    if best_w == NONE or r < best_t:
+                        best_t, best_w = r, (EXIT_MINUS if q == 0 else EXIT_PLUS)
+                elif kind == GRAZE_TOUCHES:
+                    if q == 0:
+                        touch_a = r
+                    else:
+                        touch_b = r
+            # a touch before any exit, in time order: P has a kink there
+            for tm in (min(touch_a, touch_b), max(touch_a, touch_b)):
+                if tm < best_t:
+                    touch(ctx, tm, mode)
+        # 3. none in a region: an extremum of h hidden between the samples
+        if mode != SLIDING and best_w == NONE and extremum_between(ctx, i):
+            st, r, kind = hidden_extremum(ctx, i, mode)
+            if st != OK:
+                return st, r, NONE, -1
+            if kind == GRAZE_CROSSES:
+                best_t, best_w = r, SWITCH
+            elif kind == GRAZE_TOUCHES:
+                touch(ctx, r, mode)
+        # 4. the sections, in order: a hit that comes first, or at a switch's instant
+        best_k = -1
+        for k in range(n_sections(ctx)):
+            if not section_crosses(ctx, k, i):
+                continue
+            st, r = section_root(ctx, k, i, mode)
+            if st != OK:
+                return st, r, NONE, -1
+            t_min, xtol = section_bounds(ctx, k)
+            if (section_first(r, t_min, best_t, best_w == SECTION, xtol)
+                    and section_counts(ctx, k, i, r, mode)):
+                best_t, best_w, best_k = r, SECTION, k
+        return OK, best_t, best_w, best_k
+
+    return interval_event
