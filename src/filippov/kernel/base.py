@@ -10,37 +10,16 @@ from numba.extending import intrinsic
 
 from .. import rules
 from ..abi import PIECES
+# the status codes: one set for both engines, declared in filippov.loop.status
+from ..loop.status import (BAD_START, EVENT_LIMIT, FLOW_OFF_FIELD, NON_FINITE,  # noqa: F401
+                           NO_RETURN, NO_SLIDING, OK, ROOT_FAILED, SECTION_SLIDING, STATUS,
+                           STEP_FAILED, STEP_LIMIT, ZENO)
 
 
 # ----------------------------------------------------------------------------- signatures
 _vec = types.float64[::1]
 #: the numba types of the model's pieces, in the kernel's order (filippov.abi.PIECES)
 _PIECE_TYPES = tuple(types.FunctionType(sig) for _, sig in PIECES)
-
-# ----------------------------------------------------------------------------- status codes
-OK = 0
-NO_RETURN = 1      # t_max reached before the section
-EVENT_LIMIT = 2    # more than max_events switches
-STEP_LIMIT = 3     # more than max_steps windows / integration steps
-ZENO = 4           # zeno_count switches within zeno_span
-NON_FINITE = 5     # non-finite state or field value
-NO_SLIDING = 6     # attracting sliding reached, but the model declares no sliding
-STEP_FAILED = 7    # the sliding integrator's step size collapsed
-ROOT_FAILED = 8    # an event could not be bracketed / refined
-BAD_START = 9      # non-finite start point
-SECTION_SLIDING = 10  # the orbit slides inside the section (a section on H)
-FLOW_OFF_FIELD = 11  # an exact flow moved the state farther than its field allows
-
-STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event limit",
-          STEP_LIMIT: "step limit", ZENO: "accumulation of switches (Zeno)",
-          NON_FINITE: "non-finite state or field value",
-          NO_SLIDING: "attracting sliding reached, but the model declares no sliding",
-          STEP_FAILED: "sliding integrator: step size too small",
-          ROOT_FAILED: "event refinement failed (no bracket or no convergence)",
-          BAD_START: "non-finite start point",
-          SECTION_SLIDING: "the orbit slides along H inside the section (a section on the "
-                           "switching surface): its crossings there would be rounding noise",
-          FLOW_OFF_FIELD: "the exact flow does not follow its field"}
 
 # crossing predicates (filippov.rules)
 # (codes handed to compiled helpers are numpy integers, not Python ints: numba types a
