@@ -23,8 +23,8 @@ from numba import njit, types
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from ..system import PLUS, SLIDING
-from .base import (BAD_START, EVENT_LIMIT, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
-                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO, _PIECE_ADDRS, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
+from .base import (BAD_START, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
+                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, _PIECE_ADDRS, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
                    _banded_shift, _clears_band, _exit_band, _exit_drift, _exit_shift,
                    _flow_minus, _flow_plus, _jit, _jit_inline, _next_mode, _onto_switch,
                    _slides_in_section, _speeds, _start_on_switch, _start_side, _vec, _h,
