@@ -17,19 +17,26 @@ periodic_orbit: compiled).
 
 The reference driver (:mod:`filippov.simulate`) and the compiled engine
 (:mod:`filippov.fastmap`, :mod:`filippov.kernel`) take every decision from one rule book
-(:mod:`filippov.rules`). In a sample interval both run one event search,
-:mod:`filippov.loop.interval` (written once, compiled into the kernel, run as Python by
-the reference), which asks in one order -- the crossing of H (or of a or b while
-sliding), the end of sliding hidden between the samples, then a hidden extremum of H,
-then each section, whose root at the instant of a switch wins the tie
+(:mod:`filippov.rules`), and the event loop's structure is written once, beside it, in
+:mod:`filippov.loop` (the reference runs it as Python, the kernel compiles it, each
+with its own operations). In a sample interval both run one event search,
+:mod:`filippov.loop.interval`, which asks in one order -- the crossing of H (or of a
+or b while sliding), the end of sliding hidden between the samples, then a hidden
+extremum of H, then each section, whose root at the instant of a switch wins the tie
 (``rules.section_first``) -- each engine answering with its own samples and
-refinements. Both keep the hard bounds ``max_events`` (switches)
-and ``max_steps`` (integration steps, or exact-flow windows), counted alike and checked
-before the Zeno ring (``rules.accumulates`` over the last ``zeno_count`` switches); the
-start mode (``rules.start_side``, ``rules.start_on_switch``); the refusal to slide inside
-a section, at the start and at each arrival on H; a start on the section up to rounding
-(``rules.starts_on_section``, the probes of ``rules.section_probe``); the fold exit
-(``rules.exit_drift``, ``onto_switch``, ``exit_band``); the exact-flow check
+refinements. What is done at an event is one function, :mod:`filippov.loop.event`:
+the decision (``rules.next_mode``), sliding the system does not build, the refusal to
+slide inside a section at an arrival on H, the fold exit (``rules.exit_drift``,
+``onto_switch``, ``exit_band``, ``exit_shift``), the switch counted against
+``max_events`` before the Zeno ring (``rules.accumulates`` over the last ``zeno_count``
+switches: one array ring, :func:`filippov.loop.event.make_note_switch`), then the
+engine's own budget verdict (item 2); both share one set of status codes
+(:mod:`filippov.loop.status`: the reference turns a status into its exception). The
+rest they ask in the same order on each side: the hard bound ``max_steps``
+(integration steps, or exact-flow windows), counted alike; the start mode
+(``rules.start_side``, ``rules.start_on_switch``); the refusal to slide inside a
+section at the start; a start on the section up to rounding
+(``rules.starts_on_section``, the probes of ``rules.section_probe``); the exact-flow check
 (``rules.flow_consistent``); non-finite states and fields (an error, or a status);
 the options (:mod:`filippov.options`, one check for both). What remains different is
 listed here, each entry with its reason and the test that pins it; a change of either
@@ -46,7 +53,8 @@ engine that moves one of these makes its test fail.
 2. **The event budget projected from the switching rate.** At each switch past the
    Zeno ring's ``zeno_count``, the reference projects the rate of the last ones to
    ``t_end`` and stops (EventLimitError, "switching every ...") when it would exceed
-   ``max_events``; the compiled engine has the hard bound only. Deliberate: the
+   ``max_events``; the compiled engine has the hard bound only (its ``over_budget``
+   operation of the shared event says no). Deliberate: the
    projection saves minutes of a Python run that will hit the bound anyway; the kernel
    gets there in milliseconds, and a return ends at the section, often long before
    ``t_max``, where a projection to ``t_max`` refuses a return that would have come.

@@ -24,7 +24,7 @@ same algorithm for a whole batch of start points inside one compiled call:
   :class:`filippov.simulate.Section`); roots are refined with a port of scipy's
   ``brentq`` (same tolerances) and then stepped to the far side of the crossing;
 * at ``h = 0`` the Filippov decision uses ``a = grad h . F_-`` and
-  ``b = grad h . F_+`` exactly as :func:`filippov.simulate._decide`;
+  ``b = grad h . F_+`` exactly as the reference driver (:mod:`filippov.loop.event`);
 * sliding is integrated with a port of scipy's ``DOP853`` (same coefficients,
   step-size control, initial step and 7th-order dense output) with the Filippov
   field ``(a F_+ - b F_-)/(a - b)``; it ends where ``a`` or ``b`` reaches zero,

@@ -115,8 +115,7 @@ def exact_window(elapsed: float, h: float, h_slow: float, transient: float) -> f
     eps scale) at first, then as long as the time elapsed -- the fast part of the flow
     decays like exp(-t/eps), so after k windows it is below exp(-4k) of its size and
     needs no finer look than the time gone by -- never longer than ``h_slow``, and
-    ``h_slow`` once ``transient`` has passed. (Windows of h throughout the transient
-    cost two thirds of a return of the Hopf example at eps = 1e-4.)"""
+    ``h_slow`` once ``transient`` has passed (docs/decisions.md#exact-windows-grow)."""
     if elapsed >= transient:
         return h_slow
     return min(max(h, elapsed), h_slow)
@@ -163,13 +162,10 @@ SLIDE_TANGENT = 1e-6
 # ------------------------------------------------------------- the end of sliding, hidden
 # While sliding, the samples hold the normal speeds a (> 0) and b (< 0); a slide ends
 # where a sign change puts one of them past 0 (a <= 0: TO_NONPOS, b >= 0: TO_NONNEG). A
-# window where b > 0 (or a < 0) shorter than the sample spacing shows at no sample (a
-# polynomial sliding flow has error estimates ~0, so DOP853's steps grow tenfold and its 4
-# samples per step stepped over b > 0 lasting 0.01 of a step of ~1: the orbit slid on past
-# the exit, a silently wrong return). As for a hidden extremum of h in regions + and -
-# (extremum_between, graze), the rates of a and b along the orbit at the samples show an
-# extremum toward the exit between two of them; it is refined (a root of the rate), and
-# the speed there decides: an exit, a touch, or nothing.
+# window where b > 0 (or a < 0) shorter than the sample spacing shows at no sample
+# (docs/decisions.md#hidden-slide-end): as for a hidden extremum of h, the rates of a and
+# b at the samples show an extremum toward the exit between two of them; it is refined
+# (a root of the rate), and the speed there decides: an exit, a touch, or nothing.
 
 def speed_extremum_between(pred: int, d0, d1):
     """While sliding: the normal speed whose sign change ``pred`` ends the slide (a:
@@ -462,17 +458,13 @@ def section_first(r: float, t_min: float, best_t: float, best_is_section: bool,
 
 
 #: A section crossing in the first sample interval of a run that lies within
-#: START_ULPS rounding errors (eps times the largest component of the state) of
-#: the start point is the start itself, put a hair before the section by rounding:
-#: not a hit. Ignored rather than an error, because a start exactly on the section
-#: is no hit either (no sign change), and one rounding error must not change the
-#: return. The test is in state, not in time: the time to cross is rounding over
-#: speed, far above event_xtol for a slow field and far below it for a fast one.
-#: The crossing point is interpolated between the start and the refined root,
-#: since brentq places that up to event_xtol past the crossing, which a fast field
-#: turns into a movement far above rounding. Within one sample interval nothing
-#: the sampling resolves returns to the start, so a periodic orbit's genuine
-#: return P(z) = z is never taken for this.
+#: START_ULPS rounding errors (eps times the largest component of the state) of the
+#: start point is the start itself, put a hair before the section by rounding: not a
+#: hit (ignored, not an error: a start exactly on the section is no hit either). The
+#: test is in state, not in time; the crossing point is interpolated between the start
+#: and the refined root; within one sample interval nothing the sampling resolves returns
+#: to the start, so a periodic orbit's P(z) = z is never taken for this
+#: (docs/decisions.md#start-on-section).
 START_ULPS = 64
 
 
@@ -482,10 +474,8 @@ def starts_on_section(s0, z0, sr, zr, z_start) -> bool:
     the first sample as the stay's stepper gives it -- for an exact flow, the closed
     form at tau = 0 from the run's start ``z_start`` (else z_start itself) --, whose
     rounding counts too, as in :func:`exit_band`: a closed form built around another
-    point (z* + V e^{B tau} V^-1 (z - z*)) rounds at the scale of |z*|, not of |z|.
-    Found by tests/test_properties.py: a start at the origin exactly on the section,
-    its flow at tau = 0 read s = -1.1e-16 (|z_flow - z| = 2.2e-16 while |z| = 0), and
-    the crossing back at tau = 5e-16 was taken for the return."""
+    point (z* + V e^{B tau} V^-1 (z - z*)) rounds at the scale of |z*|, not of |z|
+    (docs/decisions.md#start-on-section)."""
     # linear interpolation to the crossing; sr is on the far side, so the fraction is <= 1
     frac = min(1.0, abs(s0) / abs(s0 - sr)) if s0 != sr else 1.0
     size, moved, flow = 0.0, 0.0, 0.0
@@ -499,12 +489,10 @@ def starts_on_section(s0, z0, sr, zr, z_start) -> bool:
 
 
 #: Probes each side of the start (2 SECTION_PROBES + 1 points) that measure the section
-#: function's own rounding there: :func:`starts_on_section` judges rounding of the state,
-#: but a section whose terms are large against the state (s = c.z - d with |d| = 22 at
-#: |z| ~ 1: s rounds in units of 3.6e-15) puts a start "on" it a hair below by more than
-#: the state's rounding -- found by tests/test_properties.py: the compiled engine
-#: returned such a start itself at t = 1.5e-14. The section is a black box, so its
-#: rounding is measured, not assumed from |z|.
+#: function's own rounding there: a section whose terms are large against the state puts
+#: a start "on" it a hair below by more than the state's rounding, and the section is a
+#: black box, so its rounding is measured, not assumed from |z|
+#: (docs/decisions.md#start-on-section).
 SECTION_PROBES = 8
 #: Probes only for a crossing this close to the start (relative to the state): a start
 #: rounding puts below a section whose terms are up to ~1e10 times the state. Over a

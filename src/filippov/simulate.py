@@ -22,7 +22,6 @@ from __future__ import annotations
 import contextlib
 import functools
 import math
-from collections import deque
 from dataclasses import dataclass, field
 from typing import Callable, Optional, Sequence
 
@@ -35,6 +34,8 @@ from .loop import interval
 from .radau_iia import RadauIIA
 from .system import MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
+from .loop.event import REFERENCE_BOOK, SECTION, EventOps, make_event
+from .loop.status import EVENT_LIMIT, GO_ON, NO_SLIDING, OK, SECTION_SLIDING, ZENO
 
 
 @dataclass(frozen=True)
@@ -460,7 +461,10 @@ class _Run:
         self.t, self.z = self.t0, z
         self.preds = [rules.section_pred(sec.direction) for sec in sections]
         self.hits = [0] * len(sections)
-        self.recent = deque(maxlen=self.zeno_count)
+        # the Zeno ring (filippov.loop.event.make_note_switch): the last zeno_count
+        # switch times, entry k at k % zeno_count
+        self.ring, self.ring_entries = np.empty(self.zeno_count), 0
+        self.hit_section, self.projected = None, None
         self._flow_field = None  # (mode, f, z) at the end of the last exact window
         self.n_switch = 0
         self.shift = 0.0  # subtracted from H in this stay (rules.exit_shift)
@@ -646,43 +650,43 @@ class _Run:
 
     # ------------------------------------------------------------------ one event
     def event(self, what, idx):
-        """Records the event at (t, z): a section hit (which may end the run) or a
-        switch, decided by the rules and counted against the limits."""
-        te, ze, mode, traj = self.t, self.z, self.mode, self.traj
-        if what == "section":
-            sec = self.sections[idx]
-            self.hits[idx] += 1
-            traj.events.append(Event(te, "section", ze.copy(), mode, mode, sec.name))
-            if sec.terminal is not None and self.hits[idx] >= sec.terminal:
-                return self.stop(f"section:{sec.name}")
+        """The event at (t, z): a section hit (which may end the run) or a switch, done in
+        the shared order of :mod:`filippov.loop.event`; a status that ends the run becomes
+        the trajectory's end or its exception."""
+        self.hit_section = idx
+        status, new_mode = _EVENT(self.mode, self.t, what, self)
+        if status == GO_ON:
+            self.mode = self.traj.mode = new_mode
             return None
-        new_mode, kind = _decide(self.system, mode, what, ze)
-        drift, h0, band = False, 0.0, 0.0
-        if kind == "slide_end":
-            h0 = float(self.system.switch(ze))
-            grad = self.system.switch_grad(ze[:, None])[:, 0]
-            drift = rules.exit_drift(new_mode, h0, ze, grad, self.touch_tol)
-            if drift:
-                ze = ze.copy()
-                rules.onto_switch(ze, h0, grad)
-                self.z = ze
-                h0 = float(self.system.switch(ze))  # what rounding left
-            band = rules.exit_band(ze, self._flow_at_zero(new_mode, ze), grad)
-        if new_mode == SLIDING and mode != SLIDING:
+        if status == OK:
+            return self.stop(f"section:{self.sections[idx].name}")
+        raise self._event_error(status)
+
+    def _event_error(self, status):
+        """The exception of a status :func:`_EVENT` ended the run with, at (t, z)."""
+        te, ze = self.t, self.z
+        if status == NO_SLIDING:
+            return _no_sliding(None, ze)
+        if status == SECTION_SLIDING:
             _refuse_sliding_in_sections(self.system, self.sections, ze, te)
-        traj.events.append(Event(te, kind, ze.copy(), mode, new_mode))
-        self.n_switch += new_mode != mode
-        if self.n_switch > self.max_events:
-            raise EventLimitError(
+        if status == ZENO:
+            oldest = self.ring[self.ring_entries % self.zeno_count]
+            return ZenoError(
+                f"accumulation of switches: {self.zeno_count} switches within "
+                f"{te - oldest:.3e} time units near t={te!r}, state "
+                f"{ze.tolist()} (Zeno point or chattering below the time resolution)")
+        if status == EVENT_LIMIT and self.n_switch > self.max_events:
+            return EventLimitError(
                 f"event limit {self.max_events} hit: rapid switching near t={te!r}, "
                 f"state {ze.tolist()}")
-        self._check_rate(te, ze, new_mode)
-        # after a sliding exit the stay measures H from the exit point's rounding
-        self.shift = (rules.exit_shift(new_mode, h0, self.touch_tol, drift)
-                      if kind == "slide_end" else 0.0)
-        self.band = band
-        self.mode = traj.mode = new_mode
-        return None
+        if status == EVENT_LIMIT:
+            every, ahead, new_mode = self.projected
+            return EventLimitError(
+                f"switching every {every:.3g} time units near t={te!r} (state "
+                f"{ze.tolist()}, mode {MODE_NAMES[new_mode]}): ~{ahead:.3g} more switches "
+                f"to t_end={self.t_end!r} exceed max_events={self.max_events} (raise "
+                f"max_events if this rate does not last)")
+        return SimulationError(f"event at t={te!r}: status {status}")  # no such status
 
     def _flow_at_zero(self, mode, z):
         """The state the next stay in ``mode`` starts from as its stepper evaluates it:
@@ -693,27 +697,15 @@ class _Run:
             return np.asarray(zf, dtype=float).reshape(-1)
         return z
 
-    def _check_rate(self, te, ze, new_mode):
-        """The Zeno ring: zeno_count switches in no time is an accumulation; at the
-        rate of the last ones, the event budget must last to t_end."""
-        recent = self.recent
-        recent.append(te)
-        if len(recent) < recent.maxlen:
-            return
-        if rules.accumulates(recent[0], te, self.zeno_span):
-            raise ZenoError(
-                f"accumulation of switches: {recent.maxlen} switches within "
-                f"{recent[-1] - recent[0]:.3e} time units near t={te!r}, state "
-                f"{ze.tolist()} (Zeno point or chattering below the time resolution)")
-        if recent[-1] > recent[0]:
-            ahead = (self.t_end - te) * (recent.maxlen - 1) / (recent[-1] - recent[0])
-            if self.n_switch + ahead > self.max_events:
-                raise EventLimitError(
-                    f"switching every {(recent[-1] - recent[0]) / (recent.maxlen - 1):.3g} "
-                    f"time units near t={te!r} (state {ze.tolist()}, mode "
-                    f"{MODE_NAMES[new_mode]}): ~{ahead:.3g} more switches to "
-                    f"t_end={self.t_end!r} exceed max_events={self.max_events} (raise "
-                    f"max_events if this rate does not last)")
+    def _over_budget(self, te, new_mode, switches):
+        """At the rate of the last zeno_count switches, the event budget must last to
+        t_end (the reference's projection: :mod:`filippov.engines`, item 2)."""
+        oldest = self.ring[self.ring_entries % self.zeno_count]
+        if not te > oldest:
+            return False
+        ahead = (self.t_end - te) * (self.zeno_count - 1) / (te - oldest)
+        self.projected = ((te - oldest) / (self.zeno_count - 1), ahead, new_mode)
+        return switches + ahead > self.max_events
 
 
 def _no_sliding(t, z) -> SlidingNotBuiltError:
@@ -723,22 +715,64 @@ def _no_sliding(t, z) -> SlidingNotBuiltError:
         "with sliding=False; build it with sliding=True to follow sliding")
 
 
-_ENDED_BY = {"switch": rules.SWITCH, "exit_minus": rules.EXIT_MINUS, "exit_plus": rules.EXIT_PLUS}
+def _section_hit(mode, t, run):
+    """Logs the hit; GO_ON, or OK when the section is terminal and hit often enough."""
+    idx = run.hit_section
+    sec = run.sections[idx]
+    run.hits[idx] += 1
+    run.traj.events.append(Event(t, "section", run.z.copy(), mode, mode, sec.name))
+    return OK if sec.terminal is not None and run.hits[idx] >= sec.terminal else GO_ON
 
 
-def _decide(system, mode, what, z):
-    """The Filippov decision at a point of H = 0 (:func:`filippov.rules.next_mode`),
-    with the kind of event it makes."""
-    a, b = (float(v) for v in system.normal_speeds(z))
-    ended_by = _ENDED_BY[what]
-    new_mode = rules.next_mode(mode, ended_by, a, b)
-    if ended_by != rules.SWITCH:
-        return new_mode, "slide_end"
-    if new_mode != SLIDING:
-        return new_mode, "crossing"
-    if not system.sliding:
-        raise _no_sliding(None, z)
-    return SLIDING, "slide_start"
+def _switch_state(run):
+    """The event's state, a copy of its own: the event may move it onto H."""
+    run.z = run.z.copy()
+    return run.z
+
+
+def _record_switch(mode, new_mode, what, t, run):
+    kind = ("slide_end" if what != rules.SWITCH
+            else "crossing" if new_mode != SLIDING else "slide_start")
+    run.traj.events.append(Event(t, kind, run.z.copy(), mode, new_mode))
+
+
+def _count_switch(changed, t, run):
+    run.n_switch += changed
+    return run.n_switch
+
+
+def _store_exit(new_mode, shift, band, run):
+    run.shift, run.band = shift, band
+
+
+def _store_ring(entries, run):
+    run.ring_entries = entries
+
+
+def _nothing(*args):
+    return None
+
+
+#: the reference driver's event (filippov.loop.event) on its Python operations; ctx: the _Run
+_EVENT = make_event(REFERENCE_BOOK, EventOps(
+    section_hit=_section_hit,
+    speeds=lambda run: tuple(float(v) for v in run.system.normal_speeds(run.z)),
+    h=lambda run: float(run.system.switch(run.z)),
+    grad_h=lambda run: run.system.switch_grad(run.z[:, None])[:, 0],
+    state=_switch_state,
+    flow_at_zero=lambda mode, z, run: run._flow_at_zero(mode, z),
+    sliding_built=lambda run: run.system.sliding,
+    slides_in_section=lambda run: any(_slides_in(run.system, sec.func, run.z)
+                                      for sec in run.sections),
+    record_switch=_record_switch,
+    count_switch=_count_switch,
+    limits=lambda run: (run.max_events, run.zeno_count, run.zeno_span, run.touch_tol),
+    ring=lambda run: (run.ring, run.ring_entries),
+    store_ring=_store_ring,
+    over_budget=lambda t, new_mode, switches, run: run._over_budget(t, new_mode, switches),
+    store_exit=_store_exit,
+    switch_derivative=_nothing,  # dP/dz: filippov.variational, from the trajectory
+    entered=_nothing))
 
 
 def _speed_rates(system, Z, z0):
@@ -851,7 +885,7 @@ class _Scan:
             _, r, what, k = _interval_event(self, i, self.mode)
             if what != interval.NONE:
                 z = np.asarray(self.Z(r), dtype=float).reshape(-1).copy()
-                return (r, z, _WHAT[what], k), self.band
+                return (r, z, what, k), self.band
         return None, self.band
 
     def _unband(self, i):
@@ -986,6 +1020,5 @@ _interval_event = interval.make_interval_event(
     _Scan._n_sections, _Scan._section_crosses, _Scan._section_root, _Scan._section_bounds,
     _Scan._section_counts, rules.section_first)
 
-#: the event codes of the search, as this driver's events name them
-_WHAT = {rules.SWITCH: "switch", rules.EXIT_MINUS: "exit_minus",
-         rules.EXIT_PLUS: "exit_plus", interval.SECTION: "section"}
+# the event search and what is done at an event speak the same codes
+assert interval.SECTION == SECTION and interval.OK == OK

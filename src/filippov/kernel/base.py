@@ -11,6 +11,10 @@ from numba.extending import intrinsic, register_jitable
 from .. import rules
 from ..abi import PIECES
 from ..loop import interval
+# the status codes: one set for both engines, declared in filippov.loop.status
+from ..loop.status import (BAD_START, EVENT_LIMIT, FLOW_OFF_FIELD, NON_FINITE,  # noqa: F401
+                           NO_RETURN, NO_SLIDING, OK, ROOT_FAILED, SECTION_SLIDING, STATUS,
+                           STEP_FAILED, STEP_LIMIT, ZENO)
 
 
 # ----------------------------------------------------------------------------- signatures
@@ -18,35 +22,7 @@ _vec = types.float64[::1]
 #: the numba types of the model's pieces, in the kernel's order (filippov.abi.PIECES)
 _PIECE_TYPES = tuple(types.FunctionType(sig) for _, sig in PIECES)
 
-# ----------------------------------------------------------------------------- status codes
-OK = 0
-NO_RETURN = 1      # t_max reached before the section
-EVENT_LIMIT = 2    # more than max_events switches
-STEP_LIMIT = 3     # more than max_steps windows / integration steps
-ZENO = 4           # zeno_count switches within zeno_span
-NON_FINITE = 5     # non-finite state or field value
-NO_SLIDING = 6     # attracting sliding reached, but the model declares no sliding
-STEP_FAILED = 7    # the sliding integrator's step size collapsed
-ROOT_FAILED = 8    # an event could not be bracketed / refined
-BAD_START = 9      # non-finite start point
-SECTION_SLIDING = 10  # the orbit slides inside the section (a section on H)
-FLOW_OFF_FIELD = 11  # an exact flow moved the state farther than its field allows
-
-STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event limit",
-          STEP_LIMIT: "step limit", ZENO: "accumulation of switches (Zeno)",
-          NON_FINITE: "non-finite state or field value",
-          NO_SLIDING: "attracting sliding reached, but the model declares no sliding",
-          STEP_FAILED: "sliding integrator: step size too small",
-          ROOT_FAILED: "event refinement failed (no bracket or no convergence)",
-          BAD_START: "non-finite start point",
-          SECTION_SLIDING: "the orbit slides along H inside the section (a section on the "
-                           "switching surface): its crossings there would be rounding noise",
-          FLOW_OFF_FIELD: "the exact flow does not follow its field"}
-
-# crossing predicates (filippov.rules)
-# (codes handed to compiled helpers are numpy integers, not Python ints: numba types a
-# global Python int as a literal and compiles one specialization of the callee per value
-# -- _brentq five times, _refine four: 9 s of a 30 s cold compile)
+# crossing predicates (filippov.rules), as numpy integers (docs/decisions.md#kernel-codes-are-numpy-integers)
 _TO_NEG, _TO_NONNEG, _TO_NONPOS, _EITHER = (
     np.int64(c) for c in (rules.TO_NEG, rules.TO_NONNEG, rules.TO_NONPOS, rules.EITHER))
 # scalar functions of the state whose zeros are events; and the rates of a and b along
@@ -63,20 +39,14 @@ _TINY = np.finfo(float).tiny
 _EPS = np.finfo(float).eps
 
 
-# Every helper of the kernel works on arrays it is handed and allocates nothing, so it is
-# compiled without numba's reference counting (_nrt=False): otherwise each call
-# of a helper pays an atomic incref/decref per array argument, which was half the
-# run time. Only the kernel _batch allocates (its work arrays, once per call).
-# Nor are they ever called from Python: built without numba's CPython and C wrappers
-# (which unbox the 40 named work arrays and the model's function tuple: code generated and
-# machine-compiled for every helper, 5 s of a 24 s cold compile)
+# Every helper works on arrays it is handed and allocates nothing (only _batch allocates)
+# and is never called from Python: compiled without reference counting and without
+# numba's CPython and C wrappers (docs/decisions.md#kernel-no-refcounting)
 _jit = njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 # the rules keep their wrappers (scalars only: cheap), so tests call them from Python
 _jit_rule = njit(cache=True, _nrt=False)
 # the driver's pieces (kernel.driver: _window, _stay_*, _event) are inlined into _one at the
-# IR level: as separate calls they were 4-13% slower on the fig04/fig11 maps, each
-# call passing the named work arrays by value; so are the pieces of kernel.scan._find
-# (one function of 142 lines before, the same per-return cost split)
+# IR level, and so are the pieces of kernel.scan._find (docs/decisions.md#kernel-inlined-driver)
 _jit_inline = njit(cache=True, _nrt=False, inline="always")
 
 
@@ -107,15 +77,8 @@ assert OK == interval.OK
 # ============================================================================= model pieces
 # The model's pieces reach the kernel as their compiled addresses: a tuple of integers
 # (_PIECE_ADDRS, in the order of filippov.abi.PIECES; fastmap.compute_returns takes them
-# from numba-compiled pieces only, once per piece: fastmap._address). Handed over as
-# numba first-class functions instead, each call of the kernel had numba look up both
-# addresses of all nine pieces again in Python (get_compile_result, a pickled signature
-# loaded, LLVM's symbol lookup): 0.3-0.9 ms a call, most of the time of the attractor
-# sweeps, whose calls hold few returns each (fig12 chunk: 8544 calls, 7 of its 8 s). And
-# numba's own call of a first-class function (fns[k](...)) carries a path that takes the
-# GIL and asks Python for a missing address: ~150 lines of IR at each of the 34 call
-# sites (1-2 s of the cold compile). So each piece is called straight at its address,
-# with its signature from PIECES.
+# from numba-compiled pieces only, once per piece: fastmap._address), each called straight
+# at its address with its signature from PIECES (docs/decisions.md#kernel-piece-addresses)
 _PIECE_ADDRS = types.UniTuple(types.intp, len(PIECES))
 
 

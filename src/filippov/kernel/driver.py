@@ -23,8 +23,8 @@ from numba import njit, types
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from ..system import PLUS, SLIDING
-from .base import (BAD_START, EVENT_LIMIT, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
-                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO, _PIECE_ADDRS, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
+from .base import (BAD_START, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
+                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, _PIECE_ADDRS, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
                    _banded_shift, _clears_band, _exit_band, _exit_drift, _exit_shift,
                    _flow_minus, _flow_plus, _jit, _jit_inline, _next_mode, _onto_switch,
                    _slides_in_section, _speeds, _start_on_switch, _start_side, _vec, _h,
@@ -39,6 +39,8 @@ from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY
                     Orbit, Outputs, Samples, Scratch, Settings, Work, kernel_signature)  # noqa: F401
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
+from ..loop.event import SECTION, Book, EventOps, make_event, make_note_switch
+from ..loop.status import GO_ON
 
 
 @_jit
@@ -88,7 +90,8 @@ def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
 # Settings, Outputs; their types and the signature declared there once);
 # fastmap.compute_returns builds them.
 
-_GO_ON = -1  # no event yet / the orbit goes on (never a returned status)
+_GO_ON = GO_ON  # no event yet / the orbit goes on (never a returned status)
+assert _W_SECTION == SECTION
 
 #: the compile-time switch of the dP/dz code: every branch that carries the derivative
 #: (Settings.jac) is guarded by it too, and numba prunes a branch on a False global before
@@ -214,77 +217,162 @@ def _end_slide(t, w):
         w.slide_dz[k] += w.z[k] - w.slide_z0[k]
 
 
+# ------------------------------------------------------------------ the event's operations
+# What the kernel does at an event, for filippov.loop.event, which holds the order: each
+# takes ctx = (fns, p, s, w) (the model's pieces, its parameters, kernel.state's Settings
+# and Work) and works at the event's state w.z.
+
 @_jit_inline
-def _event(mode, t, what, fns, p, s, w):
-    """The event ``what`` at (t, w.z): a section hit ends the run (OK); a switch is
-    decided (rules.next_mode) and counted against the limits and the Zeno ring.
-    (status, mode to go on in); status _GO_ON unless the run ends here."""
-    if what == _W_SECTION:
-        # the age in this mode at the hit (the next return of an iterated run goes on
-        # from it: a hit is no mode entry)
-        w.tally[T_AGE] = (t - w.seg[SEG_ENTRY] + w.tally[T_AGE] if (mode != SLIDING and s.exact)
-                          else 0.0)
-        if mode == SLIDING:
-            _end_slide(t, w)
-        if _DERIVATIVES and s.jac:
-            _section_derivative(mode, fns, p, w)
-        return OK, mode
-    a, b = _speeds(w.z, fns, p, w.wg, w.wf, w.wp)
-    new_mode = _next_mode(mode, what, a, b)  # what: rules.SWITCH/EXIT_MINUS/EXIT_PLUS
-    if new_mode == SLIDING and not s.sliding:
-        return NO_SLIDING, mode
-    if new_mode == SLIDING and mode != SLIDING and _slides_in(w.z, fns, p, w.wg, w.wf, w.wp,
-                                                             w.wz):
-        return SECTION_SLIDING, mode
-    drift, h0, band = False, 0.0, 0.0
+def _at_section(mode, t, ctx):
+    """A section hit ends the run: the age in this mode at the hit (the next return of an
+    iterated run goes on from it: a hit is no mode entry), the slide it ends, dP/dz."""
+    fns, p, s, w = ctx
+    w.tally[T_AGE] = (t - w.seg[SEG_ENTRY] + w.tally[T_AGE] if (mode != SLIDING and s.exact)
+                      else 0.0)
     if mode == SLIDING:
-        if new_mode != SLIDING:
-            h0 = _h(fns, w.z, p)
-            drift = _exit_drift(new_mode, h0, w.z, w.wg, s.touch_tol)
-            if drift:  # w.wg holds grad h at w.z (from _speeds)
-                _onto_switch(w.z, h0, w.wg)
-                h0 = _h(fns, w.z, p)  # what rounding left
-            # the state the next stay starts from as it evaluates it: the exact flow
-            # over time 0 (its rounding), or w.z itself when integrated (rules.exit_band)
-            for k in range(w.z.size):
-                w.wz[k] = w.z[k]
-            if s.exact:
-                if new_mode == PLUS:
-                    _flow_plus(fns, w.z, 0.0, p, w.wz)
-                else:
-                    _flow_minus(fns, w.z, 0.0, p, w.wz)
-            band = _exit_band(w.z, w.wz, w.wg)
+        _end_slide(t, w)
+    if _DERIVATIVES and s.jac:
+        _section_derivative(mode, fns, p, w)
+    return OK
+
+
+@_jit_inline
+def _event_speeds(ctx):
+    fns, p, s, w = ctx
+    return _speeds(w.z, fns, p, w.wg, w.wf, w.wp)
+
+
+@_jit_inline
+def _event_h(ctx):
+    fns, p, s, w = ctx
+    return _h(fns, w.z, p)
+
+
+@_jit_inline
+def _event_grad(ctx):
+    """grad h at w.z: left in w.wg by _event_speeds."""
+    return ctx[3].wg
+
+
+@_jit_inline
+def _event_state(ctx):
+    return ctx[3].z
+
+
+@_jit_inline
+def _event_flow_at_zero(mode, z, ctx):
+    """The exact flow of z over time 0 (its rounding), or z itself when integrated."""
+    fns, p, s, w = ctx
+    for k in range(z.size):
+        w.wz[k] = z[k]
+    if s.exact:
+        if mode == PLUS:
+            _flow_plus(fns, z, 0.0, p, w.wz)
+        else:
+            _flow_minus(fns, z, 0.0, p, w.wz)
+    return w.wz
+
+
+@_jit_inline
+def _event_sliding_built(ctx):
+    return ctx[2].sliding
+
+
+@_jit_inline
+def _event_slides_in(ctx):
+    fns, p, s, w = ctx
+    return _slides_in(w.z, fns, p, w.wg, w.wf, w.wp, w.wz)
+
+
+@_jit_inline
+def _record_switch(mode, new_mode, what, t, ctx):
+    """The sliding tallies: the slide that ends, the one that starts."""
+    w = ctx[3]
+    if mode == SLIDING:
         _end_slide(t, w)
     if new_mode == SLIDING:
         w.tally[T_SLIDE_START] = t
         for k in range(w.z.size):
             w.slide_z0[k] = w.z[k]
-    if new_mode != mode:
+
+
+@_jit_inline
+def _count_switch(changed, t, ctx):
+    w = ctx[3]
+    if changed:
         w.count[N_SWITCHES] += 1
         if w.count[N_SWITCHES] == 1:
             w.first_sw[0] = t
-    if w.count[N_SWITCHES] > s.max_events:
-        return EVENT_LIMIT, mode
-    w.recent[w.count[N_RING] % s.zeno_count] = t
-    w.count[N_RING] += 1
-    if w.count[N_RING] >= s.zeno_count and _accumulates(w.recent[w.count[N_RING] % s.zeno_count], t,
-                                                   s.zeno_span):
-        return ZENO, mode
-    w.seg[SEG_SHIFT] = 0.0
-    w.seg[SEG_BAND] = 0.0
-    w.seg[SEG_EXIT_SHIFT] = 0.0
-    if mode == SLIDING and new_mode != SLIDING:
-        w.seg[SEG_EXIT_SHIFT] = _exit_shift(new_mode, h0, s.touch_tol, drift)
-        w.seg[SEG_BAND] = band
-        w.seg[SEG_SHIFT] = _banded_shift(new_mode, w.seg[SEG_EXIT_SHIFT], band) if band > 0.0 else w.seg[SEG_EXIT_SHIFT]
-    # (the end of sliding: identity)
-    if _DERIVATIVES and s.jac and mode != SLIDING and new_mode != mode:
+    return w.count[N_SWITCHES]
+
+
+@_jit_inline
+def _event_limits(ctx):
+    s = ctx[2]
+    return s.max_events, s.zeno_count, s.zeno_span, s.touch_tol
+
+
+@_jit_inline
+def _event_ring(ctx):
+    w = ctx[3]
+    return w.recent, w.count[N_RING]
+
+
+@_jit_inline
+def _store_ring(entries, ctx):
+    ctx[3].count[N_RING] = entries
+
+
+@_jit_inline
+def _over_budget(t, new_mode, switches, ctx):
+    """The hard bound only (filippov.engines, item 2)."""
+    return False
+
+
+@_jit_inline
+def _store_exit(new_mode, shift, band, ctx):
+    """The next stay's shift of H: rules.exit_shift, moved by the band while inside it."""
+    seg = ctx[3].seg
+    seg[SEG_EXIT_SHIFT] = shift
+    seg[SEG_BAND] = band
+    seg[SEG_SHIFT] = _banded_shift(new_mode, shift, band) if band > 0.0 else shift
+
+
+@_jit_inline
+def _event_switch_derivative(mode, new_mode, ctx):
+    fns, p, s, w = ctx
+    if _DERIVATIVES and s.jac:
         _switch_derivative(mode, new_mode, fns, p, w)
+
+
+@_jit_inline
+def _entered(mode, new_mode, t, ctx):
+    """The age in the mode the orbit goes on in (rules.exact_window's transient)."""
+    s, w = ctx[2], ctx[3]
     if new_mode != mode:
         w.tally[T_AGE] = 0.0  # an entry: the fast transient starts again
     elif mode != SLIDING and s.exact:
         w.tally[T_AGE] += t - w.seg[SEG_ENTRY]  # the stay goes on from here
-    return _GO_ON, new_mode
+
+
+#: the operations by their place in filippov.loop.event.EventOps
+_EVENT_OPS = ("_at_section", "_event_speeds", "_event_h", "_event_grad", "_event_state",
+              "_event_flow_at_zero", "_event_sliding_built", "_event_slides_in",
+              "_record_switch", "_count_switch", "_event_limits", "_event_ring", "_store_ring",
+              "_over_budget", "_store_exit", "_event_switch_derivative", "_entered")
+#: the rules the event asks, the kernel's compiled copies (kernel.base)
+_BOOK = Book(_next_mode, _exit_drift, _onto_switch, _exit_band, _exit_shift,
+             _jit_inline(make_note_switch(_accumulates)))
+
+
+def _build_event(ns):
+    """The event function (filippov.loop.event.make_event) on the operations of the
+    namespace ``ns`` (this module's globals, or the plain build's copies of them)."""
+    return _jit_inline(make_event(_BOOK, EventOps(*(ns[name] for name in _EVENT_OPS))))
+
+
+_build_event.builds = True  # _without_derivatives builds it, not copies it
+_event = _build_event(globals())
 
 
 @_jit
@@ -331,7 +419,7 @@ def _one(z0, age0, fns, p, s, w):
         else:
             st, t, what = _stay_integrated(mode, t, fns, p, s, w)
         if st == OK:
-            st, mode = _event(mode, t, what, fns, p, s, w)
+            st, mode = _event(mode, t, what, (fns, p, s, w))
         if st != _GO_ON:  # _event hands back the mode it was asked about unless it goes on
             return st, t, w.count[N_SWITCHES], w.tally[T_SLID], mode
 
@@ -428,9 +516,13 @@ def _without_derivatives(decorated):
     """The driver functions ``decorated`` ({name: decorator}, callees first) built again
     from the same code with _DERIVATIVES False, in globals of their own (each copy calls
     the others' copies); each copy gets a qualified name of its own, which numba names
-    its cache files by. Returns the copies by name."""
+    its cache files by. A decorator marked ``builds`` (_build_event) builds its function
+    from the copies' globals instead (a closure over them). Returns the copies by name."""
     env = dict(globals(), _DERIVATIVES=False)
     for name, decorator in decorated.items():
+        if getattr(decorator, "builds", False):  # a closure over the copies: built again
+            env[name] = decorator(env)
+            continue
         f = globals()[name].py_func
         g = pytypes.FunctionType(f.__code__, env, f.__name__, f.__defaults__, f.__closure__)
         g.__qualname__, g.__doc__ = f"{f.__qualname__}_plain", f.__doc__
@@ -440,7 +532,9 @@ def _without_derivatives(decorated):
 
 # the functions on the way from _batch to a _DERIVATIVES branch
 _PLAIN = _without_derivatives({"_window": _jit_inline, "_stay_exact": _jit_inline,
-                               "_stay_integrated": _jit_inline, "_event": _jit_inline,
+                               "_stay_integrated": _jit_inline, "_at_section": _jit_inline,
+                               "_event_switch_derivative": _jit_inline,
+                               "_event": _build_event,
                                "_one": _jit, "_batch": njit(cache=True, nogil=True)})
 _one_plain, _batch_plain = _PLAIN["_one"], _PLAIN["_batch"]
 

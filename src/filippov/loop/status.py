@@ -1,0 +1,30 @@
+"""The status codes of a run, one set for both engines: what the compiled kernel writes
+per start (:data:`filippov.fastmap.STATUS`) and what the loop's shared functions
+(:mod:`filippov.loop.event`) hand back, which the reference driver turns into its
+exceptions (:mod:`filippov.errors`). Plain integers: numba compiles them as literals."""
+from __future__ import annotations
+
+GO_ON = -1         # the orbit goes on (never a run's final status)
+OK = 0
+NO_RETURN = 1      # t_max reached before the section
+EVENT_LIMIT = 2    # more than max_events switches
+STEP_LIMIT = 3     # more than max_steps windows / integration steps
+ZENO = 4           # zeno_count switches within zeno_span
+NON_FINITE = 5     # non-finite state or field value
+NO_SLIDING = 6     # attracting sliding reached, but the model declares no sliding
+STEP_FAILED = 7    # the sliding integrator's step size collapsed
+ROOT_FAILED = 8    # an event could not be bracketed / refined
+BAD_START = 9      # non-finite start point
+SECTION_SLIDING = 10  # the orbit slides inside the section (a section on H)
+FLOW_OFF_FIELD = 11  # an exact flow moved the state farther than its field allows
+
+STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event limit",
+          STEP_LIMIT: "step limit", ZENO: "accumulation of switches (Zeno)",
+          NON_FINITE: "non-finite state or field value",
+          NO_SLIDING: "attracting sliding reached, but the model declares no sliding",
+          STEP_FAILED: "sliding integrator: step size too small",
+          ROOT_FAILED: "event refinement failed (no bracket or no convergence)",
+          BAD_START: "non-finite start point",
+          SECTION_SLIDING: "the orbit slides along H inside the section (a section on the "
+                           "switching surface): its crossings there would be rounding noise",
+          FLOW_OFF_FIELD: "the exact flow does not follow its field"}

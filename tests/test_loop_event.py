@@ -1,0 +1,120 @@
+"""What is done at an event is written once (filippov.loop.event), for both engines: the
+decisions asked from one place, both engines running the one event function, and the
+Zeno ring the same on both."""
+import ast
+import os
+import subprocess
+import sys
+from collections import deque
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from filippov import EventLimitError, ZenoError, compute_returns, rules, simulate
+from filippov.fastmap import EVENT_LIMIT, ZENO
+from filippov.loop.event import make_note_switch
+from filippov.models import pseudo_equilibrium
+
+SRC = Path(__file__).resolve().parents[1] / "src" / "filippov"
+
+#: the rules of an event: asked only by filippov.loop.event (the kernel's compiled
+#: copies carry a leading underscore)
+EVENT_RULES = {"next_mode", "accumulates", "exit_drift", "onto_switch", "exit_band",
+               "exit_shift"}
+
+
+def _calls(path):
+    """The names of the functions ``path`` calls (f(...) and m.f(...))."""
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Call):
+            f = node.func
+            yield f.id if isinstance(f, ast.Name) else f.attr if isinstance(
+                f, ast.Attribute) else None
+
+
+def test_the_event_rules_are_asked_only_by_the_loop():
+    askers = {}
+    for path in SRC.rglob("*.py"):
+        for name in _calls(path):
+            if name is not None and name.lstrip("_") in EVENT_RULES:
+                askers.setdefault(name.lstrip("_"), set()).add(
+                    str(path.relative_to(SRC)))
+    assert askers, "no rule asked at all: the AST walk is broken"
+    assert all(files == {"loop/event.py"} for files in askers.values()), askers
+
+
+def test_both_engines_build_their_event_from_the_loop():
+    builders = {str(p.relative_to(SRC)) for p in SRC.rglob("*.py")
+                if "make_event" in set(_calls(p))}
+    assert builders == {"simulate.py", "kernel/driver.py"}
+    # and each calls what it built: the reference's _EVENT, the kernel's _event
+    assert "_EVENT" in set(_calls(SRC / "simulate.py"))
+    assert "_event" in set(_calls(SRC / "kernel" / "driver.py"))
+    # the reference's own copies are gone
+    reference = (SRC / "simulate.py").read_text()
+    assert "def _decide" not in reference and "def _check_rate" not in reference
+    assert "deque" not in reference
+
+
+@pytest.mark.parametrize("zeno_count", [2, 3, 7])
+def test_the_ring_is_the_deque_of_the_last_switches(zeno_count):
+    # the array ring answers as a deque(maxlen=zeno_count) of the switch times does
+    note_switch = make_note_switch(rules.accumulates)
+    ring, entries, times = np.empty(zeno_count), 0, deque(maxlen=zeno_count)
+    rng = np.random.default_rng(1)
+    t = 0.0
+    for k in range(40):
+        t += float(rng.choice([1e-3, 1e-13]))
+        times.append(t)
+        entries, zeno = note_switch(ring, entries, t, zeno_count, 1e-10)
+        full = len(times) == zeno_count
+        assert entries == k + 1
+        assert zeno == (full and rules.accumulates(times[0], t, 1e-10))
+
+
+# the pseudo-equilibrium example with eps = 1e-13 chatters across H at ~1e-12 (exact
+# flows): (start, zeno_count, zeno_span, t_end) and the switch the ring stops at; in
+# the last case the first switches are slower and the ring goes round before it does
+CHATTER = [([1e-12, 0.0], 2, 1e-10, 1.0, 2), ([1e-12, 0.0], 64, 1e-10, 1.0, 64),
+           ([3e-11, 0.0], 5, 3e-12, 1e-9, 6)]
+
+
+@pytest.mark.parametrize("start,zeno_count,zeno_span,t_end,stop", CHATTER)
+def test_both_engines_stop_chatter_at_the_same_switch(start, zeno_count, zeno_span, t_end,
+                                                      stop):
+    system = pseudo_equilibrium.system(1e-13, -0.5)
+    opts = dict(zeno_count=zeno_count, zeno_span=zeno_span)
+    model = system.compiled(lambda z, p: z[0] - 5.0, direction=1)  # never reached
+    out = compute_returns(model, [start], t_end, **opts)
+    assert out.status[0] == ZENO and out.n_switches[0] == stop
+    with pytest.raises(ZenoError, match=f"{zeno_count} switches within"):
+        simulate(system, start, t_end, **opts)
+    if stop > zeno_count:
+        return  # with fewer switches allowed the reference's projection stops it first
+    # one switch fewer allowed: both stop at the same switch on the hard bound, which
+    # is counted before the ring
+    out = compute_returns(model, [start], t_end, max_events=stop - 1, **opts)
+    assert out.status[0] == EVENT_LIMIT and out.n_switches[0] == stop
+    with pytest.raises(EventLimitError, match=f"event limit {stop - 1} hit"):
+        simulate(system, start, t_end, max_events=stop - 1, **opts)
+
+
+_PLAIN = """
+from filippov.fastmap import compile_kernel
+from filippov.kernel import derivative
+assert not compile_kernel()  # compiled here, not loaded
+print(sum(len(f.signatures) for f in vars(derivative).values()
+          if getattr(getattr(f, "py_func", None), "__module__", None) == derivative.__name__))
+"""
+
+
+def test_the_plain_kernel_does_not_compile_the_derivative_code(tmp_path):
+    # the event's dP/dz hooks are built again for the plain build (kernel.driver.
+    # _without_derivatives), where numba prunes them: returns without dP/dz never wait
+    # for the derivative code to compile
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path),
+               PYTHONPATH=str(SRC.parent) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    run = subprocess.run([sys.executable, "-c", _PLAIN], env=env, capture_output=True,
+                         text=True, check=True)
+    assert run.stdout.split()[-1] == "0"
