@@ -54,12 +54,11 @@ def _reference_return(system, section, direction: int, where, t_max: float, opti
     """As :func:`_compiled_return` on the reference driver, dP/dz from the variational
     equations afterwards (each return starts afresh: age 0)."""
     from .simulate import simulate
-    from .variational import return_jacobian
+    from .variational import reference_view, return_jacobian
 
-    python = engines.reference_system(system, "periodic_orbit")
-    sec = system.python_section(section, direction=direction, where=where)
     # exact field Jacobians where the system has them (filippov.symbolic), else differences
-    jac = system.jacobian if getattr(system, "has_jacobians", False) else None
+    python, jac = reference_view(system, None, "periodic_orbit")
+    sec = system.python_section(section, direction=direction, where=where)
 
     def single(z, age):
         traj = simulate(python, z, t_max, sections=[sec], dense=False, **options)
