@@ -11,7 +11,7 @@ import pkgutil
 
 from filippov_paper import product, tolerance
 from filippov_paper.config import SCENE_ID, SceneError
-from filippov.simulate import SlidingNotBuiltError
+from filippov.errors import SlidingNotBuiltError
 from filippov_paper.scenes import chunking
 
 
