@@ -77,7 +77,8 @@ def test_scene_refuses_an_unknown_model_naming_the_field(tmp_path):
     from filippov_paper import scenes
 
     scene = _scene("fig10_dfo")
-    with pytest.raises(SceneError, match=r"^fig10_dfo: model: unknown model 'nope'; expected one of"):
+    with pytest.raises(SceneError,
+                       match=r"^fig10_dfo: model: unknown model 'nope'; expected one of"):
         scenes.check(dict(scene, model="nope"))
     # and when the scene file is read
     src = ROOT / "config" / "scenes" / "fig12_period_adding.yaml"

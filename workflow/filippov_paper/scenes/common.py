@@ -77,7 +77,9 @@ def _parameters(wanted):
 
 
 def _arguments(wanted) -> str:
-    return f"({', '.join(p.name if p.kind != p.KEYWORD_ONLY else p.name + '=' for p in _parameters(wanted))})"
+    """The protocol function's arguments as the error names them: ``(a, b, c=)``."""
+    names = (p.name + "=" if p.kind == p.KEYWORD_ONLY else p.name for p in _parameters(wanted))
+    return f"({', '.join(names)})"
 
 
 def _takes(function, wanted) -> bool:
