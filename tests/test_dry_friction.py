@@ -38,21 +38,21 @@ def test_model_fields_match_fast_system_and_reduce_to_dfo1():
 def test_hopf_point_matches_analytic_condition():
     vh = df.hopf_speed(**{k: LAW[k] for k in ("fv", "fc")})
     assert abs(vh - np.log(2.5 / 0.3)) < 1e-15
-    assert abs(f10.hopf_numeric(LAW, (1.0, 3.0)) - vh) < 1e-9
+    assert abs(f10.hopf_numeric(df, LAW, (1.0, 3.0)) - vh) < 1e-9
     assert np.isnan(df.hopf_speed(0.3, 2.5, "literal"))
 
 
 def test_grazing_point_converges_under_tolerance_refinement():
-    v = [f10.grazing_speed(LAW, (2.2, 3.6), rtol=r, atol=r * 1e-2) for r in (1e-9, 1e-11, 1e-13)]
+    v = [f10.grazing_speed(df, LAW, (2.2, 3.6), rtol=r, atol=r * 1e-2) for r in (1e-9, 1e-11, 1e-13)]
     assert abs(v[1] - v[2]) < 1e-9 and abs(v[1] - v[2]) <= abs(v[0] - v[2]) + 1e-12
     assert 3.15 < v[2] < 3.16
     # the orbit grazing at GS passes through the sticking exit point (2, v)
-    assert abs(f10.gs_mismatch(v[2], LAW)) < 1e-10
+    assert abs(f10.gs_mismatch(df, v[2], LAW)) < 1e-10
 
 
 def test_stick_slip_multipliers_match_forward_simulation():
     v = 2.6
-    r = f10.stick_slip_orbit(v, LAW)
+    r = f10.stick_slip_orbit(df, v, LAW)
     m = np.abs(r["multipliers"])
     assert abs(m[0] - 1) < 1e-6 and m[1] < 1e-6   # sticking collapses the neighbourhood
     # forward simulation from a perturbed start: back on the orbit after one period
@@ -62,8 +62,8 @@ def test_stick_slip_multipliers_match_forward_simulation():
                   dense=False)
     assert abs(tr.section_hits("s")[0].state[0] - r["x1"]) < 1e-9
     # the unstable cycle in x2 < v: multiplier > 1
-    u = f10.start_cycle(2.64, LAW)
-    assert np.abs(f10.multipliers_smooth(u, LAW)[0]) > 1.5
+    u = f10.start_cycle(df, 2.64, LAW)
+    assert np.abs(f10.multipliers_smooth(df, u, LAW)[0]) > 1.5
 
 
 def test_slow_manifold_is_invariant_and_attracting():
@@ -78,23 +78,23 @@ def test_slow_manifold_is_invariant_and_attracting():
 def test_reduced_and_slow_fast_returns_converge_as_eps_to_zero():
     # a start point whose orbit sticks: P(x1) approaches the reduced stick-slip amplitude
     v = 3.1
-    ref = f10.stick_slip_orbit(v, LAW)["x1"]
+    ref = f10.stick_slip_orbit(df, v, LAW)["x1"]
     errs = []
     for eps in (0.04, 0.01):
-        r = f11.return_map([4.5], eps, v, LAW11, with_residual=False)
+        r = f11.return_map(df, [4.5], eps, v, LAW11, with_residual=False)
         errs.append(abs(r["P"][0] - ref))
     assert errs[1] < errs[0] / 2 and errs[1] < 0.05
 
 
 def test_lemma_case_quantity():
-    chi, a, b = f11.lemma_quantity(LAW11, 3.1)
+    chi, a, b = f11.lemma_quantity(df, LAW11, 3.1)
     assert chi == pytest.approx(2 * 2.0 * 3.0)   # -2 f0 (1 + gamma) > 0: case 1
-    chi_l, _, _ = f11.lemma_quantity(dict(LAW11, convention="literal"), 3.1)
+    chi_l, _, _ = f11.lemma_quantity(df, dict(LAW11, convention="literal"), 3.1)
     assert chi_l < 0
 
 
 def test_return_map_fixed_point_stable_under_refinement():
-    fp = [f11.P_pair(f11.fixed_point_near(4.43, 3.1, 0.01, LAW11, r, r * 1e-2), 3.1, 0.01,
+    fp = [f11.P_pair(df, f11.fixed_point_near(df, 4.43, 3.1, 0.01, LAW11, r, r * 1e-2), 3.1, 0.01,
                      LAW11, r, r * 1e-2)[0] for r in (1e-10, 1e-12)]
     assert abs(fp[0] - fp[1]) < 1e-8
 
@@ -102,34 +102,34 @@ def test_return_map_fixed_point_stable_under_refinement():
 # ---------------------------------------------------------------- fig11: grid, onset, saddle-node
 def test_saddle_node_converges_under_tolerance_refinement():
     # eps = 0.1 (cheap); search and correction at rtol 1e-9 and at 1e-11
-    out = [f11.saddle_node(0.1, LAW11, 4.25, 4.55, 3.15625 + 1.7 * 0.1, rtol=r, atol=r * 1e-2,
+    out = [f11.saddle_node(df, 0.1, LAW11, 4.25, 4.55, 3.15625 + 1.7 * 0.1, rtol=r, atol=r * 1e-2,
                            search_rtol=r * 100) for r in (1e-9, 1e-11)]
     (x_a, v_a, _, vs_a), (x_b, v_b, _, vs_b) = out
     assert abs(v_a - v_b) < 1e-7          # measured: about 1e-9
     assert abs(vs_b - v_b) < 1e-7         # search tolerance vs full-tolerance correction
     assert 3.3227 < v_b < 3.3230 and 4.30 < x_b < 4.37
     # at the fold, P - x1 has a double zero: G(x) = 0 and the max over x1 is ~ 0
-    g = f11.P_scalar(x_b, v_b, 0.1, LAW11, 1e-11, 1e-13) - x_b
+    g = f11.P_scalar(df, x_b, v_b, 0.1, LAW11, 1e-11, 1e-13) - x_b
     assert abs(g) < 1e-7
 
 
 def test_onset_of_sticking_is_located_and_refined_grid_makes_P_continuous():
     eps, v0 = 0.01, 3.1
     start = df.slow_manifold_plus_on_L(4.2, 4.4, eps, v0, **LAW11)
-    on = {r: f11.sticking_onset(eps, v0, LAW11, 4.30, 4.32, rtol=r, atol=r * 1e-2, start=start)
+    on = {r: f11.sticking_onset(df, eps, v0, LAW11, 4.30, 4.32, rtol=r, atol=r * 1e-2, start=start)
           for r in (1e-12, 1e-13)}
     x_on = on[1e-12][0]
     assert on[1e-12][1] < 1e-10                    # the iteration converged
     assert abs(on[1e-12][0] - on[1e-13][0]) < 1e-10  # and the tolerance (measured: 7e-12)
     # no sticking just below the onset, sticking just above it, P continuous across
-    r = f11.return_map([x_on - 1e-8, x_on + 1e-8], eps, v0, LAW11, with_residual=False,
+    r = f11.return_map(df, [x_on - 1e-8, x_on + 1e-8], eps, v0, LAW11, with_residual=False,
                        start=start)
     assert r["slide_length"][0] == 0 and r["slide_length"][1] > 0
     assert abs(r["P"][1] - r["P"][0]) < 1e-5
     # refined grid (looser rtol, cheap): the onset is a grid point, and neighbouring
     # values of P differ by at most dP_max everywhere, in particular across the onset
     dP, rt = 0.03, 1e-10
-    maps, onsets = f11.refined_return_maps(np.linspace(4.27, 4.35, 4), [(eps, v0)], LAW11,
+    maps, onsets = f11.refined_return_maps(df, np.linspace(4.27, 4.35, 4), [(eps, v0)], LAW11,
                                            rtol=rt, atol=rt * 1e-2, dP_max=dP, max_rounds=5,
                                            starts=[start])
     x, P = maps[0]["x1"], maps[0]["P"]
@@ -148,14 +148,14 @@ def test_grid_fixed_points_are_fixed_points():
     for eps, v0 in ((0.1, 3.32), (0.01, 3.1)):
         start = df.slow_manifold_plus_on_L(4.2, 4.55, eps, v0, **LAW11)
         x = np.linspace(4.25, 4.5, 6)
-        P = lambda a: f11.return_map(a, eps, v0, LAW11, with_residual=False, start=start)["P"]
+        P = lambda a: f11.return_map(df, a, eps, v0, LAW11, with_residual=False, start=start)["P"]
         fps = f11.fixed_points(x, P(x), refine=lambda a: P([a])[0], xtol=1e-12)
         assert len(fps) == 2
         assert np.max(np.abs(P(fps) - fps)) < 1e-10
         # the other construction of the start (pulled back along the slow flow,
         # P_pair; its first hit of L is a hair off x1, amplified by P' - 1 at the
         # unstable point) agrees to that offset and to the ambiguity of M_+
-        alt = [f11.P_pair(a, v0, eps, LAW11, 1e-12, 1e-14) for a in fps]
+        alt = [f11.P_pair(df, a, v0, eps, LAW11, 1e-12, 1e-14) for a in fps]
         assert max(abs(b - a) for a, b in alt) < (1e-6 if eps < 0.05 else 1e-4)
 
 
@@ -175,15 +175,15 @@ def test_fig11_engines_agree():
     and the same pair of hits for the saddle-node search."""
     eps, v0 = 0.1, 3.32
     x1 = np.array([4.2, 4.3, 4.35, 4.45, 4.55])
-    ref = f11.return_map(x1, eps, v0, LAW11, with_residual=False)
-    fast = f11.return_map(x1, eps, v0, LAW11, with_residual=False, engine="compiled")
+    ref = f11.return_map(df, x1, eps, v0, LAW11, with_residual=False)
+    fast = f11.return_map(df, x1, eps, v0, LAW11, with_residual=False, engine="compiled")
     np.testing.assert_array_equal(fast["n_switches"], ref["n_switches"])
     assert np.any(ref["slide_length"] > 0) and np.any(ref["slide_length"] == 0)
     for key in ("P", "time", "slide_time", "slide_length"):
         np.testing.assert_allclose(fast[key], ref[key], rtol=0, atol=1e-11, err_msg=key)
     np.testing.assert_allclose(fast["w"], ref["w"], rtol=0, atol=1e-10)
-    a = f11.P_pair(4.4, v0, eps, LAW11, 1e-12, 1e-14)
-    b = f11.P_pair(4.4, v0, eps, LAW11, 1e-12, 1e-14, engine="compiled")
+    a = f11.P_pair(df, 4.4, v0, eps, LAW11, 1e-12, 1e-14)
+    b = f11.P_pair(df, 4.4, v0, eps, LAW11, 1e-12, 1e-14, engine="compiled")
     np.testing.assert_allclose(b, a, rtol=0, atol=1e-11)
 
 

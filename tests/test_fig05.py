@@ -113,7 +113,7 @@ def _expansion_gap(eps):
     g2 = np.linspace(*p["x2_range"], 9)
     X1, X2 = np.meshgrid(g1, g2, indexing="ij")
     y, _, _ = fig05.numeric_slow_manifold_minus(model, X1, X2, p["settle"])
-    return np.max(np.abs(y - fig05.expansion_minus(X1, X2, eps, p["mu"], p["omega"])))
+    return np.max(np.abs(y - hopf.slow_manifold_minus_first_order(X1, X2, eps, p["mu"], p["omega"])))
 
 
 def test_expansion_error_is_order_eps_squared(ds):

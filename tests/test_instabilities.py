@@ -56,7 +56,7 @@ def _window(eps, n, s0, order=None):
     """(left end, right end) of the period-n orbit followed from s0 (branches.follow):
     slow-fast for order None, else the limit map of that order."""
     if order is None:
-        at = fig12._slow_fast_orbit_at({"omega": OMEGA}, -0.5, eps, n, {})
+        at = fig12._slow_fast_orbit_at(hopf, {"omega": OMEGA}, -0.5, eps, n, {})
         guess = _attractor(eps, -0.5, s0, transient=400).states[-1]
     else:
         at = fig12._limit_orbit_at(-0.5, eps, OMEGA, n, order)
@@ -130,7 +130,7 @@ def test_two_windows_orbits_coexist_where_the_followed_branches_overlap():
     cm = hopf.compiled(eps, -0.5, mu, OMEGA, sliding=False)
     periods = []
     for n, start in ((2, 3.0), (3, 1.5)):
-        at = fig12._slow_fast_orbit_at({"omega": OMEGA}, -0.5, eps, n, {})
+        at = fig12._slow_fast_orbit_at(hopf, {"omega": OMEGA}, -0.5, eps, n, {})
         end = branches.follow(at, start, _attractor(eps, -0.5, start, transient=400)
                               .states[-1], s, step=0.025, xtol=1e-9, near=0.5)
         assert end.kind == branches.BEYOND   # still stable at s

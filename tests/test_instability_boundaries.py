@@ -73,8 +73,8 @@ def test_the_limit_maps_attractor_changes_type_at_its_flips(s):
 
 def test_the_slow_fast_flips_are_bifurcations_of_its_attractor():
     eps, s = 1e-3, 1.0
-    one = slow_fast_flip(eps, s, 1, OMEGA, *FLIP_ONE)
-    two = slow_fast_flip(eps, s, 2, OMEGA, one - FLIP_STEP, FLIP_TWO_OUTSIDE)
+    one = slow_fast_flip(hopf, eps, s, 1, OMEGA, *FLIP_ONE)
+    two = slow_fast_flip(hopf, eps, s, 2, OMEGA, one - FLIP_STEP, FLIP_TWO_OUTSIDE)
     assert THETA_CHAOS - 0.03 < two < one < THETA_ONE + 0.03
     above, between, below = (_attractor(eps, th, s) for th in (one + 0.005,
                                                                0.5 * (one + two), two - 0.01))
@@ -91,13 +91,13 @@ def test_the_slow_fast_flips_approach_the_limit_maps_like_eps():
         gaps = []
         for e in eps:
             lim1 = limit_map.flip_point(s, 1, *FLIP_ONE, eps=e, omega=OMEGA)
-            sf1 = slow_fast_flip(e, s, 1, OMEGA, *FLIP_ONE)
+            sf1 = slow_fast_flip(hopf, e, s, 1, OMEGA, *FLIP_ONE)
             if n == 1:
                 gaps.append(sf1 - lim1)
             else:
                 lim2 = limit_map.flip_point(s, 2, lim1 - FLIP_STEP, FLIP_TWO_OUTSIDE, eps=e,
                                             omega=OMEGA)
-                gaps.append(slow_fast_flip(e, s, 2, OMEGA, sf1 - FLIP_STEP,
+                gaps.append(slow_fast_flip(hopf, e, s, 2, OMEGA, sf1 - FLIP_STEP,
                                            FLIP_TWO_OUTSIDE) - lim2)
         gaps = np.array(gaps)
         assert np.all(gaps > 0)

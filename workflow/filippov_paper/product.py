@@ -62,6 +62,9 @@ SCENE = (
        "the figure's dataset from a validated scene"),
     _f("report", True, "report(ds: Dataset | None, macros: report.Macros) -> str | None",
        "the report part: adds the scene's LaTeX macros, returns its table (or None)"),
+    _v("MODEL", True, type, "a typing.Protocol class",
+       "what the scene uses of its model module (the scene file's `model:` key names it; "
+       "a model without these members is refused naming `model`)"),
     _v("REPORT_OPTIONAL", False, bool, "bool (default False)",
        "the report is built without this scene's dataset"),
     _v("ENGINES", False, tuple, "tuple[str, ...] (default ('reference',))",

@@ -38,6 +38,7 @@ import numpy as np
 import sympy as sp
 from sympy.codegen.cfunctions import expm1
 
+from .. import codegen
 from ..model import TRANSIENT, SlowFastModel
 from ..symbolic import SymbolicSlowFast
 
@@ -48,12 +49,45 @@ NAME = "hopf"
 # ----------------------------------------------------------------- the definition
 x1, x2, y, eps, theta, mu, omega, t = sp.symbols("x1 x2 y eps theta mu omega t")
 _r2 = x1 ** 2 + x2 ** 2
+_NAMES = {str(s): s for s in (x1, x2, y, eps, theta, mu, omega)}
+
+
+def _written(text: str, **parts):
+    """``text`` in SymPy kept in its written order (``parts``: named written pieces), so a
+    NumPy helper printed from it rounds as that text does; ``.doit()``: canonical."""
+    return codegen.parse_written(text, {**_NAMES, **parts})
+
+
+_FIELD_X1 = _written("mu * x1 - omega * x2 - (x1 ** 2 + x2 ** 2) * x1")
 #: f_+ = the Hopf normal form (x1', x2')
-HOPF_FIELD = (mu * x1 - omega * x2 - _r2 * x1, omega * x1 + mu * x2 - _r2 * x2)
-#: y on ``M_-``, the exact slow invariant manifold of region - (a cubic in x1)
-SLOW_MANIFOLD_MINUS = (x1 + eps * (mu * x1 - omega * x2 - _r2 * x1 - 1)
-                       - eps ** 2 * (mu - 3 * x1 ** 2 - x2 ** 2) - 6 * eps ** 3 * x1
-                       + 6 * eps ** 4)
+HOPF_FIELD = (_FIELD_X1.doit(), _written("omega * x1 + mu * x2 - (x1 ** 2 + x2 ** 2) * x2").doit())
+#: g = eps y', the same in both regions: y relaxes onto x1 + eps x1'
+FAST = _written("eps * f1 + x1 - y", f1=_FIELD_X1)
+#: y on ``M_-``, the exact slow invariant manifold of region - (a cubic in x1), by powers of eps
+_M_MINUS = _written("x1 + eps * (mu * x1 - omega * x2 - (x1 ** 2 + x2 ** 2) * x1 - 1)"
+                    " - eps ** 2 * (mu - 3 * x1 ** 2 - x2 ** 2) - 6 * eps ** 3 * x1 + 6 * eps ** 4")
+SLOW_MANIFOLD_MINUS = _M_MINUS.doit()
+#: the switching function h; H_s = {h = 0}
+SWITCH = theta * x1 + (1 - theta) * y + 1
+
+
+def _through_order(written, k: int):
+    """The terms of the written sum ``written`` of order <= k in eps, in written order."""
+    return sp.Add(*(a for a in written.args if sp.degree(a.doit(), eps) <= k), evaluate=False)
+
+
+def _ascending_in_eps(expr):
+    """A polynomial in eps with its terms in ascending order (the order printed)."""
+    terms = sp.Add.make_args(sp.expand(expr))
+    return sp.Add(*sorted(terms, key=lambda a: sp.degree(a, eps)), evaluate=False)
+
+
+#: eq:ymm: y on M_- to O(eps) (its terms of order 1 and eps)
+SLOW_MANIFOLD_MINUS_FIRST_ORDER = _through_order(_M_MINUS, 1)
+#: y on H_s, the switching surface solved for the fast variable
+SWITCHING_SURFACE_Y = sp.solve(SWITCH, y)[0]
+#: y_m+ - y_m- at x = (-1, 0) for mu = 1 (M_+ = {y = x1}; the grazing point of theta < 0)
+GRAZING_GAP = _ascending_in_eps((x1 - SLOW_MANIFOLD_MINUS).subs({x1: -1, x2: 0, mu: 1}))
 
 
 def _polar_flow_exprs():
@@ -67,7 +101,7 @@ def _polar_flow_exprs():
 def _definition() -> SymbolicSlowFast:
     p1, p2 = _polar_flow_exprs()
     decay = sp.exp(-t / eps)
-    g = eps * HOPF_FIELD[0] + x1 - y
+    g = FAST.doit()
     flows = {
         # region +: y - x1 decays like exp(-t/eps) exactly
         "full": {"plus": [p1, p2, p1 + (y - x1) * decay],
@@ -77,7 +111,7 @@ def _definition() -> SymbolicSlowFast:
         "reduced": {"plus": [p1, p2], "minus": [x1 + t, x2]}}
     return SymbolicSlowFast(
         (x1, x2), (y,), f_minus=(1, 0), f_plus=HOPF_FIELD, g_minus=(g,), g_plus=(g,),
-        switch=theta * x1 + (1 - theta) * y + 1, eps=eps,
+        switch=SWITCH, eps=eps,
         params={eps: 0.01, theta: 0.0, mu: 1.0, omega: 8 * np.pi}, time=t, flows=flows,
         name="hopf")
 
@@ -107,6 +141,15 @@ hopf_rhs = sp.lambdify((x1, x2, mu, omega), HOPF_FIELD, "numpy")
 hopf_rhs.__doc__ = "(x1', x2') of the Hopf normal form (f_+), elementwise."
 slow_manifold_minus = sp.lambdify((x1, x2, eps, mu, omega), SLOW_MANIFOLD_MINUS, "numpy")
 slow_manifold_minus.__doc__ = "y on ``M_-``, the exact slow invariant manifold of region -."
+slow_manifold_minus_first_order = codegen.lambdify_written(
+    (x1, x2, eps, mu, omega), SLOW_MANIFOLD_MINUS_FIRST_ORDER)
+slow_manifold_minus_first_order.__doc__ = "eq:ymm: y on ``M_-`` to O(eps)."
+fast_field = codegen.lambdify_written((x1, x2, y, eps, mu, omega), FAST)
+fast_field.__doc__ = "g(x, y) = eps y', elementwise (both regions)."
+switching_surface_y = sp.lambdify((x1, theta), SWITCHING_SURFACE_Y, "numpy")
+switching_surface_y.__doc__ = "y on H_s = {h = 0} above x1."
+grazing_gap = codegen.lambdify_written((eps,), GRAZING_GAP)
+grazing_gap.__doc__ = "y_m+ - y_m- at x = (-1, 0), mu = 1, from the exact cubic."
 _polar = sp.lambdify((x1, x2, t, mu, omega), _polar_flow_exprs(), "numpy")
 
 

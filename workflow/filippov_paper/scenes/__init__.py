@@ -13,6 +13,7 @@ from filippov_paper import product, tolerance
 from filippov_paper.config import SCENE_ID, SceneError
 from filippov.errors import SlidingNotBuiltError
 from filippov_paper.scenes import chunking
+from filippov_paper.scenes.common import model_problems, registered_model
 
 
 
@@ -39,25 +40,23 @@ def _module(scene: dict):
 
 
 def _check_model(scene: dict, module) -> None:
-    """The scene's ``model`` is a registered model (:func:`filippov.models.get`) and the one
-    its module computes with: a model module the scene module holds must be that one
-    (modules that take it from the scene, :func:`~filippov_paper.scenes.common.registered_model`,
-    hold none)."""
-    import types
-
-    from filippov import models
-
+    """The scene's ``model`` is a registered model (:func:`filippov.models.get`) that has
+    what the scene module needs of it: the members of its ``MODEL`` protocol (see
+    :func:`~filippov_paper.scenes.common.model_problems`). Scene modules take their model
+    from the scene (:func:`~filippov_paper.scenes.common.registered_model`), never by
+    importing one."""
     if "model" not in scene:   # a partial scene (the schema requires one of every scene file)
         return
     try:
-        chosen = models.get(scene["model"])
+        chosen = registered_model(scene)
     except ValueError as exc:
         raise SceneError(f"{scene.get('id')}: {exc}") from None
-    held = {v.NAME for v in vars(module).values() if isinstance(v, types.ModuleType)
-            and v.__name__.startswith("filippov.models.") and hasattr(v, "NAME")}
-    if held - {chosen.NAME}:
-        raise SceneError(f"{scene.get('id')}: model: {chosen.NAME!r}, but the scene computes "
-                         f"with {', '.join(sorted(held))}")
+    protocol = product.hook(module, "MODEL")
+    problems = model_problems(protocol, chosen)
+    if problems:
+        raise SceneError(f"{scene.get('id')}: model: {scene['model']!r} does not have what "
+                         f"this scene needs of its model ({protocol.__name__}): "
+                         f"{'; '.join(problems)}")
 
 
 def check(scene: dict) -> None:

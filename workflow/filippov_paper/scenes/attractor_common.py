@@ -10,6 +10,8 @@ on the same grid, at order 1 for each eps and at order 0 (eps -> 0).
 """
 from __future__ import annotations
 
+from typing import Protocol
+
 import numpy as np
 import xarray as xr
 
@@ -17,10 +19,21 @@ from filippov import attractors
 from filippov_paper import tolerance
 from filippov.analytic import limit_map
 from filippov_paper.config import SceneError
-from filippov.models import hopf
 from filippov.progress import Progress
 from filippov_paper.tolerance import Tolerance
-from filippov_paper.scenes.common import require, solver_options
+from filippov_paper.scenes.common import registered_model, require, solver_options
+
+
+
+class HopfReturns(Protocol):
+    """What the orbit-diagram scenes use of their model (``model:``): the compiled return
+    map to L1 at (eps, theta, mu, omega), and the system with its section L1 (fig12's
+    and fig14's periodic orbits)."""
+    L1: dict
+
+    def compiled(self, eps, theta, mu, omega, *, sliding): ...
+    def system(self, eps, theta, mu, omega, *, sliding): ...
+
 
 CHUNK_AXIS = "s"
 ENGINES = ("compiled",)
@@ -73,17 +86,18 @@ def validate(scene: dict) -> None:
                          "between the two cases (no scale)")
 
 
-def _model(p, theta, eps, s):
-    """The compiled model at the sweep point s of (theta, eps) and the start there."""
+def _model(model, p, theta, eps, s):
+    """The compiled model at the sweep point s of (theta, eps) and the start there
+    (``model``: the scene's model module)."""
     mu = 1.0 + s * limit_map.scale(eps, theta)
-    cm = hopf.compiled(eps, theta, mu, float(p["omega"]), sliding=theta > 0)
+    cm = model.compiled(eps, theta, mu, float(p["omega"]), sliding=theta > 0)
     return cm, [0.0, np.sqrt(mu), 0.0]
 
 
-def _settle(p, theta, eps, s, options, lyapunov, point=None, first=None):
+def _settle(model, p, theta, eps, s, options, lyapunov, point=None, first=None):
     """The attractor at the sweep point s (``point``, ``first``: its model and start, and
     its first returns, already made by :func:`_first_returns`)."""
-    cm, start = point if point is not None else _model(p, theta, eps, s)
+    cm, start = point if point is not None else _model(model, p, theta, eps, s)
     w = float(p["window"])
     return attractors.settle(
         cm, start, coordinate=1, transient=int(p["n_transient"]), keep=int(p["n_keep"]),
@@ -91,12 +105,12 @@ def _settle(p, theta, eps, s, options, lyapunov, point=None, first=None):
         window=(1.0 - w, 1.0 + w), lyapunov=lyapunov, first=first, **options)
 
 
-def _first_returns(p, theta, eps, s, options, lyapunov):
+def _first_returns(model, p, theta, eps, s, options, lyapunov):
     """The models and starts of every point s of (theta, eps), and their first
     n_transient + n_keep returns in one compiled call (one model at different mu, the start points spread over the cores);
     row k is what attractors.settle would make for s[k] itself, bit for bit."""
     attractors.check_resolvable(limit_map.scale(eps, theta))  # settle's refusal, first
-    points = [_model(p, theta, eps, float(sk)) for sk in s]
+    points = [_model(model, p, theta, eps, float(sk)) for sk in s]
     return points, attractors.iterate_sweep(
         [cm for cm, _ in points], [z for _, z in points], transient=int(p["n_transient"]),
         keep=int(p["n_keep"]), t_max=T_RETURN, jacobian=lyapunov, **options)
@@ -110,6 +124,7 @@ def sweep(scene: dict, s: np.ndarray, *, progress: bool = False) -> xr.Dataset:
     opts = solver_options(scene)
     opts.pop("method")
     lyapunov = bool(p.get("lyapunov", False))
+    model = registered_model(scene)
     th, ep, s = thetas(p), eps_list(p), np.asarray(s, dtype=float)
     keep = int(p["n_keep"])
     shape = (len(th), len(ep), s.size)
@@ -120,9 +135,9 @@ def sweep(scene: dict, s: np.ndarray, *, progress: bool = False) -> xr.Dataset:
     for i, theta in enumerate(th):
         for j, eps in enumerate(ep):
             sigma = limit_map.scale(eps, theta)
-            points, first = _first_returns(p, theta, eps, s, opts, lyapunov)
+            points, first = _first_returns(model, p, theta, eps, s, opts, lyapunov)
             for k, sk in enumerate(s):
-                at = _settle(p, theta, eps, float(sk), opts, lyapunov, point=points[k],
+                at = _settle(model, p, theta, eps, float(sk), opts, lyapunov, point=points[k],
                              first=attractors.row(first, k))
                 u[i, j, k] = (at.values - 1.0) / sigma
                 period[i, j, k] = at.period

@@ -1,6 +1,7 @@
 """fig:slidesketch: one crossing and one sliding trajectory of concrete planar systems."""
 from __future__ import annotations
 
+from typing import Protocol
 import numpy as np
 import xarray as xr
 
@@ -9,6 +10,14 @@ from filippov.io import finalize
 from filippov.progress import Progress
 from filippov_paper.scenes.common import registered_model, require, solver_options
 from filippov_paper.report import Macros, tex_escape, var
+
+
+class PlanarCases(Protocol):
+    """What this scene uses of its model (``model:``): a planar system per case."""
+    def system(self, case): ...
+
+
+MODEL = PlanarCases
 
 CASES = ("crossing", "sliding")
 

@@ -1,6 +1,7 @@
 """fig:cases: the pseudo-equilibrium example for theta > 0 (sliding) and theta < 0 (chatter)."""
 from __future__ import annotations
 
+from typing import Protocol
 import numpy as np
 import xarray as xr
 
@@ -13,6 +14,14 @@ from filippov.system import PLUS
 from filippov_paper.scenes.common import registered_model, require, solver_options
 import math
 from filippov_paper.report import Macros, value, var
+
+
+class SlowFastFamily(Protocol):
+    """What this scene uses of its model (``model:``): the slow-fast model at (eps, theta)."""
+    def model(self, eps, theta): ...
+
+
+MODEL = SlowFastFamily
 
 #: names and units of the variables without them below (checked by filippov_paper.scenes)
 VARIABLE_ATTRS = {

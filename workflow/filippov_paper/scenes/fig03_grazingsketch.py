@@ -25,6 +25,7 @@ the solver measured.
 """
 from __future__ import annotations
 
+from typing import Protocol
 import numpy as np
 import xarray as xr
 from scipy.optimize import brentq
@@ -37,6 +38,15 @@ from filippov_paper.tolerance import Tolerance
 from filippov_paper.scenes.common import registered_model, require, solver_options
 import math
 from filippov_paper.report import Macros, source, value, var
+
+
+class HopfFamily(Protocol):
+    """What this scene uses of its model (``model:``): the model at (eps, theta, mu, omega),
+    whose reduced system it follows."""
+    def model(self, eps, theta, mu, omega): ...
+
+
+MODEL = HopfFamily
 
 #: this scene's block of the scene schema: filippov_paper.config.load_scene adds it to
 #: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it

@@ -12,6 +12,7 @@ rate of change of h along the region-minus field at the grazing point p_g.
 """
 from __future__ import annotations
 
+from typing import Protocol
 import numpy as np
 import xarray as xr
 
@@ -24,6 +25,16 @@ from filippov_paper.scenes.common import engine, registered_model, require, solv
 from filippov_paper.tolerance import Tolerance, sqrt_law
 import math
 from filippov_paper.report import Macros, source, value, var
+
+
+class HopfFamily(Protocol):
+    """What this scene uses of its model (``model:``): the model at (eps, theta, mu, omega)
+    for the reference driver and its compiled form (with its section) for the kernel."""
+    def model(self, eps, theta, mu, omega): ...
+    def compiled(self, eps, theta, mu, omega, *, sliding, exact): ...
+
+
+MODEL = HopfFamily
 
 #: this scene's block of the scene schema: filippov_paper.config.load_scene adds it to
 #: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it

@@ -10,7 +10,7 @@ What is computed, and how:
   eps y' = g(x, y)) are integrated with DOP853 for ``settle`` * eps time units
   into each grid point, from y = x1 (on M_+). Off-manifold parts decay like
   exp(-t/eps), so what arrives is M_- to ~exp(-settle). The result is stored
-  next to the exact cubic (hopf.slow_manifold_minus), the O(eps) expansion
+  next to the exact cubic (the model's slow_manifold_minus), the O(eps) expansion
   eq:ymm and the differences, plus the invariance residual of the exact cubic;
 * one switching trajectory from L1 slightly outside the grazing orbit, run by
   the solver with the exact flows until it returns to L1: it crosses H_s into
@@ -19,17 +19,34 @@ What is computed, and how:
 """
 from __future__ import annotations
 
+from typing import Protocol
+
 import numpy as np
 import xarray as xr
 from scipy.integrate import solve_ivp
 
-from filippov import simulate
+from filippov import models, simulate
 from filippov.io import finalize
-from filippov.models import hopf
 from filippov.simulate import Section
 from filippov.system import MINUS, PLUS
 from filippov_paper.scenes.common import registered_model, require, solver_options
 from filippov_paper.report import Macros, var
+
+
+class HopfManifolds(Protocol):
+    """What this scene uses of its model (``model:``): the model at (eps, theta, mu,
+    omega), the exact slow manifold M_- and its O(eps) expansion, the fast field g, H_s
+    solved for y and the gap between M_+ and M_- at the grazing point, each derived from
+    the model's definition."""
+    def model(self, eps, theta, mu, omega): ...
+    def slow_manifold_minus(self, x1, x2, eps, mu, omega): ...
+    def slow_manifold_minus_first_order(self, x1, x2, eps, mu, omega): ...
+    def fast_field(self, x1, x2, y, eps, mu, omega): ...
+    def switching_surface_y(self, x1, theta): ...
+    def grazing_gap(self, eps): ...
+
+
+MODEL = HopfManifolds
 
 #: this scene's block of the scene schema: filippov_paper.config.load_scene adds it to
 #: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it
@@ -72,11 +89,6 @@ def section_L1() -> Section:
     return Section("L1", lambda z: z[0], direction=-1, where=lambda z: z[1] > 0, terminal=1)
 
 
-def expansion_minus(x1, x2, eps, mu, omega):
-    """eq:ymm without its O(eps^2) remainder."""
-    return x1 + eps * (mu * x1 - omega * x2 - (x1 * x1 + x2 * x2) * x1 - 1.0)
-
-
 def numeric_slow_manifold_minus(model, x1, x2, settle: float = 40.0,
                                 rtol: float = 1e-12, atol: float = 1e-14):
     """M_- at the points (x1, x2) from integrated E_- trajectories (no closed form).
@@ -85,7 +97,8 @@ def numeric_slow_manifold_minus(model, x1, x2, settle: float = 40.0,
     (x1 - settle eps, x2, y = x1 - settle eps), i.e. on M_+, and is integrated
     with the model's own f_- and g_- fields. Returns (y, t, dev) with ``dev``
     the largest distance to the final surface along the way, sampled at ``t``
-    (for showing the convergence; it is measured against the exact cubic).
+    (for showing the convergence; it is measured against the exact cubic of the model's
+    module, ``slow_manifold_minus``).
     """
     eps = model.eps
     x1 = np.asarray(x1, dtype=float)
@@ -109,18 +122,18 @@ def numeric_slow_manifold_minus(model, x1, x2, settle: float = 40.0,
     if not sol.success:
         raise RuntimeError(f"E_- integration failed: {sol.message}")
     xs = a1[:, None] - T + sol.t[None, :]
-    exact = hopf.slow_manifold_minus(xs, a2[:, None], eps, mu, omega)
+    exact = models.get(model.name).slow_manifold_minus(xs, a2[:, None], eps, mu, omega)
     dev = np.max(np.abs(sol.y - exact), axis=0)
     return sol.y[:, -1].reshape(shape), sol.t - T, dev
 
 
-def invariance_residual(x1, x2, eps, mu, omega, step: float = 1e-20):
-    """eps * D y_m- . f_- - g_-(x, y_m-) for the exact cubic, by complex-step
-    differentiation along f_- = (1, 0): zero on an invariant graph."""
-    d = hopf.slow_manifold_minus(x1 + 1j * step, x2, eps, mu, omega).imag / step
-    y = hopf.slow_manifold_minus(x1, x2, eps, mu, omega)
-    g = eps * hopf.hopf_rhs(x1, x2, mu, omega)[0] + x1 - y
-    return eps * d - g
+def invariance_residual(family, x1, x2, eps, mu, omega, step: float = 1e-20):
+    """eps * D y_m- . f_- - g_-(x, y_m-) for the exact cubic of the model module
+    ``family``, by complex-step differentiation along f_- = (1, 0): zero on an
+    invariant graph."""
+    d = family.slow_manifold_minus(x1 + 1j * step, x2, eps, mu, omega).imag / step
+    y = family.slow_manifold_minus(x1, x2, eps, mu, omega)
+    return eps * d - family.fast_field(x1, x2, y, eps, mu, omega)
 
 
 def relaxation_rate(t, z, t_from: float, t_to: float, floor: float = 1e-9):
@@ -141,11 +154,12 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     traj, sw = switching_trajectory(system, omega, float(p["start_x2"]), opts, scene["id"])
     t, z, mode = traj.sample(np.linspace(0.0, traj.t, n))
     rate = relaxation_after_return(traj, sw, float(p["rate_window"]) * eps)
-    s = surfaces(model, p, opts)
+    family = registered_model(scene)
+    s = surfaces(family, model, p, opts)
     ds = xr.Dataset(
         # one dict in the dataset's variable order: trajectories, surfaces, numbers
         {**_trajectory_vars(z, mode, z_orb, sw), **_surface_vars(s),
-         **_number_vars(eps, rate, s, touches, z_orb)},
+         **_number_vars(family, eps, rate, s, touches, z_orb)},
         coords={
             "t": ("t", t, {"long_name": "time", "units": "1"}),
             "t_orbit": ("t_orbit", t_orb, {"long_name": "time on the grazing orbit",
@@ -217,9 +231,10 @@ def relaxation_after_return(traj, sw, span: float) -> float:
     return relaxation_rate(tf, zf, t_back, tf[-1])
 
 
-def surfaces(model, p: dict, opts: dict) -> dict:
+def surfaces(family, model, p: dict, opts: dict) -> dict:
     """M_- (numerical, exact, expanded), M_+'s gap to it at p_g, H_s and the invariance
-    residual on the zoom window's grid."""
+    residual on the zoom window's grid (``family``: the model module, ``model``: its
+    slow-fast model at the scene's parameters)."""
     eps, theta = float(p["eps"]), float(p["theta"])
     mu, omega = float(p["mu"]), float(p["omega"])
     g1 = np.linspace(*map(float, p["x1_range"]), int(p["n_grid"]))
@@ -228,10 +243,10 @@ def surfaces(model, p: dict, opts: dict) -> dict:
     settle = float(p["settle"])
     tol = {k: opts[k] for k in ("rtol", "atol")}
     y_num, t_conv, dev_conv = numeric_slow_manifold_minus(model, X1, X2, settle, **tol)
-    y_exact = hopf.slow_manifold_minus(X1, X2, eps, mu, omega)
-    y_exp = expansion_minus(X1, X2, eps, mu, omega)
-    y_hs = (-1.0 - theta * X1) / (1.0 - theta)
-    resid = invariance_residual(X1, X2, eps, mu, omega)
+    y_exact = family.slow_manifold_minus(X1, X2, eps, mu, omega)
+    y_exp = family.slow_manifold_minus_first_order(X1, X2, eps, mu, omega)
+    y_hs = family.switching_surface_y(X1, theta)
+    resid = invariance_residual(family, X1, X2, eps, mu, omega)
     y_pg_num, _, _ = numeric_slow_manifold_minus(model, P_G[:1], P_G[1:2], settle, **tol)
     gap_pg = float(P_G[0] - y_pg_num[0])  # y_m+ - y_m- at x = (-1, 0)
     return dict(g1=g1, g2=g2, X1=X1, settle=settle, y_num=y_num, t_conv=t_conv,
@@ -293,7 +308,7 @@ def _surface_vars(s: dict) -> dict:
     }
 
 
-def _number_vars(eps: float, rate: float, s: dict, touches, z_orb) -> dict:
+def _number_vars(family, eps: float, rate: float, s: dict, touches, z_orb) -> dict:
     """The scalars the report quotes: decay rate, gap at p_g, surface errors, orbit."""
     one = lambda v, ln, **kw: ((), float(v), {"long_name": ln, "units": "1", **kw})
     return {
@@ -301,7 +316,7 @@ def _number_vars(eps: float, rate: float, s: dict, touches, z_orb) -> dict:
                                 "return to region +", expected=1.0 / eps),
         "decay_rate_rel_error": one(rate * eps - 1.0, "decay_rate * eps - 1"),
         "gap_pg": one(s["gap_pg"], "y_m+ - y_m- at x = (-1, 0) from the numerical M_-"),
-        "gap_pg_exact": one(eps - 2 * eps ** 2 - 6 * eps ** 3 - 6 * eps ** 4,
+        "gap_pg_exact": one(family.grazing_gap(eps),
                             "y_m+ - y_m- at x = (-1, 0) from the exact cubic"),
         "M_minus_max_error": one(np.max(np.abs(s["y_num"] - s["y_exact"])),
                                  "max |numerical M_- - exact cubic| on the grid"),

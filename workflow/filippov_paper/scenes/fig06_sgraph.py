@@ -2,12 +2,25 @@
 parametrised by the sliding time t_s, from the closed forms in analytic.sgraph."""
 from __future__ import annotations
 
+from typing import Protocol
 import numpy as np
 import xarray as xr
 
 from filippov.io import finalize
 from filippov_paper.scenes.common import registered_model, require
 from filippov_paper.report import Macros, source, var
+
+
+class SGraphClosedForm(Protocol):
+    """What this scene uses of its model (``model:``): the closed forms of the s graph."""
+    def xi1(self, t, theta, omega): ...
+    def image(self, t, theta, omega): ...
+    def slope(self, t, theta, omega): ...
+    def slope_at_zero(self, theta): ...
+    def image_limit(self, theta, omega): ...
+
+
+MODEL = SGraphClosedForm
 
 
 def t_grid(p: dict) -> np.ndarray:

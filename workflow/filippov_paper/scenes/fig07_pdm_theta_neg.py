@@ -64,7 +64,7 @@ def tolerances(scene: dict) -> dict:
     return {**{n: in_xi for n in names}, "xi2_entry": xi2, "xi2_exit": xi2,
             "error_xi2_entry": xi2,
             "rate_first_order": rate, "rate_zero_order": rate}
-from filippov_paper.scenes.pdm_common import (CHUNK_AXIS, base_dataset, checked_theta, chunk_grid,  # noqa: F401
+from filippov_paper.scenes.pdm_common import (CHUNK_AXIS, HopfFamily as MODEL, base_dataset, checked_theta, chunk_grid,  # noqa: F401
                          fields_from_dataset, max_error, rates, sweep_dataset)
 # CHUNK_AXIS, chunk_grid, sweep and assemble make the scene splittable (see .chunking)
 

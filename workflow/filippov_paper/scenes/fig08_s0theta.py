@@ -1,12 +1,23 @@
 """fig:s0theta: s0(theta) for theta < 0, by Lambert W and by root finding."""
 from __future__ import annotations
 
+from typing import Protocol
 import numpy as np
 import xarray as xr
 
 from filippov.io import finalize
 from filippov_paper.scenes.common import registered_model, require
 from filippov_paper.report import Macros
+
+
+class S0ClosedForm(Protocol):
+    """What this scene uses of its model (``model:``): s0(theta) two ways, and eq:s0def."""
+    def s0_lambert(self, theta): ...
+    def s0_root(self, theta): ...
+    def residual(self, s, theta): ...
+
+
+MODEL = S0ClosedForm
 
 VARIABLE_ATTRS = {"residual": ("left side of eq:s0def at the closed-form s0", "1")}
 from filippov_paper.tolerance import U, Tolerance

@@ -66,7 +66,7 @@ def tolerances(scene: dict) -> dict:
     return {**{n: in_xi for n in names},
             **{n: sqrt for n in ("xi2_entry", "xi2_exit", "excursion_time", "sliding_time")},
             "error_slope": slope, "slope_left": slope, "rate": rate, "rate_core": rate}
-from filippov_paper.scenes.pdm_common import (CHUNK_AXIS, base_dataset, checked_theta, chunk_grid,  # noqa: F401
+from filippov_paper.scenes.pdm_common import (CHUNK_AXIS, HopfFamily as MODEL, base_dataset, checked_theta, chunk_grid,  # noqa: F401
                          fields_from_dataset, max_error, rates, sweep_dataset)
 # CHUNK_AXIS, chunk_grid, sweep and assemble make the scene splittable (see .chunking)
 

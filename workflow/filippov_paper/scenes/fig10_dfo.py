@@ -21,6 +21,8 @@ largest block position x1 along the orbit (x1 where the orbit crosses
 """
 from __future__ import annotations
 
+from typing import Protocol
+
 import functools
 
 import numpy as np
@@ -30,10 +32,9 @@ from scipy.optimize import brentq
 
 from filippov import continuation as cont
 from filippov.io import finalize
-from filippov.models import dry_friction as df
 from filippov.progress import Progress
 from filippov.simulate import Section, simulate
-from filippov_paper.scenes.common import require
+from filippov_paper.scenes.common import registered_model, require
 from filippov_paper.tolerance import Tolerance
 from filippov_paper.report import Macros, absent, scalar_table, var
 
@@ -90,6 +91,24 @@ LATEX_NAMES = {
     "F_c_static": r"$F_c(0^+)$, the static friction level",
 }
 
+
+
+class FrictionOscillator(Protocol):
+    """What this scene uses of its model (``model:``), all functions of a friction law
+    (f0, fv, fc, convention): the friction branches and F_c itself, the Hopf speed, the
+    equilibrium, the reduced region-+ field with its derivatives, the reference model
+    at (eps, v) and the reduced system's Jacobians."""
+    def friction_branches(self, f0, fv, fc, convention): ...
+    def friction(self, nu, *, f0, fv, fc, convention): ...
+    def hopf_speed(self, fv, fc, convention): ...
+    def equilibrium(self, v, *, f0, fv, fc, convention): ...
+    def plus_field_reduced(self, v, *, f0, fv, fc, convention): ...
+    def model(self, eps, v0, *, f0, fv, fc, convention): ...
+    def reduced_jacobian(self, v, *, f0, fv, fc, convention): ...
+
+
+MODEL = FrictionOscillator
+
 RTOL, ATOL = 1e-12, 1e-14
 N_MAX = 400  # continuation steps per direction
 
@@ -107,12 +126,12 @@ def section_event(x1_min: float):
     return ev
 
 
-def _to_section(v, z0, law, backward=False, rtol=RTOL, atol=ATOL):
+def _to_section(model, v, z0, law, backward=False, rtol=RTOL, atol=ATOL):
     """From z0 follow the region-+ field (forward or backward) to the section;
     returns (x1 there, time)."""
-    f = df.plus_field_reduced(v, **law)[0]
+    f = model.plus_field_reduced(v, **law)[0]
     sign = -1.0 if backward else 1.0
-    x_eq = float(df.equilibrium(v, **law)[0])
+    x_eq = float(model.equilibrium(v, **law)[0])
     ev = section_event(x_eq)
     ev.terminal = True
     ev.direction = -1 if not backward else 1
@@ -123,29 +142,31 @@ def _to_section(v, z0, law, backward=False, rtol=RTOL, atol=ATOL):
     return float(sol.y_events[0][0][0]), float(sol.t_events[0][0])
 
 
-def exit_point(law) -> float:
+def exit_point(model, law) -> float:
     """x1 where sticking ends: b = x1 + F_c(0-) = 0 (eq:atSl with h = v - x2)."""
-    return float(-df.friction_branches(law["f0"], law["fv"], law["fc"], law["convention"])[0](0.0))
+    branches = model.friction_branches(law["f0"], law["fv"], law["fc"], law["convention"])
+    return float(-branches[0](0.0))
 
 
-def gs_mismatch(v, law, rtol=RTOL, atol=ATOL):
+def gs_mismatch(model, v, law, rtol=RTOL, atol=ATOL):
     """Forward minus backward section hit of the orbit through the exit point (x_e, v):
     zero iff that orbit is a closed orbit in region + touching x2 = v (grazing)."""
-    xe = exit_point(law)
-    fwd = _to_section(v, [xe, v], law, rtol=rtol, atol=atol)[0]
-    bwd = _to_section(v, [xe, v], law, backward=True, rtol=rtol, atol=atol)[0]
+    xe = exit_point(model, law)
+    fwd = _to_section(model, v, [xe, v], law, rtol=rtol, atol=atol)[0]
+    bwd = _to_section(model, v, [xe, v], law, backward=True, rtol=rtol, atol=atol)[0]
     return fwd - bwd
 
 
-def grazing_speed(law, bracket, rtol=RTOL, atol=ATOL) -> float:
-    return brentq(lambda v: gs_mismatch(v, law, rtol, atol), *bracket, xtol=1e-15, rtol=1e-15)
+def grazing_speed(model, law, bracket, rtol=RTOL, atol=ATOL) -> float:
+    return brentq(lambda v: gs_mismatch(model, v, law, rtol, atol), *bracket, xtol=1e-15,
+                  rtol=1e-15)
 
 
-def hopf_numeric(law, bracket) -> float:
+def hopf_numeric(model, law, bracket) -> float:
     """v where the largest real part of the Jacobian eigenvalues at the numerically
     found equilibrium crosses zero (Jacobian by central differences)."""
     def re(v):
-        f = df.plus_field_reduced(v, **law)[0]
+        f = model.plus_field_reduced(v, **law)[0]
         x = np.array([0.5, 0.0])
         for _ in range(50):  # Newton on f(x) = 0
             J = cont.fd_jacobian(f, x, 1e-6)
@@ -158,15 +179,15 @@ def hopf_numeric(law, bracket) -> float:
 
 
 # --------------------------------------------------------------------------- branches
-def hopf_problem(law):
+def hopf_problem(model, law):
     """Shooting (G, J, unpack) with u = (x1, T, v), start point (x1, 0)."""
-    return cont.shooting_residual(lambda v: df.plus_field_reduced(v, **law), 1, 0.0, 2)
+    return cont.shooting_residual(lambda v: model.plus_field_reduced(v, **law), 1, 0.0, 2)
 
 
-def max_x2(u, law):
+def max_x2(model, u, law):
     """Largest x2 along the orbit of u = (x1, T, v): where x2' = 0 with x2 > 0."""
     x1, T, v = u
-    f = df.plus_field_reduced(v, **law)[0]
+    f = model.plus_field_reduced(v, **law)[0]
     sol = solve_ivp(lambda t, z: f(z), (0.0, T), [x1, 0.0], method="DOP853", rtol=RTOL,
                     atol=ATOL, dense_output=True)
     ev = lambda t, z: f(z)[1]
@@ -179,58 +200,60 @@ def max_x2(u, law):
     return best
 
 
-def start_cycle(v, law, amp=0.2):
+def start_cycle(model, v, law, amp=0.2):
     """An unstable cycle of region + at v, reached by flowing backward in time
     (it attracts in reverse time) from near the equilibrium, then Newton."""
-    f = df.plus_field_reduced(v, **law)[0]
-    x_eq = float(df.equilibrium(v, **law)[0])
+    f = model.plus_field_reduced(v, **law)[0]
+    x_eq = float(model.equilibrium(v, **law)[0])
     sol = solve_ivp(lambda t, z: -f(z), (0.0, 400.0), [x_eq + amp, 0.0], method="DOP853",
                     rtol=1e-10, atol=1e-12)
     z = sol.y[:, -1]
-    x1, _ = _to_section(v, z, law)
-    _, T = _to_section(v, [x1, -1e-9], law)  # just past the section: one turn
-    G, J, _ = hopf_problem(law)
+    x1, _ = _to_section(model, v, z, law)
+    _, T = _to_section(model, v, [x1, -1e-9], law)  # just past the section: one turn
+    G, J, _ = hopf_problem(model, law)
     u, _ = cont.newton(G, J, np.array([x1, T, v]),
                        extra=lambda w: (w[2] - v, np.array([0.0, 0.0, 1.0])))
     return u
 
 
-def _branch_amplitude(u, law) -> float:
-    return u[0] - float(df.equilibrium(u[2], **law)[0])
+def _branch_amplitude(model, u, law) -> float:
+    return u[0] - float(model.equilibrium(u[2], **law)[0])
 
 
-def branch_start(law, v_hopf, v_gs):
+def branch_start(model, law, v_hopf, v_gs):
     """The cycle both continuation directions start from: at v midway between H and GS."""
-    return start_cycle(0.5 * (v_hopf + v_gs), law)
+    return start_cycle(model, 0.5 * (v_hopf + v_gs), law)
 
 
-def branch_to_hopf(law, u0, amp_min, ds, progress=None):
+def branch_to_hopf(model, law, u0, amp_min, ds, progress=None):
     """From u0 towards H (v decreasing) until the amplitude drops below amp_min.
     Returns the rows u = (x1, T, v) ordered by increasing v (u0 last) and the
     number of folds between kept rows."""
-    G, J, _ = hopf_problem(law)
+    G, J, _ = hopf_problem(model, law)
     to_h = cont.pseudo_arclength(G, u0, [0, 0, -1], J=J, ds=ds, ds_max=2 * ds, n_max=N_MAX,
-                                 stop=lambda u: "amplitude" if _branch_amplitude(u, law) < amp_min
-                                 else "", progress=progress)
+                                 stop=lambda u: "amplitude"
+                                 if _branch_amplitude(model, u, law) < amp_min else "",
+                                 progress=progress)
     # past H the shooting solutions continue onto the same small cycles seen from
     # the other side of the equilibrium (x1 < x1_eq): keep the physical half
-    keep = np.array([_branch_amplitude(u, law) > 0 for u in to_h.u])
+    keep = np.array([_branch_amplitude(model, u, law) > 0 for u in to_h.u])
     folds = [i for i in to_h.folds if keep[i] and keep[i + 1]]
     return to_h.u[keep][::-1], len(folds)
 
 
-def branch_to_grazing(law, u0, ds, progress=None):
+def branch_to_grazing(model, law, u0, ds, progress=None):
     """From u0 towards GS (v increasing) until the cycle touches x2 = v; the grazing
     cycle is refined on the branch (v - max x2 = 0 with G = 0). Returns the rows
     after u0 ending with the grazing cycle, the number of folds, and that cycle."""
-    G, J, _ = hopf_problem(law)
+    G, J, _ = hopf_problem(model, law)
     to_gs = cont.pseudo_arclength(G, u0, [0, 0, 1], J=J, ds=ds, ds_max=4 * ds, n_max=N_MAX,
-                                  stop=lambda u: "grazing" if max_x2(u, law) > u[2] else "",
+                                  stop=lambda u: "grazing" if max_x2(model, u, law) > u[2]
+                                  else "",
                                   progress=progress)
     if to_gs.stopped != "grazing":
         raise RuntimeError(f"Hopf branch did not reach grazing ({to_gs.stopped})")
     # grazing on the branch: Newton from the secant guess of the last two points
-    gfun = lambda u: u[2] - max_x2(u, law)
+    gfun = lambda u: u[2] - max_x2(model, u, law)
     ua, ub = to_gs.u[-2], to_gs.u[-1]
     ga, gb = gfun(ua), gfun(ub)
     guess = ua + ga / (ga - gb) * (ub - ua)
@@ -239,33 +262,33 @@ def branch_to_grazing(law, u0, ds, progress=None):
     return np.vstack([to_gs.u[1:-1], u_gs[None]]), len(to_gs.folds), u_gs
 
 
-def hopf_branch(law, v_start, v_hopf, amp_min, ds, progress=None):
+def hopf_branch(model, law, v_start, v_hopf, amp_min, ds, progress=None):
     """Unstable periodic orbits from the Hopf point to grazing, as rows u = (x1, T, v)
     ordered by v, with the grazing point refined on the branch (both directions
     from the cycle at v_start; the workflow runs them as separate jobs)."""
-    u0 = start_cycle(v_start, law)
-    low, n_low = branch_to_hopf(law, u0, amp_min, ds, progress)
-    high, n_high, u_gs = branch_to_grazing(law, u0, ds, progress)
+    u0 = start_cycle(model, v_start, law)
+    low, n_low = branch_to_hopf(model, law, u0, amp_min, ds, progress)
+    high, n_high, u_gs = branch_to_grazing(model, law, u0, ds, progress)
     return np.vstack([low, high]), u_gs, n_low + n_high
 
 
-def multipliers_smooth(u, law):
+def multipliers_smooth(model, u, law):
     """Floquet multipliers of a region-+ cycle u = (x1, T, v) (no switching)."""
     x1, T, v = u
-    f, dfdx, dfdv = df.plus_field_reduced(v, **law)
+    f, dfdx, dfdv = model.plus_field_reduced(v, **law)
     _, Phi, _, _ = cont.flow_with_sensitivities(f, dfdx, dfdv, [x1, 0.0], T)
     m = np.linalg.eigvals(Phi)
     return m[np.argsort(-np.abs(m))]
 
 
-def stick_slip_orbit(v, law, *, rtol=RTOL, atol=ATOL):
+def stick_slip_orbit(model, v, law, *, rtol=RTOL, atol=ATOL):
     """The stick-slip orbit at v: leave sticking at (x_e, v), go to the section, then
     one full period back to it with the event-driven solver. Returns a dict."""
-    system = df.model(0.0, v, **law).reduced()
-    xe = exit_point(law)
-    x_start, _ = _to_section(v, [xe, v], law, rtol=rtol, atol=atol)
+    system = model.model(0.0, v, **law).reduced()
+    xe = exit_point(model, law)
+    x_start, _ = _to_section(model, v, [xe, v], law, rtol=rtol, atol=atol)
     sec = Section("x2=0", lambda z: z[1], direction=-1,
-                  where=lambda z: z[0] > float(df.equilibrium(v, **law)[0]), terminal=1)
+                  where=lambda z: z[0] > float(model.equilibrium(v, **law)[0]), terminal=1)
     traj = simulate(system, [x_start, 0.0], 100.0, method="integrate", rtol=rtol, atol=atol,
                     sections=[sec], dense=False)
     if traj.status != "section:x2=0":
@@ -275,7 +298,7 @@ def stick_slip_orbit(v, law, *, rtol=RTOL, atol=ATOL):
     ends = [e for e in traj.events if e.kind == "slide_end"]
     if len(starts) != 1 or len(ends) != 1:
         raise RuntimeError(f"v={v!r}: expected one sticking phase, got events {kinds}")
-    _, mult = cont.monodromy(system, traj, jacobian=df.reduced_jacobian(v, **law))
+    _, mult = cont.monodromy(system, traj, jacobian=model.reduced_jacobian(v, **law))
     return {"x1": x_start, "x1_return": float(traj.z[0]), "period": traj.t,
             "stick_time": ends[0].t - starts[0].t,
             "stick_length": float(ends[0].state[0] - starts[0].state[0]),
@@ -302,21 +325,22 @@ def _checked(scene: dict) -> dict:
     return scene["parameters"]
 
 
-def _special_speeds(scene: dict):
-    """(law, v_hopf, v_gs): the friction law, the Hopf point and the GS point."""
+def _special_speeds(model, scene: dict):
+    """(law, v_hopf, v_gs): the friction law, the Hopf point and the GS point of the
+    scene's model module ``model``."""
     p = _checked(scene)
     law = _law(p)
-    v_hopf = df.hopf_speed(law["fv"], law["fc"], law["convention"])
+    v_hopf = model.hopf_speed(law["fv"], law["fc"], law["convention"])
     if not np.isfinite(v_hopf):
         raise ValueError(f"{scene['id']}: parameters: this friction law has no Hopf point")
-    return law, v_hopf, _grazing_speed_cached(tuple(sorted(law.items())), v_hopf,
+    return law, v_hopf, _grazing_speed_cached(model, tuple(sorted(law.items())), v_hopf,
                                               float(p["v_max"]))
 
 
 @functools.lru_cache(maxsize=8)
-def _grazing_speed_cached(law_items, v_hopf, v_max):
+def _grazing_speed_cached(model, law_items, v_hopf, v_max):
     # chunk_grid, sweep and assemble each need GS; one root search per process
-    return grazing_speed(dict(law_items), (v_hopf + 1e-3, v_max))
+    return grazing_speed(model, dict(law_items), (v_hopf + 1e-3, v_max))
 
 
 def stick_slip_speeds(p: dict, v_gs: float) -> np.ndarray:
@@ -329,7 +353,7 @@ def stick_slip_speeds(p: dict, v_gs: float) -> np.ndarray:
 
 def chunk_grid(scene: dict) -> np.ndarray:
     """Task numbers 0 .. n_stick_slip + 1 (see the comment above)."""
-    _, _, v_gs = _special_speeds(scene)
+    _, _, v_gs = _special_speeds(registered_model(scene), scene)
     return np.arange(stick_slip_speeds(scene["parameters"], v_gs).size + 2, dtype=np.int32)
 
 
@@ -341,7 +365,8 @@ def sweep(scene: dict, tasks, progress: bool = False) -> xr.Dataset:
     """Raw results of the given tasks: stick-slip scalars per task, and the branch
     rows of the two continuation tasks padded with NaN to N_MAX + 1 rows."""
     p = _checked(scene)
-    law, v_hopf, v_gs = _special_speeds(scene)
+    model = registered_model(scene)
+    law, v_hopf, v_gs = _special_speeds(model, scene)
     vs = stick_slip_speeds(p, v_gs)
     n_tasks = vs.size + 2
     tasks = np.asarray(tasks, dtype=np.int32)
@@ -355,11 +380,11 @@ def sweep(scene: dict, tasks, progress: bool = False) -> xr.Dataset:
     br_u, br_mult = nan(k, rows, 3), nan(k, rows)
     br_rows, br_folds = np.zeros(k, np.int32), np.zeros(k, np.int32)
     u_gs = nan(k, 3)
-    u0 = branch_start(law, v_hopf, v_gs) if n_branch else None
+    u0 = branch_start(model, law, v_hopf, v_gs) if n_branch else None
     for j, (task, kind) in enumerate(zip(tasks, kinds)):
         if kind == STICK_SLIP:
             v = vs[task - 1]
-            r = stick_slip_orbit(v, law)
+            r = stick_slip_orbit(model, v, law)
             m = np.abs(r["multipliers"])
             for name, value in (("v", v), ("x1", r["x1"]), ("period", r["period"]),
                                 ("stick_time", r["stick_time"]),
@@ -370,11 +395,11 @@ def sweep(scene: dict, tasks, progress: bool = False) -> xr.Dataset:
             bar.step()
             continue
         if kind == TO_HOPF:
-            u, n_folds = branch_to_hopf(law, u0, float(p["amp_min"]), float(p["ds"]), bar)
+            u, n_folds = branch_to_hopf(model, law, u0, float(p["amp_min"]), float(p["ds"]), bar)
         else:
-            u, n_folds, u_gs[j] = branch_to_grazing(law, u0, float(p["ds"]), bar)
+            u, n_folds, u_gs[j] = branch_to_grazing(model, law, u0, float(p["ds"]), bar)
         br_u[j, :len(u)] = u
-        br_mult[j, :len(u)] = [np.abs(multipliers_smooth(row, law)[0]) for row in u]
+        br_mult[j, :len(u)] = [np.abs(multipliers_smooth(model, row, law)[0]) for row in u]
         br_rows[j], br_folds[j] = len(u), n_folds
     raw = {f"ss_{name}": (CHUNK_AXIS, value) for name, value in ss.items()}
     raw.update(kind=(CHUNK_AXIS, kinds), br_u=((CHUNK_AXIS, "row", "u"), br_u),
@@ -389,16 +414,17 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
 
 def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     p = _checked(scene)
-    law, v_hopf, v_gs = _special_speeds(scene)
-    v_hopf_num = hopf_numeric(law, (0.5 * v_hopf, 1.5 * v_hopf))
+    model = registered_model(scene)
+    law, v_hopf, v_gs = _special_speeds(model, scene)
+    v_hopf_num = hopf_numeric(model, law, (0.5 * v_hopf, 1.5 * v_hopf))
     br, po_mult, u_gs, n_folds = unstable_cycles(raw)
     ds = xr.Dataset(
         # one dict in the dataset's variable order
-        {**_point_vars(law, v_hopf, v_hopf_num, v_gs, u_gs, n_folds),
-         **_equilibrium_vars(law, p, v_hopf),
+        {**_point_vars(model, law, v_hopf, v_hopf_num, v_gs, u_gs, n_folds),
+         **_equilibrium_vars(model, law, p, v_hopf),
          **_cycle_vars(br, po_mult),
          **_stick_slip_vars(_stick_slip_rows(raw)),
-         **_friction_vars(law, p)},
+         **_friction_vars(model, law, p)},
     )
     return finalize(ds, scene, method="integrate", friction_convention=law["convention"],
                     title="dry-friction oscillator eq:dfo1: friction law and bifurcation "
@@ -429,7 +455,7 @@ def _stick_slip_rows(raw: xr.Dataset) -> dict:
     return {name[3:]: raw[name].values[sel] for name in raw.data_vars if name.startswith("ss_")}
 
 
-def _point_vars(law, v_hopf, v_hopf_num, v_gs, u_gs, n_folds) -> dict:
+def _point_vars(model, law, v_hopf, v_hopf_num, v_gs, u_gs, n_folds) -> dict:
     """The special points: Hopf, grazing-sliding, the exit of sticking."""
     return {
         "v_hopf": ((), v_hopf, {"long_name": "Hopf point: belt speed with F_c'(-v) = 0, ln(fc/fv)",
@@ -442,18 +468,18 @@ def _point_vars(law, v_hopf, v_hopf_num, v_gs, u_gs, n_folds) -> dict:
                                           "of unstable cycles", "units": "1"}),
         "x1_gs": ((), float(u_gs[0]), {"long_name": "max x1 of the grazing orbit", "units": "1"}),
         "period_gs": ((), float(u_gs[1]), {"long_name": "period of the grazing orbit", "units": "1"}),
-        "x1_exit": ((), exit_point(law), {"long_name": "x1 where sticking ends (-F_c(0-))",
+        "x1_exit": ((), exit_point(model, law), {"long_name": "x1 where sticking ends (-F_c(0-))",
                                           "units": "1"}),
         "n_folds_hopf_branch": ((), n_folds, {"long_name": "folds on the unstable branch",
                                                   "units": "1"}),
     }
 
 
-def _equilibrium_vars(law, p: dict, v_hopf: float) -> dict:
+def _equilibrium_vars(model, law, p: dict, v_hopf: float) -> dict:
     """The equilibrium over [v_min, v_max] with the Hopf point on the grid."""
     ve = np.linspace(float(p["v_min"]), float(p["v_max"]), 401)
     veq = np.unique(np.concatenate([ve, [v_hopf]]))
-    x_eq = df.equilibrium(veq, **law)[0]
+    x_eq = model.equilibrium(veq, **law)[0]
     return {
         "eq_v": ("eq", veq, {"long_name": "belt speed v", "units": "1"}),
         "eq_x1": ("eq", x_eq, {"long_name": "x1 of the equilibrium, -F_c(-v)", "units": "1"}),
@@ -499,15 +525,15 @@ def _stick_slip_vars(ss: dict) -> dict:
     }
 
 
-def _friction_vars(law, p: dict) -> dict:
+def _friction_vars(model, law, p: dict) -> dict:
     """The friction law over the relative velocity, as adopted and as printed."""
     nu = np.linspace(-float(p["nu_max"]), float(p["nu_max"]), 801)
     # both sides of the jump at 0, not 0 itself (F_c is set-valued there)
     nu = np.unique(np.concatenate([nu, [-1e-12, 1e-12]]))
     nu = nu[nu != 0]
-    F = df.friction(nu, **law)
-    F_lit = df.friction(nu, **dict(law, convention="literal"))
-    _, _, Fm, _ = df.friction_branches(**law)
+    F = model.friction(nu, **law)
+    F_lit = model.friction(nu, **dict(law, convention="literal"))
+    _, _, Fm, _ = model.friction_branches(**law)
     return {
         "nu": ("nu", nu, {"long_name": "relative velocity x2 - v", "units": "1"}),
         "F_c": ("nu", F, {"long_name": "friction force F_c (adopted convention)", "units": "1"}),

@@ -30,6 +30,8 @@ literally, together with the solver's normal speeds at a point of H_s.
 """
 from __future__ import annotations
 
+from typing import Protocol
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,14 +41,34 @@ from scipy.optimize import brentq, minimize_scalar
 
 from filippov import fastmap
 from filippov.io import finalize
-from filippov.models import dry_friction as df
 from filippov.poincare import fixed_points, sliding_time
 from filippov.progress import Progress
 from filippov.simulate import Section, simulate
 from filippov.system import SLIDING
-from filippov_paper.scenes.common import engine, require, solver_options
+from filippov_paper.scenes.common import engine, registered_model, require, solver_options
 from filippov_paper.tolerance import Tolerance
 from filippov_paper.report import Macros, absent, scalar_table, var
+
+class FrictionReturns(Protocol):
+    """What this scene uses of its model (``model:``), all functions of a friction law
+    (gamma, f0, fv, fc, convention) at (eps, v0): the slow-fast system for either engine,
+    the slow manifold M_+ (by relaxation, and along L), the region-+ pieces printed from
+    the definition (REGION_PLUS: the fields and the expansion w2 of M_+), the law's
+    coefficients, the friction branches and the reference model."""
+    REGION_PLUS: dict
+
+    def compiled(self, eps, v0, *, gamma, f0, fv, fc, convention): ...
+    def full_system(self, eps, v0, *, gamma, f0, fv, fc, convention): ...
+    def slow_manifold_plus(self, x1, x2, eps, v0, *, gamma, f0, fv, fc, convention,
+                           rtol, atol): ...
+    def slow_manifold_plus_on_L(self, x1_lo, x1_hi, eps, v0, *, gamma, f0, fv, fc,
+                                convention, rtol, atol): ...
+    def law_coefficients(self, f0, fv, fc, convention): ...
+    def friction_branches(self, f0, fv, fc, convention): ...
+    def model(self, eps, v0, *, gamma, f0, fv, fc, convention): ...
+
+
+MODEL = FrictionReturns
 
 #: this scene's block of the scene schema: filippov_paper.config.load_scene adds it to
 #: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it
@@ -170,13 +192,13 @@ def _slide_length(events) -> float:
     return total
 
 
-def compiled_returns(z0s, eps, v0, law, rtol, atol):
+def compiled_returns(model, z0s, eps, v0, law, rtol, atol):
     """First returns to L of the states ``z0s`` by the compiled kernel (every mode
     integrated with DOP853 there, the algorithm of the reference driver), sampled
     as the scene's reference driver runs it (one sample per step)."""
     ml = {k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")}
     z0s = np.atleast_2d(np.asarray(z0s, dtype=float))
-    out = fastmap.compute_returns(df.compiled(eps, v0, **ml), z0s, T_RETURN, rtol=rtol,
+    out = fastmap.compute_returns(model.compiled(eps, v0, **ml), z0s, T_RETURN, rtol=rtol,
                                   atol=atol, samples_per_step=1)
     bad = np.flatnonzero(out.status != fastmap.OK)
     if bad.size:
@@ -186,7 +208,7 @@ def compiled_returns(z0s, eps, v0, law, rtol, atol):
     return out
 
 
-def return_map(x1, eps, v0, law, *, rtol=1e-12, atol=1e-14, progress=None,
+def return_map(model, x1, eps, v0, law, *, rtol=1e-12, atol=1e-14, progress=None,
                with_residual=True, start=None, engine="reference"):
     """P(x1) on L for start points on M_+. Returns a dict of arrays.
     ``start``: optional ``x1 -> (w, estimate)`` on M_+
@@ -196,12 +218,12 @@ def return_map(x1, eps, v0, law, *, rtol=1e-12, atol=1e-14, progress=None,
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     ml = {k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")}
     if start is None:
-        w0, res0 = df.slow_manifold_plus(x1, 0.0, eps, v0, **ml, rtol=rtol, atol=atol)
+        w0, res0 = model.slow_manifold_plus(x1, 0.0, eps, v0, **ml, rtol=rtol, atol=atol)
     else:
         w0, res0 = start(x1)
     if engine == "compiled":
-        ret = compiled_returns(np.stack([x1, np.zeros_like(x1), w0], axis=1), eps, v0, law,
-                               rtol, atol)
+        ret = compiled_returns(model, np.stack([x1, np.zeros_like(x1), w0], axis=1), eps, v0,
+                               law, rtol, atol)
         out = {"P": ret.state[:, 0].copy(), "w": ret.state[:, 2].copy(), "time": ret.time,
                "slide_time": ret.sliding_time,
                "slide_length": ret.sliding_displacement[:, 0].copy(),
@@ -211,7 +233,7 @@ def return_map(x1, eps, v0, law, *, rtol=1e-12, atol=1e-14, progress=None,
     else:
         out = {k: np.empty(x1.size) for k in ("P", "w", "time", "slide_time", "slide_length")}
         out["n_switches"] = np.empty(x1.size, dtype=np.int32)
-        system = df.full_system(eps, v0, **ml)
+        system = model.full_system(eps, v0, **ml)
         sec = section_L()
         for i, (a, w) in enumerate(zip(x1, w0)):
             traj = simulate(system, [a, 0.0, w], T_RETURN, method="integrate", rtol=rtol,
@@ -228,19 +250,19 @@ def return_map(x1, eps, v0, law, *, rtol=1e-12, atol=1e-14, progress=None,
     out["start_residual"] = res0
     if with_residual:
         # distance of the returned point to M_+ (relaxation since the last switch)
-        wr, _ = df.slow_manifold_plus(out["P"], 0.0, eps, v0, **ml, rtol=rtol, atol=atol)
+        wr, _ = model.slow_manifold_plus(out["P"], 0.0, eps, v0, **ml, rtol=rtol, atol=atol)
         out["return_residual"] = np.abs(out["w"] - wr)
     return out
 
 
-def near_manifold_start(x1, eps, v0, law, t_pull=0.5):
+def near_manifold_start(model, x1, eps, v0, law, t_pull=0.5):
     """A start point that is on M_+ up to about exp(-T/eps) by the time it
     reaches L: (x1, 0) pulled back along the slow flow on the second-order
     expansion w2 of the model (:data:`filippov.models.dry_friction.W2_PLUS`, analytic
     branch) for T = min(30 eps, t_pull) (short enough to stay below H_s)."""
     gamma = law["gamma"]
-    coef = df.law_coefficients(law["f0"], law["fv"], law["fc"], law["convention"])
-    plus = df.REGION_PLUS["analytic"]
+    coef = model.law_coefficients(law["f0"], law["fv"], law["fc"], law["convention"])
+    plus = model.REGION_PLUS["analytic"]
     w2 = lambda a, b: plus["w2"](a, b, eps, v0, gamma, *coef)  # noqa: E731
     back = lambda t, z: -np.array([z[1], plus["slow"](z[0], z[1], w2(z[0], z[1]), gamma, *coef)])
     T = min(30 * eps, t_pull)
@@ -248,37 +270,39 @@ def near_manifold_start(x1, eps, v0, law, t_pull=0.5):
     return np.array([zs[0], zs[1], w2(zs[0], zs[1])])
 
 
-def P_pair(x1, v0, eps, law, rtol, atol, engine="reference"):
+def P_pair(model, x1, v0, eps, law, rtol, atol, engine="reference"):
     """(x1 at the first hit of L, x1 at the next): a return of a point that
     reaches L on M_+ (to about exp(-30) for eps = 0.01; for eps = 0.1 the
     deviation decays by exp(-t/eps) long before the orbit reaches H_s).
     The compiled engine runs the two returns as two calls (the second from
     the first hit)."""
     if engine == "compiled":
-        first = compiled_returns(near_manifold_start(x1, eps, v0, law), eps, v0, law, rtol,
-                                 atol).state
-        second = compiled_returns(first, eps, v0, law, rtol, atol).state
+        first = compiled_returns(model, near_manifold_start(model, x1, eps, v0, law), eps, v0,
+                                 law, rtol, atol).state
+        second = compiled_returns(model, first, eps, v0, law, rtol, atol).state
         return float(first[0, 0]), float(second[0, 0])
-    system = df.full_system(eps, v0, **{k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")})
+    system = model.full_system(eps, v0, **{k: law[k] for k in ("gamma", "f0", "fv", "fc",
+                                                               "convention")})
     sec = Section("L", lambda z: z[1], direction=-1, where=lambda z: z[0] > 0, terminal=2)
-    traj = simulate(system, near_manifold_start(x1, eps, v0, law), T_RETURN, method="integrate",
-                    rtol=rtol, atol=atol, sections=[sec], dense=False, samples_per_step=1)
+    traj = simulate(system, near_manifold_start(model, x1, eps, v0, law), T_RETURN,
+                    method="integrate", rtol=rtol, atol=atol, sections=[sec], dense=False,
+                    samples_per_step=1)
     hits = traj.section_hits("L")
     if len(hits) != 2:
         raise RuntimeError(f"x1={x1!r}, v0={v0!r}, eps={eps!r}: no return ({traj.status})")
     return float(hits[0].state[0]), float(hits[1].state[0])
 
 
-def P_scalar(x1, v0, eps, law, rtol, atol, engine="reference"):
+def P_scalar(model, x1, v0, eps, law, rtol, atol, engine="reference"):
     """P(x1) - x1 measured on the pair of hits of :func:`P_pair` (so the start
     abscissa is the actual first hit, a hair away from x1)."""
-    a, b = P_pair(x1, v0, eps, law, rtol, atol, engine)
+    a, b = P_pair(model, x1, v0, eps, law, rtol, atol, engine)
     return b - a + x1
 
 
-def fixed_point_near(x1_guess, v0, eps, law, rtol, atol, width=0.05):
+def fixed_point_near(model, x1_guess, v0, eps, law, rtol, atol, width=0.05):
     """A fixed point of P by the secant method from ``x1_guess``."""
-    g = lambda x: P_scalar(x, v0, eps, law, rtol, atol) - x
+    g = lambda x: P_scalar(model, x, v0, eps, law, rtol, atol) - x
     a, b = x1_guess - width, x1_guess + width
     ga, gb = g(a), g(b)
     if ga * gb > 0:
@@ -286,7 +310,7 @@ def fixed_point_near(x1_guess, v0, eps, law, rtol, atol, width=0.05):
     return brentq(g, a, b, xtol=1e-13)
 
 
-def saddle_node(eps, law, x1_lo, x1_hi, v0_guess, *, rtol=1e-12, atol=1e-14,
+def saddle_node(model, eps, law, x1_lo, x1_hi, v0_guess, *, rtol=1e-12, atol=1e-14,
                 search_rtol=1e-10, window=0.02, progress=None, engine="reference"):
     """The fold of the stick-slip fixed points of P in v0.
 
@@ -316,7 +340,7 @@ def saddle_node(eps, law, x1_lo, x1_hi, v0_guess, *, rtol=1e-12, atol=1e-14,
         x0 = state["x"]
         bounds = (x1_lo, x1_hi) if x0 is None else (max(x1_lo, x0 - win),
                                                        min(x1_hi, x0 + win))
-        f = lambda x: -(P_scalar(x, v, eps, law, rt, rt * atol / rtol, engine) - x)
+        f = lambda x: -(P_scalar(model, x, v, eps, law, rt, rt * atol / rtol, engine) - x)
         res = minimize_scalar(f, bounds=bounds, method="bounded", options={"xatol": xatol})
         if x0 is not None and min(res.x - bounds[0], bounds[1] - res.x) < 0.05 * win:
             # the argmax ran to the window's edge: maximise over the full range
@@ -347,7 +371,7 @@ def saddle_node(eps, law, x1_lo, x1_hi, v0_guess, *, rtol=1e-12, atol=1e-14,
 
 
 # --------------------------------------------------------------------------- onset of sticking
-def grazing_gap(x1, eps, v0, law, rtol=1e-12, atol=1e-14, start=None):
+def grazing_gap(model, x1, eps, v0, law, rtol=1e-12, atol=1e-14, start=None):
     """g(x1): the first local minimum of h = w - (1 + gamma) x2 on the orbit
     from the start point (x1, 0, w_+) on L, following the region-+ field
     F_+ continued smoothly across H_s (the friction branch F_plus is analytic
@@ -363,10 +387,10 @@ def grazing_gap(x1, eps, v0, law, rtol=1e-12, atol=1e-14, start=None):
     x1 = np.atleast_1d(np.asarray(x1, dtype=float))
     ml = {k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")}
     if start is None:
-        w0, _ = df.slow_manifold_plus(x1, 0.0, eps, v0, **ml, rtol=rtol, atol=atol)
+        w0, _ = model.slow_manifold_plus(x1, 0.0, eps, v0, **ml, rtol=rtol, atol=atol)
     else:
         w0 = start(x1)[0]
-    system = df.full_system(eps, v0, **ml)
+    system = model.full_system(eps, v0, **ml)
     grad = np.asarray(system.switch_grad(np.zeros(3)), dtype=float)
     rhs = lambda t, z: system.field(PLUS, z)
     dh = lambda t, z: float(grad @ system.field(PLUS, z))
@@ -381,7 +405,7 @@ def grazing_gap(x1, eps, v0, law, rtol=1e-12, atol=1e-14, start=None):
     return out
 
 
-def sticking_onset(eps, v0, law, lo, hi, *, rtol=1e-12, atol=1e-14, xtol=1e-10,
+def sticking_onset(model, eps, v0, law, lo, hi, *, rtol=1e-12, atol=1e-14, xtol=1e-10,
                    max_rounds=4, start=None):
     """The x1 on L where sticking begins: the root of :func:`grazing_gap` in
     [lo, hi] (a bracket from the grid). Batched interpolation rounds (each one
@@ -392,7 +416,7 @@ def sticking_onset(eps, v0, law, lo, hi, *, rtol=1e-12, atol=1e-14, xtol=1e-10,
     corrections).
     Returns (x1_onset, last correction, |g| at the last nodes' interpolant)."""
     nodes = lo + (hi - lo) * 0.5 * (1 - np.cos(np.pi * np.arange(5) / 4))
-    g = grazing_gap(nodes, eps, v0, law, rtol, atol, start)
+    g = grazing_gap(model, nodes, eps, v0, law, rtol, atol, start)
     if not (g[0] > 0 > g[-1]):
         raise RuntimeError(f"eps={eps}, v0={v0}: no onset of sticking in [{lo}, {hi}] "
                            f"(g = {g[0]:.3e} .. {g[-1]:.3e})")
@@ -400,7 +424,7 @@ def sticking_onset(eps, v0, law, lo, hi, *, rtol=1e-12, atol=1e-14, xtol=1e-10,
     d, step = 1e-3 * (hi - lo), np.inf
     for _ in range(max_rounds):
         pts = x + d * np.array([-1.0, 0.0, 1.0])
-        gp = grazing_gap(pts, eps, v0, law, rtol, atol, start)
+        gp = grazing_gap(model, pts, eps, v0, law, rtol, atol, start)
         xn = _interp_root(pts, gp, pts[0] - 10 * d, pts[-1] + 10 * d)
         step, x = abs(xn - x), xn
         if step <= xtol:
@@ -425,7 +449,7 @@ def _merge(maps, new):
     return {k: v[order] for k, v in out.items()}
 
 
-def refined_return_maps(x_base, panels, law, *, rtol, atol, dP_max, max_rounds, bar=None,
+def refined_return_maps(model, x_base, panels, law, *, rtol, atol, dP_max, max_rounds, bar=None,
                         starts=None, engine="reference"):
     """P on one x1 grid shared by all panels: the uniform ``x_base``, plus the
     onset of sticking of each panel, plus points subdividing every interval
@@ -438,7 +462,7 @@ def refined_return_maps(x_base, panels, law, *, rtol, atol, dP_max, max_rounds, 
     def run(x):
         outs = []
         for (eps, v0), st in zip(panels, starts):
-            r = return_map(x, eps, v0, law, rtol=rtol, atol=atol, progress=bar,
+            r = return_map(model, x, eps, v0, law, rtol=rtol, atol=atol, progress=bar,
                            with_residual=False, start=st, engine=engine)
             r["x1"] = np.asarray(x, dtype=float).copy()
             outs.append(r)
@@ -452,7 +476,7 @@ def refined_return_maps(x_base, panels, law, *, rtol, atol, dP_max, max_rounds, 
         if i.size != 1:
             raise RuntimeError(f"eps={eps}: expected one onset of sticking on the grid, "
                                f"found {i.size}")
-        onsets.append(sticking_onset(eps, v0, law, m["x1"][i[0]], m["x1"][i[0] + 1],
+        onsets.append(sticking_onset(model, eps, v0, law, m["x1"][i[0]], m["x1"][i[0] + 1],
                                      rtol=rtol, atol=atol, start=st))
     new = _subdivide(maps, dP_max, extra=[x for x, _ in onsets])
     for _ in range(max_rounds):
@@ -492,12 +516,13 @@ def secant(g, a, b, tol=1e-13, max_iter=30):
     raise RuntimeError(f"secant did not converge (last step {abs(b - a):.3e})")
 
 
-def lemma_quantity(law, v, x0=None):
+def lemma_quantity(model, law, v, x0=None):
     """eq:chiminus, dh/dx f_- - dh/dx f_+ at the reduced grazing point
     (x0, y0(x0)) with x0 = (x_exit, v), plus the reduced system's normal speeds
     (a, b) at a sticking point (0, v) (eq:atSl: a > 0 > b is attracting)."""
-    m = df.model(0.0, v, **law)
-    xe = -df.friction_branches(law["f0"], law["fv"], law["fc"], law["convention"])[0](0.0)
+    m = model.model(0.0, v, **law)
+    branches = model.friction_branches(law["f0"], law["fv"], law["fc"], law["convention"])
+    xe = -branches[0](0.0)
     x = np.array([xe, v]) if x0 is None else np.asarray(x0, float)
     y = m.y0(x)
     hx, _ = m.switch_grad(x, y)
@@ -508,14 +533,15 @@ def lemma_quantity(law, v, x0=None):
 
 def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     c = _settings(scene)
+    model = c.model
     bar = Progress(scene["id"], len(c.eps) * (2 * c.n + 60), progress)
     panels = list(zip(c.eps, c.v0))
     # start points on M_+ over the grid and over the returns, one relaxation per panel
     span = (min(c.lo, c.x1_return_min), c.hi)
-    starts = [df.slow_manifold_plus_on_L(*span, eps, v0, **c.model_law, rtol=c.rtol,
+    starts = [model.slow_manifold_plus_on_L(*span, eps, v0, **c.model_law, rtol=c.rtol,
                                          atol=c.atol)
               for eps, v0 in panels]
-    maps, onsets = refined_return_maps(np.linspace(c.lo, c.hi, c.n), panels, c.law,
+    maps, onsets = refined_return_maps(model, np.linspace(c.lo, c.hi, c.n), panels, c.law,
                                        rtol=c.rtol, atol=c.atol, dP_max=c.dP_max,
                                        max_rounds=c.rounds, bar=bar, starts=starts,
                                        engine=c.kernel)
@@ -542,8 +568,9 @@ class _Settings:
     rtol: float
     atol: float
     kernel: str                 # the engine
+    model: object               # the model module (the scene's ``model:``; FrictionReturns)
     law: dict                   # the friction law (_law)
-    model_law: dict             # the law's keys that df.slow_manifold_plus_on_L takes
+    model_law: dict             # the law's keys that the model's slow_manifold_plus_on_L takes
     eps: list                   # one per panel
     v0: list                    # one per panel
     lo: float                   # the uniform x1 grid
@@ -575,7 +602,8 @@ def _settings(scene: dict) -> _Settings:
                          f"({len(v0_list)} != {len(eps_list)})")
     vgs, cgs = (float(v) for v in p.get("sn_v0_guess", [3.15625, 1.7]))
     return _Settings(
-        rtol=float(opts["rtol"]), atol=float(opts["atol"]), kernel=kernel, law=law,
+        rtol=float(opts["rtol"]), atol=float(opts["atol"]), kernel=kernel,
+        model=registered_model(scene), law=law,
         model_law={k: law[k] for k in ("gamma", "f0", "fv", "fc", "convention")},
         eps=eps_list, v0=v0_list,
         lo=float(p["x1_min"]), hi=float(p["x1_max"]), n=int(p["n_x1"]),
@@ -588,19 +616,20 @@ def _settings(scene: dict) -> _Settings:
 def _panel_analysis(c: _Settings, eps: float, v0: float, r: dict, st, x1, bar):
     """One panel's return residual (into ``r``), the fixed points of its map and the
     saddle-node of its stick-slip orbits."""
-    law, rtol, atol, kernel = c.law, c.rtol, c.atol, c.kernel
+    model, law, rtol, atol, kernel = c.model, c.law, c.rtol, c.atol, c.kernel
     # distance of the returned points to M_+ (relaxation since the last switch)
     r["return_residual"] = np.abs(r["w"] - st(r["P"])[0])
     # fixed points of the same map (same start points), Brent in each sign change
     Pm = lambda x, e=eps, v=v0, s_=st: float(return_map(
-        [x], e, v, law, rtol=rtol, atol=atol, with_residual=False, start=s_,
+        model, [x], e, v, law, rtol=rtol, atol=atol, with_residual=False, start=s_,
         engine=kernel)["P"][0])
     fp = np.asarray(fixed_points(x1, r["P"], refine=Pm, xtol=1e-12))
     # saddle-node of the stick-slip orbits; first guess: reduced GS + c eps
-    xs, vs, br, v_search = saddle_node(eps, law, c.sn_lo, c.sn_hi, c.v_gs + c.c_gs * eps,
-                                       rtol=rtol, atol=atol, search_rtol=c.search_rtol,
+    xs, vs, br, v_search = saddle_node(model, eps, law, c.sn_lo, c.sn_hi,
+                                       c.v_gs + c.c_gs * eps, rtol=rtol, atol=atol,
+                                       search_rtol=c.search_rtol,
                                        progress=bar, engine=kernel)
-    at = return_map([xs], eps, vs, law, rtol=rtol, atol=atol, with_residual=False,
+    at = return_map(model, [xs], eps, vs, law, rtol=rtol, atol=atol, with_residual=False,
                     engine=kernel)
     return fp, {"x1": xs, "v0": vs, "v0_search": v_search,
                 "slide_length": float(at["slide_length"][0]),
@@ -691,9 +720,10 @@ def _panel_vars(c: _Settings, sns, onsets, maps, x1) -> dict:
 def _lemma_vars(c: _Settings) -> dict:
     """The case of lemma thm:gen (eq:chiminus) and the reduced sticking speeds, for the
     law as used and as printed (literal), at the panels' mean v0."""
-    chi, a, b = lemma_quantity(c.model_law, float(np.mean(c.v0)))
+    model = c.model
+    chi, a, b = lemma_quantity(model, c.model_law, float(np.mean(c.v0)))
     lit = dict(c.law, convention="literal")
-    chi_l, a_l, b_l = lemma_quantity(lit, float(np.mean(c.v0)))
+    chi_l, a_l, b_l = lemma_quantity(model, lit, float(np.mean(c.v0)))
     one = "1"
     return {
         "chi_minus": ((), chi, {"long_name": "dh/dx f_- - dh/dx f_+ at the grazing point "

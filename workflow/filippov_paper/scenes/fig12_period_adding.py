@@ -24,12 +24,11 @@ from filippov.analytic import limit_map
 from filippov import branches
 from filippov.fastmap import OK, compute_returns
 from filippov.io import finalize
-from filippov.models import hopf
 from filippov.periodic import periodic_orbit
-from filippov_paper.scenes.attractor_common import (CHUNK_AXIS, ENGINES, chunk_grid, PERIOD_TOL, T_RETURN,  # noqa: F401
+from filippov_paper.scenes.attractor_common import (CHUNK_AXIS, ENGINES, HopfReturns as MODEL, chunk_grid, PERIOD_TOL, T_RETURN,  # noqa: F401
                                VARIABLE_ATTRS as _COMMON_ATTRS, _settle, chaos_tolerances,
                                common_dataset, eps_list, s_grid, sweep, thetas, validate)
-from filippov_paper.scenes.common import solver_options
+from filippov_paper.scenes.common import registered_model, solver_options
 from filippov_paper import tolerance
 from filippov_paper.tolerance import Tolerance
 from filippov_paper.report import Macros, eps_tex, head, num, source, tabular, value
@@ -160,19 +159,20 @@ def _fit(x: np.ndarray, y: np.ndarray):
     return float(a), float(b), float(np.sqrt(np.mean((M @ [a, b] - y[ok]) ** 2)))
 
 
-def _slow_fast_orbit_at(p: dict, theta: float, eps: float, n: int, options: dict):
+def _slow_fast_orbit_at(model, p: dict, theta: float, eps: float, n: int, options: dict):
     """orbit_at(s, guess) for branches.follow: the period-n orbit of the slow-fast return
     map to L1 at mu = 1 + s eps (Newton with the engine's dP/dz), its largest nontrivial
-    multiplier and its itinerary: the number of switches on each of its n returns."""
+    multiplier and its itinerary: the number of switches on each of its n returns
+    (``model``: the scene's model module, :class:`HopfReturns`)."""
     omega = float(p["omega"])
 
     def at(s, guess):
         mu = 1.0 + s * eps
-        system = hopf.system(eps, theta, mu, omega, sliding=False)
-        orbit = periodic_orbit(system, guess, hopf.L1["section"], returns=n,
-                               direction=hopf.L1["direction"], where=hopf.L1["where"],
+        system = model.system(eps, theta, mu, omega, sliding=False)
+        orbit = periodic_orbit(system, guess, model.L1["section"], returns=n,
+                               direction=model.L1["direction"], where=model.L1["where"],
                                engine="compiled", t_max=T_RETURN, **options)
-        cm = system.compiled(**hopf.L1)
+        cm = system.compiled(**model.L1)
         run = attractors.iterate(cm, orbit.point, transient=0, keep=n, t_max=T_RETURN,
                                  **options)
         points = np.concatenate([orbit.point[None], run.orbit[0, :-1]])
@@ -264,6 +264,7 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     omega, n_tr = float(p["omega"]), int(p["n_transient"])
     opts = solver_options(scene)
     opts.pop("method")
+    model = registered_model(scene)
 
     def limit_start(e, order):
         return lambda x: limit_map.orbit([x], eps=e, theta=theta, omega=omega,
@@ -275,10 +276,10 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     edge_lim, kind_lim = np.full(shape, np.nan), np.full(shape, NOT_FOUND, np.int32)
     for j, e in enumerate(eps):
         def sf_start(x, e=e):
-            return _settle(p, theta, e, x, opts, False).states[-1]
+            return _settle(model, p, theta, e, x, opts, False).states[-1]
         for m, n in enumerate(ns):
             edge[j, m], kind[j, m], mult[j, m] = window_edges(
-                _slow_fast_orbit_at(p, theta, e, n, opts), s, ds.period.values[0, j], n,
+                _slow_fast_orbit_at(model, p, theta, e, n, opts), s, ds.period.values[0, j], n,
                 sf_start, tol)
             edge_lim[j, m], kind_lim[j, m], _ = window_edges(
                 _limit_orbit_at(theta, e, omega, n, 1), s, ds.period_limit.values[0, j], n,

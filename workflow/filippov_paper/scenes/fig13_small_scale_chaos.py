@@ -26,7 +26,7 @@ from filippov_paper import tolerance
 from filippov.analytic import limit_map
 from filippov.io import finalize
 from filippov_paper.tolerance import Tolerance
-from filippov_paper.scenes.attractor_common import (CHUNK_AXIS, ENGINES, chunk_grid, T_RETURN,  # noqa: F401
+from filippov_paper.scenes.attractor_common import (CHUNK_AXIS, ENGINES, HopfReturns as MODEL, chunk_grid, T_RETURN,  # noqa: F401
                                VARIABLE_ATTRS as _COMMON_ATTRS, chaos_tolerances, width_tolerance,
                                common_dataset, eps_list, lyapunov_limit, s_grid, sweep, thetas)
 from filippov_paper.scenes.attractor_common import validate as _validate_common

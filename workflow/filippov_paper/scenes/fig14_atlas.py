@@ -16,12 +16,12 @@ import xarray as xr
 from filippov import attractors
 from filippov.analytic import limit_map
 from filippov.io import finalize
-from filippov.models import hopf
 from filippov.periodic import PeriodicOrbitError, periodic_orbit
 from filippov_paper.tolerance import Tolerance
-from filippov_paper.scenes.attractor_common import (CHUNK_AXIS, ENGINES, chunk_grid, T_RETURN,  # noqa: F401
+from filippov_paper.scenes.attractor_common import (CHUNK_AXIS, ENGINES, HopfReturns as MODEL, chunk_grid, T_RETURN,  # noqa: F401
                                VARIABLE_ATTRS as _COMMON_ATTRS, chaos_tolerances,
                                common_dataset, lyapunov_limit, s_grid, sweep, validate)
+from filippov_paper.scenes.common import registered_model
 from filippov_paper.report import Macros, source, value
 
 #: this scene's block of the scene schema: filippov_paper.config.load_scene adds it to
@@ -129,16 +129,17 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     lam = limit_map.multiplier(1.0, float(p["omega"]))
     ds["theta_critical"] = ((), limit_map.flip_threshold(lam))
     ds["theta_chaos"] = ((), limit_map.chaos_threshold(lam))
-    ds = ds.assign(boundaries(p))
+    ds = ds.assign(boundaries(registered_model(scene), p))
     return finalize(ds, scene, engine="compiled", method="exact",
                     title="atlas of the attractor near grazing, slow-fast Hopf example")
 
 
-def boundaries(p: dict) -> dict:
+def boundaries(model, p: dict) -> dict:
     """Where period one gives way to period two and period two to chaos, past grazing:
-    on the limit map at the scene's eps (over boundary_s) and on the slow-fast system at
-    each boundary_eps (the multiplier of the followed orbit crossing -1, located by
-    bisection in theta: bifurcation points, not edges of a basin on a grid)."""
+    on the limit map at the scene's eps (over boundary_s) and on the slow-fast system of
+    ``model`` (the scene's model module) at each boundary_eps (the multiplier of the
+    followed orbit crossing -1, located by bisection in theta: bifurcation points, not
+    edges of a basin on a grid)."""
     omega, eps = float(p["omega"]), float(p["eps"][0])
     s_b = np.asarray(p["boundary_s"], dtype=float)
     e_b = np.asarray(sorted(p["boundary_eps"], reverse=True), dtype=float)
@@ -149,8 +150,9 @@ def boundaries(p: dict) -> dict:
 
     lim1 = np.array([limit(s, 1, *FLIP_ONE) for s in s_b])
     lim2 = np.array([limit(s, 2, t - FLIP_STEP, FLIP_TWO_OUTSIDE) for s, t in zip(s_b, lim1)])
-    sf1 = np.array([[slow_fast_flip(e, s, 1, omega, *FLIP_ONE) for s in s_b] for e in e_b])
-    sf2 = np.array([[slow_fast_flip(e, s, 2, omega, t - FLIP_STEP, FLIP_TWO_OUTSIDE)
+    sf1 = np.array([[slow_fast_flip(model, e, s, 1, omega, *FLIP_ONE) for s in s_b]
+                    for e in e_b])
+    sf2 = np.array([[slow_fast_flip(model, e, s, 2, omega, t - FLIP_STEP, FLIP_TWO_OUTSIDE)
                      for s, t in zip(s_b, row)] for e, row in zip(e_b, sf1)])
     return {"theta_flip_limit": (("s_boundary",), lim1),
             "theta_chaos_limit": (("s_boundary",), lim2),
@@ -159,21 +161,22 @@ def boundaries(p: dict) -> dict:
             "s_boundary": (("s_boundary",), s_b), "eps_boundary": (("eps_boundary",), e_b)}
 
 
-def slow_fast_flip(eps: float, s: float, n: int, omega: float, inside: float,
+def slow_fast_flip(model, eps: float, s: float, n: int, omega: float, inside: float,
                    outside: float) -> float:
-    """theta where the period-n orbit of the slow-fast return map to L1 at (eps, s) has
-    the multiplier -1 (periodic_orbit with returns=n on the compiled engine, followed
-    from the attractor at ``inside`` towards ``outside``)."""
+    """theta where the period-n orbit of the slow-fast return map to L1 at (eps, s) of
+    ``model`` (the scene's model module, :class:`HopfReturns`) has the multiplier -1
+    (periodic_orbit with returns=n on the compiled engine, followed from the attractor
+    at ``inside`` towards ``outside``)."""
     sigma = eps * eps
     mu = 1.0 + s * sigma
-    at = _attractor_point(eps, inside, mu, omega)
+    at = _attractor_point(model, eps, inside, mu, omega)
     last = {"z": at}
 
     def excess(theta):
-        system = hopf.system(eps, theta, mu, omega, sliding=True)
+        system = model.system(eps, theta, mu, omega, sliding=True)
         try:
-            orbit = periodic_orbit(system, last["z"], hopf.L1["section"],
-                                   direction=hopf.L1["direction"], where=hopf.L1["where"],
+            orbit = periodic_orbit(system, last["z"], model.L1["section"],
+                                   direction=model.L1["direction"], where=model.L1["where"],
                                    returns=n, engine="compiled", t_max=T_RETURN)
         except PeriodicOrbitError as exc:
             raise PeriodicOrbitError(f"eps={eps}, s={s}, theta={theta}: {exc}") from None
@@ -184,9 +187,9 @@ def slow_fast_flip(eps: float, s: float, n: int, omega: float, inside: float,
                                      what=f"slow-fast period-{n} orbit")
 
 
-def _attractor_point(eps, theta, mu, omega):
+def _attractor_point(model, eps, theta, mu, omega):
     """The state after 400 returns from the cycle's point (Newton's start)."""
-    cm = hopf.compiled(eps, theta, mu, omega, sliding=True)
+    cm = model.compiled(eps, theta, mu, omega, sliding=True)
     run = attractors.iterate(cm, [0.0, np.sqrt(mu), 0.0], transient=399, keep=1,
                              t_max=T_RETURN)
     return run.orbit[0, -1]

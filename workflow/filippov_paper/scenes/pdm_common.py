@@ -2,6 +2,7 @@
 the xi1 grid, the numerical P_DM for every eps, and convergence measures."""
 from __future__ import annotations
 
+from typing import Protocol
 import numpy as np
 import xarray as xr
 
@@ -9,6 +10,12 @@ from filippov_paper.config import SceneError
 from filippov.pdm import discontinuity_map, scale_for
 from filippov.progress import Progress
 from filippov_paper.scenes.common import registered_model, require, solver_options
+
+
+class HopfFamily(Protocol):
+    """What the discontinuity-map scenes use of their model (``model:``): the slow-fast
+    model at (eps, theta, mu, omega) (:func:`filippov.pdm.discontinuity_map` takes it)."""
+    def model(self, eps, theta, mu, omega): ...
 
 
 def xi1_grid(p: dict) -> np.ndarray:
