@@ -262,6 +262,13 @@ def workflow_benchmarks() -> dict[str, dict]:
     return found
 
 
+def benchmark_figures() -> list[str]:
+    """The benchmarks with a figure module ``plotting/bench_<name>.py`` (a figure of
+    `make bench`, figures/bench_<name>.{pdf,png} from results/bench_<name>.nc), found
+    from the file names."""
+    return sorted(p.stem[len("bench_"):] for p in (PACKAGE / "plotting").glob("bench_*.py"))
+
+
 def report_benchmarks() -> dict[str, dict]:
     """{name: REPORT} of the benchmarks with a report part, in their report order (read
     from the source: the workflow asks which datasets and tables the report has while it

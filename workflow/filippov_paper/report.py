@@ -466,7 +466,7 @@ def _benchmark_modules() -> list:
             for name, place in product.report_benchmarks().items()]
 
 
-def _benchmark_parts(datasets, m: Macros) -> dict[str, str]:
+def benchmark_parts(datasets, m: Macros) -> dict[str, str]:
     """{table file: text} of the benchmarks' report parts: each adds its flags and macros
     and gives its block (or None); the blocks of one table, in REPORT's order, joined."""
     blocks: dict[str, list] = {}
@@ -504,7 +504,7 @@ def generate(datasets: Mapping[str, Optional[xr.Dataset]]) -> dict[str, str]:
         except KeyError as exc:
             raise KeyError(f"{sid}: the report reads {exc} but the dataset lacks it") from None
         texts[f"{sid}.tex"] = table if table is not None else f"% {sid}: no table\n"
-    texts.update(_benchmark_parts(datasets, m))
+    texts.update(benchmark_parts(datasets, m))
     try:
         tab_hard, tab_return = hard_cases(datasets.get("hard_cases"), m)
     except KeyError as exc:

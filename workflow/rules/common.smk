@@ -156,12 +156,33 @@ def report_data(wildcards):
     return data
 
 
-# The benchmarks' outputs (`make bench`) are read when present but are not inputs:
-# an input would make every library edit rerun the minutes-long benchmark before
-# the report. Their modification times are a param instead, so a new benchmark
-# run still refreshes the report.
-BENCH_OUTPUTS = ["results/bench_effect_cost.nc", "results/bench_attractor_cost.nc",
-                 "results/bench_compile_cost.nc"]
+# The benchmarks' report parts (filippov_paper.product.report_benchmarks, read from the
+# modules' source): the dataset each reads and the table its block goes into. A dataset of
+# `make bench` (results/bench_<name>.nc of a generated rule bench_<name>) is read when present
+# but is no input: an input would make every library edit rerun the minutes-long benchmark
+# before the report. Its modification time is a param instead, so a new benchmark run still
+# refreshes the report. Any other (work_precision: the default build's sweep) is an input.
+def report_benchmarks():
+    from filippov_paper.product import report_benchmarks as declared
+
+    try:
+        return declared()
+    except (ValueError, SyntaxError) as exc:
+        fail(exc)
+
+
+def report_bench_datasets(optional):
+    """results/<dataset>.nc of the benchmarks' report parts: those made by `make bench`
+    (optional=True) or the others (inputs of the report)."""
+    made_by_bench = {f"bench_{name}" for name in workflow_benchmarks()}
+    return [f"results/{place['dataset']}.nc" for place in report_benchmarks().values()
+            if (place["dataset"] in made_by_bench) == optional]
+
+
+def report_bench_tables():
+    """The files of paper/generated/ the benchmarks' report parts write (tab_bench.tex)."""
+    return list(dict.fromkeys(place["table"] for place in report_benchmarks().values()
+                              if place["table"]))
 
 
 def workflow_benchmarks():
@@ -176,8 +197,17 @@ def workflow_benchmarks():
         fail(exc)
 
 
+def benchmark_figures():
+    """The benchmarks with a figure of `make bench` (filippov_paper.product; from the
+    plotting modules' file names): bench.smk makes a rule plot_bench_<name> for each."""
+    from filippov_paper.product import benchmark_figures as found
+
+    return found()
+
+
 def bench_stamps():
-    return {p: Path(p).stat().st_mtime_ns for p in BENCH_OUTPUTS if Path(p).exists()}
+    return {p: Path(p).stat().st_mtime_ns for p in report_bench_datasets(optional=True)
+            if Path(p).exists()}
 
 
 def report_figures(wildcards):
