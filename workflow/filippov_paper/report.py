@@ -24,10 +24,10 @@ report can do without its data, ``REPORT_OPTIONAL = True`` (then ``ds`` may be
 None). There is no list of scenes here, and none of benchmarks: a benchmark module
 ``filippov_paper.benchmarks.<name>`` with a report part declares ``REPORT`` (the dataset
 it reads, the table its block goes into, its place among the benchmarks) and
-``report(ds, macros)`` (:mod:`filippov_paper.product`). A scene's report part (those names and its
-``_report_*`` helpers, :func:`filippov_paper.config.is_report_part`) is left out of the code
-hash of the compute jobs and is not in the plotting code: editing it rebuilds the
-report tables only.
+``report(ds, macros)`` (:mod:`filippov_paper.product`). A scene's or benchmark's report
+part (those names and its ``_report_*`` helpers, :func:`filippov_paper.config.is_report_part`)
+is left out of the code hash of the jobs that compute its data and is not in the plotting
+code: editing it rebuilds the report tables only.
 
 No Snakemake inside; ``workflow/scripts/report_tables.py`` is the thin caller.
 """
