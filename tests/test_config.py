@@ -186,6 +186,14 @@ def test_the_benchmark_hash_leaves_out_exactly_the_report_part():
         assert edited != text and without_report_part(edited) == kept, name
     rules = (ROOT / "workflow" / "rules" / "common.smk").read_text()
     assert 'rel.startswith(("scenes/", "benchmarks/"))' in rules
+    assert 'rel == "hard_cases.py"' in rules
+    # and the hard-case sweep's (REPORT, report, _report_*)
+    text = (ROOT / "workflow" / "filippov_paper" / "hard_cases.py").read_text()
+    kept = without_report_part(text)
+    names = {n.id for n in ast.walk(ast.parse(kept)) if isinstance(n, ast.Name)}
+    names |= {n.name for n in ast.parse(kept).body if isinstance(n, ast.FunctionDef)}
+    assert "def report(" in text and "sweep" in names
+    assert not {u for u in names if is_report_part(u)}, names
 
 
 # the parameters that several scenes share are declared once in the scene schema's $defs

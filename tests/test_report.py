@@ -45,7 +45,8 @@ def test_absent_optional_results_say_not_yet_computed():
     tb = work_precision.report(None, m)
     for name in ("compile_cost", "effect_cost", "attractor_cost"):  # `make bench` only
         assert _bench_module(name).report(None, m) is None
-    th, tr = report.hard_cases(None, m)
+    from filippov_paper import hard_cases
+    th, tr = hard_cases.report(None, m)
     for text in (t10, t11, tb, th, tr):
         assert report.NOT_YET in text
     assert m.flags == {"rpHaveTen": False, "rpHaveEleven": False, "rpHaveBench": False,

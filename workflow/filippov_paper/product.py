@@ -140,6 +140,10 @@ HARD_CASES = (
     _f("compute_part", True, "compute_part(config, i, progress=False) -> Dataset",
        "chunk i of the sweep (a workflow job)"),
     _f("merge", True, "merge(parts, config=None) -> Dataset", "the dataset from its chunks"),
+    _v("REPORT", True, dict, "dict: {'tables': [str, ...]} (literal)",
+       "the files of paper/generated/ its report part writes"),
+    _f("report", True, "report(ds: Dataset | None, macros: report.Macros) -> tuple[str, ...]",
+       "the report part: adds its flags and macros, returns one text per REPORT['tables']"),
 )
 
 #: kind -> its hooks
@@ -267,6 +271,18 @@ def benchmark_figures() -> list[str]:
     `make bench`, figures/bench_<name>.{pdf,png} from results/bench_<name>.nc), found
     from the file names."""
     return sorted(p.stem[len("bench_"):] for p in (PACKAGE / "plotting").glob("bench_*.py"))
+
+
+def hard_case_tables() -> list[str]:
+    """REPORT["tables"] of the hard-case sweep, read from its source (for the workflow)."""
+    path = PACKAGE / "hard_cases.py"
+    declared = literal(path, "REPORT")
+    tables = declared.get("tables") if isinstance(declared, dict) else None
+    if set(declared or {}) != {"tables"} or not isinstance(tables, list) or not tables or \
+            not all(isinstance(t, str) for t in tables):
+        raise ValueError(f"{path}: REPORT: expected {{'tables': [file name, ...]}}, "
+                         f"got {declared!r}")
+    return list(tables)
 
 
 def report_benchmarks() -> dict[str, dict]:

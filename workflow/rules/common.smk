@@ -21,8 +21,8 @@ from filippov_paper.config import (DEFAULT_RESOLUTION, SceneError, apply_resolut
 
 # Library parts no scene computation imports: editing them must not recompute data.
 # (hard_cases.py is the hard-case sweep's own module: rule hard_cases hashes it.)
-# The report part of each scene and benchmark module (filippov_paper.config.is_report_part)
-# is left out of their hash as well (strip_reports=True).
+# The report part of each scene and benchmark module and of hard_cases.py
+# (filippov_paper.config.is_report_part) is left out of their hash as well (strip_reports=True).
 NOT_COMPUTE = ("plotting/", "benchmarks/", "report.py", "manifest.py",
                "hard_cases.py", "paper_labels.py", "report_html.py")
 
@@ -40,7 +40,7 @@ def _library_hash(include, exclude, strip_reports):
     (filippov_paper) under `include`, minus the paths in `exclude` (a folder "name/" or a
     file "name.py", relative to the package that holds it: the two packages share no
     name, so "plotting" or "report.py" is the pipeline's); with `strip_reports`, the
-    scene and benchmark modules without their report part."""
+    scene and benchmark modules and hard_cases.py without their report part."""
     from filippov_paper.config import without_report_part
 
     files = []
@@ -58,7 +58,8 @@ def _library_hash(include, exclude, strip_reports):
         if any(rel == e or (e.endswith("/") and rel.startswith(e)) for e in exclude):
             continue
         text = path.read_bytes()
-        if strip_reports and rel.startswith(("scenes/", "benchmarks/")):
+        if strip_reports and (rel.startswith(("scenes/", "benchmarks/"))
+                              or rel == "hard_cases.py"):
             text = without_report_part(text.decode("utf-8")).encode("utf-8")
         digest.update(b"\0".join([rel.encode(), text, b""]))  # rel NUL text NUL
     return digest.hexdigest()[:16]
@@ -177,6 +178,16 @@ def report_bench_datasets(optional):
     made_by_bench = {f"bench_{name}" for name in workflow_benchmarks()}
     return [f"results/{place['dataset']}.nc" for place in report_benchmarks().values()
             if (place["dataset"] in made_by_bench) == optional]
+
+
+def hard_case_tables():
+    """The files of paper/generated/ the hard-case sweep's report part writes."""
+    from filippov_paper.product import hard_case_tables as declared
+
+    try:
+        return declared()
+    except (ValueError, SyntaxError) as exc:
+        fail(exc)
 
 
 def report_bench_tables():

@@ -9,7 +9,7 @@
 # TeX is installed (see TEX_OK in the Snakefile). The hard-case eps sweep
 # (results/hard_cases.nc, rule hard_cases) is an input: it takes seconds.
 # The helpers (tex_available, report_data, report_figures, report_bench_datasets,
-# report_bench_tables, bench_stamps) are in common.smk.
+# report_bench_tables, hard_case_tables, bench_stamps) are in common.smk.
 from filippov_paper.config import scene_files
 
 report: "../report/workflow.rst"
@@ -20,9 +20,10 @@ report: "../report/workflow.rst"
 # instead of a stale table. Which scenes the report cannot do without is the
 # scenes' own declaration (REPORT_OPTIONAL in filippov_paper.scenes.<id>).
 SCENE_FILES = scene_files("config/scenes")
-# The benchmarks' tables (tab_bench.tex) are those their report parts name (REPORT).
+# The benchmarks' tables (tab_bench.tex) are those their report parts name (REPORT), the
+# hard-case sweep's those of its REPORT.
 REPORT_GENERATED = ["macros.tex", *[f"{s}.tex" for s in SCENE_FILES], *report_bench_tables(),
-                    "tab_hard_cases.tex", "tab_hard_return.tex"]
+                    *hard_case_tables()]
 TEX_PACKAGES = ("texlive-publishers texlive-latex-extra texlive-latex-recommended "
                 "texlive-fonts-recommended latexmk")
 
