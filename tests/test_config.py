@@ -161,6 +161,41 @@ def test_the_compute_hash_leaves_out_exactly_the_report_part():
     assert rules.count("library_hash(exclude=NOT_COMPUTE, strip_reports=True)") == 3
 
 
+def test_the_benchmark_hash_leaves_out_exactly_the_report_part():
+    # the same for a benchmark's report part (REPORT, report, _report_*): the jobs that
+    # run the benchmark hash its module without it (strip_reports covers benchmarks/), so
+    # editing the work-precision table does not rerun the sweep of the default build
+    import ast
+
+    from filippov_paper import product
+    from filippov_paper.config import is_report_part, without_report_part
+    folder = ROOT / "workflow" / "filippov_paper" / "benchmarks"
+    assert product.report_benchmarks()
+    for name in product.report_benchmarks():
+        text = (folder / f"{name}.py").read_text()
+        kept = without_report_part(text)
+        tree = ast.parse(kept)
+        defined = {t.id for n in tree.body if isinstance(n, ast.Assign) for t in n.targets
+                   if isinstance(t, ast.Name)}
+        defined |= {n.name for n in tree.body if isinstance(n, ast.FunctionDef)}
+        assert "report" not in defined and "REPORT" not in defined and "main" in defined, name
+        used = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+        assert not {u for u in used if is_report_part(u)}, name
+        edited = text.replace("def report(ds, m: Macros)", "def report(ds, m: Macros):  # x\n"
+                              "    pass\n\n\ndef _report_unused(ds, m: Macros)")
+        assert edited != text and without_report_part(edited) == kept, name
+    rules = (ROOT / "workflow" / "rules" / "common.smk").read_text()
+    assert 'rel.startswith(("scenes/", "benchmarks/"))' in rules
+    assert 'rel == "hard_cases.py"' in rules
+    # and the hard-case sweep's (REPORT, report, _report_*)
+    text = (ROOT / "workflow" / "filippov_paper" / "hard_cases.py").read_text()
+    kept = without_report_part(text)
+    names = {n.id for n in ast.walk(ast.parse(kept)) if isinstance(n, ast.Name)}
+    names |= {n.name for n in ast.parse(kept).body if isinstance(n, ast.FunctionDef)}
+    assert "def report(" in text and "sweep" in names
+    assert not {u for u in names if is_report_part(u)}, names
+
+
 # the parameters that several scenes share are declared once in the scene schema's $defs
 # (attractor_sweep, pdm_sweep, friction_law) and referenced by each scene's block; a name
 # a block does not list is refused by its propertyNames

@@ -144,3 +144,137 @@ def test_test_knobs_are_not_part_of_the_compute_hash():
     # a change of what is computed still shows
     assert without_report_part(source.replace("def ", "def x", 1)) != \
         without_report_part(source)
+
+
+def test_the_report_parts_of_the_benchmarks_come_from_their_modules(monkeypatch, tmp_path):
+    declared = product.report_benchmarks()
+    # in the order of the generated macros.tex: the compile times, the sweep, its blocks
+    assert list(declared) == ["compile_cost", "work_precision", "effect_cost",
+                              "attractor_cost"]
+    assert declared["work_precision"] == {"dataset": "work_precision",
+                                          "table": "tab_bench.tex", "order": 20}
+    assert declared["compile_cost"]["table"] is None
+    # REPORT without report, and a malformed REPORT, name the file
+    (tmp_path / "benchmarks").mkdir()
+    odd = tmp_path / "benchmarks" / "odd.py"
+    odd.write_text("REPORT = {'dataset': 'bench_odd', 'order': 1}\ndef main(argv=None): pass\n")
+    monkeypatch.setattr(product, "PACKAGE", tmp_path)
+    with pytest.raises(ValueError, match=r"odd.py: REPORT without a report\(ds, macros\)"):
+        product.report_benchmarks()
+    odd.write_text("REPORT = {'dataset': 'bench_odd', 'order': '1'}\n"
+                   "def main(argv=None): pass\ndef report(ds, m): pass\n")
+    with pytest.raises(ValueError, match=r"odd.py: REPORT: expected .*'order': '1'"):
+        product.report_benchmarks()
+    got = product.problems(_fake("filippov_paper.benchmarks.odd",
+                                 "def main(argv=None): pass\ndef report(ds, m): pass\n",
+                                 tmp_path))
+    assert got == ["filippov_paper.benchmarks.odd: a report part needs both REPORT and report"]
+
+
+#: a benchmark dropped into a copy of the project: its module and its figure module, and
+#: no other file edited (test_a_new_benchmark_is_one_or_two_files)
+TOY_BENCHMARK = '''"""A throwaway benchmark: one number, written to --out."""
+import argparse
+
+import xarray as xr
+
+from filippov.io import write_dataset
+from filippov_paper.report import Macros, var
+
+WORKFLOW = {"args": ["--value", "2.5"]}
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--value", type=float, default=1.0)
+    ap.add_argument("--out", required=True)
+    args = ap.parse_args(argv)
+    write_dataset(xr.Dataset({"value": ((), args.value)}), args.out)
+
+
+REPORT = {"dataset": "bench_toy", "table": "tab_toy.tex", "order": 50}
+
+
+def report(ds, m: Macros):
+    m.flag("rpHaveToy", ds is not None)
+    if ds is None:
+        return None
+    var(m, "rpToyValue", ds, REPORT["dataset"], "value")
+    return "toy block\\n"
+'''
+TOY_FIGURE = '''"""The throwaway benchmark's figure."""
+import xarray as xr
+from matplotlib.figure import Figure
+
+
+def draw(ds):
+    fig = Figure()
+    fig.add_subplot().bar([0], [float(ds.value)])
+    return fig
+
+
+def synthetic_dataset():
+    return xr.Dataset({"value": ((), 1.0)})
+'''
+
+
+def test_a_new_benchmark_is_one_or_two_files(tmp_path):
+    """A benchmark module (WORKFLOW, REPORT, report) and a figure module dropped into a
+    copy of the project, nothing else edited: `make bench` plans its rule and its figure's,
+    the report writes its table, and report.generate calls its report part."""
+    import os
+    import subprocess
+    import sys
+
+    from conftest import copy_project
+
+    work = copy_project(tmp_path / "project")
+    package = work / "workflow" / "filippov_paper"
+    (package / "benchmarks" / "toy.py").write_text(TOY_BENCHMARK)
+    (package / "plotting" / "bench_toy.py").write_text(TOY_FIGURE)
+    # the copy's pipeline package, not this tree's, is the one imported
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(work / "workflow"), str(ROOT / "src")]),
+               PATH=os.pathsep.join([str(Path(sys.executable).parent), os.environ["PATH"]]),
+               MPLBACKEND="Agg")
+    run = subprocess.run([sys.executable, "-m", "snakemake", "--dry-run", "--cores", "1",
+                          "--directory", str(work), "bench", "paper/generated/macros.tex"],
+                         cwd=work, env=env, capture_output=True, text=True, timeout=600)
+    out = run.stdout + run.stderr
+    assert run.returncode == 0, out[-3000:]
+    planned = re.findall(r"^(?:local)?rule (\w+):", out, re.M)
+    assert {"bench_toy", "plot_bench_toy", "report_tables"} <= set(planned), planned
+    assert "results/bench_toy.nc" in out and "figures/bench_toy.pdf" in out
+    assert "paper/generated/tab_toy.tex" in out  # its table is an output of the report
+    # and it runs: its rule writes its dataset, its figure rule draws it
+    run = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "1", "--directory",
+                          str(work), "figures/bench_toy.pdf"], cwd=work, env=env,
+                         capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, (run.stdout + run.stderr)[-3000:]
+    assert (work / "figures" / "bench_toy.png").stat().st_size > 0
+    assert (work / "logs" / "bench_toy.log").exists()
+    # its report part, found by the copy's report.generate machinery
+    check = ("import xarray as xr\n"
+             "from filippov_paper import product, report\n"
+             "import filippov_paper.benchmarks.toy as toy\n"
+             "assert product.problems(toy) == [], product.problems(toy)\n"
+             "m = report.Macros()\n"
+             "tables = report.benchmark_parts({'bench_toy': xr.Dataset({'value': ((), 2.5)})}, m)\n"
+             "assert tables['tab_toy.tex'] == 'toy block\\n', tables\n"
+             "assert m.flags['rpHaveToy'] and m.values()['rpToyValue'][0] == 2.5\n"
+             "assert list(m.flags)[-1] == 'rpHaveToy'  # order 50: after the others\n"
+             "m = report.Macros()\n"
+             "assert report.benchmark_parts({}, m)['tab_toy.tex'] == '% tab_toy.tex: no table\\n'\n"
+             "print('toy ok')\n")
+    run = subprocess.run([sys.executable, "-c", check], cwd=work, env=env, capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode == 0 and "toy ok" in run.stdout, run.stdout + run.stderr
+    # and nothing else of the copy differs from this tree
+    changed = sorted(str(p.relative_to(work)) for p in (work / "workflow").rglob("*.py")
+                     if "__pycache__" not in p.parts
+                     and p.read_bytes() != _bytes_or_none(ROOT / p.relative_to(work)))
+    assert changed == ["workflow/filippov_paper/benchmarks/toy.py",
+                       "workflow/filippov_paper/plotting/bench_toy.py"], changed
+
+
+def _bytes_or_none(path: Path):
+    return path.read_bytes() if path.exists() else None

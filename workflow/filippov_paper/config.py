@@ -221,10 +221,11 @@ def is_test_knob(name: str) -> bool:
 
 
 def is_report_part(name: str) -> bool:
-    """A top-level name of a scene module that belongs to its report part (``report``,
-    ``REPORT_OPTIONAL``, ``_report_*``, ``_REPORT_*``): what the reproduction report
-    reads, and nothing a computation uses."""
-    return name in ("report", "REPORT_OPTIONAL") or name.startswith(("_report", "_REPORT"))
+    """A top-level name of a scene or benchmark module that belongs to its report part
+    (``report``, ``REPORT_OPTIONAL``, ``REPORT``, ``_report_*``, ``_REPORT_*``): what the
+    reproduction report reads, and nothing a computation uses."""
+    return name in ("report", "REPORT_OPTIONAL", "REPORT") or \
+        name.startswith(("_report", "_REPORT"))
 
 
 def without_report_part(source: str) -> str:

@@ -40,6 +40,8 @@ from filippov import fastmap
 from filippov.analytic import chatter
 from filippov.io import finalize
 from filippov_paper.tolerance import ULP, Tolerance, annotate, sqrt_law
+from filippov_paper.report import (Macros, count_phrase, head, not_yet, num, per_eps_rows,
+                                   share_phrase, tabular, value, var)
 from filippov.models import hopf, pseudo_equilibrium
 from filippov.progress import Progress
 from filippov_paper.scenes.chunking import bounds
@@ -455,3 +457,101 @@ def merge(parts, config=None) -> xr.Dataset:
     if not np.array_equal(merged, np.asarray(eps, dtype="f8")):
         raise ValueError(f"{name}: the chunks do not cover the configured eps grid")
     return _finish(_variables(merged, columns), eps)
+
+# ============================================================================= report
+# What the reproduction report quotes from the sweep's dataset (filippov_paper.report calls
+# `report`). This part -- REPORT, report and the _report_* names -- is left out of the
+# code hash of the sweep's jobs: editing it rebuilds the report only.
+#: the files of paper/generated/ its tables go into, in the order report returns them
+REPORT = {"tables": ["tab_hard_cases.tex", "tab_hard_return.tex"]}
+
+
+def report(ds, m: Macros) -> tuple[str, str]:
+    """Macros and the per-eps table of the hard-case sweep (results/hard_cases.nc):
+    jump/eps (theta < 0), one-sided slope (theta > 0), chatter period, slide-in."""
+    m.flag("rpHaveHardCases", ds is not None)
+    if ds is None:
+        return (not_yet("Hard-case eps sweep", f"results/{DATASET_ID}.nc"),
+                not_yet("Sliding return sweep", f"results/{DATASET_ID}.nc"))
+    sid = DATASET_ID
+    eps = [float(e) for e in ds.eps.values]
+    kmax, kmin = int(np.argmax(eps)), int(np.argmin(eps))
+    m.add("rpHardN", len(eps), f"{sid}:eps (size)")
+    m.add("rpHardNValues", None, f"{sid}:eps (size)", text=count_phrase(len(eps), "value"))
+    m.add("rpHardEpsMax", eps[kmax], f"{sid}:eps[{kmax}]")
+    m.add("rpHardEpsMin", eps[kmin], f"{sid}:eps[{kmin}]")
+    for attr, name, sig in (("jump_theta", "JumpTheta", 3), ("jump_x2_offset", "JumpOffset", 3),
+                            ("slope_theta", "SlopeTheta", 3), ("slope_probe_factor", "ProbeFactor", 3),
+                            ("slope_probe_floor", "ProbeFloor", 3),
+                            ("chatter_theta", "ChatterTheta", 3),
+                            ("chatter_periods", "ChatterPeriods", 4),
+                            ("slide_theta", "SlideTheta", 3),
+                            ("slide_start_over_eps", "SlideStart", 3),
+                            ("kernel_start", "KernelStart", 3)):
+        m.add(f"rpHard{name}", float(ds.attrs[attr]), f"{sid}:attrs.{attr}", sig)
+    var(m, "rpHardJumpFirst", ds, sid, "jump_over_eps", sig=5, eps=eps[kmax])
+    var(m, "rpHardJumpLast", ds, sid, "jump_over_eps", sig=5, eps=eps[kmin])
+    from filippov.analytic.s0 import s0_lambert
+    mu, omega = float(ds.attrs["mu"]), float(ds.attrs["omega"])
+    pred = float(s0_lambert(np.array([float(ds.attrs["jump_theta"])]))[0]) \
+        * math.exp(-3 * math.pi * mu / omega)
+    m.add("rpHardJumpPred", pred, "derived: s0(jump_theta) exp(-3 pi mu/omega)", 5)
+    if len(eps) > 1:
+        m.add("rpHardJumpDiffLast", abs(value(ds, "jump_over_eps", eps=eps[kmin])
+                                        - value(ds, "jump_over_eps", eps=sorted(eps)[1])),
+              "derived: |difference of jump_over_eps| between the two smallest eps", 2)
+    m.add("rpHardSlopeMin", float(ds.slope.min()), "derived: min slope over eps", 3)
+    m.add("rpHardSlopeMax", float(ds.slope.max()), "derived: max slope over eps", 3)
+    var(m, "rpHardPeriodOverEps", ds, sid, "chatter_period_over_eps", sig=6, eps=eps[kmin])
+    m.add("rpHardPeriodDev", float(ds.chatter_period_max_rel_dev.max()),
+          "derived: max chatter_period_max_rel_dev over eps", 2)
+    m.add("rpHardSlideOffset", float(np.abs(ds.slide_start_offset).max()),
+          "derived: max |slide_start_offset| over eps", 2)
+    m.add("rpHardSlideFinal", float(ds.slide_final_abs_x.max()),
+          "derived: max slide_final_abs_x over eps", 2)
+    m.add("rpHardKernelFinal", float(ds.kernel_final_abs_x.max()),
+          "derived: max kernel_final_abs_x over eps", 2)
+    maps = per_eps_rows(ds, lambda d: [
+        f"${num(float(d.jump_over_eps), 6)}$", f"${num(float(d.slope), 4)}$",
+        f"${num(float(d.slope_probe), 2)}$"])
+    chatter = per_eps_rows(ds, lambda d: [
+        f"${num(float(d.chatter_period_over_eps), 6)}$",
+        f"${num(float(d.chatter_period_max_rel_dev), 2)}$",
+        f"${num(float(d.slide_start_offset), 2)}$", f"${num(float(d.slide_final_abs_x), 2)}$",
+        f"${num(float(d.kernel_final_abs_x), 2)}$"])
+    # the return maps, then the pseudo-equilibrium (two tabulars: one would not fit)
+    table = tabular("rrrr", [head(r"$\epsilon$", r"jump$/\epsilon$", "slope", "$x_2-1$")],
+                     maps) + "\n\\medskip\n\n" + tabular("rrrrrr", [head(
+                         r"$\epsilon$", r"period//$/\epsilon$", "period//dev.",
+                         r"slide start//$+(1-\theta)\epsilon$", "final//$|x|$",
+                         "final $|x|$,//kernel")], chatter)
+    return table, _report_return(ds, m, eps)
+
+
+def _report_return(ds, m: Macros, eps: list) -> str:
+    """The theta > 0 sliding return per eps: 1 - P against eps^2, sliding time, cost."""
+    sid = DATASET_ID
+    m.add("rpHardReturnTheta", float(ds.attrs["return_theta"]), f"{sid}:attrs.return_theta", 3)
+    m.add("rpHardReturnXtwo", float(ds.attrs["return_x2"]), f"{sid}:attrs.return_x2", 3)
+    gap = np.abs(ds.return_P_reduced.values - ds.return_P.values)
+    scaled = gap / ds.eps.values ** 2
+    small = [k for k, e in enumerate(eps) if e <= 1e-3] or list(range(len(eps)))
+    m.add("rpHardReturnScaledMin", float(scaled[small].min()),
+          "derived: min |P_reduced - P|/eps^2 over eps <= 1e-3", 3)
+    m.add("rpHardReturnScaledMax", float(scaled[small].max()),
+          "derived: max |P_reduced - P|/eps^2 over eps <= 1e-3", 3)
+    steps = ds.return_steps.values
+    m.add("rpHardReturnStepsMin", int(steps.min()), "derived: min return_steps over eps")
+    m.add("rpHardReturnStepsMax", int(steps.max()), "derived: max return_steps over eps")
+    m.add("rpHardReturnStiffN", int(ds.return_stiff.values.sum()),
+          "derived: eps values whose sliding was finished by Radau IIA")
+    m.add("rpHardReturnStiffShare", None,
+          "derived: eps values whose sliding was finished by Radau IIA, of all",
+          text=share_phrase(ds.return_stiff.values.sum(), len(eps), r"$\epsilon$ value"))
+    rows = per_eps_rows(ds.assign(gap=("eps", gap), scaled=("eps", scaled)), lambda d: [
+        f"${num(float(d.gap), 3)}$", f"${num(float(d.scaled), 4)}$",
+        f"${num(float(d.return_sliding_time), 5)}$", f"${int(d.return_steps)}$",
+        "Radau IIA" if int(d.return_stiff) else "DOP853"])
+    return tabular("rrrrrl", [
+        r"$\epsilon$ & $|P_0-P|$ & $|P_0-P|/\epsilon^2$ & sliding time & steps & "
+        r"sliding by \\"], rows)

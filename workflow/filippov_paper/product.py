@@ -4,7 +4,9 @@ A *product* is a module the pipeline finds by its name and asks by hook names:
 
 * a **scene** ``filippov_paper.scenes.figNN_name`` (scene dict in, Dataset out),
 * a **figure** ``filippov_paper.plotting.figNN_name`` or ``bench_name`` (Dataset in, figure out),
-* a **benchmark** ``filippov_paper.benchmarks.<name>`` (a module that defines ``main``),
+* a **benchmark** ``filippov_paper.benchmarks.<name>`` (a module that defines ``main``;
+  ``WORKFLOW`` makes it a rule of `make bench`, ``REPORT`` + ``report`` a part of the
+  reproduction report, a figure module ``plotting/bench_<name>`` a figure of `make bench`),
 * the **hard-case sweep** ``filippov_paper.hard_cases``.
 
 :data:`HOOKS` lists, per kind, each name such a module may define: required or
@@ -16,7 +18,8 @@ and :func:`problems` is the conformance check every product passes.
 Test knobs (``TEST_*``, ``synthetic_dataset``) are hooks too: what the test suite
 needs to know about a figure lives in its modules, not in dictionaries under
 ``tests/``. So a new figure is three files -- its YAML in ``config/scenes/``, its
-scene module and its figure module -- and a new benchmark one module.
+scene module and its figure module -- and a new benchmark one module (two with its
+figure): the workflow's rules and the report's parts are generated from them.
 
 This module imports nothing numeric: the workflow reads it while building the DAG.
 """
@@ -111,6 +114,15 @@ BENCHMARK = (
        "the measurement as a dataset (what main writes)"),
     _v("WORKFLOW", False, dict, "dict: {'args': [str, ...], 'threads': 'one' | 'all'} (literal)",
        "part of `make bench`: a rule bench_<name> writing results/bench_<name>.nc"),
+    _v("REPORT", False, dict,
+       "dict: {'dataset': str, 'table': str (optional), 'order': int} (literal)",
+       "the report part's place: the dataset it reads (results/<dataset>.nc; optional when it "
+       "is this benchmark's own of `make bench`, bench_<name>, else an input of the report), "
+       "the file of paper/generated/ its block goes into, and where its flags, macros and "
+       "block go among the benchmarks' (ascending order)"),
+    _f("report", False, "report(ds: Dataset | None, macros: report.Macros) -> str | None",
+       "the report part (with REPORT): adds its flags and macros, returns its block of "
+       "REPORT['table'] (or None); ds is None when the dataset is absent"),
 )
 
 HARD_CASES = (
@@ -131,6 +143,10 @@ HARD_CASES = (
     _f("compute_part", True, "compute_part(config, i, progress=False) -> Dataset",
        "chunk i of the sweep (a workflow job)"),
     _f("merge", True, "merge(parts, config=None) -> Dataset", "the dataset from its chunks"),
+    _v("REPORT", True, dict, "dict: {'tables': [str, ...]} (literal)",
+       "the files of paper/generated/ its report part writes"),
+    _f("report", True, "report(ds: Dataset | None, macros: report.Macros) -> tuple[str, ...]",
+       "the report part: adds its flags and macros, returns one text per REPORT['tables']"),
 )
 
 #: kind -> its hooks
@@ -253,6 +269,49 @@ def workflow_benchmarks() -> dict[str, dict]:
     return found
 
 
+def benchmark_figures() -> list[str]:
+    """The benchmarks with a figure module ``plotting/bench_<name>.py`` (a figure of
+    `make bench`, figures/bench_<name>.{pdf,png} from results/bench_<name>.nc), found
+    from the file names."""
+    return sorted(p.stem[len("bench_"):] for p in (PACKAGE / "plotting").glob("bench_*.py"))
+
+
+def hard_case_tables() -> list[str]:
+    """REPORT["tables"] of the hard-case sweep, read from its source (for the workflow)."""
+    path = PACKAGE / "hard_cases.py"
+    declared = literal(path, "REPORT")
+    tables = declared.get("tables") if isinstance(declared, dict) else None
+    if set(declared or {}) != {"tables"} or not isinstance(tables, list) or not tables or \
+            not all(isinstance(t, str) for t in tables):
+        raise ValueError(f"{path}: REPORT: expected {{'tables': [file name, ...]}}, "
+                         f"got {declared!r}")
+    return list(tables)
+
+
+def report_benchmarks() -> dict[str, dict]:
+    """{name: REPORT} of the benchmarks with a report part, in their report order (read
+    from the source: the workflow asks which datasets and tables the report has while it
+    builds the DAG). A malformed REPORT is a ValueError naming the file."""
+    found = {}
+    for name in benchmarks():
+        path = PACKAGE / "benchmarks" / f"{name}.py"
+        declared = literal(path, "REPORT")
+        if declared is None:
+            continue
+        if set(declared) - {"dataset", "table", "order"} or \
+                not isinstance(declared.get("dataset"), str) or \
+                not isinstance(declared.get("table", ""), str) or \
+                not isinstance(declared.get("order"), int) or \
+                isinstance(declared.get("order"), bool):
+            raise ValueError(f"{path}: REPORT: expected {{'dataset': str, 'table': str "
+                             f"(optional), 'order': int}}, got {declared!r}")
+        if "report" not in defined_names(path):
+            raise ValueError(f"{path}: REPORT without a report(ds, macros) function")
+        found[name] = {"dataset": declared["dataset"], "table": declared.get("table"),
+                       "order": declared["order"]}
+    return dict(sorted(found.items(), key=lambda item: (item[1]["order"], item[0])))
+
+
 def _kind_ok(h: Hook, value) -> bool:
     if h.kind == "function":
         return inspect.isfunction(value)
@@ -277,6 +336,8 @@ def problems(module) -> list[str]:
         elif not _kind_ok(h, names[h.name]):
             out.append(f"{where}: {h.name} must be a {h.kind} ({h.signature}), got "
                        f"{type(names[h.name]).__name__}")
+    if kind == "benchmark" and ("REPORT" in names) != ("report" in names):
+        out.append(f"{where}: a report part needs both REPORT and report")
     if kind == "scene":
         present = [n for n in CHUNK_HOOKS if n in names]
         if present and len(present) < len(CHUNK_HOOKS):

@@ -12,17 +12,23 @@ ones are ``None``) and returns ``{file name: LaTeX text}`` for
 * ``<scene id>.tex`` for every scene -- the table its scene module's ``report``
   returns (e.g. convergence over eps), a "not yet computed" sentence for an
   optional scene without data, or a comment when the scene has no table;
-* ``tab_bench.tex`` -- the work--precision sweep, or "not yet computed";
+* ``tab_bench.tex`` (and any other table a benchmark names) -- the blocks of the
+  benchmarks' report parts: the work--precision sweep (or "not yet computed"), then what
+  `make bench` measured when it has;
 * ``tab_hard_cases.tex``, ``tab_hard_return.tex`` -- the hard-case eps sweep
-  (``results/hard_cases.nc``, :mod:`filippov_paper.hard_cases`), one row per eps.
+  (``results/hard_cases.nc``), one row per eps: the tables of the report part of
+  :mod:`filippov_paper.hard_cases` (its ``REPORT`` and ``report``).
 
 The scenes declare their own part: each scene module ``filippov_paper.scenes.<id>`` defines
 ``report(ds, macros)`` (adds its macros, returns its table or None) and, when the
 report can do without its data, ``REPORT_OPTIONAL = True`` (then ``ds`` may be
-None). There is no list of scenes here. A scene's report part (those names and its
-``_report_*`` helpers, :func:`filippov_paper.config.is_report_part`) is left out of the code
-hash of the compute jobs and is not in the plotting code: editing it rebuilds the
-report tables only.
+None). There is no list of scenes here, and none of benchmarks: a benchmark module
+``filippov_paper.benchmarks.<name>`` with a report part declares ``REPORT`` (the dataset
+it reads, the table its block goes into, its place among the benchmarks) and
+``report(ds, macros)`` (:mod:`filippov_paper.product`). A scene's or benchmark's report
+part (those names and its ``_report_*`` helpers, :func:`filippov_paper.config.is_report_part`)
+is left out of the code hash of the jobs that compute its data and is not in the plotting
+code: editing it rebuilds the report tables only.
 
 No Snakemake inside; ``workflow/scripts/report_tables.py`` is the thin caller.
 """
@@ -344,301 +350,10 @@ def table_frame(ds: xr.Dataset, max_rows: int = 30) -> str:
     return tabular("l" * len(dims) + "r" * len(names), [head], rows)
 
 
-#: the methods as the work-precision table names them (short: the table fits the page)
-METHOD_TEX = {"project compiled exact": "compiled, exact flows",
-              "project python exact": "Python, exact flows",
-              "project compiled DOP853": "compiled DOP853",
-              "project DOP853": "Python DOP853",
-              "solve_ivp RK45": "scipy RK45",
-              "solve_ivp DOP853": "scipy DOP853",
-              "solve_ivp Radau": "scipy Radau",
-              "solve_ivp LSODA": "scipy LSODA"}
-
-
 #: around each table of measured times: the widths of their numbers follow the machine's
 #: speed and load (a slow run's "12345" ms), so a table is shrunk to the line width where
 #: it would overrun it (adjustbox's max width; a table that fits is left as it is)
 FIT_BEGIN, FIT_END = r"\begin{adjustbox}{max width=\linewidth}", r"\end{adjustbox}"
-
-
-def _bench_tabular(ds, probs: list[int]) -> list[str]:
-    """One tabular: a row per method and tolerance, error / time / missed switches
-    for each problem in ``probs``; a configuration that failed says so in its cells."""
-    head = " & ".join(rf"\multicolumn{{3}}{{c}}{{{_problem_tex(str(ds.problem.values[i]))}}}"
-                      for i in probs)
-    rules = "".join(rf"\cmidrule(lr){{{3 + 3 * k}-{5 + 3 * k}}}" for k in range(len(probs)))
-    sub = " & ".join(["error & ms & missed"] * len(probs))
-    lines = [FIT_BEGIN, r"\begin{tabular}{@{}ll" + "rrr" * len(probs) + "@{}}", r"\toprule",
-             rf"method & rtol & {head} \\", rules, rf" & & {sub} \\", r"\midrule"]
-    rows = [j for j in range(ds.sizes["config"])
-            if any(str(ds.status.values[i, j]) != "n/a" for i in probs)]
-    for j in rows:
-        fam = str(ds.method.values[j])
-        cells = [METHOD_TEX.get(fam, tex_escape(fam)), f"${num(float(ds.tolerance.values[j]), 2)}$"]
-        for i in probs:
-            status = str(ds.status.values[i, j])
-            if status != "ok":
-                cells.append(r"\multicolumn{3}{c}{\emph{" + tex_escape(status.split(":")[0]) + "}}")
-                continue
-            cells += [f"${num(float(ds.error_map.values[i, j]), 2)}$",
-                      f"${num(1e3 * float(ds.wall_time.values[i, j]), 2)}$",
-                      str(int(ds.missed_switches.values[i, j]))]
-        lines.append(" & ".join(cells) + r" \\")
-    return lines + [r"\bottomrule", r"\end{tabular}", FIT_END, ""]
-
-
-def _problem_tex(name: str) -> str:
-    """'fig04 theta=-0.5' -> the paper's symbols ('$\theta=-0.5$')."""
-    parts = name.split()
-    rest = " ".join(parts[1:])
-    for key, sym in (("theta", r"\theta"), ("eps", r"\epsilon")):
-        rest = re.sub(rf"{key}=(\S+)", lambda mm: f"${sym}={mm.group(1)}$", rest)
-    return rest
-
-
-def _bench_timing(ds, m: Macros) -> None:
-    """How the sweep's times were measured (filippov_paper.benchmarks.timing): the statistic
-    shown, the warm-up runs, the least rounds and seconds asked for, and the rounds the
-    shown cells took. A sweep measured before the convention (no ``timing_statistic``)
-    sets ``rpHaveBenchTiming`` false and quotes nothing."""
-    have = "timing_statistic" in ds.attrs and "runs" in ds
-    m.flag("rpHaveBenchTiming", have)
-    if not have:
-        return
-    sid = "work_precision"
-    stat = str(ds.attrs["timing_statistic"])
-    m.add("rpBenchStatistic", None, f"{sid}:attrs.timing_statistic",
-          text=r"\text{" + tex_escape(stat) + "}")
-    for name, attr, sig in (("rpBenchWarmup", "timing_warmup", 4),
-                            ("rpBenchMinRounds", "timing_min_rounds", 4),
-                            ("rpBenchMinTime", "timing_min_time", 3)):
-        m.add(name, float(ds.attrs[attr]), f"{sid}:attrs.{attr}", sig)
-    # the counts as the prose says them ("one untimed run", "3 to 250 runs")
-    m.add("rpBenchWarmupRuns", None, f"{sid}:attrs.timing_warmup",
-          text=count_phrase(ds.attrs["timing_warmup"], "untimed run"))
-    m.add("rpBenchMinRoundsRuns", None, f"{sid}:attrs.timing_min_rounds",
-          text=count_phrase(ds.attrs["timing_min_rounds"], "timed run"))
-    timed = np.asarray(ds.runs.values)[np.asarray(ds.status.values).astype(str) == "ok"]
-    m.add("rpBenchRoundsLeast", float(timed.min()) if timed.size else math.nan,
-          "derived: min of work_precision:runs over the configurations that ran", 4)
-    m.add("rpBenchRoundsMost", float(timed.max()) if timed.size else math.nan,
-          "derived: max of work_precision:runs over the configurations that ran", 4)
-    m.add("rpBenchRoundsRange", None,
-          "derived: min to max of work_precision:runs over the configurations that ran",
-          text=range_phrase(timed.min(), timed.max(), "run") if timed.size else "no runs")
-
-
-def failed_sentence(n: int) -> str:
-    """The sentence of the work-precision text on the configurations that failed."""
-    if n == 0:
-        return "No configuration failed outright on any map."
-    return (count_phrase(n, "configuration", capital=True)
-            + r" failed outright over all maps (cells marked \emph{failed}; the dataset's "
-            r"\texttt{status} says why).")
-
-
-def bench(ds, m: Macros, effects=None, returns=None, compile_cost=None) -> str:
-    """The work-precision tables of the default build's sweep (results/work_precision.nc):
-    per problem set (fig04, fig11), one row per method and tolerance, error / time /
-    missed switches per problem; the speed-up at the target error and what the
-    scipy solvers a user reaches for first get wrong; the cost of each model
-    ingredient when results/bench_effect_cost.nc is there and the cost of one iterated
-    return when results/bench_attractor_cost.nc is (`make bench`); the compile and load
-    times of the compiled engine (macros only) when results/bench_compile_cost.nc is."""
-    _compile_cost_macros(m, compile_cost)
-    missing = absent(m, "rpHaveBench", ds, "Work--precision sweep", "results/work_precision.nc")
-    m.flag("rpHaveBenchTiming", False)  # set by _bench_timing when the sweep says how it timed
-    # the blocks of `make bench` (set below when measured): defined for every build, as
-    # the table's caption asks for them
-    m.flag("rpHaveEffects", False)
-    m.flag("rpHaveReturnCost", False)
-    if missing:
-        return missing
-    if "method" not in ds.coords or "problem" not in ds.dims:
-        return table_frame(ds)
-    names = [str(p) for p in ds.problem.values]
-    lines = []
-    for prefix in ("fig04", "fig11"):
-        probs = [i for i, p in enumerate(names) if p.startswith(prefix)]
-        if probs:
-            lines += ([r"\medskip", ""] if lines else []) + _bench_tabular(ds, probs)
-    _bench_problem_macros(ds, m, names)
-    _bench_timing(ds, m)
-    m.flag("rpHaveEffects", effects is not None)
-    if effects is not None:
-        lines += _effects_tabular(effects)
-    m.flag("rpHaveReturnCost", returns is not None)
-    if returns is not None:
-        lines += _return_cost_tabular(returns)
-    return "\n".join(lines)
-
-
-def _compile_cost_macros(m: Macros, compile_cost) -> None:
-    """The compiled engine's cold and warm compile/load times of the quoted stages."""
-    quoted = (("kernel", "Kernel"), ("kernel_dpdz", "KernelDpdz"), ("model", "Model"))
-    if compile_cost is not None and not {s for s, _ in quoted} <= set(compile_cost.stage.values):
-        compile_cost = None  # measured by an older benchmark: measured again by make bench
-    m.flag("rpHaveCompileCost", compile_cost is not None)
-    if compile_cost is not None:
-        for stage, tag in quoted:
-            for kind in ("cold", "warm"):
-                var(m, f"rpCompile{tag}{kind.title()}", compile_cost, "bench_compile_cost",
-                    kind, sig=2, stage=stage)
-
-
-def _bench_problem_macros(ds, m: Macros, names) -> None:
-    """Per problem (the first four: A-D) the speed-up, the reference floor, the points,
-    and what solve_ivp's RK45 and DOP853 miss; then the failed configurations."""
-    sid = "work_precision"
-    fam = np.array([str(f) for f in ds.method.values])
-    for i, p in enumerate(names[:4]):
-        key = "ABCD"[i]
-        m.add(f"rpBenchSpeedup{key}", float(ds.speedup_vs_rk45.values[i]),
-              source(sid, f"speedup_vs_rk45[{i}]"), 2)
-        m.add(f"rpBenchFloor{key}", float(ds.reference_check.values[i]),
-              source(sid, f"reference_check[{i}]"), 2)
-        m.add(f"rpBenchPoints{key}", float(ds.n_points.values[i]),
-              source(sid, f"n_points[{i}]"), 4)
-        ok = ds.status.values[i] == "ok"
-        for tag, family in (("RK", "solve_ivp RK45"), ("DOP", "solve_ivp DOP853")):
-            sel = (fam == family) & ok
-            m.add(f"rpBenchMissed{tag}{key}",
-                  float(ds.missed_switches.values[i, sel].max()) if sel.any() else 0.0,
-                  f"derived: max of work_precision:missed_switches[{i}] over {family}", 4)
-            m.add(f"rpBenchBest{tag}{key}",
-                  float(np.nanmin(ds.error_map.values[i, sel])) if sel.any() else math.nan,
-                  f"derived: min of work_precision:error_map[{i}] over {family}", 2)
-    failed = int(np.count_nonzero(np.char.startswith(ds.status.values.astype(str), "failed")))
-    m.add("rpBenchFailed", float(failed),
-          "derived: configurations of work_precision:status that failed", 4)
-    m.add("rpBenchFailedSentence", None,
-          "derived: configurations of work_precision:status that failed",
-          text=failed_sentence(failed))
-    m.add("rpBenchConfigs", float(ds.sizes["config"]), "work_precision:config (size)", 4)
-
-
-def _effects_tabular(effects) -> list[str]:
-    """The cost of each model ingredient (results/bench_effect_cost.nc)."""
-    lines = [r"\medskip", "", FIT_BEGIN, r"\begin{tabular}{llrrl}", r"\toprule",
-             r"scene & ingredient switched & time [s] & $\times$ declared & outcome \\",
-             r"\midrule"]
-    for k in range(effects.sizes["variant"]):
-        status = str(effects.status.values[k])
-        outcome = "ok" if status == "ok" else status.split(":")[0]
-        lines.append(" & ".join([
-            r"\texttt{" + tex_escape(str(effects.scene.values[k])) + "}",
-            tex_escape(str(effects.change.values[k])).replace("->", r"$\to$"),
-            f"${num(float(effects.seconds.values[k]), 3)}$",
-            f"${num(float(effects.relative.values[k]), 3)}$",
-            r"\emph{" + tex_escape(outcome) + "}"]) + r" \\")
-    return lines + [r"\bottomrule", r"\end{tabular}", FIT_END, ""]
-
-
-def _return_cost_tabular(returns) -> list[str]:
-    """The cost of one iterated return (results/bench_attractor_cost.nc)."""
-    lines = [r"\medskip", "", FIT_BEGIN, r"\begin{tabular}{rrrrrr}", r"\toprule",
-             r"$\theta$ & $\epsilon$ & $s$ & $\mu$s/return & with $DP$ & "
-             r"switches/return \\", r"\midrule"]
-    for k in range(returns.sizes["case"]):
-        lines.append(" & ".join([
-            f"${num(float(returns.theta.values[k]), 2)}$",
-            f"${num(float(returns.eps.values[k]), 1)}$",
-            f"${num(float(returns.s.values[k]), 2)}$",
-            f"${num(1e6 * float(returns.time_per_return.values[k]), 3)}$",
-            f"${num(1e6 * float(returns.time_per_return_jacobian.values[k]), 3)}$",
-            f"${num(float(returns.switches_per_return.values[k]), 3)}$"]) + r" \\")
-    return lines + [r"\bottomrule", r"\end{tabular}", FIT_END, ""]
-
-
-def hard_cases(ds, m: Macros) -> str:
-    """Macros and the per-eps table of the hard-case sweep (results/hard_cases.nc):
-    jump/eps (theta < 0), one-sided slope (theta > 0), chatter period, slide-in."""
-    m.flag("rpHaveHardCases", ds is not None)
-    if ds is None:
-        return (not_yet("Hard-case eps sweep", "results/hard_cases.nc"),
-                not_yet("Sliding return sweep", "results/hard_cases.nc"))
-    sid = "hard_cases"
-    eps = [float(e) for e in ds.eps.values]
-    kmax, kmin = int(np.argmax(eps)), int(np.argmin(eps))
-    m.add("rpHardN", len(eps), f"{sid}:eps (size)")
-    m.add("rpHardNValues", None, f"{sid}:eps (size)", text=count_phrase(len(eps), "value"))
-    m.add("rpHardEpsMax", eps[kmax], f"{sid}:eps[{kmax}]")
-    m.add("rpHardEpsMin", eps[kmin], f"{sid}:eps[{kmin}]")
-    for attr, name, sig in (("jump_theta", "JumpTheta", 3), ("jump_x2_offset", "JumpOffset", 3),
-                            ("slope_theta", "SlopeTheta", 3), ("slope_probe_factor", "ProbeFactor", 3),
-                            ("slope_probe_floor", "ProbeFloor", 3),
-                            ("chatter_theta", "ChatterTheta", 3),
-                            ("chatter_periods", "ChatterPeriods", 4),
-                            ("slide_theta", "SlideTheta", 3),
-                            ("slide_start_over_eps", "SlideStart", 3),
-                            ("kernel_start", "KernelStart", 3)):
-        m.add(f"rpHard{name}", float(ds.attrs[attr]), f"{sid}:attrs.{attr}", sig)
-    var(m, "rpHardJumpFirst", ds, sid, "jump_over_eps", sig=5, eps=eps[kmax])
-    var(m, "rpHardJumpLast", ds, sid, "jump_over_eps", sig=5, eps=eps[kmin])
-    from filippov.analytic.s0 import s0_lambert
-    mu, omega = float(ds.attrs["mu"]), float(ds.attrs["omega"])
-    pred = float(s0_lambert(np.array([float(ds.attrs["jump_theta"])]))[0]) \
-        * math.exp(-3 * math.pi * mu / omega)
-    m.add("rpHardJumpPred", pred, "derived: s0(jump_theta) exp(-3 pi mu/omega)", 5)
-    if len(eps) > 1:
-        m.add("rpHardJumpDiffLast", abs(value(ds, "jump_over_eps", eps=eps[kmin])
-                                        - value(ds, "jump_over_eps", eps=sorted(eps)[1])),
-              "derived: |difference of jump_over_eps| between the two smallest eps", 2)
-    m.add("rpHardSlopeMin", float(ds.slope.min()), "derived: min slope over eps", 3)
-    m.add("rpHardSlopeMax", float(ds.slope.max()), "derived: max slope over eps", 3)
-    var(m, "rpHardPeriodOverEps", ds, sid, "chatter_period_over_eps", sig=6, eps=eps[kmin])
-    m.add("rpHardPeriodDev", float(ds.chatter_period_max_rel_dev.max()),
-          "derived: max chatter_period_max_rel_dev over eps", 2)
-    m.add("rpHardSlideOffset", float(np.abs(ds.slide_start_offset).max()),
-          "derived: max |slide_start_offset| over eps", 2)
-    m.add("rpHardSlideFinal", float(ds.slide_final_abs_x.max()),
-          "derived: max slide_final_abs_x over eps", 2)
-    m.add("rpHardKernelFinal", float(ds.kernel_final_abs_x.max()),
-          "derived: max kernel_final_abs_x over eps", 2)
-    maps = per_eps_rows(ds, lambda d: [
-        f"${num(float(d.jump_over_eps), 6)}$", f"${num(float(d.slope), 4)}$",
-        f"${num(float(d.slope_probe), 2)}$"])
-    chatter = per_eps_rows(ds, lambda d: [
-        f"${num(float(d.chatter_period_over_eps), 6)}$",
-        f"${num(float(d.chatter_period_max_rel_dev), 2)}$",
-        f"${num(float(d.slide_start_offset), 2)}$", f"${num(float(d.slide_final_abs_x), 2)}$",
-        f"${num(float(d.kernel_final_abs_x), 2)}$"])
-    # the return maps, then the pseudo-equilibrium (two tabulars: one would not fit)
-    table = tabular("rrrr", [head(r"$\epsilon$", r"jump$/\epsilon$", "slope", "$x_2-1$")],
-                     maps) + "\n\\medskip\n\n" + tabular("rrrrrr", [head(
-                         r"$\epsilon$", r"period//$/\epsilon$", "period//dev.",
-                         r"slide start//$+(1-\theta)\epsilon$", "final//$|x|$",
-                         "final $|x|$,//kernel")], chatter)
-    return table, _hard_return(ds, m, eps)
-
-
-def _hard_return(ds, m: Macros, eps: list) -> str:
-    """The theta > 0 sliding return per eps: 1 - P against eps^2, sliding time, cost."""
-    sid = "hard_cases"
-    m.add("rpHardReturnTheta", float(ds.attrs["return_theta"]), f"{sid}:attrs.return_theta", 3)
-    m.add("rpHardReturnXtwo", float(ds.attrs["return_x2"]), f"{sid}:attrs.return_x2", 3)
-    gap = np.abs(ds.return_P_reduced.values - ds.return_P.values)
-    scaled = gap / ds.eps.values ** 2
-    small = [k for k, e in enumerate(eps) if e <= 1e-3] or list(range(len(eps)))
-    m.add("rpHardReturnScaledMin", float(scaled[small].min()),
-          "derived: min |P_reduced - P|/eps^2 over eps <= 1e-3", 3)
-    m.add("rpHardReturnScaledMax", float(scaled[small].max()),
-          "derived: max |P_reduced - P|/eps^2 over eps <= 1e-3", 3)
-    steps = ds.return_steps.values
-    m.add("rpHardReturnStepsMin", int(steps.min()), "derived: min return_steps over eps")
-    m.add("rpHardReturnStepsMax", int(steps.max()), "derived: max return_steps over eps")
-    m.add("rpHardReturnStiffN", int(ds.return_stiff.values.sum()),
-          "derived: eps values whose sliding was finished by Radau IIA")
-    m.add("rpHardReturnStiffShare", None,
-          "derived: eps values whose sliding was finished by Radau IIA, of all",
-          text=share_phrase(ds.return_stiff.values.sum(), len(eps), r"$\epsilon$ value"))
-    rows = per_eps_rows(ds.assign(gap=("eps", gap), scaled=("eps", scaled)), lambda d: [
-        f"${num(float(d.gap), 3)}$", f"${num(float(d.scaled), 4)}$",
-        f"${num(float(d.return_sliding_time), 5)}$", f"${int(d.return_steps)}$",
-        "Radau IIA" if int(d.return_stiff) else "DOP853"])
-    return tabular("rrrrrl", [
-        r"$\epsilon$ & $|P_0-P|$ & $|P_0-P|/\epsilon^2$ & sliding time & steps & "
-        r"sliding by \\"], rows)
 
 
 # ----------------------------------------------------------------------------- entry point
@@ -652,9 +367,40 @@ def _scene_modules() -> list:
             for sid in known_scenes()]
 
 
+def _benchmark_modules() -> list:
+    """(name, REPORT, module) of every benchmark with a report part, in REPORT's order
+    (filippov_paper.product.report_benchmarks: no list of benchmarks here)."""
+    import importlib
+
+    return [(name, place, importlib.import_module(f".benchmarks.{name}", __package__))
+            for name, place in product.report_benchmarks().items()]
+
+
+def benchmark_parts(datasets, m: Macros) -> dict[str, str]:
+    """{table file: text} of the benchmarks' report parts: each adds its flags and macros
+    and gives its block (or None); the blocks of one table, in REPORT's order, joined."""
+    blocks: dict[str, list] = {}
+    for name, place, mod in _benchmark_modules():
+        try:
+            block = product.hook(mod, "report")(datasets.get(place["dataset"]), m)
+        except KeyError as exc:
+            raise KeyError(f"{name}: the report reads {exc} but the dataset "
+                           f"{place['dataset']} lacks it") from None
+        if place["table"]:
+            blocks.setdefault(place["table"], [])
+            if block is not None:
+                blocks[place["table"]].append(block)
+        elif block is not None:
+            raise ValueError(f"benchmark {name}: report returned a table but REPORT names "
+                             "no 'table' to put it in")
+    return {table: "\n".join(parts) if parts else f"% {table}: no table\n"
+            for table, parts in blocks.items()}
+
+
 def generate(datasets: Mapping[str, Optional[xr.Dataset]]) -> dict[str, str]:
     """All generated LaTeX files, keyed by file name. The datasets of scenes that do
-    not declare ``REPORT_OPTIONAL`` are required."""
+    not declare ``REPORT_OPTIONAL`` are required; a benchmark's report part says what
+    it does without its dataset."""
     modules = _scene_modules()
     missing = [sid for sid, mod in modules
                if datasets.get(sid) is None and not product.hook(mod, "REPORT_OPTIONAL", False)]
@@ -668,14 +414,25 @@ def generate(datasets: Mapping[str, Optional[xr.Dataset]]) -> dict[str, str]:
         except KeyError as exc:
             raise KeyError(f"{sid}: the report reads {exc} but the dataset lacks it") from None
         texts[f"{sid}.tex"] = table if table is not None else f"% {sid}: no table\n"
-    tab_bench = bench(datasets.get("work_precision"), m, datasets.get("bench_effect_cost"),
-                      datasets.get("bench_attractor_cost"), datasets.get("bench_compile_cost"))
+    texts.update(benchmark_parts(datasets, m))
+    texts.update(hard_case_parts(datasets, m))
+    return {"macros.tex": m.tex(), **texts}
+
+
+def hard_case_parts(datasets, m: Macros) -> dict[str, str]:
+    """{table file: text} of the hard-case sweep's report part (its REPORT["tables"])."""
+    import importlib
+
+    hard = importlib.import_module(".hard_cases", __package__)
+    sid = product.hook(hard, "DATASET_ID")
     try:
-        tab_hard, tab_return = hard_cases(datasets.get("hard_cases"), m)
+        tables = product.hook(hard, "report")(datasets.get(sid), m)
     except KeyError as exc:
-        raise KeyError(f"hard_cases: the report reads {exc} but the dataset lacks it") from None
-    return {"macros.tex": m.tex(), **texts, "tab_bench.tex": tab_bench,
-            "tab_hard_cases.tex": tab_hard, "tab_hard_return.tex": tab_return}
+        raise KeyError(f"{sid}: the report reads {exc} but the dataset lacks it") from None
+    names = product.hook(hard, "REPORT")["tables"]
+    if len(tables) != len(names):
+        raise ValueError(f"{sid}: report gave {len(tables)} tables for REPORT {names}")
+    return dict(zip(names, tables))
 
 
 def read_macros(text: str) -> dict:

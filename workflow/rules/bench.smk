@@ -80,23 +80,6 @@ rule bench_work_precision:
         "../scripts/bench_work_precision.py"
 
 
-rule plot_bench:
-    input:
-        data="results/bench_work_precision.nc",
-        script="workflow/scripts/plot_scene.py",
-    output:
-        pdf="figures/bench_work_precision.pdf",
-        png="figures/bench_work_precision.png",
-    params:
-        code=library_hash("plotting"),
-    log:
-        "logs/plot_bench.log",
-    conda:
-        "../envs/filippov.yaml"
-    script:
-        "../scripts/plot_scene.py"
-
-
 # The other benchmarks of `make bench`, one rule each, generated from the benchmark modules
 # that declare WORKFLOW (filippov_paper.product.workflow_benchmarks, read from their source):
 # rule bench_<name> runs the module's main(WORKFLOW["args"] + --out) through the one script
@@ -125,7 +108,34 @@ for _name, _spec in BENCHMARKS.items():
             "../scripts/bench.py"
 
 
+# The figures of `make bench`, one rule each, generated from the figure modules
+# filippov_paper.plotting.bench_<name> (filippov_paper.product.benchmark_figures): rule
+# plot_bench_<name> draws results/bench_<name>.nc into figures/bench_<name>.{pdf,png}. A new
+# benchmark with a figure is its module and its figure module.
+BENCH_FIGURES = benchmark_figures()
+
+for _name in BENCH_FIGURES:
+
+    rule:
+        name:
+            f"plot_bench_{_name}"
+        input:
+            data=f"results/bench_{_name}.nc",
+            script="workflow/scripts/plot_scene.py",
+        output:
+            pdf=f"figures/bench_{_name}.pdf",
+            png=f"figures/bench_{_name}.png",
+        params:
+            code=library_hash("plotting"),
+        log:
+            f"logs/plot_bench_{_name}.log",
+        conda:
+            "../envs/filippov.yaml"
+        script:
+            "../scripts/plot_scene.py"
+
+
 rule bench:
     input:
-        rules.plot_bench.output,
+        expand("figures/bench_{name}.{ext}", name=BENCH_FIGURES, ext=["pdf", "png"]),
         expand("results/bench_{name}.nc", name=BENCHMARKS),

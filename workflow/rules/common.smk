@@ -21,8 +21,8 @@ from filippov_paper.config import (DEFAULT_RESOLUTION, SceneError, apply_resolut
 
 # Library parts no scene computation imports: editing them must not recompute data.
 # (hard_cases.py is the hard-case sweep's own module: rule hard_cases hashes it.)
-# The report part of each scene module (filippov_paper.config.is_report_part) is left out of
-# their hash as well (strip_reports=True).
+# The report part of each scene and benchmark module and of hard_cases.py
+# (filippov_paper.config.is_report_part) is left out of their hash as well (strip_reports=True).
 NOT_COMPUTE = ("plotting/", "benchmarks/", "report.py", "manifest.py",
                "hard_cases.py", "paper_labels.py", "report_html.py")
 
@@ -40,7 +40,7 @@ def _library_hash(include, exclude, strip_reports):
     (filippov_paper) under `include`, minus the paths in `exclude` (a folder "name/" or a
     file "name.py", relative to the package that holds it: the two packages share no
     name, so "plotting" or "report.py" is the pipeline's); with `strip_reports`, the
-    scene modules without their report part."""
+    scene and benchmark modules and hard_cases.py without their report part."""
     from filippov_paper.config import without_report_part
 
     files = []
@@ -58,7 +58,8 @@ def _library_hash(include, exclude, strip_reports):
         if any(rel == e or (e.endswith("/") and rel.startswith(e)) for e in exclude):
             continue
         text = path.read_bytes()
-        if strip_reports and rel.startswith("scenes/"):
+        if strip_reports and (rel.startswith(("scenes/", "benchmarks/"))
+                              or rel == "hard_cases.py"):
             text = without_report_part(text.decode("utf-8")).encode("utf-8")
         digest.update(b"\0".join([rel.encode(), text, b""]))  # rel NUL text NUL
     return digest.hexdigest()[:16]
@@ -156,12 +157,43 @@ def report_data(wildcards):
     return data
 
 
-# The benchmarks' outputs (`make bench`) are read when present but are not inputs:
-# an input would make every library edit rerun the minutes-long benchmark before
-# the report. Their modification times are a param instead, so a new benchmark
-# run still refreshes the report.
-BENCH_OUTPUTS = ["results/bench_effect_cost.nc", "results/bench_attractor_cost.nc",
-                 "results/bench_compile_cost.nc"]
+# The benchmarks' report parts (filippov_paper.product.report_benchmarks, read from the
+# modules' source): the dataset each reads and the table its block goes into. A dataset of
+# `make bench` (results/bench_<name>.nc of a generated rule bench_<name>) is read when present
+# but is no input: an input would make every library edit rerun the minutes-long benchmark
+# before the report. Its modification time is a param instead, so a new benchmark run still
+# refreshes the report. Any other (work_precision: the default build's sweep) is an input.
+def report_benchmarks():
+    from filippov_paper.product import report_benchmarks as declared
+
+    try:
+        return declared()
+    except (ValueError, SyntaxError) as exc:
+        fail(exc)
+
+
+def report_bench_datasets(optional):
+    """results/<dataset>.nc of the benchmarks' report parts: those made by `make bench`
+    (optional=True) or the others (inputs of the report)."""
+    made_by_bench = {f"bench_{name}" for name in workflow_benchmarks()}
+    return [f"results/{place['dataset']}.nc" for place in report_benchmarks().values()
+            if (place["dataset"] in made_by_bench) == optional]
+
+
+def hard_case_tables():
+    """The files of paper/generated/ the hard-case sweep's report part writes."""
+    from filippov_paper.product import hard_case_tables as declared
+
+    try:
+        return declared()
+    except (ValueError, SyntaxError) as exc:
+        fail(exc)
+
+
+def report_bench_tables():
+    """The files of paper/generated/ the benchmarks' report parts write (tab_bench.tex)."""
+    return list(dict.fromkeys(place["table"] for place in report_benchmarks().values()
+                              if place["table"]))
 
 
 def workflow_benchmarks():
@@ -176,8 +208,17 @@ def workflow_benchmarks():
         fail(exc)
 
 
+def benchmark_figures():
+    """The benchmarks with a figure of `make bench` (filippov_paper.product; from the
+    plotting modules' file names): bench.smk makes a rule plot_bench_<name> for each."""
+    from filippov_paper.product import benchmark_figures as found
+
+    return found()
+
+
 def bench_stamps():
-    return {p: Path(p).stat().st_mtime_ns for p in BENCH_OUTPUTS if Path(p).exists()}
+    return {p: Path(p).stat().st_mtime_ns for p in report_bench_datasets(optional=True)
+            if Path(p).exists()}
 
 
 def report_figures(wildcards):

@@ -1,15 +1,15 @@
 # The reproduction report: results/*.nc -> paper/generated/*.tex (numbers and
 # tables, never typed by hand) and figures/*.pdf + paper/*.tex -> paper/main.pdf.
 # Optional inputs: the dry-friction scenes (fig10_dfo, fig11_dfo_retmaps) are
-# used when they are listed in config["scenes"]; the cost of each model
-# ingredient when results/bench_effect_cost.nc exists (`make bench`). The
-# work-precision sweep of the default build (results/work_precision.nc, rule
-# work_precision; seconds) is an input. The report says "not yet
-# computed" for whatever is absent. Rule `all` asks for paper/main.pdf only when
+# used when they are listed in config["scenes"]; the datasets of `make bench` that a
+# benchmark's report part reads (results/bench_<name>.nc) when they exist. The other
+# datasets of the benchmarks' report parts -- the work-precision sweep of the default
+# build (results/work_precision.nc, rule work_precision; seconds) -- are inputs. The
+# report says "not yet computed" for whatever is absent. Rule `all` asks for paper/main.pdf only when
 # TeX is installed (see TEX_OK in the Snakefile). The hard-case eps sweep
 # (results/hard_cases.nc, rule hard_cases) is an input: it takes seconds.
-# The helpers (tex_available, report_data, report_figures, bench_stamps) are in
-# common.smk.
+# The helpers (tex_available, report_data, report_figures, report_bench_datasets,
+# report_bench_tables, hard_case_tables, bench_stamps) are in common.smk.
 from filippov_paper.config import scene_files
 
 report: "../report/workflow.rst"
@@ -20,8 +20,10 @@ report: "../report/workflow.rst"
 # instead of a stale table. Which scenes the report cannot do without is the
 # scenes' own declaration (REPORT_OPTIONAL in filippov_paper.scenes.<id>).
 SCENE_FILES = scene_files("config/scenes")
-REPORT_GENERATED = ["macros.tex", *[f"{s}.tex" for s in SCENE_FILES], "tab_bench.tex",
-                    "tab_hard_cases.tex", "tab_hard_return.tex"]
+# The benchmarks' tables (tab_bench.tex) are those their report parts name (REPORT), the
+# hard-case sweep's those of its REPORT.
+REPORT_GENERATED = ["macros.tex", *[f"{s}.tex" for s in SCENE_FILES], *report_bench_tables(),
+                    *hard_case_tables()]
 TEX_PACKAGES = ("texlive-publishers texlive-latex-extra texlive-latex-recommended "
                 "texlive-fonts-recommended latexmk")
 
@@ -30,7 +32,7 @@ rule report_tables:
     input:
         data=report_data,
         hard_cases="results/hard_cases.nc",  # the eps sweep (rule hard_cases; cheap)
-        work_precision="results/work_precision.nc",  # rule work_precision (seconds)
+        benchmarks=report_bench_datasets(optional=False),  # rule work_precision (seconds)
         script="workflow/scripts/report_tables.py",
     output:
         [f"paper/generated/{name}" for name in REPORT_GENERATED],

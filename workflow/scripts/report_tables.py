@@ -11,11 +11,12 @@ import filippov.io  # noqa: E402
 import filippov_paper.report  # noqa: E402
 
 datasets = {}
-# the scenes' datasets, the hard-case and work-precision sweeps (inputs), and the
-# ingredient costs when `make bench` made them; each checked against its checksum
+# the scenes' datasets, the hard-case sweep and the benchmarks' datasets of the default
+# build (inputs), and those of `make bench` when it made them; each checked against its
+# checksum
 try:
     for path in [*snakemake.input.data, snakemake.input.hard_cases,  # noqa: F821
-                 snakemake.input.work_precision,  # noqa: F821
+                 *snakemake.input.benchmarks,  # noqa: F821
                  *[p for p in snakemake.params.bench if p.endswith(".nc")]]:  # noqa: F821
         datasets[Path(path).stem] = filippov.io.read_dataset(path)
 except filippov.io.DatasetError as exc:

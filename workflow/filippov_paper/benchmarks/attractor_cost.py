@@ -19,6 +19,7 @@ from filippov.fastmap import OK, compute_returns
 from filippov_paper.benchmarks import command_line, timing
 from filippov.io import finalize
 from filippov.models import hopf
+from filippov_paper.report import FIT_BEGIN, FIT_END, Macros, num
 
 #: (theta, eps, s): the cascade (theta < 0) and the chaos (theta > 0) at the scenes' eps
 CASES = [(-0.5, 1e-2, 1.0), (-0.5, 1e-4, 1.0), (-0.5, 1e-6, 1.0),
@@ -101,6 +102,34 @@ def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
 
 #: part of `make bench` (filippov_paper.product): rule bench_attractor_cost runs main(args + ['--out', 'results/bench_attractor_cost.nc'])
 WORKFLOW = {"args": []}
+
+
+# ============================================================================= report
+# What the reproduction report quotes from this benchmark's dataset (filippov_paper.report
+# calls `report`, in REPORT's order among the benchmarks). This part -- REPORT, report and
+# the _report_* / _REPORT_* names -- is left out of the code hash of the jobs that run the
+# benchmark: editing it rebuilds the report only.
+REPORT = {"dataset": "bench_attractor_cost", "table": "tab_bench.tex", "order": 40}
+
+
+def report(ds, m: Macros) -> str | None:
+    """The cost of one iterated return: the last block of Table tab:bench (None when not
+    measured)."""
+    m.flag("rpHaveReturnCost", ds is not None)
+    if ds is None:
+        return None
+    lines = [r"\medskip", "", FIT_BEGIN, r"\begin{tabular}{rrrrrr}", r"\toprule",
+             r"$\theta$ & $\epsilon$ & $s$ & $\mu$s/return & with $DP$ & "
+             r"switches/return \\", r"\midrule"]
+    for k in range(ds.sizes["case"]):
+        lines.append(" & ".join([
+            f"${num(float(ds.theta.values[k]), 2)}$",
+            f"${num(float(ds.eps.values[k]), 1)}$",
+            f"${num(float(ds.s.values[k]), 2)}$",
+            f"${num(1e6 * float(ds.time_per_return.values[k]), 3)}$",
+            f"${num(1e6 * float(ds.time_per_return_jacobian.values[k]), 3)}$",
+            f"${num(float(ds.switches_per_return.values[k]), 3)}$"]) + r" \\")
+    return "\n".join(lines + [r"\bottomrule", r"\end{tabular}", FIT_END, ""])
 
 
 def main(argv=None) -> None:

@@ -26,6 +26,7 @@ import xarray as xr
 from filippov_paper.config import load_scene
 from filippov.io import finalize, write_dataset
 from filippov_paper.benchmarks import timing
+from filippov_paper.report import FIT_BEGIN, FIT_END, Macros, num, tex_escape
 
 ROOT = Path(__file__).resolve().parents[3]
 SCHEMA = ROOT / "config" / "schema" / "scene.schema.json"
@@ -115,6 +116,35 @@ def measure(scene_ids, cap: float, log=print, repeat: int = timing.MIN_ROUNDS,
 
 #: part of `make bench` (filippov_paper.product): rule bench_effect_cost runs main(args + ['--out', 'results/bench_effect_cost.nc'])
 WORKFLOW = {"args": []}
+
+
+# ============================================================================= report
+# What the reproduction report quotes from this benchmark's dataset (filippov_paper.report
+# calls `report`, in REPORT's order among the benchmarks). This part -- REPORT, report and
+# the _report_* / _REPORT_* names -- is left out of the code hash of the jobs that run the
+# benchmark: editing it rebuilds the report only.
+REPORT = {"dataset": "bench_effect_cost", "table": "tab_bench.tex", "order": 30}
+
+
+def report(ds, m: Macros) -> str | None:
+    """The cost of each model ingredient: a block of Table tab:bench, below the
+    work-precision sweep's (None when not measured)."""
+    m.flag("rpHaveEffects", ds is not None)
+    if ds is None:
+        return None
+    lines = [r"\medskip", "", FIT_BEGIN, r"\begin{tabular}{llrrl}", r"\toprule",
+             r"scene & ingredient switched & time [s] & $\times$ declared & outcome \\",
+             r"\midrule"]
+    for k in range(ds.sizes["variant"]):
+        status = str(ds.status.values[k])
+        outcome = "ok" if status == "ok" else status.split(":")[0]
+        lines.append(" & ".join([
+            r"\texttt{" + tex_escape(str(ds.scene.values[k])) + "}",
+            tex_escape(str(ds.change.values[k])).replace("->", r"$\to$"),
+            f"${num(float(ds.seconds.values[k]), 3)}$",
+            f"${num(float(ds.relative.values[k]), 3)}$",
+            r"\emph{" + tex_escape(outcome) + "}"]) + r" \\")
+    return "\n".join(lines + [r"\bottomrule", r"\end{tabular}", FIT_END, ""])
 
 
 def main(argv=None) -> None:

@@ -40,6 +40,8 @@ with its status, never dropped. A table is printed; the dataset goes to
 from __future__ import annotations
 
 import argparse
+import math
+import re
 import sys
 import time
 from dataclasses import dataclass
@@ -56,6 +58,8 @@ from filippov.models import dry_friction
 from filippov.models import hopf
 from filippov_paper.scenes.fig04_retmaps import return_map, x2_grid
 from filippov_paper.benchmarks import baseline, timing
+from filippov_paper.report import (FIT_BEGIN, FIT_END, Macros, absent, count_phrase, num,
+                                   range_phrase, source, table_frame, tex_escape)
 
 ROOT = Path(__file__).resolve().parents[3]
 SCENE = ROOT / "config" / "scenes" / "fig04_retmaps.yaml"
@@ -527,6 +531,155 @@ def table(ds: xr.Dataset) -> str:
         lines.append(f"at error {TARGET_ERROR:g}: project {float(ds.time_ours_at_target[i]):.4f} s, "
                      f"RK45 {float(ds.time_rk45_at_target[i]):.4f} s, "
                      f"speed-up {float(ds.speedup_vs_rk45[i]):.2g}x")
+    return "\n".join(lines)
+
+
+# ============================================================================= report
+# What the reproduction report quotes from the default build's sweep (filippov_paper.report
+# calls `report`, in REPORT's order among the benchmarks): Table tab:bench's first blocks
+# and the macros of sec_bench. This part -- REPORT, report and the _report_* / _REPORT_*
+# names -- is left out of the code hash of the jobs that run the sweep: editing it rebuilds
+# the report only.
+REPORT = {"dataset": "work_precision", "table": "tab_bench.tex", "order": 20}
+
+#: the methods as the work-precision table names them (short: the table fits the page)
+_REPORT_METHOD_TEX = {"project compiled exact": "compiled, exact flows",
+                      "project python exact": "Python, exact flows",
+                      "project compiled DOP853": "compiled DOP853",
+                      "project DOP853": "Python DOP853",
+                      "solve_ivp RK45": "scipy RK45",
+                      "solve_ivp DOP853": "scipy DOP853",
+                      "solve_ivp Radau": "scipy Radau",
+                      "solve_ivp LSODA": "scipy LSODA"}
+
+
+def _report_tabular(ds, probs: list[int]) -> list[str]:
+    """One tabular: a row per method and tolerance, error / time / missed switches
+    for each problem in ``probs``; a configuration that failed says so in its cells."""
+    head = " & ".join(rf"\multicolumn{{3}}{{c}}{{{_report_problem_tex(str(ds.problem.values[i]))}}}"
+                      for i in probs)
+    rules = "".join(rf"\cmidrule(lr){{{3 + 3 * k}-{5 + 3 * k}}}" for k in range(len(probs)))
+    sub = " & ".join(["error & ms & missed"] * len(probs))
+    lines = [FIT_BEGIN, r"\begin{tabular}{@{}ll" + "rrr" * len(probs) + "@{}}", r"\toprule",
+             rf"method & rtol & {head} \\", rules, rf" & & {sub} \\", r"\midrule"]
+    rows = [j for j in range(ds.sizes["config"])
+            if any(str(ds.status.values[i, j]) != "n/a" for i in probs)]
+    for j in rows:
+        fam = str(ds.method.values[j])
+        cells = [_REPORT_METHOD_TEX.get(fam, tex_escape(fam)),
+                 f"${num(float(ds.tolerance.values[j]), 2)}$"]
+        for i in probs:
+            status = str(ds.status.values[i, j])
+            if status != "ok":
+                cells.append(r"\multicolumn{3}{c}{\emph{" + tex_escape(status.split(":")[0]) + "}}")
+                continue
+            cells += [f"${num(float(ds.error_map.values[i, j]), 2)}$",
+                      f"${num(1e3 * float(ds.wall_time.values[i, j]), 2)}$",
+                      str(int(ds.missed_switches.values[i, j]))]
+        lines.append(" & ".join(cells) + r" \\")
+    return lines + [r"\bottomrule", r"\end{tabular}", FIT_END, ""]
+
+
+def _report_problem_tex(name: str) -> str:
+    """'fig04 theta=-0.5' -> the paper's symbols ('$\theta=-0.5$')."""
+    parts = name.split()
+    rest = " ".join(parts[1:])
+    for key, sym in (("theta", r"\theta"), ("eps", r"\epsilon")):
+        rest = re.sub(rf"{key}=(\S+)", lambda mm: f"${sym}={mm.group(1)}$", rest)
+    return rest
+
+
+def _report_timing(ds, m: Macros) -> None:
+    """How the sweep's times were measured (filippov_paper.benchmarks.timing): the statistic
+    shown, the warm-up runs, the least rounds and seconds asked for, and the rounds the
+    shown cells took. A sweep measured before the convention (no ``timing_statistic``)
+    sets ``rpHaveBenchTiming`` false and quotes nothing."""
+    have = "timing_statistic" in ds.attrs and "runs" in ds
+    m.flag("rpHaveBenchTiming", have)
+    if not have:
+        return
+    sid = "work_precision"
+    stat = str(ds.attrs["timing_statistic"])
+    m.add("rpBenchStatistic", None, f"{sid}:attrs.timing_statistic",
+          text=r"\text{" + tex_escape(stat) + "}")
+    for name, attr, sig in (("rpBenchWarmup", "timing_warmup", 4),
+                            ("rpBenchMinRounds", "timing_min_rounds", 4),
+                            ("rpBenchMinTime", "timing_min_time", 3)):
+        m.add(name, float(ds.attrs[attr]), f"{sid}:attrs.{attr}", sig)
+    # the counts as the prose says them ("one untimed run", "3 to 250 runs")
+    m.add("rpBenchWarmupRuns", None, f"{sid}:attrs.timing_warmup",
+          text=count_phrase(ds.attrs["timing_warmup"], "untimed run"))
+    m.add("rpBenchMinRoundsRuns", None, f"{sid}:attrs.timing_min_rounds",
+          text=count_phrase(ds.attrs["timing_min_rounds"], "timed run"))
+    timed = np.asarray(ds.runs.values)[np.asarray(ds.status.values).astype(str) == "ok"]
+    m.add("rpBenchRoundsLeast", float(timed.min()) if timed.size else math.nan,
+          "derived: min of work_precision:runs over the configurations that ran", 4)
+    m.add("rpBenchRoundsMost", float(timed.max()) if timed.size else math.nan,
+          "derived: max of work_precision:runs over the configurations that ran", 4)
+    m.add("rpBenchRoundsRange", None,
+          "derived: min to max of work_precision:runs over the configurations that ran",
+          text=range_phrase(timed.min(), timed.max(), "run") if timed.size else "no runs")
+
+
+def _report_failed_sentence(n: int) -> str:
+    """The sentence of the work-precision text on the configurations that failed."""
+    if n == 0:
+        return "No configuration failed outright on any map."
+    return (count_phrase(n, "configuration", capital=True)
+            + r" failed outright over all maps (cells marked \emph{failed}; the dataset's "
+            r"\texttt{status} says why).")
+
+
+def _report_problem_macros(ds, m: Macros, names) -> None:
+    """Per problem (the first four: A-D) the speed-up, the reference floor, the points,
+    and what solve_ivp's RK45 and DOP853 miss; then the failed configurations."""
+    sid = "work_precision"
+    fam = np.array([str(f) for f in ds.method.values])
+    for i, p in enumerate(names[:4]):
+        key = "ABCD"[i]
+        m.add(f"rpBenchSpeedup{key}", float(ds.speedup_vs_rk45.values[i]),
+              source(sid, f"speedup_vs_rk45[{i}]"), 2)
+        m.add(f"rpBenchFloor{key}", float(ds.reference_check.values[i]),
+              source(sid, f"reference_check[{i}]"), 2)
+        m.add(f"rpBenchPoints{key}", float(ds.n_points.values[i]),
+              source(sid, f"n_points[{i}]"), 4)
+        ok = ds.status.values[i] == "ok"
+        for tag, family in (("RK", "solve_ivp RK45"), ("DOP", "solve_ivp DOP853")):
+            sel = (fam == family) & ok
+            m.add(f"rpBenchMissed{tag}{key}",
+                  float(ds.missed_switches.values[i, sel].max()) if sel.any() else 0.0,
+                  f"derived: max of work_precision:missed_switches[{i}] over {family}", 4)
+            m.add(f"rpBenchBest{tag}{key}",
+                  float(np.nanmin(ds.error_map.values[i, sel])) if sel.any() else math.nan,
+                  f"derived: min of work_precision:error_map[{i}] over {family}", 2)
+    failed = int(np.count_nonzero(np.char.startswith(ds.status.values.astype(str), "failed")))
+    m.add("rpBenchFailed", float(failed),
+          "derived: configurations of work_precision:status that failed", 4)
+    m.add("rpBenchFailedSentence", None,
+          "derived: configurations of work_precision:status that failed",
+          text=_report_failed_sentence(failed))
+    m.add("rpBenchConfigs", float(ds.sizes["config"]), "work_precision:config (size)", 4)
+
+
+def report(ds, m: Macros) -> str:
+    """The work-precision tables of the default build's sweep (results/work_precision.nc):
+    per problem set (fig04, fig11), one row per method and tolerance, error / time /
+    missed switches per problem; the speed-up at the target error and what the
+    scipy solvers a user reaches for first get wrong (macros)."""
+    missing = absent(m, "rpHaveBench", ds, "Work--precision sweep", "results/work_precision.nc")
+    m.flag("rpHaveBenchTiming", False)  # set by _report_timing when the sweep says how it timed
+    if missing:
+        return missing
+    if "method" not in ds.coords or "problem" not in ds.dims:
+        return table_frame(ds)
+    names = [str(p) for p in ds.problem.values]
+    lines = []
+    for prefix in ("fig04", "fig11"):
+        probs = [i for i, p in enumerate(names) if p.startswith(prefix)]
+        if probs:
+            lines += ([r"\medskip", ""] if lines else []) + _report_tabular(ds, probs)
+    _report_problem_macros(ds, m, names)
+    _report_timing(ds, m)
     return "\n".join(lines)
 
 
