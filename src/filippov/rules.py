@@ -433,6 +433,17 @@ def accumulates(oldest: float, newest: float, zeno_span: float) -> bool:
     return newest - oldest <= zeno_span * max(1.0, abs(newest))
 
 
+def note_switch(recent, entries: int, t: float, zeno_count: int, zeno_span: float):
+    """The Zeno ring both engines keep: enters the switch at ``t`` in ``recent`` (an array
+    of zeno_count times, entry k at k % zeno_count; ``entries`` so far) and says whether
+    the last zeno_count switches, from the oldest the ring holds to ``t``, accumulate
+    (:func:`accumulates`). Returns (entries, zeno)."""
+    recent[entries % zeno_count] = t
+    entries += 1
+    return entries, (entries >= zeno_count
+                     and accumulates(recent[entries % zeno_count], t, zeno_span))
+
+
 #: the iteration bound of Brent's method on both engines, for an event's root and for the
 #: extremum of h (or of a normal speed) between two samples alike
 BRENT_MAXITER = 200
@@ -468,7 +479,7 @@ def section_first(r: float, t_min: float, best_t: float, best_is_section: bool,
 START_ULPS = 64
 
 
-def starts_on_section(s0, z0, sr, zr, z_start) -> bool:
+def starts_on_section(s0: float, z0, sr: float, zr, z_start) -> bool:
     """The start ``z0`` (section value ``s0``) lies on the section up to rounding,
     given the refined root ``zr`` (section value ``sr``); 1-D float arrays. ``z0`` is
     the first sample as the stay's stepper gives it -- for an exact flow, the closed
