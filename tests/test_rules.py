@@ -283,3 +283,15 @@ def test_a_refined_root_walks_to_the_first_probe_past_the_crossing():
         assert r == r0 + 14 * ulp and seen == [r0 + k * ulp for k in (0, 2, 6, 14)]
         assert walk(r0, 2.0)[0] == r0                         # already past
         assert walk(3.0, r0 + 5 * ulp)[0] == r0 + 5 * ulp     # none past before tb
+
+
+def test_a_leave_crossing_ends_the_stay_into_the_region_next_mode_takes():
+    """rules.ended_by names what a leave function's sign change ends a stay with, and
+    next_mode takes the stay on from there: h in a region switches; while sliding a
+    reaching 0 leaves into region -, b into region +."""
+    assert rules.ended_by(PLUS, 0) == rules.ended_by(MINUS, 0) == rules.SWITCH
+    assert rules.ended_by(SLIDING, 0) == rules.EXIT_MINUS
+    assert rules.ended_by(SLIDING, 1) == rules.EXIT_PLUS
+    for q, region in ((0, MINUS), (1, PLUS)):
+        for a, b in itertools.product(SPEEDS, SPEEDS):
+            assert rules.next_mode(SLIDING, rules.ended_by(SLIDING, q), a, b) == region

@@ -266,6 +266,16 @@ def slides_in_section(s_at_z: float, d: float, rate_minus: float, rate_plus: flo
 SWITCH, EXIT_MINUS, EXIT_PLUS = 0, 1, 2
 
 
+def ended_by(mode: int, q: int) -> int:
+    """What a sign change of leave function ``q`` ends a stay in ``mode`` with (the
+    ``ended_by`` of :func:`next_mode`): in a region q = 0 is H, a SWITCH; while sliding
+    q = 0 is a (F_- turned tangent: EXIT_MINUS) and q = 1 is b (EXIT_PLUS), whether the
+    crossing shows at the samples or hides between them."""
+    if mode != SLIDING:
+        return SWITCH
+    return EXIT_MINUS if q == 0 else EXIT_PLUS
+
+
 def start_side(H: float, touch_tol: float) -> int:
     """PLUS or MINUS for a start off H (beyond ``touch_tol``); SLIDING (0) for a
     start on H, where the field directions decide (:func:`start_on_switch`)."""

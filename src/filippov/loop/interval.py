@@ -3,7 +3,7 @@
 Between two samples of a stay the scan asks, in this order:
 
 1. does a leave function change sign (h: a switch; while sliding, a or b: an exit into
-   region - or +)? Its root, refined; the earliest of them is the event so far;
+   region - or +: ``rules.ended_by``)? Its root, refined; the earliest of them is the event so far;
 2. none, and sliding: has a or b an extremum toward its sign change hidden between the
    samples (``rules.speed_extremum_between``)? The engine refines it and
    ``rules.speed_graze`` tells an exit (the earliest wins) from a touch, which is
@@ -36,7 +36,7 @@ from __future__ import annotations
 import math
 
 from .. import rules
-from ..rules import (EXIT_MINUS, EXIT_PLUS, GRAZE_CROSSES, GRAZE_TOUCHES, SWITCH)
+from ..rules import GRAZE_CROSSES, GRAZE_TOUCHES, SWITCH
 from ..system import SLIDING
 
 #: the status of an operation that succeeded (the kernel's OK)
@@ -79,8 +79,7 @@ def make_interval_event(leave_crosses, leave_root, slide_end_between, hidden_sli
                 if st != OK:
                     return st, r, NONE, -1
                 if best_w == NONE or r < best_t:
-                    best_t, best_w = r, (SWITCH if mode != SLIDING
-                                         else (EXIT_MINUS if q == 0 else EXIT_PLUS))
+                    best_t, best_w = r, rules.ended_by(mode, q)
         # 2. none while sliding: the end of sliding hidden between the samples
         if mode == SLIDING and best_w == NONE:
             touch_a, touch_b = math.inf, math.inf
@@ -92,7 +91,7 @@ def make_interval_event(leave_crosses, leave_root, slide_end_between, hidden_sli
                     return st, r, NONE, -1
                 if kind == GRAZE_CROSSES:
                     if best_w == NONE or r < best_t:
-                        best_t, best_w = r, (EXIT_MINUS if q == 0 else EXIT_PLUS)
+                        best_t, best_w = r, rules.ended_by(mode, q)
                 elif kind == GRAZE_TOUCHES:
                     if q == 0:
                         touch_a = r
