@@ -221,7 +221,8 @@ def test_the_exit_band_is_the_flows_rounding_scale(band_of):
 def test_the_band_moves_the_shift_to_the_wrong_side_until_cleared(mode):
     band, shift = 3e-15, 0.0
     for banded, clears in ((rules.banded_shift, rules.clears_band),
-                           (kernel.compiled_rule("banded_shift"), kernel.compiled_rule("clears_band"))):
+                           (kernel.compiled_rule("banded_shift"),
+                            kernel.compiled_rule("clears_band"))):
         c = banded(mode, shift, band)
         sign = 1.0 if mode == PLUS else -1.0
         # H read at -band/2 on the wrong side is no crossing of the banded function

@@ -104,10 +104,12 @@ def test_compiled_and_python_decide_alike(mode):
                                          SPEEDS, SPEEDS):
         if mode == SLIDING and ended == rules.SWITCH:
             continue
-        assert kernel.compiled_rule("next_mode")(mode, ended, a, b) == rules.next_mode(mode, ended, a, b)
+        assert (kernel.compiled_rule("next_mode")(mode, ended, a, b)
+                == rules.next_mode(mode, ended, a, b))
     for H, a, b in itertools.product((-1e-17, 0.0, 1e-17), SPEEDS, SPEEDS):
         for sliding in (True, False):
-            assert kernel.compiled_rule("start_on_switch")(H, a, b, sliding) == rules.start_on_switch(H, a, b, sliding)
+            assert (kernel.compiled_rule("start_on_switch")(H, a, b, sliding)
+                    == rules.start_on_switch(H, a, b, sliding))
 
 
 def test_filippov_decision_table():

@@ -1,9 +1,11 @@
 """The decisions of the event-driven method, each written once.
 
-Plain scalar Python: :mod:`filippov.simulate` calls these functions as they are,
-and :mod:`filippov.fastmap` compiles the same functions with numba, so the two
-engines cannot drift apart on a decision (the engines differ only in how they
-step, sample and store). Modes are the integers of :mod:`filippov.system`;
+Plain scalar Python: :mod:`filippov.simulate` and the event loop
+(:mod:`filippov.loop`) call these functions as they are, and the compiled kernel
+compiles the same functions with numba where they are called (every public function
+here is registered as compilable by :mod:`filippov.kernel.base`; a new rule needs no
+list entry), so the two engines cannot drift apart on a decision (the engines differ
+only in how they step, sample and store). Modes are the integers of :mod:`filippov.system`;
 ``a = grad H . F_-`` and ``b = grad H . F_+`` are the normal speeds (eq:atSl).
 """
 from __future__ import annotations

@@ -1,6 +1,7 @@
 """What every part of the compiled kernel shares: the model pieces' function types,
 the status codes, event and predicate codes, the compile decorators, the rule book
-compiled from its one source (filippov.rules) and the small model-piece helpers."""
+registered as compilable from its one source (filippov.rules) and the small model-piece
+helpers."""
 from __future__ import annotations
 
 import functools

@@ -5,12 +5,13 @@ the event budget and the Zeno ring: written once for both engines.
 (:class:`EventOps`: how it evaluates the speeds, h and grad h at the event's state, the
 exact flow over time 0, how it records a hit or a switch, keeps its counters and the next
 stay's shift, updates dP/dz); the rules it asks it calls as ``rules.<name>`` on both
-engines (the kernel registers every rule as compilable: :mod:`filippov.kernel.base`). The result, ``event(mode, t, what, ctx) ->
-(status, mode)``, is plain scalar Python in the subset numba compiles: the reference
-driver (:mod:`filippov.simulate`) calls it as it is, with ``ctx`` its run, and turns a
-status into its exception; the compiled kernel (:mod:`filippov.kernel.driver`) compiles
-it inlined into its driver, with ``ctx`` its records.  The Zeno ring both engines keep, an
-array of the last ``zeno_count`` switch times, is rules.note_switch.
+engines (the kernel registers every rule as compilable: :mod:`filippov.kernel.base`).
+The result, ``event(mode, t, what, ctx) -> (status, mode)``, is plain scalar Python in
+the subset numba compiles: the reference driver (:mod:`filippov.simulate`) calls it as
+it is, with ``ctx`` its run, and turns a status into its exception; the compiled kernel
+(:mod:`filippov.kernel.driver`) compiles it inlined into its driver, with ``ctx`` its
+records. The Zeno ring both engines keep, an array of the last ``zeno_count`` switch
+times, is rules.note_switch.
 
 The order at a switch: the decision (rules.next_mode); sliding that the system does not
 build (NO_SLIDING); an arrival on H that would slide inside a section
