@@ -205,16 +205,7 @@ def test_the_return_in_the_exits_first_window_is_located_at_h_zero(engine):
 
 
 # ----------------------------------------------------------------------------- the rules
-def test_the_compiled_engine_compiles_the_band_rules_themselves():
-    for compiled, source in ((kernel._exit_band, rules.exit_band),
-                             (kernel._banded_shift, rules.banded_shift),
-                             (kernel._clears_band, rules.clears_band),
-                             (kernel._band_probe, rules.band_probe),
-                             (kernel._graze, rules.graze)):
-        assert compiled.py_func is source
-
-
-@pytest.mark.parametrize("band_of", [rules.exit_band, kernel._exit_band])
+@pytest.mark.parametrize("band_of", [rules.exit_band, kernel.compiled_rule("exit_band")])
 def test_the_exit_band_is_the_flows_rounding_scale(band_of):
     z, grad = np.array([0.0, -0.38256777, 0.56876841]), np.array([1.0, 0.0, 0.0])
     eps = np.finfo(float).eps
@@ -230,7 +221,8 @@ def test_the_exit_band_is_the_flows_rounding_scale(band_of):
 def test_the_band_moves_the_shift_to_the_wrong_side_until_cleared(mode):
     band, shift = 3e-15, 0.0
     for banded, clears in ((rules.banded_shift, rules.clears_band),
-                           (kernel._banded_shift, kernel._clears_band)):
+                           (kernel.compiled_rule("banded_shift"),
+                            kernel.compiled_rule("clears_band"))):
         c = banded(mode, shift, band)
         sign = 1.0 if mode == PLUS else -1.0
         # H read at -band/2 on the wrong side is no crossing of the banded function
@@ -246,7 +238,7 @@ def test_the_band_moves_the_shift_to_the_wrong_side_until_cleared(mode):
 
 def test_no_touch_at_the_exits_own_tangency():
     tol, band = 1e-15, 3e-15
-    for graze in (rules.graze, kernel._graze):
+    for graze in (rules.graze, kernel.compiled_rule("graze")):
         # outside an exit's band: a touch within touch_tol, a crossing beyond it
         assert graze(PLUS, -5e-16, tol, 0.0) == rules.GRAZE_TOUCHES
         assert graze(PLUS, -2e-15, tol, 0.0) == rules.GRAZE_CROSSES

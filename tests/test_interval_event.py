@@ -42,8 +42,7 @@ EVENT = make_interval_event(
     section_crosses=lambda c, k, i: c.sections[k] is not None,
     section_root=lambda c, k, i, mode: c.answer(f"section{k}", c.sections[k][0]),
     section_bounds=lambda c, k: (c.sections[k][1], XTOL),
-    section_counts=lambda c, k, i, r, mode: c.sections[k][2],
-    section_first=rules.section_first)
+    section_counts=lambda c, k, i, r, mode: c.sections[k][2])
 
 
 def test_the_earliest_leave_crossing_is_the_event_and_hidden_extrema_are_not_asked():

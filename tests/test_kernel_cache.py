@@ -9,15 +9,16 @@ from pathlib import Path
 
 SRC = str(Path(__file__).resolve().parents[1] / "src")
 
-# compiles one small function of the engine module into the cache, after the check (a
-# rule: the kernel's other helpers have no CPython wrapper and cannot be called from here)
+# compiles one small helper of the kernel into the cache, after the check (compiled for
+# its signature: the kernel's helpers have no CPython wrapper to call from here)
 _RUN = """
+from numba import types
 from filippov.kernel import base, driver
-index = lambda: len(base._after._cache._cache_file._load_index())
+index = lambda: len(base._dot._cache._cache_file._load_index())
 before = index()
 driver._fresh_cache()
 after = index()
-base._after(0, -1.0)
+base._dot.compile((types.float64[::1], types.float64[::1]))
 print(before, after, index())
 """
 

@@ -13,14 +13,13 @@ import pytest
 
 from filippov import EventLimitError, ZenoError, compute_returns, rules, simulate
 from filippov.fastmap import EVENT_LIMIT, ZENO
-from filippov.loop.event import make_note_switch
 from filippov.models import pseudo_equilibrium
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "filippov"
 
-#: the rules of an event: asked only by filippov.loop.event (the kernel's compiled
-#: copies carry a leading underscore)
-EVENT_RULES = {"next_mode", "accumulates", "exit_drift", "onto_switch", "exit_band",
+#: the rules of an event: asked only by filippov.loop.event (rules.accumulates by
+#: rules.note_switch, the Zeno ring)
+EVENT_RULES = {"next_mode", "note_switch", "exit_drift", "onto_switch", "exit_band",
                "exit_shift"}
 
 
@@ -42,6 +41,8 @@ def test_the_event_rules_are_asked_only_by_the_loop():
                     str(path.relative_to(SRC)))
     assert askers, "no rule asked at all: the AST walk is broken"
     assert all(files == {"loop/event.py"} for files in askers.values()), askers
+    assert {str(p.relative_to(SRC)) for p in SRC.rglob("*.py")
+            if "accumulates" in set(_calls(p))} == {"rules.py"}
 
 
 def test_both_engines_build_their_event_from_the_loop():
@@ -60,7 +61,7 @@ def test_both_engines_build_their_event_from_the_loop():
 @pytest.mark.parametrize("zeno_count", [2, 3, 7])
 def test_the_ring_is_the_deque_of_the_last_switches(zeno_count):
     # the array ring answers as a deque(maxlen=zeno_count) of the switch times does
-    note_switch = make_note_switch(rules.accumulates)
+    note_switch = rules.note_switch
     ring, entries, times = np.empty(zeno_count), 0, deque(maxlen=zeno_count)
     rng = np.random.default_rng(1)
     t = 0.0

@@ -249,15 +249,8 @@ def test_the_fold_exit_cases_at_the_default_samples(monkeypatch):
 
 
 # ----------------------------------------------------------------------------- the rules
-def test_the_compiled_engine_compiles_the_sliding_rules_themselves():
-    for compiled, source in ((kernel._speed_extremum_between, rules.speed_extremum_between),
-                             (kernel._speed_graze, rules.speed_graze),
-                             (kernel._rate_step, rules.rate_step)):
-        assert compiled.py_func is source
-
-
 @pytest.mark.parametrize("between", [rules.speed_extremum_between,
-                                     kernel._speed_extremum_between])
+                                     kernel.compiled_rule("speed_extremum_between")])
 def test_an_extremum_toward_the_exit(between):
     # b (exit TO_NONNEG): a maximum, its rate from > 0 to <= 0
     assert between(rules.TO_NONNEG, 1.0, -1.0)
@@ -274,7 +267,7 @@ def test_an_extremum_toward_the_exit(between):
                                      np.array([-1.0, 1.0, 1.0])), [True, False, False])
 
 
-@pytest.mark.parametrize("graze", [rules.speed_graze, kernel._speed_graze])
+@pytest.mark.parametrize("graze", [rules.speed_graze, kernel.compiled_rule("speed_graze")])
 def test_the_hidden_extremum_of_a_speed_is_judged_by_the_excursion_it_makes(graze):
     tol = 1e-15
     # b's maximum vm, its rates 1 and -1 over a sample interval of 0.5 (curvature 4): the
@@ -296,7 +289,7 @@ def test_the_hidden_extremum_of_a_speed_is_judged_by_the_excursion_it_makes(graz
     assert graze(rules.TO_NONNEG, 1e-100, 1.0, -1.0, 0.5, 0.0) == rules.GRAZE_CROSSES
 
 
-@pytest.mark.parametrize("step", [rules.rate_step, kernel._rate_step])
+@pytest.mark.parametrize("step", [rules.rate_step, kernel.compiled_rule("rate_step")])
 def test_the_rates_difference_step(step):
     z, fm, fp = np.array([0.0, -3.0, 2.0]), np.array([1.0, 2.0, 1.0]), np.array([-1.0, 2.0, 1.0])
     # Filippov's field (a F_+ - b F_-)/(a - b) = (0, 2, 1) at a = 1, b = -1: the orbit moves
@@ -306,5 +299,5 @@ def test_the_rates_difference_step(step):
     assert step(z, fm, fp, 1.0, 1.0) == 0.0
     assert step(z, np.zeros(3), np.zeros(3), 1.0, -1.0) == 0.0
     # a sample interval of no length (a window below the spacing of floats): never a touch
-    for graze in (rules.speed_graze, kernel._speed_graze):
+    for graze in (rules.speed_graze, kernel.compiled_rule("speed_graze")):
         assert graze(rules.TO_NONNEG, 1e-3, 1.0, -1.0, 0.0, 1e-15) == rules.GRAZE_CROSSES

@@ -29,7 +29,7 @@ the decision (``rules.next_mode``), sliding the system does not build, the refus
 slide inside a section at an arrival on H, the fold exit (``rules.exit_drift``,
 ``onto_switch``, ``exit_band``, ``exit_shift``), the switch counted against
 ``max_events`` before the Zeno ring (``rules.accumulates`` over the last ``zeno_count``
-switches: one array ring, :func:`filippov.loop.event.make_note_switch`), then the
+switches: one array ring, ``rules.note_switch``), then the
 engine's own budget verdict (item 2); both share one set of status codes
 (:mod:`filippov.loop.status`: the reference turns a status into its exception). The
 rest they ask in the same order on each side: the hard bound ``max_steps``

@@ -1,9 +1,11 @@
 """The decisions of the event-driven method, each written once.
 
-Plain scalar Python: :mod:`filippov.simulate` calls these functions as they are,
-and :mod:`filippov.fastmap` compiles the same functions with numba, so the two
-engines cannot drift apart on a decision (the engines differ only in how they
-step, sample and store). Modes are the integers of :mod:`filippov.system`;
+Plain scalar Python: :mod:`filippov.simulate` and the event loop
+(:mod:`filippov.loop`) call these functions as they are, and the compiled kernel
+compiles the same functions with numba where they are called (every public function
+here is registered as compilable by :mod:`filippov.kernel.base`; a new rule needs no
+list entry), so the two engines cannot drift apart on a decision (the engines differ
+only in how they step, sample and store). Modes are the integers of :mod:`filippov.system`;
 ``a = grad H . F_-`` and ``b = grad H . F_+`` are the normal speeds (eq:atSl).
 """
 from __future__ import annotations
@@ -266,6 +268,16 @@ def slides_in_section(s_at_z: float, d: float, rate_minus: float, rate_plus: flo
 SWITCH, EXIT_MINUS, EXIT_PLUS = 0, 1, 2
 
 
+def ended_by(mode: int, q: int) -> int:
+    """What a sign change of leave function ``q`` ends a stay in ``mode`` with (the
+    ``ended_by`` of :func:`next_mode`): in a region q = 0 is H, a SWITCH; while sliding
+    q = 0 is a (F_- turned tangent: EXIT_MINUS) and q = 1 is b (EXIT_PLUS), whether the
+    crossing shows at the samples or hides between them."""
+    if mode != SLIDING:
+        return SWITCH
+    return EXIT_MINUS if q == 0 else EXIT_PLUS
+
+
 def start_side(H: float, touch_tol: float) -> int:
     """PLUS or MINUS for a start off H (beyond ``touch_tol``); SLIDING (0) for a
     start on H, where the field directions decide (:func:`start_on_switch`)."""
@@ -433,6 +445,17 @@ def accumulates(oldest: float, newest: float, zeno_span: float) -> bool:
     return newest - oldest <= zeno_span * max(1.0, abs(newest))
 
 
+def note_switch(recent, entries: int, t: float, zeno_count: int, zeno_span: float):
+    """The Zeno ring both engines keep: enters the switch at ``t`` in ``recent`` (an array
+    of zeno_count times, entry k at k % zeno_count; ``entries`` so far) and says whether
+    the last zeno_count switches, from the oldest the ring holds to ``t``, accumulate
+    (:func:`accumulates`). Returns (entries, zeno)."""
+    recent[entries % zeno_count] = t
+    entries += 1
+    return entries, (entries >= zeno_count
+                     and accumulates(recent[entries % zeno_count], t, zeno_span))
+
+
 #: the iteration bound of Brent's method on both engines, for an event's root and for the
 #: extremum of h (or of a normal speed) between two samples alike
 BRENT_MAXITER = 200
@@ -468,7 +491,7 @@ def section_first(r: float, t_min: float, best_t: float, best_is_section: bool,
 START_ULPS = 64
 
 
-def starts_on_section(s0, z0, sr, zr, z_start) -> bool:
+def starts_on_section(s0: float, z0, sr: float, zr, z_start) -> bool:
     """The start ``z0`` (section value ``s0``) lies on the section up to rounding,
     given the refined root ``zr`` (section value ``sr``); 1-D float arrays. ``z0`` is
     the first sample as the stay's stepper gives it -- for an exact flow, the closed

@@ -34,7 +34,7 @@ from .loop import interval
 from .radau_iia import RadauIIA
 from .system import MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
-from .loop.event import REFERENCE_BOOK, SECTION, EventOps, make_event
+from .loop.event import SECTION, EventOps, make_event
 from .loop.status import EVENT_LIMIT, GO_ON, NO_SLIDING, OK, SECTION_SLIDING, ZENO
 
 
@@ -461,7 +461,7 @@ class _Run:
         self.t, self.z = self.t0, z
         self.preds = [rules.section_pred(sec.direction) for sec in sections]
         self.hits = [0] * len(sections)
-        # the Zeno ring (filippov.loop.event.make_note_switch): the last zeno_count
+        # the Zeno ring (filippov.rules.note_switch): the last zeno_count
         # switch times, entry k at k % zeno_count
         self.ring, self.ring_entries = np.empty(self.zeno_count), 0
         self.hit_section, self.projected = None, None
@@ -754,7 +754,7 @@ def _nothing(*args):
 
 
 #: the reference driver's event (filippov.loop.event) on its Python operations; ctx: the _Run
-_EVENT = make_event(REFERENCE_BOOK, EventOps(
+_EVENT = make_event(EventOps(
     section_hit=_section_hit,
     speeds=lambda run: tuple(float(v) for v in run.system.normal_speeds(run.z)),
     h=lambda run: float(run.system.switch(run.z)),
@@ -1018,7 +1018,7 @@ _interval_event = interval.make_interval_event(
     _Scan._leave_crosses, _Scan._leave_root, _Scan._slide_end_between,
     _Scan._hidden_slide_end, _Scan._extremum_between, _Scan._hidden_extremum, _Scan._touch,
     _Scan._n_sections, _Scan._section_crosses, _Scan._section_root, _Scan._section_bounds,
-    _Scan._section_counts, rules.section_first)
+    _Scan._section_counts)
 
 # the event search and what is done at an event speak the same codes
 assert interval.SECTION == SECTION and interval.OK == OK

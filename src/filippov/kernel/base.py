@@ -1,7 +1,11 @@
 """What every part of the compiled kernel shares: the model pieces' function types,
 the status codes, event and predicate codes, the compile decorators, the rule book
-compiled from its one source (filippov.rules) and the small model-piece helpers."""
+registered as compilable from its one source (filippov.rules) and the small model-piece
+helpers."""
 from __future__ import annotations
+
+import functools
+import inspect
 
 import numpy as np
 from numba import njit, types
@@ -43,31 +47,34 @@ _EPS = np.finfo(float).eps
 # and is never called from Python: compiled without reference counting and without
 # numba's CPython and C wrappers (docs/decisions.md#kernel-no-refcounting)
 _jit = njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-# the rules keep their wrappers (scalars only: cheap), so tests call them from Python
-_jit_rule = njit(cache=True, _nrt=False)
 # the driver's pieces (kernel.driver: _window, _stay_*, _event) are inlined into _one at the
 # IR level, and so are the pieces of kernel.scan._find (docs/decisions.md#kernel-inlined-driver)
 _jit_inline = njit(cache=True, _nrt=False, inline="always")
 
 
-# a rule that another rule calls (section_first: same_instant) is compiled into its caller
-register_jitable(rules.same_instant)
+def rule_book():
+    """The rule book: every public function of filippov.rules, by name."""
+    return {name: f for name, f in vars(rules).items()
+            if inspect.isfunction(f) and f.__module__ == rules.__name__
+            and not name.startswith("_")}
 
-# every decision and crossing predicate, compiled from its one source (filippov.rules)
-(_after, _crosses, _clamp, _far_side, _extremum_between, _graze, _central_step,
- _slides_in_section, _starts_on_section, _same_instant, _start_side, _start_on_switch,
- _next_mode, _accumulates, _exit_shift, _dips_and_returns, _exact_window, _onto_switch,
- _exit_drift, _carried_age, _far_side_probe, _exit_band, _banded_shift, _clears_band,
- _band_probe, _speed_extremum_between, _speed_graze, _rate_step, _flow_consistent,
- _section_probe, _section_noise, _on_section_by_value, _section_first) = (
-    _jit_rule(getattr(rules, name)) for name in (
-    "after", "crosses", "clamp", "far_side", "extremum_between", "graze", "central_step",
-    "slides_in_section", "starts_on_section", "same_instant", "start_side", "start_on_switch",
-    "next_mode", "accumulates", "exit_shift", "dips_and_returns", "exact_window",
-    "onto_switch", "exit_drift", "carried_age", "far_side_probe", "exit_band",
-    "banded_shift", "clears_band", "band_probe", "speed_extremum_between", "speed_graze",
-    "rate_step", "flow_consistent", "section_probe", "section_noise", "on_section_by_value",
-    "section_first"))
+
+# Every rule compiles where compiled code calls it: the loop (filippov.loop), the kernel
+# and a rule calling another (section_first: same_instant) all call ``rules.<name>`` as
+# the reference driver does, and numba compiles that function into its caller, without
+# a wrapper or a cache of its own (its caller's cache holds it; kernel.driver's stamp
+# covers rules.py). A new rule needs no entry here.
+for _rule in rule_book().values():
+    register_jitable(_nrt=False)(_rule)
+
+
+@functools.cache
+def compiled_rule(name):
+    """rules.<name> compiled on its own, as the kernel compiles it, with a wrapper so that
+    Python calls it: what tests compare with the rule run as Python."""
+    return njit(_nrt=False)(rule_book()[name])
+
+
 # the codes the one event search (filippov.loop.interval) hands back
 assert (_W_NONE, _W_SWITCH, _W_EXIT_MINUS, _W_EXIT_PLUS, _W_SECTION) == (
     interval.NONE, rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS, interval.SECTION)

@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import rules
 from ..system import PLUS
-from .base import (_central_step, _dot, _flow_minus, _flow_plus, _grad_h, _jacobian, _jit,
-                   _section)
+from .base import (_dot, _flow_minus, _flow_plus, _grad_h, _jacobian, _jit, _section)
 from .dop853 import (_A, _B, _NS, _TRIAL, _checked_field, _stage)
 from .state import Fill, Stages
 
@@ -53,7 +53,7 @@ def _flow_jacobian(mode, za, tau, fns, p, J, z1, z2):
     rules.central_step per component; za is restored bit for bit)."""
     for k in range(za.size):
         orig = za[k]
-        d = _central_step(max(1.0, abs(orig)), 1.0)
+        d = rules.central_step(max(1.0, abs(orig)), 1.0)
         za[k] = orig + d
         up = za[k]
         if mode == PLUS:
@@ -80,7 +80,7 @@ def _jvp(mode, y, v, out, fns, p, w):
     for k in range(n):
         size = max(size, abs(y[k]))
         vmax = max(vmax, abs(v[k]))
-    d = _central_step(size, vmax)
+    d = rules.central_step(size, vmax)
     if d == 0.0:
         for k in range(n):
             out[k] = 0.0 if vmax == 0.0 else np.nan
@@ -159,7 +159,7 @@ def _section_derivative(mode, fns, p, w):
     _checked_field(z, mode, _TRIAL, fns, p, Fill(w.wg, w.wf, w.wp), w.jf1)
     for k in range(z.size):
         orig = z[k]
-        d = _central_step(max(1.0, abs(orig)), 1.0)
+        d = rules.central_step(max(1.0, abs(orig)), 1.0)
         z[k] = orig + d
         up = z[k]
         s1 = _section(fns, z, p)

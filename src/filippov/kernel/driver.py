@@ -22,13 +22,12 @@ import numpy as np
 from numba import njit, types
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
+from .. import rules
 from ..system import PLUS, SLIDING
 from .base import (BAD_START, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
-                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, _PIECE_ADDRS, _W_NONE, _W_SECTION, _accumulates, _carried_age, _central_step, _exact_window,
-                   _banded_shift, _clears_band, _exit_band, _exit_drift, _exit_shift,
-                   _flow_minus, _flow_plus, _jit, _jit_inline, _next_mode, _onto_switch,
-                   _slides_in_section, _speeds, _start_on_switch, _start_side, _vec, _h,
-                   _section)
+                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, _PIECE_ADDRS, _W_NONE,
+                   _W_SECTION, _flow_minus, _flow_plus, _jit, _jit_inline, _speeds, _vec,
+                   _h, _section)
 from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
                      _dop_step, _non_finite_stage)
 from .segment import _zat
@@ -39,7 +38,7 @@ from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY
                     Orbit, Outputs, Samples, Scratch, Settings, Work, kernel_signature)  # noqa: F401
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
-from ..loop.event import SECTION, Book, EventOps, make_event, make_note_switch
+from ..loop.event import SECTION, EventOps, make_event
 from ..loop.status import GO_ON
 
 
@@ -63,10 +62,10 @@ def _slides_in(z, fns, p, wg, wm, wp, wz):
     for k in range(z.size):
         speed = max(speed, abs(wm[k]), abs(wp[k]))
         size = max(size, abs(z[k]))
-    d = _central_step(size, speed)
+    d = rules.central_step(size, speed)
     if d == 0.0:
         return False
-    return _slides_in_section(_section(fns, z, p), d,
+    return rules.slides_in_section(_section(fns, z, p), d,
                               _section_rate(z, wm, wp, (1.0, 0.0), d, fns, p, wz),
                               _section_rate(z, wm, wp, (0.0, 1.0), d, fns, p, wz),
                               _section_rate(z, wm, wp, (-b / (a - b), a / (a - b)), d, fns, p, wz))
@@ -76,11 +75,11 @@ def _slides_in(z, fns, p, wg, wm, wp, wz):
 def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
     """simulate.initial_mode (rules.start_side, rules.start_on_switch)."""
     H = _h(fns, z, p)
-    side = _start_side(H, touch_tol)
+    side = rules.start_side(H, touch_tol)
     if side != SLIDING:
         return side
     a, b = _speeds(z, fns, p, wg, wm, wp)
-    mode, _ = _start_on_switch(H, a, b, sliding)
+    mode, _ = rules.start_on_switch(H, a, b, sliding)
     return mode
 
 
@@ -132,7 +131,7 @@ def _window(mode, ta, tb, frac, first, o, s, w):
     if what == _W_NONE:
         for c in range(w.z.size):
             w.z[c] = w.ynew[c]
-        if w.seg[SEG_BAND] > 0.0 and _clears_band(mode, w.vals[0, ns - 1], w.seg[SEG_BAND]):
+        if w.seg[SEG_BAND] > 0.0 and rules.clears_band(mode, w.vals[0, ns - 1], w.seg[SEG_BAND]):
             # out of the exit's rounding band: H unbiased from here
             w.seg[SEG_SHIFT] = w.seg[SEG_EXIT_SHIFT]
             w.seg[SEG_BAND] = 0.0
@@ -157,7 +156,7 @@ def _stay_exact(mode, t, fns, p, s, w):
         if w.count[N_STEPS] > s.max_steps:
             return STEP_LIMIT, ta, _W_NONE
         age = ta - w.seg[SEG_ENTRY] + w.tally[T_AGE]
-        tb = min(ta + _exact_window(age, s.hwin, s.hwin_slow, s.transient), s.t_max)
+        tb = min(ta + rules.exact_window(age, s.hwin, s.hwin_slow, s.transient), s.t_max)
         if tb == ta:
             tb = np.nextafter(ta, np.inf)
         st, t, what = _window(mode, ta, tb, s.frac_ex, first, o, s, w)
@@ -335,7 +334,7 @@ def _store_exit(new_mode, shift, band, ctx):
     seg = ctx[3].seg
     seg[SEG_EXIT_SHIFT] = shift
     seg[SEG_BAND] = band
-    seg[SEG_SHIFT] = _banded_shift(new_mode, shift, band) if band > 0.0 else shift
+    seg[SEG_SHIFT] = rules.banded_shift(new_mode, shift, band) if band > 0.0 else shift
 
 
 @_jit_inline
@@ -360,15 +359,12 @@ _EVENT_OPS = ("_at_section", "_event_speeds", "_event_h", "_event_grad", "_event
               "_event_flow_at_zero", "_event_sliding_built", "_event_slides_in",
               "_record_switch", "_count_switch", "_event_limits", "_event_ring", "_store_ring",
               "_over_budget", "_store_exit", "_event_switch_derivative", "_entered")
-#: the rules the event asks, the kernel's compiled copies (kernel.base)
-_BOOK = Book(_next_mode, _exit_drift, _onto_switch, _exit_band, _exit_shift,
-             _jit_inline(make_note_switch(_accumulates)))
 
 
 def _build_event(ns):
     """The event function (filippov.loop.event.make_event) on the operations of the
     namespace ``ns`` (this module's globals, or the plain build's copies of them)."""
-    return _jit_inline(make_event(_BOOK, EventOps(*(ns[name] for name in _EVENT_OPS))))
+    return _jit_inline(make_event(EventOps(*(ns[name] for name in _EVENT_OPS))))
 
 
 _build_event.builds = True  # _without_derivatives builds it, not copies it
@@ -404,7 +400,7 @@ def _one(z0, age0, fns, p, s, w):
         w.count[k] = 0
     w.tally[T_SLID] = 0.0
     w.tally[T_SLIDE_START] = 0.0
-    w.tally[T_AGE] = 0.0 if mode == SLIDING else _carried_age(_h(fns, w.z, p), s.touch_tol, age0)
+    w.tally[T_AGE] = 0.0 if mode == SLIDING else rules.carried_age(_h(fns, w.z, p), s.touch_tol, age0)
     w.seg[SEG_SHIFT] = 0.0
     w.seg[SEG_BAND] = 0.0
     w.seg[SEG_EXIT_SHIFT] = 0.0

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import (_EPS, _MAXITER_EVENT, _after, _far_side, _far_side_probe, _jit)
+from .. import rules
+from .base import (_EPS, _MAXITER_EVENT, _jit)
 from .segment import _fval
 
 # brentq's relative tolerance: scipy's default (4 eps), the reference driver's
@@ -85,7 +86,7 @@ def _brentq_f(sel, xa, xb, maxiter, mode, o, sc):
 def _refine(sel, pred, ta, tb, va, mode, o, sc):
     """simulate._refine: root in [ta, tb] on the far side of the crossing (va: the value
     at ta), to o.xtol; (t, ok)."""
-    pred = _far_side(pred, va)
+    pred = rules.far_side(pred, va)
     if va == 0.0:
         r = ta
         fr = _fval(sel, r, mode, o, sc)
@@ -98,13 +99,13 @@ def _refine(sel, pred, ta, tb, va, mode, o, sc):
             # just-entered mode was clamped inside while the true value is already
             # past the crossing -- the event is at once
             fr = _fval(sel, ta, mode, o, sc)
-            if _after(pred, fr):
+            if rules.after(pred, fr):
                 r = ta
             else:
                 return r, False
     done, step = False, 0.0
     while not done:  # to the far side of the crossing (rules.far_side_probe)
-        done, r, step = _far_side_probe(r, step, tb, _after(pred, fr))
+        done, r, step = rules.far_side_probe(r, step, tb, rules.after(pred, fr))
         if not done:
             fr = _fval(sel, r, mode, o, sc)
     return r, True

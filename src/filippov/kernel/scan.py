@@ -9,13 +9,10 @@ import numpy as np
 from .. import rules
 from ..loop.interval import make_interval_event
 from ..system import MINUS, PLUS, SLIDING
-from .base import (OK, ROOT_FAILED, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB, _S_H, _S_SEC, _TO_NEG, _TO_NONNEG,
-                   _TO_NONPOS, _W_NONE,
-                   _after, _band_probe, _clamp, _clears_band, _crosses, _dips_and_returns, _dot, _extremum_between,
-                   _flow_consistent, _graze, _jit, _jit_inline, _rate_step, _section_first, _speed_extremum_between, _speed_graze,
-                   _speeds, _starts_on_section, _field_minus, _section_probe, _section_noise,
-                   _on_section_by_value,
-                   _field_plus, _grad_h, _h, _section, _where)
+from .base import (OK, ROOT_FAILED, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB, _S_H,
+                   _S_SEC, _TO_NEG, _TO_NONNEG, _TO_NONPOS, _W_NONE, _dot, _jit,
+                   _jit_inline, _speeds, _field_minus, _field_plus, _grad_h, _h, _section,
+                   _where)
 from .segment import (_fval, _rates, _zat)
 from .state import (SEG_BAND, SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_LAST_H, SEG_LAST_SPEED2,
                     SEG_RATE_STEP, SEG_SHIFT)
@@ -52,7 +49,7 @@ def _sample(mode, ta, tb, frac, k0, o, sm, sc):
             vals[0, k] = a
             vals[1, k] = b
             if k == 0:  # one difference step for the window (wf, wp: F_-, F_+ at wz)
-                sg[SEG_RATE_STEP] = _rate_step(wz, wf, wp, a, b)
+                sg[SEG_RATE_STEP] = rules.rate_step(wz, wf, wp, a, b)
             if sg[SEG_RATE_STEP] > 0.0:  # (overwrites wz)
                 da, db = _rates(tk, a, b, mode, o, sc)
                 dvals[0, k] = da
@@ -95,7 +92,7 @@ def _flow_follows(za, zb, dt, speed2_a, fb):
     for c in range(za.size):
         d2 += (zb[c] - za[c]) * (zb[c] - za[c])
         size = max(size, abs(za[c]), abs(zb[c]))
-    return _flow_consistent(np.sqrt(d2), dt, np.sqrt(speed2_a), np.sqrt(_dot(fb, fb)), size)
+    return rules.flow_consistent(np.sqrt(d2), dt, np.sqrt(speed2_a), np.sqrt(_dot(fb, fb)), size)
 
 
 @_jit
@@ -104,13 +101,13 @@ def _in_section_rounding(fns, p, s0, z0, zr, probe):
     rounding measured at the probes about z0 toward zr (``probe``: scratch)."""
     noise, s_2, s_1 = 0.0, 0.0, 0.0
     for j in range(-rules.SECTION_PROBES, rules.SECTION_PROBES + 1):
-        if not _section_probe(z0, zr, j, probe):
+        if not rules.section_probe(z0, zr, j, probe):
             return False
         s = _section(fns, probe, p)
         if j >= 2 - rules.SECTION_PROBES:
-            noise = _section_noise(noise, s_2, s_1, s)
+            noise = rules.section_noise(noise, s_2, s_1, s)
         s_2, s_1 = s_1, s
-    return _on_section_by_value(s0, noise)
+    return rules.on_section_by_value(s0, noise)
 
 
 #: how an orbit leaves its mode: through n leave functions (1: h; 2 while sliding: a and
@@ -146,8 +143,8 @@ def _band_root(r, lo, mode, lv, o, sc):
     sg = o.seg
     tq, step, done, clear = r, 0.0, False, False
     while not done:
-        clear = _clears_band(mode, _fval(_S_H, tq, mode, o, sc), sg[SEG_BAND])
-        done, tq, step = _band_probe(tq, step, lo, clear)
+        clear = rules.clears_band(mode, _fval(_S_H, tq, mode, o, sc), sg[SEG_BAND])
+        done, tq, step = rules.band_probe(tq, step, lo, clear)
     if clear:
         banded = sg[SEG_SHIFT]
         sg[SEG_SHIFT] = sg[SEG_EXIT_SHIFT]
@@ -164,10 +161,10 @@ def _leave_root(i, mode, first, lv, o, sm, sc):
     ta, tb = sm.ts[i], sm.ts[i + 1]
     lo, vlo = ta, sm.vals[0, i]
     if (first and i == 0 and mode != SLIDING
-            and _dips_and_returns(mode, sm.dvals[0, 0], sm.dvals[0, 1])):
+            and rules.dips_and_returns(mode, sm.dvals[0, 0], sm.dvals[0, 1])):
         tm, ok = _brentq(lv.sel_d, ta, tb, _MAXITER_EXTREMUM, mode, o, sc)
         hm = _fval(_S_H, tm, mode, o, sc)
-        if ok and not _after(lv.pred, hm):  # refine beyond the dip (rules)
+        if ok and not rules.after(lv.pred, hm):  # refine beyond the dip (rules)
             lo, vlo = tm, hm
     r, ok = _refine(lv.sel, lv.pred, lo, tb, vlo, mode, o, sc)
     if not ok:
@@ -217,7 +214,7 @@ def _speed_exit(ctx, q, i, mode):
     if not ok:
         return ROOT_FAILED, tm, rules.GRAZE_NONE
     vm = _fval(sel_v, tm, mode, o, sc)
-    kind = _speed_graze(pred, vm, sm.dvals[q, i], sm.dvals[q, i + 1], tb - ta, s.touch_tol)
+    kind = rules.speed_graze(pred, vm, sm.dvals[q, i], sm.dvals[q, i + 1], tb - ta, s.touch_tol)
     if kind == rules.GRAZE_CROSSES:
         r, ok = _refine(sel_v, pred, ta, tm, sm.vals[q, i], mode, o, sc)
         return (OK if ok else ROOT_FAILED), r, kind
@@ -240,7 +237,7 @@ def _h_extremum(ctx, i, mode):
     if not ok:
         return ROOT_FAILED, tm, rules.GRAZE_NONE
     hm = _fval(_S_H, tm, mode, o, sc)
-    kind = _graze(mode, hm, s.touch_tol, o.seg[SEG_BAND])
+    kind = rules.graze(mode, hm, s.touch_tol, o.seg[SEG_BAND])
     if kind == rules.GRAZE_CROSSES:
         r, ok = _refine(_S_H, lv.pred, ta, tm, sm.vals[0, i], mode, o, sc)
         return (OK if ok else ROOT_FAILED), r, kind
@@ -290,7 +287,7 @@ def _section_counts(ctx, k, i, r, mode):
     # (integrated, sliding) starts at wg itself and za is stale there (it took
     # crossings within 64 x 1e-10 for the start)
     exact = mode != SLIDING and o.seg[SEG_INTEGRATED] == 0.0
-    return not (_starts_on_section(sm.svals[i], wg, _section(o.fns, wz, o.p), wz,
+    return not (rules.starts_on_section(sm.svals[i], wg, _section(o.fns, wz, o.p), wz,
                                    o.za if exact else wg)
                 or _in_section_rounding(o.fns, o.p, sm.svals[i], wg, wz, sc.wf))
 
@@ -298,7 +295,7 @@ def _section_counts(ctx, k, i, r, mode):
 _interval_event = _jit_inline(make_interval_event(
     _leave_crosses, _leave_root_at, _slide_end_between, _speed_exit, _extremum_between_at,
     _h_extremum, _touch, _n_sections, _section_crosses, _section_root, _section_bounds,
-    _section_counts, _section_first))
+    _section_counts))
 
 
 @_jit
@@ -309,24 +306,24 @@ def _find(mode, ns, first, s, o, sm, sc):
     lv = _leave_of(mode)
     vals, dvals, svals, sg = sm.vals, sm.dvals, sm.svals, o.seg
     if first:  # just entered this mode: its start is inside by construction
-        vals[0, 0] = _clamp(lv.pred, vals[0, 0])
+        vals[0, 0] = rules.clamp(lv.pred, vals[0, 0])
         if lv.n == 2:
-            vals[1, 0] = _clamp(_TO_NONNEG, vals[1, 0])
+            vals[1, 0] = rules.clamp(_TO_NONNEG, vals[1, 0])
     for i in range(ns - 1):
-        c0 = _crosses(lv.pred, vals[0, i], vals[0, i + 1])
-        c1 = lv.n == 2 and _crosses(_TO_NONNEG, vals[1, i], vals[1, i + 1])
-        cd = mode != SLIDING and _extremum_between(mode, dvals[0, i], dvals[0, i + 1])
-        cs = _crosses(s.sec_pred, svals[i], svals[i + 1])
+        c0 = rules.crosses(lv.pred, vals[0, i], vals[0, i + 1])
+        c1 = lv.n == 2 and rules.crosses(_TO_NONNEG, vals[1, i], vals[1, i + 1])
+        cd = mode != SLIDING and rules.extremum_between(mode, dvals[0, i], dvals[0, i + 1])
+        cs = rules.crosses(s.sec_pred, svals[i], svals[i + 1])
         # while sliding: a minimum of a, a maximum of b between the samples (rules)
-        ha = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and _speed_extremum_between(
+        ha = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and rules.speed_extremum_between(
             _TO_NONPOS, dvals[0, i], dvals[0, i + 1])
-        hb = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and _speed_extremum_between(
+        hb = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and rules.speed_extremum_between(
             _TO_NONNEG, dvals[1, i], dvals[1, i + 1])
         if not (c0 or c1 or cd or cs or ha or hb):
             continue
-        if sg[SEG_BAND] > 0.0 and _clears_band(mode, vals[0, i], sg[SEG_BAND]):
+        if sg[SEG_BAND] > 0.0 and rules.clears_band(mode, vals[0, i], sg[SEG_BAND]):
             _unband(i, ns, mode, o, sm, sc)
-            c0 = _crosses(lv.pred, vals[0, i], vals[0, i + 1])
+            c0 = rules.crosses(lv.pred, vals[0, i], vals[0, i + 1])
             if not (c0 or c1 or cd or cs):
                 continue
         st, t, what, _ = _interval_event((first, lv, s, o, sm, sc, c0, c1, cd, cs, ha, hb),

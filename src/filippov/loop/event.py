@@ -1,23 +1,25 @@
 """What is done at an event -- a section hit or a switch -- and in what order, against
 the event budget and the Zeno ring: written once for both engines.
 
-:func:`make_event` builds the event function from the rules it asks (:class:`Book`: the
-rule book's functions, or the kernel's compiled copies of them) and the engine's own
-operations (:class:`EventOps`: how it evaluates the speeds, h and grad h at the event's
-state, the exact flow over time 0, how it records a hit or a switch, keeps its counters
-and the next stay's shift, updates dP/dz). The result, ``event(mode, t, what, ctx) ->
-(status, mode)``, is plain scalar Python in the subset numba compiles: the reference
-driver (:mod:`filippov.simulate`) calls it as it is, with ``ctx`` its run, and turns a
-status into its exception; the compiled kernel (:mod:`filippov.kernel.driver`) compiles
-it inlined into its driver, with ``ctx`` its records. :func:`make_note_switch` builds
-the Zeno ring both engines keep, an array of the last ``zeno_count`` switch times.
+:func:`make_event` builds the event function from the engine's own operations
+(:class:`EventOps`: how it evaluates the speeds, h and grad h at the event's state, the
+exact flow over time 0, how it records a hit or a switch, keeps its counters and the next
+stay's shift, updates dP/dz); the rules it asks it calls as ``rules.<name>`` on both
+engines (the kernel registers every rule as compilable: :mod:`filippov.kernel.base`).
+The result, ``event(mode, t, what, ctx) -> (status, mode)``, is plain scalar Python in
+the subset numba compiles: the reference driver (:mod:`filippov.simulate`) calls it as
+it is, with ``ctx`` its run, and turns a status into its exception; the compiled kernel
+(:mod:`filippov.kernel.driver`) compiles it inlined into its driver, with ``ctx`` its
+records. The Zeno ring both engines keep, an array of the last ``zeno_count`` switch
+times, is rules.note_switch.
 
 The order at a switch: the decision (rules.next_mode); sliding that the system does not
 build (NO_SLIDING); an arrival on H that would slide inside a section
 (SECTION_SLIDING); the end of a slide (rules.exit_drift, onto_switch, exit_band,
 exit_shift: the exact flow over time 0); the switch recorded and counted; the hard
-bound max_events (EVENT_LIMIT); the Zeno ring (ZENO); the engine's own budget verdict
-(the reference's projection of the switching rate, :mod:`filippov.engines` item 2);
+bound max_events (EVENT_LIMIT); the Zeno ring (rules.note_switch: ZENO); the engine's own
+budget verdict (the reference's projection of the switching rate, :mod:`filippov.engines`
+item 2);
 then the next stay's shift and band, dP/dz across the switch and the engine's entry
 into the new mode.
 """
@@ -33,11 +35,6 @@ from .status import EVENT_LIMIT, GO_ON, NO_SLIDING, SECTION_SLIDING, ZENO
 #: EXIT_PLUS: rules.next_mode's ``ended_by``), or a hit of a section
 SECTION = 3
 assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
-
-#: the rules an event asks: the rule book's functions (:data:`REFERENCE_BOOK`) or the
-#: kernel's compiled copies; note_switch: the Zeno ring (:func:`make_note_switch`)
-Book = namedtuple("Book", ["next_mode", "exit_drift", "onto_switch", "exit_band",
-                           "exit_shift", "note_switch"])
 
 #: the engine's operations at an event (``ctx``: the engine's state; the state at the
 #: event is the engine's, each operation evaluates at it):
@@ -59,32 +56,12 @@ EventOps = namedtuple("EventOps", [
     "over_budget", "store_exit", "switch_derivative", "entered"])
 
 
-def make_note_switch(accumulates):
-    """The Zeno ring, with the rule ``accumulates`` (rules.accumulates or its compiled
-    copy): ``note_switch(recent, entries, t, zeno_count, zeno_span) -> (entries, zeno)``
-    enters the switch at ``t`` in the ring ``recent`` (an array of zeno_count times, the
-    entry k at k % zeno_count) and says whether the last zeno_count switches, from the
-    oldest the ring holds to ``t``, accumulate."""
-    def note_switch(recent, entries, t, zeno_count, zeno_span):
-        recent[entries % zeno_count] = t
-        entries += 1
-        return entries, (entries >= zeno_count
-                         and accumulates(recent[entries % zeno_count], t, zeno_span))
-    return note_switch
-
-
-#: the reference driver's rules: the rule book itself
-REFERENCE_BOOK = Book(rules.next_mode, rules.exit_drift, rules.onto_switch, rules.exit_band,
-                      rules.exit_shift, make_note_switch(rules.accumulates))
-
-
-def make_event(book: Book, ops: EventOps):
+def make_event(ops: EventOps):
     """``event(mode, t, what, ctx) -> (status, mode)``: the event ``what`` (:data:`SECTION`
     or rules.SWITCH/EXIT_MINUS/EXIT_PLUS) at time ``t`` of an orbit in ``mode``, done in
-    the order of this module's doc with ``book``'s rules and ``ops``'s operations. The
+    the order of this module's doc with the rule book's rules and ``ops``'s operations. The
     status is GO_ON with the mode to go on in, or the run's end (OK at a terminal section
     hit, NO_SLIDING, SECTION_SLIDING, EVENT_LIMIT, ZENO) with ``mode`` itself."""
-    next_mode, exit_drift, onto_switch, exit_band, exit_shift, note_switch = book
     (section_hit, speeds, h, grad_h, state, flow_at_zero, sliding_built, slides_in_section,
      record_switch, count_switch, limits, ring, store_ring, over_budget, store_exit,
      switch_derivative, entered) = ops
@@ -93,7 +70,7 @@ def make_event(book: Book, ops: EventOps):
         if what == SECTION:
             return section_hit(mode, t, ctx), mode
         a, b = speeds(ctx)
-        new_mode = next_mode(mode, what, a, b)
+        new_mode = rules.next_mode(mode, what, a, b)
         if new_mode == SLIDING and not sliding_built(ctx):
             return NO_SLIDING, mode
         if new_mode == SLIDING and mode != SLIDING and slides_in_section(ctx):
@@ -104,18 +81,18 @@ def make_event(book: Book, ops: EventOps):
             # the end of a slide: a state the slide left off H beyond rounding is moved
             # onto it; the next stay measures H from the exit's rounding
             z, grad, h0 = state(ctx), grad_h(ctx), h(ctx)
-            drift = exit_drift(new_mode, h0, z, grad, touch_tol)
+            drift = rules.exit_drift(new_mode, h0, z, grad, touch_tol)
             if drift:
-                onto_switch(z, h0, grad)
+                rules.onto_switch(z, h0, grad)
                 h0 = h(ctx)  # what rounding left
-            band = exit_band(z, flow_at_zero(new_mode, z, ctx), grad)
-            shift = exit_shift(new_mode, h0, touch_tol, drift)
+            band = rules.exit_band(z, flow_at_zero(new_mode, z, ctx), grad)
+            shift = rules.exit_shift(new_mode, h0, touch_tol, drift)
         record_switch(mode, new_mode, what, t, ctx)
         switches = count_switch(new_mode != mode, t, ctx)
         if switches > max_events:
             return EVENT_LIMIT, mode
         recent, entries = ring(ctx)
-        entries, zeno = note_switch(recent, entries, t, zeno_count, zeno_span)
+        entries, zeno = rules.note_switch(recent, entries, t, zeno_count, zeno_span)
         store_ring(entries, ctx)
         if zeno:
             return ZENO, mode

@@ -3,7 +3,7 @@
 Between two samples of a stay the scan asks, in this order:
 
 1. does a leave function change sign (h: a switch; while sliding, a or b: an exit into
-   region - or +)? Its root, refined; the earliest of them is the event so far;
+   region - or +: ``rules.ended_by``)? Its root, refined; the earliest of them is the event so far;
 2. none, and sliding: has a or b an extremum toward its sign change hidden between the
    samples (``rules.speed_extremum_between``)? The engine refines it and
    ``rules.speed_graze`` tells an exit (the earliest wins) from a touch, which is
@@ -35,7 +35,8 @@ from __future__ import annotations
 
 import math
 
-from ..rules import (EXIT_MINUS, EXIT_PLUS, GRAZE_CROSSES, GRAZE_TOUCHES, SWITCH)
+from .. import rules
+from ..rules import GRAZE_CROSSES, GRAZE_TOUCHES, SWITCH
 from ..system import SLIDING
 
 #: the status of an operation that succeeded (the kernel's OK)
@@ -47,8 +48,7 @@ NONE, SECTION = -1, 3
 
 def make_interval_event(leave_crosses, leave_root, slide_end_between, hidden_slide_end,
                         extremum_between, hidden_extremum, touch, n_sections,
-                        section_crosses, section_root, section_bounds, section_counts,
-                        section_first):
+                        section_crosses, section_root, section_bounds, section_counts):
     """``interval_event(ctx, i, mode) -> (status, t, what, k)``: the earliest event between
     samples i and i + 1 of a stay in ``mode``, asked in the order of this module's
     docstring, from the engine's operations on its state ``ctx``:
@@ -64,7 +64,10 @@ def make_interval_event(leave_crosses, leave_root, slide_end_between, hidden_sli
     * ``n_sections(ctx)``, ``section_crosses(ctx, k, i)``, ``section_root(ctx, k, i,
       mode) -> (status, t)``, ``section_bounds(ctx, k) -> (t_min, xtol)``,
       ``section_counts(ctx, k, i, t, mode)``: the crossing at t is a hit (where holds, not
-      the start itself); ``section_first``: the rule as the engine calls it (compiled).
+      the start itself).
+
+    The rules it asks it calls as ``rules.<name>`` on both engines (the kernel registers
+    every rule as compilable: :mod:`filippov.kernel.base`).
     """
 
     def interval_event(ctx, i, mode):
@@ -76,8 +79,7 @@ def make_interval_event(leave_crosses, leave_root, slide_end_between, hidden_sli
                 if st != OK:
                     return st, r, NONE, -1
                 if best_w == NONE or r < best_t:
-                    best_t, best_w = r, (SWITCH if mode != SLIDING
-                                         else (EXIT_MINUS if q == 0 else EXIT_PLUS))
+                    best_t, best_w = r, rules.ended_by(mode, q)
         # 2. none while sliding: the end of sliding hidden between the samples
         if mode == SLIDING and best_w == NONE:
             touch_a, touch_b = math.inf, math.inf
@@ -89,7 +91,7 @@ def make_interval_event(leave_crosses, leave_root, slide_end_between, hidden_sli
                     return st, r, NONE, -1
                 if kind == GRAZE_CROSSES:
                     if best_w == NONE or r < best_t:
-                        best_t, best_w = r, (EXIT_MINUS if q == 0 else EXIT_PLUS)
+                        best_t, best_w = r, rules.ended_by(mode, q)
                 elif kind == GRAZE_TOUCHES:
                     if q == 0:
                         touch_a = r
@@ -117,7 +119,7 @@ def make_interval_event(leave_crosses, leave_root, slide_end_between, hidden_sli
             if st != OK:
                 return st, r, NONE, -1
             t_min, xtol = section_bounds(ctx, k)
-            if (section_first(r, t_min, best_t, best_w == SECTION, xtol)
+            if (rules.section_first(r, t_min, best_t, best_w == SECTION, xtol)
                     and section_counts(ctx, k, i, r, mode)):
                 best_t, best_w, best_k = r, SECTION, k
         return OK, best_t, best_w, best_k
