@@ -19,14 +19,14 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-from numba import njit, types
+from numba import njit
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from .. import rules
 from ..system import PLUS, SLIDING
 from .base import (BAD_START, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
-                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, _PIECE_ADDRS, _W_NONE,
-                   _W_SECTION, _flow_minus, _flow_plus, _jit, _jit_inline, _speeds, _vec,
+                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, _W_NONE,
+                   _W_SECTION, _flow_minus, _flow_plus, _jit, _jit_inline, _speeds,
                    _h, _section)
 from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
                      _dop_step, _non_finite_stage)
