@@ -82,11 +82,11 @@ def _ascending_in_eps(expr):
     return sp.Add(*sorted(terms, key=lambda a: sp.degree(a, eps)), evaluate=False)
 
 
-#: eq:ymm: y on M_- to O(eps) (its terms of order 1 and eps)
+#: eq:ymm: y on ``M_-`` to O(eps) (its terms of order 1 and eps)
 SLOW_MANIFOLD_MINUS_FIRST_ORDER = _through_order(_M_MINUS, 1)
 #: y on H_s, the switching surface solved for the fast variable
 SWITCHING_SURFACE_Y = sp.solve(SWITCH, y)[0]
-#: y_m+ - y_m- at x = (-1, 0) for mu = 1 (M_+ = {y = x1}; the grazing point of theta < 0)
+#: ``y_m+ - y_m-`` at x = (-1, 0) for mu = 1 (``M_+ = {y = x1}``; the grazing point of theta < 0)
 GRAZING_GAP = _ascending_in_eps((x1 - SLOW_MANIFOLD_MINUS).subs({x1: -1, x2: 0, mu: 1}))
 
 
