@@ -250,15 +250,20 @@ def benchmarks() -> list[str]:
                   if not p.stem.startswith("_") and "main" in defined_names(p))
 
 
+def _declaring(hook: str):
+    """(name, path, value) of each benchmark whose source assigns ``hook`` a literal."""
+    for name in benchmarks():
+        path = PACKAGE / "benchmarks" / f"{name}.py"
+        declared = literal(path, hook)
+        if declared is not None:
+            yield name, path, declared
+
+
 def workflow_benchmarks() -> dict[str, dict]:
     """{name: WORKFLOW} of the benchmarks that declare a rule of `make bench` (read from
     the source, for the workflow: no numerics while the DAG is built)."""
     found = {}
-    for name in benchmarks():
-        path = PACKAGE / "benchmarks" / f"{name}.py"
-        declared = literal(path, "WORKFLOW")
-        if declared is None:
-            continue
+    for name, path, declared in _declaring("WORKFLOW"):
         if not isinstance(declared, dict) or set(declared) - {"args", "threads"} or \
                 not all(isinstance(a, str) for a in declared.get("args", [])) or \
                 declared.get("threads", "one") not in ("one", "all"):
@@ -293,11 +298,7 @@ def report_benchmarks() -> dict[str, dict]:
     from the source: the workflow asks which datasets and tables the report has while it
     builds the DAG). A malformed REPORT is a ValueError naming the file."""
     found = {}
-    for name in benchmarks():
-        path = PACKAGE / "benchmarks" / f"{name}.py"
-        declared = literal(path, "REPORT")
-        if declared is None:
-            continue
+    for name, path, declared in _declaring("REPORT"):
         if set(declared) - {"dataset", "table", "order"} or \
                 not isinstance(declared.get("dataset"), str) or \
                 not isinstance(declared.get("table", ""), str) or \
