@@ -217,3 +217,25 @@ def test_shared_parameters_are_checked_and_named(tmp_path, sid, old, new, messag
     path = _write(tmp_path, text.replace(old, new, 1), name=sid)
     with pytest.raises(SceneError, match=rf"^{path}: {message}"):
         load_scene(path, SCHEMA)
+
+
+def test_the_documented_full_resolution_command_passes_the_limits():
+    # docs/pipeline.md gives the command for the fine grids; every scene must load at
+    # resolution=full within the limits that command sets (fig14's atlas is over the
+    # default max_points: without the raise the documented command stops at planning)
+    import re
+    import shlex
+
+    from filippov_paper.config import limits
+    doc = (ROOT / "docs" / "pipeline.md").read_text(encoding="utf-8")
+    line = next(ln for ln in doc.splitlines() if "--config resolution=full" in ln)
+    words = shlex.split(line.split("#")[0])
+    pairs = words[words.index("--config") + 1:]
+    overrides = dict(w.split("=", 1) for w in pairs if re.fullmatch(r"\w+=\S+", w))
+    assert overrides.pop("resolution") == "full"
+    lim = limits(overrides)
+    for path in SCENES:
+        scene = load_scene(path, SCHEMA, lim, resolution="full")
+        assert scene["id"] == path.stem
+    with pytest.raises(SceneError, match="max_points"):  # and the raise is needed
+        load_scene(ROOT / "config" / "scenes" / "fig14_atlas.yaml", SCHEMA, resolution="full")
