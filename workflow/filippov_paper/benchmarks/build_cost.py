@@ -9,7 +9,9 @@ jobs, their CPU, and the CPU per job; the last line is the build's total. A clea
 (``rm -rf results figures .snakemake logs`` first) measures the cold build of issue 33:
 its jobs' CPU, compiles and imports included, Snakemake's own scheduling not (it runs
 in the process that calls the jobs). Not part of ``make bench``: it reads a build, it
-does not make one.
+does not make one. With ``--cores 2 64``, after a full-resolution build (docs/pipeline.md),
+it also projects the chunked scenes' wall time on that many cores (or SLURM jobs) from
+their chunks' measured CPU: what the README's full-resolution table quotes.
 """
 from __future__ import annotations
 
@@ -55,12 +57,52 @@ def table(logs: Path) -> list[tuple[str, int, float, float]]:
     return sorted(((k, *v) for k, v in rows.items()), key=lambda r: -r[2])
 
 
+def makespan(durations, cores: int) -> float:
+    """The wall time of independent jobs of the given durations on ``cores`` cores, each
+    job on one core, the longest started first, each on the core that frees first
+    (list scheduling, as Snakemake runs ready jobs; within 4/3 of the best order)."""
+    if not (isinstance(cores, int) and cores >= 1):
+        raise ValueError(f"cores: must be an integer >= 1, got {cores!r}")
+    load = [0.0] * min(cores, max(len(durations), 1))
+    for d in sorted(durations, reverse=True):
+        load[load.index(min(load))] += d
+    return max(load)
+
+
+def chunked_projection(logs: Path, cores: int) -> tuple[float, dict]:
+    """A projected wall time for the chunked scenes a build's ``logs`` hold, on ``cores``
+    cores with no queue waits: all their chunk jobs scheduled together
+    (:func:`makespan`), then the longest merge job. Also each scene's
+    (chunks, chunk CPU s, longest chunk s, merge CPU s)."""
+    def cpu_of(log: Path) -> float:
+        try:
+            return job_cpu(log.read_text(encoding="utf-8", errors="replace"))[0]
+        except (OSError, ValueError) as exc:  # an unfinished build: say which job
+            raise ValueError(f"{log}: {exc}") from None
+
+    scenes = {}
+    for log in sorted((logs / "compute_chunk").glob("*/*.log")):
+        scenes.setdefault(log.parent.name, []).append(cpu_of(log))
+    merges = {s: cpu_of(logs / "merge_chunks" / f"{s}.log") for s in scenes}
+    every = [d for chunks in scenes.values() for d in chunks]
+    wall = makespan(every, cores) + max(merges.values(), default=0.0)
+    return wall, {s: (len(c), sum(c), max(c), merges[s]) for s, c in scenes.items()}
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("logs", nargs="?", default="logs", help="the build's log directory")
-    logs = Path(ap.parse_args(argv).logs)
+    ap.add_argument("--cores", type=int, nargs="+", metavar="N",
+                    help="also project the chunked scenes' wall time on N cores")
+    args = ap.parse_args(argv)
+    logs = Path(args.logs)
     if not logs.is_dir():
         raise SystemExit(f"error: logs: {logs} is not a directory (run a build first)")
+    if args.cores:
+        try:
+            _print_projection(logs, args.cores)
+        except ValueError as exc:
+            raise SystemExit(f"error: --cores: {exc}") from None
     rows = table(logs)
     print(f"{'rule':28s} {'jobs':>5s} {'CPU s':>9s} {'s/job':>7s} {'before script s':>16s}")
     for rule, jobs, cpu, before in rows:
@@ -69,6 +111,17 @@ def main(argv=None) -> None:
     jobs = sum(r[1] for r in rows)
     cpu = sum(r[2] for r in rows)
     print(f"{'total':28s} {jobs:5d} {cpu:9.2f} {'':7s} {sum(r[3] for r in rows):16.2f}")
+
+
+
+def _print_projection(logs: Path, cores: list[int]) -> None:
+    _, scenes = chunked_projection(logs, 1)
+    print(f"{'chunked scene':28s} {'chunks':>6s} {'CPU s':>9s} {'longest s':>10s} {'merge s':>8s}")
+    for scene, (n, cpu, longest, merge) in scenes.items():
+        print(f"{scene:28s} {n:6d} {cpu:9.1f} {longest:10.1f} {merge:8.1f}")
+    for n in cores:
+        print(f"projected wall on {n} cores: {chunked_projection(logs, n)[0]:.0f} s")
+    print()
 
 
 if __name__ == "__main__":
