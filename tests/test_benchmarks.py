@@ -45,6 +45,37 @@ def test_work_precision_fig11_smoke():
     assert "n/a" in wp.table(ds)
 
 
+def test_work_precision_times_the_compiled_engine_last(monkeypatch):
+    """run() times every configuration off the compiled engine before any on it (a cold
+    build's work_precision job then runs while another job compiles the kernel), and
+    scores each against its own problem's reference as before."""
+    calls = []
+
+    def fake_runner(problem, family, tol, time_cap):   # P and switch times = (tol, k tol)
+        def run():
+            calls.append((family, tol))
+            return np.full(2, tol), np.full(2, (1 + problem.x2[0]) * tol)
+        return run
+
+    monkeypatch.setattr(wp, "runner", fake_runner)
+    base = wp.fig04_problems(every=97)[0]
+    probs = [wp.Problem(f"p{k}", np.array([x, x + 0.1]), base.model, np.ones(2, bool))
+             for k, x in enumerate((0.5, 2.0))]
+    fams = [("project compiled exact", [1e-10]), ("solve_ivp RK45", [1e-6]),
+            ("project compiled DOP853", [1e-8]), ("project DOP853", [1e-8])]
+    ds = wp.run(probs, fams, repeat=1, time_cap=60.0, log=lambda s: None, min_time=0.0)
+    timed = [f.startswith("project compiled") for f, tol in calls if tol != 1e-13]
+    assert True in timed and False in timed
+    assert timed.index(True) > len(timed) - 1 - timed[::-1].index(False)
+    # references: compiled exact 1e-13, its check project DOP853 1e-13 (exact: the check)
+    for i, x in enumerate((0.5, 2.0)):
+        for j, (fam, (tol,)) in enumerate(fams):
+            assert ds.error_map.values[i, j] == pytest.approx(tol - 1e-13, rel=1e-12)
+            assert ds.error_switch.values[i, j] == pytest.approx((1 + x) * (tol - 1e-13),
+                                                                 rel=1e-12)
+    assert np.all(ds.status.values == "ok")
+
+
 def test_time_at_error_interpolates_log_log():
     errs, times = np.array([1e-4, 1e-6, 1e-10]), np.array([1.0, 2.0, 8.0])
     assert wp.time_at_error(errs, times, 1e-6) == 2.0

@@ -40,7 +40,7 @@ def _parts(config, tmp_path, tag="p"):
 def test_configured_sweep_is_valid_with_one_job_per_eps():
     cfg = hard_cases.check_config(_configured())
     assert cfg["eps"] == [1e-2, 1e-3, 1e-4, 1e-5, 1e-6]
-    assert cfg["chunks"] == len(cfg["eps"])   # the report says: one job per eps
+    assert cfg["chunks"] == len(cfg["eps"])   # the report says: one job per value on a cluster
 
 
 @pytest.mark.parametrize("config", [None, {"eps": [1e-2, 1e-3, 1e-4], "chunks": 2}],
@@ -149,13 +149,21 @@ def _planned_rules(out: str) -> list[str]:
     return re.findall(r"^(?:local)?rule (\w+):", out, re.M)
 
 
-def test_workflow_plans_one_job_per_chunk_and_a_local_merge(tmp_path):
+@pytest.mark.parametrize("sweep_jobs", [None, "scene", 2])
+def test_workflow_plans_one_job_per_chunk_and_a_local_merge(sweep_jobs, tmp_path):
+    """hard_cases.chunks jobs (a cluster: sweep_jobs=scene), at most sweep_jobs of them
+    (config/config.yaml's value for a local build when not given)."""
     work = copy_project(tmp_path / "project")
-    run = run_snakemake(work, "-n", "results/hard_cases.nc", timeout=600)
+    extra = () if sweep_jobs is None else ("--config", f"sweep_jobs={sweep_jobs}")
+    run = run_snakemake(work, "-n", "results/hard_cases.nc", *extra, timeout=600)
     out = run.stdout + run.stderr
     assert run.returncode == 0, out
     rules = _planned_rules(out)
     n = hard_cases.check_config(_configured())["chunks"]
+    if sweep_jobs != "scene":
+        cap = sweep_jobs or yaml.safe_load((ROOT / "config" / "config.yaml").read_text())[
+            "sweep_jobs"]
+        n = min(n, cap)
     assert sorted(rules) == sorted(["hard_cases_part"] * n + ["hard_cases"]), rules
     # the merge runs on the submitting host (a dry run with local cores prints no marker)
     smk = (work / "workflow" / "rules" / "hard_cases.smk").read_text()

@@ -38,6 +38,74 @@ def test_builds_every_figure_then_nothing_to_do(workflow_build):
     assert "Nothing to be done" in out, "\n".join(l for l in out.splitlines() if "reason" in l)
 
 
+def _rule_counts(out: str) -> dict[str, int]:
+    counts: dict[str, int] = {}
+    for rule in re.findall(r"^(?:local)?rule (\w+):", out, re.M):
+        counts[rule] = counts.get(rule, 0) + 1
+    return counts
+
+
+def _declared_chunks(work: Path) -> dict[str, int]:
+    out = {}
+    for path in sorted((work / "config" / "scenes").glob("*.yaml")):
+        n = yaml.safe_load(path.read_text()).get("chunks")
+        if n:
+            out[path.stem] = n
+    return out
+
+
+@pytest.mark.parametrize("sweep_jobs", [None, 2, "scene"])
+def test_a_build_splits_sweeps_into_at_most_sweep_jobs(sweep_jobs, tmp_path):
+    """The jobs a clean build plans: a local build (config.yaml: sweep_jobs 1) one job per
+    scene and one hard-case part; `scene` (the SLURM profile) every scene file's
+    `chunks`; an integer caps them."""
+    work = _project(tmp_path)
+    extra = () if sweep_jobs is None else ("--config", f"sweep_jobs={sweep_jobs}")
+    run = _snakemake(work, "-n", "--forceall", *extra)
+    out = run.stdout + run.stderr
+    assert run.returncode == 0, out[-3000:]
+    counts = _rule_counts(out)
+    cap = yaml.safe_load((work / "config" / "config.yaml").read_text())["sweep_jobs"] \
+        if sweep_jobs is None else sweep_jobs
+    declared = _declared_chunks(work)
+    hard = yaml.safe_load((work / "config" / "config.yaml").read_text())["hard_cases"]["chunks"]
+    split = {s: n if cap == "scene" else min(n, cap) for s, n in declared.items()}
+    split = {s: n for s, n in split.items() if n > 1}
+    scenes = scene_files(work / "config" / "scenes")
+    assert counts.get("compute_chunk", 0) == sum(split.values())
+    assert counts.get("merge_chunks", 0) == len(split)
+    assert counts["compute"] == len(scenes) - len(split)
+    assert counts["hard_cases_part"] == (hard if cap == "scene" else min(hard, cap))
+    assert counts["plot"] == len(scenes)
+    if sweep_jobs is None:
+        assert cap == 1 and "compute_chunk" not in counts and counts["hard_cases_part"] == 1
+
+
+def test_sweep_jobs_must_be_a_positive_count_or_scene(tmp_path):
+    work = _project(tmp_path)
+    for bad in ("0", "many"):
+        run = _snakemake(work, "-n", "--config", f"sweep_jobs={bad}")
+        assert run.returncode != 0
+        assert "error: config/config.yaml: sweep_jobs: " in run.stdout + run.stderr, bad
+
+
+def test_a_chunked_build_writes_the_unsplit_dataset(workflow_build, tmp_path):
+    """fig04 through the workflow's chunk and merge jobs (sweep_jobs=scene, as on a
+    cluster) is byte-identical to the shared build's one compute job."""
+    assert workflow_build["run"].returncode == 0
+    built = workflow_build["work"]   # read only
+    work = copy_project(tmp_path / "split")
+    run = _snakemake(work, "results/fig04_retmaps.nc", "--config", "sweep_jobs=scene")
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    n = _declared_chunks(work)["fig04_retmaps"]
+    assert n > 1 and len(list((work / "logs" / "compute_chunk" / "fig04_retmaps").glob(
+        "*.log"))) == n
+    assert (work / "logs" / "merge_chunks" / "fig04_retmaps.log").exists()
+    assert not (built / "logs" / "compute_chunk").exists()   # the shared build: unsplit
+    assert (work / "results" / "fig04_retmaps.nc").read_bytes() == \
+        (built / "results" / "fig04_retmaps.nc").read_bytes()
+
+
 def test_invalid_scene_fails_cleanly(tmp_path):
     work = _project(tmp_path)
     scene = work / "config" / "scenes" / "fig02_cases.yaml"
@@ -101,14 +169,14 @@ def test_changing_one_scene_reruns_only_its_chain(workflow_build, tmp_path):
 
 
 def test_changing_a_compiled_engine_scene_reruns_only_its_chain(workflow_build, tmp_path):
-    """As above for a scene on the compiled engine (chunked): no job it shares with the
+    """As above for a scene on the compiled engine (one that a cluster splits into chunks;
+    one job on a local build, sweep_jobs: 1): no job it shares with the
     other compiled-engine scenes, the hard cases or the work-precision sweep (a shared
     input regenerated for it -- a kernel-compiled marker was tried -- would rerun them
     all: 'input files updated by another job')."""
     jobs = _planned_after_edit(workflow_build, tmp_path, "fig04_retmaps", "n_geometric: 100",
                                "n_geometric: 101")
-    assert jobs.pop("compute_chunk") == {"fig04_retmaps"}
-    assert jobs.pop("merge_chunks") == {"fig04_retmaps"}
+    assert jobs.pop("compute") == {"fig04_retmaps"}
     assert jobs.pop("plot") == {"fig04_retmaps"}
     jobs.pop("all", None)
     assert jobs.pop("publish_scene", {"fig04_retmaps"}) == {"fig04_retmaps"}

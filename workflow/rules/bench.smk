@@ -4,6 +4,9 @@
 # differ between any two runs (tolerance rule "measured"); its errors are
 # reproducible.
 rule work_precision:
+    # the longest job of a build: started first, it runs its Python and solve_ivp part
+    # while another job compiles the kernel (filippov_paper.benchmarks.work_precision.run)
+    priority: 10
     output:
         report("results/work_precision.nc", caption="../report/work_precision.rst",
                category="Datasets", labels=dataset_labels),

@@ -124,8 +124,23 @@ def scene_chunks():
             pass  # malformed: the schema check of the job names the field
         n = data.get("chunks") if isinstance(data, dict) else None
         if isinstance(n, int) and not isinstance(n, bool) and n >= 1:
-            found[path.stem] = n
+            n = sweep_jobs(n)
+            if n > 1 or SWEEP_JOBS is None:  # capped to one job: rule compute runs it
+                found[path.stem] = n
     return found
+
+
+# How many jobs a split sweep runs as (config["sweep_jobs"]): at most that many, or,
+# with "scene", as many as the scene file's `chunks` (or hard_cases.chunks) asks. A
+# layout choice only: the merged datasets are byte-identical for any split
+# (tests/test_chunks.py, tests/test_hard_cases_workflow.py). Read from the config, not
+# from the executor, so that a cluster's job steps plan the same jobs as the host.
+SWEEP_JOBS = None if config.get("sweep_jobs", "scene") == "scene" else int(config["sweep_jobs"])
+
+
+def sweep_jobs(declared):
+    """The jobs a sweep that asks for `declared` chunks is split into in this run."""
+    return declared if SWEEP_JOBS is None else min(declared, SWEEP_JOBS)
 
 
 # ----------------------------------------------------------------------------- hard cases
@@ -135,7 +150,7 @@ def hard_cases_chunks():
     `compute` does for scenes), so one job is planned for it."""
     block = config.get("hard_cases")
     n = block.get("chunks", 1) if isinstance(block, dict) else 1
-    return n if isinstance(n, int) and not isinstance(n, bool) and n >= 1 else 1
+    return sweep_jobs(n) if isinstance(n, int) and not isinstance(n, bool) and n >= 1 else 1
 
 
 # ----------------------------------------------------------------------------- report

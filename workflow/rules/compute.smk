@@ -49,6 +49,7 @@ rule compute_chunk:
     params:
         code=library_hash(exclude=NOT_COMPUTE, strip_reports=True),  # see common.smk
         resolution=lambda wc: scene_resolution(wc.scene),  # --config resolution=full
+        chunks=lambda wc: CHUNKS[wc.scene],  # the scene's `chunks`, capped by sweep_jobs
     log:
         "logs/compute_chunk/{scene}/{chunk}.log",
     conda:

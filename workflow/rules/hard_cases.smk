@@ -5,7 +5,9 @@
 # one process. The settings and the library's hash are params, so editing
 # either reruns the sweep (see common.smk); scenes do not import hard_cases.py,
 # so editing it reruns the sweep only.
-# (hard_cases_chunks: common.smk)
+# (hard_cases_chunks: common.smk) The jobs run is hard_cases.chunks capped by
+# config["sweep_jobs"] (one on a local build; config/config.yaml): a param of both rules,
+# since the sweep's block itself is checked as written.
 import json
 
 HARD_CASES_SETTINGS = json.dumps(config.get("hard_cases"), sort_keys=True)
@@ -23,6 +25,7 @@ rule hard_cases_part:
         i="[0-9]+",
     params:
         settings=HARD_CASES_SETTINGS,
+        jobs=hard_cases_chunks(),
         code=HARD_CASES_CODE,  # see common.smk
     log:
         "logs/hard_cases_part/{i}.log",
@@ -41,6 +44,7 @@ rule hard_cases:
                labels=dataset_labels),
     params:
         settings=HARD_CASES_SETTINGS,
+        jobs=hard_cases_chunks(),
         code=HARD_CASES_CODE,  # see common.smk
         caption=dataset_caption,  # the HTML report's (report_html.smk; no rerun trigger)
     log:

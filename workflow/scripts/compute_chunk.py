@@ -17,6 +17,7 @@ try:
     filippov_paper.scenes.check(scene)  # the engine it asks for, the size of its grid
 except SceneError as exc:
     sys.exit(f"error: {exc}")
-index = int(snakemake.wildcards.chunk)  # noqa: F821; the count is the scene's `chunks`
-ds = filippov_paper.scenes.compute_chunk(scene, index, progress=True)
+index = int(snakemake.wildcards.chunk)  # noqa: F821
+count = int(snakemake.params.chunks)  # noqa: F821; the scene's `chunks`, capped by sweep_jobs
+ds = filippov_paper.scenes.compute_chunk(scene, index, count, progress=True)
 filippov.io.write_dataset(ds, snakemake.output[0])  # noqa: F821

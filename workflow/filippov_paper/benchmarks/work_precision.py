@@ -343,18 +343,31 @@ def run(problems, families, repeat: int, time_cap: float, log=print,
     configs = [(fam, tol) for fam, tols in families for tol in tols]
     res = _Results.empty(len(problems), len(configs))
     ref_check = np.empty(len(problems))
-    ref_names = []
+    ref_names = [""] * len(problems)
+    warmed = [set() for _ in problems]  # families run once untimed on each problem
+    got = {}
+    # Every configuration off the compiled engine first, then those on it, then the
+    # references and the scores. Same results as problem by problem; but in a cold
+    # workflow build this job (started first: the longest) times its Python and
+    # solve_ivp runs while another job compiles the kernel, which it then loads,
+    # instead of waiting for that compile with a core idle.
+    for compiled in (False, True):
+        for i, prob in enumerate(problems):
+            mine = [j for j, (fam, _) in enumerate(configs) if _compiled(fam) == compiled]
+            for j in mine:
+                got[i, j] = res.measure(i, j, prob, *configs[j], repeat=repeat,
+                                        min_time=min_time, time_cap=time_cap,
+                                        warmed=warmed[i])
+            log(f"{prob.name}: timed {len(mine)} configurations "
+                f"{'on' if compiled else 'off'} the compiled engine")
     for i, prob in enumerate(problems):
-        ref, chk, ref_check[i], name = _reference(prob)
-        ref_names.append(name)
+        ref, chk, ref_check[i], ref_names[i] = _reference(prob)
         log(f"{prob.name}: {prob.x2.size} start points; reference check "
-            f"({ref_names[-1]}): {ref_check[i]:.2e}")
-        warmed = set()  # families run once untimed on this problem
+            f"({ref_names[i]}): {ref_check[i]:.2e}")
         for j, (fam, tol) in enumerate(configs):
             # the reference's own method is scored against the independent check
-            want = chk if prob.scored_by_check(fam) else ref
-            res.measure(i, j, prob, fam, tol, want, repeat=repeat, min_time=min_time,
-                        time_cap=time_cap, warmed=warmed)
+            if got[i, j] is not None:
+                res.score(i, j, prob, got[i, j], chk if prob.scored_by_check(fam) else ref)
             log(res.line(i, j, fam, tol, prob.x2.size))
     fam_of = np.array([c[0] for c in configs])
     t_ours, t_rk45, ratio = _at_target(fam_of, res.err_map, res.wall)
@@ -366,6 +379,11 @@ def run(problems, families, repeat: int, time_cap: float, log=print,
                     grazing_gap=GRAZING_GAP, min_time=min_time, **settings,
                     **timing.describe(min_rounds=repeat, min_time=min_time),
                     title="work-precision of the fig04 and fig11 return maps: project vs solve_ivp")
+
+
+def _compiled(family: str) -> bool:
+    """Whether configurations of ``family`` run on the compiled kernel."""
+    return family.startswith("project compiled")
 
 
 def _reference(prob: Problem):
@@ -397,25 +415,29 @@ class _Results:
                    runs=np.zeros(shape, dtype=np.int32), missed=np.zeros(shape, dtype=np.int32),
                    status=np.full(shape, "ok", dtype=object))
 
-    def measure(self, i, j, prob, fam, tol, want, *, repeat, min_time, time_cap, warmed):
-        """Time configuration j on problem i and score it against ``want``; a failure
-        is listed in ``status``, not dropped."""
-        want_p, want_sw = want
+    def measure(self, i, j, prob, fam, tol, *, repeat, min_time, time_cap, warmed):
+        """Time configuration j on problem i: its (P, first switch times), or None after
+        a failure, which is listed in ``status``, not dropped."""
         try:
             t = timed(runner(prob, fam, tol, time_cap), repeat, min_time,
                       warmup=0 if fam in warmed else 1)
             warmed.add(fam)
             self.wall[i, j], self.wall_min[i, j], self.runs[i, j] = t.median, t.min, t.rounds
-            got_p, got_sw = t.value
+            return t.value
         except NotApplicable:
             self.status[i, j] = "n/a"
         except baseline.TimeCapExceeded as exc:
             self.status[i, j] = f"time cap: {exc}"
         except Exception as exc:  # listed, not dropped
             self.status[i, j] = f"failed: {type(exc).__name__}: {exc}"[:200]
-        else:
-            self.err_map[i, j] = max_dev(got_p, want_p, prob.scored)[0]
-            self.err_sw[i, j], self.missed[i, j] = max_dev(got_sw, want_sw, prob.scored)
+        return None
+
+    def score(self, i, j, prob, got, want):
+        """The errors of configuration j's (P, first switch times) ``got`` on problem i
+        against ``want``."""
+        (got_p, got_sw), (want_p, want_sw) = got, want
+        self.err_map[i, j] = max_dev(got_p, want_p, prob.scored)[0]
+        self.err_sw[i, j], self.missed[i, j] = max_dev(got_sw, want_sw, prob.scored)
 
     def line(self, i, j, fam, tol, n_points) -> str:
         """The log line of configuration j on problem i."""
