@@ -32,10 +32,8 @@ _ERR_EXP = -1.0 / (7 + 1)  # error estimator order 7
 def _dense_eval(t, t_old, hs, y_old, F, out):
     """scipy's Dop853DenseOutput at a scalar t."""
     x = (t - t_old) / hs
-    # one component at a time, the same operations in the same order per component as
-    # scipy's; the interchanged loops compile small (k outermost, LLVM unrolled the
-    # power loop and vectorized each pass over k: 1.7k instructions, compiled again into
-    # every caller)
+    # one component at a time: per component scipy's operations in scipy's order, in
+    # loops that compile small (docs/decisions.md#kernel-small-loops)
     for k in range(y_old.size):
         acc = 0.0
         for i in range(_NI):
@@ -61,7 +59,7 @@ def _checked_field(z, mode, first_call, fns, p, fl, out):
     for k in range(z.size):
         if not np.isfinite(out[k]):
             finite = False
-            break  # (an early exit: not vectorized, a small test in every caller)
+            break  # an early exit: not vectorized (docs/decisions.md#kernel-small-loops)
     if not finite:
         if first_call:
             return False
@@ -208,14 +206,13 @@ def _non_finite_stage(y, h, K, out):
         for k in range(n):
             if K[s, k] != 1e300:
                 hit = False
-                break  # (an early exit: LLVM does not vectorize this test 12 times)
+                break  # an early exit: not vectorized (docs/decisions.md#kernel-small-loops)
         if hit:
             found = s
             break
     if found == 0:
         return False
-    # the stage's state once, after the search, not unrolled into each of the 12 stages
-    # (a failure path was 1.5k instructions, compiled again into every caller)
+    # the stage's state once, after the search (docs/decisions.md#kernel-small-loops)
     for k in range(n):
         acc = 0.0
         for j in range(found):
