@@ -32,19 +32,14 @@ _ERR_EXP = -1.0 / (7 + 1)  # error estimator order 7
 def _dense_eval(t, t_old, hs, y_old, F, out):
     """scipy's Dop853DenseOutput at a scalar t."""
     x = (t - t_old) / hs
-    n = y_old.size
-    for k in range(n):
-        out[k] = 0.0
-    for i in range(_NI):
-        r = _NI - 1 - i
-        for k in range(n):
-            out[k] += F[r, k]
-            if i % 2 == 0:
-                out[k] *= x
-            else:
-                out[k] *= 1.0 - x
-    for k in range(n):
-        out[k] += y_old[k]
+    # one component at a time: per component scipy's operations in scipy's order, in
+    # loops that compile small (docs/decisions.md#kernel-small-loops)
+    for k in range(y_old.size):
+        acc = 0.0
+        for i in range(_NI):
+            acc += F[_NI - 1 - i, k]
+            acc *= x if i % 2 == 0 else 1.0 - x
+        out[k] = acc + y_old[k]
 
 
 @_jit
@@ -64,6 +59,7 @@ def _checked_field(z, mode, first_call, fns, p, fl, out):
     for k in range(z.size):
         if not np.isfinite(out[k]):
             finite = False
+            break  # an early exit: not vectorized (docs/decisions.md#kernel-small-loops)
     if not finite:
         if first_call:
             return False
@@ -204,19 +200,25 @@ def _non_finite_stage(y, h, K, out):
     """After a failed step from y over h (stages in K): True if a stage met a non-finite
     field value (_checked_field put 1e300 in its row), with that stage's state in out."""
     n = y.size
+    found = 0
     for s in range(1, _NS + 1):
         hit = True
         for k in range(n):
             if K[s, k] != 1e300:
                 hit = False
+                break  # an early exit: not vectorized (docs/decisions.md#kernel-small-loops)
         if hit:
-            for k in range(n):
-                acc = 0.0
-                for j in range(s):
-                    acc += K[j, k] * (_B[j] if s == _NS else _A[s, j])
-                out[k] = y[k] + acc * h
-            return True
-    return False
+            found = s
+            break
+    if found == 0:
+        return False
+    # the stage's state once, after the search (docs/decisions.md#kernel-small-loops)
+    for k in range(n):
+        acc = 0.0
+        for j in range(found):
+            acc += K[j, k] * (_B[j] if found == _NS else _A[found, j])
+        out[k] = y[k] + acc * h
+    return True
 
 
 @_jit
