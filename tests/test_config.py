@@ -233,6 +233,9 @@ def test_the_documented_full_resolution_command_passes_the_limits():
     pairs = words[words.index("--config") + 1:]
     overrides = dict(w.split("=", 1) for w in pairs if re.fullmatch(r"\w+=\S+", w))
     assert overrides.pop("resolution") == "full"
+    # a local build runs each split sweep as one job (config.yaml sweep_jobs: 1): the
+    # fine grids are only spread over the cores with their scenes' chunks
+    assert overrides.pop("sweep_jobs") == "scene"
     lim = limits(overrides)
     for path in SCENES:
         scene = load_scene(path, SCHEMA, lim, resolution="full")
