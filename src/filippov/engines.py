@@ -117,9 +117,13 @@ engine that moves one of these makes its test fail.
    Test: tests/test_engine_asymmetries.py::test_the_compiled_model_has_no_sliding_flow
 
 10. **Failures.** The reference raises where a run fails; the compiled engine gives each
-    start a status and goes on with the batch, and its wrapper raises the same error
-    classes for the first failure. Deliberate (one failing start must not lose a batch).
-    Test: tests/test_errors.py::test_the_compiled_engine_s_failures_are_the_reference_driver_s_classes
+    start a status and goes on with the batch, and its front door raises the first
+    failure. Both turn a status into its exception through one table,
+    :func:`filippov.errors.run_error` (the class, the status's words, where), so a
+    status gives the same class and words on both; the detail after them is each
+    engine's own. Deliberate (one failing start must not lose a batch).
+    Tests: tests/test_errors.py::test_the_compiled_engine_s_failures_are_the_reference_driver_s_classes,
+    tests/test_end_status.py::test_a_status_raises_the_same_class_and_words_on_both_engines
 """
 from __future__ import annotations
 
