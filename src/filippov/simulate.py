@@ -23,6 +23,7 @@ import contextlib
 import functools
 import math
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 from typing import Callable, Optional, Sequence
 
 import numpy as np
@@ -32,11 +33,13 @@ from scipy.optimize import brentq
 from . import checks, engines, options, rules, variational
 from .loop import interval
 from .radau_iia import RadauIIA
-from .system import MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
+from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
 from .errors import run_error
 from .loop.event import SECTION, EventOps, make_event
-from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_SLIDING, OK,
+from .loop.stay import before_stay, make_slides_in, make_start
+from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN,
+                          NO_SLIDING, OK,
                           ROOT_FAILED, SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO)
 
 
@@ -327,25 +330,45 @@ def _refine(fun, pred, ta, tb, va, vb, xtol):
     return r
 
 
-def _slides_in(system: PiecewiseSystem, func, z) -> bool:
-    """True if the sliding flow at ``z`` (on H) stays in the section ``func = 0``
-    (:func:`filippov.rules.slides_in_section`)."""
-    z = np.asarray(z, dtype=float)
-    fm, fp = np.asarray(system.field_minus(z), float), np.asarray(system.field_plus(z), float)
-    d = rules.central_step(max(1.0, np.abs(z).max()), max(np.abs(fm).max(), np.abs(fp).max()))
+def _slide_fields(run):
+    z = np.asarray(run.z, dtype=float)
+    return (z, np.asarray(run.system.field_minus(z), float),
+            np.asarray(run.system.field_plus(z), float))
+
+
+def _section_along(k, mode, d, run):
+    """Section k at z + d times the field of ``mode`` at z (d = 0: at z itself)."""
+    z, func = np.asarray(run.z, dtype=float), run.sections[k].func
     if d == 0.0:
-        return False
+        return float(func(z))
+    system = run.system
+    f = (system.field_minus(z) if mode == MINUS else system.field_plus(z) if mode == PLUS
+         else system.sliding_field(z))
+    return float(func(z + d * np.asarray(f, float)))
 
-    def rate(f):
-        return (float(func(z + d * f)) - float(func(z - d * f))) / (2 * d)
 
-    fs = np.asarray(system.sliding_field(z), float)
-    return rules.slides_in_section(float(func(z)), d, rate(fm), rate(fp), rate(fs))
+#: does the sliding flow at the run's state (on H) stay in section k
+#: (filippov.loop.stay.make_slides_in, on this engine's operations; ctx: the _Run)
+_slides_in = make_slides_in(_slide_fields, _section_along)
+
+
+def _normal_speeds(run):
+    """(a, b) at the run's state."""
+    return tuple(float(v) for v in run.system.normal_speeds(run.z))
+
+
+def _slides_in_a_section(run):
+    return any(_slides_in(k, run) for k in range(len(run.sections)))
+
+
+#: the start's mode and its refusal to slide in a section (filippov.loop.stay.make_start)
+_START = make_start(_normal_speeds, _slides_in_a_section)
 
 
 def _refuse_sliding_in_sections(system, sections, z, t) -> None:
-    for sec in sections:
-        if _slides_in(system, sec.func, z):
+    at = SimpleNamespace(system=system, sections=sections, z=z)
+    for k, sec in enumerate(sections):
+        if _slides_in(k, at):
             raise run_error(
                 SECTION_SLIDING, t, z, f": it slides from there inside section "
                 f"{sec.name!r} (the section lies on H there). Stop at the arrival on H (a "
@@ -358,12 +381,8 @@ def initial_mode(system: PiecewiseSystem, z: np.ndarray, touch_tol: float) -> tu
     """Region to start in; on H = 0 (to ``touch_tol``) the field directions decide
     (:func:`filippov.rules.start_on_switch`), so a start point that rounding puts a
     hair on the wrong side is not a switch."""
-    H = float(system.switch(z))
-    side = rules.start_side(H, touch_tol)
-    if side != SLIDING:
-        return side, "start"
-    a, b = (float(v) for v in system.normal_speeds(z))
-    mode, repelling = rules.start_on_switch(H, a, b, system.sliding)
+    _, mode, repelling = _START(float(system.switch(z)), touch_tol, system.sliding,
+                                SimpleNamespace(system=system, sections=(), z=z))
     return mode, ("repelling_start" if repelling else "start")
 
 
@@ -453,12 +472,14 @@ class _Run:
         self.system, self.sections = system, sections
         self.__dict__.update(opts)
         self.traj = Trajectory(system=system, t0=self.t0, z0=z.copy(), t=self.t0, z=z.copy())
-        self.mode, kind = initial_mode(system, z, self.touch_tol)
-        self.traj.mode = self.mode
-        self.traj.events.append(Event(self.t0, kind, z.copy(), self.mode, self.mode))
-        if self.mode == SLIDING:
-            _refuse_sliding_in_sections(system, sections, z, self.t0)
         self.t, self.z = self.t0, z
+        status, self.mode, repelling = _START(float(system.switch(z)), self.touch_tol,
+                                              system.sliding, self)
+        self.traj.mode = self.mode
+        self.traj.events.append(Event(self.t0, "repelling_start" if repelling else "start",
+                                      z.copy(), self.mode, self.mode))
+        if status != GO_ON:
+            raise self._event_error(status)
         self.preds = [rules.section_pred(sec.direction) for sec in sections]
         self.hits = [0] * len(sections)
         # the Zeno ring (filippov.rules.note_switch): the last zeno_count
@@ -481,10 +502,11 @@ class _Run:
 
     def go(self) -> Trajectory:
         while True:
-            if self.t >= self.t_end:
+            status = before_stay(self.mode, self.t, self.t_end, self.system.sliding)
+            if status == NO_RETURN:
                 return self.stop("t_end")
-            if self.mode == SLIDING and not self.system.sliding:
-                raise _no_sliding(self.t, self.z)
+            if status != GO_ON:
+                raise self._event_error(status)
             done = self.stay()
             if done is not None:
                 return done
@@ -751,14 +773,13 @@ def _nothing(*args):
 #: the reference driver's event (filippov.loop.event) on its Python operations; ctx: the _Run
 _EVENT = make_event(EventOps(
     section_hit=_section_hit,
-    speeds=lambda run: tuple(float(v) for v in run.system.normal_speeds(run.z)),
+    speeds=_normal_speeds,
     h=lambda run: float(run.system.switch(run.z)),
     grad_h=lambda run: run.system.switch_grad(run.z[:, None])[:, 0],
     state=_switch_state,
     flow_at_zero=lambda mode, z, run: run._flow_at_zero(mode, z),
     sliding_built=lambda run: run.system.sliding,
-    slides_in_section=lambda run: any(_slides_in(run.system, sec.func, run.z)
-                                      for sec in run.sections),
+    slides_in_section=_slides_in_a_section,
     record_switch=_record_switch,
     count_switch=_count_switch,
     limits=lambda run: (run.max_events, run.zeno_count, run.zeno_span, run.touch_tol),
