@@ -55,7 +55,7 @@ def _slide_fields(ctx):
     return w.z, w.wf, w.wp
 
 
-@_jit_inline
+@_jit  # a call: make_slides_in asks it seven times (inlined, it grew the cold compile)
 def _section_along(k, mode, d, ctx):
     """The section at w.z + d (cm F_- + cp F_+), the field of ``mode`` as its weights
     (Filippov's while sliding, from F_-, F_+ and grad h left by _slide_fields); d = 0:
