@@ -96,7 +96,7 @@ def test_sliding_segment_of_pseudo_equilibrium():
 def test_a_system_built_without_sliding_errs_instead_of_sliding():
     system = pseudo_equilibrium.model(0.02, 0.4).full(sliding=False)
     from filippov import SimulationError
-    with pytest.raises(SimulationError, match="sliding reached .* built with sliding=False"):
+    with pytest.raises(SimulationError, match="sliding reached.* built with sliding=False"):
         simulate(system, [0.2, 0.1], 2.0)
 
 

@@ -30,12 +30,17 @@ slide inside a section at an arrival on H, the fold exit (``rules.exit_drift``,
 ``onto_switch``, ``exit_band``, ``exit_shift``), the switch counted against
 ``max_events`` before the Zeno ring (``rules.accumulates`` over the last ``zeno_count``
 switches: one array ring, ``rules.note_switch``), then the
-engine's own budget verdict (item 2); both share one set of status codes
-(:mod:`filippov.loop.status`: the reference turns a status into its exception). The
+engine's own budget verdict (item 2). The start is one function too,
+:mod:`filippov.loop.stay` (the start mode, ``rules.start_side`` and
+``rules.start_on_switch``, and the refusal to slide inside a section, whose test
+``make_slides_in`` is shared with the event), and so is the check before each stay (the
+run's end time; sliding the system does not build). Both share one set of status codes
+(:mod:`filippov.loop.status`), and one table turns a status into its exception class and
+message (:func:`filippov.errors.run_error`, item 10). The
 rest they ask in the same order on each side: the hard bound ``max_steps``
-(integration steps, or exact-flow windows), counted alike; the start mode
-(``rules.start_side``, ``rules.start_on_switch``); the refusal to slide inside a
-section at the start; a start on the section up to rounding
+(integration steps, or exact-flow windows), counted alike; the walk over a window's
+candidate intervals, the exit's rounding band ended at the first candidate whose
+start is out of it (``rules.clears_band``); a start on the section up to rounding
 (``rules.starts_on_section``, the probes of ``rules.section_probe``); the exact-flow check
 (``rules.flow_consistent``); non-finite states and fields (an error, or a status);
 the options (:mod:`filippov.options`, one check for both). What remains different is
@@ -117,9 +122,13 @@ engine that moves one of these makes its test fail.
    Test: tests/test_engine_asymmetries.py::test_the_compiled_model_has_no_sliding_flow
 
 10. **Failures.** The reference raises where a run fails; the compiled engine gives each
-    start a status and goes on with the batch, and its wrapper raises the same error
-    classes for the first failure. Deliberate (one failing start must not lose a batch).
-    Test: tests/test_errors.py::test_the_compiled_engine_s_failures_are_the_reference_driver_s_classes
+    start a status and goes on with the batch, and its front door raises the first
+    failure. Both turn a status into its exception through one table,
+    :func:`filippov.errors.run_error` (the class, the status's words, where), so a
+    status gives the same class and words on both; the detail after them is each
+    engine's own. Deliberate (one failing start must not lose a batch).
+    Tests: tests/test_errors.py::test_the_compiled_engine_s_failures_are_the_reference_driver_s_classes,
+    tests/test_end_status.py::test_a_status_raises_the_same_class_and_words_on_both_engines
 """
 from __future__ import annotations
 

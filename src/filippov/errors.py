@@ -61,3 +61,32 @@ class SymbolicError(ValueError):
 class DatasetError(ValueError):
     """A file that is not a sound dataset of this project (unreadable, damaged,
     truncated, written by something else, or of another scene)."""
+
+
+# ------------------------------------------------------------------ a run's end status
+# What a run that ends with a status of filippov.loop.status raises, one table for both
+# engines: the reference driver raises it where its run stops, the compiled engine's front
+# door for a start that did not return (tests/test_errors.py pins each status on both).
+def _run_errors():
+    from .loop import status as s
+    return {s.NO_RETURN: RuntimeError, s.EVENT_LIMIT: EventLimitError,
+            s.STEP_LIMIT: EventLimitError, s.ZENO: ZenoError, s.NON_FINITE: SimulationError,
+            s.NO_SLIDING: SlidingNotBuiltError, s.STEP_FAILED: SimulationError,
+            s.ROOT_FAILED: SimulationError, s.BAD_START: ValueError,
+            s.SECTION_SLIDING: SimulationError, s.FLOW_OFF_FIELD: SimulationError}
+
+
+#: status -> the exception class a run that ends with it raises
+RUN_ERRORS = _run_errors()
+
+
+def run_error(status: int, t, z, detail: str = "") -> Exception:
+    """The exception of a run that ended with ``status`` at time ``t`` in state ``z``, on
+    either engine: the class of :data:`RUN_ERRORS`, the message the status's words
+    (:data:`filippov.loop.status.STATUS`), where, then the engine's ``detail``."""
+    import numpy as np
+
+    from .loop.status import STATUS
+
+    state = np.asarray(z, dtype=float).reshape(-1).tolist()
+    return RUN_ERRORS[status](f"{STATUS[status]} at t={float(t)!r}, state {state}{detail}")

@@ -76,10 +76,11 @@ from .kernel.base import (BAD_START, EVENT_LIMIT, FLOW_OFF_FIELD, NO_RETURN,  # 
 from .kernel.driver import KERNEL_SOURCES, compile_kernel, kernel  # noqa: F401
 from .kernel.state import Outputs, Settings
 from .checks import check_compiled
+from .errors import run_error
 from .system import MINUS, MODE_NAMES, PLUS
 from .poincare import Returns
 from .progress import Progress
-from .simulate import (EXACT_BLOCK, EventLimitError, SimulationError,
+from .simulate import (EXACT_BLOCK, EventLimitError, SimulationError,  # noqa: F401
                        SlidingNotBuiltError, ZenoError, slow_window)
 
 @dataclass(frozen=True)
@@ -484,11 +485,19 @@ def failure(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:
     """Why start ``i`` of ``out`` did not return, in words: its status, where (t, state)
     and in which mode; for a non-finite value the piece that gave it (checked by
     evaluating the pieces at that state)."""
+    code, z = int(out.status[i]), out.state[i]
+    return f"{STATUS[code]} at t={float(out.time[i])!r}, state {z.tolist()}" + _failure_detail(
+        cmodel, out, i)
+
+
+def _failure_detail(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:
+    """What :func:`failure` says after the status, time and state: the mode, and the
+    evidence for a non-finite value or an exact flow off its field."""
     from .checks import non_finite_piece
 
     code, z = int(out.status[i]), out.state[i]
     mode = int(out.mode[i]) if out.mode is not None else None
-    where = f"{STATUS[code]} at t={float(out.time[i])!r}, state {z.tolist()}"
+    where = ""
     if mode is not None:
         where += f", mode {MODE_NAMES.get(mode, mode)}"
     if code == FLOW_OFF_FIELD and mode in (MINUS, PLUS):
@@ -525,10 +534,6 @@ def _flow_off_field(cmodel: CompiledModel, mode: int, z) -> str:
             f"check the flow's formula)")
 
 
-_ERRORS = {EVENT_LIMIT: EventLimitError, STEP_LIMIT: EventLimitError, ZENO: ZenoError,
-           NO_SLIDING: SlidingNotBuiltError}
-
-
 def first_returns_compiled(cmodel: CompiledModel, starts, t_max: float, *,
                            progress: Progress | None = None, **options) -> Returns:
     """Replaced by the front door ``first_returns(cmodel, starts, None, t_max,
@@ -544,10 +549,9 @@ def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
     """:func:`filippov.first_returns` on the compiled engine: one batch call of
     :func:`compute_returns`; ``progress`` is stepped once by the number of start points,
     after the batch. A start point that does not return is an error naming it (the
-    first one, with its status), raised as the reference driver would:
-    :class:`EventLimitError` for the event and step bounds, :class:`ZenoError`,
-    :class:`SimulationError` for a numerical failure, RuntimeError for no return within
-    ``t_max``.
+    first one, with its status), raised as the reference driver raises it: the class and
+    the words of its status (:func:`filippov.errors.run_error`, one table for both
+    engines), then the failure's detail (:func:`failure`).
     """
     cmodel = engines.compiled_model(system, "first_returns", section, direction=direction,
                                     where=where)
@@ -559,10 +563,8 @@ def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
         i = int(bad[0])
         code = int(out.status[i])
         z0 = np.atleast_2d(np.asarray(starts, dtype=float))[i]
-        msg = (f"start point {z0.tolist()} did not return to the section of "
-               f"{cmodel.name!r} within t_max={t_max!r}: {failure(cmodel, out, i)} "
-               f"({bad.size} of {out.status.size} start points failed)")
-        if code == NO_RETURN:
-            raise RuntimeError(msg)
-        raise _ERRORS.get(code, SimulationError)(msg)
+        raise run_error(code, out.time[i], out.state[i], _failure_detail(cmodel, out, i)
+                        + f": start point {z0.tolist()} did not return to the section of "
+                        f"{cmodel.name!r} within t_max={t_max!r} ({bad.size} of "
+                        f"{out.status.size} start points failed)")
     return Returns(out.state, out.time, out.n_switches, out.sliding_time, out.first_switch)

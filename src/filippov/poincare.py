@@ -13,6 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import engines
+from .errors import run_error
+from .loop.status import NO_RETURN
 from .progress import Progress
 from .simulate import Section, simulate
 from .system import SLIDING
@@ -88,8 +90,9 @@ def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
     for i, z0 in enumerate(starts):
         traj = simulate(system, z0, t_max, sections=[section], dense=False, **options)
         if traj.status != f"section:{section.name}":
-            raise RuntimeError(f"start point {z0.tolist()} did not return to section "
-                               f"{section.name!r} within t_max={t_max!r} (status {traj.status})")
+            raise run_error(NO_RETURN, traj.t, traj.z, f": start point {z0.tolist()} did "
+                            f"not return to section {section.name!r} within t_max={t_max!r} "
+                            f"(status {traj.status})")
         hit = traj.events[-1]
         state[i], time[i] = hit.state, hit.t - traj.t0
         switches = traj.switches()

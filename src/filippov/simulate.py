@@ -23,6 +23,7 @@ import contextlib
 import functools
 import math
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 from typing import Callable, Optional, Sequence
 
 import numpy as np
@@ -32,10 +33,14 @@ from scipy.optimize import brentq
 from . import checks, engines, options, rules, variational
 from .loop import interval
 from .radau_iia import RadauIIA
-from .system import MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
+from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
+from .errors import run_error
 from .loop.event import SECTION, EventOps, make_event
-from .loop.status import EVENT_LIMIT, GO_ON, NO_SLIDING, OK, SECTION_SLIDING, ZENO
+from .loop.stay import before_stay, make_slides_in, make_start
+from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN,
+                          NO_SLIDING, OK,
+                          ROOT_FAILED, SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO)
 
 
 @dataclass(frozen=True)
@@ -204,7 +209,7 @@ class _IntegratingStepper:
             calls[0] += 1
             if not math.isfinite(v.sum()) and not np.all(np.isfinite(v)):
                 if calls[0] == 1:
-                    raise SimulationError(self._non_finite_message(tt, zz))
+                    raise self._non_finite(tt, zz)
                 if self.non_finite is None:  # the first in this step: near the orbit
                     self.non_finite = (tt, np.array(zz, dtype=float))
                 v = np.full(np.shape(v), 1e300)
@@ -216,10 +221,10 @@ class _IntegratingStepper:
                              **({} if method is DOP853 else
                                 {"vectorized": True, "stages": STIFF_STAGES}))
 
-    def _non_finite_message(self, tt, zz):
+    def _non_finite(self, tt, zz, more=""):
         zz = np.asarray(zz, dtype=float)
-        return (f"{self.piece(zz)} returned a non-finite value at t={float(tt)!r}, "
-                f"z={zz.tolist()}")
+        return run_error(NON_FINITE, tt, zz, f" ({self.piece(zz)} returned a non-finite "
+                                             f"value there{more})")
 
     def step(self):
         s = self.solver
@@ -233,10 +238,9 @@ class _IntegratingStepper:
             msg = s.step()
         if s.status == "failed":
             if self.non_finite is not None:  # the step size collapsed on a NaN or inf
-                raise SimulationError(
-                    self._non_finite_message(*self.non_finite)
-                    + f" ({self.method.__name__} could not step past it from t={float(ta)!r})")
-            raise SimulationError(f"{self.method.__name__} failed at t={ta!r}: {msg}")
+                raise self._non_finite(*self.non_finite, more=f"; {self.method.__name__} "
+                                       f"could not step past it from t={float(ta)!r}")
+            raise run_error(STEP_FAILED, ta, s.y, f": {self.method.__name__} failed: {msg}")
         return ta, s.t, s.dense_output()
 
 
@@ -326,31 +330,50 @@ def _refine(fun, pred, ta, tb, va, vb, xtol):
     return r
 
 
-def _slides_in(system: PiecewiseSystem, func, z) -> bool:
-    """True if the sliding flow at ``z`` (on H) stays in the section ``func = 0``
-    (:func:`filippov.rules.slides_in_section`)."""
-    z = np.asarray(z, dtype=float)
-    fm, fp = np.asarray(system.field_minus(z), float), np.asarray(system.field_plus(z), float)
-    d = rules.central_step(max(1.0, np.abs(z).max()), max(np.abs(fm).max(), np.abs(fp).max()))
+def _slide_fields(run):
+    z = np.asarray(run.z, dtype=float)
+    return (z, np.asarray(run.system.field_minus(z), float),
+            np.asarray(run.system.field_plus(z), float))
+
+
+def _section_along(k, mode, d, run):
+    """Section k at z + d times the field of ``mode`` at z (d = 0: at z itself)."""
+    z, func = np.asarray(run.z, dtype=float), run.sections[k].func
     if d == 0.0:
-        return False
+        return float(func(z))
+    system = run.system
+    f = (system.field_minus(z) if mode == MINUS else system.field_plus(z) if mode == PLUS
+         else system.sliding_field(z))
+    return float(func(z + d * np.asarray(f, float)))
 
-    def rate(f):
-        return (float(func(z + d * f)) - float(func(z - d * f))) / (2 * d)
 
-    fs = np.asarray(system.sliding_field(z), float)
-    return rules.slides_in_section(float(func(z)), d, rate(fm), rate(fp), rate(fs))
+#: does the sliding flow at the run's state (on H) stay in section k
+#: (filippov.loop.stay.make_slides_in, on this engine's operations; ctx: the _Run)
+_slides_in = make_slides_in(_slide_fields, _section_along)
+
+
+def _normal_speeds(run):
+    """(a, b) at the run's state."""
+    return tuple(float(v) for v in run.system.normal_speeds(run.z))
+
+
+def _slides_in_a_section(run):
+    return any(_slides_in(k, run) for k in range(len(run.sections)))
+
+
+#: the start's mode and its refusal to slide in a section (filippov.loop.stay.make_start)
+_START = make_start(_normal_speeds, _slides_in_a_section)
 
 
 def _refuse_sliding_in_sections(system, sections, z, t) -> None:
-    for sec in sections:
-        if _slides_in(system, sec.func, z):
-            raise SimulationError(
-                f"the orbit slides along the switching surface from t={t!r}, state "
-                f"{z.tolist()}, inside section {sec.name!r} (the section lies on H there): "
-                "its crossings while sliding would be rounding noise. Stop at the arrival "
-                "on H (a terminal hit there ends the run first) or use a section "
-                "transverse to the sliding flow")
+    at = SimpleNamespace(system=system, sections=sections, z=z)
+    for k, sec in enumerate(sections):
+        if _slides_in(k, at):
+            raise run_error(
+                SECTION_SLIDING, t, z, f": it slides from there inside section "
+                f"{sec.name!r} (the section lies on H there). Stop at the arrival on H (a "
+                "terminal hit there ends the run first) or use a section transverse to "
+                "the sliding flow")
 
 
 # --------------------------------------------------------------------------- driver
@@ -358,12 +381,8 @@ def initial_mode(system: PiecewiseSystem, z: np.ndarray, touch_tol: float) -> tu
     """Region to start in; on H = 0 (to ``touch_tol``) the field directions decide
     (:func:`filippov.rules.start_on_switch`), so a start point that rounding puts a
     hair on the wrong side is not a switch."""
-    H = float(system.switch(z))
-    side = rules.start_side(H, touch_tol)
-    if side != SLIDING:
-        return side, "start"
-    a, b = (float(v) for v in system.normal_speeds(z))
-    mode, repelling = rules.start_on_switch(H, a, b, system.sliding)
+    _, mode, repelling = _START(float(system.switch(z)), touch_tol, system.sliding,
+                                SimpleNamespace(system=system, sections=(), z=z))
     return mode, ("repelling_start" if repelling else "start")
 
 
@@ -453,12 +472,14 @@ class _Run:
         self.system, self.sections = system, sections
         self.__dict__.update(opts)
         self.traj = Trajectory(system=system, t0=self.t0, z0=z.copy(), t=self.t0, z=z.copy())
-        self.mode, kind = initial_mode(system, z, self.touch_tol)
-        self.traj.mode = self.mode
-        self.traj.events.append(Event(self.t0, kind, z.copy(), self.mode, self.mode))
-        if self.mode == SLIDING:
-            _refuse_sliding_in_sections(system, sections, z, self.t0)
         self.t, self.z = self.t0, z
+        status, self.mode, repelling = _START(float(system.switch(z)), self.touch_tol,
+                                              system.sliding, self)
+        self.traj.mode = self.mode
+        self.traj.events.append(Event(self.t0, "repelling_start" if repelling else "start",
+                                      z.copy(), self.mode, self.mode))
+        if status != GO_ON:
+            raise self._event_error(status)
         self.preds = [rules.section_pred(sec.direction) for sec in sections]
         self.hits = [0] * len(sections)
         # the Zeno ring (filippov.rules.note_switch): the last zeno_count
@@ -481,10 +502,11 @@ class _Run:
 
     def go(self) -> Trajectory:
         while True:
-            if self.t >= self.t_end:
+            status = before_stay(self.mode, self.t, self.t_end, self.system.sliding)
+            if status == NO_RETURN:
                 return self.stop("t_end")
-            if self.mode == SLIDING and not self.system.sliding:
-                raise _no_sliding(self.t, self.z)
+            if status != GO_ON:
+                raise self._event_error(status)
             done = self.stay()
             if done is not None:
                 return done
@@ -565,18 +587,18 @@ class _Run:
         traj, mode = self.traj, self.mode
         traj.n_steps += 1
         if traj.n_steps > self.max_steps:
-            raise EventLimitError(
-                f"step limit {self.max_steps} hit at t={self.t!r}, state {self.z.tolist()}, "
-                f"mode {MODE_NAMES[mode]}: the run is too long or the step size collapsed")
+            raise run_error(STEP_LIMIT, self.t, self.z, f", mode {MODE_NAMES[mode]}: step "
+                            f"limit {self.max_steps} hit: the run is too long or the step "
+                            "size collapsed")
         ta, tb, Z = stepper.step()
         stepper.n_taken += 1
         mean = (tb - stepper.t_start) / stepper.n_taken
         left = ((self.t_end - tb) / mean if stepper.n_taken > PROJECT_AFTER and mean > 0
                 else 0.0)
         if traj.n_steps + left > self.max_steps:
-            raise EventLimitError(
-                f"steps of {tb - ta:.3g} (mean {mean:.3g}) at t={ta!r} in mode "
-                f"{MODE_NAMES[mode]} (state {self.z.tolist()}): ~{left:.3g} more steps to "
+            raise run_error(
+                STEP_LIMIT, ta, self.z, f", mode {MODE_NAMES[mode]}: steps of {tb - ta:.3g} "
+                f"(mean {mean:.3g}): ~{left:.3g} more steps to "
                 f"t_end={self.t_end!r} exceed max_steps={self.max_steps}"
                 + ("; the integrated field is stiff here (a fast time scale, e.g. a "
                    "small eps): use exact flows or a shorter t_end"
@@ -589,9 +611,9 @@ class _Run:
         ts[-1] = tb
         zs = Z(ts)
         if not np.all(np.isfinite(zs)):
-            raise SimulationError(
-                f"non-finite state in mode {MODE_NAMES[self.mode]} between t={ta!r} and "
-                f"t={tb!r}, last finite state {self.z.tolist()}")
+            raise run_error(NON_FINITE, ta, self.z, f", mode {MODE_NAMES[self.mode]}: the "
+                            f"state turns non-finite before t={tb!r} (the state given: the "
+                            "last finite one)")
         if stepper.method is None:
             self._check_flow(ta, tb, zs[:, -1])
         return ts, zs
@@ -612,13 +634,12 @@ class _Run:
         if not rules.flow_consistent(dz, tb - ta, float(np.linalg.norm(fa)),
                                      float(np.linalg.norm(fb)),
                                      float(max(np.abs(za).max(), np.abs(zb).max()))):
-            raise SimulationError(
-                f"the exact flow of mode {MODE_NAMES[self.mode]} moved the state by "
-                f"{dz:.3g} from t={ta!r} to t={tb!r}, but its field's speed is "
-                f"{np.linalg.norm(fa):.3g} .. {np.linalg.norm(fb):.3g}: the closed form "
-                f"does not follow the field there (state at ta {za.tolist()}, at tb "
-                f"{zb.tolist()}); use integrated flows (method='integrate') or check the "
-                "flow's formula")
+            raise run_error(
+                FLOW_OFF_FIELD, ta, za, f": the exact flow of mode {MODE_NAMES[self.mode]} "
+                f"moved the state by {dz:.3g} to t={tb!r} (state {zb.tolist()}), but its "
+                f"field's speed is {np.linalg.norm(fa):.3g} .. {np.linalg.norm(fb):.3g}: the "
+                f"closed form does not follow the field there; use integrated flows "
+                "(method='integrate') or check the flow's formula")
 
     def _scan(self, Z, ts, zs, leave, first, ta, tb):
         try:
@@ -627,11 +648,11 @@ class _Run:
                                 self.band, self._leave(self.mode, banded=False)
                                 if self.band > 0.0 else None)
         except ValueError as exc:  # scipy's root finders: no context of their own
-            raise SimulationError(
-                f"event location failed in mode {MODE_NAMES[self.mode]} between t={ta!r} and "
-                f"t={tb!r} (state at ta {self.z.tolist()}): {exc}; the sampled sign change "
-                f"did not survive refinement (time scale of the system: sample_step "
-                f"{self.system.sample_step!r})") from exc
+            raise run_error(
+                ROOT_FAILED, ta, self.z, f", mode {MODE_NAMES[self.mode]}: between t={ta!r} "
+                f"and t={tb!r}: {exc}; the sampled sign change did not survive refinement "
+                f"(time scale of the system: sample_step {self.system.sample_step!r})"
+            ) from exc
         self.band = band
         return found
 
@@ -666,27 +687,25 @@ class _Run:
         """The exception of a status :func:`_EVENT` ended the run with, at (t, z)."""
         te, ze = self.t, self.z
         if status == NO_SLIDING:
-            return _no_sliding(None, ze)
+            return _no_sliding(te, ze)
         if status == SECTION_SLIDING:
             _refuse_sliding_in_sections(self.system, self.sections, ze, te)
         if status == ZENO:
             oldest = self.ring[self.ring_entries % self.zeno_count]
-            return ZenoError(
-                f"accumulation of switches: {self.zeno_count} switches within "
-                f"{te - oldest:.3e} time units near t={te!r}, state "
-                f"{ze.tolist()} (Zeno point or chattering below the time resolution)")
+            return run_error(ZENO, te, ze, f": {self.zeno_count} switches within "
+                                           f"{te - oldest:.3e} time units (Zeno point or "
+                                           "chattering below the time resolution)")
         if status == EVENT_LIMIT and self.n_switch > self.max_events:
-            return EventLimitError(
-                f"event limit {self.max_events} hit: rapid switching near t={te!r}, "
-                f"state {ze.tolist()}")
+            return run_error(EVENT_LIMIT, te, ze, f": event limit {self.max_events} hit "
+                                                  "(rapid switching)")
         if status == EVENT_LIMIT:
             every, ahead, new_mode = self.projected
-            return EventLimitError(
-                f"switching every {every:.3g} time units near t={te!r} (state "
-                f"{ze.tolist()}, mode {MODE_NAMES[new_mode]}): ~{ahead:.3g} more switches "
-                f"to t_end={self.t_end!r} exceed max_events={self.max_events} (raise "
-                f"max_events if this rate does not last)")
-        return SimulationError(f"event at t={te!r}: status {status}")  # no such status
+            return run_error(
+                EVENT_LIMIT, te, ze, f", mode {MODE_NAMES[new_mode]}: switching every "
+                f"{every:.3g} time units: ~{ahead:.3g} more switches to t_end={self.t_end!r} "
+                f"exceed max_events={self.max_events} (raise max_events if this rate does "
+                "not last)")
+        return run_error(status, te, ze)
 
     def _flow_at_zero(self, mode, z):
         """The state the next stay in ``mode`` starts from as its stepper evaluates it:
@@ -709,10 +728,8 @@ class _Run:
 
 
 def _no_sliding(t, z) -> SlidingNotBuiltError:
-    at = f"t={t!r}, " if t is not None else ""
-    return SlidingNotBuiltError(
-        f"attracting sliding reached at {at}state {z.tolist()}, but the system was built "
-        "with sliding=False; build it with sliding=True to follow sliding")
+    return run_error(NO_SLIDING, t, z, ": the system was built with sliding=False; build "
+                                       "it with sliding=True to follow sliding")
 
 
 def _section_hit(mode, t, run):
@@ -756,14 +773,13 @@ def _nothing(*args):
 #: the reference driver's event (filippov.loop.event) on its Python operations; ctx: the _Run
 _EVENT = make_event(EventOps(
     section_hit=_section_hit,
-    speeds=lambda run: tuple(float(v) for v in run.system.normal_speeds(run.z)),
+    speeds=_normal_speeds,
     h=lambda run: float(run.system.switch(run.z)),
     grad_h=lambda run: run.system.switch_grad(run.z[:, None])[:, 0],
     state=_switch_state,
     flow_at_zero=lambda mode, z, run: run._flow_at_zero(mode, z),
     sliding_built=lambda run: run.system.sliding,
-    slides_in_section=lambda run: any(_slides_in(run.system, sec.func, run.z)
-                                      for sec in run.sections),
+    slides_in_section=_slides_in_a_section,
     record_switch=_record_switch,
     count_switch=_count_switch,
     limits=lambda run: (run.max_events, run.zeno_count, run.zeno_span, run.touch_tol),

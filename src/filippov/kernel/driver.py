@@ -23,9 +23,9 @@ from numba import njit
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from .. import rules
-from ..system import PLUS, SLIDING
-from .base import (BAD_START, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN, NO_SLIDING, OK,
-                   SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, _W_NONE,
+from ..system import MINUS, PLUS, SLIDING
+from .base import (BAD_START, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN, OK,
+                   STEP_FAILED, STEP_LIMIT, _W_NONE, _dot,
                    _W_SECTION, _flow_minus, _flow_plus, _jit, _jit_inline, _speeds,
                    _h, _section)
 from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
@@ -39,48 +39,52 @@ from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
 from ..loop.event import SECTION, EventOps, make_event
+from ..loop.stay import before_stay, make_slides_in, make_start
 from ..loop.status import GO_ON
 
 
-@_jit
-def _section_rate(z, wm, wp, c, d, fns, p, wz):
-    """Central difference of the section along the field cm F_- + cp F_+, c = (cm, cp)."""
-    cm, cp = c
-    for k in range(z.size):
-        wz[k] = z[k] + d * (cm * wm[k] + cp * wp[k])
-    s1 = _section(fns, wz, p)
-    for k in range(z.size):
-        wz[k] = z[k] - d * (cm * wm[k] + cp * wp[k])
-    return (s1 - _section(fns, wz, p)) / (2.0 * d)
+# ------------------------------------------------------------------ sliding in the section
+# For filippov.loop.stay.make_slides_in (at the start and at an arrival on H): each takes
+# ctx = (fns, p, s, w), as the event's operations below, and works at the state w.z.
+
+@_jit_inline
+def _slide_fields(ctx):
+    """(z, F_-, F_+) at w.z, in w.wf and w.wp (grad h left in w.wg)."""
+    fns, p, s, w = ctx
+    _speeds(w.z, fns, p, w.wg, w.wf, w.wp)
+    return w.z, w.wf, w.wp
 
 
-@_jit
-def _slides_in(z, fns, p, wg, wm, wp, wz):
-    """simulate._slides_in: the sliding flow at z stays in the section (on H)."""
-    a, b = _speeds(z, fns, p, wg, wm, wp)
-    speed, size = 0.0, 1.0
-    for k in range(z.size):
-        speed = max(speed, abs(wm[k]), abs(wp[k]))
-        size = max(size, abs(z[k]))
-    d = rules.central_step(size, speed)
+@_jit  # a call: make_slides_in asks it seven times (inlined, it grew the cold compile)
+def _section_along(k, mode, d, ctx):
+    """The section at w.z + d (cm F_- + cp F_+), the field of ``mode`` as its weights
+    (Filippov's while sliding, from F_-, F_+ and grad h left by _slide_fields); d = 0:
+    at w.z."""
+    fns, p, s, w = ctx
+    z, wm, wp = w.z, w.wf, w.wp
     if d == 0.0:
-        return False
-    return rules.slides_in_section(_section(fns, z, p), d,
-                              _section_rate(z, wm, wp, (1.0, 0.0), d, fns, p, wz),
-                              _section_rate(z, wm, wp, (0.0, 1.0), d, fns, p, wz),
-                              _section_rate(z, wm, wp, (-b / (a - b), a / (a - b)), d, fns, p, wz))
+        return _section(fns, z, p)
+    if mode == MINUS:
+        cm, cp = 1.0, 0.0
+    elif mode == PLUS:
+        cm, cp = 0.0, 1.0
+    else:
+        a, b = _dot(w.wg, wm), _dot(w.wg, wp)
+        cm, cp = -b / (a - b), a / (a - b)
+    for c in range(z.size):
+        w.wz[c] = z[c] + d * (cm * wm[c] + cp * wp[c])
+    return _section(fns, w.wz, p)
+
+
+_slides_in_section = _jit_inline(make_slides_in(_slide_fields, _section_along))
 
 
 @_jit
-def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
-    """simulate.initial_mode (rules.start_side, rules.start_on_switch)."""
-    H = _h(fns, z, p)
-    side = rules.start_side(H, touch_tol)
-    if side != SLIDING:
-        return side
-    a, b = _speeds(z, fns, p, wg, wm, wp)
-    mode, _ = rules.start_on_switch(H, a, b, sliding)
-    return mode
+def _slides_in(fns, p, s, w):
+    """The sliding flow at w.z stays in the section (on H): filippov.loop.stay."""
+    return _slides_in_section(0, (fns, p, s, w))
+
+
 
 
 # The kernel's ABI: _batch(fns, params, starts, ages, settings, out): the compiled
@@ -90,6 +94,7 @@ def _initial_mode(z, fns, p, touch_tol, sliding, wg, wm, wp):
 # fastmap.compute_returns builds them.
 
 _GO_ON = GO_ON  # no event yet / the orbit goes on (never a returned status)
+_before_stay = _jit_inline(before_stay)
 assert _W_SECTION == SECTION
 
 #: the compile-time switch of the dP/dz code: every branch that carries the derivative
@@ -280,7 +285,7 @@ def _event_sliding_built(ctx):
 @_jit_inline
 def _event_slides_in(ctx):
     fns, p, s, w = ctx
-    return _slides_in(w.z, fns, p, w.wg, w.wf, w.wp, w.wz)
+    return _slides_in(fns, p, s, w)
 
 
 @_jit_inline
@@ -369,6 +374,9 @@ def _build_event(ns):
 
 _build_event.builds = True  # _without_derivatives builds it, not copies it
 _event = _build_event(globals())
+#: the start's mode and its refusal to slide in the section (filippov.loop.stay), on the
+#: event's operations at the state w.z
+_start = _jit_inline(make_start(_event_speeds, _event_slides_in))
 
 
 @_jit
@@ -385,9 +393,9 @@ def _one(z0, age0, fns, p, s, w):
         w.z[k] = z0[k]
         if not np.isfinite(z0[k]):
             return BAD_START, 0.0, 0, 0.0, 0
-    mode = _initial_mode(w.z, fns, p, s.touch_tol, s.sliding, w.wg, w.wf, w.wp)
-    if mode == SLIDING and _slides_in(w.z, fns, p, w.wg, w.wf, w.wp, w.wz):
-        return SECTION_SLIDING, 0.0, 0, 0.0, mode
+    st, mode, _ = _start(_h(fns, w.z, p), s.touch_tol, s.sliding, (fns, p, s, w))
+    if st != _GO_ON:
+        return st, 0.0, 0, 0.0, mode
     w.touched[0] = False
     if _DERIVATIVES and s.jac:
         # a start that slides: the return is not differentiable across H there
@@ -406,10 +414,9 @@ def _one(z0, age0, fns, p, s, w):
     w.seg[SEG_EXIT_SHIFT] = 0.0
     t = 0.0
     while True:
-        if t >= s.t_max:
-            return NO_RETURN, t, w.count[N_SWITCHES], w.tally[T_SLID], mode
-        if mode == SLIDING and not s.sliding:
-            return NO_SLIDING, t, w.count[N_SWITCHES], w.tally[T_SLID], mode
+        st = _before_stay(mode, t, s.t_max, s.sliding)
+        if st != _GO_ON:
+            return st, t, w.count[N_SWITCHES], w.tally[T_SLID], mode
         if mode != SLIDING and s.exact:
             st, t, what = _stay_exact(mode, t, fns, p, s, w)
         else:

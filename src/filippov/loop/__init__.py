@@ -1,8 +1,10 @@
 """The event loop's structure, written once for both engines.
 
 :mod:`filippov.rules` holds each decision (which side, which mode, which tie); this
-package holds the order in which the loop asks them -- in a sample interval, at an
-event, against the budgets -- as plain scalar Python built from the engine's own
+package holds the order in which the loop asks them -- at the start and before each
+stay (:mod:`~filippov.loop.stay`), in a sample interval (:mod:`~filippov.loop.interval`),
+at an event and against the budgets (:mod:`~filippov.loop.event`) -- as plain scalar
+Python built from the engine's own
 operations (how it steps, samples, refines and stores). The reference driver
 (:mod:`filippov.simulate`) runs these functions as they are, with its Python
 operations; the compiled kernel (:mod:`filippov.kernel`) compiles the same functions

@@ -1,0 +1,73 @@
+"""A run's start and its stays -- when a stay may begin, the start's mode, and the
+refusal to slide inside a section (at the start, and at an arrival on H:
+:mod:`filippov.loop.event`) -- written once for both engines.
+
+Like :mod:`filippov.loop.event` this is plain scalar Python in the subset numba
+compiles: the reference driver (:mod:`filippov.simulate`) calls these functions as they
+are, with its Python operations; the compiled kernel (:mod:`filippov.kernel.driver`)
+compiles them inlined, with its compiled operations. A function built from operations
+(:func:`make_start`, :func:`make_slides_in`) takes the engine's state ``ctx`` last, as
+the event does.
+"""
+from __future__ import annotations
+
+from .. import rules
+from ..system import MINUS, PLUS, SLIDING
+from .status import GO_ON, NO_RETURN, NO_SLIDING, SECTION_SLIDING
+
+
+def before_stay(mode, t, t_end, sliding):
+    """May a stay in ``mode`` begin at ``t``? GO_ON; NO_RETURN at the run's end time
+    (the reference's end of its trajectory, the kernel's t_max); NO_SLIDING for a slide
+    the system does not build."""
+    if t >= t_end:
+        return NO_RETURN
+    if mode == SLIDING and not sliding:
+        return NO_SLIDING
+    return GO_ON
+
+
+def make_start(speeds, slides_in_section):
+    """``start(h, touch_tol, sliding, ctx) -> (status, mode, repelling)``: the start's
+    mode, decided by the rule book from H at the start (rules.start_side) and, on H, the
+    normal speeds (rules.start_on_switch; ``repelling``: a start on repelling H); status
+    SECTION_SLIDING for a start that slides inside a section, else GO_ON. The engine's
+    operations: ``speeds(ctx) -> (a, b)`` at the start, ``slides_in_section(ctx) ->
+    bool`` (:func:`make_slides_in`)."""
+
+    def start(h, touch_tol, sliding, ctx):
+        side = rules.start_side(h, touch_tol)
+        if side != SLIDING:
+            return GO_ON, side, False
+        a, b = speeds(ctx)
+        mode, repelling = rules.start_on_switch(h, a, b, sliding)
+        if mode == SLIDING and slides_in_section(ctx):
+            return SECTION_SLIDING, mode, repelling
+        return GO_ON, mode, repelling
+    return start
+
+
+def make_slides_in(fields, section_along):
+    """``slides_in(k, ctx) -> bool``: does the sliding flow at the state (on H) stay in
+    section k? rules.slides_in_section from the section's value there and its rates along
+    F_-, F_+ and the sliding field, by central differences of the step rules.central_step
+    gives (0: no). The engine's operations: ``fields(ctx) -> (z, F_-, F_+)`` at the
+    state, arrays; ``section_along(k, mode, d, ctx)``: section k at z + d times the field
+    of ``mode`` (MINUS, PLUS, SLIDING; d = 0: at z)."""
+
+    def slides_in(k, ctx):
+        z, fm, fp = fields(ctx)
+        speed, size = 0.0, 1.0
+        for c in range(z.size):
+            speed = max(speed, abs(fm[c]), abs(fp[c]))
+            size = max(size, abs(z[c]))
+        d = rules.central_step(size, speed)
+        if d == 0.0:
+            return False
+        rate_m = (section_along(k, MINUS, d, ctx) - section_along(k, MINUS, -d, ctx)) / (2.0 * d)
+        rate_p = (section_along(k, PLUS, d, ctx) - section_along(k, PLUS, -d, ctx)) / (2.0 * d)
+        rate_s = (section_along(k, SLIDING, d, ctx)
+                  - section_along(k, SLIDING, -d, ctx)) / (2.0 * d)
+        return rules.slides_in_section(section_along(k, SLIDING, 0.0, ctx), d, rate_m,
+                                       rate_p, rate_s)
+    return slides_in
