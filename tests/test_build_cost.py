@@ -26,9 +26,10 @@ def test_the_projection_reads_chunk_and_merge_logs(tmp_path):
     _log(tmp_path / "merge_chunks" / "figA.log", 1.0)
     _log(tmp_path / "merge_chunks" / "figB.log", 0.5)
     wall, scenes = chunked_projection(tmp_path, 2)
-    assert wall == 8.0 + 1.0  # {6, 2}, {4, 4}; then the longest merge
+    assert wall == 8.0 + 1.0  # {6, 2}, {4, 4}: figB done at 6, its merge to 6.5; figA at 8
     assert scenes == {"figA": (3, 10.0, 4.0, 1.0), "figB": (1, 6.0, 6.0, 0.5)}
-    assert chunked_projection(tmp_path, 4)[0] == 6.0 + 1.0
+    assert chunked_projection(tmp_path, 4)[0] == 6.5  # figA done at 4, merged by 5
+    assert chunked_projection(tmp_path, 1)[0] == 16.0 + 1.5  # all in a row
     (tmp_path / "merge_chunks" / "figB.log").write_text("killed\n")
     with pytest.raises(ValueError, match=r"figB\.log: no .joblog: CPU"):
         chunked_projection(tmp_path, 2)

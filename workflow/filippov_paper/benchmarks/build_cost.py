@@ -57,36 +57,54 @@ def table(logs: Path) -> list[tuple[str, int, float, float]]:
     return sorted(((k, *v) for k, v in rows.items()), key=lambda r: -r[2])
 
 
+def _list_schedule(jobs, free: list[float]) -> list[float]:
+    """Run ``jobs`` ((ready time, duration), in the order given) each on the core that
+    frees first, not before it is ready; ``free`` (the cores' free times) is updated;
+    the jobs' end times are returned."""
+    ends = []
+    for ready, duration in jobs:
+        core = free.index(min(free))
+        free[core] = max(free[core], ready) + duration
+        ends.append(free[core])
+    return ends
+
+
 def makespan(durations, cores: int) -> float:
     """The wall time of independent jobs of the given durations on ``cores`` cores, each
     job on one core, the longest started first, each on the core that frees first
     (list scheduling, as Snakemake runs ready jobs; within 4/3 of the best order)."""
     if not (isinstance(cores, int) and cores >= 1):
         raise ValueError(f"cores: must be an integer >= 1, got {cores!r}")
-    load = [0.0] * min(cores, max(len(durations), 1))
-    for d in sorted(durations, reverse=True):
-        load[load.index(min(load))] += d
-    return max(load)
+    free = [0.0] * cores
+    _list_schedule([(0.0, d) for d in sorted(durations, reverse=True)], free)
+    return max(free)
 
 
 def chunked_projection(logs: Path, cores: int) -> tuple[float, dict]:
     """A projected wall time for the chunked scenes a build's ``logs`` hold, on ``cores``
-    cores with no queue waits: all their chunk jobs scheduled together
-    (:func:`makespan`), then the longest merge job. Also each scene's
-    (chunks, chunk CPU s, longest chunk s, merge CPU s)."""
+    cores (or SLURM jobs) with no queue waits: all their chunk jobs scheduled together,
+    longest first (:func:`makespan`), then each scene's merge job once its chunks are
+    done. Also each scene's (chunks, chunk CPU s, longest chunk s, merge CPU s)."""
     def cpu_of(log: Path) -> float:
         try:
             return job_cpu(log.read_text(encoding="utf-8", errors="replace"))[0]
         except (OSError, ValueError) as exc:  # an unfinished build: say which job
             raise ValueError(f"{log}: {exc}") from None
 
-    scenes = {}
+    makespan([], cores)  # checks cores
+    chunks = {}
     for log in sorted((logs / "compute_chunk").glob("*/*.log")):
-        scenes.setdefault(log.parent.name, []).append(cpu_of(log))
-    merges = {s: cpu_of(logs / "merge_chunks" / f"{s}.log") for s in scenes}
-    every = [d for chunks in scenes.values() for d in chunks]
-    wall = makespan(every, cores) + max(merges.values(), default=0.0)
-    return wall, {s: (len(c), sum(c), max(c), merges[s]) for s, c in scenes.items()}
+        chunks.setdefault(log.parent.name, []).append(cpu_of(log))
+    merges = {s: cpu_of(logs / "merge_chunks" / f"{s}.log") for s in chunks}
+    order = sorted(((d, s) for s, ds in chunks.items() for d in ds), reverse=True)
+    free = [0.0] * cores
+    ends = _list_schedule([(0.0, d) for d, _ in order], free)
+    done = {}
+    for (_, scene), end in zip(order, ends):
+        done[scene] = max(done.get(scene, 0.0), end)
+    merge_jobs = sorted((done[s], merges[s]) for s in chunks)
+    wall = max(_list_schedule(merge_jobs, free), default=0.0)
+    return wall, {s: (len(c), sum(c), max(c), merges[s]) for s, c in chunks.items()}
 
 
 def main(argv=None) -> None:
