@@ -50,3 +50,18 @@ def test_the_readme_s_property_suite_numbers_are_the_suite_s():
     assert f"dP/dz to {_short(tp.TOL_JAC)} relative" in text
     deep = settings.get_profile("deep").max_examples
     assert re.search(rf"`make test-deep` {deep} random systems per test", text)
+
+
+def test_the_code_map_names_what_is_there():
+    """Every name the README's code map quotes is a path of the repository, a module or
+    package of the library or of the pipeline, or a name the library exports."""
+    import filippov
+
+    section = TEXT.split("## Where the code lives")[1].split("\n## ")[0]
+    names = [n for n in re.findall(r"`([^`]+)`", section) if not n.startswith("pip ")]
+    assert len(names) >= 15
+    homes = (ROOT, ROOT / "src" / "filippov", ROOT / "workflow" / "filippov_paper")
+    for name in names:
+        bare = name.rstrip("/")
+        assert (any((home / bare).exists() or (home / f"{bare}.py").exists() for home in homes)
+                or bare in filippov.__all__), name

@@ -22,8 +22,8 @@ from __future__ import annotations
 import contextlib
 import functools
 import math
+from collections import namedtuple
 from dataclasses import dataclass, field
-from types import SimpleNamespace
 from typing import Callable, Optional, Sequence
 
 import numpy as np
@@ -357,23 +357,42 @@ def _normal_speeds(run):
     return tuple(float(v) for v in run.system.normal_speeds(run.z))
 
 
+def _sliding_section(run):
+    """The index of the first section the sliding flow at the run's state stays in, or
+    -1 (none)."""
+    for k in range(len(run.sections)):
+        if _slides_in(k, run):
+            return k
+    return -1
+
+
 def _slides_in_a_section(run):
-    return any(_slides_in(k, run) for k in range(len(run.sections)))
+    return _sliding_section(run) >= 0
 
 
 #: the start's mode and its refusal to slide in a section (filippov.loop.stay.make_start)
 _START = make_start(_normal_speeds, _slides_in_a_section)
 
+#: where a start is asked about, for the operations above (they read these fields of a _Run)
+_At = namedtuple("_At", ["system", "sections", "z"])
+
+
+def _start(at, touch_tol):
+    """(status, mode, what the start event is called) of a start at ``at`` (an _At or
+    a _Run)."""
+    status, mode, repelling = _START(float(at.system.switch(at.z)), touch_tol,
+                                     at.system.sliding, at)
+    return status, mode, ("repelling_start" if repelling else "start")
+
 
 def _refuse_sliding_in_sections(system, sections, z, t) -> None:
-    at = SimpleNamespace(system=system, sections=sections, z=z)
-    for k, sec in enumerate(sections):
-        if _slides_in(k, at):
-            raise run_error(
-                SECTION_SLIDING, t, z, f": it slides from there inside section "
-                f"{sec.name!r} (the section lies on H there). Stop at the arrival on H (a "
-                "terminal hit there ends the run first) or use a section transverse to "
-                "the sliding flow")
+    k = _sliding_section(_At(system, sections, z))
+    if k >= 0:
+        raise run_error(
+            SECTION_SLIDING, t, z, f": it slides from there inside section "
+            f"{sections[k].name!r} (the section lies on H there). Stop at the arrival on H (a "
+            "terminal hit there ends the run first) or use a section transverse to "
+            "the sliding flow")
 
 
 # --------------------------------------------------------------------------- driver
@@ -381,9 +400,8 @@ def initial_mode(system: PiecewiseSystem, z: np.ndarray, touch_tol: float) -> tu
     """Region to start in; on H = 0 (to ``touch_tol``) the field directions decide
     (:func:`filippov.rules.start_on_switch`), so a start point that rounding puts a
     hair on the wrong side is not a switch."""
-    _, mode, repelling = _START(float(system.switch(z)), touch_tol, system.sliding,
-                                SimpleNamespace(system=system, sections=(), z=z))
-    return mode, ("repelling_start" if repelling else "start")
+    _, mode, kind = _start(_At(system, (), z), touch_tol)
+    return mode, kind
 
 
 def _quiet_floating_point(fn):
@@ -473,11 +491,9 @@ class _Run:
         self.__dict__.update(opts)
         self.traj = Trajectory(system=system, t0=self.t0, z0=z.copy(), t=self.t0, z=z.copy())
         self.t, self.z = self.t0, z
-        status, self.mode, repelling = _START(float(system.switch(z)), self.touch_tol,
-                                              system.sliding, self)
+        status, self.mode, kind = _start(self, self.touch_tol)
         self.traj.mode = self.mode
-        self.traj.events.append(Event(self.t0, "repelling_start" if repelling else "start",
-                                      z.copy(), self.mode, self.mode))
+        self.traj.events.append(Event(self.t0, kind, z.copy(), self.mode, self.mode))
         if status != GO_ON:
             raise self._event_error(status)
         self.preds = [rules.section_pred(sec.direction) for sec in sections]

@@ -69,13 +69,19 @@ def _list_schedule(jobs, free: list[float]) -> list[float]:
     return ends
 
 
+def _cores(cores) -> list[float]:
+    """The free times of ``cores`` idle cores (all 0); refuses a count that is not an
+    integer >= 1."""
+    if not (isinstance(cores, int) and cores >= 1):
+        raise ValueError(f"cores: must be an integer >= 1, got {cores!r}")
+    return [0.0] * cores
+
+
 def makespan(durations, cores: int) -> float:
     """The wall time of independent jobs of the given durations on ``cores`` cores, each
     job on one core, the longest started first, each on the core that frees first
     (list scheduling, as Snakemake runs ready jobs; within 4/3 of the best order)."""
-    if not (isinstance(cores, int) and cores >= 1):
-        raise ValueError(f"cores: must be an integer >= 1, got {cores!r}")
-    free = [0.0] * cores
+    free = _cores(cores)
     _list_schedule([(0.0, d) for d in sorted(durations, reverse=True)], free)
     return max(free)
 
@@ -91,13 +97,12 @@ def chunked_projection(logs: Path, cores: int) -> tuple[float, dict]:
         except (OSError, ValueError) as exc:  # an unfinished build: say which job
             raise ValueError(f"{log}: {exc}") from None
 
-    makespan([], cores)  # checks cores
+    free = _cores(cores)
     chunks = {}
     for log in sorted((logs / "compute_chunk").glob("*/*.log")):
         chunks.setdefault(log.parent.name, []).append(cpu_of(log))
     merges = {s: cpu_of(logs / "merge_chunks" / f"{s}.log") for s in chunks}
     order = sorted(((d, s) for s, ds in chunks.items() for d in ds), reverse=True)
-    free = [0.0] * cores
     ends = _list_schedule([(0.0, d) for d, _ in order], free)
     done = {}
     for (_, scene), end in zip(order, ends):
