@@ -4,8 +4,9 @@
   codes, event and predicate codes, the compile decorators, the rule book compiled
   from its one source (:mod:`filippov.rules`), the model-piece helpers;
 * :mod:`.state` -- the kernel's state declared once: Settings and Outputs with their
-  numba types (the kernel's signature is built from them), the work arrays (Work), the
-  groups of them the helpers take, the named positions of w.seg, w.count, w.tally;
+  numba types (the kernel's signature is built from them), the work arrays (Work, and
+  dP/dz's own, Deriv), the groups of them the helpers take, the named positions of
+  w.seg, w.count, w.tally;
 * :mod:`.dop853` -- scipy's DOP853 (step, initial step, dense output);
 * :mod:`.segment` -- the state on the current segment (exact flow or dense output);
 * :mod:`.roots` -- brentq and the far-side refinement of a crossing;

@@ -7,10 +7,10 @@ from .. import rules
 from ..system import PLUS
 from .base import (_dot, _flow_minus, _flow_plus, _grad_h, _jacobian, _jit, _section)
 from .dop853 import (_A, _B, _NS, _TRIAL, _checked_field, _stage)
-from .state import Fill, Stages
+from .state import Stages
 
 
-# The derivative of a return, carried in w.M while the orbit runs (Settings.jac), as the
+# The derivative of a return, carried in w.deriv.M while the orbit runs (Settings.jac), as the
 # reference driver's filippov.variational composes it: an exact-flow stay by central
 # differences of the closed-form flow from its mode entry; an integrated stay (sliding,
 # or a model without flows) by the variational equation taken through the very DOP853
@@ -72,7 +72,7 @@ def _flow_jacobian(mode, za, tau, fns, p, J, z1, z2):
 
 
 @_jit
-def _jvp(mode, y, v, out, fns, p, w):
+def _jvp(mode, y, v, out, fns, p, fl, dv):
     """out = J(y) v, the field's Jacobian along v, by a central difference
     (rules.central_step along v)."""
     n = y.size
@@ -86,77 +86,76 @@ def _jvp(mode, y, v, out, fns, p, w):
             out[k] = 0.0 if vmax == 0.0 else np.nan
         return
     for k in range(n):
-        w.jz1[k] = y[k] + d * v[k]
-        w.jz2[k] = y[k] - d * v[k]
-    _checked_field(w.jz1, mode, _TRIAL, fns, p, Fill(w.wg, w.wf, w.wp), w.jf1)
-    _checked_field(w.jz2, mode, _TRIAL, fns, p, Fill(w.wg, w.wf, w.wp), w.jf2)
+        dv.jz1[k] = y[k] + d * v[k]
+        dv.jz2[k] = y[k] - d * v[k]
+    _checked_field(dv.jz1, mode, _TRIAL, fns, p, fl, dv.jf1)
+    _checked_field(dv.jz2, mode, _TRIAL, fns, p, fl, dv.jf2)
     for k in range(n):
-        out[k] = (w.jf1[k] - w.jf2[k]) / (2.0 * d)
+        out[k] = (dv.jf1[k] - dv.jf2[k]) / (2.0 * d)
 
 
 @_jit
-def _var_stage(s, mode, exact, fns, p, w):
-    """w.KP[s] = J(w.ys) w.Mt: with the model's exact Jacobian (one evaluation), or
+def _var_stage(s, mode, exact, fns, p, fl, dv):
+    """dv.KP[s] = J(dv.ys) dv.Mt: with the model's exact Jacobian (one evaluation), or
     column by column with Jacobian-vector products by central differences."""
-    n = w.ys.size
+    n = dv.ys.size
     if exact:
-        _jacobian(fns, mode, w.ys, p, w.Jm)
+        _jacobian(fns, mode, dv.ys, p, dv.Jm)
         for a in range(n):
             for b in range(n):
                 acc = 0.0
                 for k in range(n):
-                    acc += w.Jm[a * n + k] * w.Mt[k, b]
-                w.KP[s, a, b] = acc
+                    acc += dv.Jm[a * n + k] * dv.Mt[k, b]
+                dv.KP[s, a, b] = acc
         return
     for b in range(n):
         for a in range(n):
-            w.jv[a] = w.Mt[a, b]
-        _jvp(mode, w.ys, w.jv, w.jo, fns, p, w)
+            dv.jv[a] = dv.Mt[a, b]
+        _jvp(mode, dv.ys, dv.jv, dv.jo, fns, p, fl, dv)
         for a in range(n):
-            w.KP[s, a, b] = w.jo[a]
+            dv.KP[s, a, b] = dv.jo[a]
 
 
 @_jit
-def _var_step(mode, y0, h, fns, p, w, exact):
-    """w.M <- the DOP853 step of size h from y0 applied to the variational equation
+def _var_step(mode, y0, h, fns, p, fl, dv, exact):
+    """dv.M <- the DOP853 step of size h from y0 applied to the variational equation
     M' = J(z(t)) M, with the state's stages recomputed from y0 (the same numbers as the
     step of the state); J exact where the model has it (``exact``)."""
     n = y0.size
     for s in range(_NS):
-        _stage(s, mode, y0, h, Stages(w.KV, w.ys), fns, p, Fill(w.wg, w.wf, w.wp))
+        _stage(s, mode, y0, h, Stages(dv.KV, dv.ys), fns, p, fl)
         for a in range(n):
             for b in range(n):
                 acc = 0.0
                 for j in range(s):
-                    acc += w.KP[j, a, b] * _A[s, j]
-                w.Mt[a, b] = w.M[a, b] + acc * h
-        _var_stage(s, mode, exact, fns, p, w)
+                    acc += dv.KP[j, a, b] * _A[s, j]
+                dv.Mt[a, b] = dv.M[a, b] + acc * h
+        _var_stage(s, mode, exact, fns, p, fl, dv)
     for a in range(n):
         for b in range(n):
             acc = 0.0
             for j in range(_NS):
-                acc += w.KP[j, a, b] * _B[j]
-            w.M[a, b] += h * acc
+                acc += dv.KP[j, a, b] * _B[j]
+            dv.M[a, b] += h * acc
 
 
 @_jit
-def _switch_derivative(mode, new_mode, fns, p, w):
-    """w.M <- S w.M, S the saltation matrix of the switch mode -> new_mode at w.z."""
-    _checked_field(w.z, mode, _TRIAL, fns, p, Fill(w.wg, w.wf, w.wp), w.jf1)
-    _checked_field(w.z, new_mode, _TRIAL, fns, p, Fill(w.wg, w.wf, w.wp), w.jf2)
-    _grad_h(fns, w.z, p, w.jz1)
-    speed = _dot(w.jz1, w.jf1)
-    for k in range(w.z.size):
-        w.jf2[k] -= w.jf1[k]
-    _rank_one(w.M, w.jf2, w.jz1, speed)
+def _switch_derivative(mode, new_mode, fns, p, z, fl, dv):
+    """dv.M <- S dv.M, S the saltation matrix of the switch mode -> new_mode at z."""
+    _checked_field(z, mode, _TRIAL, fns, p, fl, dv.jf1)
+    _checked_field(z, new_mode, _TRIAL, fns, p, fl, dv.jf2)
+    _grad_h(fns, z, p, dv.jz1)
+    speed = _dot(dv.jz1, dv.jf1)
+    for k in range(z.size):
+        dv.jf2[k] -= dv.jf1[k]
+    _rank_one(dv.M, dv.jf2, dv.jz1, speed)
 
 
 @_jit
-def _section_derivative(mode, fns, p, w):
-    """w.M <- (I - f g^T / (g . f)) w.M at the section hit w.z: f the field there, g the
-    section's gradient (central differences; w.z is restored bit for bit)."""
-    z = w.z
-    _checked_field(z, mode, _TRIAL, fns, p, Fill(w.wg, w.wf, w.wp), w.jf1)
+def _section_derivative(mode, fns, p, z, fl, dv):
+    """dv.M <- (I - f g^T / (g . f)) dv.M at the section hit z: f the field there, g the
+    section's gradient (central differences; z is restored bit for bit)."""
+    _checked_field(z, mode, _TRIAL, fns, p, fl, dv.jf1)
     for k in range(z.size):
         orig = z[k]
         d = rules.central_step(max(1.0, abs(orig)), 1.0)
@@ -167,5 +166,5 @@ def _section_derivative(mode, fns, p, w):
         down = z[k]
         s2 = _section(fns, z, p)
         z[k] = orig
-        w.jz1[k] = (s1 - s2) / (up - down)
-    _rank_one(w.M, w.jf1, w.jz1, -_dot(w.jz1, w.jf1))
+        dv.jz1[k] = (s1 - s2) / (up - down)
+    _rank_one(dv.M, dv.jf1, dv.jz1, -_dot(dv.jz1, dv.jf1))

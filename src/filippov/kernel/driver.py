@@ -34,8 +34,9 @@ from .segment import _zat
 from .scan import (_carry_sample, _find, _flow_follows, _sample)
 from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY,
                     SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_SHIFT, SEG_SIZE, SEG_STEP_H,
-                    SEG_STEP_T, T_AGE, T_SLID, T_SLIDE_START, TALLY_SIZE, Control, Dop, Fill,
-                    Orbit, Outputs, Samples, Scratch, Settings, Work, kernel_signature)  # noqa: F401
+                    SEG_STEP_T, T_AGE, T_SLID, T_SLIDE_START, TALLY_SIZE, Control, Deriv, Dop,
+                    Fill, Orbit, Outputs, Samples, Scratch, Settings, Work,
+                    kernel_signature)  # noqa: F401
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
 from ..loop.event import SECTION, EventOps, make_event
@@ -45,23 +46,23 @@ from ..loop.status import GO_ON
 
 # ------------------------------------------------------------------ sliding in the section
 # For filippov.loop.stay.make_slides_in (at the start and at an arrival on H): each takes
-# ctx = (fns, p, s, w), as the event's operations below, and works at the state w.z.
+# at = (fns, p, z, wg, wf, wp, wz): the model, the state on H and the scratch vectors, no
+# more (docs/decisions.md#kernel-small-records).
 
 @_jit_inline
-def _slide_fields(ctx):
-    """(z, F_-, F_+) at w.z, in w.wf and w.wp (grad h left in w.wg)."""
-    fns, p, s, w = ctx
-    _speeds(w.z, fns, p, w.wg, w.wf, w.wp)
-    return w.z, w.wf, w.wp
+def _slide_fields(at):
+    """(z, F_-, F_+) at z, in wf and wp (grad h left in wg)."""
+    fns, p, z, wg, wf, wp, _ = at
+    _speeds(z, fns, p, wg, wf, wp)
+    return z, wf, wp
 
 
 @_jit  # a call: make_slides_in asks it seven times (inlined, it grew the cold compile)
-def _section_along(k, mode, d, ctx):
-    """The section at w.z + d (cm F_- + cp F_+), the field of ``mode`` as its weights
+def _section_along(k, mode, d, at):
+    """The section at z + d (cm F_- + cp F_+), the field of ``mode`` as its weights
     (Filippov's while sliding, from F_-, F_+ and grad h left by _slide_fields); d = 0:
-    at w.z."""
-    fns, p, s, w = ctx
-    z, wm, wp = w.z, w.wf, w.wp
+    at z."""
+    fns, p, z, wg, wm, wp, wz = at
     if d == 0.0:
         return _section(fns, z, p)
     if mode == MINUS:
@@ -69,22 +70,21 @@ def _section_along(k, mode, d, ctx):
     elif mode == PLUS:
         cm, cp = 0.0, 1.0
     else:
-        a, b = _dot(w.wg, wm), _dot(w.wg, wp)
+        a, b = _dot(wg, wm), _dot(wg, wp)
         cm, cp = -b / (a - b), a / (a - b)
     for c in range(z.size):
-        w.wz[c] = z[c] + d * (cm * wm[c] + cp * wp[c])
-    return _section(fns, w.wz, p)
+        wz[c] = z[c] + d * (cm * wm[c] + cp * wp[c])
+    return _section(fns, wz, p)
 
 
 _slides_in_section = _jit_inline(make_slides_in(_slide_fields, _section_along))
 
 
 @_jit
-def _slides_in(fns, p, s, w):
-    """The sliding flow at w.z stays in the section (on H): filippov.loop.stay."""
-    return _slides_in_section(0, (fns, p, s, w))
-
-
+def _slides_in(fns, p, z, sc):
+    """The sliding flow at z (on H) stays in the section: filippov.loop.stay; sc: the
+    Scratch vectors."""
+    return _slides_in_section(0, (fns, p, z, sc.wg, sc.wf, sc.wp, sc.wz))
 
 
 # The kernel's ABI: _batch(fns, params, starts, ages, settings, out): the compiled
@@ -130,7 +130,7 @@ def _window(mode, ta, tb, frac, first, o, s, w):
     if _DERIVATIVES and s.jac and w.touched[0]:
         for i in range(w.z.size):
             for j in range(w.z.size):
-                w.M[i, j] = np.nan
+                w.deriv.M[i, j] = np.nan
     if st != OK:
         return st, ta, _W_NONE
     if what == _W_NONE:
@@ -167,8 +167,10 @@ def _stay_exact(mode, t, fns, p, s, w):
         st, t, what = _window(mode, ta, tb, s.frac_ex, first, o, s, w)
         if st != _GO_ON:
             if _DERIVATIVES and st == OK and s.jac:
-                _flow_jacobian(mode, w.za, t - w.seg[SEG_ENTRY], fns, p, w.Mt, w.jz1, w.jz2)
-                _apply(w.Mt, w.M, w.KP[0])
+                dv = w.deriv
+                _flow_jacobian(mode, w.za, t - w.seg[SEG_ENTRY], fns, p, dv.Mt, dv.jz1,
+                               dv.jz2)
+                _apply(dv.Mt, dv.M, dv.KP[0])
             return st, t, what
         ta, first = tb, False
 
@@ -207,7 +209,8 @@ def _stay_integrated(mode, t, fns, p, s, w):
         w.seg[SEG_STEP_H] = tb - ta
         st, t, what = _window(mode, ta, tb, s.frac_in, first, o, s, w)
         if _DERIVATIVES and s.jac and (st == _GO_ON or (st == OK and t > ta)):
-            _var_step(mode, w.y_old, (tb if st == _GO_ON else t) - ta, fns, p, w, s.jac == 2)
+            _var_step(mode, w.y_old, (tb if st == _GO_ON else t) - ta, fns, p, fl, w.deriv,
+                      s.jac == 2)
         if st != _GO_ON:
             return st, t, what
         ta, first = tb, False
@@ -236,7 +239,7 @@ def _at_section(mode, t, ctx):
     if mode == SLIDING:
         _end_slide(t, w)
     if _DERIVATIVES and s.jac:
-        _section_derivative(mode, fns, p, w)
+        _section_derivative(mode, fns, p, w.z, Fill(w.wg, w.wf, w.wp), w.deriv)
     return OK
 
 
@@ -285,7 +288,7 @@ def _event_sliding_built(ctx):
 @_jit_inline
 def _event_slides_in(ctx):
     fns, p, s, w = ctx
-    return _slides_in(fns, p, s, w)
+    return _slides_in(fns, p, w.z, Scratch(w.wz, w.wg, w.wf, w.wp))
 
 
 @_jit_inline
@@ -346,7 +349,7 @@ def _store_exit(new_mode, shift, band, ctx):
 def _event_switch_derivative(mode, new_mode, ctx):
     fns, p, s, w = ctx
     if _DERIVATIVES and s.jac:
-        _switch_derivative(mode, new_mode, fns, p, w)
+        _switch_derivative(mode, new_mode, fns, p, w.z, Fill(w.wg, w.wf, w.wp), w.deriv)
 
 
 @_jit_inline
@@ -401,7 +404,7 @@ def _one(z0, age0, fns, p, s, w):
         # a start that slides: the return is not differentiable across H there
         for i in range(n):
             for j in range(n):
-                w.M[i, j] = np.nan if mode == SLIDING else (1.0 if i == j else 0.0)
+                w.deriv.M[i, j] = np.nan if mode == SLIDING else (1.0 if i == j else 0.0)
     for k in range(n):
         w.slide_z0[k] = w.z[k]
     for k in range(COUNT_SIZE):
@@ -453,12 +456,16 @@ def _batch(fns, params, starts, ages, s, out):
     K = np.zeros((_NSE, n))
     F = np.zeros((_NI, n))
     first = np.zeros(1)
+    if _DERIVATIVES:
+        deriv = Deriv(np.zeros((n, n)), np.zeros((n, n)), np.zeros((_NS, n)),
+                      np.zeros((_NS, n, n)), np.zeros(n), np.zeros(n), np.zeros(n),
+                      np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n * n))
+    else:
+        deriv = 0  # the build without the dP/dz code carries no derivative
     w = Work(ts, vals, dvals, svals, recent, seg, za, y, f, y_old, f_old, K, ynew, ytmp, scale,
              F, wz, wg, wf, wp, np.zeros(n), first, np.zeros(n), np.zeros(n),
              np.zeros(COUNT_SIZE, dtype=np.int64), np.zeros(TALLY_SIZE),
-             np.zeros((n, n)), np.zeros((n, n)), np.zeros((_NS, n)), np.zeros((_NS, n, n)),
-             np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
-             np.zeros(n), np.zeros(1, dtype=np.bool_), np.zeros(n * n))
+             np.zeros(1, dtype=np.bool_), deriv)
     keep_jac = out.orbit_jacobian.shape[1]
     n_iter, keep = s.iterations, out.orbit.shape[1]
     zin = np.empty(n)
@@ -478,10 +485,12 @@ def _batch(fns, params, starts, ages, s, out):
             if j >= 0:
                 for c in range(n):
                     out.orbit[i, j, c] = w.z[c]
-                if keep_jac > 0:  # element by element: a slice assignment compiles
-                    for a in range(n):   # docs/decisions.md#kernel-elementwise-copy
+                # element by element: a slice assignment compiles
+                # (docs/decisions.md#kernel-elementwise-copy)
+                if _DERIVATIVES and keep_jac > 0:
+                    for a in range(n):
                         for b in range(n):
-                            out.orbit_jacobian[i, j, a, b] = w.M[a, b]
+                            out.orbit_jacobian[i, j, a, b] = w.deriv.M[a, b]
             if done >= n_iter:
                 break
             for c in range(n):
@@ -494,10 +503,13 @@ def _batch(fns, params, starts, ages, s, out):
             out.state[i, c] = w.z[c]
             out.sliding_displacement[i, c] = w.slide_dz[c]
         out.status[i] = st
-        made = s.jac != 0 and st == OK
         for a in range(n):
             for b in range(n):
-                out.jacobian[i, a, b] = w.M[a, b] if made else np.nan
+                out.jacobian[i, a, b] = np.nan
+        if _DERIVATIVES and s.jac != 0 and st == OK:
+            for a in range(n):
+                for b in range(n):
+                    out.jacobian[i, a, b] = w.deriv.M[a, b]
         out.time[i] = t
         out.n_switches[i] = nsw
         out.sliding_time[i] = sl

@@ -1,7 +1,8 @@
 """The kernel's state, declared once: its ABI (Settings, Outputs: the fields and their
-numba types, from which the kernel's one signature is built), its work arrays (Work),
-the groups of them its helpers take (Orbit, Scratch, Samples), and the named positions
-of its small state vectors (w.seg, w.count, w.tally).
+numba types, from which the kernel's one signature is built), its work arrays (Work;
+dP/dz's in a record of their own, Deriv), the groups of them its helpers take (Orbit,
+Scratch, Samples, ...), and the named positions of its small state vectors (w.seg,
+w.count, w.tally).
 
 The positions are module constants, not a numba record: a global int is a compile-time
 literal to numba, so ``w.seg[SEG_ENTRY]`` compiles to the very code ``w.seg[0]`` did (no
@@ -64,9 +65,14 @@ def kernel_signature(settings=SETTINGS, outputs=OUTPUTS):
 Work = namedtuple("Work", [
     "ts", "vals", "dvals", "svals", "recent", "seg", "za", "y", "f", "y_old", "f_old", "K",
     "ynew", "ytmp", "scale", "F", "wz", "wg", "wf", "wp", "z", "first_sw", "slide_dz",
-    "slide_z0", "count", "tally",
-    # dP/dz (Settings.jac): the derivative so far, workspaces, the variational stages
-    "M", "Mt", "KV", "KP", "ys", "jv", "jo", "jz1", "jz2", "jf1", "jf2", "touched", "Jm"])
+    "slide_z0", "count", "tally", "touched",
+    # dP/dz (Settings.jac): a Deriv (in the build without the dP/dz code: 0, no arrays)
+    "deriv"])
+
+#: dP/dz's arrays: the derivative so far (M), workspaces, the variational stages; a record
+#: of their own (docs/decisions.md#kernel-small-records)
+Deriv = namedtuple("Deriv", ["M", "Mt", "KV", "KP", "ys", "jv", "jo", "jz1", "jz2", "jf1",
+                             "jf2", "Jm"])
 
 # ----------------------------------------------------------------- w.seg (float64)
 # The current segment of the orbit and its stay. The state on it is the exact flow from
