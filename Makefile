@@ -6,6 +6,7 @@
 #                  hypothesis profile "deep": many more generated systems, randomized
 #   make verify    two clean builds in a temporary directory: byte-identical,
 #                  and in agreement with tests/reference/manifest.json
+#                  (VERIFY_ARGS="--first-build DIR" keeps the first, for cross-cpu --native)
 #   make manifest  rewrite the manifest from results/ and figures/ (prints changes)
 #   make cross-cpu emulate another CPU's last bits (libm, numpy SIMD, numba) and check
 #                  every scene against the manifest: results moved by up to 2 ulps
@@ -137,8 +138,9 @@ docs: $(VENV)/.done
 	$(VENV_PATH) $(PY) -m sphinx -W --keep-going -q -b html -d docs/_build/doctrees docs docs/_build/html
 	@echo "wrote docs/_build/html/index.html"
 
+VERIFY_ARGS ?=
 verify: $(VENV)/.done
-	$(VENV_PATH) $(PY) workflow/scripts/verify.py
+	$(VENV_PATH) $(PY) workflow/scripts/verify.py $(VERIFY_ARGS)
 
 CROSS_CPU_ARGS ?=
 cross-cpu: $(VENV)/.done

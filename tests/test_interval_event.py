@@ -125,7 +125,114 @@ def test_both_engines_run_the_one_event_search():
     from filippov.kernel import scan
 
     assert scan._interval_event.py_func.__code__ is simulate._interval_event.__code__
-    assert "_interval_event" in _calls(SRC / "simulate.py")
-    assert "_interval_event" in _calls(SRC / "kernel/scan.py")
+    # each engine's window walk asks it
+    for walk, event in ((simulate._window_event, simulate._interval_event),
+                        (scan._window_event.py_func, scan._interval_event)):
+        assert event in [cell.cell_contents for cell in walk.__closure__]
     for gone in ("_event_in", "_leave_crossing", "_section_hit"):
         assert not hasattr(simulate._Scan, gone) and not hasattr(scan, gone)
+
+
+# ----------------------------------------------------------- the walk over a window
+class Window:
+    """A window whose intervals are scripted: ``cand`` the candidate intervals (banded),
+    ``unbanded`` those once the band ends, ``clear`` the first interval whose start is out
+    of the band, ``events`` {i: t}; ``asked`` the intervals the event search was asked."""
+
+    def __init__(self, cand, events, clear=None, unbanded=()):
+        self.cand, self.events, self.clear, self.unbanded = list(cand), events, clear, unbanded
+        self.band, self.asked, self.unbands = clear is not None, [], []
+
+
+WALK = interval.make_window_event(
+    next_candidate=lambda c, i, mode: (min((j for j in c.cand if j >= i), default=-1), c),
+    clears_band_at=lambda c, i, mode: c.band and i >= c.clear,
+    unband=lambda c, i, mode: (c.unbands.append(i), setattr(c, "band", False),
+                               setattr(c, "cand", [j for j in c.unbanded if j >= i])),
+    interval_event=lambda c, i, mode: (c.asked.append(i), (
+        (OK, c.events[i], rules.SWITCH, -1) if i in c.events else (OK, math.inf, NONE, -1)))[1])
+
+
+def test_the_window_asks_its_candidates_in_time_order_up_to_the_first_event():
+    c = Window(cand=[2, 5, 9, 11], events={9: 4.5, 11: 5.5})
+    assert WALK(c, PLUS) == (OK, 4.5, rules.SWITCH, -1)
+    assert c.asked == [2, 5, 9] and c.unbands == []
+    c = Window(cand=[], events={})
+    assert WALK(c, MINUS) == (OK, math.inf, NONE, -1) and c.asked == []
+
+
+def test_the_band_ends_at_the_first_candidate_out_of_it_and_that_interval_is_asked_again():
+    # out of the band at interval 5: h unbiased from there shows no change at 5 any more
+    c = Window(cand=[2, 5, 9], events={7: 3.5}, clear=5, unbanded=[0, 7, 9])
+    assert WALK(c, PLUS) == (OK, 3.5, rules.SWITCH, -1)
+    assert c.unbands == [5] and c.asked == [2, 7]  # 0 lies before the band's end
+    # ... or still does: then that interval is asked at once
+    c = Window(cand=[2, 5], events={5: 2.5}, clear=5, unbanded=[5])
+    assert WALK(c, PLUS) == (OK, 2.5, rules.SWITCH, -1)
+    assert c.unbands == [5] and c.asked == [2, 5]
+
+
+def test_a_failed_search_stops_the_walk():
+    c = Window(cand=[1, 3], events={})
+    walk = interval.make_window_event(
+        lambda c, i, mode: (min((j for j in c.cand if j >= i), default=-1), c),
+        lambda c, i, mode: False, lambda c, i, mode: None,
+        lambda c, i, mode: (c.asked.append(i), (7, 0.25, NONE, -1))[1])
+    assert walk(c, SLIDING) == (7, 0.25, NONE, -1) and c.asked == [1]
+
+
+def test_both_engines_walk_their_windows_with_the_one_function():
+    import importlib
+
+    simulate = importlib.import_module("filippov.simulate")
+    from filippov.kernel import scan
+
+    assert scan._window_event.py_func.__code__ is simulate._window_event.__code__
+    assert "_window_event" in _calls(SRC / "simulate.py")
+    assert "_window_event" in _calls(SRC / "kernel/scan.py")
+
+
+def test_a_switch_beyond_the_band_is_refined_again_from_the_first_probe_out_of_it():
+    """make_past_band probes back from r toward lo (rules.band_probe) and refines the
+    unbiased h from the first probe whose banded h clears the band; none: r stands."""
+    band, asked = 0.1, []
+
+    def walk(clear_before):  # banded h in region +: clears the band before clear_before
+        refined = []
+        past = interval.make_past_band(
+            lambda c, t, mode: (asked.append(t), 1.0 if t < clear_before else 0.0)[1],
+            lambda c, lo, hi, mode: (refined.append((lo, hi)), 0.5 * (lo + hi))[1])
+        return past(None, 2.0, 1.0, PLUS, band), refined
+
+    t, refined = walk(clear_before=1.5)
+    assert asked[0] == 2.0 and all(b < a for a, b in zip(asked, asked[1:]))
+    tq = asked[-1]
+    assert tq < 1.5 <= asked[-2] and refined == [(tq, 2.0)] and t == 0.5 * (tq + 2.0)
+    asked.clear()
+    t, refined = walk(clear_before=1.0)  # never out of the band after lo: r stands
+    assert t == 2.0 and refined == [] and asked[-1] == 1.0
+
+
+def test_both_engines_probe_past_the_band_with_the_one_function():
+    import importlib
+
+    simulate = importlib.import_module("filippov.simulate")
+    from filippov.kernel import scan
+
+    assert scan._past_band.py_func.__code__ is simulate._past_band.__code__
+    for gone in ("_band_root",):
+        assert not hasattr(scan, gone)
+    assert not hasattr(simulate._Scan, "_past_band")
+
+
+def test_the_walk_asks_for_the_next_candidate_in_one_place():
+    """The kernel inlines every call of an operation (numba, inline="always"): the walk
+    calls each of its operations once, so the kernel holds one copy of each."""
+    import inspect
+    import textwrap
+
+    tree = ast.parse(textwrap.dedent(inspect.getsource(interval.make_window_event)))
+    calls = [node.func.id for node in ast.walk(tree)
+             if isinstance(node, ast.Call) and isinstance(node.func, ast.Name)]
+    for op in ("next_candidate", "clears_band_at", "unband", "interval_event"):
+        assert calls.count(op) == 1, op

@@ -19,7 +19,12 @@ The reference driver (:mod:`filippov.simulate`) and the compiled engine
 (:mod:`filippov.fastmap`, :mod:`filippov.kernel`) take every decision from one rule book
 (:mod:`filippov.rules`), and the event loop's structure is written once, beside it, in
 :mod:`filippov.loop` (the reference runs it as Python, the kernel compiles it, each
-with its own operations). In a sample interval both run one event search,
+with its own operations). Over a window both walk its candidate intervals in
+time order with one function (``make_window_event``: the exit's rounding band ended at
+the first candidate whose start is out of it, ``rules.clears_band``, and that interval
+asked again; a switch found beyond the band refined again on H, ``make_past_band``),
+each finding its candidates its own way (the reference with array
+operations, the kernel with scalars). In a sample interval both run one event search,
 :mod:`filippov.loop.interval`, which asks in one order -- the crossing of H (or of a
 or b while sliding), the end of sliding hidden between the samples, then a hidden
 extremum of H, then each section, whose root at the instant of a switch wins the tie
@@ -38,9 +43,7 @@ run's end time; sliding the system does not build). Both share one set of status
 (:mod:`filippov.loop.status`), and one table turns a status into its exception class and
 message (:func:`filippov.errors.run_error`, item 10). The
 rest they ask in the same order on each side: the hard bound ``max_steps``
-(integration steps, or exact-flow windows), counted alike; the walk over a window's
-candidate intervals, the exit's rounding band ended at the first candidate whose
-start is out of it (``rules.clears_band``); a start on the section up to rounding
+(integration steps, or exact-flow windows), counted alike; a start on the section up to rounding
 (``rules.starts_on_section``, the probes of ``rules.section_probe``); the exact-flow check
 (``rules.flow_consistent``); non-finite states and fields (an error, or a status);
 the options (:mod:`filippov.options`, one check for both). What remains different is

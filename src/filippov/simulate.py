@@ -865,6 +865,7 @@ class _Scan:
         self.leave, self.sections, self.preds, self.first = leave, sections, preds, first
         self.touch_tol, self.xtol, self.traj = touch_tol, xtol, traj
         self.band, self.unbanded = band, unbanded
+        self.order = None  # the candidate intervals still to ask (earliest, _unband)
         self.vals = []
         for func, pred, what in leave:
             v = np.asarray(func(zs), dtype=float)
@@ -907,31 +908,34 @@ class _Scan:
 
     def earliest(self):
         """(t, z, what, section index) of the earliest event, or None; the band after it."""
-        order, pos = np.flatnonzero(self.candidates()), 0
-        while pos < order.size:
-            i = int(order[pos])
-            pos += 1
-            if self.band > 0.0 and rules.clears_band(self.mode, self.vals[0][i], self.band):
-                order, pos = self._unband(i), 0
-                continue
-            _, r, what, k = _interval_event(self, i, self.mode)
-            if what != interval.NONE:
-                z = np.asarray(self.Z(r), dtype=float).reshape(-1).copy()
-                return (r, z, what, k), self.band
-        return None, self.band
+        self.order = np.flatnonzero(self.candidates())
+        _, r, what, k = _window_event(self, self.mode)
+        if what == interval.NONE:
+            return None, self.band
+        return (r, np.asarray(self.Z(r), dtype=float).reshape(-1).copy(), what, k), self.band
 
-    def _unband(self, i):
+    # -------------------------------------------- the window walk's operations on it
+    # (filippov.loop.interval.make_window_event, _window_event below)
+
+    def _next_candidate(self, i, mode):
+        pos = int(np.searchsorted(self.order, i))
+        return (int(self.order[pos]) if pos < self.order.size else -1), self
+
+    def _clears_band_at(self, i, mode):
+        return self.band > 0.0 and bool(rules.clears_band(mode, self.vals[0][i], self.band))
+
+    def _unband(self, i, mode):
         """Out of the exit's rounding band at ts[i]: H unbiased from there on, so a
-        return across H is refined at H = 0 (as the compiled engine's _find). The
-        candidate intervals from i on, again."""
+        return across H is refined at H = 0 (as the compiled engine's). The candidate
+        intervals from i on, again."""
         self.band, self.leave = 0.0, self.unbanded
         self.vals[0] = np.asarray(self.leave[0][0](self.zs), dtype=float)
         again = rules.crosses(self.leave[0][1], self.vals[0][:-1], self.vals[0][1:])
-        again |= rules.extremum_between(self.mode, self.D[:-1], self.D[1:])
+        again |= rules.extremum_between(mode, self.D[:-1], self.D[1:])
         for pred, sv in zip(self.preds, self.svals):
             again |= rules.crosses(pred, sv[:-1], sv[1:])
         again[:i] = False
-        return np.flatnonzero(again)
+        self.order = np.flatnonzero(again)
 
     # -------------------------------------------- the event search's operations on it
     # The order of the questions in one sample interval and its ties are the one event
@@ -958,19 +962,15 @@ class _Scan:
                 lo, vlo = tm, hm
         r = _refine(self._along(func), pred, lo, tb, vlo, v[i + 1], self.xtol)
         if self.band > 0.0 and what == "switch":
-            r = self._past_band(func, pred, lo, r)
+            r = _past_band(self, r, lo, mode, self.band)
         return interval.OK, r
 
-    def _past_band(self, func, pred, lo, r):
-        """A switch found beyond the exit's band: again on H itself (rules.band_probe)."""
+    def _banded_h(self, t, mode):
+        return float(self.leave[0][0](self.Z(t)))
+
+    def _refine_unbanded(self, lo, hi, mode):
         h = self._along(self.unbanded[0][0])
-        tq, step, done, clear = r, 0.0, False, False
-        while not done:
-            clear = rules.clears_band(self.mode, float(func(self.Z(tq))), self.band)
-            done, tq, step = rules.band_probe(tq, step, lo, clear)
-        if clear:
-            r = _refine(h, pred, tq, r, h(tq), h(r), self.xtol)
-        return r
+        return _refine(h, self.leave[0][1], lo, hi, h(lo), h(hi), self.xtol)
 
     def _slide_end_between(self, q, i):
         Dv = self.R[q] if self.rates is not None else None
@@ -1051,6 +1051,9 @@ _interval_event = interval.make_interval_event(
     _Scan._hidden_slide_end, _Scan._extremum_between, _Scan._hidden_extremum, _Scan._touch,
     _Scan._n_sections, _Scan._section_crosses, _Scan._section_root, _Scan._section_bounds,
     _Scan._section_counts)
+_past_band = interval.make_past_band(_Scan._banded_h, _Scan._refine_unbanded)
+_window_event = interval.make_window_event(_Scan._next_candidate, _Scan._clears_band_at,
+                                           _Scan._unband, _interval_event)
 
 # the event search and what is done at an event speak the same codes
 assert interval.SECTION == SECTION and interval.OK == OK

@@ -11,6 +11,10 @@
 3. The first build is compared with the committed manifest
    (tests/reference/manifest.json, see filippov_paper.manifest).
 
+``--first-build DIR`` builds the first copy in DIR and keeps it: CI hands it to
+`make cross-cpu` as its native build (``--native DIR``) instead of building the
+same tree a third time.
+
 Run by make, not by a Snakemake rule. tests/conftest.py reuses copy_project and
 run_snakemake from here.
 """
@@ -77,7 +81,12 @@ def identical(a: Path, b: Path) -> list[str]:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--keep", action="store_true", help="keep the build directories")
+    ap.add_argument("--first-build", type=Path, metavar="DIR",
+                    help="build the first copy in DIR (new or empty) and keep it")
     args = ap.parse_args(argv)
+    first = args.first_build
+    if first is not None and first.exists() and (not first.is_dir() or any(first.iterdir())):
+        ap.error(f"--first-build: {first} exists and is not an empty directory")
     sys.path[:0] = [str(ROOT / "src"), str(ROOT / "workflow")]
     from filippov_paper import manifest
 
@@ -85,7 +94,12 @@ def main(argv=None) -> int:
     try:
         builds = []
         for name in ("a", "b"):
-            work = copy_project(tmp / name)
+            dest = tmp / name
+            if name == "a" and first is not None:
+                if first.exists():
+                    first.rmdir()  # empty: checked above
+                dest = first.resolve()
+            work = copy_project(dest)
             for rel in MEASURED if builds else ():  # build b reuses a's timings
                 (work / rel).parent.mkdir(parents=True, exist_ok=True)
                 shutil.copy2(builds[0] / rel, work / rel)

@@ -81,10 +81,10 @@ _slides_in_section = _jit_inline(make_slides_in(_slide_fields, _section_along))
 
 
 @_jit
-def _slides_in(fns, p, z, sc):
-    """The sliding flow at z (on H) stays in the section: filippov.loop.stay; sc: the
-    Scratch vectors."""
-    return _slides_in_section(0, (fns, p, z, sc.wg, sc.wf, sc.wp, sc.wz))
+def _slides_in(at):
+    """The sliding flow at z (on H) stays in the section: filippov.loop.stay; at: as
+    _section_along's."""
+    return _slides_in_section(0, at)
 
 
 # The kernel's ABI: _batch(fns, params, starts, ages, settings, out): the compiled
@@ -288,7 +288,7 @@ def _event_sliding_built(ctx):
 @_jit_inline
 def _event_slides_in(ctx):
     fns, p, s, w = ctx
-    return _slides_in(fns, p, w.z, Scratch(w.wz, w.wg, w.wf, w.wp))
+    return _slides_in((fns, p, w.z, w.wg, w.wf, w.wp, w.wz))
 
 
 @_jit_inline

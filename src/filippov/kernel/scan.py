@@ -7,7 +7,7 @@ from collections import namedtuple
 import numpy as np
 
 from .. import rules
-from ..loop.interval import make_interval_event
+from ..loop.interval import make_interval_event, make_past_band, make_window_event
 from ..system import MINUS, PLUS, SLIDING
 from .base import (OK, ROOT_FAILED, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB, _S_H,
                    _S_SEC, _TO_NEG, _TO_NONNEG, _TO_NONPOS, _W_NONE, _dot, _jit,
@@ -126,33 +126,24 @@ def _leave_of(mode):
 
 
 @_jit_inline
-def _unband(i, ns, mode, o, sm, sc):
-    """The orbit is out of its exit's rounding band at ts[i]: from there H is unbiased
-    (rules.clears_band), so a return across H is refined at H = 0: the shift dropped and
-    h sampled again from ts[i] on."""
-    o.seg[SEG_SHIFT] = o.seg[SEG_EXIT_SHIFT]
-    o.seg[SEG_BAND] = 0.0
-    for k in range(i, ns):
-        sm.vals[0, k] = _fval(_S_H, sm.ts[k], mode, o, sc)
+def _banded_h(ctx, t, mode):
+    return _fval(_S_H, t, mode, ctx[1], ctx[2])
 
 
 @_jit_inline
-def _band_root(r, lo, mode, lv, o, sc):
-    """A crossing of H found at r beyond the exit's band, refined again on H itself
-    (rules.band_probe) where the orbit has cleared the band before r; (r, ok)."""
+def _refine_unbanded(ctx, lo, hi, mode):
+    """h's root in [lo, hi] on H itself: the exit's shift in force of the banded one."""
+    lv, o, sc = ctx
     sg = o.seg
-    tq, step, done, clear = r, 0.0, False, False
-    while not done:
-        clear = rules.clears_band(mode, _fval(_S_H, tq, mode, o, sc), sg[SEG_BAND])
-        done, tq, step = rules.band_probe(tq, step, lo, clear)
-    if clear:
-        banded = sg[SEG_SHIFT]
-        sg[SEG_SHIFT] = sg[SEG_EXIT_SHIFT]
-        r2, ok = _refine(lv.sel, lv.pred, tq, r, _fval(_S_H, tq, mode, o, sc), mode, o, sc)
-        sg[SEG_SHIFT] = banded
-        if ok:
-            r = r2
-    return r
+    banded = sg[SEG_SHIFT]
+    sg[SEG_SHIFT] = sg[SEG_EXIT_SHIFT]
+    r, ok = _refine(lv.sel, lv.pred, lo, hi, _fval(_S_H, lo, mode, o, sc), mode, o, sc)
+    sg[SEG_SHIFT] = banded
+    return r if ok else hi
+
+
+#: a crossing of H found beyond the exit's band, refined again on H itself (loop.interval)
+_past_band = _jit_inline(make_past_band(_banded_h, _refine_unbanded))
 
 
 @_jit_inline
@@ -170,15 +161,17 @@ def _leave_root(i, mode, first, lv, o, sm, sc):
     if not ok:
         return r, False
     if o.seg[SEG_BAND] > 0.0:  # found beyond the exit's band: again on H itself
-        r = _band_root(r, lo, mode, lv, o, sc)
+        r = _past_band((lv, o, sc), r, lo, mode, o.seg[SEG_BAND])
     return r, True
 
 
 # ------------------------------------------------------------------ the event search
-# The order of the questions in one sample interval and its ties are the one event search
-# (filippov.loop.interval); what follows is how the kernel answers each, on its samples
-# (sm) and its segment (o). Its state ``ctx`` is the tuple (first, lv, s, o, sm, sc, c0,
-# c1, cd, cs, ha, hb): the window's records and the sign changes _find saw in the interval.
+# The order of the questions in one sample interval and its ties, and the walk over the
+# window's intervals, are the one event search (filippov.loop.interval); what follows is
+# how the kernel answers each, on its samples (sm) and its segment (o). The walk's state
+# is the tuple (first, lv, s, o, sm, sc, ns): the window's records and its number of
+# samples; the event search's (first, lv, s, o, sm, sc, c0, c1, cd, cs, ha, hb): the
+# window's records and the sign changes _next_candidate saw in the interval.
 
 @_jit_inline
 def _leave_crosses(ctx, q, i):
@@ -298,36 +291,59 @@ _interval_event = _jit_inline(make_interval_event(
     _section_counts))
 
 
-@_jit
+@_jit_inline
+def _next_candidate(ctx, i, mode):
+    """The first sample interval from i on where a sign change shows (-1: none), and the
+    event search's state there: the window's records and the sign changes seen."""
+    first, lv, s, o, sm, sc, ns = ctx
+    vals, dvals, svals, sg = sm.vals, sm.dvals, sm.svals, o.seg
+    for j in range(i, ns - 1):
+        c0 = rules.crosses(lv.pred, vals[0, j], vals[0, j + 1])
+        c1 = lv.n == 2 and rules.crosses(_TO_NONNEG, vals[1, j], vals[1, j + 1])
+        cd = mode != SLIDING and rules.extremum_between(mode, dvals[0, j], dvals[0, j + 1])
+        cs = rules.crosses(s.sec_pred, svals[j], svals[j + 1])
+        # while sliding: a minimum of a, a maximum of b between the samples (rules)
+        ha = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and rules.speed_extremum_between(
+            _TO_NONPOS, dvals[0, j], dvals[0, j + 1])
+        hb = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and rules.speed_extremum_between(
+            _TO_NONNEG, dvals[1, j], dvals[1, j + 1])
+        if c0 or c1 or cd or cs or ha or hb:
+            return j, (first, lv, s, o, sm, sc, c0, c1, cd, cs, ha, hb)
+    return -1, (first, lv, s, o, sm, sc, False, False, False, False, False, False)
+
+
+@_jit_inline
+def _clears_band_at(ctx, i, mode):
+    sg = ctx[3].seg
+    return sg[SEG_BAND] > 0.0 and rules.clears_band(mode, ctx[4].vals[0, i], sg[SEG_BAND])
+
+
+@_jit_inline
+def _unband(ctx, i, mode):
+    """The orbit is out of its exit's rounding band at ts[i]: from there h is unbiased
+    (rules.clears_band), so a return across H is refined at H = 0: the shift dropped and
+    h sampled again from ts[i] on."""
+    o, sm, sc, ns = ctx[3], ctx[4], ctx[5], ctx[6]
+    o.seg[SEG_SHIFT] = o.seg[SEG_EXIT_SHIFT]
+    o.seg[SEG_BAND] = 0.0
+    for k in range(i, ns):
+        sm.vals[0, k] = _fval(_S_H, sm.ts[k], mode, o, sc)
+
+
+#: a call with its pieces inlined, as _find was (docs/decisions.md#kernel-inlined-driver)
+_window_event = _jit(make_window_event(_next_candidate, _clears_band_at, _unband,
+                                       _interval_event))
+
+
+@_jit_inline
 def _find(mode, ns, first, s, o, sm, sc):
     """The earliest event on the samples (the one event search of loop.interval, asked in
     each interval where a sign change shows); (status, t, what). A touch of H on the way
     (no event) sets sm.touched[0]."""
     lv = _leave_of(mode)
-    vals, dvals, svals, sg = sm.vals, sm.dvals, sm.svals, o.seg
     if first:  # just entered this mode: its start is inside by construction
-        vals[0, 0] = rules.clamp(lv.pred, vals[0, 0])
+        sm.vals[0, 0] = rules.clamp(lv.pred, sm.vals[0, 0])
         if lv.n == 2:
-            vals[1, 0] = rules.clamp(_TO_NONNEG, vals[1, 0])
-    for i in range(ns - 1):
-        c0 = rules.crosses(lv.pred, vals[0, i], vals[0, i + 1])
-        c1 = lv.n == 2 and rules.crosses(_TO_NONNEG, vals[1, i], vals[1, i + 1])
-        cd = mode != SLIDING and rules.extremum_between(mode, dvals[0, i], dvals[0, i + 1])
-        cs = rules.crosses(s.sec_pred, svals[i], svals[i + 1])
-        # while sliding: a minimum of a, a maximum of b between the samples (rules)
-        ha = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and rules.speed_extremum_between(
-            _TO_NONPOS, dvals[0, i], dvals[0, i + 1])
-        hb = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and rules.speed_extremum_between(
-            _TO_NONNEG, dvals[1, i], dvals[1, i + 1])
-        if not (c0 or c1 or cd or cs or ha or hb):
-            continue
-        if sg[SEG_BAND] > 0.0 and rules.clears_band(mode, vals[0, i], sg[SEG_BAND]):
-            _unband(i, ns, mode, o, sm, sc)
-            c0 = rules.crosses(lv.pred, vals[0, i], vals[0, i + 1])
-            if not (c0 or c1 or cd or cs):
-                continue
-        st, t, what, _ = _interval_event((first, lv, s, o, sm, sc, c0, c1, cd, cs, ha, hb),
-                                         i, mode)
-        if st != OK or what != _W_NONE:
-            return st, t, what
-    return OK, np.inf, _W_NONE
+            sm.vals[1, 0] = rules.clamp(_TO_NONNEG, sm.vals[1, 0])
+    st, t, what, _ = _window_event((first, lv, s, o, sm, sc, ns), mode)
+    return st, t, what

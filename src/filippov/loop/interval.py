@@ -1,4 +1,5 @@
-"""The event search of one sample interval, written once for both engines.
+"""The event search of one sample interval, and the walk over a window's intervals,
+written once for both engines.
 
 Between two samples of a stay the scan asks, in this order:
 
@@ -17,7 +18,14 @@ Between two samples of a stay the scan asks, in this order:
    arrives on H) and the engine counts it there (``where`` holds, and it is not the run's
    start on the section up to rounding).
 
-:func:`make_interval_event` builds this from the engine's own operations -- how it tests
+A window's intervals are asked in time order (:func:`make_window_event`), only those
+where a sign change shows; while the exit's rounding band is in force, the first such
+interval whose start is out of the band (``rules.clears_band``) ends it: h is sampled
+again unbiased from there and that interval is asked again whether it still holds a
+sign change. A switch found while the band is in force, at a time where the orbit is
+already out of it, is refined again on h itself (:func:`make_past_band`).
+
+:func:`make_interval_event` builds the search from the engine's own operations -- how it tests
 its samples, refines a root, finds a hidden extremum, records a touch --, each a
 function of the engine's state ``ctx`` first. The reference driver
 (:class:`filippov.simulate._Scan`) passes its Python methods and runs the result as it
@@ -125,3 +133,59 @@ def make_interval_event(leave_crosses, leave_root, slide_end_between, hidden_sli
         return OK, best_t, best_w, best_k
 
     return interval_event
+
+
+def make_window_event(next_candidate, clears_band_at, unband, interval_event):
+    """``window_event(ctx, mode) -> (status, t, what, k)``: the earliest event over a
+    window's sample intervals, asked in time order (this module's docstring), from the
+    engine's operations on its state ``ctx``:
+
+    * ``next_candidate(ctx, i, mode) -> (j, at)``: the first interval j from i on where
+      a sign change shows (one of interval_event's questions may hold), -1 if none, and
+      the state ``at`` the event search is asked on there (ctx itself, or ctx with what
+      the engine saw at j);
+    * ``clears_band_at(ctx, i, mode)``: the exit's band is in force and the orbit is out
+      of it at the start of interval i; ``unband(ctx, i, mode)``: the band ends there
+      (h unbiased from sample i on, the candidates from i on found again);
+    * ``interval_event``: :func:`make_interval_event`'s, asked on ``at``.
+    """
+
+    def window_event(ctx, mode):
+        i = 0
+        while True:  # one call of next_candidate: the kernel inlines each
+            i, at = next_candidate(ctx, i, mode)
+            if i < 0:
+                return OK, math.inf, NONE, -1
+            if clears_band_at(ctx, i, mode):
+                unband(ctx, i, mode)  # then interval i is asked again, h unbiased
+                continue
+            st, t, what, k = interval_event(at, i, mode)
+            if st != OK or what != NONE:
+                return st, t, what, k
+            i += 1
+
+    return window_event
+
+
+def make_past_band(banded_h, refine_unbanded):
+    """``past_band(ctx, r, lo, mode, band) -> t``: a switch found at r (the root of h as
+    biased by the exit's band, searched from lo) refined again on h itself when the orbit
+    is out of the band before r: probed back from r toward lo (``rules.band_probe``)
+    until a time out of the band (``rules.clears_band``), the root of the unbiased h
+    between it and r; r itself if no probe clears the band. The engine's operations:
+
+    * ``banded_h(ctx, t, mode)``: h as biased by the band, at t;
+    * ``refine_unbanded(ctx, lo, hi, mode)``: the root of the unbiased h in [lo, hi]
+      (hi if the engine's refinement fails).
+    """
+
+    def past_band(ctx, r, lo, mode, band):
+        tq, step, done, clear = r, 0.0, False, False
+        while not done:
+            clear = rules.clears_band(mode, banded_h(ctx, tq, mode), band)
+            done, tq, step = rules.band_probe(tq, step, lo, clear)
+        if clear:
+            return refine_unbanded(ctx, tq, r, mode)
+        return r
+
+    return past_band
