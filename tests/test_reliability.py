@@ -273,8 +273,6 @@ def test_manifest_check_defaults_to_the_working_directory(tmp_path, monkeypatch)
     assert manifest.main(["check"]) == 1
 
 
-
-
 def test_verify_refuses_a_first_build_directory_that_is_not_empty(tmp_path, capsys):
     import verify
     (tmp_path / "kept.txt").write_text("a user's file")

@@ -926,7 +926,7 @@ class _Scan:
 
     def _unband(self, i, mode):
         """Out of the exit's rounding band at ts[i]: H unbiased from there on, so a
-        return across H is refined at H = 0 (as the compiled engine's). The candidate
+        return across H is refined at H = 0 (as in the compiled engine). The candidate
         intervals from i on, again."""
         self.band, self.leave = 0.0, self.unbanded
         self.vals[0] = np.asarray(self.leave[0][0](self.zs), dtype=float)

@@ -37,7 +37,7 @@ MEASURED = ("results/work_precision.nc",)
 
 def copy_project(dest: Path) -> Path:
     """What a fresh clone needs to run the workflow: Snakefile, config, workflow, paper."""
-    dest.mkdir(parents=True)
+    dest.mkdir(parents=True, exist_ok=True)  # new, or an empty directory given to fill
     shutil.copy(ROOT / "Snakefile", dest / "Snakefile")
     for folder in ("config", "workflow"):
         shutil.copytree(ROOT / folder, dest / folder)
@@ -87,6 +87,7 @@ def main(argv=None) -> int:
     first = args.first_build
     if first is not None and first.exists() and (not first.is_dir() or any(first.iterdir())):
         ap.error(f"--first-build: {first} exists and is not an empty directory")
+    first_dir = first.resolve() if first is not None else None
     sys.path[:0] = [str(ROOT / "src"), str(ROOT / "workflow")]
     from filippov_paper import manifest
 
@@ -96,9 +97,7 @@ def main(argv=None) -> int:
         for name in ("a", "b"):
             dest = tmp / name
             if name == "a" and first is not None:
-                if first.exists():
-                    first.rmdir()  # empty: checked above
-                dest = first.resolve()
+                dest = first_dir  # new or empty: checked above
             work = copy_project(dest)
             for rel in MEASURED if builds else ():  # build b reuses a's timings
                 (work / rel).parent.mkdir(parents=True, exist_ok=True)
@@ -107,7 +106,9 @@ def main(argv=None) -> int:
             print(f"== clean build {name} in {work}", flush=True)
             run = run_snakemake(work, cores="all", capture=False)
             if run.returncode != 0:
-                print(f"verify: build {name} failed (exit {run.returncode})", file=sys.stderr)
+                left = f"; its incomplete copy is left in {work}" if work == first_dir else ""
+                print(f"verify: build {name} failed (exit {run.returncode}){left}",
+                      file=sys.stderr)
                 return 1
             print(f"== build {name}: {time.perf_counter() - t0:.0f} s", flush=True)
             builds.append(work)
@@ -126,6 +127,8 @@ def main(argv=None) -> int:
               f"{'OK' if not problems else f'{len(problems)} mismatches'}")
         return 1 if diff or problems else 0
     finally:
+        if first is not None:
+            print(f"first build kept in {first_dir}")
         if args.keep:
             print(f"builds kept in {tmp}")
         else:
