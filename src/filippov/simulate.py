@@ -930,10 +930,7 @@ class _Scan:
         intervals from i on, again."""
         self.band, self.leave = 0.0, self.unbanded
         self.vals[0] = np.asarray(self.leave[0][0](self.zs), dtype=float)
-        again = rules.crosses(self.leave[0][1], self.vals[0][:-1], self.vals[0][1:])
-        again |= rules.extremum_between(mode, self.D[:-1], self.D[1:])
-        for pred, sv in zip(self.preds, self.svals):
-            again |= rules.crosses(pred, sv[:-1], sv[1:])
+        again = self.candidates()  # a band is in force in a region only: h, dH/dt, sections
         again[:i] = False
         self.order = np.flatnonzero(again)
 
