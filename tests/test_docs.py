@@ -71,7 +71,9 @@ def test_make_docs_is_a_target_and_runs_in_ci():
     assert re.search(r"^docs:", makefile, re.M)
     assert re.search(r"-W\b.*--keep-going|--keep-going.*-W\b", makefile)
     ci = (ROOT / ".ci" / "run").read_text()
-    assert ci.index("make test") < ci.index("make docs") < ci.index("make verify")
+    # verify's first build is the suite's shared build and cross-cpu's native one
+    assert (ci.index("make verify") < ci.index('FILIPPOV_TEST_BUILD="$native" make test')
+            < ci.index("make docs") < ci.index("make cross-cpu"))
     lock = (ROOT / "requirements.lock").read_text()
     for pkg in ("sphinx", "myst-parser", "sphinx-gallery"):
         assert re.search(rf"^{pkg}==", lock, re.M | re.I), f"{pkg} is not pinned"

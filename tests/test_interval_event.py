@@ -135,22 +135,33 @@ def test_both_engines_run_the_one_event_search():
 
 # ----------------------------------------------------------- the walk over a window
 class Window:
-    """A window whose intervals are scripted: ``cand`` the candidate intervals (banded),
-    ``unbanded`` those once the band ends, ``clear`` the first interval whose start is out
-    of the band, ``events`` {i: t}; ``asked`` the intervals the event search was asked."""
+    """A window of ``n`` samples whose intervals are scripted: ``cand`` the candidate
+    intervals (banded), ``unbanded`` those once the band ends, ``clear`` the first sample
+    out of the band, ``events`` {i: t}; ``asked`` the intervals the event search was
+    asked, ``unbands`` the samples the band ended at."""
 
-    def __init__(self, cand, events, clear=None, unbanded=()):
+    def __init__(self, cand, events, clear=None, unbanded=(), n=12):
         self.cand, self.events, self.clear, self.unbanded = list(cand), events, clear, unbanded
-        self.band, self.asked, self.unbands = clear is not None, [], []
+        self.n, self.band, self.asked, self.unbands = n, clear is not None, [], []
 
 
-WALK = interval.make_window_event(
-    next_candidate=lambda c, i, mode: (min((j for j in c.cand if j >= i), default=-1), c),
-    clears_band_at=lambda c, i, mode: c.band and i >= c.clear,
-    unband=lambda c, i, mode: (c.unbands.append(i), setattr(c, "band", False),
-                               setattr(c, "cand", [j for j in c.unbanded if j >= i])),
-    interval_event=lambda c, i, mode: (c.asked.append(i), (
-        (OK, c.events[i], rules.SWITCH, -1) if i in c.events else (OK, math.inf, NONE, -1)))[1])
+def _next_candidate(c, i, mode):
+    return min((j for j in c.cand if j >= i), default=-1), c
+
+
+def _walk(interval_event):
+    """The walk on a scripted Window, with the given event search."""
+    return interval.make_window_event(
+        next_candidate=_next_candidate,
+        last_sample=lambda c: c.n - 1,
+        clears_band_at=lambda c, i, mode: c.band and i >= c.clear,
+        unband=lambda c, i, mode: (c.unbands.append(i), setattr(c, "band", False),
+                                   setattr(c, "cand", [j for j in c.unbanded if j >= i])),
+        interval_event=interval_event)
+
+
+WALK = _walk(lambda c, i, mode: (c.asked.append(i), (
+    (OK, c.events[i], rules.SWITCH, -1) if i in c.events else (OK, math.inf, NONE, -1)))[1])
 
 
 def test_the_window_asks_its_candidates_in_time_order_up_to_the_first_event():
@@ -172,12 +183,23 @@ def test_the_band_ends_at_the_first_candidate_out_of_it_and_that_interval_is_ask
     assert c.unbands == [5] and c.asked == [2, 5]
 
 
+def test_a_window_with_no_event_ends_the_band_at_its_last_sample_out_of_it():
+    # no candidate out of the band, but the last sample (11) is: the band ends there,
+    # with no sample after it to take again
+    c = Window(cand=[2], events={}, clear=8)
+    assert WALK(c, PLUS) == (OK, math.inf, NONE, -1)
+    assert c.asked == [2] and c.unbands == [12] and not c.band
+    # still in the band at the last sample: it stays in force for the next window
+    c = Window(cand=[2], events={}, clear=20)
+    assert WALK(c, PLUS) == (OK, math.inf, NONE, -1) and c.unbands == [] and c.band
+    # an event in the window: the window ends there, the band with it only if passed
+    c = Window(cand=[2], events={2: 1.0}, clear=8)
+    assert WALK(c, PLUS) == (OK, 1.0, rules.SWITCH, -1) and c.unbands == [] and c.band
+
+
 def test_a_failed_search_stops_the_walk():
     c = Window(cand=[1, 3], events={})
-    walk = interval.make_window_event(
-        lambda c, i, mode: (min((j for j in c.cand if j >= i), default=-1), c),
-        lambda c, i, mode: False, lambda c, i, mode: None,
-        lambda c, i, mode: (c.asked.append(i), (7, 0.25, NONE, -1))[1])
+    walk = _walk(lambda c, i, mode: (c.asked.append(i), (7, 0.25, NONE, -1))[1])
     assert walk(c, SLIDING) == (7, 0.25, NONE, -1) and c.asked == [1]
 
 
@@ -234,5 +256,5 @@ def test_the_walk_asks_for_the_next_candidate_in_one_place():
     tree = ast.parse(textwrap.dedent(inspect.getsource(interval.make_window_event)))
     calls = [node.func.id for node in ast.walk(tree)
              if isinstance(node, ast.Call) and isinstance(node.func, ast.Name)]
-    for op in ("next_candidate", "clears_band_at", "unband", "interval_event"):
+    for op in ("next_candidate", "last_sample", "clears_band_at", "unband", "interval_event"):
         assert calls.count(op) == 1, op

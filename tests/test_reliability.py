@@ -281,3 +281,24 @@ def test_verify_refuses_a_first_build_directory_that_is_not_empty(tmp_path, caps
     assert stop.value.code == 2
     assert "--first-build" in capsys.readouterr().err
     assert [p.name for p in tmp_path.iterdir()] == ["kept.txt"]  # nothing built, nothing removed
+
+
+def test_the_suite_reuses_only_a_finished_build_of_this_tree(tmp_path):
+    """FILIPPOV_TEST_BUILD (CI: verify's first build) is taken only when its copied files
+    are this tree's and it holds results and figures; else each test needing it fails
+    naming the variable."""
+    import conftest
+    from verify import copy_project
+
+    work = copy_project(tmp_path / "build")
+    with pytest.raises(pytest.UsageError, match="FILIPPOV_TEST_BUILD.*no results"):
+        conftest._reused_build(work)  # this tree's files, nothing built
+    (work / "results").mkdir()
+    (work / "figures").mkdir()
+    (work / "results" / "fig02_chatter.nc").write_bytes(b"")
+    (work / "figures" / "fig02_chatter.pdf").write_bytes(b"")
+    assert conftest._reused_build(work).returncode == 0
+    config = work / "config" / "config.yaml"
+    config.write_text(config.read_text() + "\n# edited\n")
+    with pytest.raises(pytest.UsageError, match="FILIPPOV_TEST_BUILD.*not a build of this tree"):
+        conftest._reused_build(work)

@@ -31,7 +31,7 @@ from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
 from . import checks, engines, options, rules, variational
-from .loop import interval
+from .loop import interval, refine
 from .radau_iia import RadauIIA
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
@@ -308,26 +308,33 @@ def _brent(fun, ta, tb, fa, fb, xtol):
     return brentq(pinned, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=rules.BRENT_MAXITER)
 
 
+# the refinement of a crossing (filippov.loop.refine, written once for both engines) on
+# this engine's operations: f a callable of time, ctx the tolerance xtol, scipy's brentq
+
+def _bracket_root(xtol, fun, ta, tb, mode):
+    try:
+        r = brentq(fun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps,
+                   maxiter=rules.BRENT_MAXITER)
+    except ValueError:  # no sign change between fun(ta) and fun(tb)
+        return False, ta, math.nan
+    return True, r, fun(r)
+
+
+def _value_at(xtol, fun, t, mode):
+    return fun(t)
+
+
+def _lost_bracket(xtol, fun, ta, tb, va, vb, mode):
+    r = _brent(fun, ta, tb, va, vb, xtol)  # the bracket pinned to the samples (see there)
+    return True, r, fun(r)
+
+
+_refine_at = refine.make_refine(_bracket_root, _value_at, _lost_bracket)
+
+
 def _refine(fun, pred, ta, tb, va, vb, xtol):
     """Root of ``fun`` in [ta, tb], returned on the far side of the crossing."""
-    pred = rules.far_side(pred, va)
-    if va == 0.0:
-        r = ta
-    else:
-        try:
-            r = brentq(fun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=rules.BRENT_MAXITER)
-        except ValueError:
-            # no sign change between fun(ta) and fun(tb): the start sample of a
-            # just-entered mode is clamped inside, while rounding put the true
-            # value a hair past the crossing already: the event is at once
-            if rules.after(pred, fun(ta)):
-                r = ta
-            else:   # the far end lost the sign change the samples saw (see _brent)
-                r = _brent(fun, ta, tb, va, vb, xtol)
-    done, step = False, 0.0
-    while not done:  # to the far side of the crossing (rules.far_side_probe)
-        done, r, step = rules.far_side_probe(r, step, tb, rules.after(pred, fun(r)))
-    return r
+    return _refine_at(xtol, fun, pred, ta, tb, va, vb, None)[1]
 
 
 def _slide_fields(run):
@@ -572,10 +579,7 @@ class _Run:
                 self.traj.segments.append((ta, tb, mode, Z))
             if found is None:
                 self.t, self.z = tb, zs[:, -1].copy()
-                if self.band > 0.0 and rules.clears_band(
-                        mode, float(leave[0][0](zs[:, -1:])[0]), self.band):
-                    self.band = 0.0  # out of the exit's rounding band: H unbiased on
-                if self.band != band:
+                if self.band != band:  # the scan ended the exit's band: H unbiased on
                     leave = self._leave(mode)
                 if tb >= self.t_end:
                     self._note_tolerance(stepper)
@@ -848,7 +852,8 @@ def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xto
     in force after it. ``band``: the rounding band of the sliding exit the stay began
     at, while the orbit is inside it (rules.exit_band, rules.graze; ``leave`` then
     measures H from the band's edge, ``unbanded`` from the exit shift alone): it ends at
-    the first sample interval examined whose start is out of the band (rules.clears_band)."""
+    the first sample interval examined whose start is out of the band (rules.clears_band),
+    or at the last sample of a segment with no event."""
     return _Scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xtol,
                  traj, band, unbanded).earliest()
 
@@ -920,6 +925,9 @@ class _Scan:
     def _next_candidate(self, i, mode):
         pos = int(np.searchsorted(self.order, i))
         return (int(self.order[pos]) if pos < self.order.size else -1), self
+
+    def _last_sample(self):
+        return self.ts.size - 1
 
     def _clears_band_at(self, i, mode):
         return self.band > 0.0 and bool(rules.clears_band(mode, self.vals[0][i], self.band))
@@ -1049,8 +1057,9 @@ _interval_event = interval.make_interval_event(
     _Scan._n_sections, _Scan._section_crosses, _Scan._section_root, _Scan._section_bounds,
     _Scan._section_counts)
 _past_band = interval.make_past_band(_Scan._banded_h, _Scan._refine_unbanded)
-_window_event = interval.make_window_event(_Scan._next_candidate, _Scan._clears_band_at,
-                                           _Scan._unband, _interval_event)
+_window_event = interval.make_window_event(_Scan._next_candidate, _Scan._last_sample,
+                                           _Scan._clears_band_at, _Scan._unband,
+                                           _interval_event)
 
 # the event search and what is done at an event speak the same codes
 assert interval.SECTION == SECTION and interval.OK == OK

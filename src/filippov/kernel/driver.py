@@ -136,10 +136,6 @@ def _window(mode, ta, tb, frac, first, o, s, w):
     if what == _W_NONE:
         for c in range(w.z.size):
             w.z[c] = w.ynew[c]
-        if w.seg[SEG_BAND] > 0.0 and rules.clears_band(mode, w.vals[0, ns - 1], w.seg[SEG_BAND]):
-            # out of the exit's rounding band: H unbiased from here
-            w.seg[SEG_SHIFT] = w.seg[SEG_EXIT_SHIFT]
-            w.seg[SEG_BAND] = 0.0
         return (NO_RETURN if tb >= s.t_max else _GO_ON), tb, _W_NONE
     _zat(te, mode, o, w.z)
     return OK, te, what

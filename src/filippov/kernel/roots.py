@@ -1,11 +1,11 @@
 """Root finding: a port of scipy's brentq, and the refinement of a crossing to its far
-side (as filippov.simulate._refine)."""
+side (filippov.loop.refine on the kernel's operations)."""
 from __future__ import annotations
 
 import numpy as np
 
-from .. import rules
-from .base import (_EPS, _MAXITER_EVENT, _jit)
+from ..loop.refine import make_refine
+from .base import (_EPS, _MAXITER_EVENT, _jit, _jit_inline)
 from .segment import _fval
 
 # brentq's relative tolerance: scipy's default (4 eps), the reference driver's
@@ -82,30 +82,26 @@ def _brentq_f(sel, xa, xb, maxiter, mode, o, sc):
     return xcur, fcur, False
 
 
-@_jit
-def _refine(sel, pred, ta, tb, va, mode, o, sc):
-    """simulate._refine: root in [ta, tb] on the far side of the crossing (va: the value
-    at ta), to o.xtol; (t, ok)."""
-    pred = rules.far_side(pred, va)
-    if va == 0.0:
-        r = ta
-        fr = _fval(sel, r, mode, o, sc)
-    else:
-        # fr: the value at r, which brentq evaluated last (the same call, bit for bit:
-        # not evaluated again for the first far-side probe)
-        r, fr, ok = _brentq_f(sel, ta, tb, _MAXITER_EVENT, mode, o, sc)
-        if not ok:
-            # as simulate._refine: no sign change because the start sample of a
-            # just-entered mode was clamped inside while the true value is already
-            # past the crossing -- the event is at once
-            fr = _fval(sel, ta, mode, o, sc)
-            if rules.after(pred, fr):
-                r = ta
-            else:
-                return r, False
-    done, step = False, 0.0
-    while not done:  # to the far side of the crossing (rules.far_side_probe)
-        done, r, step = rules.far_side_probe(r, step, tb, rules.after(pred, fr))
-        if not done:
-            fr = _fval(sel, r, mode, o, sc)
-    return r, True
+# the refinement of a crossing (loop.refine, written once for both engines) on the
+# kernel's operations; its state ctx is (o, sc): the segment (state.Orbit) and its scratch
+
+@_jit_inline
+def _bracket_root(ctx, sel, ta, tb, mode):
+    r, fr, ok = _brentq_f(sel, ta, tb, _MAXITER_EVENT, mode, ctx[0], ctx[1])
+    return ok, r, fr
+
+
+@_jit_inline
+def _value_at(ctx, sel, t, mode):
+    return _fval(sel, t, mode, ctx[0], ctx[1])
+
+
+@_jit_inline
+def _lost_bracket(ctx, sel, ta, tb, va, vb, mode):
+    # the kernel samples and refines through the same compiled scalar functions: a lost
+    # sign change is a failure (ROOT_FAILED), not pinned (filippov.engines, item 5)
+    return False, ta, va
+
+
+#: (ok, t): the root in [ta, tb] on the far side of the crossing, to o.xtol
+_refine = _jit(make_refine(_bracket_root, _value_at, _lost_bracket))

@@ -137,7 +137,9 @@ def _refine_unbanded(ctx, lo, hi, mode):
     sg = o.seg
     banded = sg[SEG_SHIFT]
     sg[SEG_SHIFT] = sg[SEG_EXIT_SHIFT]
-    r, ok = _refine(lv.sel, lv.pred, lo, hi, _fval(_S_H, lo, mode, o, sc), mode, o, sc)
+    # vb: not sampled here, and the kernel's refinement never reads it (roots._lost_bracket)
+    ok, r = _refine((o, sc), lv.sel, lv.pred, lo, hi, _fval(_S_H, lo, mode, o, sc), np.nan,
+                    mode)
     sg[SEG_SHIFT] = banded
     return r if ok else hi
 
@@ -157,7 +159,7 @@ def _leave_root(i, mode, first, lv, o, sm, sc):
         hm = _fval(_S_H, tm, mode, o, sc)
         if ok and not rules.after(lv.pred, hm):  # refine beyond the dip (rules)
             lo, vlo = tm, hm
-    r, ok = _refine(lv.sel, lv.pred, lo, tb, vlo, mode, o, sc)
+    ok, r = _refine((o, sc), lv.sel, lv.pred, lo, tb, vlo, sm.vals[0, i + 1], mode)
     if not ok:
         return r, False
     if o.seg[SEG_BAND] > 0.0:  # found beyond the exit's band: again on H itself
@@ -185,7 +187,8 @@ def _leave_root_at(ctx, q, i, mode):
     if q == 0:
         r, ok = _leave_root(i, mode, first, lv, o, sm, sc)
     else:
-        r, ok = _refine(_S_B, _TO_NONNEG, sm.ts[i], sm.ts[i + 1], sm.vals[1, i], mode, o, sc)
+        ok, r = _refine((o, sc), _S_B, _TO_NONNEG, sm.ts[i], sm.ts[i + 1], sm.vals[1, i],
+                        sm.vals[1, i + 1], mode)
     return (OK if ok else ROOT_FAILED), r
 
 
@@ -209,7 +212,7 @@ def _speed_exit(ctx, q, i, mode):
     vm = _fval(sel_v, tm, mode, o, sc)
     kind = rules.speed_graze(pred, vm, sm.dvals[q, i], sm.dvals[q, i + 1], tb - ta, s.touch_tol)
     if kind == rules.GRAZE_CROSSES:
-        r, ok = _refine(sel_v, pred, ta, tm, sm.vals[q, i], mode, o, sc)
+        ok, r = _refine((o, sc), sel_v, pred, ta, tm, sm.vals[q, i], vm, mode)
         return (OK if ok else ROOT_FAILED), r, kind
     return OK, tm, kind
 
@@ -232,7 +235,7 @@ def _h_extremum(ctx, i, mode):
     hm = _fval(_S_H, tm, mode, o, sc)
     kind = rules.graze(mode, hm, s.touch_tol, o.seg[SEG_BAND])
     if kind == rules.GRAZE_CROSSES:
-        r, ok = _refine(_S_H, lv.pred, ta, tm, sm.vals[0, i], mode, o, sc)
+        ok, r = _refine((o, sc), _S_H, lv.pred, ta, tm, sm.vals[0, i], hm, mode)
         return (OK if ok else ROOT_FAILED), r, kind
     return OK, tm, kind
 
@@ -255,7 +258,8 @@ def _section_crosses(ctx, k, i):
 @_jit_inline
 def _section_root(ctx, k, i, mode):
     s, o, sm, sc = ctx[2], ctx[3], ctx[4], ctx[5]
-    r, ok = _refine(_S_SEC, s.sec_pred, sm.ts[i], sm.ts[i + 1], sm.svals[i], mode, o, sc)
+    ok, r = _refine((o, sc), _S_SEC, s.sec_pred, sm.ts[i], sm.ts[i + 1], sm.svals[i],
+                    sm.svals[i + 1], mode)
     return (OK if ok else ROOT_FAILED), r
 
 
@@ -319,6 +323,11 @@ def _clears_band_at(ctx, i, mode):
 
 
 @_jit_inline
+def _last_sample(ctx):
+    return ctx[6] - 1
+
+
+@_jit_inline
 def _unband(ctx, i, mode):
     """The orbit is out of its exit's rounding band at ts[i]: from there h is unbiased
     (rules.clears_band), so a return across H is refined at H = 0: the shift dropped and
@@ -331,8 +340,8 @@ def _unband(ctx, i, mode):
 
 
 #: a call with its pieces inlined, as _find was (docs/decisions.md#kernel-inlined-driver)
-_window_event = _jit(make_window_event(_next_candidate, _clears_band_at, _unband,
-                                       _interval_event))
+_window_event = _jit(make_window_event(_next_candidate, _last_sample, _clears_band_at,
+                                       _unband, _interval_event))
 
 
 @_jit_inline

@@ -3,7 +3,8 @@
 :mod:`filippov.rules` holds each decision (which side, which mode, which tie); this
 package holds the order in which the loop asks them -- at the start and before each
 stay (:mod:`~filippov.loop.stay`), in a sample interval and over a window
-(:mod:`~filippov.loop.interval`),
+(:mod:`~filippov.loop.interval`), from a crossing to its event time
+(:mod:`~filippov.loop.refine`),
 at an event and against the budgets (:mod:`~filippov.loop.event`) -- as plain scalar
 Python built from the engine's own
 operations (how it steps, samples, refines and stores). The reference driver

@@ -22,7 +22,8 @@ A window's intervals are asked in time order (:func:`make_window_event`), only t
 where a sign change shows; while the exit's rounding band is in force, the first such
 interval whose start is out of the band (``rules.clears_band``) ends it: h is sampled
 again unbiased from there and that interval is asked again whether it still holds a
-sign change. A switch found while the band is in force, at a time where the orbit is
+sign change; a window with no event ends it when its last sample is out of the band.
+A switch found while the band is in force, at a time where the orbit is
 already out of it, is refined again on h itself (:func:`make_past_band`).
 
 :func:`make_interval_event` builds the search from the engine's own operations -- how it tests
@@ -135,7 +136,7 @@ def make_interval_event(leave_crosses, leave_root, slide_end_between, hidden_sli
     return interval_event
 
 
-def make_window_event(next_candidate, clears_band_at, unband, interval_event):
+def make_window_event(next_candidate, last_sample, clears_band_at, unband, interval_event):
     """``window_event(ctx, mode) -> (status, t, what, k)``: the earliest event over a
     window's sample intervals, asked in time order (this module's docstring), from the
     engine's operations on its state ``ctx``:
@@ -144,21 +145,30 @@ def make_window_event(next_candidate, clears_band_at, unband, interval_event):
       a sign change shows (one of interval_event's questions may hold), -1 if none, and
       the state ``at`` the event search is asked on there (ctx itself, or ctx with what
       the engine saw at j);
+    * ``last_sample(ctx)``: the index of the window's last sample;
     * ``clears_band_at(ctx, i, mode)``: the exit's band is in force and the orbit is out
-      of it at the start of interval i; ``unband(ctx, i, mode)``: the band ends there
-      (h unbiased from sample i on, the candidates from i on found again);
+      of it at sample i; ``unband(ctx, i, mode)``: the band ends, h is sampled again
+      unbiased from sample i on and the candidates from i on are found again (none
+      when i is past the last sample);
     * ``interval_event``: :func:`make_interval_event`'s, asked on ``at``.
+
+    A window with no event ends the band when its last sample is out of it: the next
+    window then samples h unbiased from its start.
     """
 
     def window_event(ctx, mode):
         i = 0
-        while True:  # one call of next_candidate: the kernel inlines each
+        while True:  # one call of each operation: the kernel inlines each
             i, at = next_candidate(ctx, i, mode)
-            if i < 0:
+            done = i < 0  # no candidate left: the band may still end at the last sample
+            j = last_sample(ctx) if done else i
+            if clears_band_at(ctx, j, mode):
+                # h unbiased from sample j on (none to take again after the last one)
+                unband(ctx, j + 1 if done else j, mode)
+                if not done:
+                    continue  # interval i is asked again, h unbiased
+            if done:
                 return OK, math.inf, NONE, -1
-            if clears_band_at(ctx, i, mode):
-                unband(ctx, i, mode)  # then interval i is asked again, h unbiased
-                continue
             st, t, what, k = interval_event(at, i, mode)
             if st != OK or what != NONE:
                 return st, t, what, k

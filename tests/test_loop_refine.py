@@ -1,0 +1,92 @@
+"""The refinement of a sign change (filippov.loop.refine), written once: its four cases
+on scripted operations, and both engines running the one function."""
+from __future__ import annotations
+
+import importlib
+import math
+
+from filippov import rules
+from filippov.loop.refine import make_refine
+
+
+class Script:
+    """f on a scripted table {t: value} (a linear f elsewhere: t - root); the engine's
+    root finder returns ``root`` (not ok when ``bracket`` is False); ``asked`` the times
+    f was evaluated at, ``lost`` the calls of lost_bracket."""
+
+    def __init__(self, values=None, root=1.0, bracket=True, pinned=None):
+        self.values, self.root, self.bracket, self.pinned = values or {}, root, bracket, pinned
+        self.asked, self.lost = [], []
+
+    def f(self, t):
+        self.asked.append(t)
+        return self.values.get(t, t - self.root)
+
+
+REFINE = make_refine(
+    bracket_root=lambda c, f, ta, tb, mode: (c.bracket, c.root, f(c.root)) if c.bracket
+    else (False, ta, math.nan),
+    value_at=lambda c, f, t, mode: f(t),
+    lost_bracket=lambda c, f, ta, tb, va, vb, mode: (
+        c.lost.append((ta, tb, va, vb)),
+        (True, c.pinned, f(c.pinned)) if c.pinned is not None else (False, ta, math.nan))[1])
+
+
+def test_a_sample_exactly_zero_is_the_crossing():
+    c = Script(values={0.5: 0.0})
+    assert REFINE(c, c.f, rules.TO_NONNEG, 0.5, 2.0, 0.0, 1.0, None) == (True, 0.5)
+    assert c.asked == [0.5] and c.lost == []  # no root finder asked
+    # a section without direction (EITHER) takes the far side of the crossing at hand
+    c = Script(values={0.5: 0.0})
+    assert REFINE(c, c.f, rules.EITHER, 0.5, 2.0, 0.0, 1.0, None) == (True, 0.5)
+
+
+def test_the_root_is_walked_to_the_far_side_of_the_crossing():
+    # the root finder stops a hair before the sign flips: f(1.0) = -1e-17 < 0 (near side
+    # of TO_NONNEG); the probe walks forward until f is past it
+    c = Script(values={1.0: -1e-17})
+    ok, r = REFINE(c, c.f, rules.TO_NONNEG, 0.0, 2.0, -1.0, 1.0, None)
+    assert ok and r > 1.0 and r - 1.0 < 1e-12 and c.f(r) >= 0.0
+    assert c.asked[0] == 1.0 and c.lost == []
+    # already past: the root stands, f evaluated there only (the finder's own value)
+    c = Script()
+    assert REFINE(c, c.f, rules.TO_NONNEG, 0.0, 2.0, -1.0, 1.0, None) == (True, 1.0)
+    assert c.asked == [1.0]
+
+
+def test_a_lost_bracket_with_the_start_already_past_is_an_event_at_once():
+    # the start sample was clamped inside (va < 0) while f(ta) is past the crossing
+    c = Script(values={0.0: 1e-18}, bracket=False)
+    assert REFINE(c, c.f, rules.TO_NONNEG, 0.0, 2.0, -1e-300, 1.0, None) == (True, 0.0)
+    assert c.lost == [] and c.asked == [0.0]
+
+
+def test_a_lost_bracket_otherwise_is_the_engines_to_answer():
+    c = Script(values={0.0: -1e-18}, bracket=False, pinned=1.25)  # the reference pins
+    assert REFINE(c, c.f, rules.TO_NONNEG, 0.0, 2.0, -1.0, 3.0, None) == (True, 1.25)
+    assert c.lost == [(0.0, 2.0, -1.0, 3.0)]
+    c = Script(values={0.0: -1e-18}, bracket=False)  # the kernel fails
+    ok, _ = REFINE(c, c.f, rules.TO_NONNEG, 0.0, 2.0, -1.0, 3.0, None)
+    assert not ok and len(c.lost) == 1
+
+
+def test_both_engines_refine_with_the_one_function():
+    simulate = importlib.import_module("filippov.simulate")
+    from filippov.kernel import roots
+
+    assert roots._refine.py_func.__code__ is simulate._refine_at.__code__
+    ops = {cell.cell_contents for cell in roots._refine.py_func.__closure__}
+    assert roots._lost_bracket in ops and roots._bracket_root in ops
+    ops = {cell.cell_contents for cell in simulate._refine_at.__closure__}
+    assert simulate._lost_bracket in ops and simulate._bracket_root in ops
+
+
+def test_the_reference_refines_a_crossing_to_its_far_side():
+    """The reference's operations (scipy's brentq) through the shared function."""
+    simulate = importlib.import_module("filippov.simulate")
+    root = 0.1 + 0.2  # not exactly representable: brentq stops on either side of it
+    r = simulate._refine(lambda t: t - root, rules.TO_NONNEG, 0.0, 1.0, -root, 1.0 - root,
+                         1e-12)
+    assert r - root >= 0.0 and r - root < 1e-11
+    r = simulate._refine(lambda t: root - t, rules.TO_NEG, 0.0, 1.0, root, root - 1.0, 1e-12)
+    assert root - r < 0.0 and r - root < 1e-11
