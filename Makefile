@@ -6,7 +6,8 @@
 #                  hypothesis profile "deep": many more generated systems, randomized
 #   make verify    two clean builds in a temporary directory: byte-identical,
 #                  and in agreement with tests/reference/manifest.json
-#                  (VERIFY_ARGS="--first-build DIR" keeps the first, for cross-cpu --native)
+#                  (VERIFY_ARGS="--first-build DIR" keeps the first: CI's test suite
+#                  reads it, FILIPPOV_TEST_BUILD=DIR, and so does cross-cpu --native)
 #   make manifest  rewrite the manifest from results/ and figures/ (prints changes)
 #   make cross-cpu emulate another CPU's last bits (libm, numpy SIMD, numba) and check
 #                  every scene against the manifest: results moved by up to 2 ulps

@@ -48,26 +48,51 @@ from verify import copy_project, run_snakemake  # noqa: E402
 REUSE_BUILD = "FILIPPOV_TEST_BUILD"
 
 
+def _project_files(work: Path) -> dict[str, Path]:
+    """The files copy_project copies (Snakefile, config/, workflow/, paper/*.tex), by
+    relative path; bytecode and the editable install's metadata left out (Python and pip
+    write them into workflow/ as the pipeline is imported or installed, after any copy)."""
+    def copied(rel: Path) -> bool:
+        if rel.parts[0] == "paper":
+            return len(rel.parts) == 2 and rel.suffix == ".tex"
+        return (rel.parts[0] in ("Snakefile", "config", "workflow")
+                and not any(part == "__pycache__" or part.endswith(".egg-info")
+                            for part in rel.parts) and rel.suffix != ".pyc")
+    return {rel.as_posix(): p for p in work.rglob("*")
+            if p.is_file() and copied(rel := p.relative_to(work))}
+
+
 def _reused_build(work: Path):
-    """``work`` as the shared build: only a finished build of this very tree (the files
-    copy_project copies, byte for byte, and every figure and dataset made); a
-    CompletedProcess standing for its (successful) run."""
+    """``work`` as the shared build, only if it is a finished build of this tree: the
+    files copy_project copies are this tree's, both ways and byte for byte; every
+    scene's figure is there; and no dataset is older than the library's sources
+    (src/ is not copied: a build reads it from this tree). A CompletedProcess stands
+    for its (successful) run; anything else raises, naming the variable."""
+    from filippov_paper.config import scene_files
     from filippov_paper.manifest import data_files
 
     fresh = Path(tempfile.mkdtemp(prefix="filippov-reuse-"))
     try:
-        copy_project(fresh)
-        names = sorted(p.relative_to(fresh).as_posix() for p in fresh.rglob("*") if p.is_file())
-        same = all((work / n).is_file() and filecmp.cmp(fresh / n, work / n, shallow=False)
-                   for n in names)
+        ours, theirs = _project_files(copy_project(fresh / "p")), _project_files(work)
+        same = set(ours) == set(theirs) and all(
+            filecmp.cmp(ours[n], theirs[n], shallow=False) for n in ours)
     finally:
         shutil.rmtree(fresh, ignore_errors=True)
     if not same:
         raise pytest.UsageError(f"{REUSE_BUILD}={work}: not a build of this tree "
                                 "(its Snakefile, config/, workflow/ or paper/ differ)")
-    if not data_files(work / "results") or not list((work / "figures").glob("*.pdf")):
-        raise pytest.UsageError(f"{REUSE_BUILD}={work}: no results or figures (not a "
-                                "finished build)")
+    missing = [s for s in scene_files(work / "config" / "scenes")
+               if not (work / "figures" / f"{s}.pdf").is_file()]
+    datasets = data_files(work / "results")
+    if missing:
+        raise pytest.UsageError(f"{REUSE_BUILD}={work}: not a finished build (no figure "
+                                f"of {', '.join(missing)})")
+    if not datasets:
+        raise pytest.UsageError(f"{REUSE_BUILD}={work}: not a finished build (no dataset)")
+    newest = max(p.stat().st_mtime for p in SRC.rglob("*.py"))
+    if min(p.stat().st_mtime for p in datasets) < newest:
+        raise pytest.UsageError(f"{REUSE_BUILD}={work}: a dataset is older than the "
+                                "library's sources in src/ (a stale build)")
     return subprocess.CompletedProcess(["snakemake"], 0, f"(reused: {work})\n", "")
 
 

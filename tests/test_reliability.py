@@ -285,20 +285,38 @@ def test_verify_refuses_a_first_build_directory_that_is_not_empty(tmp_path, caps
 
 def test_the_suite_reuses_only_a_finished_build_of_this_tree(tmp_path):
     """FILIPPOV_TEST_BUILD (CI: verify's first build) is taken only when its copied files
-    are this tree's and it holds results and figures; else each test needing it fails
-    naming the variable."""
+    are this tree's (both ways; bytecode aside), every scene's figure is there and no
+    dataset is older than src/; else each test needing it fails naming the variable."""
+    import os
+
     import conftest
+    from filippov_paper.config import scene_files
     from verify import copy_project
 
     work = copy_project(tmp_path / "build")
-    with pytest.raises(pytest.UsageError, match="FILIPPOV_TEST_BUILD.*no results"):
+    with pytest.raises(pytest.UsageError, match="FILIPPOV_TEST_BUILD.*not a finished build"):
         conftest._reused_build(work)  # this tree's files, nothing built
     (work / "results").mkdir()
     (work / "figures").mkdir()
-    (work / "results" / "fig02_chatter.nc").write_bytes(b"")
-    (work / "figures" / "fig02_chatter.pdf").write_bytes(b"")
-    assert conftest._reused_build(work).returncode == 0
+    for scene in scene_files(work / "config" / "scenes"):
+        (work / "figures" / f"{scene}.pdf").write_bytes(b"")
+    with pytest.raises(pytest.UsageError, match="no dataset"):
+        conftest._reused_build(work)
+    dataset = work / "results" / "fig02_chatter.nc"
+    dataset.write_bytes(b"")
+    (work / "workflow" / "__pycache__").mkdir(exist_ok=True)
+    (work / "workflow" / "__pycache__" / "stray.cpython-311.pyc").write_bytes(b"")
+    assert conftest._reused_build(work).returncode == 0  # bytecode is not the tree's
+    os.utime(dataset, (0, 0))
+    with pytest.raises(pytest.UsageError, match="older than the library's sources"):
+        conftest._reused_build(work)
+    os.utime(dataset)
+    extra = work / "config" / "scenes" / "fig99_extra.yaml"
+    extra.write_text("id: fig99_extra\n")
+    with pytest.raises(pytest.UsageError, match="not a build of this tree"):
+        conftest._reused_build(work)  # a file the tree does not have
+    extra.unlink()
     config = work / "config" / "config.yaml"
     config.write_text(config.read_text() + "\n# edited\n")
-    with pytest.raises(pytest.UsageError, match="FILIPPOV_TEST_BUILD.*not a build of this tree"):
+    with pytest.raises(pytest.UsageError, match="not a build of this tree"):
         conftest._reused_build(work)

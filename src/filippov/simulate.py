@@ -933,9 +933,10 @@ class _Scan:
         return self.band > 0.0 and bool(rules.clears_band(mode, self.vals[0][i], self.band))
 
     def _unband(self, i, mode):
-        """Out of the exit's rounding band at ts[i]: H unbiased from there on, so a
-        return across H is refined at H = 0 (as in the compiled engine). The candidate
-        intervals from i on, again."""
+        """Out of the exit's rounding band at ts[i] (at the last sample when i is
+        ts.size: no interval left): H unbiased from there on, so a return across H is
+        refined at H = 0 (as in the compiled engine). The candidate intervals from i on,
+        again."""
         self.band, self.leave = 0.0, self.unbanded
         self.vals[0] = np.asarray(self.leave[0][0](self.zs), dtype=float)
         again = self.candidates()  # a band is in force in a region only: h, dH/dt, sections

@@ -11,9 +11,10 @@
 3. The first build is compared with the committed manifest
    (tests/reference/manifest.json, see filippov_paper.manifest).
 
-``--first-build DIR`` builds the first copy in DIR and keeps it: CI hands it to
-`make cross-cpu` as its native build (``--native DIR``) instead of building the
-same tree a third time.
+``--first-build DIR`` builds the first copy in DIR and keeps it: CI hands it to the
+test suite as its shared build (``FILIPPOV_TEST_BUILD=DIR``, tests/conftest.py) and to
+`make cross-cpu` as its native build (``--native DIR``) instead of building the same
+tree twice more.
 
 Run by make, not by a Snakemake rule. tests/conftest.py reuses copy_project and
 run_snakemake from here.

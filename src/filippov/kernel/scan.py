@@ -329,9 +329,10 @@ def _last_sample(ctx):
 
 @_jit_inline
 def _unband(ctx, i, mode):
-    """The orbit is out of its exit's rounding band at ts[i]: from there h is unbiased
-    (rules.clears_band), so a return across H is refined at H = 0: the shift dropped and
-    h sampled again from ts[i] on."""
+    """The orbit is out of its exit's rounding band at ts[i] (at the last sample when i
+    is ns: none left to sample): from there h is unbiased (rules.clears_band), so a
+    return across H is refined at H = 0: the shift dropped and h sampled again from ts[i]
+    on."""
     o, sm, sc, ns = ctx[3], ctx[4], ctx[5], ctx[6]
     o.seg[SEG_SHIFT] = o.seg[SEG_EXIT_SHIFT]
     o.seg[SEG_BAND] = 0.0
