@@ -181,3 +181,36 @@ def test_return_floor_counts_without_changing_returns(monkeypatch):
     assert flows == ds.samples.values[0] + ds.root_flows.values[0]
     assert 0 < ds.flow_floor.values[0] < ds.floor.values[0]
     assert ds.target.values[0] == 5e-6 and "floor" in lines[0]
+
+
+def test_instruction_cost_reads_callgrind_s_dumps_in_order(tmp_path):
+    """Per return: (I(2N) - I(N)) / N of each case and build, from the numbered dumps in
+    their numeric order (10 after 9); a dump without its summary, a count of dumps that
+    is not 3 per case and build, and no valgrind are refused by name."""
+    from filippov_paper.benchmarks import instruction_cost as ic
+
+    n, cases = 4, 2
+    counts = []
+    for case in range(cases):
+        for build in range(len(ic.BUILDS)):
+            per = 100 * (case + 1) + 10 * build
+            counts += [7_000_000, 50 + n * per, 50 + 2 * n * per]
+    for k, c in enumerate(counts, start=1):
+        (tmp_path / f"cg.out.{k}").write_text(f"version: 1\nsummary: {c}\ntotals: {c}\n")
+    (tmp_path / "cg.out").write_text("summary: 1\n")  # the part after the last dump
+    read = ic.dump_counts(str(tmp_path / "cg.out"))
+    assert read == counts
+    assert ic.per_return(read, n, cases).tolist() == [[100.0, 110.0], [200.0, 210.0]]
+    with pytest.raises(ValueError, match="expected 12 callgrind dumps"):
+        ic.per_return(read[:-1], n, cases)
+    (tmp_path / "cg.out.13").write_text("version: 1\n")
+    with pytest.raises(ValueError, match="cg.out.13: no 'summary:'"):
+        ic.dump_counts(str(tmp_path / "cg.out"))
+
+
+def test_instruction_cost_names_valgrind_when_it_is_missing(monkeypatch):
+    from filippov_paper.benchmarks import instruction_cost as ic
+
+    monkeypatch.setattr(ic.shutil, "which", lambda name: None)
+    with pytest.raises(RuntimeError, match="needs valgrind"):
+        ic._valgrind()
