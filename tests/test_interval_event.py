@@ -145,14 +145,13 @@ class Window:
         self.n, self.band, self.asked, self.unbands = n, clear is not None, [], []
 
 
-def _next_candidate(c, i, mode):
-    return min((j for j in c.cand if j >= i), default=-1), c
-
-
-def _walk(interval_event):
-    """The walk on a scripted Window, with the given event search."""
+def _walk(interval_event, skip=True):
+    """The walk on a scripted Window, with the given event search; ``skip``: jump to the
+    next candidate (as the reference does) or test every interval (as the kernel does)."""
     return interval.make_window_event(
-        next_candidate=_next_candidate,
+        skip_to=lambda c, i, mode: (min((j for j in c.cand if j >= i), default=c.n - 1)
+                                    if skip else i),
+        candidate_at=lambda c, i, mode: (i in c.cand, c),
         last_sample=lambda c: c.n - 1,
         clears_band_at=lambda c, i, mode: c.band and i >= c.clear,
         unband=lambda c, i, mode: (c.unbands.append(i), setattr(c, "band", False),
@@ -160,11 +159,17 @@ def _walk(interval_event):
         interval_event=interval_event)
 
 
-WALK = _walk(lambda c, i, mode: (c.asked.append(i), (
-    (OK, c.events[i], rules.SWITCH, -1) if i in c.events else (OK, math.inf, NONE, -1)))[1])
+def _search(c, i, mode):
+    c.asked.append(i)
+    return (OK, c.events[i], rules.SWITCH, -1) if i in c.events else (OK, math.inf, NONE, -1)
 
 
-def test_the_window_asks_its_candidates_in_time_order_up_to_the_first_event():
+WALKS = [_walk(_search), _walk(_search, skip=False)]
+walks = pytest.mark.parametrize("WALK", WALKS, ids=["skipping", "every-interval"])
+
+
+@walks
+def test_the_window_asks_its_candidates_in_time_order_up_to_the_first_event(WALK):
     c = Window(cand=[2, 5, 9, 11], events={9: 4.5, 11: 5.5})
     assert WALK(c, PLUS) == (OK, 4.5, rules.SWITCH, -1)
     assert c.asked == [2, 5, 9] and c.unbands == []
@@ -172,7 +177,8 @@ def test_the_window_asks_its_candidates_in_time_order_up_to_the_first_event():
     assert WALK(c, MINUS) == (OK, math.inf, NONE, -1) and c.asked == []
 
 
-def test_the_band_ends_at_the_first_candidate_out_of_it_and_that_interval_is_asked_again():
+@walks
+def test_the_band_ends_at_the_first_candidate_out_of_it_and_that_interval_is_asked_again(WALK):
     # out of the band at interval 5: h unbiased from there shows no change at 5 any more
     c = Window(cand=[2, 5, 9], events={7: 3.5}, clear=5, unbanded=[0, 7, 9])
     assert WALK(c, PLUS) == (OK, 3.5, rules.SWITCH, -1)
@@ -183,7 +189,8 @@ def test_the_band_ends_at_the_first_candidate_out_of_it_and_that_interval_is_ask
     assert c.unbands == [5] and c.asked == [2, 5]
 
 
-def test_a_window_with_no_event_ends_the_band_at_its_last_sample_out_of_it():
+@walks
+def test_a_window_with_no_event_ends_the_band_at_its_last_sample_out_of_it(WALK):
     # no candidate out of the band, but the last sample (11) is: the band ends there,
     # with no sample after it to take again
     c = Window(cand=[2], events={}, clear=8)
@@ -247,14 +254,18 @@ def test_both_engines_probe_past_the_band_with_the_one_function():
     assert not hasattr(simulate._Scan, "_past_band")
 
 
-def test_the_walk_asks_for_the_next_candidate_in_one_place():
+def test_the_walk_is_one_loop_asking_the_event_search_in_one_place():
     """The kernel inlines every call of an operation (numba, inline="always"): the walk
-    calls each of its operations once, so the kernel holds one copy of each."""
+    asks the event search (the large one) in one place, and is one loop with none inside
+    it (a walk that restarted an inner loop of candidates after each interval cost the
+    kernel about 2% of its instructions per return: docs/decisions.md)."""
     import inspect
     import textwrap
 
     tree = ast.parse(textwrap.dedent(inspect.getsource(interval.make_window_event)))
     calls = [node.func.id for node in ast.walk(tree)
              if isinstance(node, ast.Call) and isinstance(node.func, ast.Name)]
-    for op in ("next_candidate", "last_sample", "clears_band_at", "unband", "interval_event"):
-        assert calls.count(op) == 1, op
+    assert calls.count("interval_event") == 1 and calls.count("last_sample") == 1
+    for op in ("skip_to", "candidate_at", "clears_band_at", "unband"):
+        assert calls.count(op) == 2, op  # at the start and after the band's end
+    assert sum(isinstance(node, (ast.For, ast.While)) for node in ast.walk(tree)) == 1

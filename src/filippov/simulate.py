@@ -922,9 +922,14 @@ class _Scan:
     # -------------------------------------------- the window walk's operations on it
     # (filippov.loop.interval.make_window_event, _window_event below)
 
-    def _next_candidate(self, i, mode):
+    def _skip_to(self, i, mode):
+        """The first candidate interval from i on (the last sample's index: none)."""
         pos = int(np.searchsorted(self.order, i))
-        return (int(self.order[pos]) if pos < self.order.size else -1), self
+        return int(self.order[pos]) if pos < self.order.size else self.ts.size - 1
+
+    def _candidate_at(self, i, mode):
+        pos = int(np.searchsorted(self.order, i))
+        return bool(pos < self.order.size and self.order[pos] == i), self
 
     def _last_sample(self):
         return self.ts.size - 1
@@ -1058,9 +1063,9 @@ _interval_event = interval.make_interval_event(
     _Scan._n_sections, _Scan._section_crosses, _Scan._section_root, _Scan._section_bounds,
     _Scan._section_counts)
 _past_band = interval.make_past_band(_Scan._banded_h, _Scan._refine_unbanded)
-_window_event = interval.make_window_event(_Scan._next_candidate, _Scan._last_sample,
-                                           _Scan._clears_band_at, _Scan._unband,
-                                           _interval_event)
+_window_event = interval.make_window_event(_Scan._skip_to, _Scan._candidate_at,
+                                           _Scan._last_sample, _Scan._clears_band_at,
+                                           _Scan._unband, _interval_event)
 
 # the event search and what is done at an event speak the same codes
 assert interval.SECTION == SECTION and interval.OK == OK

@@ -173,7 +173,7 @@ def _leave_root(i, mode, first, lv, o, sm, sc):
 # how the kernel answers each, on its samples (sm) and its segment (o). The walk's state
 # is the tuple (first, lv, s, o, sm, sc, ns): the window's records and its number of
 # samples; the event search's (first, lv, s, o, sm, sc, c0, c1, cd, cs, ha, hb): the
-# window's records and the sign changes _next_candidate saw in the interval.
+# window's records and the sign changes _candidate_at saw in the interval.
 
 @_jit_inline
 def _leave_crosses(ctx, q, i):
@@ -296,24 +296,27 @@ _interval_event = _jit_inline(make_interval_event(
 
 
 @_jit_inline
-def _next_candidate(ctx, i, mode):
-    """The first sample interval from i on where a sign change shows (-1: none), and the
-    event search's state there: the window's records and the sign changes seen."""
+def _skip_to(ctx, i, mode):
+    return i  # each interval is tested as the walk comes to it (_candidate_at)
+
+
+@_jit_inline
+def _candidate_at(ctx, i, mode):
+    """Sample interval i shows a sign change, and the event search's state there: the
+    window's records and the sign changes seen."""
     first, lv, s, o, sm, sc, ns = ctx
     vals, dvals, svals, sg = sm.vals, sm.dvals, sm.svals, o.seg
-    for j in range(i, ns - 1):
-        c0 = rules.crosses(lv.pred, vals[0, j], vals[0, j + 1])
-        c1 = lv.n == 2 and rules.crosses(_TO_NONNEG, vals[1, j], vals[1, j + 1])
-        cd = mode != SLIDING and rules.extremum_between(mode, dvals[0, j], dvals[0, j + 1])
-        cs = rules.crosses(s.sec_pred, svals[j], svals[j + 1])
-        # while sliding: a minimum of a, a maximum of b between the samples (rules)
-        ha = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and rules.speed_extremum_between(
-            _TO_NONPOS, dvals[0, j], dvals[0, j + 1])
-        hb = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and rules.speed_extremum_between(
-            _TO_NONNEG, dvals[1, j], dvals[1, j + 1])
-        if c0 or c1 or cd or cs or ha or hb:
-            return j, (first, lv, s, o, sm, sc, c0, c1, cd, cs, ha, hb)
-    return -1, (first, lv, s, o, sm, sc, False, False, False, False, False, False)
+    c0 = rules.crosses(lv.pred, vals[0, i], vals[0, i + 1])
+    c1 = lv.n == 2 and rules.crosses(_TO_NONNEG, vals[1, i], vals[1, i + 1])
+    cd = mode != SLIDING and rules.extremum_between(mode, dvals[0, i], dvals[0, i + 1])
+    cs = rules.crosses(s.sec_pred, svals[i], svals[i + 1])
+    # while sliding: a minimum of a, a maximum of b between the samples (rules)
+    ha = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and rules.speed_extremum_between(
+        _TO_NONPOS, dvals[0, i], dvals[0, i + 1])
+    hb = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and rules.speed_extremum_between(
+        _TO_NONNEG, dvals[1, i], dvals[1, i + 1])
+    return ((c0 or c1 or cd or cs or ha or hb),
+            (first, lv, s, o, sm, sc, c0, c1, cd, cs, ha, hb))
 
 
 @_jit_inline
@@ -341,8 +344,8 @@ def _unband(ctx, i, mode):
 
 
 #: a call with its pieces inlined, as _find was (docs/decisions.md#kernel-inlined-driver)
-_window_event = _jit(make_window_event(_next_candidate, _last_sample, _clears_band_at,
-                                       _unband, _interval_event))
+_window_event = _jit(make_window_event(_skip_to, _candidate_at, _last_sample,
+                                       _clears_band_at, _unband, _interval_event))
 
 
 @_jit_inline

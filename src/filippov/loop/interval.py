@@ -136,15 +136,19 @@ def make_interval_event(leave_crosses, leave_root, slide_end_between, hidden_sli
     return interval_event
 
 
-def make_window_event(next_candidate, last_sample, clears_band_at, unband, interval_event):
+def make_window_event(skip_to, candidate_at, last_sample, clears_band_at, unband,
+                      interval_event):
     """``window_event(ctx, mode) -> (status, t, what, k)``: the earliest event over a
     window's sample intervals, asked in time order (this module's docstring), from the
     engine's operations on its state ``ctx``:
 
-    * ``next_candidate(ctx, i, mode) -> (j, at)``: the first interval j from i on where
-      a sign change shows (one of interval_event's questions may hold), -1 if none, and
-      the state ``at`` the event search is asked on there (ctx itself, or ctx with what
-      the engine saw at j);
+    * ``skip_to(ctx, i, mode)``: the first interval from i on that may show a sign
+      change (``last_sample(ctx)`` if none): an engine that found its candidates with
+      array operations jumps to the next one, an engine that tests each interval as it
+      comes answers i itself;
+    * ``candidate_at(ctx, i, mode) -> (hit, at)``: interval i shows a sign change (one of
+      interval_event's questions may hold), and the state ``at`` the event search is
+      asked on there (ctx itself, or ctx with what the engine saw at i);
     * ``last_sample(ctx)``: the index of the window's last sample;
     * ``clears_band_at(ctx, i, mode)``: the exit's band is in force and the orbit is out
       of it at sample i; ``unband(ctx, i, mode)``: the band ends, h is sampled again
@@ -153,26 +157,26 @@ def make_window_event(next_candidate, last_sample, clears_band_at, unband, inter
     * ``interval_event``: :func:`make_interval_event`'s, asked on ``at``.
 
     A window with no event ends the band when its last sample is out of it: the next
-    window then samples h unbiased from its start.
+    window then samples h unbiased from its start. The walk is one loop over the
+    intervals with no loop inside it (why: docs/decisions.md#kernel-inlined-driver).
     """
 
     def window_event(ctx, mode):
-        i = 0
-        while True:  # one call of each operation: the kernel inlines each
-            i, at = next_candidate(ctx, i, mode)
-            done = i < 0  # no candidate left: the band may still end at the last sample
-            j = last_sample(ctx) if done else i
-            if clears_band_at(ctx, j, mode):
-                # h unbiased from sample j on (none to take again after the last one)
-                unband(ctx, j + 1 if done else j, mode)
-                if not done:
-                    continue  # interval i is asked again, h unbiased
-            if done:
-                return OK, math.inf, NONE, -1
-            st, t, what, k = interval_event(at, i, mode)
-            if st != OK or what != NONE:
-                return st, t, what, k
-            i += 1
+        n = last_sample(ctx)
+        i = skip_to(ctx, 0, mode)
+        while i < n:
+            hit, at = candidate_at(ctx, i, mode)
+            if hit and clears_band_at(ctx, i, mode):
+                unband(ctx, i, mode)  # interval i asked again, h unbiased
+                hit, at = candidate_at(ctx, i, mode)
+            if hit:
+                st, t, what, k = interval_event(at, i, mode)
+                if st != OK or what != NONE:
+                    return st, t, what, k
+            i = skip_to(ctx, i + 1, mode)
+        if clears_band_at(ctx, n, mode):
+            unband(ctx, n + 1, mode)  # no sample after the last one to take again
+        return OK, math.inf, NONE, -1
 
     return window_event
 
