@@ -24,15 +24,15 @@ time order with one function (``make_window_event``: the exit's rounding band en
 the first candidate whose start is out of it, ``rules.clears_band``, and that interval
 asked again, or at the last sample of a window with no event; a switch found beyond
 the band refined again on H, ``make_past_band``), each finding its candidates its own
-way (the reference with array operations, the kernel with scalars). In a sample interval both run one event search,
-:mod:`filippov.loop.interval`, which asks in one order -- the crossing of H (or of a
-or b while sliding), the end of sliding hidden between the samples, then a hidden
-extremum of H, then each section, whose root at the instant of a switch wins the tie
-(``rules.section_first``) -- each engine answering with its own samples and root
-finder; a crossing becomes an event time by one function, :mod:`filippov.loop.refine`
-(a sample exactly on it, the bracketing root, an event at once where a clamped start is
-already past it, then the walk to its far side). What is done at an event is one
-function, :mod:`filippov.loop.event`:
+way (the reference with array operations, the kernel with scalars). In a sample
+interval both run one event search, :mod:`filippov.loop.interval`, which asks in one
+order -- the crossing of H (or of a or b while sliding), the end of sliding hidden
+between the samples, then a hidden extremum of H, then each section, whose root at the
+instant of a switch wins the tie (``rules.section_first``) -- each engine answering with
+its own samples and root finder; a crossing becomes an event time by one function,
+:mod:`filippov.loop.refine` (a sample exactly on it, the bracketing root, an event at
+once where a clamped start is already past it, then the walk to its far side). What is
+done at an event is one function, :mod:`filippov.loop.event`:
 the decision (``rules.next_mode``), sliding the system does not build, the refusal to
 slide inside a section at an arrival on H, the fold exit (``rules.exit_drift``,
 ``onto_switch``, ``exit_band``, ``exit_shift``), the switch counted against

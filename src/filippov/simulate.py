@@ -925,7 +925,7 @@ class _Scan:
     def _skip_to(self, i, mode):
         """The first candidate interval from i on (the last sample's index: none)."""
         pos = int(np.searchsorted(self.order, i))
-        return int(self.order[pos]) if pos < self.order.size else self.ts.size - 1
+        return int(self.order[pos]) if pos < self.order.size else self._last_sample()
 
     def _candidate_at(self, i, mode):
         pos = int(np.searchsorted(self.order, i))
