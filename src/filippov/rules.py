@@ -445,6 +445,13 @@ def accumulates(oldest: float, newest: float, zeno_span: float) -> bool:
     return newest - oldest <= zeno_span * max(1.0, abs(newest))
 
 
+def step_budget_spent(n_steps: int, max_steps: int) -> bool:
+    """The hard step bound both engines keep: the run has tried more than max_steps
+    steps (every step counts, rejected or not; the reference also projects the steps
+    still to come, engines.py asymmetry 3)."""
+    return n_steps > max_steps
+
+
 def note_switch(recent, entries: int, t: float, zeno_count: int, zeno_span: float):
     """The Zeno ring both engines keep: enters the switch at ``t`` in ``recent`` (an array
     of zeno_count times, entry k at k % zeno_count; ``entries`` so far) and says whether

@@ -606,7 +606,7 @@ class _Run:
         stops now, not after minutes (the steps left projected from the mean step)."""
         traj, mode = self.traj, self.mode
         traj.n_steps += 1
-        if traj.n_steps > self.max_steps:
+        if rules.step_budget_spent(traj.n_steps, self.max_steps):
             raise run_error(STEP_LIMIT, self.t, self.z, f", mode {MODE_NAMES[mode]}: step "
                             f"limit {self.max_steps} hit: the run is too long or the step "
                             "size collapsed")

@@ -142,6 +142,14 @@ def _window(mode, ta, tb, frac, first, o, s, w):
 
 
 @_jit_inline
+def _step_budget_spent(s, w):
+    """Counts one more step of the run (a window of an exact stay, a DOP853 step of an
+    integrated one): True once the run has spent max_steps."""
+    w.count[N_STEPS] += 1
+    return rules.step_budget_spent(w.count[N_STEPS], s.max_steps)
+
+
+@_jit_inline
 def _stay_exact(mode, t, fns, p, s, w):
     """A stay in region + or - on the exact flow from the mode entry, in the windows of
     rules.exact_window (hwin growing with the time since the entry during the fast
@@ -153,8 +161,7 @@ def _stay_exact(mode, t, fns, p, s, w):
     o = Orbit(fns, p, w.seg, w.za, w.F, w.y_old, s.xtol)
     ta, first = t, True
     while True:
-        w.count[N_STEPS] += 1
-        if w.count[N_STEPS] > s.max_steps:
+        if _step_budget_spent(s, w):
             return STEP_LIMIT, ta, _W_NONE
         age = ta - w.seg[SEG_ENTRY] + w.tally[T_AGE]
         tb = min(ta + rules.exact_window(age, s.hwin, s.hwin_slow, s.transient), s.t_max)
@@ -188,8 +195,7 @@ def _stay_integrated(mode, t, fns, p, s, w):
     o = Orbit(fns, p, w.seg, w.za, w.F, w.y_old, s.xtol)
     ta, first = t, True
     while True:
-        w.count[N_STEPS] += 1
-        if w.count[N_STEPS] > s.max_steps:
+        if _step_budget_spent(s, w):
             return STEP_LIMIT, ta, _W_NONE
         ok, tb, hstep, h_abs = _dop_step(mode, ta, h_abs, ctl, fns, p, fl, d)
         if not ok:  # a non-finite field collapses the step too: say which
