@@ -46,9 +46,11 @@ run's end time; sliding the system does not build). Both share one set of status
 (:mod:`filippov.loop.status`), and one table turns a status into its exception class and
 message (:func:`filippov.errors.run_error`, item 10). The
 rest they ask in the same order on each side: the hard bound ``max_steps``
-(integration steps, or exact-flow windows), counted alike; a start on the section up to rounding
-(``rules.starts_on_section``, the probes of ``rules.section_probe``); the exact-flow check
-(``rules.flow_consistent``); non-finite states and fields (an error, or a status);
+(``rules.step_budget_spent``: integration steps, or exact-flow windows, counted alike); a
+start on the section up to rounding (``rules.starts_on_section``, the probes of
+``rules.section_probe``); the exact-flow check
+(``rules.flow_consistent``); non-finite states and fields (an error, or a status; on an
+integration step the guard of ``rules.NON_FINITE_STAGE``);
 the options (:mod:`filippov.options`, one check for both). What remains different is
 listed here, each entry with its reason and the test that pins it; a change of either
 engine that moves one of these makes its test fail.

@@ -445,6 +445,14 @@ def accumulates(oldest: float, newest: float, zeno_span: float) -> bool:
     return newest - oldest <= zeno_span * max(1.0, abs(newest))
 
 
+#: the non-finite guard both engines keep on an integration step: a non-finite field value
+#: at a stay's first evaluation is an error (NON_FINITE); on a trial stage it is replaced
+#: by this huge finite value, so the error norm rejects the step and the step shrinks (a
+#: NaN norm loops scipy's step control forever); a step size that collapses on it ends
+#: the run NON_FINITE, naming the stage's state, not STEP_FAILED
+NON_FINITE_STAGE = 1e300
+
+
 def step_budget_spent(n_steps: int, max_steps: int) -> bool:
     """The hard step bound both engines keep: the run has tried more than max_steps
     steps (every step counts, rejected or not; the reference also projects the steps

@@ -212,7 +212,7 @@ class _IntegratingStepper:
                     raise self._non_finite(tt, zz)
                 if self.non_finite is None:  # the first in this step: near the orbit
                     self.non_finite = (tt, np.array(zz, dtype=float))
-                v = np.full(np.shape(v), 1e300)
+                v = np.full(np.shape(v), rules.NON_FINITE_STAGE)
             return v
 
         self.method = method

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import dop853_tableau as _dop
+from .. import rules
 from ..system import MINUS, PLUS
 from .base import (_field_minus, _field_plus, _jit, _speeds)
 from .state import Stages
@@ -44,9 +45,9 @@ def _dense_eval(t, t_old, hs, y_old, F, out):
 
 @_jit
 def _checked_field(z, mode, first_call, fns, p, fl, out):
-    """The field of ``mode`` (the Filippov field when sliding; fl: state.Fill) with
-    simulate._IntegratingStepper's guard: a non-finite value at the first call
-    is an error (False), on a trial stage it is 1e300."""
+    """The field of ``mode`` (the Filippov field when sliding; fl: state.Fill) with the
+    non-finite guard both engines keep (rules.NON_FINITE_STAGE): a non-finite value at
+    the first call is an error (False), on a trial stage it is replaced."""
     if mode == PLUS:
         _field_plus(fns, z, p, out)
     elif mode == MINUS:
@@ -64,7 +65,7 @@ def _checked_field(z, mode, first_call, fns, p, fl, out):
         if first_call:
             return False
         for k in range(z.size):
-            out[k] = 1e300
+            out[k] = rules.NON_FINITE_STAGE
     return True
 
 
@@ -198,13 +199,14 @@ def _dop_step(mode, t, h_abs, ctl, fns, p, fl, d):
 @_jit
 def _non_finite_stage(y, h, K, out):
     """After a failed step from y over h (stages in K): True if a stage met a non-finite
-    field value (_checked_field put 1e300 in its row), with that stage's state in out."""
+    field value (_checked_field put rules.NON_FINITE_STAGE in its row), with that
+    stage's state in out."""
     n = y.size
     found = 0
     for s in range(1, _NS + 1):
         hit = True
         for k in range(n):
-            if K[s, k] != 1e300:
+            if K[s, k] != rules.NON_FINITE_STAGE:
                 hit = False
                 break  # an early exit: not vectorized (docs/decisions.md#kernel-small-loops)
         if hit:
