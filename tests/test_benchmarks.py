@@ -214,3 +214,18 @@ def test_instruction_cost_names_valgrind_when_it_is_missing(monkeypatch):
     monkeypatch.setattr(ic.shutil, "which", lambda name: None)
     with pytest.raises(RuntimeError, match="needs valgrind"):
         ic._valgrind()
+
+
+def test_instruction_cost_s_probes_mark_their_phases_with_the_one_function_callgrind_dumps_at():
+    """Every phase of both probes ends with a call of MARK and no other os call: a call of
+    MARK is what makes a dump (--dump-before), so any other would move the phases' ends.
+    The compile probe ends each of COMPILE_STAGES once; the per-return probe, per case and
+    build, its warm-up and its N and 2N returns (one call in the loop over N, 2N)."""
+    import re
+
+    from filippov_paper.benchmarks import instruction_cost as ic
+
+    for probe, marks in ((ic._COMPILE_PROBE, len(ic.COMPILE_STAGES)), (ic._PROBE, 2)):
+        calls = re.findall(r"\bos\.(\w+)\(", probe)
+        assert calls == [ic.MARK] * marks
+    assert ic.MARK != "getppid"  # entered by the cold compile itself (see MARK)

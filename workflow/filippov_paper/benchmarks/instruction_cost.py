@@ -8,9 +8,10 @@ run of the same code and inputs, whatever else the machine does. For each case o
 :data:`attractor_cost.CASES` and each build (plain, with dP/dz) one process iterates the
 Hopf map ``--returns`` and then ``2 x --returns`` times from the cycle's point, in one
 :func:`filippov.fastmap.compute_returns` call each; callgrind dumps its counters before
-every call of ``getppid`` (``--dump-before=getppid``: the probe calls ``os.getppid()``
-between its phases), so a return costs (I(2N) - I(N)) / N instructions, the import, the
-warm-up and the loading cancelled out.
+every call of ``getresgid`` (``--dump-before=getresgid``: the probe calls
+``os.getresgid()`` between its phases; :data:`MARK` says why that one), so a return
+costs (I(2N) - I(N)) / N instructions, the import, the warm-up and the loading
+cancelled out.
 
 The kernel is compiled natively first, for numba's generic x86-64 CPU
 (``NUMBA_CPU_NAME=generic``), into a cache of its own: valgrind's CPU reports other
@@ -41,8 +42,14 @@ from filippov_paper.benchmarks.attractor_cost import CASES, OMEGA, case_coords
 
 BUILDS = ("plain", "dpdz")
 
+#: the C function whose every call ends a phase of a probe (callgrind's --dump-before).
+#: Not getppid, the first choice: a cold compile at 81afc72 entered getppid once more,
+#: from no probe line (a fourth dump, 23 G instructions into the plain build); no shared
+#: library of the environment imports getresgid (nm -D), and no Python code here calls it
+MARK = "getresgid"
+
 #: the probe: per case and build, a warm-up, then N and 2N returns, each phase ended by
-#: os.getppid() (a callgrind dump); prints whether the kernel's builds came from the cache
+#: os.getresgid() (a callgrind dump); prints whether the kernel's builds came from the cache
 _PROBE = """
 import json, os, sys
 import numpy as np
@@ -57,12 +64,12 @@ for th, eps, s in cases:
     start = np.array([[0.0, np.sqrt(mu), 0.0]])
     for jac in (False, True):
         compute_returns(cm, start, 1.0, iterations=2, keep=1, jacobian=jac)
-        os.getppid()
+        os.getresgid()
         for k in (n, 2 * n):
             out = compute_returns(cm, start, 1.0, iterations=k, keep=1, jacobian=jac)
             if out.status[0] != OK:
                 sys.exit(f"theta={th}, eps={eps}: return status {out.status[0]}")
-            os.getppid()
+            os.getresgid()
 print(json.dumps({"loaded": [bool(x) for x in loaded]}))
 """
 
@@ -70,11 +77,11 @@ print(json.dumps({"loaded": [bool(x) for x in loaded]}))
 _COMPILE_PROBE = """
 import os
 from filippov.fastmap import compile_kernel
-os.getppid()
+os.getresgid()
 compile_kernel()
-os.getppid()
+os.getresgid()
 compile_kernel(derivatives=True)
-os.getppid()
+os.getresgid()
 """
 
 
@@ -98,7 +105,7 @@ def per_return(counts: list[int], n: int, cases: int) -> np.ndarray:
     the dumps (warm-up, N returns, 2N returns); (I(2N) - I(N)) / N."""
     if len(counts) != 3 * len(BUILDS) * cases:
         raise ValueError(f"expected {3 * len(BUILDS) * cases} callgrind dumps (3 per case "
-                         f"and build), got {len(counts)}: did something else call getppid?")
+                         f"and build), got {len(counts)}: did something else call {MARK}?")
     c = np.asarray(counts, dtype=float).reshape(cases, len(BUILDS), 3)
     return (c[:, :, 2] - c[:, :, 1]) / n
 
@@ -123,7 +130,7 @@ def _callgrind(script: str, args: list[str], env: dict, where: str) -> tuple[lis
     os.makedirs(where, exist_ok=True)
     out = os.path.join(where, "cg.out")
     stdout = _run([_valgrind(), "--tool=callgrind", "--dump-instr=no",
-                   "--dump-before=getppid", f"--callgrind-out-file={out}", sys.executable,
+                   f"--dump-before={MARK}", f"--callgrind-out-file={out}", sys.executable,
                    "-c", script, *args], env, "the probe under valgrind")
     return dump_counts(out), stdout
 
