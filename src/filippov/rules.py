@@ -454,9 +454,10 @@ NON_FINITE_STAGE = 1e300
 
 
 def step_budget_spent(n_steps: int, max_steps: int) -> bool:
-    """The hard step bound both engines keep: the run has tried more than max_steps
-    steps (every step counts, rejected or not; the reference also projects the steps
-    still to come, engines.py asymmetry 3)."""
+    """The hard step bound both engines keep: the run has taken more than max_steps
+    steps (accepted integration steps, and exact-flow windows; a step's rejected trials
+    count once with it; the reference also projects the steps still to come, engines.py
+    asymmetry 3)."""
     return n_steps > max_steps
 
 
