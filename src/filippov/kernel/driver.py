@@ -57,11 +57,19 @@ def _slide_fields(at):
     return z, wf, wp
 
 
-@_jit  # a call: make_slides_in asks it seven times (inlined, it grew the cold compile)
+@_jit_inline
 def _section_along(k, mode, d, at):
     """The section at z + d (cm F_- + cp F_+), the field of ``mode`` as its weights
     (Filippov's while sliding, from F_-, F_+ and grad h left by _slide_fields); d = 0:
     at z."""
+    # make_slides_in passes k and the modes as Python int constants, literals to numba:
+    # + 0 makes them int64, so the call is compiled once, not once per mode
+    # (docs/decisions.md#kernel-codes-are-numpy-integers)
+    return _section_along_at(k + 0, mode + 0, d, at)
+
+
+@_jit  # a call: make_slides_in asks it seven times (inlined, it grew the cold compile)
+def _section_along_at(k, mode, d, at):
     fns, p, z, wg, wm, wp, wz = at
     if d == 0.0:
         return _section(fns, z, p)

@@ -297,7 +297,10 @@ _interval_event = _jit_inline(make_interval_event(
 
 @_jit_inline
 def _skip_to(ctx, i, mode):
-    return i  # each interval is tested as the walk comes to it (_candidate_at)
+    # each interval is tested as the walk comes to it (_candidate_at); i + 0, not i: the
+    # walk starts at the constant 0, and a call given that literal i would be compiled
+    # twice (docs/decisions.md#kernel-codes-are-numpy-integers)
+    return i + 0
 
 
 @_jit_inline
