@@ -1,5 +1,6 @@
-"""The event search of one sample interval is written once (filippov.loop.interval): its
-order and ties on scripted operations, and both engines running that one function."""
+"""The event search of a window's sample intervals is written once
+(filippov.loop.interval): its order and ties on scripted operations, and both engines
+running that one function."""
 import ast
 import math
 from pathlib import Path
@@ -8,7 +9,7 @@ import pytest
 
 from filippov import rules
 from filippov.loop import interval
-from filippov.loop.interval import NONE, OK, SECTION, make_interval_event
+from filippov.loop.interval import NONE, OK, SECTION, make_window_event
 from filippov.system import MINUS, PLUS, SLIDING
 
 SRC = Path(interval.__file__).resolve().parents[1]
@@ -30,7 +31,7 @@ class Script:
         return (7 if self.fail == name else OK,) + value
 
 
-EVENT = make_interval_event(
+ASK = interval.IntervalOps(
     leave_crosses=lambda c, q, i: q in c.leave,
     leave_root=lambda c, q, i, mode: c.answer(f"leave{q}", c.leave[q]),
     slide_end_between=lambda c, q, i: q in c.slide,
@@ -43,6 +44,18 @@ EVENT = make_interval_event(
     section_root=lambda c, k, i, mode: c.answer(f"section{k}", c.sections[k][0]),
     section_bounds=lambda c, k: (c.sections[k][1], XTOL),
     section_counts=lambda c, k, i, r, mode: c.sections[k][2])
+#: a window of one sample interval, the questions asked on it
+ONE_INTERVAL = make_window_event(
+    interval.WalkOps(skip_to=lambda c, i, mode: i,
+                     candidate_at=lambda c, i, mode: (True, c), last_sample=lambda c: 1,
+                     clears_band_at=lambda c, i, mode: False, unband=None),
+    ASK)
+
+
+def EVENT(c, i, mode):
+    """The event of sample interval i = 0 on the scripted engine c."""
+    assert i == 0
+    return ONE_INTERVAL(c, mode)
 
 
 def test_the_earliest_leave_crossing_is_the_event_and_hidden_extrema_are_not_asked():
@@ -110,10 +123,10 @@ def test_the_tie_break_is_called_only_by_the_one_event_search():
     sources = sorted(SRC.rglob("*.py"))
     where = {name: [p.relative_to(SRC).as_posix() for p in sources
                     for call in _calls(p) if call == name]
-             for name in ("section_first", "same_instant", "make_interval_event")}
+             for name in ("section_first", "same_instant", "make_window_event")}
     assert where["section_first"] == ["loop/interval.py"]
     assert where["same_instant"] == ["rules.py"]            # within section_first
-    assert sorted(where["make_interval_event"]) == ["kernel/scan.py", "simulate.py"]
+    assert sorted(where["make_window_event"]) == ["kernel/scan.py", "simulate.py"]
 
 
 def test_both_engines_run_the_one_event_search():
@@ -124,13 +137,17 @@ def test_both_engines_run_the_one_event_search():
     simulate = importlib.import_module("filippov.simulate")  # the module, not the function
     from filippov.kernel import scan
 
-    assert scan._interval_event.py_func.__code__ is simulate._interval_event.__code__
-    # each engine's window walk asks it
-    for walk, event in ((simulate._window_event, simulate._interval_event),
-                        (scan._window_event.py_func, scan._interval_event)):
-        assert event in [cell.cell_contents for cell in walk.__closure__]
-    for gone in ("_event_in", "_leave_crossing", "_section_hit"):
+    assert scan._window_event.py_func.__code__ is simulate._window_event.__code__
+    # each engine's window walk asks its own operations
+    for walk, ops in ((simulate._window_event, (simulate._Scan._leave_root,
+                                                simulate._Scan._section_counts)),
+                      (scan._window_event.py_func, (scan._leave_root_at,
+                                                    scan._section_counts))):
+        cells = [cell.cell_contents for cell in walk.__closure__]
+        assert all(op in cells for op in ops)
+    for gone in ("_event_in", "_leave_crossing", "_section_hit", "_interval_event"):
         assert not hasattr(simulate._Scan, gone) and not hasattr(scan, gone)
+    assert not hasattr(simulate, "_interval_event")  # the questions are in the walk
 
 
 # ----------------------------------------------------------- the walk over a window
@@ -140,31 +157,42 @@ class Window:
     out of the band, ``events`` {i: t}; ``asked`` the intervals the event search was
     asked, ``unbands`` the samples the band ended at."""
 
-    def __init__(self, cand, events, clear=None, unbanded=(), n=12):
+    def __init__(self, cand, events, clear=None, unbanded=(), n=12, fail=False):
         self.cand, self.events, self.clear, self.unbanded = list(cand), events, clear, unbanded
         self.n, self.band, self.asked, self.unbands = n, clear is not None, [], []
+        self.fail = fail
+
+    def crosses(self, q, i):
+        """The scripted interval: h changes sign at an event (or the search fails)."""
+        if q == 0:
+            self.asked.append(i)
+        return q == 0 and (i in self.events or self.fail)
+
+    def root(self, q, i, mode):
+        return (7, 0.25) if self.fail else (OK, self.events[i])
 
 
-def _walk(interval_event, skip=True):
-    """The walk on a scripted Window, with the given event search; ``skip``: jump to the
-    next candidate (as the reference does) or test every interval (as the kernel does)."""
+def _walk(skip=True):
+    """The walk on a scripted Window; ``skip``: jump to the next candidate (as the
+    reference does) or test every interval (as the kernel does)."""
     return interval.make_window_event(
-        skip_to=lambda c, i, mode: (min((j for j in c.cand if j >= i), default=c.n - 1)
-                                    if skip else i),
-        candidate_at=lambda c, i, mode: (i in c.cand, c),
-        last_sample=lambda c: c.n - 1,
-        clears_band_at=lambda c, i, mode: c.band and i >= c.clear,
-        unband=lambda c, i, mode: (c.unbands.append(i), setattr(c, "band", False),
-                                   setattr(c, "cand", [j for j in c.unbanded if j >= i])),
-        interval_event=interval_event)
+        interval.WalkOps(
+            skip_to=lambda c, i, mode: (min((j for j in c.cand if j >= i), default=c.n - 1)
+                                        if skip else i),
+            candidate_at=lambda c, i, mode: (i in c.cand, c),
+            last_sample=lambda c: c.n - 1,
+            clears_band_at=lambda c, i, mode: c.band and i >= c.clear,
+            unband=lambda c, i, mode: (c.unbands.append(i), setattr(c, "band", False),
+                                       setattr(c, "cand", [j for j in c.unbanded if j >= i]))),
+        interval.IntervalOps(
+            leave_crosses=Window.crosses, leave_root=Window.root,
+            slide_end_between=lambda c, q, i: False, hidden_slide_end=None,
+            extremum_between=lambda c, i: False, hidden_extremum=None, touch=None,
+            n_sections=lambda c: 0, section_crosses=None, section_root=None,
+            section_bounds=None, section_counts=None))
 
 
-def _search(c, i, mode):
-    c.asked.append(i)
-    return (OK, c.events[i], rules.SWITCH, -1) if i in c.events else (OK, math.inf, NONE, -1)
-
-
-WALKS = [_walk(_search), _walk(_search, skip=False)]
+WALKS = [_walk(), _walk(skip=False)]
 walks = pytest.mark.parametrize("WALK", WALKS, ids=["skipping", "every-interval"])
 
 
@@ -205,9 +233,8 @@ def test_a_window_with_no_event_ends_the_band_at_its_last_sample_out_of_it(WALK)
 
 
 def test_a_failed_search_stops_the_walk():
-    c = Window(cand=[1, 3], events={})
-    walk = _walk(lambda c, i, mode: (c.asked.append(i), (7, 0.25, NONE, -1))[1])
-    assert walk(c, SLIDING) == (7, 0.25, NONE, -1) and c.asked == [1]
+    c = Window(cand=[1, 3], events={}, fail=True)
+    assert WALKS[0](c, SLIDING) == (7, 0.25, NONE, -1) and c.asked == [1]
 
 
 def test_both_engines_walk_their_windows_with_the_one_function():
@@ -254,18 +281,24 @@ def test_both_engines_probe_past_the_band_with_the_one_function():
     assert not hasattr(simulate._Scan, "_past_band")
 
 
-def test_the_walk_is_one_loop_asking_the_event_search_in_one_place():
+def test_the_walk_is_one_loop_asking_each_question_in_one_place():
     """The kernel inlines every call of an operation (numba, inline="always"): the walk
-    asks the event search (the large one) in one place, and is one loop with none inside
-    it (a walk that restarted an inner loop of candidates after each interval cost the
-    kernel about 2% of its instructions per return: docs/decisions.md)."""
+    asks each question in one place (a touch: while sliding and in a region), is one loop
+    over the intervals (a walk that restarted an inner loop of candidates after each
+    interval cost the kernel about 2% of its instructions per return), and its only other
+    loops are the questions' own (the leave functions q, the two touches, the sections k):
+    docs/decisions.md#kernel-inlined-driver."""
     import inspect
     import textwrap
 
     tree = ast.parse(textwrap.dedent(inspect.getsource(interval.make_window_event)))
     calls = [node.func.id for node in ast.walk(tree)
              if isinstance(node, ast.Call) and isinstance(node.func, ast.Name)]
-    assert calls.count("interval_event") == 1 and calls.count("last_sample") == 1
+    for op in interval.IntervalOps._fields:
+        assert calls.count(op) == (2 if op == "touch" else 1), op
+    assert calls.count("last_sample") == 1
     for op in ("skip_to", "candidate_at", "clears_band_at", "unband"):
         assert calls.count(op) == 2, op  # at the start and after the band's end
-    assert sum(isinstance(node, (ast.For, ast.While)) for node in ast.walk(tree)) == 1
+    assert sum(isinstance(node, ast.While) for node in ast.walk(tree)) == 1
+    assert sorted(node.target.id for node in ast.walk(tree)
+                  if isinstance(node, ast.For)) == ["k", "q", "q", "tm"]

@@ -950,7 +950,7 @@ class _Scan:
 
     # -------------------------------------------- the event search's operations on it
     # The order of the questions in one sample interval and its ties are the one event
-    # search (filippov.loop.interval, _interval_event below); these methods are how this
+    # search (filippov.loop.interval, _window_event below); these methods are how this
     # engine answers each, on its samples and its dense output Z. Its failures raise, so
     # each returns the status OK.
 
@@ -1055,17 +1055,17 @@ class _Scan:
                 or _in_section_rounding(sec.func, float(sv[0]), z_first, z_root))
 
 
-#: the one event search of a sample interval (filippov.loop.interval), asked through this
-#: engine's operations
-_interval_event = interval.make_interval_event(
-    _Scan._leave_crosses, _Scan._leave_root, _Scan._slide_end_between,
-    _Scan._hidden_slide_end, _Scan._extremum_between, _Scan._hidden_extremum, _Scan._touch,
-    _Scan._n_sections, _Scan._section_crosses, _Scan._section_root, _Scan._section_bounds,
-    _Scan._section_counts)
 _past_band = interval.make_past_band(_Scan._banded_h, _Scan._refine_unbanded)
-_window_event = interval.make_window_event(_Scan._skip_to, _Scan._candidate_at,
-                                           _Scan._last_sample, _Scan._clears_band_at,
-                                           _Scan._unband, _interval_event)
+#: the one event search over a window's sample intervals (filippov.loop.interval), asked
+#: through this engine's operations
+_window_event = interval.make_window_event(
+    interval.WalkOps(_Scan._skip_to, _Scan._candidate_at, _Scan._last_sample,
+                     _Scan._clears_band_at, _Scan._unband),
+    interval.IntervalOps(
+        _Scan._leave_crosses, _Scan._leave_root, _Scan._slide_end_between,
+        _Scan._hidden_slide_end, _Scan._extremum_between, _Scan._hidden_extremum,
+        _Scan._touch, _Scan._n_sections, _Scan._section_crosses, _Scan._section_root,
+        _Scan._section_bounds, _Scan._section_counts))
 
 # the event search and what is done at an event speak the same codes
 assert interval.SECTION == SECTION and interval.OK == OK

@@ -7,7 +7,7 @@ from collections import namedtuple
 import numpy as np
 
 from .. import rules
-from ..loop.interval import make_interval_event, make_past_band, make_window_event
+from ..loop.interval import IntervalOps, WalkOps, make_past_band, make_window_event
 from ..system import MINUS, PLUS, SLIDING
 from .base import (OK, ROOT_FAILED, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB, _S_H,
                    _S_SEC, _TO_NEG, _TO_NONNEG, _TO_NONPOS, _W_NONE, _dot, _jit,
@@ -289,10 +289,11 @@ def _section_counts(ctx, k, i, r, mode):
                 or _in_section_rounding(o.fns, o.p, sm.svals[i], wg, wz, sc.wf))
 
 
-_interval_event = _jit_inline(make_interval_event(
+#: how the kernel answers the questions of a sample interval (loop.interval.IntervalOps)
+_INTERVAL_OPS = IntervalOps(
     _leave_crosses, _leave_root_at, _slide_end_between, _speed_exit, _extremum_between_at,
     _h_extremum, _touch, _n_sections, _section_crosses, _section_root, _section_bounds,
-    _section_counts))
+    _section_counts)
 
 
 @_jit_inline
@@ -347,8 +348,9 @@ def _unband(ctx, i, mode):
 
 
 #: a call with its pieces inlined, as _find was (docs/decisions.md#kernel-inlined-driver)
-_window_event = _jit(make_window_event(_skip_to, _candidate_at, _last_sample,
-                                       _clears_band_at, _unband, _interval_event))
+_window_event = _jit(make_window_event(
+    WalkOps(_skip_to, _candidate_at, _last_sample, _clears_band_at, _unband),
+    _INTERVAL_OPS))
 
 
 @_jit_inline

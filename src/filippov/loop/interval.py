@@ -4,7 +4,8 @@ written once for both engines.
 Between two samples of a stay the scan asks, in this order:
 
 1. does a leave function change sign (h: a switch; while sliding, a or b: an exit into
-   region - or +: ``rules.ended_by``)? Its root, refined; the earliest of them is the event so far;
+   region - or +: ``rules.ended_by``)? Its root, refined; the earliest of them is the
+   event so far;
 2. none, and sliding: has a or b an extremum toward its sign change hidden between the
    samples (``rules.speed_extremum_between``)? The engine refines it and
    ``rules.speed_graze`` tells an exit (the earliest wins) from a touch, which is
@@ -26,8 +27,8 @@ sign change; a window with no event ends it when its last sample is out of the b
 A switch found while the band is in force, at a time where the orbit is
 already out of it, is refined again on h itself (:func:`make_past_band`).
 
-:func:`make_interval_event` builds the search from the engine's own operations -- how it tests
-its samples, refines a root, finds a hidden extremum, records a touch --, each a
+:func:`make_window_event` builds the search from the engine's own operations -- how it
+tests its samples, refines a root, finds a hidden extremum, records a touch --, each a
 function of the engine's state ``ctx`` first. The reference driver
 (:class:`filippov.simulate._Scan`) passes its Python methods and runs the result as it
 is; the compiled kernel (:mod:`filippov.kernel.scan`) passes its compiled pieces and
@@ -43,6 +44,7 @@ other event).
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 from .. import rules
 from ..rules import GRAZE_CROSSES, GRAZE_TOUCHES, SWITCH
@@ -55,111 +57,53 @@ OK = 0
 NONE, SECTION = -1, 3
 
 
-def make_interval_event(leave_crosses, leave_root, slide_end_between, hidden_slide_end,
-                        extremum_between, hidden_extremum, touch, n_sections,
-                        section_crosses, section_root, section_bounds, section_counts):
-    """``interval_event(ctx, i, mode) -> (status, t, what, k)``: the earliest event between
-    samples i and i + 1 of a stay in ``mode``, asked in the order of this module's
-    docstring, from the engine's operations on its state ``ctx``:
+#: How an engine walks a window's sample intervals, each a function of its state ``ctx``:
+#:
+#: * ``skip_to(ctx, i, mode)``: the first interval from i on that may show a sign change
+#:   (``last_sample(ctx)`` if none): an engine that found its candidates with array
+#:   operations jumps to the next one, an engine that tests each interval as it comes
+#:   answers i itself;
+#: * ``candidate_at(ctx, i, mode) -> (hit, at)``: interval i shows a sign change (one of
+#:   the questions may hold), and the state ``at`` the questions are asked on there (ctx
+#:   itself, or ctx with what the engine saw at i);
+#: * ``last_sample(ctx)``: the index of the window's last sample;
+#: * ``clears_band_at(ctx, i, mode)``: the exit's band is in force and the orbit is out
+#:   of it at sample i; ``unband(ctx, i, mode)``: the band ends, h is sampled again
+#:   unbiased from sample i on and the candidates from i on are found again (none when i
+#:   is past the last sample).
+WalkOps = namedtuple("WalkOps", (
+    "skip_to", "candidate_at", "last_sample", "clears_band_at", "unband"))
 
-    * ``leave_crosses(ctx, q, i)``: leave function q (0: h, or a while sliding; 1: b)
-      changes sign; ``leave_root(ctx, q, i, mode) -> (status, t)``: its root;
-    * ``slide_end_between(ctx, q, i)``: while sliding, speed q has an extremum toward its
-      sign change; ``hidden_slide_end(ctx, q, i, mode) -> (status, t, kind)``: judged by
-      rules.speed_graze, GRAZE_CROSSES with the speed's root before it, GRAZE_TOUCHES
-      with the extremum's time, or GRAZE_NONE; ``extremum_between(ctx, i)``,
-      ``hidden_extremum(ctx, i, mode)``: the same for h in a region (rules.graze);
-    * ``touch(ctx, t, mode)``: a touch of H at t (no event; the return map has a kink);
-    * ``n_sections(ctx)``, ``section_crosses(ctx, k, i)``, ``section_root(ctx, k, i,
-      mode) -> (status, t)``, ``section_bounds(ctx, k) -> (t_min, xtol)``,
-      ``section_counts(ctx, k, i, t, mode)``: the crossing at t is a hit (where holds, not
-      the start itself).
-
-    The rules it asks it calls as ``rules.<name>`` on both engines (the kernel registers
-    every rule as compilable: :mod:`filippov.kernel.base`).
-    """
-
-    def interval_event(ctx, i, mode):
-        best_t, best_w = math.inf, NONE
-        # 1. the leave functions' crossings: the earliest
-        for q in range(2 if mode == SLIDING else 1):
-            if leave_crosses(ctx, q, i):
-                st, r = leave_root(ctx, q, i, mode)
-                if st != OK:
-                    return st, r, NONE, -1
-                if best_w == NONE or r < best_t:
-                    best_t, best_w = r, rules.ended_by(mode, q)
-        # 2. none while sliding: the end of sliding hidden between the samples
-        if mode == SLIDING and best_w == NONE:
-            touch_a, touch_b = math.inf, math.inf
-            for q in range(2):
-                if not slide_end_between(ctx, q, i):
-                    continue
-                st, r, kind = hidden_slide_end(ctx, q, i, mode)
-                if st != OK:
-                    return st, r, NONE, -1
-                if kind == GRAZE_CROSSES:
-                    if best_w == NONE or r < best_t:
-                        best_t, best_w = r, rules.ended_by(mode, q)
-                elif kind == GRAZE_TOUCHES:
-                    if q == 0:
-                        touch_a = r
-                    else:
-                        touch_b = r
-            # a touch before any exit, in time order: P has a kink there
-            for tm in (min(touch_a, touch_b), max(touch_a, touch_b)):
-                if tm < best_t:
-                    touch(ctx, tm, mode)
-        # 3. none in a region: an extremum of h hidden between the samples
-        if mode != SLIDING and best_w == NONE and extremum_between(ctx, i):
-            st, r, kind = hidden_extremum(ctx, i, mode)
-            if st != OK:
-                return st, r, NONE, -1
-            if kind == GRAZE_CROSSES:
-                best_t, best_w = r, SWITCH
-            elif kind == GRAZE_TOUCHES:
-                touch(ctx, r, mode)
-        # 4. the sections, in order: a hit that comes first, or at a switch's instant
-        best_k = -1
-        for k in range(n_sections(ctx)):
-            if not section_crosses(ctx, k, i):
-                continue
-            st, r = section_root(ctx, k, i, mode)
-            if st != OK:
-                return st, r, NONE, -1
-            t_min, xtol = section_bounds(ctx, k)
-            if (rules.section_first(r, t_min, best_t, best_w == SECTION, xtol)
-                    and section_counts(ctx, k, i, r, mode)):
-                best_t, best_w, best_k = r, SECTION, k
-        return OK, best_t, best_w, best_k
-
-    return interval_event
+#: How an engine answers the questions of sample interval i, each on the state ``at``:
+#:
+#: * ``leave_crosses(at, q, i)``: leave function q (0: h, or a while sliding; 1: b)
+#:   changes sign; ``leave_root(at, q, i, mode) -> (status, t)``: its root;
+#: * ``slide_end_between(at, q, i)``: while sliding, speed q has an extremum toward its
+#:   sign change; ``hidden_slide_end(at, q, i, mode) -> (status, t, kind)``: judged by
+#:   rules.speed_graze, GRAZE_CROSSES with the speed's root before it, GRAZE_TOUCHES with
+#:   the extremum's time, or GRAZE_NONE; ``extremum_between(at, i)``,
+#:   ``hidden_extremum(at, i, mode)``: the same for h in a region (rules.graze);
+#: * ``touch(at, t, mode)``: a touch of H at t (no event; the return map has a kink);
+#: * ``n_sections(at)``, ``section_crosses(at, k, i)``, ``section_root(at, k, i, mode)
+#:   -> (status, t)``, ``section_bounds(at, k) -> (t_min, xtol)``, ``section_counts(at,
+#:   k, i, t, mode)``: the crossing at t is a hit (where holds, not the start itself).
+IntervalOps = namedtuple("IntervalOps", (
+    "leave_crosses", "leave_root", "slide_end_between", "hidden_slide_end",
+    "extremum_between", "hidden_extremum", "touch", "n_sections", "section_crosses",
+    "section_root", "section_bounds", "section_counts"))
 
 
-def make_window_event(skip_to, candidate_at, last_sample, clears_band_at, unband,
-                      interval_event):
+def make_window_event(walk: WalkOps, ask: IntervalOps):
     """``window_event(ctx, mode) -> (status, t, what, k)``: the earliest event over a
-    window's sample intervals, asked in time order (this module's docstring), from the
-    engine's operations on its state ``ctx``:
-
-    * ``skip_to(ctx, i, mode)``: the first interval from i on that may show a sign
-      change (``last_sample(ctx)`` if none): an engine that found its candidates with
-      array operations jumps to the next one, an engine that tests each interval as it
-      comes answers i itself;
-    * ``candidate_at(ctx, i, mode) -> (hit, at)``: interval i shows a sign change (one of
-      interval_event's questions may hold), and the state ``at`` the event search is
-      asked on there (ctx itself, or ctx with what the engine saw at i);
-    * ``last_sample(ctx)``: the index of the window's last sample;
-    * ``clears_band_at(ctx, i, mode)``: the exit's band is in force and the orbit is out
-      of it at sample i; ``unband(ctx, i, mode)``: the band ends, h is sampled again
-      unbiased from sample i on and the candidates from i on are found again (none
-      when i is past the last sample);
-    * ``interval_event``: :func:`make_interval_event`'s, asked on ``at``.
-
-    A window with no event ends the band when its last sample is out of it: the next
-    window then samples h unbiased from its start. The walk is one loop over the
-    intervals with no loop inside it (why: docs/decisions.md#kernel-inlined-driver).
-    """
+    window's sample intervals in time order, each interval's questions in the order of
+    this module's docstring, from the engine's operations (:data:`WalkOps`,
+    :data:`IntervalOps`). The questions are written in the walk's loop, not called: the
+    kernel inlines each operation here, and a composed function inlined whole costs the
+    cold compile a copy of all of it (docs/decisions.md#kernel-inlined-driver)."""
+    skip_to, candidate_at, last_sample, clears_band_at, unband = walk
+    (leave_crosses, leave_root, slide_end_between, hidden_slide_end, extremum_between,
+     hidden_extremum, touch, n_sections, section_crosses, section_root, section_bounds,
+     section_counts) = ask
 
     def window_event(ctx, mode):
         n = last_sample(ctx)
@@ -170,9 +114,59 @@ def make_window_event(skip_to, candidate_at, last_sample, clears_band_at, unband
                 unband(ctx, i, mode)  # interval i asked again, h unbiased
                 hit, at = candidate_at(ctx, i, mode)
             if hit:
-                st, t, what, k = interval_event(at, i, mode)
-                if st != OK or what != NONE:
-                    return st, t, what, k
+                best_t, best_w = math.inf, NONE
+                # 1. the leave functions' crossings: the earliest
+                for q in range(2 if mode == SLIDING else 1):
+                    if leave_crosses(at, q, i):
+                        st, r = leave_root(at, q, i, mode)
+                        if st != OK:
+                            return st, r, NONE, -1
+                        if best_w == NONE or r < best_t:
+                            best_t, best_w = r, rules.ended_by(mode, q)
+                # 2. none while sliding: the end of sliding hidden between the samples
+                if mode == SLIDING and best_w == NONE:
+                    touch_a, touch_b = math.inf, math.inf
+                    for q in range(2):
+                        if not slide_end_between(at, q, i):
+                            continue
+                        st, r, kind = hidden_slide_end(at, q, i, mode)
+                        if st != OK:
+                            return st, r, NONE, -1
+                        if kind == GRAZE_CROSSES:
+                            if best_w == NONE or r < best_t:
+                                best_t, best_w = r, rules.ended_by(mode, q)
+                        elif kind == GRAZE_TOUCHES:
+                            if q == 0:
+                                touch_a = r
+                            else:
+                                touch_b = r
+                    # a touch before any exit, in time order: P has a kink there
+                    for tm in (min(touch_a, touch_b), max(touch_a, touch_b)):
+                        if tm < best_t:
+                            touch(at, tm, mode)
+                # 3. none in a region: an extremum of h hidden between the samples
+                if mode != SLIDING and best_w == NONE and extremum_between(at, i):
+                    st, r, kind = hidden_extremum(at, i, mode)
+                    if st != OK:
+                        return st, r, NONE, -1
+                    if kind == GRAZE_CROSSES:
+                        best_t, best_w = r, SWITCH
+                    elif kind == GRAZE_TOUCHES:
+                        touch(at, r, mode)
+                # 4. the sections in order: a hit that comes first, or at a switch
+                best_k = -1
+                for k in range(n_sections(at)):
+                    if not section_crosses(at, k, i):
+                        continue
+                    st, r = section_root(at, k, i, mode)
+                    if st != OK:
+                        return st, r, NONE, -1
+                    t_min, xtol = section_bounds(at, k)
+                    if (rules.section_first(r, t_min, best_t, best_w == SECTION, xtol)
+                            and section_counts(at, k, i, r, mode)):
+                        best_t, best_w, best_k = r, SECTION, k
+                if best_w != NONE:
+                    return OK, best_t, best_w, best_k
             i = skip_to(ctx, i + 1, mode)
         if clears_band_at(ctx, n, mode):
             unband(ctx, n + 1, mode)  # no sample after the last one to take again
