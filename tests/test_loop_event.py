@@ -45,17 +45,36 @@ def test_the_event_rules_are_asked_only_by_the_loop():
             if "accumulates" in set(_calls(p))} == {"rules.py"}
 
 
-def test_both_engines_build_their_event_from_the_loop():
+def test_both_engines_build_their_run_from_the_loop():
     builders = {str(p.relative_to(SRC)) for p in SRC.rglob("*.py")
-                if "make_event" in set(_calls(p))}
+                if "make_run" in set(_calls(p))}
     assert builders == {"simulate.py", "kernel/driver.py"}
-    # and each calls what it built: the reference's _EVENT, the kernel's _event
-    assert "_EVENT" in set(_calls(SRC / "simulate.py"))
-    assert "_event" in set(_calls(SRC / "kernel" / "driver.py"))
+    # and each calls what it built: the reference's _RUN, the kernel's _one
+    assert "_RUN" in set(_calls(SRC / "simulate.py"))
+    assert "_one" in set(_calls(SRC / "kernel" / "driver.py"))
+    # the loop before each stay is asked in the run only
+    assert {str(p.relative_to(SRC)) for p in SRC.rglob("*.py")
+            if "before_stay" in set(_calls(p))} == {"loop/event.py"}
     # the reference's own copies are gone
     reference = (SRC / "simulate.py").read_text()
     assert "def _decide" not in reference and "def _check_rate" not in reference
     assert "deque" not in reference
+
+
+def test_the_event_is_written_in_the_run_loop():
+    # not a function the loop calls (numba would copy its whole IR into the run:
+    # docs/decisions.md#kernel-inlined-driver): make_run defines one function, whose
+    # one `while` asks the event's rules itself
+    tree = ast.parse((SRC / "loop" / "event.py").read_text())
+    make_run = next(n for n in tree.body if isinstance(n, ast.FunctionDef)
+                    and n.name == "make_run")
+    inner = [n for n in ast.walk(make_run) if isinstance(n, ast.FunctionDef)]
+    assert [n.name for n in inner] == ["make_run", "run"]
+    loops = [n for n in ast.walk(inner[1]) if isinstance(n, ast.While)]
+    assert len(loops) == 1
+    asked = {n.func.attr for n in ast.walk(loops[0])
+             if isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute)}
+    assert EVENT_RULES - {"accumulates"} <= asked
 
 
 @pytest.mark.parametrize("zeno_count", [2, 3, 7])

@@ -32,7 +32,8 @@ instant of a switch wins the tie (``rules.section_first``) -- each engine answer
 its own samples and root finder; a crossing becomes an event time by one function,
 :mod:`filippov.loop.refine` (a sample exactly on it, the bracketing root, an event at
 once where a clamped start is already past it, then the walk to its far side). What is
-done at an event is one function, :mod:`filippov.loop.event`:
+done at an event is written once, in the run's loop both engines run,
+:mod:`filippov.loop.event`:
 the decision (``rules.next_mode``), sliding the system does not build, the refusal to
 slide inside a section at an arrival on H, the fold exit (``rules.exit_drift``,
 ``onto_switch``, ``exit_band``, ``exit_shift``), the switch counted against
@@ -42,9 +43,9 @@ engine's own budget verdict (item 2). The start is one function too,
 :mod:`filippov.loop.stay` (the start mode, ``rules.start_side`` and
 ``rules.start_on_switch``, and the refusal to slide inside a section, whose test
 ``make_slides_in`` is shared with the event), and so is the check before each stay (the
-run's end time; sliding the system does not build). Both share one set of status codes
-(:mod:`filippov.loop.status`), and one table turns a status into its exception class and
-message (:func:`filippov.errors.run_error`, item 10). The
+run's end time; sliding the system does not build), asked by the run. Both share one
+set of status codes (:mod:`filippov.loop.status`), and one table turns a status into its
+exception class and message (:func:`filippov.errors.run_error`, item 10). The
 rest they ask in the same order on each side: the hard bound ``max_steps``
 (``rules.step_budget_spent``: integration steps, or exact-flow windows, counted alike); a
 start on the section up to rounding (``rules.starts_on_section``, the probes of

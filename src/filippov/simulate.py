@@ -36,8 +36,8 @@ from .radau_iia import RadauIIA
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
 from .errors import run_error
-from .loop.event import SECTION, EventOps, make_event
-from .loop.stay import before_stay, make_slides_in, make_start
+from .loop.event import SECTION, RunOps, make_run
+from .loop.stay import make_slides_in, make_start
 from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN,
                           NO_SLIDING, OK,
                           ROOT_FAILED, SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO)
@@ -490,8 +490,8 @@ def _simulate(system: PiecewiseSystem, z0, sections: Sequence[Section], opts: di
 
 class _Run:
     """One call of :func:`simulate`: its options, the trajectory and the counters.
-    :meth:`go` is the driver loop, :meth:`stay` follows one mode until its next
-    event, :meth:`event` records that event and decides how to go on."""
+    :meth:`go` runs the shared loop (:data:`_RUN`), :meth:`stay` follows one mode until
+    its next event; the functions under "one event" are what the loop does there."""
 
     def __init__(self, system, z, sections, opts):
         self.system, self.sections = system, sections
@@ -524,20 +524,22 @@ class _Run:
         return traj
 
     def go(self) -> Trajectory:
-        while True:
-            status = before_stay(self.mode, self.t, self.t_end, self.system.sliding)
-            if status == NO_RETURN:
-                return self.stop("t_end")
-            if status != GO_ON:
-                raise self._event_error(status)
-            done = self.stay()
-            if done is not None:
-                return done
+        """The run from the start, in the shared order of :mod:`filippov.loop.event`; a
+        status that ends it becomes the trajectory's end or its exception."""
+        status, _, _ = _RUN(self.z, 0.0, self)
+        if status == NO_RETURN:
+            return self.stop("t_end")
+        if status == OK:
+            return self.stop(f"section:{self.sections[self.hit_section].name}")
+        raise self._event_error(status)
 
     # ------------------------------------------------------------------ one stay
+    def flows_exactly(self, mode):
+        return self.method == "exact" and self.system.has_flow(mode)
+
     def _stepper(self, mode):
         system, t, z = self.system, self.t, self.z
-        if self.method == "exact" and system.has_flow(mode):
+        if self.flows_exactly(mode):
             h = min(EXACT_BLOCK * system.sample_step, self.max_step, self.t_end - self.t0)
             return _ExactStepper(system.flows[mode], z, t, self.t_end, h,
                                  slow_window(system.slow_sample_step, h, self.max_step,
@@ -563,8 +565,8 @@ class _Run:
                 (lambda zz: system.normal_speeds(zz)[1], rules.TO_NONNEG, "exit_plus")]
 
     def stay(self):
-        """Follows the current mode to its next event; the stopped trajectory, or None
-        to go on (in the mode the event decided)."""
+        """Follows the current mode to its next event: (OK, its time, what it is; the
+        section hit in hit_section), or (NO_RETURN, t_end, None)."""
         mode = self.mode
         stepper = self._stepper(mode)
         leave = self._leave(mode)
@@ -583,7 +585,7 @@ class _Run:
                     leave = self._leave(mode)
                 if tb >= self.t_end:
                     self._note_tolerance(stepper)
-                    return self.stop("t_end")
+                    return NO_RETURN, tb, None
                 steps_in_mode += 1
                 stepper = self._stiff_switch(stepper, steps_in_mode, tb - ta)
                 continue
@@ -592,7 +594,8 @@ class _Run:
                 self.traj.segments[-1] = (ta, te, mode, Z)
             self.t, self.z = te, ze
             self._note_tolerance(stepper)
-            return self.event(what, idx)
+            self.hit_section = idx
+            return OK, te, what
 
     def _note_tolerance(self, stepper):
         """At the end of a stay: how far the noise floor lifted Radau IIA's atol (the
@@ -690,21 +693,8 @@ class _Run:
                                    noise=field_noise(field, self.t, self.z))
 
     # ------------------------------------------------------------------ one event
-    def event(self, what, idx):
-        """The event at (t, z): a section hit (which may end the run) or a switch, done in
-        the shared order of :mod:`filippov.loop.event`; a status that ends the run becomes
-        the trajectory's end or its exception."""
-        self.hit_section = idx
-        status, new_mode = _EVENT(self.mode, self.t, what, self)
-        if status == GO_ON:
-            self.mode = self.traj.mode = new_mode
-            return None
-        if status == OK:
-            return self.stop(f"section:{self.sections[idx].name}")
-        raise self._event_error(status)
-
     def _event_error(self, status):
-        """The exception of a status :func:`_EVENT` ended the run with, at (t, z)."""
+        """The exception of a status :func:`_RUN` ended the run with, at (t, z)."""
         te, ze = self.t, self.z
         if status == NO_SLIDING:
             return _no_sliding(te, ze)
@@ -790,8 +780,22 @@ def _nothing(*args):
     return None
 
 
-#: the reference driver's event (filippov.loop.event) on its Python operations; ctx: the _Run
-_EVENT = make_event(EventOps(
+def _stay(mode, t, run):
+    return run.stay()
+
+
+def _entered(mode, new_mode, t, run):
+    run.mode = run.traj.mode = new_mode
+
+
+#: the reference driver's run (filippov.loop.event) on its Python operations; ctx: the
+#: _Run, which made its start when it was built (begin: the state it made)
+_RUN = make_run(RunOps(
+    begin=lambda z0, age0, run: (GO_ON, run.t, run.mode),
+    end_time=lambda run: run.t_end,
+    flows_exactly=lambda mode, run: run.flows_exactly(mode),
+    stay_exact=_stay,
+    stay_integrated=_stay,
     section_hit=_section_hit,
     speeds=_normal_speeds,
     h=lambda run: float(run.system.switch(run.z)),
@@ -808,7 +812,7 @@ _EVENT = make_event(EventOps(
     over_budget=lambda t, new_mode, switches, run: run._over_budget(t, new_mode, switches),
     store_exit=_store_exit,
     switch_derivative=_nothing,  # dP/dz: filippov.variational, from the trajectory
-    entered=_nothing))
+    entered=_entered))
 
 
 def _speed_rates(system, Z, z0):

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 from numba import njit
+from numba.extending import register_jitable
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from .. import rules
@@ -39,7 +40,7 @@ from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY
                     kernel_signature)  # noqa: F401
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
-from ..loop.event import SECTION, EventOps, make_event
+from ..loop.event import SECTION, RunOps, make_run
 from ..loop.stay import before_stay, make_slides_in, make_start
 from ..loop.status import GO_ON
 
@@ -102,7 +103,9 @@ def _slides_in(at):
 # fastmap.compute_returns builds them.
 
 _GO_ON = GO_ON  # no event yet / the orbit goes on (never a returned status)
-_before_stay = _jit_inline(before_stay)
+# the run (filippov.loop.event) asks before_stay by its name, as a rule is asked
+# (kernel.base: compiled into its caller)
+register_jitable(_nrt=False)(before_stay)
 assert _W_SECTION == SECTION
 
 #: the compile-time switch of the dP/dz code: every branch that carries the derivative
@@ -158,10 +161,16 @@ def _step_budget_spent(s, w):
 
 
 @_jit_inline
-def _stay_exact(mode, t, fns, p, s, w):
+def _flows_exactly(mode, ctx):
+    return mode != SLIDING and ctx[2].exact
+
+
+@_jit_inline
+def _stay_exact(mode, t, ctx):
     """A stay in region + or - on the exact flow from the mode entry, in the windows of
     rules.exact_window (hwin growing with the time since the entry during the fast
     transient, then hwin_slow); (status, t, what)."""
+    fns, p, s, w = ctx
     for k in range(w.z.size):
         w.za[k] = w.z[k]
     w.seg[SEG_ENTRY] = t
@@ -187,9 +196,10 @@ def _stay_exact(mode, t, fns, p, s, w):
 
 
 @_jit_inline
-def _stay_integrated(mode, t, fns, p, s, w):
+def _stay_integrated(mode, t, ctx):
     """A stay integrated by DOP853 with the mode's field (Filippov's when sliding;
     regions + and - of a model without exact flows); (status, t, what)."""
+    fns, p, s, w = ctx
     n = w.z.size
     w.seg[SEG_INTEGRATED] = 1.0
     for k in range(n):
@@ -234,10 +244,10 @@ def _end_slide(t, w):
         w.slide_dz[k] += w.z[k] - w.slide_z0[k]
 
 
-# ------------------------------------------------------------------ the event's operations
-# What the kernel does at an event, for filippov.loop.event, which holds the order: each
+# ------------------------------------------------------------------ the run's operations
+# What the kernel does in a run, for filippov.loop.event, which holds the order: each
 # takes ctx = (fns, p, s, w) (the model's pieces, its parameters, kernel.state's Settings
-# and Work) and works at the event's state w.z.
+# and Work); at an event it works at the event's state w.z.
 
 @_jit_inline
 def _at_section(mode, t, ctx):
@@ -372,43 +382,33 @@ def _entered(mode, new_mode, t, ctx):
         w.tally[T_AGE] += t - w.seg[SEG_ENTRY]  # the stay goes on from here
 
 
-#: the operations by their place in filippov.loop.event.EventOps
-_EVENT_OPS = ("_at_section", "_event_speeds", "_event_h", "_event_grad", "_event_state",
-              "_event_flow_at_zero", "_event_sliding_built", "_event_slides_in",
-              "_record_switch", "_count_switch", "_event_limits", "_event_ring", "_store_ring",
-              "_over_budget", "_store_exit", "_event_switch_derivative", "_entered")
-
-
-def _build_event(ns):
-    """The event function (filippov.loop.event.make_event) on the operations of the
-    namespace ``ns`` (this module's globals, or the plain build's copies of them)."""
-    return _jit_inline(make_event(EventOps(*(ns[name] for name in _EVENT_OPS))))
-
-
-_build_event.builds = True  # _without_derivatives builds it, not copies it
-_event = _build_event(globals())
 #: the start's mode and its refusal to slide in the section (filippov.loop.stay), on the
 #: event's operations at the state w.z
 _start = _jit_inline(make_start(_event_speeds, _event_slides_in))
 
 
-@_jit
-def _one(z0, age0, fns, p, s, w):
-    """First return of z0 (the state at the return, or where the run stopped, in w.z);
-    (status, t, n_switches, sliding_time, mode at the return or where the run stopped). w.first_sw[0]: time of the first change of
-    mode (left untouched if there is none); w.slide_dz: the change of state summed
-    over the sliding stretches (counted like sliding_time); age0: the time already spent
-    in the start's region (rules.carried_age), w.tally[T_AGE] the same at the return."""
+@_jit_inline
+def _begin(z0, age0, ctx):
+    """The run's start from z0 (its state in w.z): (status, 0.0, its mode); the counters
+    cleared first, so a start refused reports none. w.first_sw[0]: time of the first
+    change of mode (left untouched if there is none); w.slide_dz: the change of state
+    summed over the sliding stretches (counted like the sliding time w.tally[T_SLID]);
+    age0: the time already spent in the start's region (rules.carried_age),
+    w.tally[T_AGE] the same at the return."""
+    fns, p, s, w = ctx
     n = z0.size
+    for k in range(COUNT_SIZE):
+        w.count[k] = 0
+    w.tally[T_SLID] = 0.0
     for k in range(n):
         w.slide_dz[k] = 0.0
     for k in range(n):
         w.z[k] = z0[k]
         if not np.isfinite(z0[k]):
-            return BAD_START, 0.0, 0, 0.0, 0
-    st, mode, _ = _start(_h(fns, w.z, p), s.touch_tol, s.sliding, (fns, p, s, w))
+            return BAD_START, 0.0, 0
+    st, mode, _ = _start(_h(fns, w.z, p), s.touch_tol, s.sliding, ctx)
     if st != _GO_ON:
-        return st, 0.0, 0, 0.0, mode
+        return st, 0.0, mode
     w.touched[0] = False
     if _DERIVATIVES and s.jac:
         # a start that slides: the return is not differentiable across H there
@@ -417,27 +417,43 @@ def _one(z0, age0, fns, p, s, w):
                 w.deriv.M[i, j] = np.nan if mode == SLIDING else (1.0 if i == j else 0.0)
     for k in range(n):
         w.slide_z0[k] = w.z[k]
-    for k in range(COUNT_SIZE):
-        w.count[k] = 0
-    w.tally[T_SLID] = 0.0
     w.tally[T_SLIDE_START] = 0.0
-    w.tally[T_AGE] = 0.0 if mode == SLIDING else rules.carried_age(_h(fns, w.z, p), s.touch_tol, age0)
+    w.tally[T_AGE] = (0.0 if mode == SLIDING
+                      else rules.carried_age(_h(fns, w.z, p), s.touch_tol, age0))
     w.seg[SEG_SHIFT] = 0.0
     w.seg[SEG_BAND] = 0.0
     w.seg[SEG_EXIT_SHIFT] = 0.0
-    t = 0.0
-    while True:
-        st = _before_stay(mode, t, s.t_max, s.sliding)
-        if st != _GO_ON:
-            return st, t, w.count[N_SWITCHES], w.tally[T_SLID], mode
-        if mode != SLIDING and s.exact:
-            st, t, what = _stay_exact(mode, t, fns, p, s, w)
-        else:
-            st, t, what = _stay_integrated(mode, t, fns, p, s, w)
-        if st == OK:
-            st, mode = _event(mode, t, what, (fns, p, s, w))
-        if st != _GO_ON:  # _event hands back the mode it was asked about unless it goes on
-            return st, t, w.count[N_SWITCHES], w.tally[T_SLID], mode
+    return _GO_ON, 0.0, mode
+
+
+@_jit_inline
+def _end_time(ctx):
+    return ctx[2].t_max
+
+
+#: the operations by their place in filippov.loop.event.RunOps
+_RUN_OPS = ("_begin", "_end_time", "_flows_exactly", "_stay_exact", "_stay_integrated",
+            "_at_section", "_event_speeds", "_event_h", "_event_grad", "_event_state",
+            "_event_flow_at_zero", "_event_sliding_built", "_event_slides_in",
+            "_record_switch", "_count_switch", "_event_limits", "_event_ring",
+            "_store_ring", "_over_budget", "_store_exit", "_event_switch_derivative",
+            "_entered")
+
+
+def _build_run(ns):
+    """The first return of one start (filippov.loop.event.make_run) on the operations of
+    the namespace ``ns`` (this module's globals, or the plain build's copies of them):
+    ``_one(z0, age0, (fns, p, s, w)) -> (status, t, mode)``, the state at the return (or
+    where the run stopped) in w.z. A call _batch makes per return, the run's loop and its
+    operations inlined into it."""
+    run = make_run(RunOps(*(ns[name] for name in _RUN_OPS)))
+    if not ns["_DERIVATIVES"]:  # numba names a cache file by the qualified name
+        run.__qualname__ += "_plain"
+    return _jit(run)
+
+
+_build_run.builds = True  # _without_derivatives builds it, not copies it
+_one = _build_run(globals())
 
 
 _KERNEL_SIG = kernel_signature()
@@ -454,8 +470,7 @@ def _batch(fns, params, starts, ages, s, out):
     per_start = params.shape[0] > 1
     nsmax = max(s.frac_ex.size, s.frac_in.size)
     ts = np.empty(nsmax)
-    vals = np.empty((2, nsmax))
-    dvals = np.empty((2, nsmax))
+    vals, dvals = np.empty((2, nsmax)), np.empty((2, nsmax))
     svals = np.empty(nsmax)
     recent = np.empty(max(s.zeno_count, 1))
     seg = np.zeros(SEG_SIZE)
@@ -463,8 +478,7 @@ def _batch(fns, params, starts, ages, s, out):
     y_old, f_old, ynew, ytmp, scale = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n),
                                        np.zeros(n))
     wz, wg, wf, wp = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-    K = np.zeros((_NSE, n))
-    F = np.zeros((_NI, n))
+    K, F = np.zeros((_NSE, n)), np.zeros((_NI, n))
     first = np.zeros(1)
     if _DERIVATIVES:
         deriv = Deriv(np.zeros((n, n)), np.zeros((n, n)), np.zeros((_NS, n)),
@@ -485,9 +499,11 @@ def _batch(fns, params, starts, ages, s, out):
         done = 0
         age = ages[i]
         p = params[i] if per_start else params[0]  # a C-contiguous row, as pieces take
+        # once per start: built, the tuple increfs its 30 (42) arrays (_batch counts refs)
+        ctx = (fns, p, s, w)
         while True:
             first[0] = np.nan
-            st, t, nsw, sl, mode = _one(zin, age, fns, p, s, w)
+            st, t, mode = _one(zin, age, ctx)
             if st != OK:
                 break
             done += 1
@@ -521,8 +537,8 @@ def _batch(fns, params, starts, ages, s, out):
                 for b in range(n):
                     out.jacobian[i, a, b] = w.deriv.M[a, b]
         out.time[i] = t
-        out.n_switches[i] = nsw
-        out.sliding_time[i] = sl
+        out.n_switches[i] = w.count[N_SWITCHES]
+        out.sliding_time[i] = w.tally[T_SLID]
         out.mode[i] = mode
 
 
@@ -541,7 +557,7 @@ def _without_derivatives(decorated):
     """The driver functions ``decorated`` ({name: decorator}, callees first) built again
     from the same code with _DERIVATIVES False, in globals of their own (each copy calls
     the others' copies); each copy gets a qualified name of its own, which numba names
-    its cache files by. A decorator marked ``builds`` (_build_event) builds its function
+    its cache files by. A decorator marked ``builds`` (_build_run) builds its function
     from the copies' globals instead (a closure over them). Returns the copies by name."""
     env = dict(globals(), _DERIVATIVES=False)
     for name, decorator in decorated.items():
@@ -559,8 +575,8 @@ def _without_derivatives(decorated):
 _PLAIN = _without_derivatives({"_window": _jit_inline, "_stay_exact": _jit_inline,
                                "_stay_integrated": _jit_inline, "_at_section": _jit_inline,
                                "_event_switch_derivative": _jit_inline,
-                               "_event": _build_event,
-                               "_one": _jit, "_batch": njit(cache=True, nogil=True)})
+                               "_begin": _jit_inline, "_one": _build_run,
+                               "_batch": njit(cache=True, nogil=True)})
 _one_plain, _batch_plain = _PLAIN["_one"], _PLAIN["_batch"]
 
 

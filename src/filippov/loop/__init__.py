@@ -5,7 +5,8 @@ package holds the order in which the loop asks them -- at the start and before e
 stay (:mod:`~filippov.loop.stay`), in a sample interval and over a window
 (:mod:`~filippov.loop.interval`), from a crossing to its event time
 (:mod:`~filippov.loop.refine`),
-at an event and against the budgets (:mod:`~filippov.loop.event`) -- as plain scalar
+the run, stay after stay, and at each event against the budgets
+(:mod:`~filippov.loop.event`) -- as plain scalar
 Python built from the engine's own
 operations (how it steps, samples, refines and stores). The reference driver
 (:mod:`filippov.simulate`) runs these functions as they are, with its Python

@@ -5,9 +5,10 @@ refusal to slide inside a section (at the start, and at an arrival on H:
 Like :mod:`filippov.loop.event` this is plain scalar Python in the subset numba
 compiles: the reference driver (:mod:`filippov.simulate`) calls these functions as they
 are, with its Python operations; the compiled kernel (:mod:`filippov.kernel.driver`)
-compiles them inlined, with its compiled operations. A function built from operations
+compiles them inlined, with its compiled operations (:func:`before_stay`, which the run
+asks by its name, as a rule: compiled into its caller). A function built from operations
 (:func:`make_start`, :func:`make_slides_in`) takes the engine's state ``ctx`` last, as
-the event does.
+the run's operations do.
 """
 from __future__ import annotations
 
