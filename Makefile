@@ -47,7 +47,7 @@ ALLOW_NO_TESTS ?=
 
 # Top-level packages resolved by `make lock` (everything else is transitive).
 LOCK_PKGS = numpy scipy xarray netCDF4 matplotlib "snakemake>=8,<10" \
-            pyyaml jsonschema numba threadpoolctl sympy pytest hypothesis pygments snakemake-executor-plugin-slurm \
+            pyyaml jsonschema numba threadpoolctl sympy pytest pytest-xdist hypothesis pygments snakemake-executor-plugin-slurm \
             compliance-checker sphinx myst-parser sphinx-gallery
 
 export MPLBACKEND = Agg
@@ -119,8 +119,11 @@ venv: $(VENV)/.done
 figures: $(VENV)/.done
 	$(VENV_PATH) $(VENV)/bin/snakemake --cores all $(SNAKEFLAGS)
 
+# pytest-xdist: one worker per core (PYTEST_WORKERS=0: all in one process); a test
+# file stays on one worker (--dist loadfile), so its module fixtures are computed once
+PYTEST_WORKERS ?= auto
 test: $(VENV)/.done
-	@rc=0; $(VENV_PATH) $(PY) -m pytest $(PYTEST_ARGS) || rc=$$?; \
+	@rc=0; $(VENV_PATH) $(PY) -m pytest -n $(PYTEST_WORKERS) --dist loadfile $(PYTEST_ARGS) || rc=$$?; \
 	if [ $$rc -eq 5 ] && [ -n "$(ALLOW_NO_TESTS)" ]; then \
 	  echo "warning: pytest collected no tests (exit 5); accepted because ALLOW_NO_TESTS is set" >&2; rc=0; \
 	fi; \

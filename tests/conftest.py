@@ -3,7 +3,9 @@
 Makes `src/` (the library) and `workflow/` (the paper's pipeline, filippov_paper)
 importable from this tree first, installed or not.
 """
+import fcntl
 import filecmp
+import json
 import math
 import shutil
 import subprocess
@@ -107,7 +109,28 @@ def workflow_build(tmp_path_factory):
     if reuse:
         work = Path(reuse).resolve()
         return {"work": work, "run": _reused_build(work), "seconds": math.nan}
-    work = copy_project(tmp_path_factory.mktemp("build") / "project")
+    if os.environ.get("PYTEST_XDIST_WORKER") is None:
+        return _build(tmp_path_factory.mktemp("build"))
+    # `make test` runs one pytest-xdist worker per core: they share one build, made by
+    # the first worker that asks while the others wait on its lock, then read its record
+    shared = tmp_path_factory.getbasetemp().parent   # one folder per run, all workers'
+    record = shared / "build.json"
+    with open(shared / "build.lock", "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not record.is_file():
+            built = _build(shared / "build")
+            run = built["run"]
+            record.write_text(json.dumps({
+                "work": str(built["work"]), "seconds": built["seconds"], "args": run.args,
+                "returncode": run.returncode, "stdout": run.stdout, "stderr": run.stderr}))
+        saved = json.loads(record.read_text())
+    run = subprocess.CompletedProcess(saved["args"], saved["returncode"], saved["stdout"],
+                                      saved["stderr"])
+    return {"work": Path(saved["work"]), "run": run, "seconds": saved["seconds"]}
+
+
+def _build(folder: Path) -> dict:
+    work = copy_project(folder / "project")
     t0 = time.perf_counter()
     run = run_snakemake(work, cores="all")
     return {"work": work, "run": run, "seconds": time.perf_counter() - t0}

@@ -440,3 +440,59 @@ def test_chaotic_statistics_follow_their_sampling_laws(sid):
     assert "sampled statistic" in tols["u"].why
     assert tols["lyapunov"].atol == pytest.approx(3 * np.sqrt(2) * 2 / np.sqrt(n), rel=1e-15)
     assert tols["lyapunov_err"].atol == tols["lyapunov"].atol
+
+
+def test_the_emulated_builds_share_one_compile_and_one_sweep(tmp_path, monkeypatch):
+    """Every emulated build gets the same numba cache (compiled once, generic), and all
+    but the last take the native build's work-precision sweep instead of running it."""
+    native = tmp_path / "native"
+    (native / "results").mkdir(parents=True)
+    (native / "results" / "work_precision.nc").write_bytes(b"the native sweep")
+    seen = []
+
+    os.utime(native / "results" / "work_precision.nc", (0, 0))   # older than any script
+
+    def build(work, env, label, only=None):
+        sweep = work / "results" / "work_precision.nc"
+        # snakemake runs a job again whose output is older than its script
+        newer = sweep.is_file() and all(sweep.stat().st_mtime >= p.stat().st_mtime
+                                        for p in (work / "workflow").rglob("*.py"))
+        seen.append((label, env["NUMBA_CACHE_DIR"], newer))
+        return 0.0
+
+    monkeypatch.setattr(cross_cpu, "build", build)
+    monkeypatch.setattr(cross_cpu, "check", lambda *a, **k: [])
+    monkeypatch.setattr(cross_cpu, "compare_builds", lambda native, work, only: {})
+    assert cross_cpu.main(["--native", str(native), "--seeds", "1", "2"]) == 0
+    assert [s[0].split("), ")[1] for s in seen] == ["seed 1", "seed 2",
+                                                    "seed 3, every result moved"]
+    assert len({s[1] for s in seen}) == 1
+    assert [s[2] for s in seen] == [True, True, False]
+
+
+def test_no_seeds_leaves_the_build_where_every_result_moves(capsys):
+    # CI's cross-CPU check (.ci/run: --seeds with none) is that one build
+    assert cross_cpu.runs_of([], True) == [(1, True, "seed 1, every result moved")]
+    with pytest.raises(SystemExit):
+        cross_cpu.main(["--seeds", "--no-all-moved"])
+    assert "no emulated build" in capsys.readouterr().err
+
+
+def test_a_partial_emulated_build_is_compared_on_its_own_datasets(tmp_path):
+    # --scenes with --native: the native build has every dataset, the emulated one some
+    for build, names in (("native", ("fig98_a", "fig99_b")), ("emulated", ("fig99_b",))):
+        for name in names:
+            write_dataset(_ds([1.0, 2.0]), tmp_path / build / "results" / f"{name}.nc")
+    got = cross_cpu.compare_builds(tmp_path / "native", tmp_path / "emulated", ["fig99_b"])
+    assert list(got) == ["fig99_b"] and got["fig99_b"]["v"]["changed"] == 0
+
+
+def test_a_partial_run_does_not_report_the_native_builds_other_datasets(tmp_path):
+    for name in ("fig98_a", "fig99_b"):
+        write_dataset(_ds([1.0, 2.0]), tmp_path / "results" / f"{name}.nc")
+    man = {"environment": {}, "data": {}, "figures": {}}
+    everything = cross_cpu.check(tmp_path, man)
+    assert sorted(p.split(": ")[0] for p in everything) == ["results/fig98_a.nc",
+                                                           "results/fig99_b.nc"]
+    assert [p.split(": ")[0] for p in cross_cpu.check(tmp_path, man, ["fig99_b"])] == \
+        ["results/fig99_b.nc"]

@@ -15,28 +15,34 @@ the one it runs on, then builds every figure there:
 * numpy's SIMD dispatch is switched down to its baseline
   (``NPY_DISABLE_CPU_FEATURES``), so numpy's own vector loops give way to the
   perturbed libm wherever the machine had something to switch;
-* ``NUMBA_CPU_NAME=generic`` with an empty numba cache: kernels compiled for
-  no particular CPU;
+* ``NUMBA_CPU_NAME=generic`` with a numba cache of its own: kernels compiled for
+  no particular CPU. The emulated builds share that cache (the first compiles, the
+  others load): the compiled code is the same in each, and the shim moves results
+  when it calls libm, at run time. Only a libm call LLVM folds at compile time
+  (a constant argument) keeps the first build's draw, as one machine would;
 * ``OPENBLAS_CORETYPE=Prescott``: OpenBLAS (numpy's and scipy's, built for every
   x86 CPU and picking its kernels at load) runs its SSE3 kernels, as on a CPU
   without AVX and FMA; LAPACK's LU in Radau's Newton steps then rounds differently
   (the eps = 1e-4 sliding return of the hard-case sweep moves by 4e-16).
 
 Each emulated build must pass the manifest check (data within each variable's
-declared tolerance, figures by image). The emulated data are also compared
-with a native build of the same tree, full arrays: every dataset whose numbers
-pass through a transcendental function must change (an emulation that changes
-nothing emulates nothing), and the spread per variable over the seeds is set
-against its tolerance (margin = tolerance / spread; >= 10 is healthy; a count
-allowed to jump by one crossing pair has margin 1 when it does). A margin
-below 1 is a problem: the tolerance declared for that variable does not hold
-between two machines (a manifest check can still pass then, if the manifest was
-written on a machine whose values happen to lie between the two).
+declared tolerance, figures by image). The work-precision sweep (its wall
+times are measured, never compared; its errors are) runs in the last emulated
+build only: the others take the native build's file, as ``make verify``'s
+second build does. The emulated data are also compared with a native build of
+the same tree, full arrays: every dataset whose numbers pass through a
+transcendental function must change (an emulation that changes nothing
+emulates nothing), and the spread per variable over the seeds is set against
+its tolerance (margin = tolerance / spread; >= 10 is healthy; a count allowed
+to jump by one crossing pair has margin 1 when it does). A margin below 1 is a
+problem: the tolerance declared for that variable does not hold between two
+machines (a manifest check can still pass then, if the manifest was written on
+a machine whose values happen to lie between the two).
 ``--record`` writes the measured spreads into the manifest next to each
 tolerance. ``--scenes`` rebuilds only some datasets (scene ids, ``hard_cases``,
 ``work_precision``) and checks only those: for iterating on one tolerance.
 
-    python tests/crosscpu/cross_cpu.py [--ulps 2] [--seeds 1 2 3] [--no-all-moved]
+    python tests/crosscpu/cross_cpu.py [--ulps 2] [--seeds [1 2 3]] [--no-all-moved]
                                        [--scenes ID ...] [--native DIR] [--record] [--keep]
 """
 from __future__ import annotations
@@ -58,7 +64,7 @@ ROOT = HERE.parents[1]
 sys.path[:0] = [str(ROOT / "src"), str(ROOT / "workflow")]
 sys.path.insert(0, str(ROOT / "workflow" / "scripts"))
 
-from verify import copy_project, run_snakemake  # noqa: E402
+from verify import MEASURED, copy_project, run_snakemake  # noqa: E402
 
 from filippov_paper import manifest  # noqa: E402
 from filippov.io import read_dataset  # noqa: E402
@@ -86,7 +92,7 @@ def emulation_env(shim: Path, seed: int, cache: Path, ulps: int = 1,
                   all_moved: bool = False) -> dict:
     """The environment of an emulated build: results moved by up to ``ulps`` ulps
     (every one of them when ``all_moved``), numpy at its SIMD baseline, numba for a
-    generic CPU with an empty cache ``cache``, OpenBLAS's SSE3 kernels."""
+    generic CPU with the cache ``cache``, OpenBLAS's SSE3 kernels."""
     if ulps < 1:
         raise ValueError(f"ulps: at least 1, got {ulps}")
     env = {"LD_PRELOAD": str(shim), "LASTBIT_SEED": str(seed), "LASTBIT_ULPS": str(ulps),
@@ -127,6 +133,26 @@ def restrict(man: dict, only: list[str] | None) -> dict:
                 figures={k: v for k, v in man["figures"].items() if k in only})
 
 
+def reuse_measured(native: Path, work: Path, only: list[str] | None = None) -> None:
+    """The native build's measured outputs (the work-precision sweep, whose wall times
+    no check compares) into ``work``, so that its build does not run them again; the
+    last emulated build runs the sweep, for its errors (``main``). ``only``: a partial
+    run's datasets (one without the sweep gets no copy of it)."""
+    for rel in MEASURED:
+        if (native / rel).is_file() and (only is None or Path(rel).stem in only):
+            (work / rel).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy(native / rel, work / rel)  # new mtime: newer than the scripts
+
+
+def check(build: Path, man: dict, only: list[str] | None = None) -> list[str]:
+    """The manifest check of ``build``; in a partial run (``only``) the datasets of
+    the build outside it are not reported as missing from the (restricted) manifest."""
+    problems = manifest.check(build / "results", build / "figures", man)
+    outside = {f"results/{p.stem}.nc" for p in manifest.data_files(build / "results")
+               if only is not None and p.stem not in only}
+    return [p for p in problems if p.split(": ")[0] not in outside]
+
+
 def build(work: Path, env: dict | None, label: str, only: list[str] | None = None) -> float:
     """Build ``work`` (a project copy); the wall time in seconds."""
     t0 = time.perf_counter()
@@ -140,10 +166,13 @@ def build(work: Path, env: dict | None, label: str, only: list[str] | None = Non
     return elapsed
 
 
-def compare_builds(native: Path, emulated: Path) -> dict:
-    """{dataset: {variable: spread dict}} over full arrays (see filippov_paper.tolerance.spread)."""
+def compare_builds(native: Path, emulated: Path, only: list[str] | None = None) -> dict:
+    """{dataset: {variable: spread dict}} over full arrays (see
+    filippov_paper.tolerance.spread); ``only``: just these datasets (``--scenes``)."""
     out = {}
     for nc in manifest.data_files(native / "results"):
+        if only is not None and nc.stem not in only:
+            continue
         a, b = read_dataset(nc), read_dataset(emulated / "results" / nc.name)
         out[nc.stem] = {name: spread(a[name], b[name]) for name in sorted(a.variables)
                         if a[name].dtype.kind in "fiub"}
@@ -229,7 +258,9 @@ def main(argv=None) -> int:
     ap.add_argument("--ulps", type=int, default=2,
                     help="results move by up to N ulps (half of them, per input and seed; "
                          "all in one more build; default 2)")
-    ap.add_argument("--seeds", type=int, nargs="+", default=[1, 2, 3])
+    ap.add_argument("--seeds", type=int, nargs="*", default=[1, 2, 3],
+                    help="the seeds of the builds where half the results move (default 1 2 "
+                         "3; none: only the build where every result moves)")
     ap.add_argument("--all-moved", action=argparse.BooleanOptionalAction, default=True,
                     help="one more build in which every result moves (default: yes)")
     ap.add_argument("--scenes", nargs="+", metavar="ID",
@@ -240,6 +271,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.ulps < 1:
         ap.error(f"--ulps: at least 1, got {args.ulps}")
+    if not args.seeds and not args.all_moved:
+        ap.error("--seeds none and --no-all-moved: no emulated build to make")
     if args.record and args.scenes:
         ap.error("--record needs the full build (no --scenes)")
     only = args.scenes
@@ -253,15 +286,16 @@ def main(argv=None) -> int:
         if native is None:
             native = copy_project(tmp / "native")
             times["native"] = build(native, None, "native", only)
-        problems += [f"native: {p}" for p in manifest.check(native / "results",
-                                                            native / "figures", man)]
-        for seed, every, label in runs_planned:
+        problems += [f"native: {p}" for p in check(native, man, only)]
+        for k, (seed, every, label) in enumerate(runs_planned):
             work = copy_project(tmp / f"seed{seed}")
-            env = emulation_env(shim, seed, tmp / f"numba-cache-{seed}", args.ulps, every)
+            if k < len(runs_planned) - 1:  # the sweep's errors once, in the last build
+                reuse_measured(native, work, only)
+            # one cache for every emulated build: the kernels compile once (module doc)
+            env = emulation_env(shim, seed, tmp / "numba-cache-generic", args.ulps, every)
             times[label] = build(work, env, f"emulated CPU (+-{args.ulps} ulps), {label}", only)
-            problems += [f"{label}: {p}" for p in
-                         manifest.check(work / "results", work / "figures", man)]
-            runs.append(compare_builds(native, work))
+            problems += [f"{label}: {p}" for p in check(work, man, only)]
+            runs.append(compare_builds(native, work, only))
         merged = merge_spreads(runs)
         problems += report(merged)
         if args.record:
