@@ -566,7 +566,8 @@ class _Run:
 
     def stay(self):
         """Follows the current mode to its next event: (OK, its time, what it is; the
-        section hit in hit_section), or (NO_RETURN, t_end, None)."""
+        section hit in hit_section), or (NO_RETURN, the end of the step that passed
+        t_end, None)."""
         mode = self.mode
         stepper = self._stepper(mode)
         leave = self._leave(mode)
