@@ -5,8 +5,12 @@ the output does not depend on which fonts a machine happens to have.
 """
 from __future__ import annotations
 
+import contextlib
+
 import matplotlib as mpl
 import numpy as np
+
+from filippov_paper.plotting import ticks
 
 # Figures are drawn at the size they are printed (scale factor 1), so every size below
 # is a size on paper. The report, paper/main.tex, is \documentclass[preprint,11pt,
@@ -92,10 +96,13 @@ RC = {
 }
 
 
+@contextlib.contextmanager
 def context():
     """rc context used both to build figures and to save them: some rcParams
-    (tick fonts, font embedding) are read only at draw time."""
-    return mpl.rc_context(RC)
+    (tick fonts, font embedding) are read only at draw time, and so are the ticks,
+    laid here at steps no machine's libm can flip (plotting/ticks.py)."""
+    with mpl.rc_context(RC), ticks.exact_scale():
+        yield
 
 
 def panel_label(ax, text: str) -> None:
