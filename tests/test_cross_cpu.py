@@ -461,7 +461,7 @@ def test_the_emulated_builds_share_one_compile_and_one_sweep(tmp_path, monkeypat
         return 0.0
 
     monkeypatch.setattr(cross_cpu, "build", build)
-    monkeypatch.setattr(cross_cpu, "check", lambda *a, **k: [])
+    monkeypatch.setattr(cross_cpu.manifest, "check", lambda *a, **k: [])
     monkeypatch.setattr(cross_cpu, "compare_builds", lambda native, work, only: {})
     assert cross_cpu.main(["--native", str(native), "--seeds", "1", "2"]) == 0
     assert [s[0].split("), ")[1] for s in seen] == ["seed 1", "seed 2",
@@ -491,8 +491,8 @@ def test_a_partial_run_does_not_report_the_native_builds_other_datasets(tmp_path
     for name in ("fig98_a", "fig99_b"):
         write_dataset(_ds([1.0, 2.0]), tmp_path / "results" / f"{name}.nc")
     man = {"environment": {}, "data": {}, "figures": {}}
-    everything = cross_cpu.check(tmp_path, man)
+    everything = manifest.check(tmp_path / "results", tmp_path / "figures", man)
     assert sorted(p.split(": ")[0] for p in everything) == ["results/fig98_a.nc",
                                                            "results/fig99_b.nc"]
-    assert [p.split(": ")[0] for p in cross_cpu.check(tmp_path, man, ["fig99_b"])] == \
-        ["results/fig99_b.nc"]
+    partial = manifest.check(tmp_path / "results", tmp_path / "figures", man, only=["fig99_b"])
+    assert [p.split(": ")[0] for p in partial] == ["results/fig99_b.nc"]

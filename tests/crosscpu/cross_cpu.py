@@ -64,7 +64,7 @@ ROOT = HERE.parents[1]
 sys.path[:0] = [str(ROOT / "src"), str(ROOT / "workflow")]
 sys.path.insert(0, str(ROOT / "workflow" / "scripts"))
 
-from verify import MEASURED, copy_project, run_snakemake  # noqa: E402
+from verify import copy_project, reuse_measured, run_snakemake  # noqa: E402
 
 from filippov_paper import manifest  # noqa: E402
 from filippov.io import read_dataset  # noqa: E402
@@ -131,26 +131,6 @@ def restrict(man: dict, only: list[str] | None) -> dict:
         return man
     return dict(man, data={k: v for k, v in man["data"].items() if k in only},
                 figures={k: v for k, v in man["figures"].items() if k in only})
-
-
-def reuse_measured(native: Path, work: Path, only: list[str] | None = None) -> None:
-    """The native build's measured outputs (the work-precision sweep, whose wall times
-    no check compares) into ``work``, so that its build does not run them again; the
-    last emulated build runs the sweep, for its errors (``main``). ``only``: a partial
-    run's datasets (one without the sweep gets no copy of it)."""
-    for rel in MEASURED:
-        if (native / rel).is_file() and (only is None or Path(rel).stem in only):
-            (work / rel).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy(native / rel, work / rel)  # new mtime: newer than the scripts
-
-
-def check(build: Path, man: dict, only: list[str] | None = None) -> list[str]:
-    """The manifest check of ``build``; in a partial run (``only``) the datasets of
-    the build outside it are not reported as missing from the (restricted) manifest."""
-    problems = manifest.check(build / "results", build / "figures", man)
-    outside = {f"results/{p.stem}.nc" for p in manifest.data_files(build / "results")
-               if only is not None and p.stem not in only}
-    return [p for p in problems if p.split(": ")[0] not in outside]
 
 
 def build(work: Path, env: dict | None, label: str, only: list[str] | None = None) -> float:
@@ -286,15 +266,19 @@ def main(argv=None) -> int:
         if native is None:
             native = copy_project(tmp / "native")
             times["native"] = build(native, None, "native", only)
-        problems += [f"native: {p}" for p in check(native, man, only)]
+        problems += [f"native: {p}"
+                     for p in manifest.check(native / "results", native / "figures", man,
+                                             only=only)]
         for k, (seed, every, label) in enumerate(runs_planned):
             work = copy_project(tmp / f"seed{seed}")
             if k < len(runs_planned) - 1:  # the sweep's errors once, in the last build
-                reuse_measured(native, work, only)
+                reuse_measured(native, work, only)  # its wall times are never compared
             # one cache for every emulated build: the kernels compile once (module doc)
             env = emulation_env(shim, seed, tmp / "numba-cache-generic", args.ulps, every)
             times[label] = build(work, env, f"emulated CPU (+-{args.ulps} ulps), {label}", only)
-            problems += [f"{label}: {p}" for p in check(work, man, only)]
+            problems += [f"{label}: {p}"
+                         for p in manifest.check(work / "results", work / "figures", man,
+                                                 only=only)]
             runs.append(compare_builds(native, work, only))
         merged = merge_spreads(runs)
         problems += report(merged)

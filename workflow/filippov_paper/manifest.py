@@ -306,8 +306,11 @@ def build_manifest(results: Path, figures: Path, old: dict | None = None) -> dic
     return {"environment": environment(), "data": data, "figures": figs}
 
 
-def check(results: Path, figures: Path, manifest: dict, thumbs: Path = THUMBS) -> list[str]:
-    """Everything in which a build differs from the manifest (empty: it agrees)."""
+def check(results: Path, figures: Path, manifest: dict, thumbs: Path = THUMBS,
+          only: list[str] | None = None) -> list[str]:
+    """Everything in which a build differs from the manifest (empty: it agrees).
+    ``only``: the datasets of a partial build; the build's others are not reported
+    as missing from the manifest (which the caller restricts to ``only``)."""
     problems = []
     same_env = manifest["environment"] == environment()
     identical = set()   # datasets whose every variable is bit-identical to the manifest
@@ -340,6 +343,8 @@ def check(results: Path, figures: Path, manifest: dict, thumbs: Path = THUMBS) -
             if msg:
                 problems.append(f"figures/{png.name}: {msg}")
     extra = {p.stem for p in data_files(results)} - set(manifest["data"])
+    if only is not None:
+        extra &= set(only)
     problems += [f"results/{s}.nc: not in the manifest (run the manifest update)" for s in sorted(extra)]
     return problems
 

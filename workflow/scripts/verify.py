@@ -36,6 +36,17 @@ OUTPUTS = ("results", "figures", "paper/main.pdf")
 MEASURED = ("results/work_precision.nc",)
 
 
+def reuse_measured(src: Path, work: Path, only: list[str] | None = None) -> None:
+    """``src``'s measured outputs (MEASURED) into the project copy ``work``, so that
+    its build takes them instead of measuring again; ``only``: a partial build's
+    datasets (one without the sweep gets no copy of it). The copies get a new mtime:
+    snakemake runs a job again whose output is older than its script."""
+    for rel in MEASURED:
+        if (src / rel).is_file() and (only is None or Path(rel).stem in only):
+            (work / rel).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy(src / rel, work / rel)
+
+
 def copy_project(dest: Path) -> Path:
     """What a fresh clone needs to run the workflow: Snakefile, config, workflow, paper."""
     dest.mkdir(parents=True, exist_ok=True)  # new, or an empty directory given to fill
@@ -100,9 +111,8 @@ def main(argv=None) -> int:
             if name == "a" and first is not None:
                 dest = first_dir  # new or empty: checked above
             work = copy_project(dest)
-            for rel in MEASURED if builds else ():  # build b reuses a's timings
-                (work / rel).parent.mkdir(parents=True, exist_ok=True)
-                shutil.copy2(builds[0] / rel, work / rel)
+            if builds:  # build b reuses a's timings
+                reuse_measured(builds[0], work)
             t0 = time.perf_counter()
             print(f"== clean build {name} in {work}", flush=True)
             run = run_snakemake(work, cores="all", capture=False)
