@@ -387,7 +387,7 @@ def _entered(mode, new_mode, t, ctx):
 _start = _jit_inline(make_start(_event_speeds, _event_slides_in))
 
 
-@_jit_inline
+@_jit
 def _begin(z0, age0, ctx):
     """The run's start from z0 (its state in w.z): (status, 0.0, its mode); the counters
     cleared first, so a start refused reports none. w.first_sw[0]: time of the first
@@ -575,7 +575,7 @@ def _without_derivatives(decorated):
 _PLAIN = _without_derivatives({"_window": _jit_inline, "_stay_exact": _jit_inline,
                                "_stay_integrated": _jit_inline, "_at_section": _jit_inline,
                                "_event_switch_derivative": _jit_inline,
-                               "_begin": _jit_inline, "_one": _build_run,
+                               "_begin": _jit, "_one": _build_run,
                                "_batch": njit(cache=True, nogil=True)})
 _one_plain, _batch_plain = _PLAIN["_one"], _PLAIN["_batch"]
 

@@ -148,7 +148,7 @@ def _refine_unbanded(ctx, lo, hi, mode):
 _past_band = _jit_inline(make_past_band(_banded_h, _refine_unbanded))
 
 
-@_jit_inline
+@_jit
 def _leave_root(i, mode, first, lv, o, sm, sc):
     """The crossing of the first leave function between samples i and i + 1; (t, ok)."""
     ta, tb = sm.ts[i], sm.ts[i + 1]
