@@ -68,3 +68,30 @@ def test_processes_that_start_together_compile_the_kernel_once(tmp_path):
     hits = sorted(p.communicate(timeout=900)[0].strip() for p in procs)
     assert all(p.returncode == 0 for p in procs)
     assert hits == ["False", "True"]      # one compiled, the other loaded its cache
+
+
+# the plain build's copies are dispatchers of their own (driver._PLAIN), not module names:
+# a copy compiled as a call (_begin) has a cache that must be dropped with the rest
+_PLAIN_RUN = """
+from pathlib import Path
+from filippov.kernel import driver
+stamp = Path(driver._batch._cache.cache_path) / "kernel.sha256"
+stamp.parent.mkdir(parents=True, exist_ok=True)
+stamp.write_text("written by other sources")
+flushed = []
+for name, obj in driver._PLAIN.items():
+    if hasattr(obj, "_cache"):
+        obj._cache.flush = lambda name=name: flushed.append(name)
+driver._fresh_cache()
+print(" ".join(sorted(flushed)))
+"""
+
+
+def test_the_plain_builds_own_copies_are_dropped_too(tmp_path):
+    from filippov.kernel import driver
+
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path),
+               PYTHONPATH=SRC + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    out = subprocess.run([sys.executable, "-c", _PLAIN_RUN], env=env, capture_output=True,
+                         text=True, check=True)
+    assert set(out.stdout.split()) == set(driver._PLAIN)   # _begin among them

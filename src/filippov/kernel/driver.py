@@ -598,8 +598,11 @@ def _fresh_cache() -> None:
     except OSError:
         pass  # no stamp yet: a cache of unknown sources
     from . import base, derivative, dop853, roots, scan, segment
-    for module in (base, derivative, dop853, roots, scan, segment, sys.modules[__name__]):
-        for obj in list(vars(module).values()):
+    # the plain build's copies (_PLAIN) too: _begin's is a call with a cache of its own
+    for objs in [list(vars(m).values()) for m in (base, derivative, dop853, roots, scan,
+                                                  segment, sys.modules[__name__])] + \
+            [list(_PLAIN.values())]:
+        for obj in objs:
             if hasattr(obj, "py_func") and hasattr(obj, "_cache"):
                 obj._cache.flush()
     try:
