@@ -599,12 +599,10 @@ def _fresh_cache() -> None:
         pass  # no stamp yet: a cache of unknown sources
     from . import base, derivative, dop853, roots, scan, segment
     # the plain build's copies (_PLAIN) too: _begin's is a call with a cache of its own
-    for objs in [list(vars(m).values()) for m in (base, derivative, dop853, roots, scan,
-                                                  segment, sys.modules[__name__])] + \
-            [list(_PLAIN.values())]:
-        for obj in objs:
-            if hasattr(obj, "py_func") and hasattr(obj, "_cache"):
-                obj._cache.flush()
+    modules = (base, derivative, dop853, roots, scan, segment, sys.modules[__name__])
+    for obj in [o for m in modules for o in vars(m).values()] + list(_PLAIN.values()):
+        if hasattr(obj, "py_func") and hasattr(obj, "_cache"):
+            obj._cache.flush()
     try:
         stamp_file.parent.mkdir(parents=True, exist_ok=True)
         stamp_file.write_text(stamp)
