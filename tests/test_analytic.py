@@ -51,3 +51,17 @@ def test_printed_theta_formula_is_off_by_tanh():
     theta = chatter.theta_of_T(T)
     np.testing.assert_allclose(chatter.theta_of_T_as_printed(T), -theta * np.tanh(T / 2), rtol=1e-12, atol=1e-15)
     assert np.all(chatter.theta_of_T_as_printed(T) > 0) and np.all(theta < 0)
+
+
+def test_s0_of_one_theta_is_the_array_value_and_still_checked():
+    # s0_lambert memoizes a scalar theta (the limit maps ask for it at every return):
+    # the same bits and type as the array path, and a bad theta is refused every time
+    thetas = np.array([-2.0, -0.5, -0.1, -1e-9])
+    array = s0.s0_lambert(thetas)
+    for k, th in enumerate(thetas):
+        for value in (float(th), th):   # a Python float and numpy's
+            one = s0.s0_lambert(value)
+            assert type(one) is np.float64 and one.tobytes() == array[k].tobytes()
+    for bad in (0.5, float("nan"), float("nan")):
+        with pytest.raises(ValueError, match="theta must be finite and < 0"):
+            s0.s0_lambert(bad)

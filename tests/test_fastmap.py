@@ -5,6 +5,8 @@ fig04 scene's return map; the compiled path must make the same decisions (same
 number of switches) and land on the same returns, and must stop with a status
 code -- never hang -- where the reference raises.
 """
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -263,3 +265,33 @@ def test_the_vendored_dop853_tableau_is_scipys_bit_for_bit():
         assert got.shape == want.shape and np.array_equal(got, want), name
     for name in ("N_STAGES", "N_STAGES_EXTENDED", "INTERPOLATOR_POWER"):
         assert getattr(ours, name) == getattr(scipy_table, name), name
+
+
+LEVEL = 0.0   # read by _level_section at its compile (numba freezes globals then)
+
+
+def _level_section(z, p):
+    return z[0] - LEVEL
+
+
+def test_a_recompiled_piece_is_called_anew():
+    # compute_returns hands the kernel memoized addresses (fastmap._address); the memo is
+    # checked against the piece's compiled code at every call, so a piece recompiled
+    # (here: after the global it reads changed) is not run from its old code
+    global LEVEL
+    from numba import njit
+
+    from filippov.abi import SCALAR_SIG
+    piece = njit(SCALAR_SIG)(_level_section)
+    cm = dataclasses.replace(hopf.compiled(1e-2, -0.5), section=piece)
+    start = [[0.5, 1.0, 0.0]]
+    try:
+        first = fastmap.compute_returns(cm, start, 1.0)
+        LEVEL = 0.25
+        piece.recompile()
+        second = fastmap.compute_returns(cm, start, 1.0)
+    finally:
+        LEVEL = 0.0
+    assert np.all(first.status == fastmap.OK) and np.all(second.status == fastmap.OK)
+    assert first.state[0, 0] == pytest.approx(0.0, abs=1e-12)
+    assert second.state[0, 0] == pytest.approx(0.25, abs=1e-12)

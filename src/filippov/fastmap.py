@@ -57,7 +57,9 @@ Every difference between the engines, with its reason and its test:
 """
 from __future__ import annotations
 
+import functools
 import inspect
+import math
 import os
 import weakref
 from concurrent.futures import ThreadPoolExecutor
@@ -137,21 +139,30 @@ def _checked_starts(cmodel: CompiledModel, starts, start_age):
 _ADDRESSES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
-def _address(piece, sig) -> int:
+def _address(piece, name: str, sig) -> int:
     """The address of ``piece``'s compiled code for ``sig`` (numba's own lookup when it
     hands a compiled function to another as a first-class function), memoized: the
     kernel is handed addresses (kernel.base._PIECE_ADDRS), so that a call costs no
     lookup. The memo holds the compiled code it points into (alive while ``piece``
-    lives) and is looked up again if that code is no longer the piece's (a recompile)."""
+    lives) and is looked up again if that code is no longer one of the piece's (a
+    recompile)."""
     known = _ADDRESSES.setdefault(piece, {})
-    key = tuple(sig.args)
-    cres, addr = known.get(key, (None, 0))
-    if cres is None or piece.overloads.get(key) is not cres:
-        cres = piece.get_compile_result(sig)
-        addr = cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name)
-        if not (isinstance(addr, int) and addr > 0):
-            raise RuntimeError(f"no compiled address for {piece!r} with {sig}")
-        known[key] = (cres, addr)
+    cres, addr = known.get(name, (None, 0))
+    # dict's own view of numba's OrderedDict: the ordered view looks each key up again,
+    # and hashing numba's types cost most of a one-return call (fig12's periodic orbits
+    # make 72,000 such calls); membership tests identity first
+    if cres is not None and cres in dict.values(piece.overloads):
+        return addr
+    if not (hasattr(piece, "py_func") and tuple(sig.args) in getattr(piece, "signatures", ())):
+        raise TypeError(
+            f"CompiledModel.{name}: expected a numba njit function compiled with the "
+            f"signature {sig} (filippov.abi; compile_system and SymbolicSystem build "
+            f"them), got {piece!r}")
+    cres = piece.get_compile_result(sig)
+    addr = cres.library.get_pointer_to_function(cres.fndesc.llvm_func_name)
+    if not (isinstance(addr, int) and addr > 0):
+        raise RuntimeError(f"no compiled address for {piece!r} with {sig}")
+    known[name] = (cres, addr)
     return addr
 
 
@@ -165,27 +176,28 @@ def _pieces(cmodel: CompiledModel) -> tuple:
         piece = getattr(cmodel, name)
         if name == "jacobian" and piece is None:
             piece = no_jacobian
-        if not (hasattr(piece, "py_func") and tuple(sig.args) in getattr(piece, "signatures", ())):
-            raise TypeError(
-                f"CompiledModel.{name}: expected a numba njit function compiled with the "
-                f"signature {sig} (filippov.abi; compile_system and SymbolicSystem build "
-                f"them), got {piece!r}")
-        pieces.append(_address(piece, sig))
+        pieces.append(_address(piece, name, sig))
     return tuple(pieces)
+
+
+def _finite(v) -> bool:
+    """A finite real number (math's test: numpy's costs a microsecond a scalar, and this
+    runs at every call)."""
+    return isinstance(v, (int, float, np.integer, np.floating)) and math.isfinite(v)
 
 
 def _check_options(cmodel, t_max, iterations, keep, min_time) -> None:
     """compute_returns' own options (the shared ones: filippov.options), each refused
     with its name where out of range."""
-    if not (np.isfinite(t_max) and t_max >= 0):
+    if not (_finite(t_max) and t_max >= 0):
         raise ValueError(f"need a finite t_max >= 0, got {t_max!r}")
     if not (isinstance(iterations, (int, np.integer)) and iterations >= 1):
         raise ValueError(f"iterations must be an integer >= 1, got {iterations!r}")
     if not (isinstance(keep, (int, np.integer)) and 0 <= keep <= iterations):
         raise ValueError(f"keep must be an integer in [0, iterations={iterations}], got {keep!r}")
-    if not (np.isfinite(min_time) and min_time >= 0):
+    if not (_finite(min_time) and min_time >= 0):
         raise ValueError(f"min_time must be a finite number >= 0, got {min_time!r}")
-    if cmodel.exact and not (np.isfinite(cmodel.sample_step) and cmodel.sample_step > 0):
+    if cmodel.exact and not (_finite(cmodel.sample_step) and cmodel.sample_step > 0):
         raise ValueError(f"the compiled model needs a finite sample_step > 0, "
                          f"got {cmodel.sample_step!r}")
 
@@ -262,6 +274,13 @@ def _run_batch(batch, pieces, params, starts, ages, settings, out, workers: int)
             pass  # the kernel raises nothing itself; map re-raises what a thread did
 
 
+@functools.lru_cache(maxsize=32)
+def _fractions(n: int) -> np.ndarray:
+    """The n + 1 sample points of a step as fractions of it, made once for each n: the
+    kernel only reads them (one array for every call; linspace costs 15 us a call)."""
+    return np.linspace(0.0, 1.0, n + 1)
+
+
 def _settings(cmodel: CompiledModel, t_max, *, rtol, atol, max_step, max_events, max_steps,
               samples_per_step, touch_tol, event_xtol, zeno_count, zeno_span, min_time,
               iterations, jacobian) -> Settings:
@@ -271,8 +290,8 @@ def _settings(cmodel: CompiledModel, t_max, *, rtol, atol, max_step, max_events,
     hwin_slow = slow_window(cmodel.slow_sample_step, hwin, max_step, t_max)
     # an exact flow: one sample per sample step (the model's declared resolution);
     # samples_per_step is for integration steps, whose length error control sets
-    frac_ex = np.linspace(0.0, 1.0, EXACT_BLOCK + 1)
-    frac_in = np.linspace(0.0, 1.0, samples_per_step + 1)
+    frac_ex = _fractions(EXACT_BLOCK)
+    frac_in = _fractions(samples_per_step)
     # dP/dz: 0 none, 1 Jacobian-vector products by differences, 2 the model's Jacobians
     jac_mode = (2 if cmodel.jacobian is not None else 1) if jacobian else 0
     # the kernel's ABI (abi.PIECES; kernel.state: Settings, Outputs, declared there with

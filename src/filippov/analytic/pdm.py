@@ -87,11 +87,18 @@ def sliding_curve(t2, theta: float, omega: float):
     (xi_{1,0}, xi_{2,1}, xi_{1,2}) from eq:p:xi10t2, eq:p:xi21, eq:p:xi12."""
     _check_pos(theta)
     t2 = np.asarray(t2, dtype=float)
-    e = np.exp(-t2 / theta)
-    den = theta + (1.0 - theta) * e
-    xi21 = omega * theta * ((1.0 - theta) * (-np.expm1(-t2 / theta)) + t2) / den
-    xi12 = omega ** 2 * (1.0 - theta) * (theta * (-np.expm1(-t2 / theta)) - t2 * e) / den
+    v = -t2 / theta
+    e, xi21, den = _xi21(t2, v, theta, omega)
+    xi12 = omega ** 2 * (1.0 - theta) * (theta * (-np.expm1(v)) - t2 * e) / den
     return -0.5 * xi21 ** 2, xi21, xi12
+
+
+def _xi21(t2, v, theta, omega):
+    """(e, xi_{2,1}, den) at the sliding times t2 (v = -t2/theta): the piece the
+    inversion in xi1 needs, alone (half the operations of the whole curve)."""
+    e = np.exp(v)
+    den = theta + (1.0 - theta) * e
+    return e, omega * theta * ((1.0 - theta) * (-np.expm1(v)) + t2) / den, den
 
 
 def pdm_theta_pos_curve(t2, theta: float, omega: float, *, printed: bool = False):
@@ -112,13 +119,13 @@ def sliding_time_theta_pos(xi1, theta: float, omega: float, *, iterations: int =
     lo = np.zeros_like(target)
     hi = np.ones_like(target)
     for _ in range(200):  # grow the bracket until it holds the root
-        small = sliding_curve(hi, theta, omega)[1] < target
+        small = _xi21(hi, -hi / theta, theta, omega)[1] < target
         if not small.any():
             break
         hi = np.where(small, 2.0 * hi, hi)
     for _ in range(iterations):
         mid = 0.5 * (lo + hi)
-        below = sliding_curve(mid, theta, omega)[1] < target
+        below = _xi21(mid, -mid / theta, theta, omega)[1] < target
         lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
     t2 = 0.5 * (lo + hi)
     return np.where(xi1 < 0, t2, np.nan)

@@ -10,6 +10,8 @@ Two independent evaluations, used to check each other:
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy.optimize import brentq
 from scipy.special import lambertw
@@ -28,9 +30,24 @@ def residual(s, theta):
 
 
 def s0_lambert(theta):
+    if isinstance(theta, (float, np.floating)):
+        return _s0_scalar(theta)
+    return _s0(theta)
+
+
+def _s0(theta):
     theta = _check(theta)
     b = 1.0 - theta
     return b + np.real(lambertw(-b * np.exp(-b), k=0))
+
+
+@functools.lru_cache(maxsize=1024)
+def _s0_scalar(theta):
+    """s0 of one theta, computed once: the limit maps ask for the same theta at every
+    return (160,000 times in fig12), and lambertw with the check costs 100 us a call.
+    The same computation as for an array (bits and type: numpy's float64); NaN is never
+    a cache hit (nan != nan), so the check still refuses it."""
+    return _s0(theta)
 
 
 def s0_root(theta):

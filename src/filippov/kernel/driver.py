@@ -614,7 +614,7 @@ def kernel(derivatives: bool = False):
     """The kernel with (or without) the dP/dz code, compiled for its one signature or
     loaded from numba's on-disk cache (if that was written from the same sources)."""
     batch = _batch if derivatives else _batch_plain
-    if not batch.signatures:
+    if not batch.overloads:  # (its signatures list costs microseconds: this is per call)
         with _compile_lock():
             _fresh_cache()
             with warnings.catch_warnings():
