@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 SRC = str(Path(__file__).resolve().parents[1] / "src")
 
 # compiles one small helper of the kernel into the cache, after the check (compiled for
@@ -56,18 +58,54 @@ def test_the_kernel_can_be_cached():
             assert not batch.overloads[batch.signatures[0]].library.has_dynamic_globals
 
 
-def test_processes_that_start_together_compile_the_kernel_once(tmp_path):
+# a process that compiles the plain kernel or loads it from the cache, then reports which,
+# and (when it compiled) what it compiled: every helper once, none of the dP/dz code
+_COLD = """
+import sys
+from filippov.fastmap import compile_kernel
+from filippov.kernel import derivative
+hit = compile_kernel(False)
+kernel = [m for name, m in sys.modules.items() if name.startswith("filippov.kernel.")]
+twice = sorted(f"{m.__name__}.{k}" for m in kernel for k, f in vars(m).items()
+               if len(getattr(f, "signatures", ())) > 1)
+print(hit)
+print("compiled more than once:", *twice)
+print(sum(len(f.signatures) for f in vars(derivative).values()
+          if getattr(getattr(f, "py_func", None), "__module__", None) == derivative.__name__))
+"""
+
+
+@pytest.fixture(scope="module")
+def cold_pair(tmp_path_factory):
+    """Two processes started together on an empty numba cache, each running _COLD: one
+    compile of the plain kernel (about 90 s on CI's machines) that the tests below share."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path_factory.mktemp("numba")),
+               PYTHONPATH=SRC + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    procs = [subprocess.Popen([sys.executable, "-c", _COLD], env=env, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    outs = [p.communicate(timeout=900) for p in procs]
+    for p, (_, err) in zip(procs, outs):
+        assert p.returncode == 0, err
+    return sorted((out.splitlines() for out, _ in outs), key=lambda lines: lines[0])
+
+
+def test_processes_that_start_together_compile_the_kernel_once(cold_pair):
     """Jobs that start at once (a workflow's first jobs, one per core) share one compile:
     the one that takes the compile lock compiles and caches, the others wait and load
     (without the lock each compiled the same kernel: 19-40 s of CPU each)."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path),
-               PYTHONPATH=SRC + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    code = "from filippov.kernel import driver; print(driver.compile_kernel(False))"
-    procs = [subprocess.Popen([sys.executable, "-c", code], env=env, stdout=subprocess.PIPE,
-                              text=True) for _ in range(2)]
-    hits = sorted(p.communicate(timeout=900)[0].strip() for p in procs)
-    assert all(p.returncode == 0 for p in procs)
-    assert hits == ["False", "True"]      # one compiled, the other loaded its cache
+    assert [lines[0] for lines in cold_pair] == ["False", "True"]  # compiled, then loaded
+
+
+def test_the_plain_kernel_does_not_compile_the_derivative_code(cold_pair):
+    # the event's dP/dz hooks are built again for the plain build (kernel.driver.
+    # _without_derivatives), where numba prunes them: returns without dP/dz never wait
+    # for the derivative code to compile
+    compiled = cold_pair[0]
+    assert compiled[0] == "False" and compiled[-1] == "0"
+    # and every helper of the plain build is compiled once: a literal argument (a Python
+    # int constant) would compile one specialization per value
+    # (docs/decisions.md#kernel-codes-are-numpy-integers)
+    assert compiled[-2] == "compiled more than once:"
 
 
 # the plain build's copies are dispatchers of their own (driver._PLAIN), not module names:

@@ -2,9 +2,6 @@
 decisions asked from one place, both engines running the one event function, and the
 Zeno ring the same on both."""
 import ast
-import os
-import subprocess
-import sys
 from collections import deque
 from pathlib import Path
 
@@ -120,30 +117,5 @@ def test_both_engines_stop_chatter_at_the_same_switch(start, zeno_count, zeno_sp
         simulate(system, start, t_end, max_events=stop - 1, **opts)
 
 
-_PLAIN = """
-import sys
-from filippov.fastmap import compile_kernel
-from filippov.kernel import derivative
-assert not compile_kernel()  # compiled here, not loaded
-kernel = [m for name, m in sys.modules.items() if name.startswith("filippov.kernel.")]
-twice = sorted(f"{m.__name__}.{k}" for m in kernel for k, f in vars(m).items()
-               if len(getattr(f, "signatures", ())) > 1)
-print("compiled more than once:", *twice)
-print(sum(len(f.signatures) for f in vars(derivative).values()
-          if getattr(getattr(f, "py_func", None), "__module__", None) == derivative.__name__))
-"""
-
-
-def test_the_plain_kernel_does_not_compile_the_derivative_code(tmp_path):
-    # the event's dP/dz hooks are built again for the plain build (kernel.driver.
-    # _without_derivatives), where numba prunes them: returns without dP/dz never wait
-    # for the derivative code to compile
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path),
-               PYTHONPATH=str(SRC.parent) + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    run = subprocess.run([sys.executable, "-c", _PLAIN], env=env, capture_output=True,
-                         text=True, check=True)
-    assert run.stdout.split()[-1] == "0"
-    # and every helper of the plain build is compiled once: a literal argument (a Python
-    # int constant) would compile one specialization per value
-    # (docs/decisions.md#kernel-codes-are-numpy-integers)
-    assert run.stdout.splitlines()[-2] == "compiled more than once:"
+# the plain kernel compiled without the dP/dz code: tests/test_kernel_cache.py (one cold
+# compile shared with the compile lock's test)
