@@ -236,3 +236,23 @@ def test_hard_cases_grazing_itself_tiny_eps_and_escape():
     # a window the attractor leaves is an escape with its reason, not numbers
     at = _attractor(1e-2, 0.2, 3.0, window=1e-5)
     assert at.escaped and "left the window" in at.reason and np.isnan(at.width)
+
+
+@pytest.mark.parametrize("order", [0, 1])
+def test_the_limit_maps_of_many_parameters_at_once_are_each_ones_bit_for_bit(order):
+    # limit_map.orbits iterates all (theta, eps) of a scene in one array (fig12-fig14's
+    # limit diagrams); each point must get exactly what orbit() gives it alone
+    s = np.linspace(-1.0, 5.0, 7)
+    thetas, eps = [-0.5, 0.3, -0.1, 0.7], [1e-2, 1e-3]
+    kw = dict(omega=OMEGA, transient=30, keep=5, order=order)
+    together = limit_map.orbits(s, thetas, eps, **kw)
+    assert together.shape == (4, 2, 7, 5)
+    for i, th in enumerate(thetas):
+        for j, e in enumerate(eps):
+            alone = limit_map.orbit(s, eps=e, theta=th, **kw)
+            assert together[i, j].tobytes() == alone.tobytes(), (th, e)
+    with pytest.raises(ValueError, match="boundary between the two cases"):
+        limit_map.orbits(s, [0.3, 0.0], eps, **kw)
+    with pytest.raises(ValueError, match="one sign per call"):
+        limit_map.step(np.zeros(2), np.zeros(2), eps=1e-3, theta=np.array([-0.5, 0.5]),
+                       omega=OMEGA)

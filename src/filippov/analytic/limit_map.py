@@ -36,9 +36,23 @@ def multiplier(mu: float, omega: float) -> float:
 
 
 def scale(eps: float, theta: float) -> float:
+    """sigma: eps for theta < 0, eps^2 for theta > 0 (elementwise for arrays)."""
+    if np.ndim(theta) or np.ndim(eps):
+        theta, eps = np.asarray(theta, dtype=float), np.asarray(eps, dtype=float)
+        if np.any(theta == 0):
+            raise ValueError("theta = 0 is the boundary between the two cases")
+        return np.where(theta < 0, eps, eps * eps)
     if theta == 0:
         raise ValueError("theta = 0 is the boundary between the two cases")
     return eps if theta < 0 else eps * eps
+
+
+def _negative(theta) -> bool:
+    """theta < 0 (the case of P_DM), for a scalar or for an array of one sign."""
+    neg = np.asarray(theta) < 0
+    if neg.ndim and neg.any() != neg.all():
+        raise ValueError("theta: one sign per call of the map (the two cases differ)")
+    return bool(neg.all())
 
 
 def _global(s, eps: float, theta: float, omega: float, order: int):
@@ -60,7 +74,7 @@ def step(u, s, *, eps: float, theta: float, omega: float, order: int = 1):
     lam, ustar = _global(s, eps, theta, omega, order)
     rho = ustar + lam ** 0.25 * (u - ustar)
     xi = -rho
-    if theta < 0:
+    if _negative(theta):
         xi_new = pdm_theta_neg(xi, theta, omega, eps, order=order)
     else:
         xi_new = pdm_theta_pos(xi, theta, omega)
@@ -81,6 +95,29 @@ def orbit(s, *, eps: float, theta: float, omega: float, transient: int, keep: in
         u = step(u, s, eps=eps, theta=theta, omega=omega, order=order)
         if k >= transient:
             out[:, k - transient] = u
+    return out
+
+
+def orbits(s, thetas, eps, *, omega: float, transient: int, keep: int,
+           order: int = 1) -> np.ndarray:
+    """:func:`orbit` for every (theta, eps) on the grid ``s``, shape (len(thetas),
+    len(eps), len(s), keep): one iteration of the map over all the points of each sign
+    of theta at once. Each point is mapped by the arithmetic :func:`orbit` does for its own
+    (theta, eps), elementwise (numpy's loops give an element the same bits wherever it
+    sits), so the values are :func:`orbit`'s bit for bit (tests/test_instabilities.py);
+    the inversion of the theta > 0 discontinuity map costs per call more than per point,
+    and there are len(thetas) x len(eps) times fewer calls."""
+    s, th, ep = (np.atleast_1d(np.asarray(a, dtype=float)).ravel() for a in (s, thetas, eps))
+    if np.any(th == 0):
+        raise ValueError("theta = 0 is the boundary between the two cases")
+    out = np.empty((th.size, ep.size, s.size, keep))
+    for group in (th < 0, th > 0):
+        idx = np.flatnonzero(group)
+        if idx.size:
+            T, E, S = (a.ravel() for a in np.meshgrid(th[idx], ep, s, indexing="ij"))
+            u = orbit(S, eps=E, theta=T, omega=omega, transient=transient, keep=keep,
+                      order=order)
+            out[idx] = u.reshape(idx.size, ep.size, s.size, keep)
     return out
 
 

@@ -160,10 +160,9 @@ def limit_diagrams(scene: dict, s: np.ndarray) -> dict:
     p = scene["parameters"]
     th, ep = thetas(p), eps_list(p)
     n_tr, keep, omega = int(p["n_transient"]), int(p["n_keep"]), float(p["omega"])
-    u1 = np.stack([np.stack([limit_map.orbit(s, eps=e, theta=t, omega=omega, transient=n_tr,
-                                             keep=keep, order=1) for e in ep]) for t in th])
-    u0 = np.stack([limit_map.orbit(s, eps=ep[-1], theta=t, omega=omega, transient=n_tr,
-                                   keep=keep, order=0) for t in th])
+    u1 = limit_map.orbits(s, th, ep, omega=omega, transient=n_tr, keep=keep, order=1)
+    u0 = limit_map.orbits(s, th, ep[-1:], omega=omega, transient=n_tr, keep=keep,
+                          order=0)[:, 0]
     return {"u_limit": u1, "u_limit0": u0}
 
 
