@@ -20,7 +20,8 @@ still comparable to s0: the eps -> 0 limit is approached like sqrt(eps), slowly.
 theta > 0: P_DM along its curve (:func:`filippov.analytic.pdm.pdm_theta_pos`), slope
 (theta - 1)/theta at 0-, no eps left at leading order.
 
-Only numpy; the map is iterated for many s at once.
+Only numpy; the map is iterated for many s at once (:func:`orbits`: for every theta and eps
+of a scene too, bit for bit as one at a time).
 """
 from __future__ import annotations
 
