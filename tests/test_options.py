@@ -22,6 +22,9 @@ BAD = [
     ("samples_per_step", True, "samples_per_step must be an integer >= 1"),
     # one switch is no accumulation: the compiled engine took 1 (flagging every switch)
     ("zeno_count", 1, "zeno_count must be an integer >= 2"),
+    # a number no float holds, and a bool: refused by name, not by OverflowError
+    ("max_step", 10 ** 400, "max_step must be a number > 0.0"),
+    ("atol", True, "atol must be a finite number > 0.0"),
 ]
 
 

@@ -181,9 +181,8 @@ def _pieces(cmodel: CompiledModel) -> tuple:
 
 
 def _finite(v) -> bool:
-    """A finite real number (math's test: numpy's costs a microsecond a scalar, and this
-    runs at every call)."""
-    return isinstance(v, (int, float, np.integer, np.floating)) and math.isfinite(v)
+    """A finite real number (:func:`filippov.options.real`, then math's test)."""
+    return options.real(v) and math.isfinite(v)
 
 
 def _check_options(cmodel, t_max, iterations, keep, min_time) -> None:

@@ -31,16 +31,27 @@ INTEGERS = {
 }
 
 
+def real(v) -> bool:
+    """A real number a float holds (not a bool; an int too large for a float is not):
+    math's tests on it, not numpy's -- a ufunc on a scalar costs a microsecond, and
+    compute_returns checks its options at every call (fig12 makes 72,000 calls)."""
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.integer,
+                                                                 np.floating)):
+        return False
+    try:
+        float(v)
+    except OverflowError:
+        return False
+    return True
+
+
 def check(**opts) -> None:
     """Refuse any of ``opts`` (the names above, and ``stiff``) out of range, naming it."""
     for name, v in opts.items():
         if name in NUMBERS:
             low, strict, allow_inf = NUMBERS[name]
-            # math's tests, not numpy's: a ufunc on a scalar costs a microsecond, and
-            # compute_returns checks these at every call (fig12 makes 72,000 calls)
-            ok = (isinstance(v, (int, float, np.integer, np.floating))
-                  and not isinstance(v, (bool, np.bool_)) and not math.isnan(v)
-                  and (allow_inf or math.isfinite(v)) and (v > low if strict else v >= low))
+            ok = (real(v) and not math.isnan(v) and (allow_inf or math.isfinite(v))
+                  and (v > low if strict else v >= low))
             if not ok:
                 bound = f"> {low}" if strict else f">= {low}"
                 raise ValueError(f"{name} must be a {'' if allow_inf else 'finite '}number "
