@@ -59,7 +59,6 @@ from __future__ import annotations
 
 import functools
 import inspect
-import math
 import os
 import weakref
 from concurrent.futures import ThreadPoolExecutor
@@ -180,23 +179,18 @@ def _pieces(cmodel: CompiledModel) -> tuple:
     return tuple(pieces)
 
 
-def _finite(v) -> bool:
-    """A finite real number (:func:`filippov.options.real`, then math's test)."""
-    return options.real(v) and math.isfinite(v)
-
-
 def _check_options(cmodel, t_max, iterations, keep, min_time) -> None:
     """compute_returns' own options (the shared ones: filippov.options), each refused
     with its name where out of range."""
-    if not (_finite(t_max) and t_max >= 0):
+    if not (options.finite(t_max) and t_max >= 0):
         raise ValueError(f"need a finite t_max >= 0, got {t_max!r}")
     if not (isinstance(iterations, (int, np.integer)) and iterations >= 1):
         raise ValueError(f"iterations must be an integer >= 1, got {iterations!r}")
     if not (isinstance(keep, (int, np.integer)) and 0 <= keep <= iterations):
         raise ValueError(f"keep must be an integer in [0, iterations={iterations}], got {keep!r}")
-    if not (_finite(min_time) and min_time >= 0):
+    if not (options.finite(min_time) and min_time >= 0):
         raise ValueError(f"min_time must be a finite number >= 0, got {min_time!r}")
-    if cmodel.exact and not (_finite(cmodel.sample_step) and cmodel.sample_step > 0):
+    if cmodel.exact and not (options.finite(cmodel.sample_step) and cmodel.sample_step > 0):
         raise ValueError(f"the compiled model needs a finite sample_step > 0, "
                          f"got {cmodel.sample_step!r}")
 

@@ -82,8 +82,7 @@ class Section:
             raise ValueError(f"Section {self.name!r}: terminal must be None or an integer "
                              f">= 1, got {self.terminal!r}")
         m = self.min_time
-        if (isinstance(m, bool) or not isinstance(m, (int, float, np.integer, np.floating))
-                or not (np.isfinite(m) and m >= 0)):
+        if not (options.finite(m) and m >= 0):
             raise ValueError(f"Section {self.name!r}: min_time must be a finite number >= 0, "
                              f"got {self.min_time!r}")
 

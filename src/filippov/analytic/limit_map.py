@@ -51,9 +51,10 @@ def scale(eps: float, theta: float) -> float:
 def _negative(theta) -> bool:
     """theta < 0 (the case of P_DM), for a scalar or for an array of one sign."""
     neg = np.asarray(theta) < 0
-    if neg.ndim and neg.any() != neg.all():
+    every = bool(neg.all())
+    if neg.ndim and neg.any() != every:
         raise ValueError("theta: one sign per call of the map (the two cases differ)")
-    return bool(neg.all())
+    return every
 
 
 def _global(s, eps: float, theta: float, omega: float, order: int):

@@ -79,9 +79,10 @@ def hit_time_theta_neg(xi2_entry, theta: float, omega: float, eps: float):
 # ----------------------------------------------------------------------------- theta > 0
 def _check_pos(theta):
     if np.ndim(theta):   # an array of theta, one per point (limit_map.orbits)
-        if not np.all((0 < np.asarray(theta)) & (np.asarray(theta) < 1)):
+        theta = np.asarray(theta)
+        if not np.all((0 < theta) & (theta < 1)):
             raise ValueError(f"theta must lie in (0, 1) for the sliding case, got "
-                             f"{np.asarray(theta).tolist()!r}")
+                             f"{theta.tolist()!r}")
     elif not 0 < theta < 1:
         raise ValueError(f"theta must lie in (0, 1) for the sliding case, got {theta!r}")
 
