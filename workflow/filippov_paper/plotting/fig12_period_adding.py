@@ -85,11 +85,11 @@ def draw(ds):
                       color=[st.C_PLUS, st.C_MINUS, st.C_SLIDE, "black"][m % 4],
                       label=f"$n={n}$: edge $-$ edge$_{{\\varepsilon\\to0}}$" if side == 0 else None)
     ax.loglog(eps, ds.edge_gap.values, color=st.C_AUX, lw=st.LW, ls="--",
-              label="max |slow-fast $-$ limit-map edge|")
+              label="max gap, slow-fast vs limit map")  # (a text | prints as l)
     ax.set_xlabel(st.EPS)
     ax.set_ylabel(r"distance of window edges in $s$")
     fig.legend(*ax.get_legend_handles_labels(), loc="outside lower right")  # under (f)
-    st.panel_label(ax, "(f) window edges:\nleft o, right \u25a1")
+    st.panel_label(ax, "(f) window edges:\nleft \u25cf, right \u25a1")
     return fig
 
 
