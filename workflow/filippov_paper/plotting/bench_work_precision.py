@@ -2,6 +2,8 @@
 one panel per problem, one line per method swept over its tolerance."""
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import xarray as xr
 
@@ -48,8 +50,9 @@ def draw(ds):
         ax.set_yscale("log")
         # the statistic the sweep shows (filippov_paper.benchmarks.timing; older sweeps: median)
         ax.set_xlabel(f"{ds.attrs.get('timing_statistic', 'median')} wall time of one map [s]")
-        name = str(ds.problem.values[i]).replace("theta=", r"$\theta=$").replace(
-            "eps=", r"$\varepsilon=$")   # the paper's symbols
+        name = str(ds.problem.values[i])   # the paper's symbols, the value in math (a minus)
+        for key, sym in (("theta", r"\theta"), ("eps", r"\varepsilon")):
+            name = re.sub(rf"{key}=(\S+)", lambda m, sym=sym: f"${sym}={m.group(1)}$", name)
         st.panel_label(ax, f"({'abcd'[i]}) {name}, {int(ds.n_points.values[i])} points")
     for ax in axes[::ncols]:
         ax.set_ylabel(r"max $|P - P_{\mathrm{ref}}|$")
