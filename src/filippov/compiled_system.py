@@ -18,6 +18,7 @@ import numpy as np
 from numba import njit
 from numba.core.errors import NumbaError
 
+from . import frozen
 from .checks import SystemContractError
 from .spelling import one_spelling
 from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, always, no_flow
@@ -348,6 +349,17 @@ class FilippovSystem:
         self._python = None
         self._compiled = None   # the fields compiled once; each call only adds a section
         self._user = None       # the pieces as numba dispatchers, shared by both engines
+        self._frozen = None     # what numba compiles into them (filippov.frozen)
+
+    def _frozen_unchanged(self) -> None:
+        """The values the pieces read from globals and closures (numba compiles them in):
+        noted at the first use of an engine, checked at every later one."""
+        if self._frozen is None:
+            pieces = {k: f for k, f in self._pieces.items() if f is not None}
+            pieces.update({f"jacobians[{m!r}]": f for m, f in self._jacobians.items()})
+            self._frozen = frozen.record(pieces)
+        else:
+            frozen.check(self._frozen)
 
     # -- hooks: how the pieces become the engines' (a generated system overrides them)
     def _user_pieces(self) -> dict:
@@ -378,6 +390,7 @@ class FilippovSystem:
     # -- the engines
     def compiled(self, section, *, direction: int = 0, where=None, probe=None) -> CompiledModel:
         """The compiled engine's model with the section ``section(z, p) = 0``."""
+        self._frozen_unchanged()
         if self._compiled is None:
             self._compiled = dataclasses.replace(compile_system(
                 self.names, section=section, section_direction=direction, section_where=where,
@@ -422,6 +435,7 @@ class FilippovSystem:
         :func:`filippov.variational.return_jacobian` and friends."""
         from .system import MODE_NAMES
 
+        self._frozen_unchanged()
         key = MODE_NAMES.get(mode)
         if key == "sliding" and key not in self._jacobian_modes() and self.has_jacobians:
             return self._sliding_jacobian(np.ascontiguousarray(z, dtype=float))
@@ -465,6 +479,7 @@ class FilippovSystem:
 
     def python(self):
         """The reference driver's PiecewiseSystem (built once, then reused)."""
+        self._frozen_unchanged()
         if self._python is None:
             self._python = self._build_python()
         return self._python
