@@ -8,8 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from filippov import (EventLimitError, FilippovSystem, Section, compute_returns,
-                      first_returns, first_returns_compiled, rules, simulate)
+from filippov import (EventLimitError, FilippovSystem, PeriodicOrbitError, Section,
+                      compute_returns, first_returns, first_returns_compiled, periodic_orbit,
+                      rules, simulate)
 from filippov.fastmap import OK
 from filippov.kernel import base as kernel_base
 from filippov.models import hopf
@@ -120,6 +121,41 @@ def test_a_start_that_slides_counts_its_first_slide_on_both_engines(engine):
                                      [[-1.0, 0.0]], 5.0)
     assert out.time[0] == pytest.approx(2.0, rel=1e-12)
     assert out.sliding_time[0] == pytest.approx(1.0, rel=1e-10)
+
+
+def test_dpdz_of_a_return_that_starts_sliding_is_the_reference_engine_s_only():
+    # sliding on the unit circle h = x^2 + y^2 - 1: inside F_- = x (1, 1) + w (-y, x), outside
+    # F_+ = -(1 - 2y/r) (x, y) + w (-y, x); theta' = w in every mode, so the orbit (a slide
+    # for y < 1/2, the excursion outside, back onto the circle) has period 2 pi / w, and
+    # z' = -lam z + x is slaved: multipliers 1 (the flow), exp(-lam T), 0 (the slide
+    # collapses the radial perturbation). The section y = 0 (x > 0) lies on the slide.
+    w, lam = 2.0, 0.7
+
+    def outside(z, p):
+        r = np.sqrt(z[0] ** 2 + z[1] ** 2)
+        return np.array([-(1 - 2 * z[1] / r) * z[0] - w * z[1],
+                         -(1 - 2 * z[1] / r) * z[1] + w * z[0], -lam * z[2] + z[0]])
+
+    system = FilippovSystem(
+        ("x", "y", "z"), lambda z, p: np.array([z[0] - w * z[1], z[1] + w * z[0],
+                                                -lam * z[2] + z[0]]), outside,
+        switch=lambda z, p: z[0] ** 2 + z[1] ** 2 - 1,
+        switch_grad=lambda z, p: np.array([2 * z[0], 2 * z[1], 0.0]))
+    kw = dict(direction=1, where=lambda z, p: z[0] > 0, t_max=10.0)
+    section = lambda z, p: z[1]  # noqa: E731
+    po = periodic_orbit(system, [1.0, 0.0, 0.3], section, engine="reference", **kw)
+    T = 2 * np.pi / w
+    assert po.period == pytest.approx(T, rel=1e-9)
+    assert np.sort(po.multipliers)[::-1] == pytest.approx([1.0, np.exp(-lam * T), 0.0],
+                                                          abs=1e-8)
+    # from the guess, on H (h = 0 exactly: a start that slides), the kernel makes the
+    # return and leaves its derivative NaN
+    out = compute_returns(system.compiled(section, direction=1, where=kw["where"]),
+                          [[1.0, 0.0, 0.3]], 10.0, jacobian=True)
+    assert out.status[0] == OK and out.time[0] == pytest.approx(T, rel=1e-9)
+    assert np.isnan(out.jacobian[0]).all()
+    with pytest.raises(PeriodicOrbitError, match=r"dP/dz is not finite .*item 11"):
+        periodic_orbit(system, [1.0, 0.0, 0.3], section, engine="compiled", **kw)
 
 
 # ------------------------------------------------------------------ the list and the comments

@@ -139,6 +139,15 @@ engine that moves one of these makes its test fail.
     engine's own. Deliberate (one failing start must not lose a batch).
     Tests: tests/test_errors.py::test_the_compiled_engine_s_failures_are_the_reference_driver_s_classes,
     tests/test_end_status.py::test_a_status_raises_the_same_class_and_words_on_both_engines
+
+11. **dP/dz of a return that starts sliding.** Where a return starts on H and slides
+    (a section across a sliding arc, a start with h = 0 there), the kernel leaves dP/dz
+    NaN (status OK: the return is made, its derivative is not); the reference derives it
+    from the variational equations along the sliding flow.
+    ``periodic_orbit`` on the compiled engine refuses such an orbit by name
+    (PeriodicOrbitError, "dP/dz is not finite") instead of taking a Newton step from
+    NaN. Not ported: the kernel carries no derivative along a slide it starts in.
+    Test: tests/test_engine_asymmetries.py::test_dpdz_of_a_return_that_starts_sliding_is_the_reference_engine_s_only
 """
 from __future__ import annotations
 

@@ -279,6 +279,13 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
             _refuse_the_start_itself(z, period, f)
             mult = floquet_from_return(J, f, normal=_section_normal(section_value, z))
             return PeriodicOrbit(z, period, mult, J, it - 1, residual)
+        if not np.all(np.isfinite(J)):   # a Newton step from it would leave the state
+            raise PeriodicOrbitError(
+                f"dP/dz is not finite at {z.tolist()} (a tangential switch, a touch of H, "
+                f"or a return that starts sliding in the section" + (
+                    ": the compiled engine gives no dP/dz there, engine='reference' "
+                    "derives it along the sliding flow; filippov.engines, item 11)"
+                    if engine == engines.COMPILED else ")"))
         A = J - np.eye(z.size)
         try:
             z = z - np.linalg.solve(A, Pz - z)
