@@ -86,3 +86,12 @@ def test_values_that_stay_are_no_alarm(monkeypatch):
     monkeypatch.setattr(HERE, "T", (1.0, float("nan")))
     assert _return_time(system, "compiled") == first
     assert _return_time(system, "reference") == pytest.approx(first, rel=1e-9)
+
+
+def test_a_deleted_global_is_a_change(monkeypatch):
+    monkeypatch.setattr(HERE, "GONE", 1.0, raising=False)
+    system = _decay(lambda z, p: np.array([-GONE * z[0]]))  # noqa: F821
+    _return_time(system, "reference")
+    monkeypatch.delattr(HERE, "GONE")
+    with pytest.raises(SystemContractError, match="'GONE'"):
+        _return_time(system, "reference")

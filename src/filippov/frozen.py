@@ -66,9 +66,12 @@ class _Read:
         self.value = _copy(self.current())
 
     def current(self):
-        if self.cell is not None:
+        if self.cell is None:
+            return self.fn.__globals__.get(self.name, _GONE)
+        try:
             return self.cell.cell_contents
-        return self.fn.__globals__.get(self.name, _GONE)
+        except ValueError:   # the cell emptied (del): changed
+            return _GONE
 
 
 _GONE = object()   # a global deleted since: changed
