@@ -95,3 +95,19 @@ def test_a_deleted_global_is_a_change(monkeypatch):
     monkeypatch.delattr(HERE, "GONE")
     with pytest.raises(SystemContractError, match="'GONE'"):
         _return_time(system, "reference")
+
+
+def test_a_model_compiled_on_its_own_is_checked_by_the_compiled_front_doors(monkeypatch):
+    # compile_system's CompiledModel, run by compute_returns / sweep_returns directly
+    from filippov import compile_system, compute_returns, sweep_returns
+    cm = compile_system(("x",), lambda z, p: np.array([-K * z[0]]),
+                        lambda z, p: np.array([-K * z[0]]), switch=lambda z, p: z[0] + 10.0,
+                        switch_grad=lambda z, p: np.array([1.0]),
+                        section=lambda z, p: z[0] - 0.5, section_direction=-1)
+    assert compute_returns(cm, [[1.0]], 10.0).time[0] == pytest.approx(np.log(2), rel=1e-9)
+    assert sweep_returns([cm], [[1.0]], 10.0).time[0] == pytest.approx(np.log(2), rel=1e-9)
+    monkeypatch.setattr(HERE, "K", 2.0)
+    for run in (lambda: compute_returns(cm, [[1.0]], 10.0),
+                lambda: sweep_returns([cm], [[1.0]], 10.0)):
+        with pytest.raises(SystemContractError, match=r"field_minus: reads the global 'K'"):
+            run()

@@ -97,6 +97,9 @@ class CompiledModel:
     #: optional :data:`JAC_SIG` piece: exact Jacobians for dP/dz through integrated stays
     #: (None: Jacobian-vector products by central differences of the field)
     jacobian: Any = None
+    #: what numba compiled into the user's pieces from globals and closures, checked by
+    #: the compiled engine's front doors before every call (:mod:`filippov.frozen`)
+    frozen_reads: tuple = field(default=(), compare=False, repr=False)
 
     @property
     def dim(self) -> int:

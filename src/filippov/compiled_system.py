@@ -223,6 +223,9 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
         raise ValueError(f"sample_step: exact flows need a finite sample_step > 0 (the "
                          f"longest time between samples), got {sample_step!r}")
     p = np.ascontiguousarray(np.asarray(params, dtype=float).reshape(-1))
+    user = dict(field_minus=field_minus, field_plus=field_plus, switch=switch,
+                switch_grad=switch_grad, flow_minus=flow_minus, flow_plus=flow_plus)
+    reads = tuple(frozen.record({k: f for k, f in user.items() if f is not None}))
     cm = CompiledModel(
         name=name, names=names, params=p,
         flow_plus=_flow_piece(flow_plus, "flow_plus", n) if exact else no_flow,
@@ -234,7 +237,7 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
         section=_scalar_piece(section, "section"),
         section_where=_where_piece(section_where, "section_where"),
         section_direction=int(section_direction), sample_step=float(sample_step),
-        sliding=bool(sliding), exact=exact, parameters={})
+        sliding=bool(sliding), exact=exact, parameters={}, frozen_reads=reads)
     _check_shapes(cm, _probe_state(probe, n))
     return cm
 

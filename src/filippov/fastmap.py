@@ -66,7 +66,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import engines, options, rules
+from . import engines, frozen, options, rules
 # what a model hands the engine (its pieces' signatures, CompiledModel), re-exported here
 from .abi import (FIELD_SIG, FLOW_SIG, PIECES, SCALAR_SIG, WHERE_SIG,  # noqa: F401
                   CompiledModel, no_flow, no_jacobian)
@@ -363,6 +363,7 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     fewer threads, down to the calling thread alone.
     """
     starts, ages = _checked_starts(cmodel, starts, start_age)
+    frozen.check(cmodel.frozen_reads)   # no piece run with a value changed since compiled
     # the pieces checked before anything calls them: check_compiled's Python call would
     # compile a lazy njit piece (one the kernel cannot call at an address) on the spot
     pieces = _pieces(cmodel)
@@ -433,6 +434,7 @@ def sweep_returns(cmodels, starts, t_max: float, *, start_age=0.0, workers=None,
     if starts.shape[0] != len(cmodels):
         raise ValueError(f"starts: one start point per model, got {starts.shape[0]} starts "
                          f"for {len(cmodels)} cmodels")
+    frozen.check(first.frozen_reads)   # the models share their pieces (_sweep_params)
     pieces = _pieces(first)  # before check_compiled calls them (see compute_returns)
     for i, c in enumerate(cmodels):  # once a model object (checks.check_compiled)
         check_compiled(c, starts[i])

@@ -89,6 +89,14 @@ def _returns(system, section, direction: int, where, engine: str, t_max: float, 
     return one, value
 
 
+def _finite_derivative(J: np.ndarray, z: np.ndarray) -> None:
+    if not np.all(np.isfinite(J)):
+        raise PeriodicOrbitError(
+            f"dP/dz is not finite at {z.tolist()} (a tangential switch, a touch of H, or a "
+            "return that starts sliding in the section: there the compiled engine gives no "
+            "dP/dz and the reference derives it along the slide; filippov.engines, item 11)")
+
+
 def _section_normal(value, z: np.ndarray) -> np.ndarray:
     """The gradient of the section function at z by central differences (step eps^(1/3)
     times the state's size: ~1e-11 relative for a section that varies on that size)."""
@@ -279,13 +287,7 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
             _refuse_the_start_itself(z, period, f)
             mult = floquet_from_return(J, f, normal=_section_normal(section_value, z))
             return PeriodicOrbit(z, period, mult, J, it - 1, residual)
-        if not np.all(np.isfinite(J)):   # a Newton step from it would leave the state
-            raise PeriodicOrbitError(
-                f"dP/dz is not finite at {z.tolist()} (a tangential switch, a touch of H, "
-                f"or a return that starts sliding in the section" + (
-                    ": the compiled engine gives no dP/dz there, engine='reference' "
-                    "derives it along the sliding flow; filippov.engines, item 11)"
-                    if engine == engines.COMPILED else ")"))
+        _finite_derivative(J, z)   # a Newton step from a NaN would leave the state
         A = J - np.eye(z.size)
         try:
             z = z - np.linalg.solve(A, Pz - z)
