@@ -4,7 +4,7 @@ the piece."""
 import numpy as np
 import pytest
 
-from filippov import PiecewiseSystem, Section, first_returns, fastmap
+from filippov import FilippovSystem, PiecewiseSystem, Section, first_returns, fastmap
 from filippov.compiled_system import compile_system, with_section
 
 A = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, -3.0, -3.0]])   # lag 1/(s+1)^3
@@ -162,3 +162,31 @@ def test_a_piece_the_kernel_cannot_call_is_refused(piece, value, match):
     cm = dataclasses.replace(_relay_compiled(section=lambda z, p: z[0]), **{piece: value})
     with pytest.raises(TypeError, match=match):
         fastmap.compute_returns(cm, STARTS, 20.0)
+
+
+def test_a_given_jacobian_is_compared_with_its_field_once_per_mode():
+    # x' = y, y' = -x -+ 1, w' = -k w: a typo in dw'/dw (-2k for -k) gave the reference
+    # engine's multiplier exp(-2kT) for exp(-kT), silently (the flow's stayed 1)
+    from filippov import MINUS, PLUS, SystemContractError
+    k = 0.5
+    A = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, -k]])
+    wrong = A.copy()
+    wrong[2, 2] = -2 * k
+
+    def system(J):
+        return FilippovSystem(("x", "y", "w"),
+                              lambda z, p: np.array([z[1], -z[0] + 1.0, -p[0] * z[2]]),
+                              lambda z, p: np.array([z[1], -z[0] - 1.0, -p[0] * z[2]]),
+                              switch=lambda z, p: z[0], switch_grad=lambda z, p: np.array(
+                                  [1.0, 0.0, 0.0]), params=[k],
+                              jacobians={"minus": lambda z, p: A.copy(),
+                                         "plus": lambda z, p: J.copy()})
+    z = np.array([0.3, -0.2, 1.5])
+    good = system(A)
+    assert np.array_equal(good.jacobian(PLUS, z), A)
+    bad = system(wrong)
+    assert np.array_equal(bad.jacobian(MINUS, z), A)   # the right one passes
+    with pytest.raises(SystemContractError, match=r"jacobians\['plus'\]: at z=.*entry \[2, 2\] "
+                                                  r"is -1\.0, central differences of "
+                                                  r"field_plus give -0\.49999"):
+        bad.jacobian(PLUS, z)

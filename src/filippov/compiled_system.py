@@ -327,8 +327,9 @@ class FilippovSystem:
     ``jacobians`` (optional, ``{"minus"|"sliding"|"plus": J(z, p) -> (n, n)}``)
     gives :meth:`jacobian` (that of sliding derived from the two fields' where it is
     not given), used for Floquet multipliers and dP/dz on the
-    reference driver instead of central differences; :mod:`filippov.symbolic`
-    generates all three from the expressions.
+    reference driver instead of central differences (each compared with central
+    differences of its field at the first state it is asked at: a wrong one is refused);
+    :mod:`filippov.symbolic` generates all three from the expressions.
     """
 
     def __init__(self, names, field_minus, field_plus, switch, switch_grad, *, params=(),
@@ -353,6 +354,7 @@ class FilippovSystem:
         self._compiled = None   # the fields compiled once; each call only adds a section
         self._user = None       # the pieces as numba dispatchers, shared by both engines
         self._frozen = None     # what numba compiles into them (filippov.frozen)
+        self._jacobians_checked = set()   # the given Jacobians compared with their fields
 
     def _frozen_unchanged(self) -> None:
         """The values the pieces read from globals and closures (numba compiles them in):
@@ -449,7 +451,37 @@ class FilippovSystem:
         z = np.ascontiguousarray(z, dtype=float)
         if z.shape != (n,):
             raise ValueError(f"jacobian: expected one state of shape ({n},), got {z.shape}")
-        return self._jacobian_value(key, z).reshape(n, n)
+        J = self._jacobian_value(key, z).reshape(n, n)
+        if key in self._jacobians and key not in self._jacobians_checked:
+            self._check_jacobian(key, z, J)
+            self._jacobians_checked.add(key)
+        return J
+
+    def _check_jacobian(self, key: str, z: np.ndarray, J: np.ndarray) -> None:
+        """A Jacobian the user gave, against central differences of its field at the first
+        state it is asked at (step eps^(1/3) times the state's size: errors ~1e-10 of the
+        scale for a smooth field); a wrong one would give wrong multipliers and dP/dz with
+        the flow's multiplier still 1. Refused where an entry is off by 1e-6 of the scale
+        (that of J, and of F over the state's size)."""
+        if key == "sliding":
+            return   # Filippov's field off H is the caller's extension: not compared
+        field = getattr(self.python(), f"field_{key}")
+        n, size = z.size, max(1.0, float(np.abs(z).max()))
+        fd = np.empty((n, n))
+        for k in range(n):
+            e = np.zeros(n)
+            e[k] = np.cbrt(np.finfo(float).eps) * max(1.0, abs(z[k]))
+            fd[:, k] = (np.asarray(field(z + e), float) - np.asarray(field(z - e), float)) / (
+                2 * e[k])
+        scale = max(np.abs(fd).max(), float(np.abs(field(z)).max()) / size, 1e-300)
+        bad = np.abs(J - fd) > 1e-6 * scale
+        if not np.all(np.isfinite(J)) or bad.any():
+            i, k = np.argwhere(bad | ~np.isfinite(J))[0]
+            raise SystemContractError(
+                f"jacobians[{key!r}]: at z={z.tolist()} its entry [{i}, {k}] is "
+                f"{float(J[i, k])!r}, central differences of field_{key} give "
+                f"{float(fd[i, k])!r}: a wrong Jacobian gives wrong multipliers and dP/dz "
+                f"(the flow's multiplier stays 1)")
 
     def _sliding_jacobian(self, z: np.ndarray) -> np.ndarray:
         """dF_s/dz of Filippov's sliding field F_s = (a F_+ - b F_-)/(a - b), a = g.F_-,
