@@ -465,14 +465,11 @@ class FilippovSystem:
         (that of J, and of F over the state's size)."""
         if key == "sliding":
             return   # Filippov's field off H is the caller's extension: not compared
+        from .variational import fd_jacobian
+
         field = getattr(self.python(), f"field_{key}")
-        n, size = z.size, max(1.0, float(np.abs(z).max()))
-        fd = np.empty((n, n))
-        for k in range(n):
-            e = np.zeros(n)
-            e[k] = np.cbrt(np.finfo(float).eps) * max(1.0, abs(z[k]))
-            fd[:, k] = (np.asarray(field(z + e), float) - np.asarray(field(z - e), float)) / (
-                2 * e[k])
+        size = max(1.0, float(np.abs(z).max()))
+        fd = fd_jacobian(field, z, np.cbrt(np.finfo(float).eps)).astype(float)
         scale = max(np.abs(fd).max(), float(np.abs(field(z)).max()) / size, 1e-300)
         bad = np.abs(J - fd) > 1e-6 * scale
         if not np.all(np.isfinite(J)) or bad.any():
