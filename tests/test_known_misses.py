@@ -1,16 +1,22 @@
-"""Silent wrong answers on users' systems that are known and not yet mended, each against
-its closed form on both engines (found by an independent review, 2026-11-28). Each is
-marked xfail(strict=True): it runs, it fails today, and it turns the suite red the day a
-change mends it, so that its mark and the limitation written in the closing note go. No
-warning is given in any of them: that is what makes them findings.
+"""Silent wrong answers on users' systems found by an independent review (2026-11-28),
+each against its closed form on both engines. No warning was given in any of them: that
+is what made them findings.
 
-1. Two crossings of H between two samples. The event search sees h's sign at the samples
-   and a hidden extremum from the sign of dh/dt there; on a constant field DOP853's steps
-   grow (about 15 time units here) and an interval between samples (about 3.8) can hold a
-   whole excursion into region + with dh/dt of one sign at both ends.
+Mended (docs/decisions.md#resolved-windows): the samples of an integration step must
+resolve h and the sections (rules.resolves) before their sign changes are trusted; a
+window that does not is searched in shorter ones (loop.stay.make_step_windows).
+
+1. Two crossings of H between two samples: on a constant field DOP853's steps grow (about
+   15 time units here) and an interval between samples (about 3.8) held a whole excursion
+   into region + with dh/dt of one sign at both ends.
 2. A section crossed twice between two samples: sections have no hidden-extremum search
-   at all (H has), so a window above the section shorter than the sample spacing is missed
-   and a later crossing returned.
+   (H has), so a window above the section shorter than the sample spacing was missed and
+   a later crossing returned.
+
+Known and not yet mended, marked xfail(strict=True): it runs, it fails today, and it turns
+the suite red the day a change mends it, so that its mark and the limitation written in
+the tutorial go.
+
 3. ``touch_tol`` is absolute, in h's units: in a system written in micrometres a real
    crossing 2.3e-10 of the state's scale deep (2.25e-16 in h) is taken for a touch.
 """
@@ -27,13 +33,12 @@ def _miss(reason):
     return pytest.mark.xfail(strict=True, reason=reason)
 
 
-@_miss("two crossings of H between two samples of a long DOP853 step are not seen")
 @pytest.mark.parametrize("engine", ENGINES)
 def test_every_window_of_a_periodically_switched_ramp_is_counted(engine):
     # th' = 1; x' = 1 where h = sin(th) - 0.9 >= 0, else 0: x counts the time in +.
     # Every crossing is transversal (|dh/dt| = 0.436); from th = 0 to th = 50 the eight
     # windows [XA, pi - XA] + 2 pi k, k = 0..7, lie inside: x = 8 (pi - 2 XA), 16 switches
-    # (both engines give these, to 5e-15, with max_step=0.5)
+    # (both engines gave these, to 5e-15, with max_step=0.5 before the mend; 14 without)
     system = FilippovSystem(("th", "x"), field_minus=lambda z, p: np.array([1.0, 0.0]),
                             field_plus=lambda z, p: np.array([1.0, 1.0]),
                             switch=lambda z, p: np.sin(z[0]) - 0.9,
@@ -44,12 +49,11 @@ def test_every_window_of_a_periodically_switched_ramp_is_counted(engine):
     assert out.state[0, 1] == pytest.approx(8 * (np.pi - 2 * XA), rel=1e-9)
 
 
-@_miss("a section crossed twice between two samples: no hidden-extremum search on sections")
 @pytest.mark.parametrize("engine", ENGINES)
 def test_the_first_upward_crossing_of_a_wavy_section_is_returned(engine):
     # a relay in y sliding on y = 0 at x' = 1 (F_-+ = (1, +-1)); the section sin x = 0.9,
     # upward: from x = -10 the first crossing is at x = XA - 2 pi, t = XA - 2 pi + 10
-    # (both engines give it, to 1e-16, with max_step=0.1)
+    # (both engines gave it, to 1e-16, with max_step=0.1 before the mend; t = 23.69 without)
     system = FilippovSystem(("x", "y"), field_minus=lambda z, p: np.array([1.0, 1.0]),
                             field_plus=lambda z, p: np.array([1.0, -1.0]),
                             switch=lambda z, p: z[1],

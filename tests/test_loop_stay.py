@@ -55,3 +55,63 @@ def _plane(section):
 ])
 def test_a_slide_inside_a_section_is_told_from_one_across_it(section, inside):
     assert bool(stay.make_slides_in(*_plane(section))(0, None)) is inside
+
+
+def _walk_calls(resolved_length, ta=0.0, tb=1.0, event_at=None):
+    """The windows make_step_windows asks for on [ta, tb] when a window resolves once it is
+    at most ``resolved_length`` long (and may not be split), with an event at ``event_at``."""
+    calls = []
+
+    def window(mode, t0, t1, first, may_split, ctx):
+        calls.append((t0, t1, first, may_split))
+        if may_split and t1 - t0 > resolved_length:
+            return stay.UNRESOLVED, t0, -1
+        if event_at is not None and t0 <= event_at <= t1:
+            return 0, event_at, 7
+        return GO_ON, t1, -1
+
+    result = stay.make_step_windows(window)(PLUS, ta, tb, True, None)
+    return calls, result
+
+
+def test_a_resolved_step_is_one_window():
+    calls, result = _walk_calls(2.0)
+    assert calls == [(0.0, 1.0, True, True)] and result == (GO_ON, 1.0, -1)
+
+
+def test_an_unresolved_step_is_searched_in_shorter_windows_up_to_its_end():
+    calls, result = _walk_calls(0.1)
+    asked = [(t0, t1) for t0, t1, _, _ in calls]
+    assert asked[:2] == [(0.0, 1.0), (0.0, 1.0 / rules.SPLIT)]
+    searched = [(t0, t1) for t0, t1, _, may in calls if not may or t1 - t0 <= 0.1]
+    # the searched windows tile the step, in order, each first one of the stay only once
+    assert searched[0][0] == 0.0 and searched[-1][1] == 1.0
+    assert all(a[1] == b[0] for a, b in zip(searched, searched[1:]))
+    assert [c[2] for c in calls if c[0] > 0.0] == [False] * sum(c[0] > 0.0 for c in calls)
+    assert result == (GO_ON, 1.0, -1)
+
+
+def test_an_event_in_a_shorter_window_ends_the_step():
+    calls, result = _walk_calls(0.1, event_at=0.2)
+    assert result == (0, 0.2, 7)
+    assert calls[-1][0] <= 0.2 <= calls[-1][1] and calls[-1][1] < 1.0
+
+
+def test_splits_stop_after_max_splits_in_a_row():
+    """A window that never resolves (noise at every scale) is taken after
+    rules.MAX_SPLITS shortenings: the walk is bounded, never a hang."""
+    calls, result = _walk_calls(0.0)
+    first = [c for c in calls if c[0] == 0.0]
+    assert len(first) == rules.MAX_SPLITS + 1 and first[-1][3] is False
+    assert first[-1][1] - first[-1][0] == pytest.approx(rules.SPLIT ** -rules.MAX_SPLITS)
+    assert result == (GO_ON, 1.0, -1)
+    # each later window first tries SPLIT times the last one: two tries a window at most
+    assert len(calls) <= rules.MAX_SPLITS + 2 * rules.SPLIT ** rules.MAX_SPLITS
+
+
+def test_a_window_too_short_to_split_is_taken_as_it_is():
+    t = 1.0
+    tb = np.nextafter(t, 2.0)
+    assert not rules.can_split(t, tb, t, tb)
+    calls, result = _walk_calls(0.0, ta=t, tb=tb)
+    assert calls == [(t, tb, True, False)] and result == (GO_ON, tb, -1)

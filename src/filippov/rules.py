@@ -445,6 +445,62 @@ def accumulates(oldest: float, newest: float, zeno_span: float) -> bool:
     return newest - oldest <= zeno_span * max(1.0, abs(newest))
 
 
+#: An integration step's samples must resolve what is sampled on them (the leave functions,
+#: the sections) before its sign changes are trusted: on a nearly constant field the steps
+#: grow without bound while h or a section may wind between two samples (two crossings, or
+#: a section window, between samples: docs/decisions.md#resolved-windows). Five samples
+#: resolve a function when the parabola through the 1st, 3rd and 5th predicts the 2nd and
+#: 4th within RESOLVE_SHARE of the five's range (of sin(w t): always at w dt <= 0.8, never
+#: at w dt >= 1.5, whatever the phase; two extrema between samples need w dt >= pi).
+RESOLVE_SHARE = 0.2
+#: an unresolved window is shortened by SPLIT and sampled again, down to a SPLIT **
+#: MAX_SPLITS-th (1/4096) of its integration step (loop.stay.make_step_windows)
+SPLIT = 16.0
+MAX_SPLITS = 3
+#: the rounding of a sample a parabola's miss must exceed, in ulps of the largest sample
+RESOLVE_NOISE_ULPS = 64.0
+
+
+def parabola_misses(v0: float, v1: float, v2: float, v3: float, v4: float) -> bool:
+    """Five equally spaced samples do not resolve their function (:data:`RESOLVE_SHARE`,
+    beyond their rounding)."""
+    lo, hi = min(v0, v1, v2, v3, v4), max(v0, v1, v2, v3, v4)
+    miss = max(abs(v1 - (3.0 * v0 + 6.0 * v2 - v4) / 8.0),
+               abs(v3 - (6.0 * v2 + 3.0 * v4 - v0) / 8.0))
+    return (miss > RESOLVE_SHARE * (hi - lo)
+            and miss > RESOLVE_NOISE_ULPS * _EPS * max(abs(lo), abs(hi)))
+
+
+def resolves(v, n: int) -> bool:
+    """The first n samples v of a function, equally spaced, resolve it: each run of five
+    (from sample 0 at a stride of 4, and the last five) is resolved (not
+    :func:`parabola_misses`). Fewer than five samples are not judged (True:
+    samples_per_step < 4)."""
+    if n < 5:
+        return True
+    k = 0
+    while True:
+        if parabola_misses(v[k], v[k + 1], v[k + 2], v[k + 3], v[k + 4]):
+            return False
+        if k + 4 >= n - 1:
+            return True
+        k = min(k + 4, n - 5)
+
+
+def window_end(t0: float, span: float, tb: float) -> float:
+    """The end of a window of length ``span`` from t0 in an integration step that ends at
+    tb: tb when the window reaches it."""
+    return t0 + span if t0 + span < tb else tb
+
+
+def can_split(ta: float, tb: float, t0: float, t1: float) -> bool:
+    """The window [t0, t1] of the integration step [ta, tb] may be shortened by SPLIT: the
+    shorter one is no shorter than a SPLIT ** MAX_SPLITS-th of the step, and longer than
+    t0's rounding."""
+    d = (t1 - t0) / SPLIT
+    return d >= (tb - ta) / SPLIT ** MAX_SPLITS and t0 + d > t0
+
+
 #: the non-finite guard both engines keep on an integration step: a non-finite field value
 #: at a stay's first evaluation is an error (NON_FINITE); on a trial stage it is replaced
 #: by this huge finite value, so the error norm rejects the step and the step shrinks (a

@@ -37,7 +37,7 @@ from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
 from .errors import run_error
 from .loop.event import SECTION, RunOps, make_run
-from .loop.stay import make_slides_in, make_start
+from .loop.stay import UNRESOLVED, make_slides_in, make_start, make_step_windows
 from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN,
                           NO_SLIDING, OK,
                           ROOT_FAILED, SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO)
@@ -569,33 +569,53 @@ class _Run:
         t_end, None)."""
         mode = self.mode
         stepper = self._stepper(mode)
-        leave = self._leave(mode)
+        self.leave_now = self._leave(mode)
         first, steps_in_mode = True, 0
         while True:
             ta, tb, Z = self._step(stepper)
-            ts, zs = self._samples(stepper, Z, ta, tb)
-            band = self.band
-            found = self._scan(Z, ts, zs, leave, first, ta, tb)
-            first = False
             if self.dense:
                 self.traj.segments.append((ta, tb, mode, Z))
-            if found is None:
-                self.t, self.z = tb, zs[:, -1].copy()
-                if self.band != band:  # the scan ended the exit's band: H unbiased on
-                    leave = self._leave(mode)
+            if stepper.method is None:  # an exact flow: the model's sample_step resolves it
+                st, _, _ = self.window(stepper, Z, ta, tb, first, False)
+            else:
+                st, _, _ = _STEP_WINDOWS(mode, ta, tb, first, (self, stepper, Z))
+            first = False
+            if st == GO_ON:
                 if tb >= self.t_end:
                     self._note_tolerance(stepper)
                     return NO_RETURN, tb, None
                 steps_in_mode += 1
                 stepper = self._stiff_switch(stepper, steps_in_mode, tb - ta)
                 continue
-            te, ze, what, idx = found
+            te, ze, what, idx = self.found
             if self.dense:  # the segment ends at the event
                 self.traj.segments[-1] = (ta, te, mode, Z)
             self.t, self.z = te, ze
             self._note_tolerance(stepper)
             self.hit_section = idx
             return OK, te, what
+
+    def window(self, stepper, Z, ta, tb, first, may_split):
+        """The window [ta, tb] of a step: sampled, then searched for its earliest event
+        (OK, its time, what; kept in self.found) or none (GO_ON: the state at tb);
+        UNRESOLVED when ``may_split`` and its samples do not resolve what they sample
+        (loop.stay.make_step_windows)."""
+        ts, zs = self._samples(stepper, Z, ta, tb)
+        scan = _Scan(self.system, self.mode, Z, ts, zs, self.leave_now, self.sections,
+                     self.preds, first, self.touch_tol, self.event_xtol, self.traj,
+                     self.band, self._leave(self.mode, banded=False) if self.band > 0.0
+                     else None)
+        if may_split and not scan.resolved():
+            return UNRESOLVED, ta, None
+        band = self.band
+        found = self._scan(scan, ta, tb)
+        if found is None:
+            self.t, self.z = tb, zs[:, -1].copy()
+            if self.band != band:  # the scan ended the exit's band: H unbiased on
+                self.leave_now = self._leave(self.mode)
+            return GO_ON, tb, None
+        self.found = found
+        return OK, found[0], found[2]
 
     def _note_tolerance(self, stepper):
         """At the end of a stay: how far the noise floor lifted Radau IIA's atol (the
@@ -664,12 +684,9 @@ class _Run:
                 f"closed form does not follow the field there; use integrated flows "
                 "(method='integrate') or check the flow's formula")
 
-    def _scan(self, Z, ts, zs, leave, first, ta, tb):
+    def _scan(self, scan, ta, tb):
         try:
-            found, band = _scan(self.system, self.mode, Z, ts, zs, leave, self.sections,
-                                self.preds, first, self.touch_tol, self.event_xtol, self.traj,
-                                self.band, self._leave(self.mode, banded=False)
-                                if self.band > 0.0 else None)
+            found, band = scan.earliest()
         except ValueError as exc:  # scipy's root finders: no context of their own
             raise run_error(
                 ROOT_FAILED, ta, self.z, f", mode {MODE_NAMES[self.mode]}: between t={ta!r} "
@@ -790,6 +807,12 @@ def _entered(mode, new_mode, t, run):
 
 #: the reference driver's run (filippov.loop.event) on its Python operations; ctx: the
 #: _Run, which made its start when it was built (begin: the state it made)
+#: an integration step searched in windows its samples resolve (loop.stay); ctx: the run,
+#: the stepper and the step's dense output
+_STEP_WINDOWS = make_step_windows(
+    lambda mode, t0, t1, first, may_split, ctx: ctx[0].window(ctx[1], ctx[2], t0, t1, first,
+                                                             may_split))
+
 _RUN = make_run(RunOps(
     begin=lambda z0, age0, run: (GO_ON, run.t, run.mode),
     end_time=lambda run: run.t_end,
@@ -850,23 +873,15 @@ def _in_section_rounding(func, s0, z0, zr) -> bool:
     return rules.on_section_by_value(s0, noise)
 
 
-def _scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xtol, traj,
-          band=0.0, unbanded=None):
-    """Earliest event in the samples ``ts`` of one segment, or None; and the band still
-    in force after it. ``band``: the rounding band of the sliding exit the stay began
-    at, while the orbit is inside it (rules.exit_band, rules.graze; ``leave`` then
+class _Scan:
+    """One segment as :meth:`earliest` examines it: the values at the samples of the
+    functions whose sign change leaves the mode (``leave``), of dH/dt (in a region) or
+    of the rates of the sliding speeds a and b (sliding), and of the sections; the
+    exit's band while in force. ``band``: the rounding band of the sliding exit the stay
+    began at, while the orbit is inside it (rules.exit_band, rules.graze; ``leave`` then
     measures H from the band's edge, ``unbanded`` from the exit shift alone): it ends at
     the first sample interval examined whose start is out of the band (rules.clears_band),
     or at the last sample of a segment with no event."""
-    return _Scan(system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol, xtol,
-                 traj, band, unbanded).earliest()
-
-
-class _Scan:
-    """One segment as :func:`_scan` examines it: the values at the samples of the
-    functions whose sign change leaves the mode (``leave``), of dH/dt (in a region) or
-    of the rates of the sliding speeds a and b (sliding), and of the sections; the
-    exit's band while in force."""
 
     def __init__(self, system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol,
                  xtol, traj, band, unbanded):
@@ -875,9 +890,10 @@ class _Scan:
         self.touch_tol, self.xtol, self.traj = touch_tol, xtol, traj
         self.band, self.unbanded = band, unbanded
         self.order = None  # the candidate intervals still to ask (earliest, _unband)
-        self.vals = []
+        self.vals, self.raw = [], []
         for func, pred, what in leave:
             v = np.asarray(func(zs), dtype=float)
+            self.raw.append(v)
             if first:  # just entered this mode: its start is inside by construction
                 v = v.copy()
                 v[0] = rules.clamp(pred, v[0])
@@ -891,6 +907,11 @@ class _Scan:
             self.rates = _speed_rates(system, Z, np.asarray(zs[:, 0], dtype=float))
             if self.rates is not None:
                 self.R = self.rates(ts)
+
+    def resolved(self):
+        """The samples resolve the leave functions and the sections (rules.resolves; the
+        values as sampled, before the first one is clamped)."""
+        return all(rules.resolves(v, v.size) for v in self.raw + self.svals)
 
     def _along(self, func):
         """``func`` of the state as a function of time on the segment."""
@@ -916,7 +937,8 @@ class _Scan:
         return cand
 
     def earliest(self):
-        """(t, z, what, section index) of the earliest event, or None; the band after it."""
+        """(t, z, what, section index) of the earliest event in the segment, or None; and
+        the band still in force after it."""
         self.order = np.flatnonzero(self.candidates())
         _, r, what, k = _window_event(self, self.mode)
         if what == interval.NONE:

@@ -41,7 +41,7 @@ from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
 from ..loop.event import SECTION, RunOps, make_run
-from ..loop.stay import before_stay, make_slides_in, make_start
+from ..loop.stay import UNRESOLVED, before_stay, make_slides_in, make_start, make_step_windows
 from ..loop.status import GO_ON
 
 
@@ -115,16 +115,28 @@ _DERIVATIVES = True
 
 
 @_jit_inline
-def _window(mode, ta, tb, frac, first, o, s, w):
-    """Samples the segment [ta, tb] of the current mode (o: state.Orbit, of w's arrays)
-    and finds its earliest event: (_GO_ON, tb, _W_NONE) if there is none (the state at tb
-    in w.z), (OK, te, what) at an event (its state in w.z), NO_RETURN at t_max, or an
-    error (status, ta)."""
+def _resolved(mode, ns, sm):
+    """The window's samples resolve its leave functions and its section (rules.resolves)."""
+    return (rules.resolves(sm.vals[0], ns)
+            and (mode != SLIDING or rules.resolves(sm.vals[1], ns))
+            and rules.resolves(sm.svals, ns))
+
+
+@_jit_inline
+def _window(mode, ta, tb, first, may_split, o, s, w):
+    """Samples the segment [ta, tb] of the current mode (o: state.Orbit, of w's arrays;
+    at the fractions of an exact window or of an integration step) and finds its earliest
+    event: (_GO_ON, tb, _W_NONE) if there is none (the state at tb in w.z), (OK, te, what)
+    at an event (its state in w.z), NO_RETURN at t_max, or an error (status, ta);
+    (UNRESOLVED, ta) when ``may_split`` and the samples do not resolve what they sample
+    (loop.stay.make_step_windows)."""
+    exact = mode != SLIDING and w.seg[SEG_INTEGRATED] == 0.0
+    frac = s.frac_ex if exact else s.frac_in
     ns = frac.size
     sm = Samples(w.ts, w.vals, w.dvals, w.svals, w.ynew, w.touched)
     sc = Scratch(w.wz, w.wg, w.wf, w.wp)
     # an exact flow's window after the first of its stay starts at the last one's end
-    k0 = 1 if (mode != SLIDING and w.seg[SEG_INTEGRATED] == 0.0 and not first) else 0
+    k0 = 1 if (exact and not first) else 0
     if k0 == 1:
         _carry_sample(ns, w.seg, sm)
     ok, speed2_a = _sample(mode, ta, tb, frac, k0, o, sm, sc)
@@ -133,9 +145,10 @@ def _window(mode, ta, tb, frac, first, o, s, w):
     # an exact flow (SEG_INTEGRATED == 0) must follow its field over the window: from the
     # state at ta (w.z) to that at tb (w.ynew), the field at tb left in w.wf by the last
     # sample; else the run stops at ta (w.z)
-    if mode != SLIDING and w.seg[SEG_INTEGRATED] == 0.0 and not _flow_follows(
-            w.z, w.ynew, tb - ta, speed2_a, w.wf):
+    if exact and not _flow_follows(w.z, w.ynew, tb - ta, speed2_a, w.wf):
         return FLOW_OFF_FIELD, ta, _W_NONE
+    if may_split and not _resolved(mode, ns, sm):
+        return UNRESOLVED, ta, _W_NONE
     st, te, what = _find(mode, ns, first, s, o, sm, sc)
     # P is not differentiable where the orbit touches H
     if _DERIVATIVES and s.jac and w.touched[0]:
@@ -184,7 +197,7 @@ def _stay_exact(mode, t, ctx):
         tb = min(ta + rules.exact_window(age, s.hwin, s.hwin_slow, s.transient), s.t_max)
         if tb == ta:
             tb = np.nextafter(ta, np.inf)
-        st, t, what = _window(mode, ta, tb, s.frac_ex, first, o, s, w)
+        st, t, what = _window(mode, ta, tb, first, False, o, s, w)
         if st != _GO_ON:
             if _DERIVATIVES and st == OK and s.jac:
                 dv = w.deriv
@@ -193,6 +206,25 @@ def _stay_exact(mode, t, ctx):
                 _apply(dv.Mt, dv.M, dv.KP[0])
             return st, t, what
         ta, first = tb, False
+
+
+@_jit_inline
+def _step_window(mode, t0, t1, first, may_split, ctx):
+    o, s, w = ctx
+    return _window(mode, t0, t1, first, may_split, o, s, w)
+
+
+def _build_step_windows(ns):
+    """An integration step searched in windows its samples resolve
+    (loop.stay.make_step_windows) on the namespace ``ns``'s _step_window (as _build_run)."""
+    walk = make_step_windows(ns["_step_window"])
+    if not ns["_DERIVATIVES"]:
+        walk.__qualname__ += "_plain"
+    return _jit_inline(walk)
+
+
+_build_step_windows.builds = True
+_step_windows = _build_step_windows(globals())
 
 
 @_jit_inline
@@ -227,7 +259,7 @@ def _stay_integrated(mode, t, ctx):
         _dop_dense(mode, hstep, fns, p, fl, d)
         w.seg[SEG_STEP_T] = ta
         w.seg[SEG_STEP_H] = tb - ta
-        st, t, what = _window(mode, ta, tb, s.frac_in, first, o, s, w)
+        st, t, what = _step_windows(mode, ta, tb, first, (o, s, w))
         if _DERIVATIVES and s.jac and (st == _GO_ON or (st == OK and t > ta)):
             _var_step(mode, w.y_old, (tb if st == _GO_ON else t) - ta, fns, p, fl, w.deriv,
                       s.jac == 2)
@@ -572,7 +604,9 @@ def _without_derivatives(decorated):
 
 
 # the functions on the way from _batch to a _DERIVATIVES branch
-_PLAIN = _without_derivatives({"_window": _jit_inline, "_stay_exact": _jit_inline,
+_PLAIN = _without_derivatives({"_window": _jit_inline, "_step_window": _jit_inline,
+                               "_step_windows": _build_step_windows,
+                               "_stay_exact": _jit_inline,
                                "_stay_integrated": _jit_inline, "_at_section": _jit_inline,
                                "_event_switch_derivative": _jit_inline,
                                "_begin": _jit, "_one": _build_run,

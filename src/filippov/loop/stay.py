@@ -72,3 +72,33 @@ def make_slides_in(fields, section_along):
         return rules.slides_in_section(section_along(k, SLIDING, 0.0, ctx), d, rate_m,
                                        rate_p, rate_s)
     return slides_in
+
+
+#: a window whose samples do not resolve what is sampled on it (rules.resolves): not
+#: searched; the step's walk shortens it (never a run's status)
+UNRESOLVED = -2
+
+
+def make_step_windows(window):
+    """``walk(mode, ta, tb, first, ctx) -> (status, t, what)``: an integration step
+    [ta, tb] searched window by window. A window whose samples do not resolve its leave
+    functions or sections is shortened by rules.SPLIT and sampled again, down to a
+    rules.SPLIT ** rules.MAX_SPLITS-th of the step (rules.can_split); a resolved window
+    without an event hands on to the next, rules.SPLIT times longer (to the step's end at
+    most). The engine's operation: ``window(mode, t0, t1, first, may_split, ctx) ->
+    (status, t, what)``, its status UNRESOLVED (only when ``may_split``), GO_ON (no event:
+    the orbit goes on from t1) or the event's."""
+
+    def walk(mode, ta, tb, first, ctx):
+        t0, span = ta, tb - ta
+        while True:
+            t1 = rules.window_end(t0, span, tb)
+            st, t, what = window(mode, t0, t1, first, rules.can_split(ta, tb, t0, t1), ctx)
+            if st == UNRESOLVED:
+                span = (t1 - t0) / rules.SPLIT
+            elif st != GO_ON or t1 >= tb:
+                return st, t, what
+            else:
+                span = (t1 - t0) * rules.SPLIT
+                t0, first = t1, False
+    return walk
