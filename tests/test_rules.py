@@ -297,3 +297,55 @@ def test_a_leave_crossing_ends_the_stay_into_the_region_next_mode_takes():
     for q, region in ((0, MINUS), (1, PLUS)):
         for a, b in itertools.product(SPEEDS, SPEEDS):
             assert rules.next_mode(SLIDING, rules.ended_by(SLIDING, q), a, b) == region
+
+
+def _sine_samples(w_dt, phase, n=5):
+    ts = np.arange(n) * 0.5
+    w = w_dt / 0.5
+    return np.sin(w * ts + phase), w * np.cos(w * ts + phase), ts
+
+
+@pytest.mark.parametrize("slopes", [False, True])
+def test_samples_resolve_a_sine_when_dense_and_not_when_sparse(slopes):
+    """rules.resolves on sin(w t) at every phase: resolved at w dt <= 0.8 (both with the
+    slopes and from the values alone), not at w dt >= 2 (where two extrema fit between
+    samples at w dt >= pi); the compiled rule decides as Python does."""
+    compiled = kernel.compiled_rule("resolves")
+    for phase in np.linspace(0.0, 2.0 * np.pi, 61):
+        for w_dt, expected in ((0.1, True), (0.5, True), (0.8, True), (2.0, False),
+                               (3.0, False), (3.8, False)):
+            v, d, ts = _sine_samples(w_dt, phase, n=9)
+            got = rules.resolves(v, d, ts, 9, slopes)
+            assert got == expected, (w_dt, phase)
+            assert compiled(v, d, ts, 9, slopes) == got
+
+
+def test_slopes_give_away_samples_that_alias_a_fast_function():
+    """Samples 5 periods less 0.18 rad apart look like a slow sine from their values; the
+    slopes sampled with them do not agree with it (Simpson's rule on them)."""
+    w_dt = 5 * 2 * np.pi - 0.18
+    found = {True: 0, False: 0}
+    for phase in np.linspace(0.0, 2.0 * np.pi, 61):
+        v, d, ts = _sine_samples(w_dt, phase)
+        assert not rules.resolves(v, d, ts, 5, True)
+        found[rules.resolves(v, d, ts, 5, False)] += 1
+    assert found[True] > 0  # values alone cannot tell (sections: docs/tutorial.md)
+
+
+def test_rounding_and_short_windows_are_resolved():
+    ts = np.arange(5) * 0.25
+    noisy = 1.0 + np.array([0.0, 2.2e-16, -2.2e-16, 4.4e-16, 0.0])
+    assert rules.resolves(noisy, np.zeros(5), ts, 5, True)
+    assert rules.resolves(np.zeros(5), np.zeros(5), ts, 5, True)   # constant
+    assert rules.resolves(np.array([0.0, 5.0, -3.0, 1.0]), np.zeros(4), ts, 4, True)  # < 5
+
+
+def test_the_last_run_of_five_is_judged_too():
+    """Runs of five from sample 0 at a stride of 4, and the last five: with 7 samples a
+    wiggle in samples 4..6 is seen."""
+    ts = np.arange(7) * 0.1
+    v = 0.1 * ts
+    assert rules.resolves(v, np.full(7, 0.1), ts, 7, True)
+    v2 = v.copy()
+    v2[5] += 1.0
+    assert not rules.resolves(v2, np.full(7, 0.1), ts, 7, False)

@@ -451,37 +451,53 @@ def accumulates(oldest: float, newest: float, zeno_span: float) -> bool:
 #: a section window, between samples: docs/decisions.md#resolved-windows). Five samples
 #: resolve a function when the parabola through the 1st, 3rd and 5th predicts the 2nd and
 #: 4th within RESOLVE_SHARE of the five's range (of sin(w t): always at w dt <= 0.8, never
-#: at w dt >= 1.5, whatever the phase; two extrema between samples need w dt >= pi).
+#: at w dt >= 1.5, whatever the phase; two extrema between samples need w dt >= pi) and,
+#: where the slopes are sampled too (h in a region), the Hermite cubic of every other
+#: sample's value and slope predicts the one between, and Simpson's rule on the slopes the
+#: change across it (samples that alias a fast function into a smooth-looking one do not:
+#: their slopes give it away).
 RESOLVE_SHARE = 0.2
 #: an unresolved window is shortened by SPLIT and sampled again, down to a SPLIT **
 #: MAX_SPLITS-th (1/4096) of its integration step (loop.stay.make_step_windows)
 SPLIT = 16.0
 MAX_SPLITS = 3
-#: the rounding of a sample a parabola's miss must exceed, in ulps of the largest sample
+#: the rounding of a sample a prediction's miss must exceed, in ulps of the largest sample
 RESOLVE_NOISE_ULPS = 64.0
 
 
-def parabola_misses(v0: float, v1: float, v2: float, v3: float, v4: float) -> bool:
-    """Five equally spaced samples do not resolve their function (:data:`RESOLVE_SHARE`,
-    beyond their rounding)."""
-    lo, hi = min(v0, v1, v2, v3, v4), max(v0, v1, v2, v3, v4)
-    miss = max(abs(v1 - (3.0 * v0 + 6.0 * v2 - v4) / 8.0),
-               abs(v3 - (6.0 * v2 + 3.0 * v4 - v0) / 8.0))
+def misses(predicted: float, v: float, lo: float, hi: float) -> bool:
+    """A prediction of the sample v misses it by more than RESOLVE_SHARE of the samples'
+    range [lo, hi], and by more than their rounding."""
+    miss = abs(v - predicted)
     return (miss > RESOLVE_SHARE * (hi - lo)
             and miss > RESOLVE_NOISE_ULPS * _EPS * max(abs(lo), abs(hi)))
 
 
-def resolves(v, n: int) -> bool:
-    """The first n samples v of a function, equally spaced, resolve it: each run of five
-    (from sample 0 at a stride of 4, and the last five) is resolved (not
-    :func:`parabola_misses`). Fewer than five samples are not judged (True:
-    samples_per_step < 4)."""
+def resolves(v, d, ts, n: int, slopes: bool) -> bool:
+    """The first n samples v of a function at the equally spaced times ts (slopes d where
+    ``slopes``) resolve it (:data:`RESOLVE_SHARE`): in every run of five, from sample 0 at
+    a stride of 4 and the last five, the parabola through the 1st, 3rd and 5th predicts
+    the 2nd and 4th, and (``slopes``) the Hermite cubic of the samples either side of the
+    2nd, 3rd and 4th predicts it, and Simpson's rule on the slopes the change across it
+    (:func:`misses`). Fewer than five samples are not judged
+    (True: samples_per_step < 4)."""
     if n < 5:
         return True
+    dt = (ts[n - 1] - ts[0]) / (n - 1)
     k = 0
     while True:
-        if parabola_misses(v[k], v[k + 1], v[k + 2], v[k + 3], v[k + 4]):
+        lo = min(v[k], v[k + 1], v[k + 2], v[k + 3], v[k + 4])
+        hi = max(v[k], v[k + 1], v[k + 2], v[k + 3], v[k + 4])
+        if (misses((3.0 * v[k] + 6.0 * v[k + 2] - v[k + 4]) / 8.0, v[k + 1], lo, hi)
+                or misses((6.0 * v[k + 2] + 3.0 * v[k + 4] - v[k]) / 8.0, v[k + 3], lo, hi)):
             return False
+        if slopes:
+            for j in range(k + 1, k + 4):
+                if (misses((v[j - 1] + v[j + 1]) / 2.0 + dt * (d[j - 1] - d[j + 1]) / 4.0,
+                           v[j], lo, hi)
+                        or misses(v[j - 1] + dt * (d[j - 1] + 4.0 * d[j] + d[j + 1]) / 3.0,
+                                  v[j + 1], lo, hi)):
+                    return False
         if k + 4 >= n - 1:
             return True
         k = min(k + 4, n - 5)

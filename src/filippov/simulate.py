@@ -910,8 +910,12 @@ class _Scan:
 
     def resolved(self):
         """The samples resolve the leave functions and the sections (rules.resolves; the
-        values as sampled, before the first one is clamped)."""
-        return all(rules.resolves(v, v.size) for v in self.raw + self.svals)
+        values as sampled, before the first one is clamped; h with its slopes dH/dt)."""
+        ts, n = self.ts, self.ts.size
+        if self.mode != SLIDING and not rules.resolves(self.raw[0], self.D, ts, n, True):
+            return False
+        return all(rules.resolves(v, v, ts, n, False)
+                   for v in (self.raw if self.mode == SLIDING else []) + self.svals)
 
     def _along(self, func):
         """``func`` of the state as a function of time on the segment."""

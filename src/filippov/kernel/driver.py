@@ -116,10 +116,11 @@ _DERIVATIVES = True
 
 @_jit_inline
 def _resolved(mode, ns, sm):
-    """The window's samples resolve its leave functions and its section (rules.resolves)."""
-    return (rules.resolves(sm.vals[0], ns)
-            and (mode != SLIDING or rules.resolves(sm.vals[1], ns))
-            and rules.resolves(sm.svals, ns))
+    """The window's samples resolve its leave functions and its section (rules.resolves;
+    h with its slopes dh/dt)."""
+    return (rules.resolves(sm.vals[0], sm.dvals[0], sm.ts, ns, mode != SLIDING)
+            and (mode != SLIDING or rules.resolves(sm.vals[1], sm.vals[1], sm.ts, ns, False))
+            and rules.resolves(sm.svals, sm.svals, sm.ts, ns, False))
 
 
 @_jit_inline
