@@ -805,14 +805,14 @@ def _entered(mode, new_mode, t, run):
     run.mode = run.traj.mode = new_mode
 
 
-#: the reference driver's run (filippov.loop.event) on its Python operations; ctx: the
-#: _Run, which made its start when it was built (begin: the state it made)
 #: an integration step searched in windows its samples resolve (loop.stay); ctx: the run,
 #: the stepper and the step's dense output
 _STEP_WINDOWS = make_step_windows(
     lambda mode, t0, t1, first, may_split, ctx: ctx[0].window(ctx[1], ctx[2], t0, t1, first,
                                                              may_split))
 
+#: the reference driver's run (filippov.loop.event) on its Python operations; ctx: the
+#: _Run, which made its start when it was built (begin: the state it made)
 _RUN = make_run(RunOps(
     begin=lambda z0, age0, run: (GO_ON, run.t, run.mode),
     end_time=lambda run: run.t_end,
