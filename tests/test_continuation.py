@@ -156,3 +156,24 @@ def test_monodromy_of_a_sliding_orbit_does_not_depend_on_the_start(where, stretc
     _, mult = cont.monodromy(system, traj)
     np.testing.assert_allclose(np.abs(mult), [1.0, 0.0], rtol=0, atol=1e-8)
     np.testing.assert_allclose(cont.floquet_multipliers(system, traj), mult, atol=1e-14)
+
+
+@pytest.mark.parametrize("xa, xb", [(-0.5, 0.5), (-0.05, 0.5), (-0.01, 0.5), (0.5, -0.1),
+                                    (0.4, -0.02)])
+def test_a_fold_in_an_outer_quarter_of_its_bracket_is_found_with_its_kind(xa, xb):
+    """p = 1 - x^2 folds at p = 1 (a maximum): wherever it lies in the bracket (found by an
+    independent review: with x = -0.05, 0.5 the end p = 0.75 came back as a 'min')."""
+    G = lambda u: np.array([u[1] - (1.0 - u[0] ** 2)])
+    u, kind = cont.locate_fold(G, np.array([xa, 1 - xa ** 2]), np.array([xb, 1 - xb ** 2]),
+                               param_index=1)
+    assert kind == "max" and u[1] == pytest.approx(1.0, abs=1e-12)
+    G_min = lambda u: np.array([u[1] - (u[0] ** 2 - 1.0)])
+    u, kind = cont.locate_fold(G_min, np.array([xa, xa ** 2 - 1]), np.array([xb, xb ** 2 - 1]),
+                               param_index=1)
+    assert kind == "min" and u[1] == pytest.approx(-1.0, abs=1e-12)
+
+
+def test_a_bracket_without_a_fold_is_refused():
+    G = lambda u: np.array([u[1] - u[0] ** 3])   # monotone: no fold
+    with pytest.raises(cont.ContinuationError, match="no fold between"):
+        cont.locate_fold(G, np.array([0.1, 1e-3]), np.array([0.5, 0.125]), param_index=1)

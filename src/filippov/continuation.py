@@ -166,12 +166,22 @@ def locate_fold(G, u_a, u_b, *, param_index=-1, state_index=None, tol=1e-12):
 
     mid = solve(0.5 * (u_a[state_index] + u_b[state_index]))
     pa, pb, pm = u_a[p], u_b[p], mid[p]
-    kind = "max" if pm > max(pa, pb) else "min"
-    sign = -1.0 if kind == "max" else 1.0
     lo, hi = sorted([u_a[state_index], u_b[state_index]])
-    res = minimize_scalar(lambda s: sign * solve(s)[p], bounds=(lo, hi), method="bounded",
-                          options={"xatol": 1e-9 * max(1.0, abs(hi))})
-    return solve(res.x), kind
+    # the midpoint's guess of the kind is wrong where the fold lies in an outer quarter of
+    # the bracket: each kind's extremum must be beyond both ends' parameter to count
+    # (found by an independent review: p = 1 - x^2 bracketed by x = -0.05, 0.5 gave the
+    # end p = 0.75 as a 'min')
+    first = "max" if pm > max(pa, pb) else "min"
+    for kind in (first, "min" if first == "max" else "max"):
+        sign = -1.0 if kind == "max" else 1.0
+        res = minimize_scalar(lambda s: sign * solve(s)[p], bounds=(lo, hi),
+                              method="bounded", options={"xatol": 1e-9 * max(1.0, abs(hi))})
+        u = solve(res.x)
+        if sign * u[p] < sign * (max(pa, pb) if kind == "max" else min(pa, pb)):
+            return u, kind
+    raise ContinuationError(f"locate_fold: no fold between the branch points {u_a.tolist()} "
+                            f"and {u_b.tolist()}: the parameter along the branch has no "
+                            "extremum inside the bracket")
 
 
 # --------------------------------------------------------------------------- smooth flows

@@ -143,7 +143,8 @@ engine that moves one of these makes its test fail.
 11. **dP/dz of a return that starts sliding.** Where a return starts on H and slides
     (a section across a sliding arc, a start with h = 0 there), the kernel leaves dP/dz
     NaN (status OK: the return is made, its derivative is not); the reference derives it
-    from the variational equations along the sliding flow.
+    from the variational equations along the sliding flow, after the projection a
+    perturbation off H meets on its way back onto it.
     ``periodic_orbit`` on the compiled engine refuses such an orbit by name
     (PeriodicOrbitError, "dP/dz is not finite") instead of taking a Newton step from
     NaN. Not ported: the kernel carries no derivative along a slide it starts in.

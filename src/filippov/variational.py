@@ -25,17 +25,20 @@ from typing import Callable, Optional
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .system import SLIDING
+from . import rules
+from .system import PLUS, SLIDING
 from .errors import VariationalError  # noqa: F401  (re-exported)
 
 
 def fd_jacobian(fun: Callable[[np.ndarray], np.ndarray], u: np.ndarray,
                 step: float = 1e-7) -> np.ndarray:
-    """Central differences; ``step`` is relative to ``max(1, |u_i|)``."""
+    """Central differences; ``step`` is relative to ``max(|u_i|, s)``, s = 1 for u of
+    order one and above, the size of u below that (rules.difference_scale)."""
     u = np.asarray(u, dtype=float)
     cols = []
+    floor = rules.difference_scale(u.reshape(-1))
     for i in range(u.size):
-        d = step * max(1.0, abs(u[i]))
+        d = step * max(floor, abs(u[i]))
         up, um = u.copy(), u.copy()
         up[i] += d
         um[i] -= d
@@ -114,6 +117,12 @@ def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
     ev = traj.events
     for k, e in enumerate(ev):
         S = switch_matrix(system, e.mode_before, e.mode_after, e.state)
+        if k == 0 and e.mode_after == SLIDING:
+            # a start that slides: a perturbation off H comes back onto it along F_+ or
+            # F_- and slides on late, the projection of an arrival from either side
+            # (I + (F_+ - F_-) n^T / (a - b), the same from both)
+            S = saltation(system.field(PLUS, e.state), system.field(SLIDING, e.state),
+                          system.switch_grad(e.state))
         if S is not None:
             M = S @ M
         t_next = ev[k + 1].t if k + 1 < len(ev) else traj.t
