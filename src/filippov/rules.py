@@ -241,23 +241,9 @@ def rate_step(z, fm, fp, a: float, b: float) -> float:
     return RATE_STEP * size / speed
 
 
-def difference_scale(z) -> float:
-    """The least size a central-difference step in component k of the state z is taken
-    relative to (the step's size is max(|z_k|, this)): 1, as for a state of order one,
-    but the state's largest component where that is below 1, so that a system written in
-    small units is differenced at its own scale (docs/decisions.md#difference-scale); 1 at
-    the origin or where z is not finite."""
-    size = 0.0
-    for c in range(z.size):
-        if not np.isfinite(z[c]):
-            return 1.0
-        size = max(size, abs(z[c]))
-    return min(size, 1.0) if size > 0.0 else 1.0
-
-
 def central_step(size: float, speed: float) -> float:
     """The central-difference step along a direction (largest component ``speed``: a
-    field, a column of a derivative) at a state of size ``size`` (difference_scale); 0 where the
+    field, a column of a derivative) at a state of size ``size`` (>= 1); 0 where the
     direction is zero or not finite. Truncation and rounding are then both ~u^(2/3)
     of the derivative (the sliding test, the compiled engine's dP/dz)."""
     if not (np.isfinite(speed) and speed > 0.0):

@@ -25,20 +25,17 @@ from typing import Callable, Optional
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from . import rules
 from .system import PLUS, SLIDING
 from .errors import VariationalError  # noqa: F401  (re-exported)
 
 
 def fd_jacobian(fun: Callable[[np.ndarray], np.ndarray], u: np.ndarray,
                 step: float = 1e-7) -> np.ndarray:
-    """Central differences; ``step`` is relative to ``max(|u_i|, s)``, s = 1 for u of
-    order one and above, the size of u below that (rules.difference_scale)."""
+    """Central differences; ``step`` is relative to ``max(1, |u_i|)``."""
     u = np.asarray(u, dtype=float)
     cols = []
-    floor = rules.difference_scale(u.reshape(-1))
     for i in range(u.size):
-        d = step * max(floor, abs(u[i]))
+        d = step * max(1.0, abs(u[i]))
         up, um = u.copy(), u.copy()
         up[i] += d
         um[i] -= d

@@ -51,10 +51,9 @@ def _rank_one(M, u, g, speed):
 def _flow_jacobian(mode, za, tau, fns, p, J, z1, z2):
     """J = d flow(za, tau) / d za by central differences of the closed-form flow (step
     rules.central_step per component; za is restored bit for bit)."""
-    floor = rules.difference_scale(za)
     for k in range(za.size):
         orig = za[k]
-        d = rules.central_step(max(floor, abs(orig)), 1.0)
+        d = rules.central_step(max(1.0, abs(orig)), 1.0)
         za[k] = orig + d
         up = za[k]
         if mode == PLUS:
@@ -77,7 +76,7 @@ def _jvp(mode, y, v, out, fns, p, fl, dv):
     """out = J(y) v, the field's Jacobian along v, by a central difference
     (rules.central_step along v)."""
     n = y.size
-    size, vmax = rules.difference_scale(y), 0.0
+    size, vmax = 1.0, 0.0
     for k in range(n):
         size = max(size, abs(y[k]))
         vmax = max(vmax, abs(v[k]))
@@ -157,10 +156,9 @@ def _section_derivative(mode, fns, p, z, fl, dv):
     """dv.M <- (I - f g^T / (g . f)) dv.M at the section hit z: f the field there, g the
     section's gradient (central differences; z is restored bit for bit)."""
     _checked_field(z, mode, _TRIAL, fns, p, fl, dv.jf1)
-    floor = rules.difference_scale(z)
     for k in range(z.size):
         orig = z[k]
-        d = rules.central_step(max(floor, abs(orig)), 1.0)
+        d = rules.central_step(max(1.0, abs(orig)), 1.0)
         z[k] = orig + d
         up = z[k]
         s1 = _section(fns, z, p)
