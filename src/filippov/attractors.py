@@ -154,7 +154,7 @@ def lyapunov_exponent(jacobians: np.ndarray, coordinate: int) -> float:
 
 #: a cycle whose multipliers predict the returns' distance to it to shrink below this
 #: fraction over the kept returns must be seen to shrink by its square root at least
-#: (confirm's ``contracting``); a slower one only to shrink (docs/decisions.md#attractor-approach)
+#: (confirm); a slower one only to shrink (docs/decisions.md#attractor-approach)
 STRONG = 1e-3
 #: the kept returns of an orbit still converging repeat only to this fraction of the
 #: attractor's scale: the candidate period Newton is asked to confirm (a multiplier of
@@ -281,8 +281,7 @@ def _cycle_newton(cmodel: CompiledModel, z: np.ndarray, d: int, age: float, t_ma
 
 def confirm(cmodel: CompiledModel, states: np.ndarray, age: float, candidate: int, *,
             coordinate: int, t_max: float, scale: float, settled: float = 0.0,
-            tol: float = 1e-13, max_iter: int = 12, contracting: bool = False,
-            **options) -> Cycle | None:
+            tol: float = 1e-13, max_iter: int = 12, **options) -> Cycle | None:
     """The periodic orbit the iterates ``states`` (the kept returns, full states) settle
     on, if any: Newton on P^d - z from the last state for each divisor d of
     ``candidate`` (smallest first: a period-one orbit converging with multiplier near -1
@@ -290,9 +289,8 @@ def confirm(cmodel: CompiledModel, states: np.ndarray, age: float, candidate: in
     converges and its points lie within ``scale`` of the last d kept returns. ``radius``
     then decides stability, and ``converging`` whether the iterates approach it (their
     distance at the end of the kept returns below that at the start, or below
-    ``settled``: on it up to rounding; with ``contracting``, where its multipliers
-    predict a contraction below STRONG over the kept returns, by at least its square
-    root). None: no orbit
+    ``settled``: on it up to rounding; where its multipliers predict a contraction below
+    STRONG over the kept returns, by at least its square root). None: no orbit
     of a divisor's period near the iterates. A stable, approached orbit of a larger
     divisor wins over an unstable or unapproached one of a smaller (reported if none is)."""
     states = np.asarray(states, dtype=float)
@@ -322,11 +320,10 @@ def confirm(cmodel: CompiledModel, states: np.ndarray, age: float, candidate: in
         # NaN: P is not differentiable on the orbit (it touches H tangentially)
         radius = (float(np.max(np.abs(np.linalg.eigvals(J)))) if np.all(np.isfinite(J))
                   else np.nan)
-        # approaching it (with ``contracting``, by half the contraction its multipliers
-        # predict over the kept returns, in logarithm, where that is STRONG), or already
-        # on it up to the returns' rounding (docs/decisions.md#attractor-approach)
-        predicted = (radius ** ((k - two) / d)
-                     if contracting and np.isfinite(radius) and radius < 1.0 else 1.0)
+        # approaching it (by half the contraction its multipliers predict over the kept
+        # returns, in logarithm, where that is STRONG), or already on it up to the
+        # returns' rounding (docs/decisions.md#attractor-approach)
+        predicted = radius ** ((k - two) / d) if np.isfinite(radius) and radius < 1.0 else 1.0
         shrink = np.sqrt(predicted) if predicted < STRONG else 1.0
         cycle = Cycle(d, pts, radius, tail, bool(end < head * shrink or end <= settled))
         if cycle.converging and cycle.radius < 1.0:
@@ -380,8 +377,7 @@ def _periodic(cmodel, states, age, coordinate, scale, max_period, t_max, options
     candidate = period or (_best_repeat(values, max_period) if last_chance
                            else period_of(values, near, max_period))
     cycle = (confirm(cmodel, states, age, candidate, coordinate=coordinate, t_max=t_max,
-                     scale=near, settled=period_tolerance(scale), contracting=True,
-                     **options)
+                     scale=near, settled=period_tolerance(scale), **options)
              if candidate else None)
     # a cycle on which P is not differentiable (grazing) has no multipliers: it counts
     # as the attractor only if the kept returns already repeat on it to the tolerance
