@@ -109,6 +109,9 @@ class Trajectory:
     segments: list = field(default_factory=list)  # (ta, tb, mode, Z)
     status: str = "running"
     n_steps: int = 0
+    # windows of integration steps searched for events (a step's samples that do not
+    # resolve what they sample are searched in shorter windows: rules.resolves)
+    n_windows: int = 0
     integrated_modes: set = field(default_factory=set)
     # modes whose integration switched from DOP853 to the implicit Radau IIA method
     # because the field proved stiff there (see STIFF_AFTER)
@@ -601,6 +604,7 @@ class _Run:
         UNRESOLVED when ``may_split`` and its samples do not resolve what they sample
         (loop.stay.make_step_windows)."""
         ts, zs = self._samples(stepper, Z, ta, tb)
+        self.traj.n_windows += stepper.method is not None
         scan = _Scan(self.system, self.mode, Z, ts, zs, self.leave_now, self.sections,
                      self.preds, first, self.touch_tol, self.event_xtol, self.traj,
                      self.band, self._leave(self.mode, banded=False) if self.band > 0.0
@@ -840,21 +844,21 @@ _RUN = make_run(RunOps(
 
 def _speed_rates(system, Z, z0):
     """While sliding: ``rates(t) -> (da/dt, db/dt)`` on the segment ``Z`` (forward
-    differences on the orbit, of the step rules.rate_step gives at its first sample z0),
-    or None where that step is 0."""
+    differences on the orbit, of the step rules.rate_step gives at its first sample z0)
+    and that step; (None, 0.0) where it is 0."""
     fm = np.asarray(system.field_minus(z0), dtype=float)
     fp = np.asarray(system.field_plus(z0), dtype=float)
     a, b = (float(v) for v in system.normal_speeds(z0))
     d = rules.rate_step(z0, fm, fp, a, b)
     if d == 0.0:
-        return None
+        return None, 0.0
 
     def rates(tt):
         tt = np.asarray(tt, dtype=float)
         a1, b1 = system.normal_speeds(Z(tt + d))
         a0, b0 = system.normal_speeds(Z(tt))
         return (a1 - a0) / d, (b1 - b0) / d
-    return rates
+    return rates, d
 
 
 def _in_section_rounding(func, s0, z0, zr) -> bool:
@@ -903,19 +907,26 @@ class _Scan:
             self.D = np.asarray(system.speed_of_switch(mode, zs), dtype=float)
         self.svals = [np.asarray(s.func(zs), dtype=float) for s in sections]
         self.rates = self.R = None
+        self.rate_step = 0.0
         if mode == SLIDING:  # the rates of a and b along the orbit: their extrema are roots (rules)
-            self.rates = _speed_rates(system, Z, np.asarray(zs[:, 0], dtype=float))
+            self.rates, self.rate_step = _speed_rates(system, Z, np.asarray(zs[:, 0], dtype=float))
             if self.rates is not None:
                 self.R = self.rates(ts)
 
     def resolved(self):
         """The samples resolve the leave functions and the sections (rules.resolves; the
-        values as sampled, before the first one is clamped; h with its slopes dH/dt)."""
+        values as sampled, before the first one is clamped; h with its slopes dH/dt; a
+        and b above the rounding their rates show, rules.difference_noise)."""
         ts, n = self.ts, self.ts.size
-        if self.mode != SLIDING and not rules.resolves(self.raw[0], self.D, ts, n, True):
-            return False
-        return all(rules.resolves(v, v, ts, n, False)
-                   for v in (self.raw if self.mode == SLIDING else []) + self.svals)
+        if self.mode != SLIDING:
+            if not rules.resolves(self.raw[0], self.D, ts, n, True, 0.0):
+                return False
+        else:
+            for v, R in zip(self.raw, self.R if self.R is not None else self.raw):
+                if not rules.resolves(v, v, ts, n, False,
+                                      rules.difference_noise(R, n, self.rate_step)):
+                    return False
+        return all(rules.resolves(v, v, ts, n, False, 0.0) for v in self.svals)
 
     def _along(self, func):
         """``func`` of the state as a function of time on the segment."""
