@@ -464,11 +464,12 @@ MAX_SPLITS = 3
 #: the rounding of a sample a prediction's miss must exceed, in ulps of the largest sample
 RESOLVE_NOISE_ULPS = 64.0
 #: an unresolved function matters only where it could change sign between its samples:
-#: five samples farther from zero than RESOLVE_REACH times the parabola's miss are
+#: five samples farther from zero than RESOLVE_REACH times a prediction's miss are
 #: trusted (a dense output's wiggle far from zero, e.g. a and b of a stiff slide, is no
-#: event). Of 121476 sines c + sin(w t) whose five samples keep one sign while the sine
-#: crosses zero between them, 65954 are refused from the values alone, and still all
-#: 65954 with this test at a reach of 16 (docs/decisions.md#resolved-windows)
+#: event). Of 10513 sines c + sin(w t) whose five samples keep one sign while the sine
+#: crosses zero between them (tests/test_rules.py's grid), 5784 are refused from the
+#: values alone, and each of them still is at any reach down to 5.9
+#: (docs/decisions.md#resolved-windows)
 RESOLVE_REACH = 64.0
 #: the rounding of a sampled function measured by its changes over the forward
 #: differences' step, times this (a prediction combines five roundings)
