@@ -463,57 +463,24 @@ SPLIT = 16.0
 MAX_SPLITS = 3
 #: the rounding of a sample a prediction's miss must exceed, in ulps of the largest sample
 RESOLVE_NOISE_ULPS = 64.0
-#: an unresolved function matters only where it could change sign between its samples:
-#: five samples farther from zero than RESOLVE_REACH times a prediction's miss are
-#: trusted (a dense output's wiggle far from zero, e.g. a and b of a stiff slide, is no
-#: event). Of 10513 sines c + sin(w t) whose five samples keep one sign while the sine
-#: crosses zero between them (tests/test_rules.py's grid), 5784 are refused from the
-#: values alone, and each of them still is at any reach down to 5.9
-#: (docs/decisions.md#resolved-windows)
-RESOLVE_REACH = 64.0
-#: the rounding of a sampled function measured by its changes over the forward
-#: differences' step, times this (a prediction combines five roundings)
-RATE_NOISE = 4.0
 
 
-def misses(predicted: float, v: float, lo: float, hi: float, floor: float) -> bool:
+def misses(predicted: float, v: float, lo: float, hi: float) -> bool:
     """A prediction of the sample v misses it by more than RESOLVE_SHARE of the samples'
-    range [lo, hi], and by more than their rounding (RESOLVE_NOISE_ULPS of the largest,
-    or the measured ``floor`` where larger: :func:`difference_noise`), and
-    RESOLVE_REACH misses reach zero from the samples (else no sign change can hide
-    between them)."""
+    range [lo, hi], and by more than their rounding."""
     miss = abs(v - predicted)
-    gap = 0.0 if lo <= 0.0 <= hi else min(abs(lo), abs(hi))
     return (miss > RESOLVE_SHARE * (hi - lo)
-            and miss > RESOLVE_NOISE_ULPS * _EPS * max(abs(lo), abs(hi)) and miss > floor
-            and RESOLVE_REACH * miss >= gap)
+            and miss > RESOLVE_NOISE_ULPS * _EPS * max(abs(lo), abs(hi)))
 
 
-def difference_noise(d, n: int, step: float) -> float:
-    """The rounding of a function sampled with its forward differences d = (v(t + step) -
-    v(t)) / step at the first n samples (the rates of a and b while sliding,
-    :func:`rate_step`): RATE_NOISE times the largest change over the step. A smooth
-    function changes over that step (the orbit moves ~1e-8 of the state) by far less than
-    any window's samples resolve; rounding changes it by its own size -- a and b of a
-    stiff slide carry the state's rounding times the fast rate, 1e-4 of them at eps = 1e-9
-    in the Hopf model (docs/decisions.md#resolved-windows). 0 without differences
-    (step 0)."""
-    if not step > 0.0:
-        return 0.0
-    worst = 0.0
-    for k in range(n):
-        worst = max(worst, abs(d[k]) * step)
-    return RATE_NOISE * worst
-
-
-def resolves(v, d, ts, n: int, slopes: bool, floor: float) -> bool:
+def resolves(v, d, ts, n: int, slopes: bool) -> bool:
     """The first n samples v of a function at the equally spaced times ts (slopes d where
     ``slopes``) resolve it (:data:`RESOLVE_SHARE`): in every run of five, from sample 0 at
     a stride of 4 and the last five, the parabola through the 1st, 3rd and 5th predicts
     the 2nd and 4th, and (``slopes``) the Hermite cubic of the samples either side of the
     2nd, 3rd and 4th predicts it, and Simpson's rule on the slopes the change across it
-    (:func:`misses`; a miss within ``floor``, the samples' measured rounding, is none).
-    Fewer than five samples are not judged (True: samples_per_step < 4)."""
+    (:func:`misses`). Fewer than five samples are not judged
+    (True: samples_per_step < 4)."""
     if n < 5:
         return True
     dt = (ts[n - 1] - ts[0]) / (n - 1)
@@ -521,16 +488,15 @@ def resolves(v, d, ts, n: int, slopes: bool, floor: float) -> bool:
     while True:
         lo = min(v[k], v[k + 1], v[k + 2], v[k + 3], v[k + 4])
         hi = max(v[k], v[k + 1], v[k + 2], v[k + 3], v[k + 4])
-        if (misses((3.0 * v[k] + 6.0 * v[k + 2] - v[k + 4]) / 8.0, v[k + 1], lo, hi, floor)
-                or misses((6.0 * v[k + 2] + 3.0 * v[k + 4] - v[k]) / 8.0, v[k + 3], lo, hi,
-                          floor)):
+        if (misses((3.0 * v[k] + 6.0 * v[k + 2] - v[k + 4]) / 8.0, v[k + 1], lo, hi)
+                or misses((6.0 * v[k + 2] + 3.0 * v[k + 4] - v[k]) / 8.0, v[k + 3], lo, hi)):
             return False
         if slopes:
             for j in range(k + 1, k + 4):
                 if (misses((v[j - 1] + v[j + 1]) / 2.0 + dt * (d[j - 1] - d[j + 1]) / 4.0,
-                           v[j], lo, hi, floor)
+                           v[j], lo, hi)
                         or misses(v[j - 1] + dt * (d[j - 1] + 4.0 * d[j] + d[j + 1]) / 3.0,
-                                  v[j + 1], lo, hi, floor)):
+                                  v[j + 1], lo, hi)):
                     return False
         if k + 4 >= n - 1:
             return True

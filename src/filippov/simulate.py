@@ -844,21 +844,21 @@ _RUN = make_run(RunOps(
 
 def _speed_rates(system, Z, z0):
     """While sliding: ``rates(t) -> (da/dt, db/dt)`` on the segment ``Z`` (forward
-    differences on the orbit, of the step rules.rate_step gives at its first sample z0)
-    and that step; (None, 0.0) where it is 0."""
+    differences on the orbit, of the step rules.rate_step gives at its first sample z0),
+    or None where that step is 0."""
     fm = np.asarray(system.field_minus(z0), dtype=float)
     fp = np.asarray(system.field_plus(z0), dtype=float)
     a, b = (float(v) for v in system.normal_speeds(z0))
     d = rules.rate_step(z0, fm, fp, a, b)
     if d == 0.0:
-        return None, 0.0
+        return None
 
     def rates(tt):
         tt = np.asarray(tt, dtype=float)
         a1, b1 = system.normal_speeds(Z(tt + d))
         a0, b0 = system.normal_speeds(Z(tt))
         return (a1 - a0) / d, (b1 - b0) / d
-    return rates, d
+    return rates
 
 
 def _in_section_rounding(func, s0, z0, zr) -> bool:
@@ -907,26 +907,19 @@ class _Scan:
             self.D = np.asarray(system.speed_of_switch(mode, zs), dtype=float)
         self.svals = [np.asarray(s.func(zs), dtype=float) for s in sections]
         self.rates = self.R = None
-        self.rate_step = 0.0
         if mode == SLIDING:  # the rates of a and b along the orbit: their extrema are roots (rules)
-            self.rates, self.rate_step = _speed_rates(system, Z, np.asarray(zs[:, 0], dtype=float))
+            self.rates = _speed_rates(system, Z, np.asarray(zs[:, 0], dtype=float))
             if self.rates is not None:
                 self.R = self.rates(ts)
 
     def resolved(self):
         """The samples resolve the leave functions and the sections (rules.resolves; the
-        values as sampled, before the first one is clamped; h with its slopes dH/dt; a
-        and b above the rounding their rates show, rules.difference_noise)."""
+        values as sampled, before the first one is clamped; h with its slopes dH/dt)."""
         ts, n = self.ts, self.ts.size
-        if self.mode != SLIDING:
-            if not rules.resolves(self.raw[0], self.D, ts, n, True, 0.0):
-                return False
-        else:
-            for v, R in zip(self.raw, self.R if self.R is not None else self.raw):
-                if not rules.resolves(v, v, ts, n, False,
-                                      rules.difference_noise(R, n, self.rate_step)):
-                    return False
-        return all(rules.resolves(v, v, ts, n, False, 0.0) for v in self.svals)
+        if self.mode != SLIDING and not rules.resolves(self.raw[0], self.D, ts, n, True):
+            return False
+        return all(rules.resolves(v, v, ts, n, False)
+                   for v in (self.raw if self.mode == SLIDING else []) + self.svals)
 
     def _along(self, func):
         """``func`` of the state as a function of time on the segment."""

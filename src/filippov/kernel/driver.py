@@ -34,7 +34,7 @@ from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _d
 from .segment import _zat
 from .scan import (_carry_sample, _find, _flow_follows, _sample)
 from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY,
-                    SEG_EXIT_SHIFT, SEG_RATE_STEP, SEG_INTEGRATED, SEG_SHIFT, SEG_SIZE, SEG_STEP_H,
+                    SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_SHIFT, SEG_SIZE, SEG_STEP_H,
                     SEG_STEP_T, T_AGE, T_SLID, T_SLIDE_START, TALLY_SIZE, Control, Deriv, Dop,
                     Fill, Orbit, Outputs, Samples, Scratch, Settings, Work,
                     kernel_signature)  # noqa: F401
@@ -115,18 +115,12 @@ _DERIVATIVES = True
 
 
 @_jit_inline
-def _resolved(mode, ns, sm, rate_step):
+def _resolved(mode, ns, sm):
     """The window's samples resolve its leave functions and its section (rules.resolves;
-    h with its slopes dh/dt; a and b above the rounding their rates show,
-    rules.difference_noise)."""
-    sliding = mode == SLIDING
-    return (rules.resolves(sm.vals[0], sm.dvals[0], sm.ts, ns, not sliding,
-                           rules.difference_noise(sm.dvals[0], ns, rate_step) if sliding
-                           else 0.0)
-            and (not sliding or rules.resolves(sm.vals[1], sm.vals[1], sm.ts, ns, False,
-                                               rules.difference_noise(sm.dvals[1], ns,
-                                                                      rate_step)))
-            and rules.resolves(sm.svals, sm.svals, sm.ts, ns, False, 0.0))
+    h with its slopes dh/dt)."""
+    return (rules.resolves(sm.vals[0], sm.dvals[0], sm.ts, ns, mode != SLIDING)
+            and (mode != SLIDING or rules.resolves(sm.vals[1], sm.vals[1], sm.ts, ns, False))
+            and rules.resolves(sm.svals, sm.svals, sm.ts, ns, False))
 
 
 @_jit_inline
@@ -154,7 +148,7 @@ def _window(mode, ta, tb, first, may_split, o, s, w):
     # sample; else the run stops at ta (w.z)
     if exact and not _flow_follows(w.z, w.ynew, tb - ta, speed2_a, w.wf):
         return FLOW_OFF_FIELD, ta, _W_NONE
-    if may_split and not _resolved(mode, ns, sm, w.seg[SEG_RATE_STEP]):
+    if may_split and not _resolved(mode, ns, sm):
         return UNRESOLVED, ta, _W_NONE
     st, te, what = _find(mode, ns, first, s, o, sm, sc)
     # P is not differentiable where the orbit touches H
