@@ -191,3 +191,30 @@ def test_the_list_of_asymmetries_names_tests_that_exist():
         assert re.search(rf"^def {name}\(", text, re.M), f"{path}::{name} not found"
     tutorial = (ROOT / "docs/tutorial.md").read_text()
     assert "engines" in tutorial and "filippov.engines" in tutorial
+
+
+def test_the_reference_measures_the_rounding_a_function_carries():
+    """engines.py asymmetry 12: samples of a = (x - y) / eps whose scatter is the state's
+    rounding times 1/eps fail the rule at 64 ulps of the samples (the compiled engine's
+    judgement), and pass above the rounding the reference measures (simulate._rounding:
+    64 ulps of each component carried through a); a smooth feature far above it does not."""
+    from filippov import rules
+    from filippov.kernel import base as kernel
+    from filippov.simulate import _rounding
+
+    eps = 1e-9
+    a = lambda zz: (zz[0] - zz[1]) / eps  # noqa: E731
+    z = np.array([-1.0, -1.0 - 5e-10])
+    floor = _rounding(a, z)
+    u = np.finfo(float).eps
+    # 64 ulps of each of x and y, times 1/eps, to a few ulps of the probes' own rounding
+    assert floor == pytest.approx(64 * u * 2 / eps, rel=0.3)
+    ts = np.arange(5) * 1e-4
+    v = 0.5 + 2e-7 * np.array([1.0, -1.0, 0.5, 1.0, -0.5])   # rounding-sized scatter
+    compiled = kernel.compiled_rule("resolves")
+    assert not compiled(v, v, ts, 5, False, 0.0)
+    assert not rules.resolves(v, v, ts, 5, False, 0.0)
+    assert rules.resolves(v, v, ts, 5, False, floor)
+    wiggle = 0.5 + 1e-3 * np.array([1.0, -1.0, 0.5, 1.0, -0.5])  # far above the rounding
+    assert not rules.resolves(wiggle, wiggle, ts, 5, False, floor)
+    assert _rounding(lambda zz: np.full(zz.shape[1], np.nan), z) == 0.0

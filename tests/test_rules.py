@@ -315,9 +315,9 @@ def test_samples_resolve_a_sine_when_dense_and_not_when_sparse(slopes):
         for w_dt, expected in ((0.1, True), (0.5, True), (0.8, True), (2.0, False),
                                (3.0, False), (3.8, False)):
             v, d, ts = _sine_samples(w_dt, phase, n=9)
-            got = rules.resolves(v, d, ts, 9, slopes)
+            got = rules.resolves(v, d, ts, 9, slopes, 0.0)
             assert got == expected, (w_dt, phase)
-            assert compiled(v, d, ts, 9, slopes) == got
+            assert compiled(v, d, ts, 9, slopes, 0.0) == got
 
 
 def test_slopes_give_away_samples_that_alias_a_fast_function():
@@ -327,17 +327,17 @@ def test_slopes_give_away_samples_that_alias_a_fast_function():
     found = {True: 0, False: 0}
     for phase in np.linspace(0.0, 2.0 * np.pi, 61):
         v, d, ts = _sine_samples(w_dt, phase)
-        assert not rules.resolves(v, d, ts, 5, True)
-        found[rules.resolves(v, d, ts, 5, False)] += 1
+        assert not rules.resolves(v, d, ts, 5, True, 0.0)
+        found[rules.resolves(v, d, ts, 5, False, 0.0)] += 1
     assert found[True] > 0  # values alone cannot tell (sections: docs/tutorial.md)
 
 
 def test_rounding_and_short_windows_are_resolved():
     ts = np.arange(5) * 0.25
     noisy = 1.0 + np.array([0.0, 2.2e-16, -2.2e-16, 4.4e-16, 0.0])
-    assert rules.resolves(noisy, np.zeros(5), ts, 5, True)
-    assert rules.resolves(np.zeros(5), np.zeros(5), ts, 5, True)   # constant
-    assert rules.resolves(np.array([0.0, 5.0, -3.0, 1.0]), np.zeros(4), ts, 4, True)  # < 5
+    assert rules.resolves(noisy, np.zeros(5), ts, 5, True, 0.0)
+    assert rules.resolves(np.zeros(5), np.zeros(5), ts, 5, True, 0.0)   # constant
+    assert rules.resolves(np.array([0.0, 5.0, -3.0, 1.0]), np.zeros(4), ts, 4, True, 0.0)  # < 5
 
 
 def test_the_last_run_of_five_is_judged_too():
@@ -345,7 +345,7 @@ def test_the_last_run_of_five_is_judged_too():
     wiggle in samples 4..6 is seen."""
     ts = np.arange(7) * 0.1
     v = 0.1 * ts
-    assert rules.resolves(v, np.full(7, 0.1), ts, 7, True)
+    assert rules.resolves(v, np.full(7, 0.1), ts, 7, True, 0.0)
     v2 = v.copy()
     v2[5] += 1.0
-    assert not rules.resolves(v2, np.full(7, 0.1), ts, 7, False)
+    assert not rules.resolves(v2, np.full(7, 0.1), ts, 7, False, 0.0)

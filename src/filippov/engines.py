@@ -149,6 +149,17 @@ engine that moves one of these makes its test fail.
     (PeriodicOrbitError, "dP/dz is not finite") instead of taking a Newton step from
     NaN. Not ported: the kernel carries no derivative along a slide it starts in.
     Test: tests/test_engine_asymmetries.py::test_dpdz_of_a_return_that_starts_sliding_is_the_reference_engine_s_only
+12. **The rounding below which samples need not resolve a function.** Both engines ask
+    rules.resolves whether a step's samples resolve h (a and b while sliding) and the
+    sections, with misses under 64 ulps of the samples taken for rounding. Where a
+    window fails that, the reference measures the rounding at its middle sample (the
+    function's changes when each state component moves by 4 ulps) and judges again above
+    it: a and b of a stiff slide carry the state's rounding times the fast rate (1e-7 of
+    a = 0.5 at eps = 1e-9), and Radau IIA's long steps on such a slide were split down to
+    1/4096 on every step (20 times the time). The compiled engine steps explicitly, at
+    the stability limit, where that rounding is not what fails its windows, and keeps
+    the kernel free of the probes: it may split a window the reference does not, never
+    the reverse. Test: tests/test_engine_asymmetries.py::test_the_reference_measures_the_rounding_a_function_carries
 """
 from __future__ import annotations
 

@@ -463,23 +463,31 @@ SPLIT = 16.0
 MAX_SPLITS = 3
 #: the rounding of a sample a prediction's miss must exceed, in ulps of the largest sample
 RESOLVE_NOISE_ULPS = 64.0
+#: where that is not enough (a and b of a stiff slide carry the state's rounding times the
+#: fast rate: 1e-7 of a = 0.5 at eps = 1e-9), the reference engine measures the rounding:
+#: the function's changes when each component of a sample's state moves by this many
+#: ulps, summed and scaled to RESOLVE_NOISE_ULPS (a feature of the function that shows
+#: less than that at the samples is below its own rounding; docs/decisions.md#resolved-windows)
+RESOLVE_PROBE_ULPS = 4.0
 
 
-def misses(predicted: float, v: float, lo: float, hi: float) -> bool:
+def misses(predicted: float, v: float, lo: float, hi: float, floor: float) -> bool:
     """A prediction of the sample v misses it by more than RESOLVE_SHARE of the samples'
-    range [lo, hi], and by more than their rounding."""
+    range [lo, hi], and by more than their rounding: RESOLVE_NOISE_ULPS of the largest,
+    or ``floor`` where larger (the rounding of the state carried through the function,
+    measured by the reference engine: :data:`RESOLVE_PROBE_ULPS`)."""
     miss = abs(v - predicted)
     return (miss > RESOLVE_SHARE * (hi - lo)
-            and miss > RESOLVE_NOISE_ULPS * _EPS * max(abs(lo), abs(hi)))
+            and miss > RESOLVE_NOISE_ULPS * _EPS * max(abs(lo), abs(hi)) and miss > floor)
 
 
-def resolves(v, d, ts, n: int, slopes: bool) -> bool:
+def resolves(v, d, ts, n: int, slopes: bool, floor: float) -> bool:
     """The first n samples v of a function at the equally spaced times ts (slopes d where
     ``slopes``) resolve it (:data:`RESOLVE_SHARE`): in every run of five, from sample 0 at
     a stride of 4 and the last five, the parabola through the 1st, 3rd and 5th predicts
     the 2nd and 4th, and (``slopes``) the Hermite cubic of the samples either side of the
     2nd, 3rd and 4th predicts it, and Simpson's rule on the slopes the change across it
-    (:func:`misses`). Fewer than five samples are not judged
+    (:func:`misses`, above ``floor``). Fewer than five samples are not judged
     (True: samples_per_step < 4)."""
     if n < 5:
         return True
@@ -488,15 +496,16 @@ def resolves(v, d, ts, n: int, slopes: bool) -> bool:
     while True:
         lo = min(v[k], v[k + 1], v[k + 2], v[k + 3], v[k + 4])
         hi = max(v[k], v[k + 1], v[k + 2], v[k + 3], v[k + 4])
-        if (misses((3.0 * v[k] + 6.0 * v[k + 2] - v[k + 4]) / 8.0, v[k + 1], lo, hi)
-                or misses((6.0 * v[k + 2] + 3.0 * v[k + 4] - v[k]) / 8.0, v[k + 3], lo, hi)):
+        if (misses((3.0 * v[k] + 6.0 * v[k + 2] - v[k + 4]) / 8.0, v[k + 1], lo, hi, floor)
+                or misses((6.0 * v[k + 2] + 3.0 * v[k + 4] - v[k]) / 8.0, v[k + 3], lo, hi,
+                          floor)):
             return False
         if slopes:
             for j in range(k + 1, k + 4):
                 if (misses((v[j - 1] + v[j + 1]) / 2.0 + dt * (d[j - 1] - d[j + 1]) / 4.0,
-                           v[j], lo, hi)
+                           v[j], lo, hi, floor)
                         or misses(v[j - 1] + dt * (d[j - 1] + 4.0 * d[j] + d[j + 1]) / 3.0,
-                                  v[j + 1], lo, hi)):
+                                  v[j + 1], lo, hi, floor)):
                     return False
         if k + 4 >= n - 1:
             return True

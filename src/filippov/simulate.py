@@ -861,6 +861,21 @@ def _speed_rates(system, Z, z0):
     return rates
 
 
+def _rounding(func, z) -> float:
+    """The rounding of ``func`` (vectorized over states in columns) at the state z: its
+    changes when each component moves by rules.RESOLVE_PROBE_ULPS ulps, summed, scaled
+    to rules.RESOLVE_NOISE_ULPS (the state's rounding carried through the function, e.g.
+    times 1/eps by a and b of a stiff slide). 0 where not finite."""
+    n = z.size
+    probes = np.repeat(np.asarray(z, dtype=float)[:, None], n + 1, axis=1)
+    idx = np.arange(n)
+    probes[idx, idx + 1] += rules.RESOLVE_PROBE_ULPS * np.finfo(float).eps * np.abs(z)
+    v = np.asarray(func(probes), dtype=float).reshape(-1)
+    floor = (rules.RESOLVE_NOISE_ULPS / rules.RESOLVE_PROBE_ULPS) * float(
+        np.abs(v[1:] - v[0]).sum())
+    return floor if np.isfinite(floor) else 0.0
+
+
 def _in_section_rounding(func, s0, z0, zr) -> bool:
     """rules.on_section_by_value: the start's section value s0 within the section's own
     rounding, measured at the probes rules.section_probe places about z0 toward the
@@ -914,12 +929,20 @@ class _Scan:
 
     def resolved(self):
         """The samples resolve the leave functions and the sections (rules.resolves; the
-        values as sampled, before the first one is clamped; h with its slopes dH/dt)."""
+        values as sampled, before the first one is clamped; h with its slopes dH/dt),
+        above their rounding where 64 ulps of the samples fall short of it (measured at
+        the middle sample only then: :func:`_rounding`; engines.py asymmetry 12)."""
         ts, n = self.ts, self.ts.size
-        if self.mode != SLIDING and not rules.resolves(self.raw[0], self.D, ts, n, True):
-            return False
-        return all(rules.resolves(v, v, ts, n, False)
-                   for v in (self.raw if self.mode == SLIDING else []) + self.svals)
+        judged = [(v, v, False, func) for v, (func, _, _) in zip(self.raw, self.leave)]
+        if self.mode != SLIDING:
+            judged = [(self.raw[0], self.D, True, self.leave[0][0])]
+        judged += [(v, v, False, s.func) for v, s in zip(self.svals, self.sections)]
+        for v, d, slopes, func in judged:
+            if (not rules.resolves(v, d, ts, n, slopes, 0.0)
+                    and not rules.resolves(v, d, ts, n, slopes,
+                                           _rounding(func, self.zs[:, n // 2]))):
+                return False
+        return True
 
     def _along(self, func):
         """``func`` of the state as a function of time on the segment."""

@@ -117,10 +117,11 @@ _DERIVATIVES = True
 @_jit_inline
 def _resolved(mode, ns, sm):
     """The window's samples resolve its leave functions and its section (rules.resolves;
-    h with its slopes dh/dt)."""
-    return (rules.resolves(sm.vals[0], sm.dvals[0], sm.ts, ns, mode != SLIDING)
-            and (mode != SLIDING or rules.resolves(sm.vals[1], sm.vals[1], sm.ts, ns, False))
-            and rules.resolves(sm.svals, sm.svals, sm.ts, ns, False))
+    h with its slopes dh/dt; rounding as 64 ulps of the samples: engines.py asymmetry 12)."""
+    return (rules.resolves(sm.vals[0], sm.dvals[0], sm.ts, ns, mode != SLIDING, 0.0)
+            and (mode != SLIDING
+                 or rules.resolves(sm.vals[1], sm.vals[1], sm.ts, ns, False, 0.0))
+            and rules.resolves(sm.svals, sm.svals, sm.ts, ns, False, 0.0))
 
 
 @_jit_inline
