@@ -204,7 +204,7 @@ def test_the_reference_measures_the_rounding_a_function_carries():
 
     eps = 1e-9
     a = lambda zz: (zz[0] - zz[1]) / eps  # noqa: E731
-    z = np.array([-1.0, -1.0 - 5e-10])
+    z = np.array([[-1.0, -1.0 - 5e-10]]).T
     floor = _rounding(a, z)
     u = np.finfo(float).eps
     # 64 ulps of each of x and y, times 1/eps, to a few ulps of the probes' own rounding
@@ -218,3 +218,7 @@ def test_the_reference_measures_the_rounding_a_function_carries():
     wiggle = 0.5 + 1e-3 * np.array([1.0, -1.0, 0.5, 1.0, -0.5])  # far above the rounding
     assert not rules.resolves(wiggle, wiggle, ts, 5, False, floor)
     assert _rounding(lambda zz: np.full(zz.shape[1], np.nan), z) == 0.0
+    # the smallest over the samples: a sample where a is steep does not lift another's
+    two = np.array([[-1.0, 3.0], [-1.0 - 5e-10, 3.0]])
+    b = lambda zz: np.where(zz[0] > 0.0, 1e6 * zz[0], (zz[0] - zz[1]) / eps)  # noqa: E731
+    assert _rounding(b, two) == pytest.approx(min(floor, 64 * u * 3.0 * 1e6), rel=0.3)

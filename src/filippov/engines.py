@@ -152,9 +152,9 @@ engine that moves one of these makes its test fail.
 12. **The rounding below which samples need not resolve a function.** Both engines ask
     rules.resolves whether a step's samples resolve h (a and b while sliding) and the
     sections, with misses under 64 ulps of the samples taken for rounding. Where a
-    window fails that, the reference measures the rounding at its middle sample (the
-    function's changes when each state component moves by 4 ulps) and judges again above
-    it: a and b of a stiff slide carry the state's rounding times the fast rate (1e-7 of
+    window fails that, the reference measures the rounding at its samples (the
+    function's changes when each state component moves by 4 ulps; the smallest over the
+    samples) and judges again above it: a and b of a stiff slide carry the state's rounding times the fast rate (1e-7 of
     a = 0.5 at eps = 1e-9), and Radau IIA's long steps on such a slide were split down to
     1/4096 on every step (20 times the time). The compiled engine steps explicitly, at
     the stability limit, where that rounding is not what fails its windows, and keeps

@@ -861,18 +861,21 @@ def _speed_rates(system, Z, z0):
     return rates
 
 
-def _rounding(func, z) -> float:
-    """The rounding of ``func`` (vectorized over states in columns) at the state z: its
-    changes when each component moves by rules.RESOLVE_PROBE_ULPS ulps, summed, scaled
-    to rules.RESOLVE_NOISE_ULPS (the state's rounding carried through the function, e.g.
-    times 1/eps by a and b of a stiff slide). 0 where not finite."""
-    n = z.size
-    probes = np.repeat(np.asarray(z, dtype=float)[:, None], n + 1, axis=1)
-    idx = np.arange(n)
-    probes[idx, idx + 1] += rules.RESOLVE_PROBE_ULPS * np.finfo(float).eps * np.abs(z)
-    v = np.asarray(func(probes), dtype=float).reshape(-1)
+def _rounding(func, zs) -> float:
+    """The rounding of ``func`` (vectorized over states in columns) at the sampled states
+    zs (one a column): at each, its changes when each component moves by
+    rules.RESOLVE_PROBE_ULPS ulps, summed and scaled to rules.RESOLVE_NOISE_ULPS (the
+    state's rounding carried through the function, e.g. times 1/eps by a and b of a
+    stiff slide); the smallest over the samples, so that no run of five is judged above
+    another's rounding. 0 where not finite."""
+    zs = np.asarray(zs, dtype=float)
+    dim, n = zs.shape
+    probes = np.repeat(zs[:, None, :], dim + 1, axis=1)   # (dim, dim + 1, n)
+    idx = np.arange(dim)
+    probes[idx, idx + 1, :] += rules.RESOLVE_PROBE_ULPS * np.finfo(float).eps * np.abs(zs)
+    v = np.asarray(func(probes.reshape(dim, -1)), dtype=float).reshape(dim + 1, n)
     floor = (rules.RESOLVE_NOISE_ULPS / rules.RESOLVE_PROBE_ULPS) * float(
-        np.abs(v[1:] - v[0]).sum())
+        np.abs(v[1:] - v[0]).sum(axis=0).min())
     return floor if np.isfinite(floor) else 0.0
 
 
@@ -931,7 +934,7 @@ class _Scan:
         """The samples resolve the leave functions and the sections (rules.resolves; the
         values as sampled, before the first one is clamped; h with its slopes dH/dt),
         above their rounding where 64 ulps of the samples fall short of it (measured at
-        the middle sample only then: :func:`_rounding`; engines.py asymmetry 12)."""
+        the samples only then: :func:`_rounding`; engines.py asymmetry 12)."""
         ts, n = self.ts, self.ts.size
         judged = [(v, v, False, func) for v, (func, _, _) in zip(self.raw, self.leave)]
         if self.mode != SLIDING:
@@ -939,8 +942,7 @@ class _Scan:
         judged += [(v, v, False, s.func) for v, s in zip(self.svals, self.sections)]
         for v, d, slopes, func in judged:
             if (not rules.resolves(v, d, ts, n, slopes, 0.0)
-                    and not rules.resolves(v, d, ts, n, slopes,
-                                           _rounding(func, self.zs[:, n // 2]))):
+                    and not rules.resolves(v, d, ts, n, slopes, _rounding(func, self.zs))):
                 return False
         return True
 
