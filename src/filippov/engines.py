@@ -154,12 +154,12 @@ engine that moves one of these makes its test fail.
     sections, with misses under 64 ulps of the samples taken for rounding. Where a
     window fails that, the reference measures the rounding at its samples (the
     function's changes when each state component moves by 4 ulps; the smallest over the
-    samples) and judges again above it: a and b of a stiff slide carry the state's rounding times the fast rate (1e-7 of
-    a = 0.5 at eps = 1e-9), and Radau IIA's long steps on such a slide were split down to
-    1/4096 on every step (20 times the time). The compiled engine steps explicitly, at
-    the stability limit, where that rounding is not what fails its windows, and keeps
-    the kernel free of the probes: it may split a window the reference does not, never
-    the reverse. Test: tests/test_engine_asymmetries.py::test_the_reference_measures_the_rounding_a_function_carries
+    samples) and judges again above it: a and b of a stiff slide carry the state's
+    rounding times the fast rate (1e-7 of a = 0.5 at eps = 1e-9), and Radau IIA's long
+    steps on such a slide were split down to 1/4096 on every step (10 to 25 times the
+    time). The compiled engine steps explicitly, at the stability limit, where that
+    rounding is not what fails its windows, and keeps the kernel free of the probes: it
+    may split a window the reference does not, never the reverse. Test: tests/test_engine_asymmetries.py::test_the_reference_measures_the_rounding_a_function_carries
 """
 from __future__ import annotations
 
