@@ -936,8 +936,9 @@ class _Scan:
         above their rounding where 64 ulps of the samples fall short of it (measured at
         the samples only then: :func:`_rounding`; engines.py asymmetry 12)."""
         ts, n = self.ts, self.ts.size
-        judged = [(v, v, False, func) for v, (func, _, _) in zip(self.raw, self.leave)]
-        if self.mode != SLIDING:
+        if self.mode == SLIDING:
+            judged = [(v, v, False, func) for v, (func, _, _) in zip(self.raw, self.leave)]
+        else:
             judged = [(self.raw[0], self.D, True, self.leave[0][0])]
         judged += [(v, v, False, s.func) for v, s in zip(self.svals, self.sections)]
         for v, d, slopes, func in judged:
