@@ -58,20 +58,24 @@ def test_both_engines_build_their_run_from_the_loop():
     assert "deque" not in reference
 
 
-def test_the_event_is_written_in_the_run_loop():
-    # not a function the loop calls (numba would copy its whole IR into the run:
+def test_the_event_and_the_stay_are_written_in_the_run_loop():
+    # not functions the loop calls (numba would copy their whole IR into the run:
     # docs/decisions.md#kernel-inlined-driver): make_run defines one function, whose
-    # one `while` asks the event's rules itself
+    # `while` asks the event's rules itself and holds the stay's loop over its steps,
+    # which asks the engine's stay operations in their order
     tree = ast.parse((SRC / "loop" / "event.py").read_text())
     make_run = next(n for n in tree.body if isinstance(n, ast.FunctionDef)
                     and n.name == "make_run")
     inner = [n for n in ast.walk(make_run) if isinstance(n, ast.FunctionDef)]
     assert [n.name for n in inner] == ["make_run", "run"]
     loops = [n for n in ast.walk(inner[1]) if isinstance(n, ast.While)]
-    assert len(loops) == 1
+    assert len(loops) == 2 and loops[1] in list(ast.walk(loops[0]))
     asked = {n.func.attr for n in ast.walk(loops[0])
              if isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute)}
     assert EVENT_RULES - {"accumulates"} <= asked
+    steps = [n.func.id for n in ast.walk(loops[1])
+             if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)]
+    assert steps == ["next_step", "step_windows", "end_step"]
 
 
 @pytest.mark.parametrize("zeno_count", [2, 3, 7])

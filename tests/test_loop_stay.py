@@ -79,6 +79,16 @@ def test_a_resolved_step_is_one_window():
     assert calls == [(0.0, 1.0, True, True)] and result == (GO_ON, 1.0, -1)
 
 
+def test_the_first_window_is_the_whole_step_where_its_length_rounds():
+    # ta + (tb - ta) rounds below tb here: the first window still ends at tb, so no
+    # window one rounding unit long is sampled after it (an exact flow's step is one
+    # window, never split: the model's own)
+    ta, tb = 0.1180799059133742, 0.8703491968556812
+    assert ta + (tb - ta) < tb
+    calls, result = _walk_calls(2.0, ta, tb)
+    assert calls == [(ta, tb, True, True)] and result == (GO_ON, tb, -1)
+
+
 def test_an_unresolved_step_is_searched_in_shorter_windows_up_to_its_end():
     calls, result = _walk_calls(0.1)
     asked = [(t0, t1) for t0, t1, _, _ in calls]

@@ -43,7 +43,11 @@ engine's own budget verdict (item 2). The start is one function too,
 :mod:`filippov.loop.stay` (the start mode, ``rules.start_side`` and
 ``rules.start_on_switch``, and the refusal to slide inside a section, whose test
 ``make_slides_in`` is shared with the event), and so is the check before each stay (the
-run's end time; sliding the system does not build), asked by the run. Both share one
+run's end time; sliding the system does not build), asked by the run. A stay is written
+in the run's loop too: its start, then step by step the step, its windows (the step
+searched window by window, ``loop.stay.make_step_windows``: the first the whole step,
+shorter ones where its samples do not resolve what they sample) and the step's end,
+each engine answering with its own stepper. Both share one
 set of status codes (:mod:`filippov.loop.status`), and one table turns a status into its
 exception class and message (:func:`filippov.errors.run_error`, item 10). The
 rest they ask in the same order on each side: the hard bound ``max_steps``

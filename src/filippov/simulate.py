@@ -566,50 +566,55 @@ class _Run:
         return [(lambda zz: system.normal_speeds(zz)[0], rules.TO_NONPOS, "exit_minus"),
                 (lambda zz: system.normal_speeds(zz)[1], rules.TO_NONNEG, "exit_plus")]
 
-    def stay(self):
-        """Follows the current mode to its next event: (OK, its time, what it is; the
-        section hit in hit_section), or (NO_RETURN, the end of the step that passed
-        t_end, None)."""
-        mode = self.mode
-        stepper = self._stepper(mode)
-        self.leave_now = self._leave(mode)
-        first, steps_in_mode = True, 0
-        while True:
-            ta, tb, Z = self._step(stepper)
-            if self.dense:
-                self.traj.segments.append((ta, tb, mode, Z))
-            if stepper.method is None:  # an exact flow: the model's sample_step resolves it
-                st, _, _ = self.window(stepper, Z, ta, tb, first, False)
-            else:
-                st, _, _ = _STEP_WINDOWS(mode, ta, tb, first, (self, stepper, Z))
-            first = False
-            if st == GO_ON:
-                if tb >= self.t_end:
-                    self._note_tolerance(stepper)
-                    return NO_RETURN, tb, None
-                steps_in_mode += 1
-                stepper = self._stiff_switch(stepper, steps_in_mode, tb - ta)
-                continue
-            te, ze, what, idx = self.found
-            if self.dense:  # the segment ends at the event
-                self.traj.segments[-1] = (ta, te, mode, Z)
-            self.t, self.z = te, ze
-            self._note_tolerance(stepper)
-            self.hit_section = idx
-            return OK, te, what
+    # A stay, in the shared order of filippov.loop.event: start_stay, then per step
+    # next_step, its windows (window, walked by loop.stay.make_step_windows), end_step.
+    def start_stay(self):
+        """The stay in the current mode begins: its stepper and leave functions."""
+        self.stepper = self._stepper(self.mode)
+        self.leave_now = self._leave(self.mode)
+        self.steps_in_mode = 0
+        return GO_ON
 
-    def window(self, stepper, Z, ta, tb, first, may_split):
-        """The window [ta, tb] of a step: sampled, then searched for its earliest event
-        (OK, its time, what; kept in self.found) or none (GO_ON: the state at tb);
-        UNRESOLVED when ``may_split`` and its samples do not resolve what they sample
-        (loop.stay.make_step_windows)."""
+    def next_step(self):
+        """The stay's next step (its dense output in self.step_Z): (GO_ON, its end)."""
+        ta, tb, self.step_Z = self._step(self.stepper)
+        if self.dense:
+            self.traj.segments.append((ta, tb, self.mode, self.step_Z))
+        return GO_ON, tb
+
+    def end_step(self, ta, tb, status):
+        """After a step's windows: GO_ON to the next step (NO_RETURN once it passed
+        t_end), or the event found (OK: the state at it, the section hit in hit_section)."""
+        stepper = self.stepper
+        if status == GO_ON:
+            if tb >= self.t_end:
+                self._note_tolerance(stepper)
+                return NO_RETURN
+            self.steps_in_mode += 1
+            self.stepper = self._stiff_switch(stepper, self.steps_in_mode, tb - ta)
+            return GO_ON
+        te, ze, what, idx = self.found
+        if self.dense:  # the segment ends at the event
+            self.traj.segments[-1] = (ta, te, self.mode, self.step_Z)
+        self.t, self.z = te, ze
+        self._note_tolerance(stepper)
+        self.hit_section = idx
+        return OK
+
+    def window(self, ta, tb, first, may_split):
+        """The window [ta, tb] of the current step: sampled, then searched for its
+        earliest event (OK, its time, what; kept in self.found) or none (GO_ON: the state
+        at tb); UNRESOLVED when ``may_split`` and its samples do not resolve what they
+        sample (loop.stay.make_step_windows; an exact flow's window is the model's own,
+        its sample_step resolves it: never split)."""
+        stepper, Z = self.stepper, self.step_Z
         ts, zs = self._samples(stepper, Z, ta, tb)
         self.traj.n_windows += stepper.method is not None
         scan = _Scan(self.system, self.mode, Z, ts, zs, self.leave_now, self.sections,
                      self.preds, first, self.touch_tol, self.event_xtol, self.traj,
                      self.band, self._leave(self.mode, banded=False) if self.band > 0.0
                      else None)
-        if may_split and not scan.resolved():
+        if may_split and stepper.method is not None and not scan.resolved():
             return UNRESOLVED, ta, None
         band = self.band
         found = self._scan(scan, ta, tb)
@@ -801,28 +806,23 @@ def _nothing(*args):
     return None
 
 
-def _stay(mode, t, run):
-    return run.stay()
-
-
 def _entered(mode, new_mode, t, run):
     run.mode = run.traj.mode = new_mode
 
 
-#: an integration step searched in windows its samples resolve (loop.stay); ctx: the run,
-#: the stepper and the step's dense output
+#: a step searched in windows its samples resolve (loop.stay); ctx: the run
 _STEP_WINDOWS = make_step_windows(
-    lambda mode, t0, t1, first, may_split, ctx: ctx[0].window(ctx[1], ctx[2], t0, t1, first,
-                                                             may_split))
+    lambda mode, t0, t1, first, may_split, run: run.window(t0, t1, first, may_split))
 
 #: the reference driver's run (filippov.loop.event) on its Python operations; ctx: the
 #: _Run, which made its start when it was built (begin: the state it made)
 _RUN = make_run(RunOps(
     begin=lambda z0, age0, run: (GO_ON, run.t, run.mode),
     end_time=lambda run: run.t_end,
-    flows_exactly=lambda mode, run: run.flows_exactly(mode),
-    stay_exact=_stay,
-    stay_integrated=_stay,
+    start_stay=lambda mode, t, run: run.start_stay(),
+    next_step=lambda mode, ta, run: run.next_step(),
+    step_windows=_STEP_WINDOWS,
+    end_step=lambda mode, ta, tb, status, t, run: run.end_step(ta, tb, status),
     section_hit=_section_hit,
     speeds=_normal_speeds,
     h=lambda run: float(run.system.switch(run.z)),

@@ -47,9 +47,9 @@ _EPS = np.finfo(float).eps
 # and is never called from Python: compiled without reference counting and without
 # numba's CPython and C wrappers (docs/decisions.md#kernel-no-refcounting)
 _jit = njit(cache=True, _nrt=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
-# the driver's pieces (kernel.driver: _window, _stay_*, _event) are inlined into _one at the
-# IR level, and so are the pieces of the window walk, kernel.scan._window_event
-# (docs/decisions.md#kernel-inlined-driver)
+# the driver's pieces (kernel.driver: the stay's operations, _window, the event's) are
+# inlined into _one at the IR level, and so are the pieces of the window walk,
+# kernel.scan._window_event (docs/decisions.md#kernel-inlined-driver)
 _jit_inline = njit(cache=True, _nrt=False, inline="always")
 
 

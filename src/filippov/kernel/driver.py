@@ -34,7 +34,7 @@ from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _d
 from .segment import _zat
 from .scan import (_carry_sample, _find, _flow_follows, _sample)
 from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY,
-                    SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_SHIFT, SEG_SIZE, SEG_STEP_H,
+                    SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_NEXT_STEP, SEG_SHIFT, SEG_SIZE, SEG_STEP_H,
                     SEG_STEP_T, T_AGE, T_SLID, T_SLIDE_START, TALLY_SIZE, Control, Deriv, Dop,
                     Fill, Orbit, Outputs, Samples, Scratch, Settings, Work,
                     kernel_signature)  # noqa: F401
@@ -125,13 +125,16 @@ def _resolved(mode, ns, sm):
 
 
 @_jit_inline
-def _window(mode, ta, tb, first, may_split, o, s, w):
-    """Samples the segment [ta, tb] of the current mode (o: state.Orbit, of w's arrays;
+def _window(mode, ta, tb, first, may_split, ctx):
+    """Samples the segment [ta, tb] of the current mode (ctx: the run's (fns, p, s, w);
     at the fractions of an exact window or of an integration step) and finds its earliest
-    event: (_GO_ON, tb, _W_NONE) if there is none (the state at tb in w.z), (OK, te, what)
-    at an event (its state in w.z), NO_RETURN at t_max, or an error (status, ta);
-    (UNRESOLVED, ta) when ``may_split`` and the samples do not resolve what they sample
-    (loop.stay.make_step_windows)."""
+    event: (_GO_ON, tb, _W_NONE) if there is none (the state
+    at tb in w.z), (OK, te, what) at an event (its state in w.z), NO_RETURN at t_max, or
+    an error (status, ta); (UNRESOLVED, ta) when ``may_split`` and the samples of an
+    integration step do not resolve what they sample (loop.stay.make_step_windows; an
+    exact flow's window is the flow's own, rules.exact_window: never split)."""
+    fns, p, s, w = ctx
+    o = Orbit(fns, p, w.seg, w.za, w.F, w.y_old, s.xtol)
     exact = mode != SLIDING and w.seg[SEG_INTEGRATED] == 0.0
     frac = s.frac_ex if exact else s.frac_in
     ns = frac.size
@@ -149,7 +152,7 @@ def _window(mode, ta, tb, first, may_split, o, s, w):
     # sample; else the run stops at ta (w.z)
     if exact and not _flow_follows(w.z, w.ynew, tb - ta, speed2_a, w.wf):
         return FLOW_OFF_FIELD, ta, _W_NONE
-    if may_split and not _resolved(mode, ns, sm):
+    if may_split and not exact and not _resolved(mode, ns, sm):
         return UNRESOLVED, ta, _W_NONE
     st, te, what = _find(mode, ns, first, s, o, sm, sc)
     # P is not differentiable where the orbit touches H
@@ -167,59 +170,10 @@ def _window(mode, ta, tb, first, may_split, o, s, w):
     return OK, te, what
 
 
-@_jit_inline
-def _step_budget_spent(s, w):
-    """Counts one more step of the run (a window of an exact stay, a DOP853 step of an
-    integrated one): True once the run has spent max_steps."""
-    w.count[N_STEPS] += 1
-    return rules.step_budget_spent(w.count[N_STEPS], s.max_steps)
-
-
-@_jit_inline
-def _flows_exactly(mode, ctx):
-    return mode != SLIDING and ctx[2].exact
-
-
-@_jit_inline
-def _stay_exact(mode, t, ctx):
-    """A stay in region + or - on the exact flow from the mode entry, in the windows of
-    rules.exact_window (hwin growing with the time since the entry during the fast
-    transient, then hwin_slow); (status, t, what)."""
-    fns, p, s, w = ctx
-    for k in range(w.z.size):
-        w.za[k] = w.z[k]
-    w.seg[SEG_ENTRY] = t
-    w.seg[SEG_INTEGRATED] = 0.0
-    o = Orbit(fns, p, w.seg, w.za, w.F, w.y_old, s.xtol)
-    ta, first = t, True
-    while True:
-        if _step_budget_spent(s, w):
-            return STEP_LIMIT, ta, _W_NONE
-        age = ta - w.seg[SEG_ENTRY] + w.tally[T_AGE]
-        tb = min(ta + rules.exact_window(age, s.hwin, s.hwin_slow, s.transient), s.t_max)
-        if tb == ta:
-            tb = np.nextafter(ta, np.inf)
-        st, t, what = _window(mode, ta, tb, first, False, o, s, w)
-        if st != _GO_ON:
-            if _DERIVATIVES and st == OK and s.jac:
-                dv = w.deriv
-                _flow_jacobian(mode, w.za, t - w.seg[SEG_ENTRY], fns, p, dv.Mt, dv.jz1,
-                               dv.jz2)
-                _apply(dv.Mt, dv.M, dv.KP[0])
-            return st, t, what
-        ta, first = tb, False
-
-
-@_jit_inline
-def _step_window(mode, t0, t1, first, may_split, ctx):
-    o, s, w = ctx
-    return _window(mode, t0, t1, first, may_split, o, s, w)
-
-
 def _build_step_windows(ns):
-    """An integration step searched in windows its samples resolve
-    (loop.stay.make_step_windows) on the namespace ``ns``'s _step_window (as _build_run)."""
-    walk = make_step_windows(ns["_step_window"])
+    """A step searched in windows its samples resolve (loop.stay.make_step_windows) on
+    the namespace ``ns``'s _window (as _build_run)."""
+    walk = make_step_windows(ns["_window"])
     if not ns["_DERIVATIVES"]:
         walk.__qualname__ += "_plain"
     return _jit_inline(walk)
@@ -229,45 +183,85 @@ _build_step_windows.builds = True
 _step_windows = _build_step_windows(globals())
 
 
+# ------------------------------------------------------------------ a stay's operations
+# For filippov.loop.event, which holds a stay's order (start, then per step: the step, its
+# windows, its end). In region + or - of a model with exact flows the stay follows the
+# exact flow from the mode entry, in the windows of rules.exact_window (hwin growing with
+# the time since the entry during the fast transient, then hwin_slow), each a step; else
+# it is integrated by DOP853 with the mode's field (Filippov's when sliding).
+
 @_jit_inline
-def _stay_integrated(mode, t, ctx):
-    """A stay integrated by DOP853 with the mode's field (Filippov's when sliding;
-    regions + and - of a model without exact flows); (status, t, what)."""
+def _start_stay(mode, t, ctx):
+    """The stay in ``mode`` begins at t (the state w.z): GO_ON, or NON_FINITE where the
+    integrated field is not finite there."""
     fns, p, s, w = ctx
     n = w.z.size
+    if mode != SLIDING and s.exact:
+        for k in range(n):
+            w.za[k] = w.z[k]
+        w.seg[SEG_ENTRY] = t
+        w.seg[SEG_INTEGRATED] = 0.0
+        return _GO_ON
     w.seg[SEG_INTEGRATED] = 1.0
     for k in range(n):
         w.y[k] = w.z[k]
     fl = Fill(w.wg, w.wf, w.wp)
-    d = Dop(w.y, w.f, w.y_old, w.f_old, w.K, w.ynew, w.ytmp, w.scale, w.F)
-    ctl = Control(s.t_max, s.max_step, s.rtol, s.atol)
     if not _checked_field(w.y, mode, _FIRST_CALL, fns, p, fl, w.f):
-        return NON_FINITE, t, _W_NONE
-    h_abs = _dop_initial_step(mode, t, ctl, fns, p, fl, d)
-    o = Orbit(fns, p, w.seg, w.za, w.F, w.y_old, s.xtol)
-    ta, first = t, True
-    while True:
-        if _step_budget_spent(s, w):
-            return STEP_LIMIT, ta, _W_NONE
-        ok, tb, hstep, h_abs = _dop_step(mode, ta, h_abs, ctl, fns, p, fl, d)
-        if not ok:  # a non-finite field collapses the step too: say which
-            return (NON_FINITE if _non_finite_stage(w.y, hstep, w.K, w.z) else STEP_FAILED,
-                    ta, _W_NONE)
-        for k in range(n):
-            w.y_old[k] = w.y[k]
-            w.f_old[k] = w.f[k]
-            w.y[k] = w.ynew[k]
-            w.f[k] = w.K[_NS, k]
-        _dop_dense(mode, hstep, fns, p, fl, d)
-        w.seg[SEG_STEP_T] = ta
-        w.seg[SEG_STEP_H] = tb - ta
-        st, t, what = _step_windows(mode, ta, tb, first, (o, s, w))
-        if _DERIVATIVES and s.jac and (st == _GO_ON or (st == OK and t > ta)):
-            _var_step(mode, w.y_old, (tb if st == _GO_ON else t) - ta, fns, p, fl, w.deriv,
-                      s.jac == 2)
-        if st != _GO_ON:
-            return st, t, what
-        ta, first = tb, False
+        return NON_FINITE
+    w.seg[SEG_NEXT_STEP] = _dop_initial_step(
+        mode, t, Control(s.t_max, s.max_step, s.rtol, s.atol), fns, p, fl,
+        Dop(w.y, w.f, w.y_old, w.f_old, w.K, w.ynew, w.ytmp, w.scale, w.F))
+    return _GO_ON
+
+
+@_jit_inline
+def _next_step(mode, ta, ctx):
+    """The stay's next step from ta, within the step budget: (GO_ON, its end tb), or
+    (STEP_LIMIT, NON_FINITE, STEP_FAILED: why not, ta). An exact flow's step is its
+    window; an integrated one leaves its dense output in w.F."""
+    fns, p, s, w = ctx
+    w.count[N_STEPS] += 1
+    if rules.step_budget_spent(w.count[N_STEPS], s.max_steps):
+        return STEP_LIMIT, ta
+    if w.seg[SEG_INTEGRATED] == 0.0:
+        age = ta - w.seg[SEG_ENTRY] + w.tally[T_AGE]
+        tb = min(ta + rules.exact_window(age, s.hwin, s.hwin_slow, s.transient), s.t_max)
+        return _GO_ON, (np.nextafter(ta, np.inf) if tb == ta else tb)
+    fl = Fill(w.wg, w.wf, w.wp)
+    d = Dop(w.y, w.f, w.y_old, w.f_old, w.K, w.ynew, w.ytmp, w.scale, w.F)
+    ok, tb, hstep, h_next = _dop_step(
+        mode, ta, w.seg[SEG_NEXT_STEP], Control(s.t_max, s.max_step, s.rtol, s.atol),
+        fns, p, fl, d)
+    w.seg[SEG_NEXT_STEP] = h_next
+    if not ok:  # a non-finite field collapses the step too: say which
+        return (NON_FINITE if _non_finite_stage(w.y, hstep, w.K, w.z) else STEP_FAILED), ta
+    for k in range(w.z.size):
+        w.y_old[k] = w.y[k]
+        w.f_old[k] = w.f[k]
+        w.y[k] = w.ynew[k]
+        w.f[k] = w.K[_NS, k]
+    _dop_dense(mode, hstep, fns, p, fl, d)
+    w.seg[SEG_STEP_T] = ta
+    w.seg[SEG_STEP_H] = tb - ta
+    return _GO_ON, tb
+
+
+@_jit_inline
+def _end_step(mode, ta, tb, st, te, ctx):
+    """After the windows of the step [ta, tb] (their status st, the event's time te):
+    dP/dz carried over the step (an exact flow's at its event, from the mode entry); st."""
+    fns, p, s, w = ctx
+    if _DERIVATIVES and s.jac:
+        dv = w.deriv
+        if w.seg[SEG_INTEGRATED] == 0.0:
+            if st == OK:
+                _flow_jacobian(mode, w.za, te - w.seg[SEG_ENTRY], fns, p, dv.Mt, dv.jz1,
+                               dv.jz2)
+                _apply(dv.Mt, dv.M, dv.KP[0])
+        elif st == _GO_ON or (st == OK and te > ta):
+            _var_step(mode, w.y_old, (tb if st == _GO_ON else te) - ta, fns, p,
+                      Fill(w.wg, w.wf, w.wp), dv, s.jac == 2)
+    return st
 
 
 @_jit_inline
@@ -466,9 +460,9 @@ def _end_time(ctx):
 
 
 #: the operations by their place in filippov.loop.event.RunOps
-_RUN_OPS = ("_begin", "_end_time", "_flows_exactly", "_stay_exact", "_stay_integrated",
-            "_at_section", "_event_speeds", "_event_h", "_event_grad", "_event_state",
-            "_event_flow_at_zero", "_event_sliding_built", "_event_slides_in",
+_RUN_OPS = ("_begin", "_end_time", "_start_stay", "_next_step", "_step_windows",
+            "_end_step", "_at_section", "_event_speeds", "_event_h",
+            "_event_grad", "_event_state", "_event_flow_at_zero", "_event_sliding_built", "_event_slides_in",
             "_record_switch", "_count_switch", "_event_limits", "_event_ring",
             "_store_ring", "_over_budget", "_store_exit", "_event_switch_derivative",
             "_entered")
@@ -606,10 +600,9 @@ def _without_derivatives(decorated):
 
 
 # the functions on the way from _batch to a _DERIVATIVES branch
-_PLAIN = _without_derivatives({"_window": _jit_inline, "_step_window": _jit_inline,
+_PLAIN = _without_derivatives({"_window": _jit_inline,
                                "_step_windows": _build_step_windows,
-                               "_stay_exact": _jit_inline,
-                               "_stay_integrated": _jit_inline, "_at_section": _jit_inline,
+                               "_end_step": _jit_inline, "_at_section": _jit_inline,
                                "_event_switch_derivative": _jit_inline,
                                "_begin": _jit, "_one": _build_run,
                                "_batch": njit(cache=True, nogil=True)})

@@ -85,11 +85,12 @@ Deriv = namedtuple("Deriv", ["M", "Mt", "KV", "KP", "ys", "jv", "jo", "jz1", "jz
 # exit_shift alone; SEG_RATE_STEP: while sliding, the step of the forward differences that
 # give the rates of a and b along the orbit in the current window (rules.rate_step; 0:
 # none); SEG_LAST_H, SEG_LAST_SPEED2: outside sliding, h and |f|^2 at the last sample of
-# the last window (the next window's first sample: scan._carry_sample).
+# the last window (the next window's first sample: scan._carry_sample); SEG_NEXT_STEP:
+# the size DOP853 proposes for the stay's next step.
 SEG = ("entry", "step_t", "step_h", "integrated", "shift", "band", "exit_shift",
-       "rate_step", "last_h", "last_speed2")
+       "rate_step", "last_h", "last_speed2", "next_step")
 (SEG_ENTRY, SEG_STEP_T, SEG_STEP_H, SEG_INTEGRATED, SEG_SHIFT, SEG_BAND, SEG_EXIT_SHIFT,
- SEG_RATE_STEP, SEG_LAST_H, SEG_LAST_SPEED2) = range(len(SEG))
+ SEG_RATE_STEP, SEG_LAST_H, SEG_LAST_SPEED2, SEG_NEXT_STEP) = range(len(SEG))
 
 # ----------------------------------------------------------------- w.count (int64)
 # changes of mode, windows / integration steps, entries into the Zeno ring (w.recent)

@@ -47,11 +47,15 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: is the engine's, each operation evaluates at it):
 #: begin(z0, age0, ctx) -> (status, t, mode): the run's start from z0 (its age in its
 #: region age0: rules.carried_age), GO_ON or why it cannot start; end_time(ctx) -> the
-#: run's end time; flows_exactly(mode, ctx) -> bool: which stay follows ``mode``;
-#: stay_exact(mode, t, ctx), stay_integrated(mode, t, ctx) -> (status, t, what): the stay
-#: from t to its event (OK, the event's time and what) or to the run's end (NO_RETURN at
-#: the end time, or an error), two operations so that the kernel inlines each into the
-#: run rather than a composed stay (docs/decisions.md#kernel-inlined-driver);
+#: run's end time; a stay, in the order the run holds: start_stay(mode, t, ctx) ->
+#: status (GO_ON, or why it cannot begin), then per step next_step(mode, ta, ctx) ->
+#: (status, tb) (GO_ON and the step's end, or why there is none: the step budget, a
+#: failed step), step_windows(mode, ta, tb, first, ctx) -> (status, t, what) (the step
+#: searched window by window: filippov.loop.stay.make_step_windows on the engine's
+#: window), end_step(mode, ta, tb, status, t, ctx) -> status (GO_ON to the next step;
+#: OK at an event, its time t and ``what``; NO_RETURN at the end time, or an error): the
+#: stay written in the run, as the event is, so that the kernel copies no composed stay
+#: (docs/decisions.md#kernel-inlined-driver);
 #: section_hit(mode, t, ctx) -> status: records a hit (OK ends the run, GO_ON goes on);
 #: speeds(ctx) -> (a, b); h(ctx) -> H; grad_h(ctx) -> grad H, an array (called after
 #: speeds, before the state moves); state(ctx) -> the state as an array the event may
@@ -65,7 +69,7 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: and rounding band; switch_derivative(mode, new_mode, ctx): dP/dz across a crossing;
 #: entered(mode, new_mode, t, ctx): the engine's bookkeeping as the orbit goes on
 RunOps = namedtuple("RunOps", [
-    "begin", "end_time", "flows_exactly", "stay_exact", "stay_integrated",
+    "begin", "end_time", "start_stay", "next_step", "step_windows", "end_step",
     "section_hit", "speeds", "h", "grad_h", "state", "flow_at_zero", "sliding_built",
     "slides_in_section", "record_switch", "count_switch", "limits", "ring", "store_ring",
     "over_budget", "store_exit", "switch_derivative", "entered"])
@@ -77,8 +81,8 @@ def make_run(ops: RunOps):
     ``ops``'s operations, until a status ends it: OK at a terminal section hit,
     NO_RETURN at the end time, or why it stopped (the start's, a stay's or an event's
     status); t and ``mode`` where it ended."""
-    (begin, end_time, flows_exactly, stay_exact, stay_integrated, section_hit, speeds, h,
-     grad_h, state, flow_at_zero, sliding_built, slides_in_section, record_switch,
+    (begin, end_time, start_stay, next_step, step_windows, end_step, section_hit, speeds,
+     h, grad_h, state, flow_at_zero, sliding_built, slides_in_section, record_switch,
      count_switch, limits, ring, store_ring, over_budget, store_exit, switch_derivative,
      entered) = ops
 
@@ -90,10 +94,18 @@ def make_run(ops: RunOps):
             status = before_stay(mode, t, end_time(ctx), sliding_built(ctx))
             if status != GO_ON:
                 return status, t, mode
-            if flows_exactly(mode, ctx):
-                status, t, what = stay_exact(mode, t, ctx)
-            else:
-                status, t, what = stay_integrated(mode, t, ctx)
+            # the stay, step by step, to its event (OK) or to why it ends
+            what = -1  # what the stay ends at (its event's)
+            status = start_stay(mode, t, ctx)
+            ta, first = t, True
+            while status == GO_ON:
+                status, tb = next_step(mode, ta, ctx)
+                if status != GO_ON:
+                    t = ta
+                    break
+                status, t, what = step_windows(mode, ta, tb, first, ctx)
+                status = end_step(mode, ta, tb, status, t, ctx)
+                ta, first = tb, False
             if status != OK:
                 return status, t, mode
             if what == SECTION:

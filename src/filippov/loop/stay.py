@@ -80,25 +80,24 @@ UNRESOLVED = -2
 
 
 def make_step_windows(window):
-    """``walk(mode, ta, tb, first, ctx) -> (status, t, what)``: an integration step
-    [ta, tb] searched window by window. A window whose samples do not resolve its leave
-    functions or sections is shortened by rules.SPLIT and sampled again, down to a
+    """``walk(mode, ta, tb, first, ctx) -> (status, t, what)``: a step [ta, tb] searched
+    window by window, the first the whole step. A window whose samples do not resolve its
+    leave functions or sections is shortened by rules.SPLIT and sampled again, down to a
     rules.SPLIT ** rules.MAX_SPLITS-th of the step (rules.can_split); a resolved window
     without an event hands on to the next, rules.SPLIT times longer (to the step's end at
     most). The engine's operation: ``window(mode, t0, t1, first, may_split, ctx) ->
-    (status, t, what)``, its status UNRESOLVED (only when ``may_split``), GO_ON (no event:
-    the orbit goes on from t1) or the event's."""
+    (status, t, what)``, its status UNRESOLVED (only when ``may_split``, and never for an
+    exact flow's step: the model's own window), GO_ON (no event: the orbit goes on from
+    t1) or the event's."""
 
     def walk(mode, ta, tb, first, ctx):
-        t0, span = ta, tb - ta
+        t0, t1 = ta, tb
         while True:
-            t1 = rules.window_end(t0, span, tb)
             st, t, what = window(mode, t0, t1, first, rules.can_split(ta, tb, t0, t1), ctx)
             if st == UNRESOLVED:
-                span = (t1 - t0) / rules.SPLIT
+                t1 = rules.window_end(t0, (t1 - t0) / rules.SPLIT, tb)
             elif st != GO_ON or t1 >= tb:
                 return st, t, what
             else:
-                span = (t1 - t0) * rules.SPLIT
-                t0, first = t1, False
+                t0, t1, first = t1, rules.window_end(t1, (t1 - t0) * rules.SPLIT, tb), False
     return walk
