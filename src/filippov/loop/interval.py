@@ -111,8 +111,8 @@ def make_window_event(walk: WalkOps, ask: IntervalOps):
         while i < n:
             hit, at = candidate_at(ctx, i, mode)
             if hit and clears_band_at(ctx, i, mode):
-                unband(ctx, i, mode)  # interval i asked again, h unbiased
-                hit, at = candidate_at(ctx, i, mode)
+                unband(ctx, i, mode)  # interval i asked again, h unbiased (band now 0)
+                continue
             if hit:
                 best_t, best_w = math.inf, NONE
                 # 1. the leave functions' crossings: the earliest
