@@ -34,8 +34,8 @@ from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _d
 from .segment import _zat
 from .scan import (_carry_sample, _find, _flow_follows, _sample)
 from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY,
-                    SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_NEXT_STEP, SEG_SHIFT, SEG_SIZE, SEG_STEP_H,
-                    SEG_STEP_T, T_AGE, T_SLID, T_SLIDE_START, TALLY_SIZE, Control, Deriv, Dop,
+                    SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_NEXT_STEP, SEG_SHIFT, SEG_SIZE,
+                    SEG_STEP_H, SEG_STEP_T, T_AGE, T_SLID, T_SLIDE_START, TALLY_SIZE, Control, Deriv, Dop,
                     Fill, Orbit, Outputs, Samples, Scratch, Settings, Work,
                     kernel_signature)  # noqa: F401
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
@@ -128,11 +128,11 @@ def _resolved(mode, ns, sm):
 def _window(mode, ta, tb, first, may_split, ctx):
     """Samples the segment [ta, tb] of the current mode (ctx: the run's (fns, p, s, w);
     at the fractions of an exact window or of an integration step) and finds its earliest
-    event: (_GO_ON, tb, _W_NONE) if there is none (the state
-    at tb in w.z), (OK, te, what) at an event (its state in w.z), NO_RETURN at t_max, or
-    an error (status, ta); (UNRESOLVED, ta) when ``may_split`` and the samples of an
-    integration step do not resolve what they sample (loop.stay.make_step_windows; an
-    exact flow's window is the flow's own, rules.exact_window: never split)."""
+    event: (_GO_ON, tb, _W_NONE) if there is none (the state at tb in w.z), (OK, te, what)
+    at an event (its state in w.z), NO_RETURN at t_max, or an error (status, ta);
+    (UNRESOLVED, ta) when ``may_split`` and the samples of an integration step do not
+    resolve what they sample (loop.stay.make_step_windows; an exact flow's window is the
+    flow's own, rules.exact_window: never split)."""
     fns, p, s, w = ctx
     o = Orbit(fns, p, w.seg, w.za, w.F, w.y_old, s.xtol)
     exact = mode != SLIDING and w.seg[SEG_INTEGRATED] == 0.0
