@@ -144,7 +144,7 @@ def test_non_finite_field_value_names_the_piece_and_state():
     fp = lambda z: np.stack([ONES(z), np.where(z[0] > 0.5, np.nan, 0.0)])
     system = oscillator(field_plus=fp, field_minus=lambda z: np.stack([ONES(z), ZEROS(z)]))
     with pytest.raises(SimulationError,
-                       match=r"^non-finite state or field value at t=0\.5\d*, state \[0\.5\d*, "
+                       match=r"^non-finite state or value of a piece at t=0\.5\d*, state \[0\.5\d*, "
                              r"1\.0\] \(field_plus returned a non-finite value there"):
         simulate(system, [0.0, 1.0], 1.0, method="integrate")
 

@@ -283,6 +283,29 @@ def check_compiled(cmodel, z0: np.ndarray) -> None:
         pass
 
 
+def piece_not_finite_at(system, mode: int, z: np.ndarray, sections=()) -> str | None:
+    """The first piece a run in ``mode`` evaluates that is not finite at ``z`` -- the
+    mode's field (both fields while sliding), switch, switch_grad, then each of
+    ``sections`` (pairs of the words naming it and its function of the state) -- or
+    None if all are.
+    ``system`` need only have the methods it asks for (field_minus, field_plus, switch,
+    switch_grad): both engines blame a non-finite sample with it."""
+    fields = (("field_minus", system.field_minus), ("field_plus", system.field_plus))
+    if mode in FIELD_NAMES:
+        fields = tuple(f for f in fields if f[0] == FIELD_NAMES[mode])
+    asked = fields + (("switch", system.switch), ("switch_grad", system.switch_grad))
+    asked += tuple(sections)
+    z = np.asarray(z, dtype=float)
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        for name, fn in asked:
+            try:
+                if not np.all(np.isfinite(np.asarray(fn(z), dtype=float))):
+                    return name
+            except Exception:
+                return name
+    return None
+
+
 def non_finite_piece(system: PiecewiseSystem, mode: int, z: np.ndarray) -> str:
     """The piece to blame for a non-finite field value of ``mode`` at ``z``."""
     if mode in FIELD_NAMES:

@@ -494,6 +494,12 @@ class _Pieces:
     def switch_grad(self, z):
         return self._vector(self.cm.switch_grad, z)
 
+    def switch(self, z):
+        return self.cm.switch(np.ascontiguousarray(z, dtype=float), self.cm.params)
+
+    def section(self, z):
+        return self.cm.section(np.ascontiguousarray(z, dtype=float), self.cm.params)
+
 
 def failure(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:
     """Why start ``i`` of ``out`` did not return, in words: its status, where (t, state)
@@ -507,7 +513,7 @@ def failure(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:
 def _failure_detail(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:
     """What :func:`failure` says after the status, time and state: the mode, and the
     evidence for a non-finite value or an exact flow off its field."""
-    from .checks import non_finite_piece
+    from .checks import non_finite_piece, piece_not_finite_at
 
     code, z = int(out.status[i]), out.state[i]
     mode = int(out.mode[i]) if out.mode is not None else None
@@ -518,12 +524,18 @@ def _failure_detail(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:
         return where + _flow_off_field(cmodel, mode, z)
     if code != NON_FINITE:
         return where
+    if not np.all(np.isfinite(z)):
+        return where + " (the state itself)"
+    pieces = _Pieces(cmodel)
+    # a sampled value (h, its rate, the sliding speeds, the section) at the state where
+    # the run stopped, or else a field or flow on the way from it
+    piece = piece_not_finite_at(pieces, mode, z, (("section", pieces.section),))
+    if piece is not None:
+        return where + f" ({piece} returned a non-finite value there)"
     if cmodel.exact and mode in (MINUS, PLUS):  # exact flows are sampled, not integrated
         piece = "flow_plus" if mode == PLUS else "flow_minus"
         return where + f" ({piece} returned a non-finite value from there)"
-    if not np.all(np.isfinite(z)):
-        return where + " (the state itself)"
-    return where + f" ({non_finite_piece(_Pieces(cmodel), mode, z)} returned a non-finite " \
+    return where + f" ({non_finite_piece(pieces, mode, z)} returned a non-finite " \
                    f"value there)"
 
 

@@ -858,6 +858,7 @@ def _speed_rates(system, Z, z0):
         a1, b1 = system.normal_speeds(Z(tt + d))
         a0, b0 = system.normal_speeds(Z(tt))
         return (a1 - a0) / d, (b1 - b0) / d
+    rates.step = d
     return rates
 
 
@@ -929,6 +930,30 @@ class _Scan:
             self.rates = _speed_rates(system, Z, np.asarray(zs[:, 0], dtype=float))
             if self.rates is not None:
                 self.R = self.rates(ts)
+        self._check_finite()
+
+    def _check_finite(self):
+        """Every sampled value is finite, or the run stops at the first sample that is
+        not, naming the piece: a NaN sample shows no sign change, so a switch or a
+        section hit there would be missed, not found (the kernel: scan._sample)."""
+        sampled = self.raw + self.svals + ([self.D] if self.D is not None else [])
+        ahead = len(sampled)  # the rates' differences evaluate a and b a step ahead
+        sampled += list(self.R) if self.R is not None else []
+        for j, v in enumerate(sampled):
+            if not math.isfinite(float(np.sum(v))) and not np.all(np.isfinite(v)):
+                k = int(np.flatnonzero(~np.isfinite(v))[0])
+                if j < ahead:
+                    raise self._non_finite(self.ts[k], self.zs[:, k])
+                t = self.ts[k] + self.rates.step
+                raise self._non_finite(t, self.Z(t))
+
+    def _non_finite(self, t, z):
+        z = np.asarray(z, dtype=float).reshape(-1)
+        piece = checks.piece_not_finite_at(
+            self.system, self.mode, z, [(f"section {s.name!r}", s.func) for s in self.sections])
+        return run_error(NON_FINITE, t, z, f", mode {MODE_NAMES[self.mode]} "
+                                           f"({piece or 'a piece'} returned a non-finite "
+                                           "value there)")
 
     def resolved(self):
         """The samples resolve the leave functions and the sections (rules.resolves; the
@@ -948,12 +973,20 @@ class _Scan:
         return True
 
     def _along(self, func):
-        """``func`` of the state as a function of time on the segment."""
+        """``func`` of the state as a function of time on the segment (a non-finite
+        value between the samples stops the run, as at a sample)."""
         Z = self.Z
-        return lambda tt: float(func(Z(tt)))
+
+        def along(tt):
+            z = Z(tt)
+            v = float(func(z))
+            if not math.isfinite(v):
+                raise self._non_finite(tt, z)
+            return v
+        return along
 
     def _dH(self, tt):
-        return float(self.system.speed_of_switch(self.mode, self.Z(tt)))
+        return self._along(lambda z: self.system.speed_of_switch(self.mode, z))(tt)
 
     def candidates(self):
         """Sample intervals that may hold an event, found with array operations; only

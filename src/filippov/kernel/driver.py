@@ -125,6 +125,14 @@ def _resolved(mode, ns, sm):
 
 
 @_jit_inline
+def _all_finite(z):
+    for c in range(z.size):
+        if not np.isfinite(z[c]):
+            return False
+    return True
+
+
+@_jit_inline
 def _window(mode, ta, tb, first, may_split, ctx):
     """Samples the segment [ta, tb] of the current mode (ctx: the run's (fns, p, s, w);
     at the fractions of an exact window or of an integration step) and finds its earliest
@@ -144,9 +152,13 @@ def _window(mode, ta, tb, first, may_split, ctx):
     k0 = 1 if (exact and not first) else 0
     if k0 == 1:
         _carry_sample(ns, w.seg, sm)
-    ok, speed2_a = _sample(mode, ta, tb, frac, k0, o, sm, sc)
-    if not ok:
-        return NON_FINITE, ta, _W_NONE
+    bad, speed2_a = _sample(mode, ta, tb, frac, k0, o, sm, sc)
+    if bad >= 0:
+        if _all_finite(sc.wz):  # a piece's value, not the state: the run stops there
+            for c in range(w.z.size):
+                w.z[c] = sc.wz[c]
+            return NON_FINITE, sm.ts[bad], _W_NONE
+        return NON_FINITE, ta, _W_NONE  # the state itself: stopped at the last finite one
     # an exact flow (SEG_INTEGRATED == 0) must follow its field over the window: from the
     # state at ta (w.z) to that at tb (w.ynew), the field at tb left in w.wf by the last
     # sample; else the run stops at ta (w.z)

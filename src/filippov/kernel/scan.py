@@ -24,10 +24,12 @@ def _sample(mode, ta, tb, frac, k0, o, sm, sc):
     """Samples of one window at the fractions frac of [ta, tb] (sm: state.Samples): times
     ts, the leave functions (h, or a and b when sliding), their rates (dh/dt; the rates of
     a and b along the orbit while sliding, rules.rate_step: SEG_RATE_STEP) and the section;
-    the last state in sm.end. (False: non-finite, |f|^2 at the first sample outside
-    sliding -- the state at ta -- for _flow_follows). Samples from k0 on: k0 = 1 when the
-    caller carried sample 0 over (_carry_sample); outside sliding the last sample's h and
-    |f|^2 are kept in SEG_LAST_H, SEG_LAST_SPEED2 for that."""
+    the last state in sm.end. Returns (-1, |f|^2 at the first sample outside sliding --
+    the state at ta -- for _flow_follows), or (k, .) at the first sample k whose state or
+    a value sampled there is not finite (the state then in sc.wz: a NaN sample shows no
+    sign change, so a switch or section there would be missed, not found). Samples from
+    k0 on: k0 = 1 when the caller carried sample 0 over (_carry_sample); outside sliding
+    the last sample's h and |f|^2 are kept in SEG_LAST_H, SEG_LAST_SPEED2 for that."""
     ns = frac.size
     sg, wz, wg, wf, wp = o.seg, sc.wz, sc.wg, sc.wf, sc.wp
     ts, vals, dvals, svals = sm.ts, sm.vals, sm.dvals, sm.svals
@@ -39,7 +41,7 @@ def _sample(mode, ta, tb, frac, k0, o, sm, sc):
         _zat(tk, mode, o, wz)
         for c in range(wz.size):
             if not np.isfinite(wz[c]):
-                return False, speed2_a
+                return k, speed2_a
         svals[k] = _section(fns, wz, p)
         if k == ns - 1:
             for c in range(wz.size):
@@ -50,10 +52,15 @@ def _sample(mode, ta, tb, frac, k0, o, sm, sc):
             vals[1, k] = b
             if k == 0:  # one difference step for the window (wf, wp: F_-, F_+ at wz)
                 sg[SEG_RATE_STEP] = rules.rate_step(wz, wf, wp, a, b)
-            if sg[SEG_RATE_STEP] > 0.0:  # (overwrites wz)
+            if not np.isfinite(svals[k] + a + b):  # one test: finite where each term is
+                return k, speed2_a                  # (or on overflow)
+            if sg[SEG_RATE_STEP] > 0.0:  # (overwrites wz: the state at tk + the step)
                 da, db = _rates(tk, a, b, mode, o, sc)
                 dvals[0, k] = da
                 dvals[1, k] = db
+                if not np.isfinite(da + db):  # stopped where the rates evaluated a, b
+                    ts[k] = tk + sg[SEG_RATE_STEP]
+                    return k, speed2_a
         else:
             hk = _h(fns, wz, p)
             vals[0, k] = hk - sg[SEG_SHIFT]
@@ -63,12 +70,14 @@ def _sample(mode, ta, tb, frac, k0, o, sm, sc):
             else:
                 _field_minus(fns, wz, p, wf)
             dvals[0, k] = _dot(wg, wf)
+            if not np.isfinite(svals[k] + hk + dvals[0, k]):
+                return k, speed2_a
             if k == 0:
                 speed2_a = _dot(wf, wf)
             if k == ns - 1:  # for the next window's sample 0 (_carry_sample)
                 sg[SEG_LAST_H] = hk
                 sg[SEG_LAST_SPEED2] = _dot(wf, wf)
-    return True, speed2_a
+    return -1, speed2_a
 
 
 @_jit

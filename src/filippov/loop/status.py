@@ -10,7 +10,7 @@ NO_RETURN = 1      # t_max reached before the section
 EVENT_LIMIT = 2    # more than max_events switches
 STEP_LIMIT = 3     # more than max_steps windows / integration steps
 ZENO = 4           # zeno_count switches within zeno_span
-NON_FINITE = 5     # non-finite state or field value
+NON_FINITE = 5     # non-finite state, or value of a piece (a field, switch, a section)
 NO_SLIDING = 6     # attracting sliding reached, but the model declares no sliding
 STEP_FAILED = 7    # the sliding integrator's step size collapsed
 ROOT_FAILED = 8    # an event could not be bracketed / refined
@@ -20,7 +20,7 @@ FLOW_OFF_FIELD = 11  # an exact flow moved the state farther than its field allo
 
 STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event limit",
           STEP_LIMIT: "step limit", ZENO: "accumulation of switches (Zeno)",
-          NON_FINITE: "non-finite state or field value",
+          NON_FINITE: "non-finite state or value of a piece",
           NO_SLIDING: "attracting sliding reached, but the model declares no sliding",
           STEP_FAILED: "sliding integrator: step size too small",
           ROOT_FAILED: "event refinement failed (no bracket or no convergence)",
