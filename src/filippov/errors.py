@@ -90,3 +90,14 @@ def run_error(status: int, t, z, detail: str = "") -> Exception:
 
     state = np.asarray(z, dtype=float).reshape(-1).tolist()
     return RUN_ERRORS[status](f"{STATUS[status]} at t={float(t)!r}, state {state}{detail}")
+
+
+def accumulation_detail(ratio: float, t_star: float) -> str:
+    """What both engines say of switches that shrink geometrically
+    (:func:`filippov.rules.geometric_accumulation`): the ratio, and the accumulation
+    time their series sums to."""
+    return (f": the switches accumulate geometrically -- each loop (two switches) lasts "
+            f"{ratio:.6g} times the one before -- and sum to a finite time: the orbit reaches "
+            f"a Zeno point (an invisible two-fold, say) at t* = {float(t_star)!r} (estimated from "
+            "the series), where no Filippov solution goes on by crossing; stopped at the "
+            "last switch, the state given")

@@ -77,7 +77,7 @@ from .kernel.base import (BAD_START, EVENT_LIMIT, FLOW_OFF_FIELD, NO_RETURN,  # 
 from .kernel.driver import KERNEL_SOURCES, compile_kernel, kernel  # noqa: F401
 from .kernel.state import Outputs, Settings
 from .checks import check_compiled
-from .errors import run_error
+from .errors import accumulation_detail, run_error
 from .system import MINUS, MODE_NAMES, PLUS
 from .poincare import Returns
 from .progress import Progress
@@ -109,6 +109,10 @@ class BatchReturns:
     age: np.ndarray = None
     #: (m,): the mode at the return, or the one the run stopped in (MINUS, SLIDING, PLUS)
     mode: np.ndarray = None
+    #: (m, 2): where a run stopped ZENO because its switches shrink geometrically, their
+    #: ratio per loop (two switches) and the accumulation time the series sums to
+    #: (:func:`filippov.rules.geometric_accumulation`); NaN elsewhere
+    accumulation: np.ndarray = None
 
 
 def _section_pred(direction: int) -> int:
@@ -311,7 +315,8 @@ def _outputs(starts, keep: int, jacobian: bool) -> Outputs:
                      orbit=np.full((m, keep, n), np.nan),
                      returns_done=np.empty(m, dtype=np.int64), jacobian=np.empty((m, n, n)),
                      orbit_jacobian=np.full((m, keep if jacobian else 0, n, n), np.nan),
-                     age=np.empty(m), mode=np.empty(m, dtype=np.int64))
+                     age=np.empty(m), mode=np.empty(m, dtype=np.int64),
+                     accumulation=np.empty((m, 2)))
 
 
 def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float = 1e-12,
@@ -522,6 +527,8 @@ def _failure_detail(cmodel: CompiledModel, out: BatchReturns, i: int) -> str:
         where += f", mode {MODE_NAMES.get(mode, mode)}"
     if code == FLOW_OFF_FIELD and mode in (MINUS, PLUS):
         return where + _flow_off_field(cmodel, mode, z)
+    if code == ZENO and out.accumulation is not None and np.isfinite(out.accumulation[i, 0]):
+        return where + accumulation_detail(*(float(v) for v in out.accumulation[i]))
     if code != NON_FINITE:
         return where
     if not np.all(np.isfinite(z)):

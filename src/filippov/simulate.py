@@ -35,7 +35,7 @@ from .loop import interval, refine
 from .radau_iia import RadauIIA
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
-from .errors import run_error
+from .errors import accumulation_detail, run_error
 from .loop.event import SECTION, RunOps, make_run
 from .loop.stay import UNRESOLVED, make_slides_in, make_start, make_step_windows
 from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN,
@@ -727,6 +727,10 @@ class _Run:
         if status == SECTION_SLIDING:
             _refuse_sliding_in_sections(self.system, self.sections, ze, te)
         if status == ZENO:
+            ratio, t_star = rules.geometric_accumulation(self.ring, self.ring_entries,
+                                                         self.zeno_count)
+            if ratio == ratio:
+                return run_error(ZENO, te, ze, accumulation_detail(ratio, t_star))
             oldest = self.ring[self.ring_entries % self.zeno_count]
             return run_error(ZENO, te, ze, f": {self.zeno_count} switches within "
                                            f"{te - oldest:.3e} time units (Zeno point or "

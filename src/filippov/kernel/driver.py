@@ -26,7 +26,7 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 from .. import rules
 from ..system import MINUS, PLUS, SLIDING
 from .base import (BAD_START, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN, OK,
-                   STEP_FAILED, STEP_LIMIT, _W_NONE, _dot,
+                   STEP_FAILED, STEP_LIMIT, ZENO, _W_NONE, _dot,
                    _W_SECTION, _flow_minus, _flow_plus, _jit, _jit_inline, _speeds,
                    _h, _section)
 from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
@@ -577,6 +577,12 @@ def _batch(fns, params, starts, ages, s, out):
                 for b in range(n):
                     out.jacobian[i, a, b] = w.deriv.M[a, b]
         out.time[i] = t
+        ratio, t_star = np.nan, np.nan
+        if st == ZENO:
+            ratio, t_star = rules.geometric_accumulation(w.recent, w.count[N_RING],
+                                                         s.zeno_count)
+        out.accumulation[i, 0] = ratio
+        out.accumulation[i, 1] = t_star
         out.n_switches[i] = w.count[N_SWITCHES]
         out.sliding_time[i] = w.tally[T_SLID]
         out.mode[i] = mode

@@ -33,14 +33,16 @@ SETTINGS = (
 #: what a batch returns, per start (m) -- fastmap.BatchReturns' fields: state (m, n), time,
 #: n_switches, sliding_time, status, first_switch, sliding_displacement (m, n), orbit
 #: (m, keep, n), returns_done, jacobian (m, n, n), orbit_jacobian (m, keep or 0, n, n), age,
-#: mode (the mode at the return, or the one the run stopped in)
+#: mode (the mode at the return, or the one the run stopped in), accumulation (m, 2: at a
+#: ZENO stop where the switches shrink geometrically, their ratio per loop and the
+#: accumulation time: rules.geometric_accumulation; else NaN)
 OUTPUTS = (
     ("state", types.float64[:, ::1]), ("time", _vec), ("n_switches", types.int64[::1]),
     ("sliding_time", _vec), ("status", types.int64[::1]), ("first_switch", _vec),
     ("sliding_displacement", types.float64[:, ::1]), ("orbit", types.float64[:, :, ::1]),
     ("returns_done", types.int64[::1]), ("jacobian", types.float64[:, :, ::1]),
     ("orbit_jacobian", types.float64[:, :, :, ::1]), ("age", _vec),
-    ("mode", types.int64[::1]))
+    ("mode", types.int64[::1]), ("accumulation", types.float64[:, ::1]))
 
 Settings = namedtuple("Settings", [name for name, _ in SETTINGS])
 Outputs = namedtuple("Outputs", [name for name, _ in OUTPUTS])
