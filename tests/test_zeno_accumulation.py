@@ -20,7 +20,7 @@ import math
 import numpy as np
 import pytest
 
-from filippov import FilippovSystem, ZenoError, first_returns, simulate
+from filippov import FilippovSystem, SimulationError, ZenoError, first_returns, simulate
 from filippov import rules
 
 ENGINES = ("reference", "compiled")
@@ -143,3 +143,34 @@ def test_the_rule_leaves_other_series_alone(times):
     recent, entries, count = _ring(times[:-1])
     _, zeno = rules.note_switch(recent, entries, times[-1], count, 1e-10)
     assert not zeno
+
+
+# -- a slide into a two-fold: the same two fields, starts in their sliding region x < 0 < y.
+# On H the sliding field (a F+ - b F-) / (a - b), a = y, b = x, moves L = 3 y - 2 x at the
+# rate -1 exactly (L' = -(y - x) / (y - x)), and L = 0 on the sliding region only at the
+# two-fold: the slide reaches it at t = 3 y0 - 2 x0, where both fields are tangent to H and
+# no Filippov solution goes on uniquely. The compiled engine went on through it to an O(1)
+# state; the reference's steps collapsed ('step size too small'), or with DOP853 it asked
+# to raise max_events.
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("start", [(-1.0, 1.5), (-0.5, 0.3), (-1.0, 0.6)])
+def test_a_slide_into_a_two_fold_is_named(engine, start):
+    x0, y0 = start
+    with pytest.raises(SimulationError, match="the slide reached a two-fold") as err:
+        first_returns(_two_fold(), [[x0, y0, 0.0]], lambda z, p: z[0] - 100.0, 20.0,
+                      engine=engine)
+    t = float(str(err.value).split("t=")[1].split(",")[0])
+    assert t == pytest.approx(3.0 * y0 - 2.0 * x0, abs=1e-9)
+
+
+@pytest.mark.parametrize("stiff", [True, False], ids=["radau", "dop853"])
+def test_simulate_names_the_two_fold_with_either_integrator(stiff):
+    with pytest.raises(SimulationError, match="the slide reached a two-fold"):
+        simulate(_two_fold().python(), [-1.0, 1.5, 0.0], 10.0, stiff=stiff)
+
+
+def test_the_two_fold_rule_asks_both_speeds():
+    assert rules.at_two_fold(1e-9, -1e-9, 1.0, -1.0)
+    assert not rules.at_two_fold(0.0, -1e-3, 1.0, -1.0)   # an ordinary exit
+    assert not rules.at_two_fold(1e-3, 0.0, 1.0, -1.0)

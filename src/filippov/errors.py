@@ -73,7 +73,8 @@ def _run_errors():
             s.STEP_LIMIT: EventLimitError, s.ZENO: ZenoError, s.NON_FINITE: SimulationError,
             s.NO_SLIDING: SlidingNotBuiltError, s.STEP_FAILED: SimulationError,
             s.ROOT_FAILED: SimulationError, s.BAD_START: ValueError,
-            s.SECTION_SLIDING: SimulationError, s.FLOW_OFF_FIELD: SimulationError}
+            s.SECTION_SLIDING: SimulationError, s.FLOW_OFF_FIELD: SimulationError,
+            s.TWO_FOLD: SimulationError}
 
 
 #: status -> the exception class a run that ends with it raises

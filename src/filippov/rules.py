@@ -588,6 +588,19 @@ def geometric_accumulation(recent, entries: int, zeno_count: int):
     return np.nan, np.nan
 
 
+#: A slide ends at a two-fold where both normal speeds vanish at its end: each within
+#: TWO_FOLD_SHARE of its size where the slide began (a, b of a slide go to zero linearly
+#: in the distance to a two-fold; at an ordinary exit the other speed is of the order of
+#: its size along the slide, and one located to the integration's accuracy is ~1e-10 of it)
+TWO_FOLD_SHARE = 1e-6
+
+
+def at_two_fold(a: float, b: float, a_in: float, b_in: float) -> bool:
+    """The slide that began with the normal speeds a_in > 0 > b_in (F_-, F_+ along grad
+    H) ends where they are a and b at a two-fold: both tangent to H."""
+    return abs(a) <= TWO_FOLD_SHARE * abs(a_in) and abs(b) <= TWO_FOLD_SHARE * abs(b_in)
+
+
 def note_switch(recent, entries: int, t: float, zeno_count: int, zeno_span: float):
     """The Zeno ring both engines keep: enters the switch at ``t`` in ``recent`` (an array
     of zeno_count times, entry k at k % zeno_count; ``entries`` so far) and says whether

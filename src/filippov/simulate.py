@@ -38,7 +38,7 @@ from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuilt
 from .errors import accumulation_detail, run_error
 from .loop.event import SECTION, RunOps, make_run
 from .loop.stay import UNRESOLVED, make_slides_in, make_start, make_step_windows
-from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN,
+from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
                           NO_SLIDING, OK,
                           ROOT_FAILED, SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO)
 
@@ -642,7 +642,13 @@ class _Run:
             raise run_error(STEP_LIMIT, self.t, self.z, f", mode {MODE_NAMES[mode]}: step "
                             f"limit {self.max_steps} hit: the run is too long or the step "
                             "size collapsed")
-        ta, tb, Z = stepper.step()
+        try:
+            ta, tb, Z = stepper.step()
+        except SimulationError:
+            if mode == SLIDING and self._at_two_fold():
+                raise run_error(TWO_FOLD, self.t, self.z, ": the sliding field's steps "
+                                "collapsed where both normal speeds vanish") from None
+            raise
         stepper.n_taken += 1
         mean = (tb - stepper.t_start) / stepper.n_taken
         left = ((self.t_end - tb) / mean if stepper.n_taken > PROJECT_AFTER and mean > 0
@@ -656,6 +662,16 @@ class _Run:
                    "small eps): use exact flows or a shorter t_end"
                    if stepper.method is not None else ""))
         return ta, tb, Z
+
+    def _at_two_fold(self):
+        """Both normal speeds at the state are within rules.TWO_FOLD_SHARE of their sizes
+        |grad H| |F_-|, |grad H| |F_+| (a slide that ran into a two-fold, where its field's
+        steps collapse before any exit is found)."""
+        z = np.asarray(self.z, dtype=float)
+        g = float(np.linalg.norm(self.system.switch_grad(z)))
+        a, b = (float(v) for v in self.system.normal_speeds(z))
+        return rules.at_two_fold(a, b, g * float(np.linalg.norm(self.system.field_minus(z))),
+                                 g * float(np.linalg.norm(self.system.field_plus(z))))
 
     def _samples(self, stepper, Z, ta, tb):
         frac = self.frac_exact if stepper.method is None else self.frac_integrated

@@ -35,7 +35,7 @@ from collections import namedtuple
 
 from .. import rules
 from ..system import SLIDING
-from .status import EVENT_LIMIT, GO_ON, NO_SLIDING, OK, SECTION_SLIDING, ZENO
+from .status import EVENT_LIMIT, GO_ON, NO_SLIDING, OK, SECTION_SLIDING, TWO_FOLD, ZENO
 from .stay import before_stay
 
 #: what an event is: a crossing of H or an end of sliding (rules.SWITCH, EXIT_MINUS,
@@ -90,6 +90,8 @@ def make_run(ops: RunOps):
         status, t, mode = begin(z0, age0, ctx)
         if status != GO_ON:
             return status, t, mode
+        # the normal speeds where the current slide began (rules.at_two_fold)
+        a_in, b_in = speeds(ctx) if mode == SLIDING else (0.0, 0.0)
         while True:
             status = before_stay(mode, t, end_time(ctx), sliding_built(ctx))
             if status != GO_ON:
@@ -115,6 +117,10 @@ def make_run(ops: RunOps):
                 continue
             a, b = speeds(ctx)
             new_mode = rules.next_mode(mode, what, a, b)
+            if mode == SLIDING and new_mode != SLIDING and rules.at_two_fold(a, b, a_in, b_in):
+                return TWO_FOLD, t, mode
+            if new_mode == SLIDING and mode != SLIDING:
+                a_in, b_in = a, b
             if new_mode == SLIDING and not sliding_built(ctx):
                 return NO_SLIDING, t, mode
             if new_mode == SLIDING and mode != SLIDING and slides_in_section(ctx):

@@ -17,6 +17,7 @@ ROOT_FAILED = 8    # an event could not be bracketed / refined
 BAD_START = 9      # non-finite start point
 SECTION_SLIDING = 10  # the orbit slides inside the section (a section on H)
 FLOW_OFF_FIELD = 11  # an exact flow moved the state farther than its field allows
+TWO_FOLD = 12      # a slide ran into a two-fold: both fields tangent to H at once
 
 STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event limit",
           STEP_LIMIT: "step limit", ZENO: "accumulation of switches (Zeno)",
@@ -27,4 +28,6 @@ STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event lim
           BAD_START: "non-finite start point",
           SECTION_SLIDING: "the orbit slides along H inside the section (a section on the "
                            "switching surface): its crossings there would be rounding noise",
-          FLOW_OFF_FIELD: "the exact flow does not follow its field"}
+          FLOW_OFF_FIELD: "the exact flow does not follow its field",
+          TWO_FOLD: "the slide reached a two-fold (both fields tangent to H): the Filippov "
+                    "solution does not go on uniquely from there"}
