@@ -49,6 +49,14 @@ def _flow_off_field():
                           flow_plus=_drift(1.0), sample_step=0.01)
 
 
+def _two_fold():
+    # slides on x < 0 < y of H = {w = 0} into the two-fold at the origin (at t = 6.5 from
+    # (-1, 1.5): tests/test_zeno_accumulation.py)
+    return FilippovSystem(("x", "y", "w"), lambda z, p: np.array([2.0, 1.0, z[1]]),
+                          lambda z, p: np.array([-1.0, -1.0, z[0]]), lambda z, p: z[2],
+                          lambda z, p: np.array([0.0, 0.0, 1.0]))
+
+
 # status -> (system, start, section, direction, t_max, options)
 CASES = {
     status.NO_RETURN: lambda: (_hopf(), [0.0, 1.01, 0.0], _x1, -1, 0.1, {}),
@@ -61,6 +69,7 @@ CASES = {
     status.NON_FINITE: lambda: (_into_nan(), [0.0, 0.0, 1.0], _far, 0, 10.0, {}),
     status.FLOW_OFF_FIELD: lambda: (_flow_off_field(), [0.0, -0.5], lambda z, p: z[0] - 0.51,
                                     0, 200.0, {}),
+    status.TWO_FOLD: lambda: (_two_fold(), [-1.0, 1.5, 0.0], _far, 0, 20.0, {}),
 }
 
 

@@ -499,6 +499,21 @@ _one = _build_run(globals())
 _KERNEL_SIG = kernel_signature()
 
 
+@_jit_inline
+def _write_end(i, t, st, mode, s, w, out):
+    """Where start i's run ended: its time, switches, sliding time and mode; at a ZENO
+    stop the geometric series of its switches (rules.geometric_accumulation), else NaN."""
+    out.time[i] = t
+    ratio, t_star = np.nan, np.nan
+    if st == ZENO:
+        ratio, t_star = rules.geometric_accumulation(w.recent, w.count[N_RING], s.zeno_count)
+    out.accumulation[i, 0] = ratio
+    out.accumulation[i, 1] = t_star
+    out.n_switches[i] = w.count[N_SWITCHES]
+    out.sliding_time[i] = w.tally[T_SLID]
+    out.mode[i] = mode
+
+
 @njit(cache=True, nogil=True)
 def _batch(fns, params, starts, ages, s, out):
     """Each start is mapped s.iterations times by the first-return map, each return
@@ -576,16 +591,7 @@ def _batch(fns, params, starts, ages, s, out):
             for a in range(n):
                 for b in range(n):
                     out.jacobian[i, a, b] = w.deriv.M[a, b]
-        out.time[i] = t
-        ratio, t_star = np.nan, np.nan
-        if st == ZENO:
-            ratio, t_star = rules.geometric_accumulation(w.recent, w.count[N_RING],
-                                                         s.zeno_count)
-        out.accumulation[i, 0] = ratio
-        out.accumulation[i, 1] = t_star
-        out.n_switches[i] = w.count[N_SWITCHES]
-        out.sliding_time[i] = w.tally[T_SLID]
-        out.mode[i] = mode
+        _write_end(i, t, st, mode, s, w, out)
 
 
 #: the files whose code the kernel contains: every module of this package and of the
