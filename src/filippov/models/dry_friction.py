@@ -1,7 +1,7 @@
 """The autonomous dry-friction oscillator of Appendix C (Eqs. (C.1), (C.3)), M = K = 1.
 
 Slow state x = (x1, x2) (block position and velocity), fast state y = (w,) with
-w = gamma x2 + v (v: belt speed):
+w = gamma x2 + v (v: belt speed)::
 
     x1' = x2
     x2' = -x1 - F_c((1 + gamma) x2 - w)
