@@ -72,6 +72,9 @@ html_static_path = ["_static"]
 # a code or output block wider than the body scrolls instead of being cut (custom.css)
 html_css_files = ["custom.css"]
 html_last_updated_fmt = None
+# the site's own icon: without one every browser asks the server for /favicon.ico (a 404
+# in the console of tests/test_docs_browser.py)
+html_favicon = "_static/favicon.svg"
 
 # Math is typeset by MathJax served from the site itself, not from a CDN: offline every
 # formula would show its raw TeX. MathJax 3.2.2 comes from the package
