@@ -48,7 +48,7 @@ ALLOW_NO_TESTS ?=
 # Top-level packages resolved by `make lock` (everything else is transitive).
 LOCK_PKGS = numpy scipy xarray netCDF4 matplotlib "snakemake>=8,<10" \
             pyyaml jsonschema numba threadpoolctl sympy pytest pytest-xdist hypothesis pygments snakemake-executor-plugin-slurm \
-            compliance-checker sphinx myst-parser sphinx-gallery
+            compliance-checker sphinx myst-parser sphinx-gallery django-static-mathjax selenium
 
 export MPLBACKEND = Agg
 export SOURCE_DATE_EPOCH = 0

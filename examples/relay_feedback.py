@@ -1,19 +1,28 @@
-"""
+r"""
 Relay feedback
 ==============
 
-x' = A x - b sign(c^T x): the lag 1/(s+1)^3 under an ideal relay.
+:math:`\dot x = A x - b \operatorname{sign}(c^T x)`: the lag :math:`1/(s+1)^3` under an
+ideal relay.
 
-The plant (companion form of 1/(s+1)^3, output c^T x = x1) settles on a symmetric
-periodic orbit that crosses c^T x = 0 every half-period h (the relay auto-tuning
-experiment). Closed form: each field is linear, so from x0 on c^T x = 0 the orbit
-with x(h) = -x0 has (I + e^{Ah}) x0 = A^{-1} (e^{Ah} - I) b, and h is the root of
-c^T x0(h) = 0. As c^T b = 0 both saltation matrices equal S = I - 2 b c^T / (c^T A x0),
-so the monodromy matrix from x0 is M = (S e^{Ah})^2 (scipy.linalg.expm). The solver
-finds the orbit by itself: 20 periods from a point near the origin.
+The plant (companion form of :math:`1/(s+1)^3`, output :math:`c^T x = x_1`) settles on a
+symmetric periodic orbit that crosses :math:`c^T x = 0` every half-period :math:`h` (the
+relay auto-tuning experiment). Closed form: each field is linear, so from :math:`x_0` on
+:math:`c^T x = 0` the orbit with :math:`x(h) = -x_0` is
+
+.. math::
+
+   x(t) = e^{At} x_0 - A^{-1} (e^{At} - I)\, b, \quad 0 \le t \le h, \qquad
+   x(t + h) = -x(t), \qquad (I + e^{Ah})\, x_0 = A^{-1} (e^{Ah} - I)\, b,
+
+and :math:`h` is the root of :math:`c^T x_0(h) = 0`. As :math:`c^T b = 0` both saltation
+matrices equal :math:`S = I - 2\, b c^T / (c^T A x_0)`, so the monodromy matrix from
+:math:`x_0` is :math:`M = (S e^{Ah})^2` (``scipy.linalg.expm``). The solver finds the
+orbit by itself: 20 periods from a point near the origin.
 
 Run: python examples/relay_feedback.py   (filippov installed, or PYTHONPATH=src)
 """
+import matplotlib.pyplot as plt
 import numpy as np
 from scipy.linalg import expm
 from scipy.optimize import brentq
@@ -53,7 +62,14 @@ def computed(periods=20, rtol=RTOL):
     # both fields are linear: the system carries their Jacobian A (jacobians=)
     return {"half_period": down[0].t - up[-2].t, "period": up[-1].t - up[-2].t,
             "x0": up[-1].state, "monodromy": monodromy(SYSTEM, one, rtol=rtol)[0],
-            "multipliers": floquet_multipliers(SYSTEM, one, rtol=rtol)}
+            "multipliers": floquet_multipliers(SYSTEM, one, rtol=rtol), "orbit": one}
+
+
+def closed_orbit(t, x0, h):
+    """x(t) of the closed form, from x0 at t = 0 (one state per row)."""
+    s, sign = np.mod(t, h), np.where(np.mod(t, 2 * h) < h, 1.0, -1.0)
+    return np.array([g * (expm(A * si) @ x0 - np.linalg.solve(A, (expm(A * si) - np.eye(3)) @ b))
+                     for si, g in zip(s, sign)])
 
 
 def main():
@@ -64,6 +80,18 @@ def main():
             idx = np.unravel_index(i, np.shape(want[key]))  # () for a number
             name = key + (f"[{','.join(map(str, idx))}]" if idx else "")
             print(f"{name:16s} {g:20.15g} {w:20.15g} {abs(g - w):12.1e}")
+    # the last period the solver found (points), and the closed form through x0 (line)
+    t, z, _ = got["orbit"].sample(np.linspace(0.0, got["period"], 60), include_events=False)
+    line = closed_orbit(np.linspace(0.0, want["period"], 400), want["x0"], want["half_period"])
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.plot(line[:, 0], line[:, 1], "-", color="0.6", lw=3, label="closed form")
+    ax.plot(z[0], z[1], ".", color="C0", label="simulate (DOP853, rtol 1e-12)")
+    ax.plot(*want["x0"][:2], "o", mfc="none", color="C3", ms=9, label="$x_0$ (crossing up)")
+    ax.set(xlabel="$x_1 = c^T x$", ylabel="$x_2$", title="relay feedback: the periodic orbit")
+    ax.axvline(0.0, color="k", lw=0.5)
+    ax.legend(loc="center")
+    if "agg" not in plt.get_backend().lower():   # a window when run with a display
+        plt.show()
 
 
 if __name__ == "__main__":

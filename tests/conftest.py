@@ -134,3 +134,49 @@ def _build(folder: Path) -> dict:
     t0 = time.perf_counter()
     run = run_snakemake(work, cores="all")
     return {"work": work, "run": run, "seconds": time.perf_counter() - t0}
+
+
+#: a finished `make docs` site (docs/_build/html) to read instead of building one here
+REUSE_DOCS = "FILIPPOV_DOCS_BUILD"
+
+
+@pytest.fixture(scope="session")
+def docs_site(tmp_path_factory):
+    """The documentation site, built once as `make docs` builds it (sphinx, warnings as
+    errors) from a copy of docs/ and examples/ (sphinx writes generated pages into its
+    source folder: the tree's docs/ is left alone); the folder of its HTML.
+    ``FILIPPOV_DOCS_BUILD=DIR``: DIR is such a site already (e.g. docs/_build/html)."""
+    reuse = os.environ.get(REUSE_DOCS)
+    if reuse:
+        html = Path(reuse).resolve()
+        if not (html / "index.html").is_file():
+            raise pytest.UsageError(f"{REUSE_DOCS}={html}: no index.html there")
+        return html
+    if os.environ.get("PYTEST_XDIST_WORKER") is None:
+        return _build_docs(tmp_path_factory.mktemp("docs"))
+    shared = tmp_path_factory.getbasetemp().parent   # one site for all workers
+    with open(shared / "docs.lock", "a") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not (shared / "docs" / "html" / "index.html").is_file():
+            _build_docs(shared / "docs")
+    return shared / "docs" / "html"
+
+
+def _build_docs(folder: Path) -> Path:
+    project = folder / "project"
+    skip = shutil.ignore_patterns("_build", "generated", "auto_examples", "__pycache__")
+    shutil.copytree(ROOT / "docs", project / "docs", ignore=skip)
+    shutil.copytree(ROOT / "examples", project / "examples", ignore=skip)
+    for name in ("src", "workflow"):   # read only: the sources the pages document
+        (project / name).symlink_to(ROOT / name)
+    html = folder / "html"
+    env = dict(os.environ, MPLBACKEND="Agg", SOURCE_DATE_EPOCH="0",
+               PYTHONPATH=os.pathsep.join([str(SRC), str(PIPELINE)]
+                                          + [p for p in [os.environ.get("PYTHONPATH")] if p]))
+    run = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b",
+                          "html", "-d", str(folder / "doctrees"), str(project / "docs"),
+                          str(html)], cwd=project, env=env, capture_output=True, text=True)
+    if run.returncode != 0:
+        raise AssertionError(f"the docs do not build (exit {run.returncode}):\n"
+                             f"{run.stdout[-3000:]}\n{run.stderr[-5000:]}")
+    return html

@@ -131,3 +131,21 @@ def test_one_definition_and_the_symbolic_system_find_the_orbit_on_both_engines(t
     assert np.array_equal(np.asarray(scope["relay_sym"].jacobians["plus"], dtype=float),
                           relay.A)
     assert out.count("compiled 3.67975067086") == 2 and out.count("reference 3.67975067086") == 2
+
+
+def test_no_docstring_cites_a_latex_label_of_the_paper():
+    # the API reference is made from the docstrings: a paper's equation, figure or
+    # section is cited by the number the paper prints ("Eq. (9)", "Fig. 4", "Appendix C";
+    # paper/paper_labels.tex), not by its LaTeX label (eq:atSl, fig:retmaps, sec:dfo1).
+    # Every module of the library, and the pipeline's modules on the API pages.
+    from filippov_paper.report_html import INTERNAL_LABEL
+
+    modules = sorted((ROOT / "src" / "filippov").rglob("*.py"))
+    documented = re.findall(r"^\s+(filippov_paper\.[\w.]+)$",
+                            (DOCS / "modules.rst").read_text(), re.M)
+    assert documented
+    modules += [ROOT / "workflow" / (name.replace(".", "/") + ".py") for name in documented]
+    leaks = [f"{path.relative_to(ROOT)}:{text[:m.start()].count(chr(10)) + 1}: {m.group(0)}"
+             for path in modules for text in [path.read_text()]
+             for m in re.finditer(INTERNAL_LABEL.pattern + r"[A-Za-z0-9:_-]*", text)]
+    assert not leaks, leaks

@@ -1,4 +1,4 @@
-"""Slow-fast Filippov models (eq:sgfilipslow, eq:sgfilipfast) and their reduced systems.
+"""Slow-fast Filippov models (Eqs. (3), (4)) and their reduced systems.
 
 A model is written once, in the paper's terms: slow fields ``f_-(x, y)`` and
 ``f_+(x, y)``, a switching function ``h(x, y)`` that may depend on the fast
@@ -7,7 +7,7 @@ gives either
 
 * :meth:`SlowFastModel.full` -- the slow-fast system in ``z = (x, y)`` with
   fields ``(f, g/eps)``, or
-* :meth:`SlowFastModel.reduced` -- the quasi-static system (eq:filipred) in
+* :meth:`SlowFastModel.reduced` -- the quasi-static system (Eq. (6)) in
   ``z = x`` with ``y = y0(x)`` the root of ``g = 0`` at ``eps = 0``,
 
 so that a scene asks for exactly the system it needs.

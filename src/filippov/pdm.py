@@ -1,11 +1,11 @@
 """The Poincare discontinuity map P_DM of the slow-fast Hopf example, computed
-by the event-driven solver (appendix of the paper, eq:pdmdiscdef).
+by the event-driven solver (appendix of the paper, Eq. (B.1)).
 
 P_DM maps the curve L2 = {y = x1, h'_+ = 0} near the grazing point
 p_g = (-1, 0, -1) to itself. On M_+ = {y = x1} the condition h'_+ = 0 reads
 x1' = f_+,1(x) = 0, so L2 is the set of minima of x1 along the orbits of E_+ on
 M_+, and it is parametrised by x1. For a point p0 of L2 with x1 < -1
-(eq:pdmdiscdef)
+(Eq. (B.1))
 
     P_DM = Pi_3 o P_3 o Pi_2 o Pi_1:
 
@@ -31,8 +31,8 @@ again before it reaches L2; :func:`discontinuity_map` therefore also returns
 ``P_flow``, the x1 at which the true trajectory of the piecewise system first
 reaches L2 (after all its excursions): the local map the return map sees.
 
-Coordinates: xi1 = (x1 + 1) / scale with scale = eps for theta < 0 (eq:scal)
-and scale = eps^2 for theta > 0 (eq:p:scal); in both scalings x2 and time are
+Coordinates: xi1 = (x1 + 1) / scale with scale = eps for theta < 0 (Eq. (B.2))
+and scale = eps^2 for theta > 0 (Eq. (B.24)); in both scalings x2 and time are
 scaled by sqrt(scale).
 """
 from __future__ import annotations
@@ -58,7 +58,7 @@ def scale_for(eps: float, theta: float) -> float:
 
 def l2_x2(x1, mu: float, omega: float):
     """x2 of the point of L2 with the given x1: the root near 0 of
-    f_+,1 = mu x1 - omega x2 - (x1^2 + x2^2) x1 = 0 (eq:l2def), written without
+    f_+,1 = mu x1 - omega x2 - (x1^2 + x2^2) x1 = 0 (Eq. (B.9)), written without
     cancellation."""
     x1 = np.asarray(x1, dtype=float)
     c = x1 * (mu - x1 * x1)
@@ -86,8 +86,8 @@ class PDMResult:
     """P_DM on a grid of xi1 (all arrays have the grid's shape).
 
     Rescaled quantities use ``scale`` for x1 and ``sqrt(scale)`` for x2 and time;
-    times in ``excursion_time`` are in units of eps (the fast time s of eq:fm:rescaled
-    for theta < 0, the time t of eq:fs for theta > 0).
+    times in ``excursion_time`` are in units of eps (the fast time s of Eq. (B.13)
+    for theta < 0, the time t of Eq. (B.28) for theta > 0).
     """
 
     scale: float

@@ -6,7 +6,7 @@ compiles the same functions with numba where they are called (every public funct
 here is registered as compilable by :mod:`filippov.kernel.base`; a new rule needs no
 list entry), so the two engines cannot drift apart on a decision (the engines differ
 only in how they step, sample and store). Modes are the integers of :mod:`filippov.system`;
-``a = grad H . F_-`` and ``b = grad H . F_+`` are the normal speeds (eq:atSl).
+``a = grad H . F_-`` and ``b = grad H . F_+`` are the normal speeds (Eq. (9)).
 """
 from __future__ import annotations
 
@@ -305,7 +305,7 @@ def start_on_switch(H: float, a: float, b: float, sliding: bool) -> tuple[int, b
 
 
 def next_mode(mode: int, ended_by: int, a: float, b: float) -> int:
-    """The Filippov decision at a point of H = 0 (eq:atSl). A slide ends into the
+    """The Filippov decision at a point of H = 0 (Eq. (9)). A slide ends into the
     region whose field turned tangent; a crossing from H > 0 (F_+ points down)
     slides when F_- points back up (a > 0), one from H < 0 when F_+ points back
     down (b < 0), and crosses otherwise."""

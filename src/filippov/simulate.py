@@ -11,8 +11,8 @@ The loop is the textbook one for Filippov systems:
    a sample or between samples: an extremum of theirs toward zero, from their
    rates along the orbit, :func:`filippov.rules.speed_graze`), or a user
    :class:`Section`; refine it with Brent's method;
-3. at a hit of ``H = 0`` decide from ``a = dH.F_-`` and ``b = dH.F_+`` (eq:atSl,
-   eq:eminus) whether the trajectory crosses or starts sliding, log it, restart.
+3. at a hit of ``H = 0`` decide from ``a = dH.F_-`` and ``b = dH.F_+`` (Eqs. (9),
+   (A.3)) whether the trajectory crosses or starts sliding, log it, restart.
 
 Guards stop a run with a clear error instead of hanging or handing on NaN: a
 bound on events and steps, and an accumulation (Zeno) detector.

@@ -1,4 +1,4 @@
-"""Where on the switching manifold sliding attracts (eq:atSl), found by root finding.
+"""Where on the switching manifold sliding attracts (Eq. (9)), found by root finding.
 
 For a curve ``s -> z(s)`` lying in H_s the attracting sliding set is where
 ``a(s) = dH.F_-`` is positive and ``b(s) = dH.F_+`` negative; its ends are roots

@@ -362,7 +362,7 @@ def _regions(flows):
 
 @one_spelling
 class SymbolicSlowFast:
-    """A slow-fast Filippov model (the paper's eq:sgfilipslow, eq:sgfilipfast) in SymPy.
+    """A slow-fast Filippov model (the paper's Eqs. (3), (4)) in SymPy.
 
     ``x' = f_+(x, y)``, ``eps y' = g_+(x, y)`` where ``h(x, y) >= 0``, else with
     ``f_-``, ``g_-``. :meth:`full` is the slow-fast system in ``z = (x, y)``;

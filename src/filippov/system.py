@@ -5,7 +5,7 @@ slow-fast model (state ``z = (x, y)``, fields ``(f, g/eps)``) or from its reduce
 system (state ``x``, ``y = y0(x)``) is decided by whoever built it; the solver
 never knows which physics it runs.
 
-Conventions (the paper's eq:filip): region ``+`` is ``H(z) >= 0``, region ``-`` is
+Conventions (the paper's Eq. (1)): region ``+`` is ``H(z) >= 0``, region ``-`` is
 ``H(z) < 0``. All callables take a state with the components along axis 0, so
 ``z`` may be a vector ``(n,)`` or a batch ``(n, m)``; exact flows take a start
 state ``(n,)`` and elapsed times ``tau`` (scalar or ``(m,)``). The full contract
@@ -101,7 +101,7 @@ class PiecewiseSystem:
     def normal_speeds(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(a, b) = (dH.F_-, dH.F_+)``: the rates of change of H along each field.
 
-        Attracting sliding needs a > 0 > b (eq:atSl); a < 0 < b is repelling.
+        Attracting sliding needs a > 0 > b (Eq. (9)); a < 0 < b is repelling.
         """
         grad = self.switch_grad(z)
         a = np.sum(grad * self.field_minus(z), axis=0)
@@ -109,7 +109,7 @@ class PiecewiseSystem:
         return a, b
 
     def sliding_field(self, z: np.ndarray) -> np.ndarray:
-        """Filippov's convex combination (eq:slide): tangent to H = 0."""
+        """Filippov's convex combination (Eq. (2)): tangent to H = 0."""
         grad, fm, fp = self.switch_grad(z), self.field_minus(z), self.field_plus(z)
         a, b = np.sum(grad * fm, axis=0), np.sum(grad * fp, axis=0)
         return (a * fp - b * fm) / (a - b)

@@ -3,7 +3,7 @@
 Four measurements, each at one value of eps and independent of every other eps
 (so a sweep split into chunks gives the same numbers, bit for bit):
 
-* :func:`theta_negative_jump` -- the Hopf example of fig:retmaps at theta < 0:
+* :func:`theta_negative_jump` -- the Hopf example of Fig. 4 at theta < 0:
   the jump 1 - P(x2) of the return map just above grazing (x2 = 1 + 1e-13),
   from the compiled kernel; jump/eps converges as eps -> 0.
 * :func:`theta_positive_slope` -- the same map at theta > 0: the one-sided

@@ -1,4 +1,4 @@
-"""The symmetric chatter orbit of eq:peqslow/eq:peqfast for theta < 0 (sec:exmpl).
+"""The symmetric chatter orbit of Eqs. (7)/(8) for theta < 0 (Sec. 2).
 
 Let eps T be the time spent on each side and E = exp(-T). Following the flow of
 f_+ from the switch point (x_s, y_s) for time eps T must land on (-x_s, -y_s),

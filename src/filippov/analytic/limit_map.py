@@ -1,7 +1,7 @@
 """The limit map: the return map to L1 of the Hopf example near grazing as the paper's
 asymptotics give it, in scaled coordinates.
 
-Scales: sigma = eps for theta < 0 (eq:scal), eps^2 for theta > 0 (eq:p:scal). On L1
+Scales: sigma = eps for theta < 0 (Eq. (B.2)), eps^2 for theta > 0 (Eq. (B.24)). On L1
 (x1 = 0, x2 > 0) the coordinate is u = (x2 - 1)/sigma, the parameter s = (mu - 1)/sigma.
 One return is composed of
 

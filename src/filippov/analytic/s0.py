@@ -1,4 +1,4 @@
-"""s0(theta): the positive root of (1 - theta) exp(-s) - 1 + s + theta = 0 (eq:s0def).
+"""s0(theta): the positive root of (1 - theta) exp(-s) - 1 + s + theta = 0 (Eq. (B.15)).
 
 Two independent evaluations, used to check each other:
 
@@ -6,7 +6,7 @@ Two independent evaluations, used to check each other:
   z = s - b. Its branch W_{-1} gives z = -b (the trivial root s = 0); the
   principal branch gives s0 = 1 - theta + W_0(-(1 - theta) e^{theta - 1}).
 * root finding: Brent's method on the bracket [-theta, 1 - theta], where the
-  left side of eq:s0def is negative at s = -theta and positive at s = 1 - theta.
+  left side of Eq. (B.15) is negative at s = -theta and positive at s = 1 - theta.
 """
 from __future__ import annotations
 
@@ -20,12 +20,12 @@ from scipy.special import lambertw
 def _check(theta: np.ndarray) -> np.ndarray:
     theta = np.asarray(theta, dtype=float)
     if not np.all(np.isfinite(theta)) or np.any(theta >= 0):
-        raise ValueError("theta must be finite and < 0 for s0(theta) (eq:s0def)")
+        raise ValueError("theta must be finite and < 0 for s0(theta) (Eq. (B.15))")
     return theta
 
 
 def residual(s, theta):
-    """Left-hand side of eq:s0def; expm1 keeps it accurate for small s."""
+    """Left-hand side of Eq. (B.15); expm1 keeps it accurate for small s."""
     return (1 - theta) * np.expm1(-s) + s
 
 

@@ -1,4 +1,4 @@
-"""The graph of s(theta, omega, ., 0) (eq:xi1r, lemma thm:pdm, case theta > 0).
+"""The graph of s(theta, omega, ., 0) (Eq. (23), Lemma 3, case theta > 0).
 
 The zero-order discontinuity map for 0 < theta < 1 is given parametrically by the
 sliding time t_s > 0. With u = t_s/theta and e = exp(-u):
@@ -47,7 +47,7 @@ _SERIES_BELOW = 1.0
 def _check(theta: float, omega: float) -> tuple[float, float]:
     theta, omega = float(theta), float(omega)
     if not (np.isfinite(theta) and 0.0 < theta < 1.0):
-        raise ValueError(f"eq:xi1r holds for 0 < theta < 1 (case theta > 0 of thm:pdm), "
+        raise ValueError(f"Eq. (23) holds for 0 < theta < 1 (case theta > 0 of Lemma 3), "
                          f"got theta={theta!r}")
     if not (np.isfinite(omega) and omega != 0.0):
         raise ValueError(f"omega must be finite and nonzero, got {omega!r}")
@@ -84,7 +84,7 @@ def _parts(t, theta):
 
 
 def xi1(t_s, theta: float, omega: float) -> np.ndarray:
-    """xi1 of eq:xi1r as a function of the sliding time t_s (<= 0)."""
+    """xi1 of Eq. (23) as a function of the sliding time t_s (<= 0)."""
     theta, omega = _check(theta, omega)
     t = _times(t_s)
     _, D, N = _parts(t, theta)
@@ -92,7 +92,7 @@ def xi1(t_s, theta: float, omega: float) -> np.ndarray:
 
 
 def image(t_s, theta: float, omega: float) -> np.ndarray:
-    """s(theta, omega, xi1, 0) * xi1 of eq:xi1r, i.e. P_DM(xi1), as a function of t_s."""
+    """s(theta, omega, xi1, 0) * xi1 of Eq. (23), i.e. P_DM(xi1), as a function of t_s."""
     theta, omega = _check(theta, omega)
     t = _times(t_s)
     u, D, _ = _parts(t, theta)

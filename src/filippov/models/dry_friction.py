@@ -1,7 +1,7 @@
-"""The autonomous dry-friction oscillator of sec:dfo1 (eq:dfo1, eq:dfo-sf), M = K = 1.
+"""The autonomous dry-friction oscillator of Appendix C (Eqs. (C.1), (C.3)), M = K = 1.
 
 Slow state x = (x1, x2) (block position and velocity), fast state y = (w,) with
-w = gamma x2 + v (v: belt speed):
+w = gamma x2 + v (v: belt speed)::
 
     x1' = x2
     x2' = -x1 - F_c((1 + gamma) x2 - w)
@@ -9,13 +9,13 @@ w = gamma x2 + v (v: belt speed):
     h = w - (1 + gamma) x2 = v - x2          (region + : h >= 0, block slower than belt)
 
 The reduced system (eps = 0) has w = y0(x) = v0 + gamma x2, so h0 = v0 - x2 and
-the slow equations become eq:dfo1 with belt speed v = v0.
+the slow equations become Eq. (C.1) with belt speed v = v0.
 
-Friction law. The caption of fig:dfo-retmap prints
+Friction law. The caption of Fig. C.2 prints
 ``F_c(nu) = f0 sgn(nu) + fv nu + fc (1 - exp(-|nu|)) sgn(nu)`` with f0 = -2,
-fv = 0.3, fc = 2.5. Read literally with eq:dfo1 (force -F_c on the block) this
+fv = 0.3, fc = 2.5. Read literally with Eq. (C.1) (force -F_c on the block) this
 gives F_c(0+) = -2: friction would push the block along its relative velocity,
-sticking on x2 = v is repelling (eq:atSl fails) and the equilibrium never loses
+sticking on x2 = v is repelling (Eq. (9) fails) and the equilibrium never loses
 stability. The convention adopted here ("stribeck") is the one of the paper's
 commented-out friction curve: F_c acts against the relative velocity with a
 static level ``|f0| = 2`` that decays to -f0 - fc = -0.5 and then grows with fv::
@@ -158,13 +158,13 @@ def _defined(expr):
     return out.subs(nu, NU.doit())
 
 
-#: eq:dfo-sf written once; the friction law enters through (s0, sc) (see :func:`_coefficients`)
+#: Eq. (C.3) written once; the friction law enters through (s0, sc) (see :func:`_coefficients`)
 DEFINITION = SymbolicSlowFast(
     (x1, x2), (w,), f_minus=(x2, _defined(SLOW["minus"])), f_plus=(x2, _defined(SLOW["plus"])),
     g_minus=(_defined(FAST),), g_plus=(_defined(FAST),), switch=-NU.doit(), eps=eps,
     params={eps: 0.01, v0: 1.0, gamma: 2.0, s0: 2.0, sc: -2.5, fv: 0.3}, name="dry_friction")
 
-#: the section L of fig:dfo-retmap: x2 = 0 crossed downward with x1 > 0 (the caller's choice)
+#: the section L of Fig. C.2: x2 = 0 crossed downward with x1 > 0 (the caller's choice)
 L = {"section": x2, "direction": -1, "where": x1 > 0}
 
 
@@ -259,7 +259,7 @@ _FULL: dict = {}   # 'full' / 'reduced' -> the SymbolicSystem (derived once, the
 
 def system(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck", *,
            sliding=True):
-    """The slow-fast system eq:dfo-sf for either engine (a
+    """The slow-fast system Eq. (C.3) for either engine (a
     :class:`~filippov.symbolic.GeneratedSystem`, no section). No region has a
     closed-form flow: every mode is integrated (DOP853)."""
     values = _values(eps, v0, gamma, f0, fv, fc, convention)
@@ -274,7 +274,7 @@ def system(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck", *
 def slow_manifold_plus(x1, x2, eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5,
                        convention="stribeck", relax=30.0, t_max=1.0, rtol=1e-12,
                        atol=1e-14, newton_tol=1e-13, max_iter=8):
-    """w on the slow manifold M_+ of eq:dfo-sf above the points (x1, x2).
+    """w on the slow manifold M_+ of Eq. (C.3) above the points (x1, x2).
 
     M_+ attracts at rate 1/eps, so it is reached by relaxation: start at x_s
     with w on the second-order expansion :data:`W2_PLUS` of M_+, follow the region-+ field for a time T = min(relax * eps, t_max) and solve (Newton, all
@@ -302,7 +302,7 @@ def slow_manifold_plus(x1, x2, eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5,
 
 
 class _PlusRelaxation:
-    """The region-+ field of eq:dfo-sf for a batch of ``m`` points (states stacked as
+    """The region-+ field of Eq. (C.3) for a batch of ``m`` points (states stacked as
     (x1, x2, w) blocks), F_plus continued by its tangent beyond nu = 0
     (:data:`REGION_PLUS`), the second-order expansion w2 of M_+, and the relaxation onto
     M_+ that :func:`slow_manifold_plus` solves for; ``law`` = (s0, sc, fv)."""
@@ -376,7 +376,7 @@ class _PlusRelaxation:
 
 # --------------------------------------------------------------------------- fast forms
 def plus_field_reduced(v, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck"):
-    """(f, df/dx, df/dv) of eq:dfo1 in region + (friction branch F_plus, extended
+    """(f, df/dx, df/dv) of Eq. (C.1) in region + (friction branch F_plus, extended
     smoothly to x2 > v): for shooting and the variational equations; printed from
     :data:`DEFINITION` (:func:`_reduced_plus`)."""
     law = law_coefficients(f0, fv, fc, convention)
@@ -408,7 +408,7 @@ def reduced_jacobian(v, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck"):
 
 def full_system(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck",
                 sliding=True):
-    """The slow-fast system eq:dfo-sf as the reference driver's PiecewiseSystem: the
+    """The slow-fast system Eq. (C.3) as the reference driver's PiecewiseSystem: the
     generated pieces of :func:`system` (compiled loops over the samples; the same code
     as the compiled engine's, so the two engines see the same field values)."""
     return system(eps, v0, gamma, f0, fv, fc, convention, sliding=sliding).python()
@@ -466,5 +466,5 @@ def slow_manifold_plus_on_L(x1_lo, x1_hi, eps, v0, n=33, **kwargs):
 def compiled(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck", *,
              sliding=True):
     """:func:`system` on the compiled engine with the section :data:`L` of
-    fig:dfo-retmap (x2 = 0 crossed downward, x1 > 0)."""
+    Fig. C.2 (x2 = 0 crossed downward, x1 > 0)."""
     return system(eps, v0, gamma, f0, fv, fc, convention, sliding=sliding).compiled(**L)

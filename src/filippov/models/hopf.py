@@ -1,4 +1,4 @@
-"""The minimal grazing-sliding example (eq:red; eq:exslow2, eq:exfast2).
+"""The minimal grazing-sliding example (Eq. (11); Eqs. (15), (16)).
 
 Slow state x = (x1, x2), fast state y::
 
@@ -30,7 +30,7 @@ The model is written once, as SymPy expressions (:data:`DEFINITION`, with these
 flows): the reference driver's :class:`~filippov.model.SlowFastModel` (:func:`model`,
 NumPy) and the compiled engine's pieces (:func:`system`, numba) are generated from
 it, with the switching gradient and the Jacobians (:mod:`filippov.symbolic`).
-Sections are the caller's: :data:`L1` is the one of fig:retmaps.
+Sections are the caller's: :data:`L1` is the one of Fig. 4.
 """
 from __future__ import annotations
 
@@ -82,7 +82,7 @@ def _ascending_in_eps(expr):
     return sp.Add(*sorted(terms, key=lambda a: sp.degree(a, eps)), evaluate=False)
 
 
-#: eq:ymm: y on ``M_-`` to O(eps) (its terms of order 1 and eps)
+#: Eq. (18): y on ``M_-`` to O(eps) (its terms of order 1 and eps)
 SLOW_MANIFOLD_MINUS_FIRST_ORDER = _through_order(_M_MINUS, 1)
 #: y on H_s, the switching surface solved for the fast variable
 SWITCHING_SURFACE_Y = sp.solve(SWITCH, y)[0]
@@ -116,10 +116,10 @@ def _definition() -> SymbolicSlowFast:
         name="hopf")
 
 
-#: the minimal grazing-sliding example, written once (eq:red; eq:exslow2, eq:exfast2)
+#: the minimal grazing-sliding example, written once (Eq. (11); Eqs. (15), (16))
 DEFINITION = _definition()
 
-#: the section L1 of fig:retmaps: x1 = 0 crossed downwards with x2 > 0 (the caller's choice;
+#: the section L1 of Fig. 4: x1 = 0 crossed downwards with x2 > 0 (the caller's choice;
 #: the model carries no section)
 L1 = {"section": x1, "direction": -1, "where": x2 > 0}
 
@@ -143,7 +143,7 @@ slow_manifold_minus = sp.lambdify((x1, x2, eps, mu, omega), SLOW_MANIFOLD_MINUS,
 slow_manifold_minus.__doc__ = "y on ``M_-``, the exact slow invariant manifold of region -."
 slow_manifold_minus_first_order = codegen.lambdify_written(
     (x1, x2, eps, mu, omega), SLOW_MANIFOLD_MINUS_FIRST_ORDER)
-slow_manifold_minus_first_order.__doc__ = "eq:ymm: y on ``M_-`` to O(eps)."
+slow_manifold_minus_first_order.__doc__ = "Eq. (18): y on ``M_-`` to O(eps)."
 fast_field = codegen.lambdify_written((x1, x2, y, eps, mu, omega), FAST)
 fast_field.__doc__ = "g(x, y) = eps y', elementwise (both regions)."
 switching_surface_y = sp.lambdify((x1, theta), SWITCHING_SURFACE_Y, "numpy")
@@ -200,5 +200,5 @@ def system(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi, 
 def compiled(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi, *,
              sliding: bool = True, exact: bool = True):
     """The compiled engine's model of :func:`system` with the section :data:`L1` of
-    fig:retmaps (x1 = 0, x1 decreasing, x2 > 0)."""
+    Fig. 4 (x1 = 0, x1 decreasing, x2 > 0)."""
     return system(eps, theta, mu, omega, sliding=sliding, exact=exact).compiled(**L1)

@@ -1,4 +1,4 @@
-"""Two planar Filippov systems for fig:slidesketch, switching on H_s = {x2 = 0}.
+"""Two planar Filippov systems for Fig. 1, switching on H_s = {x2 = 0}.
 
 * "crossing": both fields point upward through H_s (f_- = (1, 1 + x1/2),
   f_+ = (1, 1/2)); a trajectory crosses.

@@ -1,10 +1,10 @@
-"""The pseudo-equilibrium example of section sec:exmpl (eq:peqslow, eq:peqfast).
+"""The pseudo-equilibrium example of Sec. 2 (Eqs. (7), (8)).
 
     x' = -sign(theta x + (1 - theta) y),    eps y' = x - y.
 
 Region + (h >= 0) has x' = -1, region - has x' = +1; the fast variable relaxes to
 x. Every region has a closed-form flow; so has the sliding flow on H_s for
-0 < theta < 1 (x' = -x / (eps theta), a fact derived from eq:slide). Written once
+0 < theta < 1 (x' = -x / (eps theta), a fact derived from Eq. (2)). Written once
 (:data:`DEFINITION`); both engines' pieces are generated from it.
 """
 from __future__ import annotations
@@ -39,7 +39,7 @@ def _slope(c):
     return [x + c * t, x + c * t - c * eps + (y - x + c * eps) * sp.exp(-t / eps)]
 
 
-#: the example written once; sliding on H_s has x' = -x / (eps theta) (from eq:slide,
+#: the example written once; sliding on H_s has x' = -x / (eps theta) (from Eq. (2),
 #: for 0 < theta < 1) and y = -theta x / (1 - theta)
 DEFINITION = SymbolicSlowFast(
     (x,), (y,), f_minus=(1,), f_plus=(-1,), g_minus=(x - y,), g_plus=(x - y,),
