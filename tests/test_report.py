@@ -147,6 +147,26 @@ def test_the_paper_is_cited_by_its_printed_numbers():
     assert sorted(ids) == [f"fig{k:02d}" for k in range(1, 12)]
 
 
+def test_the_lyapunov_table_heads_each_group_of_eps_columns():
+    # two groups of one column per eps: each says what it holds and that its columns
+    # are eps values, under a rule of its own (booktabs \cmidrule)
+    from filippov_paper.scenes.fig13_small_scale_chaos import _report_table
+
+    eps, s, theta = [1e-2, 1e-3, 1e-4], np.linspace(-1.0, 5.0, 7), [0.7, 0.2]
+    shape = (len(theta), len(eps), len(s))
+    ds = xr.Dataset({"lyapunov": (("theta", "eps", "s"), -np.ones(shape)),
+                     "lyapunov_limit": (("theta", "eps", "s"), -np.ones(shape)),
+                     "slope_pdm": ("theta", [-0.43, -4.0])},
+                    coords={"theta": theta, "eps": eps, "s": s}, attrs={"s_max": 5.0})
+    text = _report_table(ds)
+    head = text.split(r"\midrule")[0]
+    groups = re.findall(r"\\multicolumn\{3\}\{c\}\{([^}]*\$[^$]*\$)\}", head)
+    assert len(groups) == 2 and all(r"\epsilon=" in g for g in groups), head
+    assert r"\cmidrule(lr){3-5}" in head and r"\cmidrule(l){6-8}" in head, head
+    # the rules stand between the group heads and the row of eps values
+    assert head.index("cmidrule") < head.index(r"$\theta$"), head
+
+
 # ----------------------------------------------------------------------------- the build
 def _tex_available():
     if not all(shutil.which(t) for t in ("latexmk", "pdflatex", "kpsewhich")):
