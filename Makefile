@@ -194,7 +194,7 @@ lock: | check-python
 clean:
 	rm -rf results/ .snakemake/ logs/ paper/generated paper/.build.* report.html
 	rm -f figures/*.pdf figures/*.png
-	rm -f paper/main.pdf paper/main.log paper/main.fls paper/main.build.log
+	rm -f paper/main.pdf paper/main.log paper/main.fls paper/main.aux paper/main.build.log
 	rm -rf docs/_build docs/generated docs/auto_examples
 
 distclean: clean

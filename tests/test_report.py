@@ -118,7 +118,7 @@ def test_no_number_typed_in_the_figure_prose():
     for name in ("sec_figures.tex", "sec_pdm.tex", "sec_hardcases.tex", "sec_instabilities.tex"):
         text = (ROOT / "paper" / name).read_text()
         text = re.sub(r"\\paperfig\{[^}]*\}\{[^}]*\}", "", text)
-        text = re.sub(r"\\(pref|pnum|testref|label|ref|eqref|includegraphics|input)(\[[^]]*\])?\{[^}]*\}",
+        text = re.sub(r"\\(pref|pnum|testref|label|ref|figref|eqref|includegraphics|input)(\[[^]]*\])?\{[^}]*\}",
                       "", text)
         text = re.sub(r"\\[A-Za-z]+", "", text)   # macro names (rpTwoPeriod, ...)
         found = set(re.findall(r"(?<![A-Za-z_0-9.])-?\d+(?:\.\d+)?(?:\^\{-?\d+\})?", text))
@@ -145,6 +145,35 @@ def test_the_paper_is_cited_by_its_printed_numbers():
                        for n in ("sec_figures.tex", "sec_pdm.tex", "sec_dryfriction.tex"))
     ids = re.findall(r"\\paperfig\{fig:[^}]*\}\{(fig\d\d)", captions)
     assert sorted(ids) == [f"fig{k:02d}" for k in range(1, 12)]
+
+
+def test_every_figure_reference_records_its_page():
+    # \figref is \ref that also writes the page it is printed on into main.aux, which
+    # test_every_figure_is_printed_near_its_first_mention_before_the_references reads;
+    # a plain \ref to a figure would go unseen there
+    for tex in sorted((ROOT / "paper").glob("*.tex")):
+        plain = re.findall(r"\\ref\{(fig:[^}]*)\}", tex.read_text())
+        assert not plain, f"{tex.name}: \\ref to a figure, use \\figref: {plain}"
+
+
+def test_the_lyapunov_table_heads_each_group_of_eps_columns():
+    # two groups of one column per eps: each says what it holds and that its columns
+    # are eps values, under a rule of its own (booktabs \cmidrule)
+    from filippov_paper.scenes.fig13_small_scale_chaos import _report_table
+
+    eps, s, theta = [1e-2, 1e-3, 1e-4], np.linspace(-1.0, 5.0, 7), [0.7, 0.2]
+    shape = (len(theta), len(eps), len(s))
+    ds = xr.Dataset({"lyapunov": (("theta", "eps", "s"), -np.ones(shape)),
+                     "lyapunov_limit": (("theta", "eps", "s"), -np.ones(shape)),
+                     "slope_pdm": ("theta", [-0.43, -4.0])},
+                    coords={"theta": theta, "eps": eps, "s": s}, attrs={"s_max": 5.0})
+    text = _report_table(ds)
+    head = text.split(r"\midrule")[0]
+    groups = re.findall(r"\\multicolumn\{3\}\{c\}\{([^}]*\$[^$]*\$)\}", head)
+    assert len(groups) == 2 and all(r"\epsilon=" in g for g in groups), head
+    assert r"\cmidrule(lr){3-5}" in head and r"\cmidrule(l){6-8}" in head, head
+    # the rules stand between the group heads and the row of eps values
+    assert head.index("cmidrule") < head.index(r"$\theta$"), head
 
 
 # ----------------------------------------------------------------------------- the build
@@ -197,6 +226,42 @@ def test_log_has_no_overfull_box_over_five_points(built):
     log = (built["work"] / "paper" / "main.log").read_text(errors="replace")
     widths = [float(w) for w in re.findall(r"Overfull \\hbox \(([\d.]+)pt too wide\)", log)]
     assert all(w <= 5.0 for w in widths), f"overfull boxes: {sorted(widths)[::-1][:5]} pt"
+
+
+def _aux_pages(aux: str):
+    """From main.aux (rule `paper` keeps it): {figure label: (number, page)} of every
+    figure, {figure label: page of its first \figref} and, in the order the pages were
+    shipped out, the labels of the figures and of the references (rp:references)."""
+    labels = re.findall(r"^\\newlabel\{((?:fig|rp):[^}]*)\}\{\{([^}]*)\}\{(\d+)\}", aux, re.M)
+    figures = {lab: (int(num), int(page)) for lab, num, page in labels if lab.startswith("fig:")}
+    first = {}
+    for lab, page in re.findall(r"^\\rpfigmention\{([^}]*)\}\{(\d+)\}", aux, re.M):
+        first[lab] = min(first.get(lab, int(page)), int(page))
+    return figures, first, [lab for lab, _, _ in labels]
+
+
+def test_every_figure_is_printed_near_its_first_mention_before_the_references(built):
+    """Where the figures land in the PDF: every figure before the references (its label
+    written out on an earlier page, or higher up on the same one: the aux file is
+    written in the order the pages are shipped out) and at most two pages from the
+    first page that refers to it (\figref)."""
+    work = built["work"]
+    aux = (work / "paper" / "main.aux").read_text(errors="replace")
+    figures, first, order = _aux_pages(aux)
+    log = (work / "paper" / "main.log").read_text(errors="replace")
+    pages = int(re.search(r"Output written on \S+ \((\d+) pages?", log).group(1))
+    numbers = sorted(n for n, _ in figures.values())
+    assert numbers == list(range(1, len(numbers) + 1)), numbers
+    assert len(numbers) >= len([s for s in built["scenes"] if s in scenes.known_scenes()])
+    assert "rp:references" in order, "no rp:references label in main.aux"
+    after = order[order.index("rp:references") + 1:]
+    assert not after, f"figures printed after the references: {after}"
+    where = {lab: (num, page, first.get(lab)) for lab, (num, page) in figures.items()}
+    never = sorted(f"Fig. {n} ({lab})" for lab, (n, _, m) in where.items() if m is None)
+    assert not never, f"figures the text never refers to (\\figref): {never}"
+    far = sorted((n, lab, page, m) for lab, (n, page, m) in where.items() if abs(page - m) > 2)
+    assert not far, ("figures more than two pages from their first mention (number, label, "
+                     f"page, first mention; {pages} pages): {far}")
 
 
 def test_log_has_no_undefined_references_or_missing_files(built):

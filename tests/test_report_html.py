@@ -111,9 +111,10 @@ def test_labels_become_the_numbers_the_paper_prints():
 
 
 def test_the_scene_files_cite_the_paper_by_its_printed_numbers():
-    # a scene's description goes into its dataset (scene_config) as written: it cites
-    # the paper as printed ("Eq. (18)"), never by a LaTeX label of its source; only
-    # paper_figure is a label (the key the captions look the printed number up by)
+    # a scene's description goes into its dataset (scene_config): it cites the paper as
+    # printed ("Eq. (18)"), never by a LaTeX label of its source; only paper_figure is a
+    # label (the key the captions look the printed number up by), which the dataset's
+    # scene_config holds as printed ("Fig. 4"; scenes.printed)
     label = re.compile(r"(?<![A-Za-z0-9_])(?:%s)(?![A-Za-z0-9_\-])"
                        % "|".join(re.escape(k) for k in sorted(PRINTED, key=len, reverse=True)))
     for scene in SCENES:
@@ -373,9 +374,44 @@ def test_a_dataset_names_the_paper_s_numbers_not_its_labels():
     ds = xr.Dataset({"image": ((), 1.0, {"long_name": "s from eq:xi1r", "equation": "eq:xi1r",
                                          "units": "1"})},
                     attrs={"title": "graph from eq:xi1r (fig:p:xi12)",
-                           "scene_config": '{"description": "eq:xi1r"}'})
+                           "scene_config": '{"description": "eq:xi1r", "id": "fig06_sgraph", '
+                                           '"paper_figure": "fig:p:xi12", "x": 1.5}'})
     out = printed(ds, {"eq:xi1r": "Eq. (23)", "fig:p:xi12": "Fig. 6"})
     assert out.attrs["title"] == "graph from Eq. (23) (Fig. 6)"
     assert out["image"].attrs["long_name"] == "s from Eq. (23)"
     assert out["image"].attrs["equation"] == "Eq. (23)"
-    assert out.attrs["scene_config"] == ds.attrs["scene_config"]   # the file as given
+    # the scene as computed: its paper figure and description as printed, the rest as given
+    assert out.attrs["scene_config"] == ('{"description": "Eq. (23)", "id": "fig06_sgraph", '
+                                         '"paper_figure": "Fig. 6", "x": 1.5}')
+
+
+def test_no_dataset_attribute_holds_a_latex_label(workflow_build):
+    """The datasets of the shared build, as a reader of the netCDF files meets them: no
+    attribute (global or of a variable, the scene as computed in ``scene_config``
+    included) names one of the paper's LaTeX labels (``fig:retmaps``); a scene that
+    reproduces a figure of the paper says which by its printed number ("Fig. 4")."""
+    work, run = workflow_build["work"], workflow_build["run"]
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    paths = sorted((work / "results").glob("*.nc"))
+    assert paths
+    labelled = []
+    for path in paths:
+        with netCDF4.Dataset(path) as nc:
+            owners = [("", nc)] + [(name, var) for name, var in nc.variables.items()]
+            for owner, obj in owners:
+                for attr in obj.ncattrs():
+                    value = obj.getncattr(attr)
+                    found = report_html.INTERNAL_LABEL.search(value) \
+                        if isinstance(value, str) else None
+                    if found:
+                        where = f"{owner}.{attr}" if owner else attr
+                        labelled.append(f"{path.name}:{where}: "
+                                        f"...{value[found.start():found.start() + 30]}")
+    assert not labelled, "attributes with the paper's LaTeX labels:\n" + "\n".join(labelled)
+    for scene in scene_files(work / "config" / "scenes"):
+        data = yaml.safe_load((work / "config" / "scenes" / f"{scene}.yaml").read_text())
+        if "paper_figure" not in data:
+            continue
+        with netCDF4.Dataset(work / "results" / f"{scene}.nc") as nc:
+            computed = json.loads(nc.getncattr("scene_config"))
+        assert computed["paper_figure"] == PRINTED[data["paper_figure"]], scene

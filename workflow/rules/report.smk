@@ -49,7 +49,8 @@ rule report_tables:
 
 # latexmk builds in a fresh directory under paper/; only a complete PDF is moved
 # onto paper/main.pdf (same file system: atomic). latexmk's output is kept in
-# logs/paper.log (and the TeX log/recorder file in paper/main.{log,fls}) even on failure.
+# logs/paper.log (and the TeX log, recorder and aux files in paper/main.{log,fls,aux})
+# even on failure; tests/test_report.py reads the figures' pages from main.aux.
 rule paper:
     input:
         tex=sorted(str(p) for p in Path("paper").glob("*.tex")),
@@ -74,7 +75,7 @@ rule paper:
         ( cd paper && SOURCE_DATE_EPOCH=0 FORCE_SOURCE_DATE=1 \
             latexmk -pdf -interaction=nonstopmode -halt-on-error -file-line-error \
                     -recorder -outdir="${{build#paper/}}" main.tex ) > {log:q} 2>&1 || rc=$?
-        for ext in log fls; do
+        for ext in log fls aux; do
             if [ -f "$build/main.$ext" ]; then cp "$build/main.$ext" "paper/main.$ext"; fi
         done
         if [ "$rc" -ne 0 ]; then

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib
+import json
 import pkgutil
 
 from filippov_paper import product, tolerance
@@ -89,16 +90,21 @@ def _declared(module, scene, ds):
     return printed(tolerance.annotate(ds, declared))
 
 
-#: attributes whose text is for readers (the paper's labels in them are replaced);
-#: scene_config stays the scene file as given
+#: attributes whose text is for readers (the paper's labels in them are replaced)
 READER_ATTRS = ("title", "long_name", "equation", "comment", "description")
+#: the keys of the scene file that ``scene_config`` (the scene as JSON) holds for readers:
+#: the paper's figure the scene reproduces (a label in the scene file, the key the
+#: captions look it up by) and the description; every other key stays as given
+READER_SCENE_KEYS = ("paper_figure", "description")
 
 
 def printed(ds, labels: dict | None = None):
     """``ds`` with the paper's LaTeX labels (``eq:ymm``, ``fig:retmaps``) in its
-    titles, long names and equation attributes replaced by the numbers the paper
-    prints ("Eq. (18)", "Fig. 4"; paper/paper_labels.tex, :mod:`filippov_paper.paper_labels`):
-    a reader of the netCDF file has the paper, not its source."""
+    titles, long names and equation attributes, and in the ``paper_figure`` and
+    ``description`` of its ``scene_config``, replaced by the numbers the paper prints
+    ("Eq. (18)", "Fig. 4"; paper/paper_labels.tex, :mod:`filippov_paper.paper_labels`):
+    a reader of the netCDF file has the paper, not its source. (Chunks are not
+    printed: :func:`chunking.merge` compares their ``scene_config`` with the scene file.)"""
     from filippov_paper.paper_labels import OUT
     from filippov_paper.report_html import cite, printed_labels
 
@@ -106,9 +112,24 @@ def printed(ds, labels: dict | None = None):
     if not labels:
         return ds
 
+    def scene_config(text):
+        try:
+            scene = json.loads(text)
+        except ValueError:
+            return text
+        if not isinstance(scene, dict):
+            return text
+        for key in READER_SCENE_KEYS:
+            if isinstance(scene.get(key), str):
+                scene[key] = cite(scene[key], labels)
+        return json.dumps(scene, sort_keys=True)
+
     def fix(attrs):
-        return {k: cite(v, labels) if k in READER_ATTRS and isinstance(v, str) else v
-                for k, v in attrs.items()}
+        out = {k: cite(v, labels) if k in READER_ATTRS and isinstance(v, str) else v
+               for k, v in attrs.items()}
+        if isinstance(out.get("scene_config"), str):
+            out["scene_config"] = scene_config(out["scene_config"])
+        return out
 
     ds = ds.copy()
     ds.attrs = fix(ds.attrs)

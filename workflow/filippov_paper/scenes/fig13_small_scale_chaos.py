@@ -179,12 +179,17 @@ def _report_table(ds) -> str:
         cells += [f"${num(float(np.max(r)), 2)}$" for r in ly]
         cells += [f"${num(float(np.median(g)), 1)}$" for g in gap]
         rows.append(" & ".join(cells) + r" \\")
+    n = len(eps)
     e_head = [f"${eps_tex(e)}$" for e in eps]
-    top = " & ".join(["", "", rf"\multicolumn{{{len(eps)}}}{{c}}{{largest exponent}}",
-                      rf"\multicolumn{{{len(eps)}}}{{c}}{{gap to the limit map}}"]) + r" \\"
+    # two groups of one column per eps, each group headed by what it holds and by the
+    # parameter of its columns ("eps =" over the values), under a rule of its own
+    top = " & ".join(["", "", rf"\multicolumn{{{n}}}{{c}}{{largest exponent, $\epsilon={{}}$}}",
+                      rf"\multicolumn{{{n}}}{{c}}{{gap to the limit map, $\epsilon={{}}$}}"]) + r" \\"
+    rules = rf"\cmidrule(lr){{3-{2 + n}}}\cmidrule(l){{{3 + n}-{2 + 2 * n}}}"
     # two columns per eps: narrower column gaps keep four eps within the text width
-    return r"\setlength{\tabcolsep}{3.5pt}" + "\n" + tabular("rr" + "r" * 2 * len(eps),
-                   [top, head(r"$\theta$", r"$s(\theta,0,0)$", *e_head, *e_head)], rows)
+    return r"\setlength{\tabcolsep}{3.5pt}" + "\n" + tabular(
+        "rr" + "r" * 2 * n,
+        [top, rules, head(r"$\theta$", r"$s(\theta,0,0)$", *e_head, *e_head)], rows)
 
 
 def report(ds, m: Macros) -> str | None:
