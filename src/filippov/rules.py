@@ -552,7 +552,8 @@ def step_budget_spent(n_steps: int, max_steps: int) -> bool:
 #: and the newest interval must have shrunk to GEOMETRIC_SHRINK of the oldest of the run of
 #: steady ratios (a series of ratio 0.9 needs 44 ratios for that: the ring's 64 switches
 #: hold 62; a slower one is left to :func:`accumulates`). An orbit converging to a
-#: periodic one has ratios that tend to 1; one that chatters, ratios that alternate.
+#: periodic one has ratios that tend to 1; one that chatters, ratios that alternate
+#: (docs/decisions.md#named-edges).
 GEOMETRIC_RATIO_MAX = 0.9
 GEOMETRIC_SPREAD = 0.1
 GEOMETRIC_MIN_RATIOS = 8
