@@ -25,7 +25,7 @@ import functools
 
 import numpy as np
 from scipy.integrate import OdeSolver
-from scipy.integrate._ivp.base import DenseOutput  # public base class of dense outputs
+from scipy.integrate import DenseOutput  # the public base class of dense outputs
 from scipy.linalg import lu_factor, lu_solve
 
 NEWTON_MAXITER = 7     # simplified Newton iterations before the step is shrunk
