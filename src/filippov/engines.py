@@ -167,20 +167,47 @@ engine that moves one of these makes its test fail.
 """
 from __future__ import annotations
 
-import importlib
 import sys
 
 #: the engines, by the name the front doors' ``engine=`` takes
 REFERENCE, COMPILED = "reference", "compiled"
 ENGINES = (REFERENCE, COMPILED)
 
-#: what runs each front door on each engine: ``"module:function"`` of this package, or
-#: None where the engine lacks that output (the reason is in :data:`LACKS`)
+# What runs each front door on each engine. Each is a function here that imports its
+# module when first called, so that the reference engine never imports numba and the
+# compiled one never imports scipy's integrators it does not use (filippov.__init__).
+
+def _simulate_reference(system, z0, sections, opts):
+    from .simulate import _simulate
+    return _simulate(system, z0, sections, opts)
+
+
+def _first_returns_reference(*args, **kwargs):
+    from .poincare import _first_returns
+    return _first_returns(*args, **kwargs)
+
+
+def _first_returns_compiled(*args, **kwargs):
+    from .fastmap import _first_returns
+    return _first_returns(*args, **kwargs)
+
+
+def _periodic_reference(*args, **kwargs):
+    from .periodic import _reference_return
+    return _reference_return(*args, **kwargs)
+
+
+def _periodic_compiled(*args, **kwargs):
+    from .periodic import _compiled_return
+    return _compiled_return(*args, **kwargs)
+
+
+#: what runs each front door on each engine, or None where the engine lacks that output
+#: (the reason is in :data:`LACKS`)
 RUNS = {
-    "simulate": {REFERENCE: "simulate:_simulate", COMPILED: None},
-    "first_returns": {REFERENCE: "poincare:_first_returns", COMPILED: "fastmap:_first_returns"},
-    "periodic_orbit": {REFERENCE: "periodic:_reference_return",
-                       COMPILED: "periodic:_compiled_return"},
+    "simulate": {REFERENCE: _simulate_reference, COMPILED: None},
+    "first_returns": {REFERENCE: _first_returns_reference, COMPILED: _first_returns_compiled},
+    "periodic_orbit": {REFERENCE: _periodic_reference, COMPILED: _periodic_compiled},
 }
 
 LACKS = {
@@ -210,8 +237,7 @@ def runner(capability: str, engine):
     if target is None:
         raise ValueError(f"engine={engine!r}: {capability} is not available on this "
                          f"engine: {LACKS[capability, engine]}")
-    module, name = target.split(":")
-    return getattr(importlib.import_module(f".{module}", __package__), name)
+    return target
 
 
 def _is_compiled_model(system) -> bool:
