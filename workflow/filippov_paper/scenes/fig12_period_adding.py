@@ -536,18 +536,6 @@ def _report_bifurcations(ds, m: Macros, sid: str) -> None:
     border = np.abs(ds.edge_multiplier.values[..., 1][right == BORDER])
     m.add("rpTwelveBorderMultMax", float(border.max()), "derived: max |edge_multiplier| "
           "over the right edges", 2)
-    c = ds.coexistence.values
-    eps = ds.eps.values
-    over = [j for j in range(len(eps)) if np.nanmax(c[j], initial=-np.inf) > 0]
-    m.add("rpTwelveCoexistMax", float(np.nanmax(c)), "derived: max coexistence", 2)
-    m.add("rpTwelveGapMax", float(-np.nanmin(c)), "derived: -min coexistence", 2)
-    m.add("rpTwelveCoexistEps", None, "derived: eps with a positive coexistence",
-          text=_report_list([eps_tex(float(eps[j])) for j in over]))
-    # periods three and two at the eps with the largest overlap of that pair
-    j = int(np.nanargmax(c[:, 0]))
-    m.add("rpTwelveCoexistTwoThree", float(c[j, 0]),
-          source(sid, "coexistence", eps=float(eps[j]), n=int(ds.n.values[0])), 2)
-    m.add("rpTwelveCoexistTwoThreeEps", float(eps[j]), f"derived: eps of max coexistence[n=0]", 2)
     m.add("rpTwelveCoexistSentence", None, "derived: coexistence per eps and n, its sign "
           "and size", text=_report_coexist_sentence(ds))
 

@@ -396,20 +396,6 @@ def report(ds, m: Macros) -> str | None:
         m.add(f"rpThirteenLyapMin{w}", float(np.min(ly)),
               "derived: min lyapunov over all eps and 0 < s <= s_max", 2)
         per = ds.period.values[i, j]
-        ends = [s[np.flatnonzero((s > 0) & (ds.chaotic.values[i, jj] == 1))]
-                for jj in range(len(eps))]
-        if all(e.size for e in ends):
-            m.add(f"rpThirteenChaosEnd{w}", float(ends[-1][-1]),
-                  "derived: largest s where chaotic == 1 at the smallest eps", 3)
-            m.add(f"rpThirteenChaosEndFirst{w}", float(ends[0][-1]),
-                  "derived: largest s where chaotic == 1 at the largest eps", 3)
-            last = np.array([e[-1] for e in ends])
-            m.add(f"rpThirteenChaosEndSpread{w}", float(last.max() / last.min()),
-                  "derived: max/min over eps of the largest s where chaotic == 1", 3)
-            # on the geometric grid, the ends' indices: how many grid steps apart
-            idx = np.array([int(np.flatnonzero(s == v)[0]) for v in last])
-            m.add(f"rpThirteenChaosEndSteps{w}", float(idx.max() - idx.min()),
-                  "derived: grid steps between the largest and smallest chaos end over eps", 1)
         k = ds.width_exponent.values[i][near]
         if np.isfinite(k).any():
             m.add(f"rpThirteenK{w}", float(np.nanmedian(k)),
