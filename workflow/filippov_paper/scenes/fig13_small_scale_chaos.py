@@ -31,7 +31,7 @@ from filippov_paper.scenes.attractor_common import (CHUNK_AXIS, ENGINES, HopfRet
                                common_dataset, eps_list, lyapunov_limit, s_grid, sweep, thetas)
 from filippov_paper.scenes.attractor_common import validate as _validate_common
 from filippov_paper.config import SceneError
-from filippov_paper.report import Macros, count_word, eps_tex, head, num, source, tabular, value
+from filippov_paper.report import Macros, count_phrase, count_word, eps_tex, head, num, source, tabular, value
 
 #: this scene's block of the scene schema: filippov_paper.config.load_scene adds it to
 #: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it
@@ -267,11 +267,11 @@ def _report_chaos_end_sentence(ds) -> str:
                  rf"{_report_s_list(ends)} for $\epsilon={e_first}$ to ${e_last}$")
         trend = _report_trend(ends)
         if trend == "falls":
-            tail = (rf": it falls by {count_word(idx[0] - idx[-1])} steps of the grid, so at "
+            tail = (rf": it falls by {count_phrase(idx[0] - idx[-1], 'step')} of the grid, so at "
                     r"this $\theta$ the range of $s$ that carries chaos shrinks, and the "
                     r"chaotic range in $\mu$ faster than $\epsilon^2$, at these $\epsilon$")
         elif trend == "rises":
-            tail = (rf": it rises by {count_word(idx[-1] - idx[0])} steps of the grid, so at "
+            tail = (rf": it rises by {count_phrase(idx[-1] - idx[0], 'step')} of the grid, so at "
                     r"this $\theta$ the chaotic range in $\mu$ does \emph{not} shrink faster "
                     r"than $\epsilon^2$")
         elif trend == "stays":
