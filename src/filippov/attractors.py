@@ -169,22 +169,26 @@ LYAPUNOV_SIGMAS = 3.0
 #: and the same start with its transient doubled were typed differently)
 EXTEND = 8
 MAX_EXTENSIONS = 12
-#: blocks of the kept returns over which the Lyapunov exponent's standard error is
-#: estimated (batch means: the log-slopes are correlated over a few returns)
-LYAPUNOV_BLOCKS = 5
+#: blocks of the returns over which the Lyapunov exponent's standard error is estimated
+#: (batch means: the log-slopes are correlated over a few returns); twenty, not five,
+#: for two standard errors to cover the exponent at about the nominal 95%
+#: (docs/decisions.md#lyapunov-error; tests/test_instability_claims.py)
+LYAPUNOV_BLOCKS = 20
 
 
-def lyapunov_estimate(jacobians: np.ndarray, coordinate: int) -> tuple[float, float]:
+def lyapunov_estimate(jacobians: np.ndarray, coordinate: int,
+                      blocks: int = LYAPUNOV_BLOCKS) -> tuple[float, float]:
     """(exponent, standard error): :func:`lyapunov_exponent` over all of ``jacobians``
-    and the spread of its value over :data:`LYAPUNOV_BLOCKS` consecutive blocks (batch
-    means), std/sqrt(blocks). NaN error with fewer than two returns per block."""
+    and the spread of its value over ``blocks`` (:data:`LYAPUNOV_BLOCKS`) consecutive
+    blocks (batch means), std/sqrt(blocks). NaN error with fewer than two returns per
+    block."""
     lam = lyapunov_exponent(jacobians, coordinate)
-    k = len(jacobians) // LYAPUNOV_BLOCKS
+    k = len(jacobians) // blocks
     if k < 2 or not np.isfinite(lam):
         return lam, np.nan
     means = [lyapunov_exponent(jacobians[b * k:(b + 1) * k], coordinate)
-             for b in range(LYAPUNOV_BLOCKS)]
-    return lam, float(np.std(means, ddof=1) / np.sqrt(LYAPUNOV_BLOCKS))
+             for b in range(blocks)]
+    return lam, float(np.std(means, ddof=1) / np.sqrt(blocks))
 
 
 #: one-sided slopes of P that differ by more than this (relative) put the point on a

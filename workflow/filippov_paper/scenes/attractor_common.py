@@ -182,8 +182,9 @@ VARIABLE_ATTRS = {
           "theta > 0)", "1"),
     "period": ("period of the attractor: a periodic orbit found by Newton from the kept "
                "returns, stable, and approached by them (0: none up to max_period)", "1"),
-    "lyapunov_err": ("standard error of lyapunov (batch means over five blocks of the kept "
-                     "returns; 0 for a confirmed periodic orbit, whose exponent is "
+    "lyapunov_err": ("standard error of lyapunov (batch means over twenty consecutive blocks "
+                     "of the returns it is the mean over, filippov.attractors.LYAPUNOV_BLOCKS; "
+                     "0 for a confirmed periodic orbit, whose exponent is "
                      "log of its spectral radius over its period)", "1"),
     "width": ("width of the attractor in u (max - min of the kept returns)", "1"),
     "lyapunov": ("largest Lyapunov exponent of the return map along the attractor (mean "

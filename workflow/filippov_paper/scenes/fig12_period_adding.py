@@ -426,6 +426,61 @@ def _report_list(items: list) -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + r"\text{ and }" + items[-1]
 
 
+def _report_pairs(ds) -> list:
+    """Per eps (dataset order): [(n + 1, n, coexistence)] for every n whose coexistence
+    is known (right edge of the window of n + 1 minus left edge of the window of n;
+    > 0: both orbits stable there, < 0: a gap), in the order of n."""
+    c, ns = ds.coexistence.values, [int(n) for n in ds.n.values]
+    return [[(n + 1, n, float(c[j, m])) for m, n in enumerate(ns) if np.isfinite(c[j, m])]
+            for j in range(ds.eps.size)]
+
+
+def _report_coexist_sentence(ds) -> str:
+    """For each eps: which neighbouring windows overlap (both orbits stable) and by how
+    much, which are separated by a gap and how wide, generated from ``coexistence``."""
+    from filippov_paper.report import count_word
+    eps = [float(e) for e in ds.eps.values]
+    ns = [int(n) for n in ds.n.values]
+
+    def say(group, lead, verb):
+        # overlap: 'a and b overlap by x, c and d by y'; gap: 'a and b are x apart, c and d y'
+        def one(k, a, b, v):
+            x, names = f"${num(abs(v), 2)}$", f"{count_word(a)} and {count_word(b)}"
+            if verb == "overlap":
+                return names + (" overlap" if k == 0 else "") + f" by {x}"
+            return names + (f" are {x} apart" if k == 0 else f" {x}")
+        items = [one(k, a, b, v) for k, (a, b, v) in enumerate(group)]
+        joined = items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+        return f"{lead} {joined}"
+    clauses = []
+    for j, pairs in enumerate(_report_pairs(ds)):
+        over = [(a, b, v) for a, b, v in pairs if v > 0]
+        gap = [(a, b, v) for a, b, v in pairs if v <= 0]
+        parts = []
+        if over:
+            parts.append(say(over, "the windows of periods", "overlap"))
+        if gap:
+            parts.append(say(gap, "those of periods" if over else "the windows of periods",
+                             "apart"))
+        text = rf"at $\epsilon={eps_tex(eps[j])}$ " + (", ".join(parts) if parts else
+                                                       "no pair of windows has both edges")
+        absent = [n for m, n in enumerate(ns) if n + 1 in ns
+                  and not np.isfinite(ds.coexistence.values[j, m])]
+        if absent:
+            why = []
+            for n in absent:
+                for k, side in ((n + 1, 1), (n, 0)):
+                    kind = int(ds.edge_kind.values[j, ns.index(k), side])
+                    if kind == -9:
+                        why.append(f"no window of period {count_word(k)} on the grid")
+                    elif not np.isfinite(ds.edge.values[j, ns.index(k), side]):
+                        why.append(f"the window of period {count_word(k)} reaches the end "
+                                   "of the grid")
+            text += " (" + "; ".join(dict.fromkeys(why)) + ")"
+        clauses.append(text)
+    return "; ".join(clauses)
+
+
 def _report_back(s, per) -> float:
     """First s > 0 from which the period is one up to the end of the grid (NaN: none)."""
     for k in range(s.size):
@@ -481,18 +536,8 @@ def _report_bifurcations(ds, m: Macros, sid: str) -> None:
     border = np.abs(ds.edge_multiplier.values[..., 1][right == BORDER])
     m.add("rpTwelveBorderMultMax", float(border.max()), "derived: max |edge_multiplier| "
           "over the right edges", 2)
-    c = ds.coexistence.values
-    eps = ds.eps.values
-    over = [j for j in range(len(eps)) if np.nanmax(c[j], initial=-np.inf) > 0]
-    m.add("rpTwelveCoexistMax", float(np.nanmax(c)), "derived: max coexistence", 2)
-    m.add("rpTwelveGapMax", float(-np.nanmin(c)), "derived: -min coexistence", 2)
-    m.add("rpTwelveCoexistEps", None, "derived: eps with a positive coexistence",
-          text=_report_list([eps_tex(float(eps[j])) for j in over]))
-    # periods three and two at the eps with the largest overlap of that pair
-    j = int(np.nanargmax(c[:, 0]))
-    m.add("rpTwelveCoexistTwoThree", float(c[j, 0]),
-          source(sid, "coexistence", eps=float(eps[j]), n=int(ds.n.values[0])), 2)
-    m.add("rpTwelveCoexistTwoThreeEps", float(eps[j]), f"derived: eps of max coexistence[n=0]", 2)
+    m.add("rpTwelveCoexistSentence", None, "derived: coexistence per eps and n, its sign "
+          "and size", text=_report_coexist_sentence(ds))
 
 
 # ----------------------------------------------------------------------------- test knobs

@@ -31,7 +31,7 @@ from filippov_paper.scenes.attractor_common import (CHUNK_AXIS, ENGINES, HopfRet
                                common_dataset, eps_list, lyapunov_limit, s_grid, sweep, thetas)
 from filippov_paper.scenes.attractor_common import validate as _validate_common
 from filippov_paper.config import SceneError
-from filippov_paper.report import Macros, eps_tex, head, num, source, tabular, value
+from filippov_paper.report import Macros, count_phrase, count_word, eps_tex, head, num, source, tabular, value
 
 #: this scene's block of the scene schema: filippov_paper.config.load_scene adds it to
 #: config/schema/scene.schema.json for this id (#/$defs/... refer there), reading it
@@ -192,6 +192,176 @@ def _report_table(ds) -> str:
         [top, rules, head(r"$\theta$", r"$s(\theta,0,0)$", *e_head, *e_head)], rows)
 
 
+def _report_join(items: list) -> str:
+    """'a', 'a and b', 'a, b and c' (text mode)."""
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
+
+
+def _report_s_list(values) -> str:
+    """'$s=a$', '$s=a$ and $b$', '$s=a$, $b$ and $c$'."""
+    items = [f"${num(float(v), 3)}$" for v in values]
+    return "$s=" + _report_join(items)[1:]
+
+
+def _report_s_run(values) -> str:
+    """Consecutive grid points: listed up to two, else '$a\\le s\\le b$'."""
+    if len(values) <= 2:
+        return _report_s_list(values)
+    return rf"${num(float(values[0]), 3)}\le s\le{num(float(values[-1]), 3)}$"
+
+
+def _report_chaotic_mask(ds) -> np.ndarray:
+    """chaotic == 1 recomputed from period, status, lyapunov and lyapunov_err (the
+    stored variable, where it is there)."""
+    return chaotic(ds) == 1
+
+
+def _report_chaos_ends(ds) -> dict:
+    """Per theta whose attractor is chaotic somewhere past grazing at every eps: the
+    largest grid s > 0 where it is chaotic, one per eps (the dataset's eps order)."""
+    s, ch = ds.s.values, _report_chaotic_mask(ds)
+    out = {}
+    for i, t in enumerate(ds.theta.values):
+        ends = [s[(s > 0) & ch[i, j]] for j in range(ds.eps.size)]
+        if all(e.size for e in ends):
+            out[float(t)] = np.array([float(e[-1]) for e in ends])
+    return out
+
+
+def _report_trend(ends: np.ndarray) -> str:
+    """How the last chaotic s moves as eps shrinks (``ends`` from the largest eps to the
+    smallest): 'falls' (never up, lower at the end), 'rises' (never down, higher at the
+    end), 'stays' or 'mixed'."""
+    d = np.diff(ends)
+    if np.all(d <= 0) and ends[-1] < ends[0]:
+        return "falls"
+    if np.all(d >= 0) and ends[-1] > ends[0]:
+        return "rises"
+    return "stays" if np.all(d == 0) else "mixed"
+
+
+def _report_interrupted(ds) -> list:
+    """(theta, eps) where a grid point s > 0 that is not chaotic lies between two chaotic
+    ones: the chaos past grazing is not one interval of the grid."""
+    s, ch = ds.s.values, _report_chaotic_mask(ds)
+    out = []
+    for i, t in enumerate(ds.theta.values):
+        for j, e in enumerate(ds.eps.values):
+            k = np.flatnonzero((s > 0) & ch[i, j])
+            if k.size and not np.all(ch[i, j, k[0]:k[-1] + 1]):
+                out.append((float(t), float(e)))
+    return out
+
+
+def _report_chaos_end_sentence(ds) -> str:
+    """Where the chaos ends past grazing, per theta chaotic at every eps, and what that
+    says of the range in s = (mu - 1)/eps^2 as eps shrinks (generated from the data:
+    'shrinks faster than eps^2' only where the last chaotic s falls with eps)."""
+    s = ds.s.values
+    eps = [float(e) for e in ds.eps.values]
+    e_first, e_last = eps_tex(eps[0]), eps_tex(eps[-1])
+    out = []
+    for t, ends in _report_chaos_ends(ds).items():
+        idx = [int(np.flatnonzero(s == v)[0]) for v in ends]
+        head_ = (rf"For $\theta={num(t, 3)}$ the last chaotic grid point lies at "
+                 rf"{_report_s_list(ends)} for $\epsilon={e_first}$ to ${e_last}$")
+        trend = _report_trend(ends)
+        if trend == "falls":
+            tail = (rf": it falls by {count_phrase(idx[0] - idx[-1], 'step')} of the grid, so at "
+                    r"this $\theta$ the range of $s$ that carries chaos shrinks, and the "
+                    r"chaotic range in $\mu$ faster than $\epsilon^2$, at these $\epsilon$")
+        elif trend == "rises":
+            tail = (rf": it rises by {count_phrase(idx[-1] - idx[0], 'step')} of the grid, so at "
+                    r"this $\theta$ the chaotic range in $\mu$ does \emph{not} shrink faster "
+                    r"than $\epsilon^2$")
+        elif trend == "stays":
+            tail = r": the same grid point, as for a range proportional to $\epsilon^2$"
+        else:
+            hi = "higher" if ends[-1] > ends[0] else ("lower" if ends[-1] < ends[0]
+                                                     else "the same")
+            tail = (r": it does not move one way as $\epsilon$ shrinks (it lies "
+                    rf"{hi}{'' if hi == 'the same' else ' at'} $\epsilon={e_last}$ "
+                    rf"{'as' if hi == 'the same' else 'than'} at $\epsilon={e_first}$), so at this "
+                    r"$\theta$ the data do \emph{not} show the chaotic range shrinking faster "
+                    r"than $\epsilon^2$")
+        out.append(head_ + tail + ".")
+    gaps = _report_interrupted(ds)
+    if gaps:
+        pairs = _report_join([rf"$({num(t, 3)},{eps_tex(e)})$" for t, e in gaps])
+        out.append(r"Nor is the chaos one interval of $s$: a periodic attractor lies between "
+                   rf"chaotic grid points at $(\theta,\epsilon)=" + pairs[1:] + ".")
+    return " ".join(out)
+
+
+_REPORT_TYPE = {0: "chaos", -1: "an aperiodic attractor without a positive exponent",
+                -2: "an escape"}
+
+
+def _report_type(ds, i, j) -> np.ndarray:
+    """Per s: the period (> 0), 0 chaotic, -1 aperiodic without a clearly positive
+    exponent, -2 escaped."""
+    per = ds.period.values[i, j].astype(int)
+    out = np.where(per > 0, per, -1)
+    out[_report_chaotic_mask(ds)[i, j]] = 0
+    out[ds.status.values[i, j] != 0] = -2
+    return out
+
+
+def _report_runs_phrase(s, kind) -> str:
+    """'period two at s = a and b, chaos at s = c, ...': consecutive grid points of one
+    type grouped, in the order of s."""
+    parts, k = [], 0
+    while k < s.size:
+        m = k
+        while m + 1 < s.size and kind[m + 1] == kind[k]:
+            m += 1
+        what = (f"period {count_word(int(kind[k]))}" if kind[k] > 0
+                else _REPORT_TYPE[int(kind[k])])
+        parts.append(f"{what} at {_report_s_run(s[k:m + 1])}")
+        k = m + 1
+    return "; ".join(parts) if len(parts) > 2 else _report_join(parts)
+
+
+def _report_period_one_sentence(ds, theta: float) -> str:
+    """Where the attractor of ``theta`` has period one past grazing: on 0 < s <= s_max at
+    which eps, and on the geometric grid beyond it at which eps, with what it is
+    instead where it is not (generated from the data)."""
+    i = int(np.flatnonzero(np.isclose(ds.theta.values, theta))[0])
+    s = ds.s.values
+    near, far = _report_near(s, ds), s > float(ds.attrs["s_max"]) + 1e-12
+    eps = [float(e) for e in ds.eps.values]
+    kinds = [_report_type(ds, i, j) for j in range(len(eps))]
+    one_near = [j for j in range(len(eps)) if np.all(kinds[j][near] == 1)]
+    one_far = [j for j in one_near if np.all(kinds[j][far] == 1)]
+    s_max, s_end = num(float(ds.attrs["s_max"]), 3), num(float(s[-1]), 3)
+
+    def eps_phrase(js):
+        if len(js) == len(eps):
+            return r"at every $\epsilon$"
+        return r"at $\epsilon=" + _report_join([f"${eps_tex(eps[j])}$" for j in js])[1:]
+    out = []
+    if one_near:
+        out.append(rf"period one at every grid point of $0<s\le{s_max}$ "
+                   + eps_phrase(one_near))
+    else:
+        out.append(rf"period one on all of $0<s\le{s_max}$ at no $\epsilon$")
+    if one_far:
+        out.append(rf"on the whole grid up to $s={s_end}$ {eps_phrase(one_far)}")
+    sentence = ", ".join(out) if len(out) > 1 else out[0]
+    rest = []
+    for j in range(len(eps)):
+        if j in one_far:
+            continue
+        mask = far if j in one_near else (s > 0)
+        where = "beyond" if j in one_near else "past grazing"
+        rest.append(rf"at $\epsilon={eps_tex(eps[j])}$ the grid {where}"
+                    rf"{' $s=' + s_max + '$' if where == 'beyond' else ''} shows "
+                    + _report_runs_phrase(s[mask], kinds[j][mask]))
+    if rest:
+        sentence += "; " + "; ".join(rest)
+    return sentence
+
+
 def report(ds, m: Macros) -> str | None:
     sid = "fig13_small_scale_chaos"
     eps = [float(e) for e in ds.eps.values]
@@ -226,20 +396,6 @@ def report(ds, m: Macros) -> str | None:
         m.add(f"rpThirteenLyapMin{w}", float(np.min(ly)),
               "derived: min lyapunov over all eps and 0 < s <= s_max", 2)
         per = ds.period.values[i, j]
-        ends = [s[np.flatnonzero((s > 0) & (ds.chaotic.values[i, jj] == 1))]
-                for jj in range(len(eps))]
-        if all(e.size for e in ends):
-            m.add(f"rpThirteenChaosEnd{w}", float(ends[-1][-1]),
-                  "derived: largest s where chaotic == 1 at the smallest eps", 3)
-            m.add(f"rpThirteenChaosEndFirst{w}", float(ends[0][-1]),
-                  "derived: largest s where chaotic == 1 at the largest eps", 3)
-            last = np.array([e[-1] for e in ends])
-            m.add(f"rpThirteenChaosEndSpread{w}", float(last.max() / last.min()),
-                  "derived: max/min over eps of the largest s where chaotic == 1", 3)
-            # on the geometric grid, the ends' indices: how many grid steps apart
-            idx = np.array([int(np.flatnonzero(s == v)[0]) for v in last])
-            m.add(f"rpThirteenChaosEndSteps{w}", float(idx.max() - idx.min()),
-                  "derived: grid steps between the largest and smallest chaos end over eps", 1)
         k = ds.width_exponent.values[i][near]
         if np.isfinite(k).any():
             m.add(f"rpThirteenK{w}", float(np.nanmedian(k)),
@@ -255,6 +411,13 @@ def report(ds, m: Macros) -> str | None:
               "derived: share of 0 < s <= s_max with period == 2 at the smallest eps", 2)
         m.add(f"rpThirteenPeriodOne{w}", float(np.all(per[near] == 1)),
               "derived: 1 if period == 1 on 0 < s <= s_max at the smallest eps", 1)
+        m.add(f"rpThirteenPeriodOneWhere{w}", None, "derived: grid points where period == 1 "
+              "(chaotic, period, status) per eps, on 0 < s <= s_max and beyond",
+              text=_report_period_one_sentence(ds, float(t)))
+    m.add("rpThirteenChaosEndSentence", None, "derived: largest s > 0 where chaotic per "
+          "theta and eps, and its trend as eps shrinks", text=_report_chaos_end_sentence(ds))
+    m.add("rpLyapunovBlocks", None, "derived: filippov.attractors.LYAPUNOV_BLOCKS",
+          text=count_word(attractors.LYAPUNOV_BLOCKS))
     return _report_table(ds)
 
 
