@@ -109,8 +109,10 @@ def _check_bench_table(tab: str, ds, macros: dict) -> int:
     shown = [v for v in ds.data_vars if v.startswith("wall_time") and ds[v].dims ==
              ("problem", "config") and ds[v].attrs.get("statistic") == stat]
     assert len(shown) == 1, shown
-    q1, q3 = (next(v for v in ds.data_vars if v.startswith("wall_time")
-                   and ds[v].attrs.get("statistic") == q) for q in ("q1", "q3"))
+    spread = [[v for v in ds.data_vars if v.startswith("wall_time")
+               and ds[v].attrs.get("statistic") == q] for q in ("q1", "q3")]
+    assert all(len(v) == 1 for v in spread), f"the sweep stores no spread: {spread}"
+    (q1,), (q3,) = spread
 
     def ms(x):
         return f"${report.num(1e3 * float(x), 2)}$"

@@ -114,6 +114,7 @@ BUILD = {"families": [("project compiled exact", [1e-8, 1e-10, 1e-12]),
 #: each slow configuration per pass, a third of each fast one's runs): as many runs and
 #: seconds as timing each configuration in one go, but a spell of load on the machine
 #: falls on every configuration alike instead of on the ones timed during it
+#: (docs/decisions.md#interleaved-timing)
 PRESETS = {"full": {"families": PROJECT + SCIPY, "every": 10, "every11": 5, "repeat": 3,
                     "time_cap": 120.0, "min_time": 1.0, "passes": 3},
            "build": BUILD,
