@@ -99,6 +99,22 @@ def test_time_at_error_interpolates_log_log():
     assert wp.time_at_error(np.array([1e-12, 1e-13]), np.array([3.0, 5.0]), 1e-8) == 3.0
 
 
+def test_the_speedup_over_rk45_is_a_range_from_the_quartiles():
+    # the fastest project configuration within the target (1e-3 s) against RK45 at the
+    # target (halfway in log between 0.5 s and 2 s: 1 s); the range: RK45's first quartile
+    # over the project's third, its third over the project's first; the medians' ratio in it
+    fam = np.array(["project compiled exact"] * 2 + ["solve_ivp RK45"] * 2)
+    err = np.array([[1e-12, 1e-12, 1e-6, 1e-10]])
+    wall = np.array([[2e-3, 1e-3, 0.5, 2.0]])
+    out = wp._at_target(fam, err, wall, 0.8 * wall, 1.5 * wall)
+    assert out["ours"][0] == 1e-3 and out["rk45"][0] == pytest.approx(1.0)
+    assert out["ratio"][0] == pytest.approx(1000.0)
+    assert out["low"][0] == pytest.approx(0.8 / 1.5e-3)
+    assert out["high"][0] == pytest.approx(1.5 / 0.8e-3)
+    # no quartiles (a sweep of before): no range
+    assert np.isnan(wp._at_target(fam, err, wall)["low"][0])
+
+
 def test_max_dev_counts_one_sided_switches():
     a, b = np.array([1.0, np.nan, 2.0, np.nan]), np.array([1.5, 1.0, 2.0, np.nan])
     err, odd = wp.max_dev(a, b, np.ones(4, bool))
