@@ -103,3 +103,80 @@ def test_first_cell_of_a_family_is_no_outlier_against_a_repeat(tmp_path, monkeyp
         assert ds.attrs["timing_statistic"] == "median" and ds.attrs["timing_warmup"] == 1
     t_first, t_again = float(first.wall_time[0, 0]), float(again.wall_time[0, 0])
     assert t_first <= 5 * t_again, (t_first, t_again)
+
+
+def test_quartiles_are_numpy_s_and_the_timing_keeps_the_spread():
+    for times in ([3.0], [3.0, 1.0], [3.0, 1.0, 2.0], [5.0, 1.0, 2.0, 9.0, 4.0, 7.0]):
+        q1, med, q3 = timing.quartiles(times)
+        assert (q1, med, q3) == tuple(np.percentile(times, [25, 50, 75]))
+    t = timing.of_rounds([5.0, 1.0, 2.0, 9.0], warmup=1, value="last")
+    assert (t.min, t.q1, t.median, t.q3, t.max) == (1.0, 1.75, 3.5, 6.0, 9.0)
+    assert (t.rounds, t.warmup, t.total, t.value) == (4, 1, 17.0, "last")
+    with pytest.raises(ValueError):
+        timing.quartiles([])
+
+
+def test_measure_interleaved_takes_the_rounds_of_all_in_passes():
+    """Round k of every function before round k+1 of any (asv's rounds), each function's
+    warm-up just before its first round, and in the end the rounds `measure` would take."""
+    order = []
+    now = [0.0]
+
+    def clock():
+        return now[0]
+
+    def make(name, seconds):
+        def fn():
+            order.append(name)
+            now[0] += seconds
+            return name
+        return fn
+
+    # a slow function (1 s a call: min_rounds decide) and a fast one (0.0625 s: min_time)
+    fns = [make("slow", 1.0), make("fast", 0.0625)]
+    out = timing.measure_interleaved(fns, warmup=lambda k: 1, min_rounds=3, min_time=0.5,
+                                     clock=clock)
+    assert [t.rounds for t in out] == [3, 8] and [t.warmup for t in out] == [1, 1]
+    assert out[1].total == 0.5 and out[0].value == "slow"
+    # pass 1: slow's warm-up and round 1, fast's warm-up and rounds up to a third of
+    # min_time; pass 2: each to two thirds; pass 3: the rest
+    assert order == (["slow", "slow"] + ["fast"] * 4 + ["slow"] + ["fast"] * 3
+                     + ["slow"] + ["fast"] * 2)
+    # the same rule as measure(): a repeat of it with one function in one pass
+    now[0], order[:] = 0.0, []
+    alone = timing.measure_interleaved([fns[1]], warmup=1, min_rounds=3, min_time=0.5,
+                                       passes=1, clock=clock)[0]
+    now[0] = 0.0
+    assert alone.rounds == timing.measure(fns[1], warmup=1, min_rounds=3, min_time=0.5,
+                                          clock=clock).rounds
+
+
+def test_measure_interleaved_drops_a_function_that_fails_and_goes_on():
+    calls = []
+
+    def ok():
+        calls.append("ok")
+
+    def bad():
+        calls.append("bad")
+        raise RuntimeError("no return")
+
+    out = timing.measure_interleaved([bad, ok], warmup=0, min_rounds=3, min_time=0.0)
+    assert isinstance(out[0], RuntimeError) and out[1].rounds == 3
+    assert calls == ["bad", "ok", "ok", "ok"]   # bad is not called in the later passes
+    with pytest.raises(ValueError):
+        timing.measure_interleaved([ok], passes=0)
+
+
+def test_machine_attrs_name_the_machine_and_the_versions():
+    import platform
+
+    import numpy
+    import scipy
+
+    attrs = timing.machine_attrs()
+    assert attrs["machine_cpu"] and attrs["cpus"] >= 1
+    assert attrs["python_version"] == platform.python_version()
+    assert (attrs["numpy_version"], attrs["scipy_version"]) == (numpy.__version__,
+                                                                scipy.__version__)
+    assert "numba_version" in attrs

@@ -45,15 +45,17 @@ def test_work_precision_fig11_smoke():
     assert "n/a" in wp.table(ds)
 
 
-def test_work_precision_times_the_compiled_engine_last(monkeypatch):
-    """run() times every configuration off the compiled engine before any on it (a cold
-    build's work_precision job then runs while another job compiles the kernel), and
-    scores each against its own problem's reference as before."""
+def test_work_precision_interleaves_its_runs_and_times_the_compiled_engine_last(monkeypatch):
+    """run() takes the runs of all configurations in passes: round k of every one before
+    round k+1 of any, so that load falls on all alike. In each pass every configuration
+    off the compiled engine comes before any on it (a cold build's work_precision job then
+    runs while another job compiles the kernel); each is scored against its own
+    problem's reference as before, and the dataset names the machine and its load."""
     calls = []
 
     def fake_runner(problem, family, tol, time_cap):   # P and switch times = (tol, k tol)
         def run():
-            calls.append((family, tol))
+            calls.append((problem.name, family, tol))
             return np.full(2, tol), np.full(2, (1 + problem.x2[0]) * tol)
         return run
 
@@ -63,10 +65,16 @@ def test_work_precision_times_the_compiled_engine_last(monkeypatch):
              for k, x in enumerate((0.5, 2.0))]
     fams = [("project compiled exact", [1e-10]), ("solve_ivp RK45", [1e-6]),
             ("project compiled DOP853", [1e-8]), ("project DOP853", [1e-8])]
-    ds = wp.run(probs, fams, repeat=1, time_cap=60.0, log=lambda s: None, min_time=0.0)
-    timed = [f.startswith("project compiled") for f, tol in calls if tol != 1e-13]
-    assert True in timed and False in timed
-    assert timed.index(True) > len(timed) - 1 - timed[::-1].index(False)
+    ds = wp.run(probs, fams, repeat=3, time_cap=60.0, log=lambda s: None, min_time=0.0)
+    cells = [(p.name, *fams[j][:1], fams[j][1][0]) for compiled in (False, True)
+             for p in probs for j in range(len(fams))
+             if fams[j][0].startswith("project compiled") == compiled]
+    # pass 1: the warm-up run and the first timed run of each; passes 2 and 3: one run each
+    first = [c for cell in cells for c in (cell, cell)]
+    assert calls[:len(first) + 2 * len(cells)] == first + cells + cells
+    assert all(tol == 1e-13 for _, _, tol in calls[len(first) + 2 * len(cells):])
+    assert np.all(ds.runs.values == 3) and ds.attrs["timing_passes"] == 3
+    assert ds.attrs["timing_order"] == "interleaved"
     # references: compiled exact 1e-13, its check project DOP853 1e-13 (exact: the check)
     for i, x in enumerate((0.5, 2.0)):
         for j, (fam, (tol,)) in enumerate(fams):
@@ -74,6 +82,13 @@ def test_work_precision_times_the_compiled_engine_last(monkeypatch):
             assert ds.error_switch.values[i, j] == pytest.approx((1 + x) * (tol - 1e-13),
                                                                  rel=1e-12)
     assert np.all(ds.status.values == "ok")
+    # the spread of every cell is stored with its median, in order
+    for lo, hi in (("wall_time_min", "wall_time_q1"), ("wall_time_q1", "wall_time"),
+                   ("wall_time", "wall_time_q3"), ("wall_time_q3", "wall_time_max")):
+        assert np.all(ds[lo].values <= ds[hi].values), (lo, hi)
+    for key in ("machine_cpu", "cpus", "load_average_before", "load_average_after",
+                "python_version", "numpy_version", "scipy_version", "numba_version"):
+        assert key in ds.attrs, key
 
 
 def test_time_at_error_interpolates_log_log():
@@ -82,6 +97,22 @@ def test_time_at_error_interpolates_log_log():
     assert np.isclose(wp.time_at_error(errs, times, 1e-8), 4.0)  # halfway in log
     assert np.isnan(wp.time_at_error(errs, times, 1e-12))          # never reached
     assert wp.time_at_error(np.array([1e-12, 1e-13]), np.array([3.0, 5.0]), 1e-8) == 3.0
+
+
+def test_the_speedup_over_rk45_is_a_range_from_the_quartiles():
+    # the fastest project configuration within the target (1e-3 s) against RK45 at the
+    # target (halfway in log between 0.5 s and 2 s: 1 s); the range: RK45's first quartile
+    # over the project's third, its third over the project's first; the medians' ratio in it
+    fam = np.array(["project compiled exact"] * 2 + ["solve_ivp RK45"] * 2)
+    err = np.array([[1e-12, 1e-12, 1e-6, 1e-10]])
+    wall = np.array([[2e-3, 1e-3, 0.5, 2.0]])
+    out = wp._at_target(fam, err, wall, 0.8 * wall, 1.5 * wall)
+    assert out["ours"][0] == 1e-3 and out["rk45"][0] == pytest.approx(1.0)
+    assert out["ratio"][0] == pytest.approx(1000.0)
+    assert out["low"][0] == pytest.approx(0.8 / 1.5e-3)
+    assert out["high"][0] == pytest.approx(1.5 / 0.8e-3)
+    # no quartiles (a sweep of before): no range
+    assert np.isnan(wp._at_target(fam, err, wall)["low"][0])
 
 
 def test_max_dev_counts_one_sided_switches():

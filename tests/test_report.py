@@ -50,7 +50,9 @@ def test_absent_optional_results_say_not_yet_computed():
     for text in (t10, t11, tb, th, tr):
         assert report.NOT_YET in text
     assert m.flags == {"rpHaveTen": False, "rpHaveEleven": False, "rpHaveBench": False,
-                       "rpHaveBenchTiming": False, "rpHaveHardCases": False,
+                       "rpHaveBenchTiming": False, "rpHaveBenchSpread": False,
+                       "rpHaveBenchPasses": False, "rpHaveBenchMachine": False,
+                       "rpHaveHardCases": False,
                        "rpHaveCompileCost": False, "rpHaveEffects": False,
                        "rpHaveReturnCost": False}
     assert m.items == []
@@ -94,6 +96,118 @@ def test_optional_tables_show_whatever_the_datasets_hold():
     text = _bench_module("work_precision").report(bench, m)
     assert r"\texttt{method}" in text and r"\texttt{exact}" in text and "$0.001$" in text
     assert m.flags["rpHaveBench"]
+
+
+def _check_bench_table(tab: str, ds, macros: dict) -> int:
+    """The work-precision table ``tab`` (generated/tab_bench.tex) against its dataset:
+    every time printed is the statistic the sweep says it shows (the variable whose
+    ``statistic`` attribute is the dataset's ``timing_statistic``), as stored, and next
+    to it the spread, its first to third quartile; the speed-ups over RK45 are quoted
+    as ranges (low, high) of the stored ends, never as one number; the machine is
+    named. ``macros``: {name: (body, source)}. Returns the time cells checked."""
+    stat = ds.attrs["timing_statistic"]
+    shown = [v for v in ds.data_vars if v.startswith("wall_time") and ds[v].dims ==
+             ("problem", "config") and ds[v].attrs.get("statistic") == stat]
+    assert len(shown) == 1, shown
+    spread = [[v for v in ds.data_vars if v.startswith("wall_time")
+               and ds[v].attrs.get("statistic") == q] for q in ("q1", "q3")]
+    assert all(len(v) == 1 for v in spread), f"the sweep stores no spread: {spread}"
+    (q1,), (q3,) = spread
+
+    def ms(x):
+        return f"${report.num(1e3 * float(x), 2)}$"
+
+    blocks = [b.split(r"\midrule")[1] for b in tab.split(r"\begin{tabular}")[1:]]
+    names = [str(p) for p in ds.problem.values]
+    prefixes = [pre for pre in ("fig04", "fig11") if any(n.startswith(pre) for n in names)]
+    assert len(blocks) >= len(prefixes)   # (then the blocks of `make bench`, if measured)
+    checked = 0
+    for block, prefix in zip(blocks, prefixes):
+        probs = [i for i, n in enumerate(names) if n.startswith(prefix)]
+        configs = [j for j in range(ds.sizes["config"])
+                   if any(str(ds.status.values[i, j]) != "n/a" for i in probs)]
+        rows = [r for r in block.split(r"\bottomrule")[0].strip().splitlines() if r.strip()]
+        assert len(rows) == len(configs), (prefix, rows)
+        for row, j in zip(rows, configs):
+            cells = [c.strip() for c in row.rstrip().removesuffix(r"\\").split("&")]
+            cells = cells[2:]                        # method, rtol
+            for i in probs:
+                if str(ds.status.values[i, j]) != "ok":
+                    assert cells.pop(0).startswith(r"\multicolumn{4}"), (row, i)
+                    continue
+                err, t, spread, missed = cells[:4]
+                del cells[:4]
+                assert t == ms(ds[shown[0]].values[i, j]), (row, i, shown[0])
+                assert spread == f"{ms(ds[q1].values[i, j])}--{ms(ds[q3].values[i, j])}", \
+                    (row, i)
+                assert int(missed) == int(ds.missed_switches.values[i, j])
+                checked += 1
+            assert not cells, row
+    for key in "ABCD"[:ds.sizes["problem"]]:
+        assert f"rpBenchSpeedup{key}" not in macros      # no single number
+        lo, hi = (macros[f"rpBenchSpeedup{end}{key}"] for end in ("Low", "High"))
+        i = "ABCD".index(key)
+        for (body, src), var in ((lo, "speedup_vs_rk45_low"), (hi, "speedup_vs_rk45_high")):
+            assert src.startswith(f"work_precision:{var}[{i}]"), src
+            if np.isfinite(ds[var].values[i]):
+                assert report.parse_num(body) == pytest.approx(float(ds[var].values[i]),
+                                                               rel=0.051)
+    assert macros["rpBenchCPU"][0] == report.tex_escape(ds.attrs["machine_cpu"])
+    for name, attr in (("rpBenchLoadBefore", "load_average_before"),
+                       ("rpBenchLoadAfter", "load_average_after"), ("rpBenchCores", "cpus")):
+        assert report.parse_num(macros[name][0]) == pytest.approx(float(ds.attrs[attr]),
+                                                                  rel=0.0051, abs=0.0051)
+    return checked
+
+
+def _bench_sweep():
+    """A sweep as run() writes it (the synthetic stand-in with the spread, the machine and
+    the timing attributes), its times far enough apart that a cell printing another
+    statistic (min, a quartile, max) than the stored one would show."""
+    import synthetic
+    from filippov_paper.benchmarks import timing
+
+    ds = synthetic.dataset("work_precision")
+    wall = ds.wall_time.values
+    status = np.array(ds.status.values, dtype=object)
+    status[1, 0] = "failed: step size underflow"
+    attrs = {**timing.describe(min_rounds=3, min_time=0.2, passes=3), **timing.machine_attrs(),
+             **timing.load_attrs((2.5, 0, 0), (3.25, 0, 0)), "target_error": 1e-8}
+    return ds.assign(
+        wall_time=(ds.wall_time.dims, wall, {"statistic": "median"}),
+        wall_time_min=(ds.wall_time.dims, 0.5 * wall, {"statistic": "min"}),
+        wall_time_q1=(ds.wall_time.dims, 0.7 * wall, {"statistic": "q1"}),
+        wall_time_q3=(ds.wall_time.dims, 1.6 * wall, {"statistic": "q3"}),
+        wall_time_max=(ds.wall_time.dims, 4.0 * wall, {"statistic": "max"}),
+        status=(ds.status.dims, status),
+        missed_switches=(ds.error_map.dims, np.arange(wall.size).reshape(wall.shape)),
+        runs=(ds.error_map.dims, np.full(wall.shape, 3)),
+        speedup_vs_rk45=("problem", [100.0, 20.0]),
+        speedup_vs_rk45_low=("problem", [44.0, 8.7]),
+        speedup_vs_rk45_high=("problem", [230.0, 46.0])).assign_attrs(attrs)
+
+
+def test_the_bench_table_prints_the_stored_statistic_and_its_spread():
+    """The time in each cell of the work-precision table is the statistic the sweep says
+    it shows, as stored (not the min, not a quartile), the spread beside it (first to
+    third quartile) and the speed-ups as ranges; on a sweep made like run()'s (the same
+    check runs on the shared build: test_the_built_bench_table_...)."""
+    from filippov_paper.benchmarks import work_precision
+
+    ds = _bench_sweep()
+    m = report.Macros()
+    tab = work_precision.report(ds, m)
+    macros = report.read_macros(m.tex())
+    assert _check_bench_table(tab, ds, macros) == 2 * 6 - 1  # one cell failed
+    assert m.flags["rpHaveBenchSpread"] and m.flags["rpHaveBenchMachine"]
+    assert macros["rpBenchPasses"][0] == "three passes"
+    # the text quotes the ranges and the machine, never a single speed-up
+    text = (ROOT / "paper" / "sec_bench.tex").read_text()
+    assert not re.search(r"\\rpBenchSpeedup[A-D]\b", text)
+    for name in ("rpBenchSpeedupLowA", "rpBenchSpeedupHighD", "rpBenchCPU", "rpBenchLoadBefore",
+                 "rpBenchLoadAfter", "rpBenchCoresPhrase", "rpBenchPython", "rpBenchNumpy",
+                 "rpBenchScipy", "rpBenchNumba", "rpBenchPasses"):
+        assert "\\" + name + "{}" in text, name
 
 
 def test_every_test_named_in_the_report_exists():
@@ -358,6 +472,17 @@ def test_derived_macros_match_the_datasets(built):
         for row, e in zip(rows, ds.eps.values):
             cells = [c.strip().strip("$") for c in row[:-2].split("&")]
             assert report.parse_num(cells[4]) == pytest.approx(float(ds.error_core.sel(eps=e)), rel=6e-3)
+
+
+def test_the_built_bench_table_prints_the_stored_statistic_and_its_spread(built):
+    """The shared build's work-precision table against its sweep: each time printed is the
+    stored statistic with its spread (test_the_bench_table_prints_the_stored_statistic_...
+    on a made-up sweep, without TeX)."""
+    work = built["work"]
+    macros = report.read_macros((work / "paper/generated/macros.tex").read_text())
+    tab = (work / "paper/generated/tab_bench.tex").read_text()
+    with xr.open_dataset(work / "results/work_precision.nc") as ds:
+        assert _check_bench_table(tab, ds.load(), macros) > 10
 
 
 def test_optional_sections_follow_the_results(built):

@@ -154,13 +154,17 @@ def test_the_bench_table_fits_the_line_whatever_the_timings(tmp_path):
     overfull box of 23 pt was seen when the suite built the report under load)."""
     ds = _bench_dataset(0)
     # two problems of one figure side by side, the longest method name, every cell 12 s
-    slow = ds.assign(wall_time=ds.wall_time * 0 + 12.3456, error_map=ds.error_map * 0 + 1.23e-12)
+    # (with the spread beside each time: the quartiles, as wide as the time itself)
+    slow = ds.assign(wall_time=ds.wall_time * 0 + 12.3456, error_map=ds.error_map * 0 + 1.23e-12,
+                     wall_time_q1=ds.wall_time * 0 + 11.2345,
+                     wall_time_q3=ds.wall_time * 0 + 98.7654)
     slow = slow.assign_coords(problem=["fig04 theta=-0.5", "fig04 theta=0.5"])
     slow["method"] = ("config", ["compiled, exact flows"] * slow.sizes["config"])
     from filippov_paper.benchmarks import work_precision
     m = report.Macros()
     table = work_precision.report(slow, m)
     assert table.count(report.FIT_BEGIN) == table.count(r"\begin{tabular}") >= 1
+    assert rf"${report.num(11234.5, 2)}$--${report.num(98765.4, 2)}$" in table
     (tmp_path / "t.tex").write_text(
         "\\documentclass[preprint,11pt,a4paper]{elsarticle}\n\\usepackage{amsmath,booktabs}\n"
         "\\usepackage[export]{adjustbox}\n\\begin{document}\n\\begin{table}\n"

@@ -11,8 +11,16 @@ without their machinery):
   ``min_time`` seconds were timed in all (a millisecond call is timed many times,
   a second-long one ``min_rounds`` times), never more than ``max_rounds``;
 * **statistic**: the *median* of the rounds is the number shown (robust to a round
-  disturbed by another process on a shared machine); the *min* (the run least
-  disturbed) and the number of rounds are kept next to it.
+  disturbed by another process on a shared machine), always with its *spread*: the
+  interquartile range (first to third quartile, :data:`SPREAD`); the *min* (the run
+  least disturbed), the max and the number of rounds are kept next to it;
+* **interleaving** (:func:`measure_interleaved`, as asv runs its rounds): several
+  things timed against each other get their rounds in passes -- a share of the rounds
+  of every one, then the next share of every one, ... -- so that a spell of load from
+  another process falls on all of them alike, not on whichever was timed during it;
+* **machine**: :func:`machine_attrs` and :func:`load_attrs` say where and under what
+  load the times were taken (CPU model, cores, load average before and after, the
+  versions of Python, numpy, scipy and numba).
 
 A per-call time cap is the caller's business (the work-precision runners raise
 :class:`filippov_paper.benchmarks.baseline.TimeCapExceeded` themselves). Write
@@ -20,14 +28,18 @@ A per-call time cap is the caller's business (the work-precision runners raise
 """
 from __future__ import annotations
 
+import math
 import os
+import platform
 import statistics
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Sequence, Union
 
 #: the statistic a benchmark table shows (the min is stored next to it)
 STATISTIC = "median"
+#: the spread shown with it: the first and third quartile of the rounds
+SPREAD = "interquartile range"
 #: the defaults of :func:`measure`
 WARMUP, MIN_ROUNDS, MIN_TIME, MAX_ROUNDS = 1, 3, 0.2, 1000
 
@@ -41,6 +53,9 @@ class Timing:
     warmup: int = 0
     total: float = 0.0  # seconds timed over all rounds (warm-up not included)
     value: Any = field(default=None, repr=False, compare=False)  # the last round's result
+    q1: float = math.nan   # first quartile of the rounds (the spread: q1 to q3)
+    q3: float = math.nan   # third quartile
+    max: float = math.nan  # the slowest round
 
     @property
     def shown(self) -> float:
@@ -64,19 +79,101 @@ def measure(fn: Callable[[], Any], *, warmup: int = WARMUP, min_rounds: int = MI
         t0 = clock()
         value = fn()
         times.append(clock() - t0)
-    return Timing(statistics.median(times), min(times), len(times), warmup, sum(times), value)
+    return of_rounds(times, warmup, value)
+
+
+def quartiles(times: Sequence[float]) -> tuple[float, float, float]:
+    """First quartile, median and third quartile of ``times`` (linear interpolation
+    between the order statistics, numpy's default; of one round: that round thrice)."""
+    x = sorted(float(t) for t in times)
+    if not x:
+        raise ValueError("quartiles of no rounds")
+
+    def at(q):
+        pos = q * (len(x) - 1)
+        lo = math.floor(pos)
+        hi = min(lo + 1, len(x) - 1)
+        return x[lo] + (pos - lo) * (x[hi] - x[lo])
+    return at(0.25), statistics.median(x), at(0.75)
+
+
+def of_rounds(times: Sequence[float], warmup: int = 0, value: Any = None) -> Timing:
+    """The :class:`Timing` of the timed rounds ``times`` (seconds)."""
+    q1, med, q3 = quartiles(times)
+    return Timing(med, min(times), len(times), warmup, sum(times), value, q1, q3, max(times))
+
+
+def measure_interleaved(fns: Sequence[Callable[[], Any]], *,
+                        warmup: Union[int, Callable[[int], int]] = WARMUP,
+                        min_rounds: int = MIN_ROUNDS, min_time: float = MIN_TIME,
+                        max_rounds: int = MAX_ROUNDS, passes: int | None = None,
+                        clock: Callable[[], float] = time.perf_counter,
+                        before: Callable[[int, int], None] | None = None) -> list:
+    """Time every ``fns[k]()`` by the rule of :func:`measure` (at least ``min_rounds``
+    rounds, more until ``min_time`` s were timed, at most ``max_rounds``), with the
+    rounds of all of them interleaved in ``passes`` passes (default ``min_rounds``):
+    pass p (of P) takes each function, in the order given, to ``p/P`` of that rule
+    (at least ceil(p min_rounds / P) rounds, more until p min_time / P s were timed,
+    at most ceil(p max_rounds / P)), so its rounds are spread over the whole
+    measurement. A function's warm-up calls (``warmup``: a count, or a function of its
+    index called just before them) come right before its first round, in the first
+    pass. ``before(pass, k)``, if given, is called before each function's turn.
+
+    Per function: its :class:`Timing`, or the exception it raised (warm-up or round;
+    it is dropped from the later passes, nothing of it is timed half)."""
+    passes = min_rounds if passes is None else passes
+    if not (passes >= 1 and min_rounds >= 1 and max_rounds >= min_rounds and min_time >= 0):
+        raise ValueError(f"measure_interleaved: need passes >= 1, 1 <= min_rounds <= "
+                         f"max_rounds and min_time >= 0 (got {passes}, {min_rounds}, "
+                         f"{max_rounds}, {min_time})")
+    n = len(fns)
+    times: list[list[float]] = [[] for _ in range(n)]
+    values: list = [None] * n
+    warmed = [0] * n
+    failed: dict[int, BaseException] = {}
+    for p in range(1, passes + 1):
+        need = math.ceil(p * min_rounds / passes)
+        cap = math.ceil(p * max_rounds / passes)
+        budget = p * min_time / passes
+        for k, fn in enumerate(fns):
+            if k in failed:
+                continue
+            if before is not None:
+                before(p, k)
+            try:
+                if p == 1:
+                    warmed[k] = warmup(k) if callable(warmup) else int(warmup)
+                    for _ in range(warmed[k]):
+                        fn()
+                got = times[k]
+                while len(got) < need or (sum(got) < budget and len(got) < cap):
+                    t0 = clock()
+                    values[k] = fn()
+                    got.append(clock() - t0)
+            except Exception as exc:  # kept for the caller, never dropped silently
+                failed[k] = exc
+    return [failed[k] if k in failed else of_rounds(times[k], warmed[k], values[k])
+            for k in range(n)]
 
 
 def describe(*, warmup: int = WARMUP, min_rounds: int = MIN_ROUNDS, min_time: float = MIN_TIME,
-             max_rounds: int = MAX_ROUNDS) -> dict:
+             max_rounds: int = MAX_ROUNDS, passes: int | None = None) -> dict:
     """The dataset attributes that say how its times were measured and which statistic
-    it shows (``timing_statistic``)."""
-    return {"timing_statistic": STATISTIC, "timing_warmup": int(warmup),
-            "timing_min_rounds": int(min_rounds), "timing_min_time": float(min_time),
-            "timing_max_rounds": int(max_rounds),
-            "timing": f"{STATISTIC} of at least {min_rounds} timed rounds (more until "
-                      f"{min_time:g} s were timed, at most {max_rounds}) after {warmup} "
-                      f"untimed warm-up call(s); the min is stored as well"}
+    it shows (``timing_statistic``) with which spread (``timing_spread``); ``passes``:
+    the rounds were interleaved in that many passes (:func:`measure_interleaved`)."""
+    out = {"timing_statistic": STATISTIC, "timing_spread": SPREAD, "timing_warmup": int(warmup),
+           "timing_min_rounds": int(min_rounds), "timing_min_time": float(min_time),
+           "timing_max_rounds": int(max_rounds),
+           "timing": f"{STATISTIC} of at least {min_rounds} timed rounds (more until "
+                     f"{min_time:g} s were timed, at most {max_rounds}) after {warmup} "
+                     f"untimed warm-up call(s), with the {SPREAD} of the rounds; the min "
+                     f"and max are stored as well"}
+    if passes is not None:
+        out["timing_passes"] = int(passes)
+        out["timing_order"] = "interleaved"
+        out["timing"] += (f"; the rounds of all configurations interleaved in {passes} "
+                          f"passes (a share of every one's rounds per pass)")
+    return out
 
 
 def load_attrs(load_before, load_after) -> dict:
@@ -84,3 +181,35 @@ def load_attrs(load_before, load_after) -> dict:
     (``os.getloadavg()`` before and after it) and how many CPUs it has."""
     return {"load_average_before": float(load_before[0]),
             "load_average_after": float(load_after[0]), "cpus": os.cpu_count() or 1}
+
+
+def cpu_model() -> str:
+    """The CPU's model name (Linux: /proc/cpuinfo; else what :mod:`platform` says)."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                key, _, val = line.partition(":")
+                if key.strip() in ("model name", "Processor", "cpu model") and val.strip():
+                    return " ".join(val.split())
+    except OSError:
+        pass
+    return platform.processor() or platform.machine() or "unknown"
+
+
+def machine_attrs() -> dict:
+    """The dataset attributes that say on what the times were taken: the CPU model
+    (``machine_cpu``), its logical cores (``cpus``), the operating system and the
+    versions of Python, numpy, scipy and numba (``python_version``, ...). Together with
+    :func:`load_attrs`: what a reader needs to judge a measured time."""
+    import numpy
+    import scipy
+
+    try:
+        import numba
+        numba_version = numba.__version__
+    except ImportError:  # numba absent: nothing compiled
+        numba_version = "none"
+    return {"machine_cpu": cpu_model(), "cpus": os.cpu_count() or 1,
+            "machine_system": f"{platform.system()} {platform.release()} {platform.machine()}",
+            "python_version": platform.python_version(), "numpy_version": numpy.__version__,
+            "scipy_version": scipy.__version__, "numba_version": numba_version}

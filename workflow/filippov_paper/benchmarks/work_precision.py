@@ -15,10 +15,18 @@ panel) each method is swept over tolerances and scored by
   run of each method on each problem first (the first tolerance of its family: it
   pays for compiling and loading the kernel and the model's generated pieces), then
   at least ``repeat`` timed runs per configuration, more until ``min_time`` seconds
-  were timed; ``wall_time_min`` is the fastest of them. For fig11 the start points on
-  M_+ are computed once beforehand and not timed;
+  were timed, the runs of all configurations interleaved (``passes`` passes, each
+  giving every configuration its share of the runs: load falls on all alike);
+  ``wall_time_q1`` and ``wall_time_q3`` are the quartiles of the runs (the spread
+  the report prints next to the median), ``wall_time_min`` and ``wall_time_max`` the
+  fastest and slowest. For fig11 the start points on M_+ are computed once beforehand
+  and not timed. The machine (CPU model, cores, versions of Python, numpy, scipy and
+  numba) and its load average before and after the timing are dataset attributes;
 * ``time_per_return``: ``wall_time`` over the map's start points, the cost of one
   return (also printed per configuration, in microseconds);
+* ``speedup_vs_rk45``: at the target error, RK45's time over the fastest project
+  configuration's, from the medians; ``speedup_vs_rk45_low`` and ``_high`` its range
+  from the quartiles (RK45's first over the project's third, third over first);
 
 against a reference computed independently of the method measured. fig04:
 the compiled exact flows at rtol 1e-13 for every integrator, and the project's
@@ -41,6 +49,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import re
 import sys
 import time
@@ -93,18 +102,24 @@ BUILD = {"families": [("project compiled exact", [1e-8, 1e-10, 1e-12]),
                       # still runs it
                       ("solve_ivp RK45", [1e-6, 1e-8, 1e-10]),
                       ("solve_ivp DOP853", [1e-6, 1e-8, 1e-10, 1e-12])],
-         "every": 20, "every11": 3, "repeat": 3, "time_cap": 60.0, "min_time": 0.2}
+         "every": 20, "every11": 3, "repeat": 3, "time_cap": 60.0, "min_time": 0.2,
+         "passes": 3}
 #: ``time_cap``: a guard against a run that hangs, not a budget: far above the slowest
 #: cell of the build (project DOP853 rtol 1e-12 on fig04 theta = 0.5: 5 s a run on an
 #: idle core, over 10 s at load 6, which tripped the former 10 s cap), since a cell that
 #: trips it on one machine and not on another changes the NaN pattern the manifest checks
 #: ``repeat``: timed runs per configuration at least (after the warm-up run of each
-#: method on each problem); ``min_time``: more runs until that many seconds were timed
+#: method on each problem); ``min_time``: more runs until that many seconds were timed;
+#: ``passes``: the runs of all configurations interleaved in that many passes (one run of
+#: each slow configuration per pass, a third of each fast one's runs): as many runs and
+#: seconds as timing each configuration in one go, but a spell of load on the machine
+#: falls on every configuration alike instead of on the ones timed during it
+#: (docs/decisions.md#interleaved-timing)
 PRESETS = {"full": {"families": PROJECT + SCIPY, "every": 10, "every11": 5, "repeat": 3,
-                    "time_cap": 120.0, "min_time": 1.0},
+                    "time_cap": 120.0, "min_time": 1.0, "passes": 3},
            "build": BUILD,
            "quick": {"families": QUICK, "every": 10, "every11": 5, "repeat": 3,
-                     "time_cap": 120.0, "min_time": 0.2}}
+                     "time_cap": 120.0, "min_time": 0.2, "passes": 3}}
 
 #: how closely two runs agree (filippov_paper.tolerance): times never do. An error
 #: |P - P_ref| of an approximate method is not a well-conditioned result: it is decided
@@ -152,9 +167,11 @@ def tolerances() -> dict:
     missed = Tolerance(0.5, 2.0, "count of grazing excursions an approximate method steps "
                                  "over: each decided by where its steps end; 0 -> 2 under a "
                                  "1-ulp change of the field for RK45 at rtol 1e-4 (measured)")
-    return {"wall_time": MEASURED, "wall_time_min": MEASURED, "time_per_return": MEASURED,
+    return {"wall_time": MEASURED, "wall_time_min": MEASURED, "wall_time_q1": MEASURED,
+            "wall_time_q3": MEASURED, "wall_time_max": MEASURED, "time_per_return": MEASURED,
             "runs": MEASURED, "time_ours_at_target": MEASURED,
             "time_rk45_at_target": MEASURED, "speedup_vs_rk45": MEASURED,
+            "speedup_vs_rk45_low": MEASURED, "speedup_vs_rk45_high": MEASURED,
             "error_map": err, "error_switch": err_switch, "reference_check": check,
             "missed_switches": missed}
 
@@ -333,51 +350,77 @@ def time_at_error(errors, times, target):
 
 
 def run(problems, families, repeat: int, time_cap: float, log=print,
-        min_time: float = timing.MIN_TIME, **settings) -> xr.Dataset:
+        min_time: float = timing.MIN_TIME, passes: int | None = None,
+        **settings) -> xr.Dataset:
     """Every configuration on every problem; ``settings`` (preset, grid strides) are
-    stored as attributes. Timing (:mod:`filippov_paper.benchmarks.timing`): before the first
-    configuration of a family on a problem, one untimed run of it (compilation and
+    stored as attributes. Timing (:mod:`filippov_paper.benchmarks.timing`): the
+    configurations' rounds are interleaved (:func:`filippov_paper.benchmarks.timing.
+    measure_interleaved`, ``passes`` passes, default ``repeat``): each pass gives every
+    configuration of every problem its share of the rounds before the next pass starts,
+    so that a spell of load falls on all alike. Before the first configuration of a
+    family on a problem, in the first pass, one untimed run of it (compilation and
     caches paid there; repeated at the next tolerance if that run fails); then at
     least ``repeat`` timed runs per configuration, more until ``min_time`` s were timed;
-    ``wall_time`` is their median, ``wall_time_min`` their min."""
+    ``wall_time`` is their median, ``wall_time_q1`` and ``wall_time_q3`` its spread
+    (the quartiles), ``wall_time_min`` and ``wall_time_max`` their extremes. The
+    machine and its load average before and after the timing are dataset attributes."""
+    passes = repeat if passes is None else passes
     configs = [(fam, tol) for fam, tols in families for tol in tols]
     res = _Results.empty(len(problems), len(configs))
     ref_check = np.empty(len(problems))
     ref_names = [""] * len(problems)
-    warmed = [set() for _ in problems]  # families run once untimed on each problem
+    warmed = [set() for _ in problems]  # families run once (untimed or not) on each problem
+    # Every configuration off the compiled engine first, then those on it (in every pass),
+    # then the references and the scores. In a cold workflow build this job (started
+    # first: the longest) times its Python and solve_ivp runs while another job compiles
+    # the kernel, which it then loads, instead of waiting for that compile with a core idle.
+    cells = [(i, j) for compiled in (False, True) for i in range(len(problems))
+             for j, (fam, _) in enumerate(configs) if _compiled(fam) == compiled]
+    fns, timed_cells = [], []
+    for i, j in cells:
+        fn = res.runner(i, j, problems[i], *configs[j], time_cap=time_cap, warmed=warmed[i])
+        if fn is not None:
+            fns.append(fn)
+            timed_cells.append((i, j))
+
+    def warmup(k):
+        i, j = timed_cells[k]
+        return 0 if configs[j][0] in warmed[i] else 1
+
+    def before(p, k):
+        if k == 0:
+            log(f"pass {p} of {passes}: {len(fns)} configurations")
+
+    load_before = os.getloadavg()
+    t0 = time.perf_counter()
     got = {}
-    # Every configuration off the compiled engine first, then those on it, then the
-    # references and the scores. Same results as problem by problem; but in a cold
-    # workflow build this job (started first: the longest) times its Python and
-    # solve_ivp runs while another job compiles the kernel, which it then loads,
-    # instead of waiting for that compile with a core idle.
-    for compiled in (False, True):
-        for i, prob in enumerate(problems):
-            mine = [j for j, (fam, _) in enumerate(configs) if _compiled(fam) == compiled]
-            for j in mine:
-                got[i, j] = res.measure(i, j, prob, *configs[j], repeat=repeat,
-                                        min_time=min_time, time_cap=time_cap,
-                                        warmed=warmed[i])
-            log(f"{prob.name}: timed {len(mine)} configurations "
-                f"{'on' if compiled else 'off'} the compiled engine")
+    for (i, j), t in zip(timed_cells, timing.measure_interleaved(
+            fns, warmup=warmup, min_rounds=repeat, min_time=min_time, passes=passes,
+            before=before)):
+        got[i, j] = res.record(i, j, t)
+    load_after = os.getloadavg()
+    log(f"timed {len(fns)} configurations in {passes} interleaved passes, "
+        f"{time.perf_counter() - t0:.1f} s; load average {load_before[0]:.2f} before, "
+        f"{load_after[0]:.2f} after")
     for i, prob in enumerate(problems):
         ref, chk, ref_check[i], ref_names[i] = _reference(prob)
         log(f"{prob.name}: {prob.x2.size} start points; reference check "
             f"({ref_names[i]}): {ref_check[i]:.2e}")
         for j, (fam, tol) in enumerate(configs):
             # the reference's own method is scored against the independent check
-            if got[i, j] is not None:
+            if got.get((i, j)) is not None:
                 res.score(i, j, prob, got[i, j], chk if prob.scored_by_check(fam) else ref)
             log(res.line(i, j, fam, tol, prob.x2.size))
     fam_of = np.array([c[0] for c in configs])
-    t_ours, t_rk45, ratio = _at_target(fam_of, res.err_map, res.wall)
-    ds = _dataset(problems, configs, fam_of, res, ref_check, ref_names, t_ours, t_rk45, ratio)
+    at_target = _at_target(fam_of, res.err_map, res.wall, res.wall_q1, res.wall_q3)
+    ds = _dataset(problems, configs, fam_of, res, ref_check, ref_names, at_target)
     from filippov_paper.tolerance import annotate
 
     ds = annotate(ds, tolerances())
     return finalize(ds, None, target_error=TARGET_ERROR, time_cap=time_cap, repeat=repeat,
                     grazing_gap=GRAZING_GAP, min_time=min_time, **settings,
-                    **timing.describe(min_rounds=repeat, min_time=min_time),
+                    **timing.describe(min_rounds=repeat, min_time=min_time, passes=passes),
+                    **{**timing.machine_attrs(), **timing.load_attrs(load_before, load_after)},
                     title="work-precision of the fig04 and fig11 return maps: project vs solve_ivp")
 
 
@@ -403,6 +446,9 @@ class _Results:
     err_sw: np.ndarray
     wall: np.ndarray
     wall_min: np.ndarray
+    wall_q1: np.ndarray
+    wall_q3: np.ndarray
+    wall_max: np.ndarray
     runs: np.ndarray
     missed: np.ndarray
     status: np.ndarray
@@ -412,24 +458,41 @@ class _Results:
         shape = (n_problems, n_configs)
         return cls(err_map=np.full(shape, np.nan), err_sw=np.full(shape, np.nan),
                    wall=np.full(shape, np.nan), wall_min=np.full(shape, np.nan),
+                   wall_q1=np.full(shape, np.nan), wall_q3=np.full(shape, np.nan),
+                   wall_max=np.full(shape, np.nan),
                    runs=np.zeros(shape, dtype=np.int32), missed=np.zeros(shape, dtype=np.int32),
                    status=np.full(shape, "ok", dtype=object))
 
-    def measure(self, i, j, prob, fam, tol, *, repeat, min_time, time_cap, warmed):
-        """Time configuration j on problem i: its (P, first switch times), or None after
-        a failure, which is listed in ``status``, not dropped."""
+    def runner(self, i, j, prob, fam, tol, *, time_cap, warmed):
+        """Configuration j on problem i as a function to time (its first success marks
+        ``fam`` warmed on the problem), or None when it does not apply there (``status``
+        n/a)."""
         try:
-            t = timed(runner(prob, fam, tol, time_cap), repeat, min_time,
-                      warmup=0 if fam in warmed else 1)
-            warmed.add(fam)
-            self.wall[i, j], self.wall_min[i, j], self.runs[i, j] = t.median, t.min, t.rounds
-            return t.value
+            fn = runner(prob, fam, tol, time_cap)
         except NotApplicable:
             self.status[i, j] = "n/a"
-        except baseline.TimeCapExceeded as exc:
-            self.status[i, j] = f"time cap: {exc}"
-        except Exception as exc:  # listed, not dropped
-            self.status[i, j] = f"failed: {type(exc).__name__}: {exc}"[:200]
+            return None
+
+        def call():
+            value = fn()
+            warmed.add(fam)
+            return value
+        return call
+
+    def record(self, i, j, t):
+        """The timing ``t`` of configuration j on problem i (a Timing, or the exception
+        it raised): its (P, first switch times), or None after a failure, which is
+        listed in ``status``, not dropped."""
+        if isinstance(t, timing.Timing):
+            self.wall[i, j], self.wall_min[i, j], self.runs[i, j] = t.median, t.min, t.rounds
+            self.wall_q1[i, j], self.wall_q3[i, j], self.wall_max[i, j] = t.q1, t.q3, t.max
+            return t.value
+        if isinstance(t, NotApplicable):
+            self.status[i, j] = "n/a"
+        elif isinstance(t, baseline.TimeCapExceeded):
+            self.status[i, j] = f"time cap: {t}"
+        else:  # listed, not dropped
+            self.status[i, j] = f"failed: {type(t).__name__}: {t}"[:200]
         return None
 
     def score(self, i, j, prob, got, want):
@@ -442,31 +505,41 @@ class _Results:
     def line(self, i, j, fam, tol, n_points) -> str:
         """The log line of configuration j on problem i."""
         wall, status = self.wall[i, j], self.status[i, j]
-        return (f"  {fam:24s} rtol {tol:7.0e}  {wall:9.4f} s (min {self.wall_min[i, j]:9.4f} s, "
+        return (f"  {fam:24s} rtol {tol:7.0e}  {wall:9.4f} s (quartiles {self.wall_q1[i, j]:9.4f} "
+                f"..{self.wall_q3[i, j]:9.4f} s, min {self.wall_min[i, j]:9.4f} s, "
                 f"{self.runs[i, j]:4d} runs; {1e6 * wall / n_points:8.1f} us/return)  "
                 f"map err {self.err_map[i, j]:9.2e}"
                 f"  switch err {self.err_sw[i, j]:9.2e} ({self.missed[i, j]} missed)  "
                 f"{status if status != 'ok' else ''}")
 
 
-def _at_target(fam_of, err_map, wall):
+def _at_target(fam_of, err_map, wall, wall_q1=None, wall_q3=None):
     """Per problem: the fastest project configuration within TARGET_ERROR, RK45's time
-    at that error, and their ratio."""
+    at that error, and their ratio (all of the medians ``wall``); and the ratio's range
+    from the spread: RK45's first quartile over the project's third, RK45's third over
+    the project's first (each time taken as the median is, from that quartile; the
+    ratio of the medians lies in it). Without quartiles the range is NaN."""
     n = err_map.shape[0]
-    ratio = np.full(n, np.nan)
-    t_ours, t_rk45 = np.full(n, np.nan), np.full(n, np.nan)
+    q1 = np.full(wall.shape, np.nan) if wall_q1 is None else wall_q1
+    q3 = np.full(wall.shape, np.nan) if wall_q3 is None else wall_q3
+    ours = np.array([f.startswith("project") for f in fam_of])
+    rk = fam_of == "solve_ivp RK45"
+    out = {k: np.full(n, np.nan) for k in ("ours", "rk45", "ratio", "low", "high")}
     for i in range(n):
-        ours = np.array([f.startswith("project") for f in fam_of])
         ok = ours & (err_map[i] <= TARGET_ERROR)
-        t_ours[i] = wall[i, ok].min() if ok.any() else np.nan
-        rk = fam_of == "solve_ivp RK45"
-        t_rk45[i] = time_at_error(err_map[i, rk], wall[i, rk], TARGET_ERROR)
-        ratio[i] = t_rk45[i] / t_ours[i]
-    return t_ours, t_rk45, ratio
+        t = {}
+        for name, times in (("med", wall), ("q1", q1), ("q3", q3)):
+            t["ours", name] = times[i, ok].min() if ok.any() else np.nan
+            t["rk", name] = time_at_error(err_map[i, rk], times[i, rk], TARGET_ERROR)
+        out["ours"][i], out["rk45"][i] = t["ours", "med"], t["rk", "med"]
+        out["ratio"][i] = t["rk", "med"] / t["ours", "med"]
+        out["low"][i] = t["rk", "q1"] / t["ours", "q3"]
+        out["high"][i] = t["rk", "q3"] / t["ours", "q1"]
+    return out
 
 
 def _dataset(problems, configs, fam_of, res: _Results, ref_check, ref_names,
-             t_ours, t_rk45, ratio) -> xr.Dataset:
+             at_target) -> xr.Dataset:
     dims = ("problem", "config")
     n_points = np.array([p.x2.size for p in problems], dtype=np.int32)
     return xr.Dataset(
@@ -484,6 +557,15 @@ def _dataset(problems, configs, fam_of, res: _Results, ref_check, ref_names,
          "wall_time_min": (dims, res.wall_min, {
              "long_name": "min wall time of one map (the fastest timed run)", "units": "s",
              "statistic": "min"}),
+         "wall_time_q1": (dims, res.wall_q1, {
+             "long_name": "first quartile of the wall times of one map (the spread of "
+                          "wall_time: q1 to q3)", "units": "s", "statistic": "q1"}),
+         "wall_time_q3": (dims, res.wall_q3, {
+             "long_name": "third quartile of the wall times of one map", "units": "s",
+             "statistic": "q3"}),
+         "wall_time_max": (dims, res.wall_max, {
+             "long_name": "max wall time of one map (the slowest timed run)", "units": "s",
+             "statistic": "max"}),
          "time_per_return": (dims, res.wall / n_points[:, None], {
              "long_name": "cost of one return: median wall time of the map over its start "
                           "points", "units": "s", "statistic": timing.STATISTIC}),
@@ -497,13 +579,20 @@ def _dataset(problems, configs, fam_of, res: _Results, ref_check, ref_names,
              "long_name": "reference and its independent check"}),
          "n_points": ("problem", n_points,
                       {"long_name": "start points per map", "units": "1"}),
-         "time_ours_at_target": ("problem", t_ours, {
+         "time_ours_at_target": ("problem", at_target["ours"], {
              "long_name": "fastest project configuration with error <= target", "units": "s"}),
-         "time_rk45_at_target": ("problem", t_rk45, {
+         "time_rk45_at_target": ("problem", at_target["rk45"], {
              "long_name": "solve_ivp RK45 time at the target error (log-log interpolation; "
                           "NaN: not reached)", "units": "s"}),
-         "speedup_vs_rk45": ("problem", ratio, {
-             "long_name": "RK45 time / project time at equal error (the target)", "units": "1"})},
+         "speedup_vs_rk45": ("problem", at_target["ratio"], {
+             "long_name": "RK45 time / project time at equal error (the target), medians",
+             "units": "1"}),
+         "speedup_vs_rk45_low": ("problem", at_target["low"], {
+             "long_name": "low end of the speed-up's range: RK45's first quartile over the "
+                          "project's third", "units": "1"}),
+         "speedup_vs_rk45_high": ("problem", at_target["high"], {
+             "long_name": "high end of the speed-up's range: RK45's third quartile over the "
+                          "project's first", "units": "1"})},
         coords={"problem": ("problem", [p.name for p in problems],
                             {"long_name": "return map measured (scene and panel)"}),
                 "method": ("config", fam_of, {"long_name": "method (project mode or solve_ivp)"}),
@@ -524,7 +613,7 @@ def merge(parts: list[xr.Dataset]) -> xr.Dataset:
                 and np.array_equal(ds.tolerance.values, first.tolerance.values)):
             raise ValueError("benchmark parts were run with different method/tolerance lists")
         for key in ("target_error", "time_cap", "repeat", "grazing_gap", "preset", "min_time",
-                    "timing_statistic", "timing_warmup", "timing_max_rounds"):
+                    "timing_statistic", "timing_warmup", "timing_max_rounds", "timing_passes"):
             if ds.attrs.get(key) != first.attrs.get(key):
                 raise ValueError(f"benchmark parts differ in their setting {key!r}")
     names = np.concatenate([ds.problem.values for ds in parts])
@@ -536,23 +625,36 @@ def merge(parts: list[xr.Dataset]) -> xr.Dataset:
 
 def table(ds: xr.Dataset) -> str:
     stat = ds.attrs.get("timing_statistic", "median")
-    has_min = "wall_time_min" in ds
+    has_min, has_q = "wall_time_min" in ds, "wall_time_q1" in ds
     lines = [f"times: {ds.attrs.get('timing', stat)}"]
+    if "machine_cpu" in ds.attrs:
+        lines.append(f"machine: {ds.attrs['machine_cpu']}, {ds.attrs.get('cpus')} cores; "
+                     f"load average {ds.attrs.get('load_average_before', math.nan):.2f} "
+                     f"before, {ds.attrs.get('load_average_after', math.nan):.2f} after; "
+                     f"Python {ds.attrs.get('python_version')}, numpy "
+                     f"{ds.attrs.get('numpy_version')}, scipy {ds.attrs.get('scipy_version')}, "
+                     f"numba {ds.attrs.get('numba_version')}")
     for i, prob in enumerate(ds.problem.values):
         lines.append(f"\n{prob}: {int(ds.n_points[i])} points, reference check "
                      f"{float(ds.reference_check[i]):.1e}")
-        lines.append(f"{'method':26s} {'rtol':>7s} {stat + ' [s]':>10s} {'min [s]':>10s} "
+        lines.append(f"{'method':26s} {'rtol':>7s} {stat + ' [s]':>10s} {'q1 [s]':>10s} "
+                     f"{'q3 [s]':>10s} {'min [s]':>10s} "
                      f"{'runs':>5s} {'map error':>10s} {'switch err':>10s} {'missed':>6s}  status")
         for j in range(ds.sizes["config"]):
             st = str(ds.status.values[i, j])
             t_min = float(ds.wall_time_min[i, j]) if has_min else np.nan
+            q1, q3 = ((float(ds.wall_time_q1[i, j]), float(ds.wall_time_q3[i, j])) if has_q
+                      else (np.nan, np.nan))
             lines.append(f"{str(ds.method.values[j]):26s} {float(ds.tolerance[j]):7.0e} "
-                         f"{float(ds.wall_time[i, j]):10.4f} {t_min:10.4f} "
+                         f"{float(ds.wall_time[i, j]):10.4f} {q1:10.4f} {q3:10.4f} {t_min:10.4f} "
                          f"{int(ds.runs[i, j]):5d} {float(ds.error_map[i, j]):10.2e} "
                          f"{float(ds.error_switch[i, j]):10.2e} {int(ds.missed_switches[i, j]):6d}  {'' if st == 'ok' else st}")
         lines.append(f"at error {TARGET_ERROR:g}: project {float(ds.time_ours_at_target[i]):.4f} s, "
                      f"RK45 {float(ds.time_rk45_at_target[i]):.4f} s, "
-                     f"speed-up {float(ds.speedup_vs_rk45[i]):.2g}x")
+                     f"speed-up {float(ds.speedup_vs_rk45[i]):.2g}x"
+                     + (f" ({float(ds.speedup_vs_rk45_low[i]):.2g}x to "
+                        f"{float(ds.speedup_vs_rk45_high[i]):.2g}x from the quartiles)"
+                        if "speedup_vs_rk45_low" in ds else ""))
     return "\n".join(lines)
 
 
@@ -575,15 +677,32 @@ _REPORT_METHOD_TEX = {"project compiled exact": "compiled, exact flows",
                       "solve_ivp LSODA": "scipy LSODA"}
 
 
+def _report_has_spread(ds) -> bool:
+    """Whether the sweep stored the spread of its times (the quartiles of the runs)."""
+    return "wall_time_q1" in ds and "wall_time_q3" in ds
+
+
+def _report_ms(seconds) -> str:
+    """A time of the table, in milliseconds (two digits: the spread says the rest)."""
+    return num(1e3 * float(seconds), 2)
+
+
 def _report_tabular(ds, probs: list[int]) -> list[str]:
-    """One tabular: a row per method and tolerance, error / time / missed switches
-    for each problem in ``probs``; a configuration that failed says so in its cells."""
-    head = " & ".join(rf"\multicolumn{{3}}{{c}}{{{_report_problem_tex(str(ds.problem.values[i]))}}}"
-                      for i in probs)
-    rules = "".join(rf"\cmidrule(lr){{{3 + 3 * k}-{5 + 3 * k}}}" for k in range(len(probs)))
-    sub = " & ".join(["error & ms & missed"] * len(probs))
-    lines = [FIT_BEGIN, r"\begin{tabular}{@{}ll" + "rrr" * len(probs) + "@{}}", r"\toprule",
-             rf"method & rtol & {head} \\", rules, rf" & & {sub} \\", r"\midrule"]
+    """One tabular: a row per method and tolerance, for each problem in ``probs`` the
+    error, the time (the statistic the sweep shows, ``timing_statistic``: the stored
+    ``wall_time``), its spread (the quartiles ``wall_time_q1`` to ``wall_time_q3``, when
+    the sweep has them) and the missed switches; a configuration that failed says so
+    in its cells."""
+    spread = _report_has_spread(ds)
+    width = 4 if spread else 3
+    head = " & ".join(rf"\multicolumn{{{width}}}{{c}}"
+                      rf"{{{_report_problem_tex(str(ds.problem.values[i]))}}}" for i in probs)
+    rules = "".join(rf"\cmidrule(lr){{{3 + width * k}-{2 + width * (k + 1)}}}"
+                    for k in range(len(probs)))
+    sub = " & ".join([r"error & ms & $Q_1$--$Q_3$ & missed" if spread
+                      else "error & ms & missed"] * len(probs))
+    lines = [FIT_BEGIN, r"\begin{tabular}{@{}ll" + ("r" * width) * len(probs) + "@{}}",
+             r"\toprule", rf"method & rtol & {head} \\", rules, rf" & & {sub} \\", r"\midrule"]
     rows = [j for j in range(ds.sizes["config"])
             if any(str(ds.status.values[i, j]) != "n/a" for i in probs)]
     for j in rows:
@@ -593,11 +712,15 @@ def _report_tabular(ds, probs: list[int]) -> list[str]:
         for i in probs:
             status = str(ds.status.values[i, j])
             if status != "ok":
-                cells.append(r"\multicolumn{3}{c}{\emph{" + tex_escape(status.split(":")[0]) + "}}")
+                cells.append(rf"\multicolumn{{{width}}}{{c}}{{\emph{{"
+                             + tex_escape(status.split(":")[0]) + "}}")
                 continue
             cells += [f"${num(float(ds.error_map.values[i, j]), 2)}$",
-                      f"${num(1e3 * float(ds.wall_time.values[i, j]), 2)}$",
-                      str(int(ds.missed_switches.values[i, j]))]
+                      f"${_report_ms(ds.wall_time.values[i, j])}$"]
+            if spread:
+                cells.append(f"${_report_ms(ds.wall_time_q1.values[i, j])}$--"
+                             f"${_report_ms(ds.wall_time_q3.values[i, j])}$")
+            cells.append(str(int(ds.missed_switches.values[i, j])))
         lines.append(" & ".join(cells) + r" \\")
     return lines + [r"\bottomrule", r"\end{tabular}", FIT_END, ""]
 
@@ -641,6 +764,37 @@ def _report_timing(ds, m: Macros) -> None:
     m.add("rpBenchRoundsRange", None,
           "derived: min to max of work_precision:runs over the configurations that ran",
           text=range_phrase(timed.min(), timed.max(), "run") if timed.size else "no runs")
+    passes = int(ds.attrs.get("timing_passes", 1))
+    m.flag("rpHaveBenchPasses", "timing_passes" in ds.attrs)
+    m.add("rpBenchPasses", None, f"{sid}:attrs.timing_passes",
+          text=count_phrase(passes, "pass", "passes"))
+    _report_machine(ds, m)
+
+
+#: the machine as the report names it: (macro, attribute, kind): text, or a number (digits)
+_REPORT_MACHINE = (("rpBenchCPU", "machine_cpu", None), ("rpBenchPython", "python_version", None),
+                   ("rpBenchNumpy", "numpy_version", None), ("rpBenchScipy", "scipy_version", None),
+                   ("rpBenchNumba", "numba_version", None),
+                   ("rpBenchLoadBefore", "load_average_before", 3),
+                   ("rpBenchLoadAfter", "load_average_after", 3), ("rpBenchCores", "cpus", 4))
+
+
+def _report_machine(ds, m: Macros) -> None:
+    """Where and under what load the sweep was timed (timing.machine_attrs, load_attrs):
+    the CPU, its cores, the load average before and after, the versions. A sweep that
+    did not record them sets ``rpHaveBenchMachine`` false and quotes nothing."""
+    sid = "work_precision"
+    have = all(attr in ds.attrs for _, attr, _ in _REPORT_MACHINE)
+    m.flag("rpHaveBenchMachine", have)
+    if not have:
+        return
+    for name, attr, digits in _REPORT_MACHINE:
+        if digits is None:
+            m.add(name, None, f"{sid}:attrs.{attr}", text=tex_escape(str(ds.attrs[attr])))
+        else:
+            m.add(name, float(ds.attrs[attr]), f"{sid}:attrs.{attr}", digits)
+    m.add("rpBenchCoresPhrase", None, f"{sid}:attrs.cpus",
+          text=count_phrase(ds.attrs["cpus"], "logical core"))
 
 
 def _report_failed_sentence(n: int) -> str:
@@ -659,8 +813,11 @@ def _report_problem_macros(ds, m: Macros, names) -> None:
     fam = np.array([str(f) for f in ds.method.values])
     for i, p in enumerate(names[:4]):
         key = "ABCD"[i]
-        m.add(f"rpBenchSpeedup{key}", float(ds.speedup_vs_rk45.values[i]),
-              source(sid, f"speedup_vs_rk45[{i}]"), 2)
+        # the speed-up as a range from the spread of the times (low, high), never one number
+        for end in ("low", "high"):
+            var = f"speedup_vs_rk45_{end}"
+            value = float(ds[var].values[i]) if var in ds else math.nan
+            m.add(f"rpBenchSpeedup{end.capitalize()}{key}", value, source(sid, f"{var}[{i}]"), 2)
         m.add(f"rpBenchFloor{key}", float(ds.reference_check.values[i]),
               source(sid, f"reference_check[{i}]"), 2)
         m.add(f"rpBenchPoints{key}", float(ds.n_points.values[i]),
@@ -681,6 +838,9 @@ def _report_problem_macros(ds, m: Macros, names) -> None:
           "derived: configurations of work_precision:status that failed",
           text=_report_failed_sentence(failed))
     m.add("rpBenchConfigs", float(ds.sizes["config"]), "work_precision:config (size)", 4)
+    m.add("rpBenchTarget", float(ds.attrs.get("target_error", TARGET_ERROR)),
+          f"{sid}:attrs.target_error" if "target_error" in ds.attrs
+          else "derived: work_precision.TARGET_ERROR (the sweep predates the attribute)", 2)
 
 
 def report(ds, m: Macros) -> str:
@@ -690,6 +850,9 @@ def report(ds, m: Macros) -> str:
     scipy solvers a user reaches for first get wrong (macros)."""
     missing = absent(m, "rpHaveBench", ds, "Work--precision sweep", "results/work_precision.nc")
     m.flag("rpHaveBenchTiming", False)  # set by _report_timing when the sweep says how it timed
+    m.flag("rpHaveBenchSpread", ds is not None and _report_has_spread(ds))
+    m.flag("rpHaveBenchPasses", False)   # ... when it interleaved its runs
+    m.flag("rpHaveBenchMachine", False)  # ... when it recorded the machine and its load
     if missing:
         return missing
     if "method" not in ds.coords or "problem" not in ds.dims:
@@ -719,6 +882,9 @@ def main(argv=None) -> None:
                          "untimed run of each method per problem)")
     ap.add_argument("--min-time", type=float,
                     help="time more runs of a configuration until this many seconds")
+    ap.add_argument("--passes", type=int,
+                    help="interleave the configurations' runs in this many passes (default: "
+                         "--repeat)")
     ap.add_argument("--time-cap", type=float, help="seconds per configuration")
     ap.add_argument("--quick", action="store_true", help="same as --preset quick")
     ap.add_argument("--out", default=str(ROOT / "results" / "bench_work_precision.nc"))
@@ -734,13 +900,14 @@ def main(argv=None) -> None:
         print(f"\nwrote {args.out}")
         return
     preset = dict(PRESETS["quick" if args.quick else args.preset])
-    for key in ("every", "every11", "repeat", "time_cap", "min_time"):
+    for key in ("every", "every11", "repeat", "time_cap", "min_time", "passes"):
         if getattr(args, key) is not None:
             preset[key] = getattr(args, key)
     if preset["every"] < 1 or preset["every11"] < 1 or preset["repeat"] < 1 \
-            or not preset["time_cap"] > 0 or not preset["min_time"] >= 0:
-        ap.error("--every, --every11 and --repeat must be >= 1, --time-cap > 0 and "
-                 "--min-time >= 0")
+            or not preset["time_cap"] > 0 or not preset["min_time"] >= 0 \
+            or not preset.get("passes") or preset["passes"] < 1:
+        ap.error("--every, --every11, --repeat and --passes must be >= 1, --time-cap > 0 "
+                 "and --min-time >= 0")
     sets = [s.strip() for s in args.problems.split(",") if s.strip()]
     if not sets or set(sets) - {"fig04", "fig11"}:
         ap.error(f"--problems: choose from fig04, fig11, got {args.problems!r}")
@@ -748,6 +915,7 @@ def main(argv=None) -> None:
                 + (fig11_problems(preset["every11"]) if "fig11" in sets else []))
     ds = run(problems, preset["families"], preset["repeat"], preset["time_cap"],
              log=lambda s: print(s, file=sys.stderr, flush=True), min_time=preset["min_time"],
+             passes=preset["passes"],
              preset="quick" if args.quick else args.preset, every=preset["every"],
              every11=preset["every11"])
     write_dataset(ds, args.out)

@@ -44,6 +44,12 @@ def draw(ds):
                 order = np.argsort(t[ok])
                 ax.plot(t[ok][order], err[ok][order], marker=marker, ls=ls, color=color,
                         ms=4, lw=1.0, label=fam)
+                if "wall_time_q1" in ds and "wall_time_q3" in ds:
+                    # the spread of the runs: first to third quartile, a horizontal bar
+                    q1 = ds.wall_time_q1.values[i, sel][ok]
+                    q3 = ds.wall_time_q3.values[i, sel][ok]
+                    ax.errorbar(t[ok], err[ok], xerr=[t[ok] - q1, q3 - t[ok]], fmt="none",
+                                ecolor=color, elinewidth=0.7, capsize=1.5)
         check = max(float(ds.reference_check.values[i]), FLOOR)
         ax.axhline(check, color=st.C_AUX, lw=0.8, ls=":", label="reference check")
         ax.set_xscale("log")
@@ -76,6 +82,8 @@ def synthetic_dataset() -> xr.Dataset:
     wall = np.array([[1e-3, 1.2e-3, 1.5e-3, 0.1, 0.3, 1.0]] * 2)
     return xr.Dataset(
         {"error_map": (("problem", "config"), err), "wall_time": (("problem", "config"), wall),
+         "wall_time_q1": (("problem", "config"), 0.9 * wall),
+         "wall_time_q3": (("problem", "config"), 1.3 * wall),
          "status": (("problem", "config"), np.full(err.shape, "ok", dtype=object)),
          "reference_check": ("problem", [1e-13, 1e-13]), "n_points": ("problem", [60, 9])},
         coords={"problem": ["fig04 theta=-0.5", "fig11 (a) eps=0.1"],
