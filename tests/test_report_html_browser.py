@@ -13,7 +13,9 @@ pages are not requests over the network), and Chromium resolves no other host na
 In every view the tests open: no error in the browser's console (one exception, below),
 no raw ``\\(``/``\\[`` TeX and no LaTeX label of the paper (``fig:``, ``eq:``, ...,
 report_html.INTERNAL_LABEL) in the visible text outside code, every image loaded
-(``naturalWidth > 0``). The workflow view draws the rule graph (vega). Every category,
+(``naturalWidth > 0``). The workflow view draws the rule graph (vega), the statistics
+their two charts; each rule's panel opens; the search box finds a scene's four files.
+Every category,
 subcategory and result is listed: each result of the report is reached by clicking its
 row (and, for the figures, the PDF/PNG toggle), its caption opens, and its view button
 shows it: a PNG figure as an image of the file's own pixel size, a PDF in a frame of its
@@ -54,6 +56,7 @@ from conftest import run_snakemake
 from filippov_paper.report_html import INTERNAL_LABEL
 from selenium import webdriver  # noqa: E402  (test_docs_browser has skipped without it)
 from selenium.webdriver.common.by import By  # noqa: E402
+from selenium.webdriver.common.keys import Keys  # noqa: E402
 from selenium.webdriver.support.ui import WebDriverWait  # noqa: E402
 
 TEX = ("\\(", "\\)", "\\[", "\\]")
@@ -227,6 +230,28 @@ def test_the_report_loads_offline_and_cleanly(report, server, browser, shots,
     assert browser.save_screenshot(str(shots / "report-statistics.png"))
     click(browser, menu_item("About"))
     settled(browser, "app.state.navbarMode === 'reportinfo'")
+    assert problems_in(view(browser)) == []
+    # each rule's panel (the rule graph's nodes open it; its code, in <pre>, not judged)
+    rules = browser.execute_script("return Object.keys(rules)")
+    assert {"compute", "plot", "paper"} <= set(rules), rules
+    for rule in rules:
+        browser.execute_script("app.setView({navbarMode: 'ruleinfo', ruleinfo: arguments[0]})",
+                               rule)
+        settled(browser, "app.state.navbarMode === 'ruleinfo'")
+        assert problems_in(view(browser)) == [], rule
+    # the search box: every result whose path holds the term, one row each
+    term = "fig05_thetalt0mfs"
+    browser.execute_script("app.setView({navbarMode: 'menu'})")
+    box = browser.find_element(By.XPATH, "//nav//input[@placeholder='Search...']")
+    box.send_keys(term, Keys.ENTER)
+    settled(browser, "app.state.navbarMode === 'searchresults'"
+                     " && document.querySelector('nav table tbody tr')")
+    rows = browser.execute_script("return [...document.querySelectorAll('nav table tbody tr')]"
+                                  ".map(r => r.innerText)")
+    hits = browser.execute_script("return Object.keys(results).filter(p => p.includes("
+                                  "arguments[0]))", term)
+    assert len(hits) == 4 and len(rows) == len(hits), (hits, rows)
+    assert all(term in row for row in rows), rows
     assert problems_in(view(browser)) == []
     assert errors(browser, server) == []
     sent = requests(browser)
