@@ -15,13 +15,13 @@ no raw ``\\(``/``\\[`` TeX and no LaTeX label of the paper (``fig:``, ``eq:``, .
 report_html.INTERNAL_LABEL) in the visible text outside code, every image loaded
 (``naturalWidth > 0``). The workflow view draws the rule graph (vega), the statistics
 their two charts; each rule's panel opens; the search box finds a scene's four files.
-Every category,
-subcategory and result is listed: each result of the report is reached by clicking its
-row (and, for the figures, the PDF/PNG toggle), its caption opens, and its view button
-shows it: a PNG figure as an image of the file's own pixel size, a PDF in a frame of its
-``data:`` URI, a dataset or scene file as a download link. Screenshots (the front page,
-a figure, its caption, the statistics) are saved to ``FILIPPOV_BROWSER_SHOTS=DIR`` or
-to the run's temporary folder, with the time `snakemake --report` took.
+Every category, subcategory and result is listed: each result of the report is reached
+by clicking its row (and, for the figures, the PDF/PNG toggle), its caption opens, and
+its view button shows it: a PNG figure as an image of the file's own pixel size, a PDF
+in a frame of its ``data:`` URI, a dataset or scene file as a download link.
+Screenshots (the front page, a figure, its caption, the statistics, a tall figure) are
+saved to ``FILIPPOV_BROWSER_SHOTS=DIR`` or to the run's temporary folder, with the time
+`snakemake --report` took (report-seconds.txt).
 
 The one console error let through: Chromium asks every server for ``/favicon.ico`` on
 its own when a page declares no icon (report.html declares none: checked), and our
