@@ -1097,3 +1097,130 @@ def curved_slides(draw, dims=DIMS):
     t1, ts, time, P = ref
     assume(np.abs(P).max() <= GROWTH)
     return CurvedSlide(g, z0, on_h, t1, ts, time, P)
+
+
+# ----------------------------------------------------------------------------- NaN regions
+# Issue 57 (1): a piece that turns non-finite where the orbit goes must stop the run by
+# name, at the time it goes there. The same structure with one more term: 0 * sqrt(level -
+# m.z), NaN on the far side of the hyperplane m.z = level, added to the one piece ``where``
+# names (0: switch, 1: switch_grad (each component), 2: the section). Its numbers follow
+# layout(n)'s in p.
+NAN_PIECES = ("switch", "switch_grad", "section")
+
+
+def nan_layout(n: int) -> dict:
+    """Offsets of the NaN term's numbers past layout(n): ``m`` (n), ``level``, ``where``;
+    ``size``."""
+    o = layout(n)["size"]
+    return {"m": o, "level": o + n, "where": o + n + 1, "size": o + n + 2}
+
+
+@njit(cache=True)
+def _nan_term(z, p, piece):
+    """0 * sqrt(level - m.z) if the term is ``piece``'s, else 0."""
+    n = z.size
+    o = _offsets(n)[1] + 2 * n + 3
+    if p[o + n + 1] != piece:
+        return 0.0
+    room = p[o + n]
+    for i in range(n):
+        room -= p[o + i] * z[i]
+    return 0.0 * np.sqrt(room)
+
+
+@njit(cache=True)
+def switch_nan(z, p):
+    return switch(z, p) + _nan_term(z, p, 0.0)
+
+
+@njit(cache=True)
+def switch_grad_nan(z, p):
+    out = switch_grad(z, p)
+    term = _nan_term(z, p, 1.0)
+    for i in range(z.size):
+        out[i] += term
+    return out
+
+
+@njit(cache=True)
+def section_nan(z, p):
+    return section(z, p) + _nan_term(z, p, 2.0)
+
+
+def nan_system(n: int, exact: bool) -> FilippovSystem:
+    """The structure of :func:`system` with the NaN term (:func:`nan_layout`), built once
+    per process with its section (crossed upwards) on both engines while p is all zeros
+    (level 0, m 0: the term is finite everywhere, as the construction's probe asks)."""
+    key = ("nan", n, exact)
+    if key not in _SYSTEMS:
+        p = np.zeros(nan_layout(n)["size"])
+        flows = dict(flow_minus=flow_minus, flow_plus=flow_plus,
+                     sample_step=SAMPLE_STEP) if exact else {}
+        fs = _Cached(tuple(f"x{i + 1}" for i in range(n)), field_minus, field_plus,
+                     switch_nan, switch_grad_nan, params=p, name=f"generated{n}-nan",
+                     jacobians={"minus": jac_minus, "plus": jac_plus}, **flows)
+        fs.compiled(section_nan, direction=+1)
+        fs.python_section(section_nan, direction=+1)
+        fs.python()
+        _SYSTEMS[key] = fs
+    return _SYSTEMS[key]
+
+
+@dataclasses.dataclass
+class NanRegion:
+    """A Crossing (``case``) whose ``piece`` is NaN where m.z > level: the orbit enters
+    that half space first at t_nan (transversally, m.z' >= RATE there), before its
+    switch (from below H) or its return (from H); ``p`` the parameter array of
+    :func:`nan_system`."""
+
+    case: Crossing
+    piece: str
+    m: np.ndarray
+    level: float
+    t_nan: float
+    p: np.ndarray
+
+    def orbit(self, t):
+        """The closed-form state at time t (before the return)."""
+        c = self.case
+        if c.start == "below" and t < c.t1:
+            return c.g.minus.flow(c.z0, t)
+        return c.g.plus.flow(c.zc, t - c.t1)
+
+    def field(self, t):
+        c = self.case
+        return (c.g.minus if c.start == "below" and t < c.t1 else c.g.plus).f(self.orbit(t))
+
+
+@st.composite
+def nan_regions(draw, dims=DIMS):
+    case = draw(crossings(dims))
+    piece = draw(st.sampled_from(NAN_PIECES), label="NaN piece")
+    # where the orbit enters the NaN region: before anything else happens (the switch
+    # from below H; the return from H), clear of the start and of it. (After a switch the
+    # engines blame samples of the old field's flow continued past H:
+    # test_properties.PHANTOM_NAN.)
+    first = case.t1 if case.start == "below" else case.time
+    t_nan = draw(st.floats(0.1, 0.9), label="t_nan / first event's time") * first
+    assume(t_nan >= 0.1 and first - t_nan >= 0.05)
+    region = NanRegion(case, piece, np.zeros(case.g.n), 0.0, t_nan, None)
+    # its boundary's normal: along the orbit's velocity there, tilted at random
+    f = region.field(t_nan)
+    m = f / np.linalg.norm(f) + vector(draw, case.g.n, -0.7, 0.7)
+    assume(np.linalg.norm(m) >= 0.3)
+    m = m / np.linalg.norm(m)
+    z_nan = region.orbit(t_nan)
+    level = float(m @ z_nan)
+    assume(m @ f >= RATE)
+    # the first entry: m.z below the level by >= 1e-3 on the way there (up to 0.05 before;
+    # all of it on the first stay's flow)
+    side, z_first = (case.g.minus, case.z0) if case.start == "below" else (case.g.plus, case.zc)
+    ts, zs = side.grid(z_first, t_nan, 201)
+    gaps = level - zs[:-1] @ m
+    assume(gaps.min() > 0 and gaps[ts[:-1] < t_nan - 0.05].min(initial=1.0) >= 1e-3)
+    L = nan_layout(case.g.n)
+    p = np.zeros(L["size"])
+    p[:case.g.p.size] = case.g.p
+    p[L["m"]:L["m"] + case.g.n], p[L["level"]] = m, level
+    p[L["where"]] = NAN_PIECES.index(piece)
+    return dataclasses.replace(region, m=m, level=level, p=p)
