@@ -1224,3 +1224,163 @@ def nan_regions(draw, dims=DIMS):
     p[L["m"]:L["m"] + case.g.n], p[L["level"]] = m, level
     p[L["where"]] = NAN_PIECES.index(piece)
     return dataclasses.replace(region, m=m, level=level, p=p)
+
+
+# ----------------------------------------------------------------------------- two-folds
+# Issue 57 (3): piecewise-constant fields in (x, y, w), H = {w = 0}: f+ = (p1, p2, x) above
+# (its fold line x = 0: w'' = p1 there, visible for p1 > 0, invisible for p1 < 0), f- =
+# (q1, q2, y) below (fold line y = 0, w'' = q2: invisible for q2 > 0). The fold lines meet
+# at the two-fold, the origin. Every stay is a parabola in closed form, and so is the map
+# over a crossing loop. On H, where the fields push toward H from both sides (x < 0 < y),
+# Filippov's sliding field is (y f+ - x f-) / (y - x) (a = y, b = x): with ds = dt / (y - x)
+# it is the linear z' = K z, K = [[-q1, p1], [-q2, p2]], and L = u y + v x with
+# [[p2, p1], [q2, q1]] (u, v) = (-1, -1) falls at the rate 1 exactly along it (t-time).
+@njit(cache=True)
+def two_fold_minus(z, p):
+    return np.array([p[2], p[3], z[1]])
+
+
+@njit(cache=True)
+def two_fold_plus(z, p):
+    return np.array([p[0], p[1], z[0]])
+
+
+@njit(cache=True)
+def two_fold_flow_minus(z0, tau, p):
+    return np.array([z0[0] + p[2] * tau, z0[1] + p[3] * tau,
+                     z0[2] + z0[1] * tau + 0.5 * p[3] * tau * tau])
+
+
+@njit(cache=True)
+def two_fold_flow_plus(z0, tau, p):
+    return np.array([z0[0] + p[0] * tau, z0[1] + p[1] * tau,
+                     z0[2] + z0[0] * tau + 0.5 * p[0] * tau * tau])
+
+
+@njit(cache=True)
+def two_fold_switch(z, p):
+    return z[2]
+
+
+@njit(cache=True)
+def two_fold_grad(z, p):
+    return np.array([0.0, 0.0, 1.0])
+
+
+@njit(cache=True)
+def two_fold_section(z, p):
+    """w = sigma (p[4])."""
+    return z[2] - p[4]
+
+
+def two_fold_system(exact: bool) -> FilippovSystem:
+    """The two-fold structure (p = (p1, p2, q1, q2, sigma)), built once per process."""
+    key = ("two-fold", exact)
+    if key not in _SYSTEMS:
+        flows = dict(flow_minus=two_fold_flow_minus, flow_plus=two_fold_flow_plus,
+                     sample_step=SAMPLE_STEP) if exact else {}
+        fs = _Cached(("x", "y", "w"), two_fold_minus, two_fold_plus, two_fold_switch,
+                     two_fold_grad, params=np.array([-1.0, -1.0, 2.0, 1.0, 100.0]),
+                     name="two-fold", **flows)
+        fs.compiled(two_fold_section, direction=+1)
+        fs.python_section(two_fold_section, direction=+1)
+        _SYSTEMS[key] = fs
+    return _SYSTEMS[key]
+
+
+def slide_rate_one(p1, p2, q1, q2):
+    """(u, v): L = u y + v x falls at the rate 1 along the sliding field."""
+    return np.linalg.solve([[p2, p1], [q2, q1]], [-1.0, -1.0])
+
+
+def crossing_loop(p1, p2, q1, q2):
+    """The map over one crossing loop of an invisible-invisible two-fold (p1 < 0 < q2),
+    from (x, y) on H with x, y > 0: the + arc to (-x, y1), y1 = y + alpha x (alpha =
+    -2 p2 / p1), the - arc to (-x - beta y1, -y1) (beta = 2 q1 / q2): [[-(1 + alpha beta),
+    -beta], [-alpha, -1]], det 1. Returns (M, alpha, beta)."""
+    alpha, beta = -2.0 * p2 / p1, 2.0 * q1 / q2
+    return np.array([[-(1.0 + alpha * beta), -beta], [-alpha, -1.0]]), alpha, beta
+
+
+@dataclasses.dataclass
+class TwoFold:
+    """A start near an invisible-invisible two-fold (p1 < 0 < q2) and what its Filippov
+    solution does. ``kind``: "zeno" (on the loop map's contracting eigenvector: crossing
+    loops each ``ratio`` times the one before, accumulating at the two-fold at t_star);
+    "leaves" (off it by a relative ``offset``: ``crossings`` crossings of H, arc by arc
+    by the map, then into attracting sliding x < 0 < y at t_slide, z_slide, and along it
+    into the two-fold at t_star); "slide" (on H in the sliding region: into the two-fold at t_star =
+    L(z0))."""
+
+    p: np.ndarray
+    z0: np.ndarray
+    kind: str
+    ratio: float
+    t_star: float
+    crossings: int = 0
+    t_slide: float = 0.0
+    z_slide: np.ndarray = None
+
+
+def _loop_coefficients(draw):
+    """p1 < 0, p2 < 0, q2 > 0 drawn, q1 > 0 set so the loop map's eigenvalues are ratio,
+    1 / ratio (trace -(2 + alpha beta) = ratio + 1 / ratio)."""
+    p1 = -draw(st.floats(0.5, 2.0), label="-p1")
+    p2 = -draw(st.floats(0.5, 2.0), label="-p2")
+    q2 = draw(st.floats(0.5, 2.0), label="q2")
+    ratio = draw(st.floats(0.1, 0.5), label="ratio per loop")
+    alpha = -2.0 * p2 / p1
+    beta = -(ratio + 1.0 / ratio + 2.0) / alpha
+    q1 = beta * q2 / 2.0
+    assume(0.2 <= q1 <= 10.0)
+    return p1, p2, q1, q2, ratio
+
+
+def _on_plus_arc(p1, p2, x, y, s):
+    """The state s into the + arc from (x, y, 0)."""
+    return np.array([x + p1 * s, y + p2 * s, x * s + 0.5 * p1 * s * s])
+
+
+@st.composite
+def invisible_two_folds(draw):
+    p1, p2, q1, q2, ratio = _loop_coefficients(draw)
+    M, alpha, beta = crossing_loop(p1, p2, q1, q2)
+    x0 = draw(st.floats(0.3, 1.5), label="x0")
+    vy = -alpha / (1.0 + ratio)           # the eigenvector (1, vy) of ratio
+    kind = draw(st.sampled_from(["zeno", "leaves", "slide"]), label="kind")
+    p = np.array([p1, p2, q1, q2, 100.0])
+    u, v = slide_rate_one(p1, p2, q1, q2)
+    if kind == "slide":
+        x, y = -draw(st.floats(0.05, 1.5), label="-x0"), draw(st.floats(0.05, 1.5), label="y0")
+        return TwoFold(p, np.array([x, y, 0.0]), kind, np.nan, float(u * y + v * x),
+                       z_slide=np.array([x, y, 0.0]))
+    # start a fraction of the first + arc in (clear of the start-on-H rules)
+    s = draw(st.floats(0.1, 0.9), label="s / first arc") * 2.0 * x0 / -p1
+    if kind == "zeno":
+        y0 = vy * x0
+        loop = 2.0 * x0 / -p1 + 2.0 * -alpha * x0 * ratio / ((1.0 + ratio) * q2)
+        return TwoFold(p, _on_plus_arc(p1, p2, x0, y0, s), kind, ratio,
+                       loop / (1.0 - ratio) - s)
+    offset = 10.0 ** draw(st.floats(-2.5, -0.3), label="log10 |offset|") \
+        * draw(st.sampled_from([-1.0, 1.0]), label="sign of the offset")
+    y0 = vy * x0 * (1.0 + offset)
+    # the loops by the map, half arc by half arc, until one ends in the sliding region
+    x, y, t = x0, y0, 0.0
+    for half in range(8):
+        if half % 2 == 0:   # + arc from (x, y), x, y > 0
+            t += 2.0 * x / -p1
+            x, y = -x, y + alpha * x
+            if y > 0:
+                break
+        else:               # - arc from (x, y), x < 0 > y
+            t += 2.0 * y / -q2
+            x, y = x + q1 * 2.0 * y / -q2, -y
+            if x < 0:
+                break
+    else:
+        assume(False)
+    # clear of the crossing region's edges (well-conditioned: the speeds that decide)
+    assume(min(abs(x), abs(y)) >= 0.05 * max(abs(x), abs(y)))
+    assume(half >= 1)   # at least one crossing
+    return TwoFold(p, _on_plus_arc(p1, p2, x0, y0, s), kind, ratio,
+                   float(t - s + u * y + v * x), half, float(t - s), np.array([x, y, 0.0]))

@@ -29,7 +29,7 @@ import pytest
 from hypothesis import example, given, settings
 
 import generated_systems as gs
-from filippov import return_jacobian, simulate
+from filippov import return_jacobian, rules, simulate
 from filippov.poincare import sliding_time
 
 ENGINES = ("compiled", "reference")
@@ -581,3 +581,62 @@ def test_a_nan_the_orbit_never_meets_past_a_switch_is_no_error(piece, engine, ex
     assert ret.n_switches[0] == 1
     _close(ret.time[0], 2.5, 1e-10, "return time")
     _close(ret.state[0], [2.0, 2.0], 1e-10, "P")
+
+
+# ----------------------------------------------------------------------------- two-folds
+# Issue 57 (3) against closed forms (tests/test_zeno_accumulation.py has one example of
+# each): piecewise-constant fields whose every arc is a parabola, so the crossing loops
+# near an invisible-invisible two-fold follow a linear map with det 1 and the slides a
+# linear field in a rescaled time (gs.two_fold_system). Both engines, exact and integrated
+# flows.
+# the ratio is estimated from the last loops' switch times (rules.geometric_accumulation),
+# loops ~1e-2 of the first ones: their times' errors (~1e-12) over their durations;
+# measured <= 2e-5 relative at the smallest ratio drawn (0.1), 1e-6 at 0.4
+RATIO_REL = 1e-4
+
+
+def _two_fold_run(case, flows, engine, section_level=100.0):
+    from filippov import first_returns
+
+    fs = gs.two_fold_system(flows == "exact")
+    fs.params[:] = case.p
+    fs.params[4] = section_level
+    return lambda: first_returns(fs, [case.z0], gs.two_fold_section, 60.0, engine=engine,
+                                 direction=+1)
+
+
+@pytest.mark.parametrize("flows", FLOWS)
+@FEW
+@given(case=gs.invisible_two_folds())
+def test_an_invisible_two_fold_is_reached_as_its_loop_map_says(flows, case):
+    """On the loop map's contracting eigenvector the crossings accumulate: a ZenoError
+    with the eigenvalue as the ratio per loop (printed to 6 digits) and the series' sum
+    t* (to 1e-9 relative, as tests/test_zeno_accumulation.py). Off it by 2-50 %, the
+    other eigenvector grows: after the map's crossings the orbit lands in attracting
+    sliding, which runs into the two-fold at t* = t_slide + L(z_slide) (L = u y + v x
+    falls at the rate 1): "the slide reached a two-fold" there, to 1e-9, at the two-fold
+    itself. And a start on H in the sliding region reaches it at L(z0)."""
+    from filippov import SimulationError, ZenoError
+
+    for engine in ENGINES:
+        run = _two_fold_run(case, flows, engine)
+        where = f"{engine} engine, {flows} flows"
+        if case.kind == "zeno":
+            with pytest.raises(ZenoError, match="accumulate geometrically") as err:
+                got = run()
+                raise AssertionError(f"{where}: returned {got}")
+            msg = str(err.value)
+            ratio = float(msg.split("lasts ")[1].split(" times")[0])
+            t_star = float(msg.split("t* = ")[1].split(" ")[0])
+            assert ratio == pytest.approx(case.ratio, rel=RATIO_REL), f"{where}: {msg}"
+            assert t_star == pytest.approx(case.t_star, rel=1e-9), f"{where}: {msg}"
+            continue
+        msg, t, state = _run_error(run)
+        assert "the slide reached a two-fold" in msg, f"{where}: {msg}"
+        # stopped where both speeds are within TWO_FOLD_SHARE of their sizes at the
+        # slide's entry, L(state) before the two-fold: the state named is on the slide
+        u, v = gs.slide_rate_one(*case.p[:4])
+        _close(t + u * state[1] + v * state[0], case.t_star, TOL[flows],
+               f"arrival at the two-fold, t + L(state) ({where})")
+        near = 2 * rules.TWO_FOLD_SHARE * np.abs(case.z_slide).max() + TOL[flows]
+        assert np.abs(state).max() <= near, f"{where}: {msg}"
