@@ -1384,3 +1384,90 @@ def invisible_two_folds(draw):
     assume(half >= 1)   # at least one crossing
     return TwoFold(p, _on_plus_arc(p1, p2, x0, y0, s), kind, ratio,
                    float(t - s + u * y + v * x), half, float(t - s), np.array([x, y, 0.0]))
+
+
+@dataclasses.dataclass
+class VisibleTwoFold:
+    """A start near a visible-invisible two-fold (f+ visible at x = 0: p1 > 0; f- invisible
+    at y = 0: q2 > 0) and its Filippov solution in closed form. From ``start`` "below"
+    (w0 < 0) the - arc reaches H at t_c, (x_c, y_c) with y_c > 0; for x_c > 0 it crosses
+    (``crossings`` 1) and rises to the section w = sigma; for x_c < 0 (or a start "on H"
+    there, t_c = 0) it slides. The slide is z' = K z in s (ds = dt / (y - x)): it leaves
+    at the visible fold x = 0 (y_e > 0) at t_c + ts -- F = f+ there, whose arc from
+    (0, y_e, 0) rises as p1 tau^2 / 2 to the section -- or it runs into the two-fold
+    (``two_fold``) at t_star = t_c + L(z_c). ``time``, ``P``: the return (nan without)."""
+
+    p: np.ndarray
+    z0: np.ndarray
+    start: str
+    t_c: float
+    z_c: np.ndarray
+    slides: bool
+    ts: float
+    two_fold: bool
+    t_star: float
+    time: float
+    P: np.ndarray
+
+
+def visible_slide(p1, p2, q1, q2, x, y):
+    """The slide from (x, y) on H (x < 0 < y) near a visible-invisible two-fold: ("exit",
+    ts, y_e), ("two-fold", None, None), or None (neither clearly: it passes within 2 % of
+    |z| of the fold line x = 0 without leaving, or runs on past s = 2e4 steps)."""
+    K = np.array([[-q1, p1, 0.0], [-q2, p2, 0.0], [-1.0, 1.0, 0.0]])
+    h = 0.02 / np.linalg.norm(K[:2, :2], 2)
+    E = expm(K * h)
+    Y = np.array([x, y, 0.0])
+    size0 = np.hypot(x, y)
+    for i in range(20000):
+        Yn = E @ Y
+        if Yn[0] >= 0.0:
+            s = brentq(lambda s: (expm(K * s) @ np.array([x, y, 0.0]))[0], i * h, (i + 1) * h,
+                       xtol=1e-15, rtol=4 * np.finfo(float).eps)
+            Ye = expm(K * s) @ np.array([x, y, 0.0])
+            return ("exit", float(Ye[2]), float(Ye[1])) if Ye[1] >= 0.05 * size0 else None
+        if -Yn[0] < 0.02 * np.hypot(Yn[0], Yn[1]):
+            return None
+        if np.hypot(Yn[0], Yn[1]) <= 1e-9 * size0:
+            return "two-fold", None, None
+        Y = Yn
+    return None
+
+
+@st.composite
+def visible_two_folds(draw):
+    p1 = draw(st.floats(0.5, 2.0), label="p1")
+    p2 = draw(st.floats(-2.0, 2.0), label="p2")
+    q1 = draw(st.floats(-2.0, 2.0), label="q1")
+    q2 = draw(st.floats(0.5, 2.0), label="q2")
+    assume(abs(p2 * q1 - p1 * q2) >= 0.1)   # L exists
+    sigma = draw(st.floats(0.1, 1.0), label="sigma")
+    p = np.array([p1, p2, q1, q2, sigma])
+    start = draw(st.sampled_from(["below", "on H"]), label="start")
+    # where the orbit is on H first: in the sliding region x < 0 < y, or (from below) in
+    # the crossing region x, y > 0 -- clear of the fold lines (well conditioned)
+    x = draw(st.floats(0.05, 1.5), label="|x_c|") \
+        * (-1.0 if start == "on H" or draw(st.booleans(), label="slides") else 1.0)
+    y = draw(st.floats(0.2 if start == "below" else 0.05, 1.5), label="y_c")
+    if start == "on H":
+        z0, t_c = np.array([x, y, 0.0]), 0.0
+    else:
+        # back along the - arc: w = y_c (t - t_c) + q2 (t - t_c)^2 / 2 < 0 on [0, t_c) for
+        # t_c < 2 y_c / q2 (its other zero before 0)
+        t_c = draw(st.floats(0.1, 0.9), label="t_c q2 / 2 y_c") * 2.0 * y / q2
+        z0 = np.array([x - q1 * t_c, y - q2 * t_c, -(y * t_c - 0.5 * q2 * t_c * t_c)])
+    z_c = np.array([x, y, 0.0])
+    if x > 0:   # crossing: x tau + p1 tau^2 / 2 = sigma
+        tau = (-x + np.sqrt(x * x + 2.0 * p1 * sigma)) / p1
+        P = np.array([x + p1 * tau, y + p2 * tau, sigma])
+        return VisibleTwoFold(p, z0, start, t_c, z_c, False, 0.0, False, np.nan, t_c + tau, P)
+    end = visible_slide(p1, p2, q1, q2, x, y)
+    assume(end is not None)
+    kind, ts, y_e = end
+    if kind == "two-fold":
+        u, v = slide_rate_one(p1, p2, q1, q2)
+        return VisibleTwoFold(p, z0, start, t_c, z_c, True, np.nan, True,
+                              float(t_c + u * y + v * x), np.nan, None)
+    tau = np.sqrt(2.0 * sigma / p1)
+    P = np.array([p1 * tau, y_e + p2 * tau, sigma])
+    return VisibleTwoFold(p, z0, start, t_c, z_c, True, ts, False, np.nan, t_c + ts + tau, P)
