@@ -1322,18 +1322,12 @@ class TwoFold:
     z_slide: np.ndarray = None
 
 
-def _loop_coefficients(draw):
-    """p1 < 0, p2 < 0, q2 > 0 drawn, q1 > 0 set so the loop map's eigenvalues are ratio,
-    1 / ratio (trace -(2 + alpha beta) = ratio + 1 / ratio)."""
-    p1 = -draw(st.floats(0.5, 2.0), label="-p1")
-    p2 = -draw(st.floats(0.5, 2.0), label="-p2")
-    q2 = draw(st.floats(0.5, 2.0), label="q2")
-    ratio = draw(st.floats(0.1, 0.5), label="ratio per loop")
+def loop_q1(p1, p2, q2, ratio):
+    """q1 such that the loop map's eigenvalues are ratio, 1 / ratio (its trace
+    -(2 + alpha beta) = ratio + 1 / ratio)."""
     alpha = -2.0 * p2 / p1
     beta = -(ratio + 1.0 / ratio + 2.0) / alpha
-    q1 = beta * q2 / 2.0
-    assume(0.2 <= q1 <= 10.0)
-    return p1, p2, q1, q2, ratio
+    return beta * q2 / 2.0
 
 
 def _on_plus_arc(p1, p2, x, y, s):
@@ -1341,28 +1335,29 @@ def _on_plus_arc(p1, p2, x, y, s):
     return np.array([x + p1 * s, y + p2 * s, x * s + 0.5 * p1 * s * s])
 
 
-@st.composite
-def invisible_two_folds(draw):
-    p1, p2, q1, q2, ratio = _loop_coefficients(draw)
+def invisible_two_fold_from(p1, p2, q2, ratio, kind, x0=1.0, s_frac=0.5, offset=0.0):
+    """The TwoFold with f+ = (p1, p2, x), f- = (q1, q2, y), q1 = loop_q1 (p1, p2 < 0 <
+    q2): ``kind`` "zeno" from x0 on the contracting eigenvector, "leaves" from it off by
+    the relative ``offset`` in y (both a fraction s_frac into the first + arc), "slide"
+    from (-x0, offset) on H. None where the generator's conditions fail."""
+    q1 = loop_q1(p1, p2, q2, ratio)
+    if not 0.2 <= q1 <= 10.0:
+        return None
     M, alpha, beta = crossing_loop(p1, p2, q1, q2)
-    x0 = draw(st.floats(0.3, 1.5), label="x0")
     vy = -alpha / (1.0 + ratio)           # the eigenvector (1, vy) of ratio
-    kind = draw(st.sampled_from(["zeno", "leaves", "slide"]), label="kind")
     p = np.array([p1, p2, q1, q2, 100.0])
     u, v = slide_rate_one(p1, p2, q1, q2)
     if kind == "slide":
-        x, y = -draw(st.floats(0.05, 1.5), label="-x0"), draw(st.floats(0.05, 1.5), label="y0")
+        x, y = -x0, offset
         return TwoFold(p, np.array([x, y, 0.0]), kind, np.nan, float(u * y + v * x),
                        z_slide=np.array([x, y, 0.0]))
     # start a fraction of the first + arc in (clear of the start-on-H rules)
-    s = draw(st.floats(0.1, 0.9), label="s / first arc") * 2.0 * x0 / -p1
+    s = s_frac * 2.0 * x0 / -p1
     if kind == "zeno":
         y0 = vy * x0
         loop = 2.0 * x0 / -p1 + 2.0 * -alpha * x0 * ratio / ((1.0 + ratio) * q2)
         return TwoFold(p, _on_plus_arc(p1, p2, x0, y0, s), kind, ratio,
                        loop / (1.0 - ratio) - s)
-    offset = 10.0 ** draw(st.floats(-2.5, -0.3), label="log10 |offset|") \
-        * draw(st.sampled_from([-1.0, 1.0]), label="sign of the offset")
     y0 = vy * x0 * (1.0 + offset)
     # the loops by the map, half arc by half arc, until one ends in the sliding region
     x, y, t = x0, y0, 0.0
@@ -1378,12 +1373,35 @@ def invisible_two_folds(draw):
             if x < 0:
                 break
     else:
-        assume(False)
-    # clear of the crossing region's edges (well-conditioned: the speeds that decide)
-    assume(min(abs(x), abs(y)) >= 0.05 * max(abs(x), abs(y)))
-    assume(half >= 1)   # at least one crossing
+        return None
+    # clear of the crossing region's edges (well conditioned: the speeds that decide),
+    # after at least one crossing
+    if min(abs(x), abs(y)) < 0.05 * max(abs(x), abs(y)) or half < 1:
+        return None
     return TwoFold(p, _on_plus_arc(p1, p2, x0, y0, s), kind, ratio,
                    float(t - s + u * y + v * x), half, float(t - s), np.array([x, y, 0.0]))
+
+
+@st.composite
+def invisible_two_folds(draw):
+    p1 = -draw(st.floats(0.5, 2.0), label="-p1")
+    p2 = -draw(st.floats(0.5, 2.0), label="-p2")
+    q2 = draw(st.floats(0.5, 2.0), label="q2")
+    ratio = draw(st.floats(0.1, 0.5), label="ratio per loop")
+    kind = draw(st.sampled_from(["zeno", "leaves", "slide"]), label="kind")
+    if kind == "slide":
+        case = invisible_two_fold_from(p1, p2, q2, ratio, kind,
+                                       draw(st.floats(0.05, 1.5), label="-x0"),
+                                       offset=draw(st.floats(0.05, 1.5), label="y0"))
+    else:
+        x0 = draw(st.floats(0.3, 1.5), label="x0")
+        s_frac = draw(st.floats(0.1, 0.9), label="s / first arc")
+        offset = 0.0 if kind == "zeno" else \
+            10.0 ** draw(st.floats(-2.5, -0.3), label="log10 |offset|") \
+            * draw(st.sampled_from([-1.0, 1.0]), label="sign of the offset")
+        case = invisible_two_fold_from(p1, p2, q2, ratio, kind, x0, s_frac, offset)
+    assume(case is not None)
+    return case
 
 
 @dataclasses.dataclass
@@ -1413,48 +1431,39 @@ class VisibleTwoFold:
 def visible_slide(p1, p2, q1, q2, x, y):
     """The slide from (x, y) on H (x < 0 < y) near a visible-invisible two-fold: ("exit",
     ts, y_e), ("two-fold", None, None), or None (neither clearly: it passes within 2 % of
-    |z| of the fold line x = 0 without leaving, or runs on past s = 2e4 steps)."""
+    |z| of the fold line x = 0 on its way into the two-fold, or runs on past 2e4 steps
+    of s)."""
     K = np.array([[-q1, p1, 0.0], [-q2, p2, 0.0], [-1.0, 1.0, 0.0]])
     h = 0.02 / np.linalg.norm(K[:2, :2], 2)
     E = expm(K * h)
     Y = np.array([x, y, 0.0])
-    size0 = np.hypot(x, y)
+    size0, closest = np.hypot(x, y), np.inf
     for i in range(20000):
         Yn = E @ Y
-        if Yn[0] >= 0.0:
+        if Yn[0] >= 0.0:   # the exit, crossing x = 0 at the rate p1 y_e in s
             s = brentq(lambda s: (expm(K * s) @ np.array([x, y, 0.0]))[0], i * h, (i + 1) * h,
                        xtol=1e-15, rtol=4 * np.finfo(float).eps)
             Ye = expm(K * s) @ np.array([x, y, 0.0])
             return ("exit", float(Ye[2]), float(Ye[1])) if Ye[1] >= 0.05 * size0 else None
-        if -Yn[0] < 0.02 * np.hypot(Yn[0], Yn[1]):
-            return None
+        closest = min(closest, -Yn[0] / np.hypot(Yn[0], Yn[1]))
         if np.hypot(Yn[0], Yn[1]) <= 1e-9 * size0:
-            return "two-fold", None, None
+            return ("two-fold", None, None) if closest >= 0.02 else None
         Y = Yn
     return None
 
 
-@st.composite
-def visible_two_folds(draw):
-    p1 = draw(st.floats(0.5, 2.0), label="p1")
-    p2 = draw(st.floats(-2.0, 2.0), label="p2")
-    q1 = draw(st.floats(-2.0, 2.0), label="q1")
-    q2 = draw(st.floats(0.5, 2.0), label="q2")
-    assume(abs(p2 * q1 - p1 * q2) >= 0.1)   # L exists
-    sigma = draw(st.floats(0.1, 1.0), label="sigma")
+def visible_two_fold_from(p1, p2, q1, q2, sigma, start, x, y, tc_frac=0.5):
+    """The VisibleTwoFold of f+ = (p1, p2, x), f- = (q1, q2, y), the section w = sigma,
+    first on H at (x, y): ``start`` "on H" there, or "below" on the - arc that reaches it
+    at t_c = tc_frac 2 y / q2 (w = y (t - t_c) + q2 (t - t_c)^2 / 2 < 0 on [0, t_c): its
+    other zero is before 0). None where the generator's conditions fail."""
+    if abs(p2 * q1 - p1 * q2) < 0.1:   # L exists
+        return None
     p = np.array([p1, p2, q1, q2, sigma])
-    start = draw(st.sampled_from(["below", "on H"]), label="start")
-    # where the orbit is on H first: in the sliding region x < 0 < y, or (from below) in
-    # the crossing region x, y > 0 -- clear of the fold lines (well conditioned)
-    x = draw(st.floats(0.05, 1.5), label="|x_c|") \
-        * (-1.0 if start == "on H" or draw(st.booleans(), label="slides") else 1.0)
-    y = draw(st.floats(0.2 if start == "below" else 0.05, 1.5), label="y_c")
     if start == "on H":
         z0, t_c = np.array([x, y, 0.0]), 0.0
     else:
-        # back along the - arc: w = y_c (t - t_c) + q2 (t - t_c)^2 / 2 < 0 on [0, t_c) for
-        # t_c < 2 y_c / q2 (its other zero before 0)
-        t_c = draw(st.floats(0.1, 0.9), label="t_c q2 / 2 y_c") * 2.0 * y / q2
+        t_c = tc_frac * 2.0 * y / q2
         z0 = np.array([x - q1 * t_c, y - q2 * t_c, -(y * t_c - 0.5 * q2 * t_c * t_c)])
     z_c = np.array([x, y, 0.0])
     if x > 0:   # crossing: x tau + p1 tau^2 / 2 = sigma
@@ -1462,7 +1471,8 @@ def visible_two_folds(draw):
         P = np.array([x + p1 * tau, y + p2 * tau, sigma])
         return VisibleTwoFold(p, z0, start, t_c, z_c, False, 0.0, False, np.nan, t_c + tau, P)
     end = visible_slide(p1, p2, q1, q2, x, y)
-    assume(end is not None)
+    if end is None:
+        return None
     kind, ts, y_e = end
     if kind == "two-fold":
         u, v = slide_rate_one(p1, p2, q1, q2)
@@ -1471,3 +1481,22 @@ def visible_two_folds(draw):
     tau = np.sqrt(2.0 * sigma / p1)
     P = np.array([p1 * tau, y_e + p2 * tau, sigma])
     return VisibleTwoFold(p, z0, start, t_c, z_c, True, ts, False, np.nan, t_c + ts + tau, P)
+
+
+@st.composite
+def visible_two_folds(draw):
+    p1 = draw(st.floats(0.5, 2.0), label="p1")
+    p2 = draw(st.floats(-2.0, 2.0), label="p2")
+    q1 = draw(st.floats(-2.0, 2.0), label="q1")
+    q2 = draw(st.floats(0.5, 2.0), label="q2")
+    sigma = draw(st.floats(0.1, 1.0), label="sigma")
+    start = draw(st.sampled_from(["below", "on H"]), label="start")
+    # where the orbit is on H first: in the sliding region x < 0 < y, or (from below) in
+    # the crossing region x, y > 0 -- clear of the fold lines (well conditioned)
+    x = draw(st.floats(0.05, 1.5), label="|x_c|") \
+        * (-1.0 if start == "on H" or draw(st.booleans(), label="slides") else 1.0)
+    y = draw(st.floats(0.2 if start == "below" else 0.05, 1.5), label="y_c")
+    tc_frac = draw(st.floats(0.1, 0.9), label="t_c q2 / 2 y_c") if start == "below" else 0.0
+    case = visible_two_fold_from(p1, p2, q1, q2, sigma, start, x, y, tc_frac)
+    assume(case is not None)
+    return case

@@ -549,17 +549,14 @@ def test_a_piece_that_turns_nan_on_the_way_stops_the_run_by_name(flows, region):
 # of the three pieces, raised "non-finite ... mode minus (<piece> returned a non-finite
 # value there)" at t = 0.775-0.93, state (0, 0.27-0.43) (y > 0: region +, in mode
 # minus). At 1e0caeb (before the NaN check) all twelve returned (2, 2) at t = 2.5.
-def _phantom_root(z):
-    return np.sqrt(0.25 - (z[1] - z[0]))
-
-
 PHANTOM_NAN = {
-    "switch": (lambda z, p: z[1] + 0.0 * _phantom_root(z),
+    "switch": (lambda z, p: z[1] + 0.0 * np.sqrt(0.25 - z[1] + z[0]),
                lambda z, p: np.array([0.0, 1.0]), lambda z, p: z[0] - 2.0),
-    "switch_grad": (lambda z, p: z[1], lambda z, p: np.array([0.0 * _phantom_root(z), 1.0]),
+    "switch_grad": (lambda z, p: z[1],
+                    lambda z, p: np.array([0.0 * np.sqrt(0.25 - z[1] + z[0]), 1.0]),
                     lambda z, p: z[0] - 2.0),
     "section": (lambda z, p: z[1], lambda z, p: np.array([0.0, 1.0]),
-                lambda z, p: z[0] - 2.0 + 0.0 * _phantom_root(z)),
+                lambda z, p: z[0] - 2.0 + 0.0 * np.sqrt(0.25 - z[1] + z[0])),
 }
 
 
@@ -607,6 +604,9 @@ def _two_fold_run(case, flows, engine, section_level=100.0):
 
 @pytest.mark.parametrize("flows", FLOWS)
 @FEW
+@example(case=gs.invisible_two_fold_from(-1.0, -1.0, 1.0, 0.3, "zeno"))
+@example(case=gs.invisible_two_fold_from(-1.0, -1.0, 1.0, 0.3, "leaves", 1.0, 0.5, 0.05))
+@example(case=gs.invisible_two_fold_from(-1.0, -1.0, 1.0, 0.3, "slide", 1.0, offset=0.5))
 @given(case=gs.invisible_two_folds())
 def test_an_invisible_two_fold_is_reached_as_its_loop_map_says(flows, case):
     """On the loop map's contracting eigenvector the crossings accumulate: a ZenoError
@@ -642,8 +642,21 @@ def test_an_invisible_two_fold_is_reached_as_its_loop_map_says(flows, case):
         assert np.abs(state).max() <= near, f"{where}: {msg}"
 
 
+# one case of each outcome, whatever the ci profile draws
+VISIBLE_TWO_FOLD_CASES = [(0.5, -2.0, -1.0, 0.5, 0.5, "below", 0.5, 1.0),    # crosses
+                          (0.5, -2.0, 2.0, 0.5, 0.5, "on H", -0.5, 1.0),    # leaves at x = 0
+                          (0.5, -2.0, 2.0, 0.5, 0.5, "below", -0.5, 1.0),   # the same, from below
+                          (0.5, -2.0, 0.5, 0.5, 0.5, "on H", -1.0, 0.5),    # into the two-fold
+                          (0.5, -2.0, 0.5, 0.5, 0.5, "below", -0.5, 1.0)]   # the same, from below
+
+
 @pytest.mark.parametrize("flows", FLOWS)
 @FEW
+@example(case=gs.visible_two_fold_from(*VISIBLE_TWO_FOLD_CASES[0]))
+@example(case=gs.visible_two_fold_from(*VISIBLE_TWO_FOLD_CASES[1]))
+@example(case=gs.visible_two_fold_from(*VISIBLE_TWO_FOLD_CASES[2]))
+@example(case=gs.visible_two_fold_from(*VISIBLE_TWO_FOLD_CASES[3]))
+@example(case=gs.visible_two_fold_from(*VISIBLE_TWO_FOLD_CASES[4]))
 @given(case=gs.visible_two_folds())
 def test_near_a_visible_invisible_two_fold_the_orbit_does_what_its_closed_form_says(
         flows, case):
