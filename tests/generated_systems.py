@@ -1193,9 +1193,9 @@ class NanRegion:
 
 
 @st.composite
-def nan_regions(draw, dims=DIMS):
+def nan_regions(draw, dims=DIMS, pieces=NAN_PIECES):
     case = draw(crossings(dims))
-    piece = draw(st.sampled_from(NAN_PIECES), label="NaN piece")
+    piece = draw(st.sampled_from(pieces), label="NaN piece")
     # where the orbit enters the NaN region: before anything else happens (the switch
     # from below H; the return from H), clear of the start and of it. (After a switch the
     # engines blame samples of the old field's flow continued past H:
@@ -1476,10 +1476,13 @@ def visible_two_fold_from(p1, p2, q1, q2, sigma, start, x, y, tc_frac=0.5):
     kind, ts, y_e = end
     if kind == "two-fold":
         u, v = slide_rate_one(p1, p2, q1, q2)
-        return VisibleTwoFold(p, z0, start, t_c, z_c, True, np.nan, True,
-                              float(t_c + u * y + v * x), np.nan, None)
+        t_star = float(t_c + u * y + v * x)
+        return VisibleTwoFold(p, z0, start, t_c, z_c, True, np.nan, True, t_star, np.nan,
+                              None) if t_star <= T_MAX else None
     tau = np.sqrt(2.0 * sigma / p1)
     P = np.array([p1 * tau, y_e + p2 * tau, sigma])
+    if t_c + ts + tau > T_MAX or np.abs(P).max() > GROWTH:   # O(1) times and states
+        return None
     return VisibleTwoFold(p, z0, start, t_c, z_c, True, ts, False, np.nan, t_c + ts + tau, P)
 
 
