@@ -1503,3 +1503,66 @@ def visible_two_folds(draw):
     case = visible_two_fold_from(p1, p2, q1, q2, sigma, start, x, y, tc_frac)
     assume(case is not None)
     return case
+
+
+# ----------------------------------------------------------------------------- a NaN past a switch
+# test_properties.PHANTOM_NAN: x' = 0 below H = {y = 0}, 1 above, y' = 1; the piece named
+# is NaN where y - x > 1/4, which only the flow of region - continued past H reaches.
+@njit(cache=True)
+def _phantom_term(z):
+    return 0.0 * np.sqrt(0.25 - z[1] + z[0])
+
+
+@njit(cache=True)
+def phantom_minus(z, p):
+    return np.array([0.0, 1.0])
+
+
+@njit(cache=True)
+def phantom_plus(z, p):
+    return np.array([1.0, 1.0])
+
+
+@njit(cache=True)
+def phantom_flow_minus(z0, tau, p):
+    return np.array([z0[0], z0[1] + tau])
+
+
+@njit(cache=True)
+def phantom_flow_plus(z0, tau, p):
+    return np.array([z0[0] + tau, z0[1] + tau])
+
+
+@njit(cache=True)
+def phantom_switch(z, p):
+    return z[1] + (_phantom_term(z) if p[0] == 0.0 else 0.0)
+
+
+@njit(cache=True)
+def phantom_grad(z, p):
+    return np.array([_phantom_term(z) if p[0] == 1.0 else 0.0, 1.0])
+
+
+@njit(cache=True)
+def phantom_section(z, p):
+    """x = 2."""
+    return z[0] - 2.0 + (_phantom_term(z) if p[0] == 2.0 else 0.0)
+
+
+def phantom_system(piece: str, exact: bool) -> FilippovSystem:
+    """The system of test_properties.PHANTOM_NAN with ``piece`` NaN where y - x > 1/4
+    (p[0]: its index in NAN_PIECES), built once per process (with p[0] = 3, no NaN, for
+    the construction's probe)."""
+    key = ("phantom", exact)
+    if key not in _SYSTEMS:
+        flows = dict(flow_minus=phantom_flow_minus, flow_plus=phantom_flow_plus,
+                     sample_step=0.1) if exact else {}
+        fs = _Cached(("x", "y"), phantom_minus, phantom_plus, phantom_switch, phantom_grad,
+                     params=np.array([3.0]), name="phantom", **flows)
+        fs.compiled(phantom_section)
+        fs.python_section(phantom_section)
+        fs.python()
+        _SYSTEMS[key] = fs
+    fs = _SYSTEMS[key]
+    fs.params[0] = NAN_PIECES.index(piece)
+    return fs

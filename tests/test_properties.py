@@ -552,41 +552,26 @@ def test_a_piece_that_turns_nan_on_the_way_stops_the_run_by_name(flows, piece, d
         assert region.m @ state - region.level > -TOL[flows], where
 
 
-# Found by the property above (issue 57, 1): a NaN met past a switch on samples of the
-# old field's flow continued through H -- a state the orbit never visits -- stops the run
-# in the old mode there. x' = 0 below H = {y = 0} and 1 above, y' = 1: from (0, -0.5) the
+# PHANTOM_NAN, found by the property above (issue 57, 1): a NaN met past a switch on
+# samples of the old field's flow continued through H -- a state the orbit never visits --
+# stops the run in the old mode there. x' = 0 below H = {y = 0} and 1 above, y' = 1: from (0, -0.5) the
 # orbit crosses at t = 0.5, then runs along y - x = 0.5 - 0.5 = 0 to the section x = 2 at
 # t = 2.5, state (2, 2). The piece is NaN where y - x > 0.25, which only the continued
 # flow of region - reaches (at t = 0.75, x = 0). Both engines, with either flows and any
 # of the three pieces, raised "non-finite ... mode minus (<piece> returned a non-finite
 # value there)" at t = 0.775-0.93, state (0, 0.27-0.43) (y > 0: region +, in mode
 # minus). At 1e0caeb (before the NaN check) all twelve returned (2, 2) at t = 2.5.
-PHANTOM_NAN = {
-    "switch": (lambda z, p: z[1] + 0.0 * np.sqrt(0.25 - z[1] + z[0]),
-               lambda z, p: np.array([0.0, 1.0]), lambda z, p: z[0] - 2.0),
-    "switch_grad": (lambda z, p: z[1],
-                    lambda z, p: np.array([0.0 * np.sqrt(0.25 - z[1] + z[0]), 1.0]),
-                    lambda z, p: z[0] - 2.0),
-    "section": (lambda z, p: z[1], lambda z, p: np.array([0.0, 1.0]),
-                lambda z, p: z[0] - 2.0 + 0.0 * np.sqrt(0.25 - z[1] + z[0])),
-}
-
-
 @pytest.mark.xfail(strict=True, reason="a NaN on the old field's flow continued past a "
                    "switch (a state the orbit never visits) stops the run (PHANTOM_NAN)")
 @pytest.mark.parametrize("exact", [False, True], ids=["integrated", "exact"])
 @pytest.mark.parametrize("engine", ENGINES)
-@pytest.mark.parametrize("piece", sorted(PHANTOM_NAN))
+@pytest.mark.parametrize("piece", gs.NAN_PIECES)
 def test_a_nan_the_orbit_never_meets_past_a_switch_is_no_error(piece, engine, exact):
-    from filippov import FilippovSystem, first_returns
+    """PHANTOM_NAN (gs.phantom_system): the return (2, 2) at t = 2.5, one switch."""
+    from filippov import first_returns
 
-    switch, grad, section = PHANTOM_NAN[piece]
-    flows = dict(flow_minus=lambda z0, tau, p: np.array([z0[0], z0[1] + tau]),
-                 flow_plus=lambda z0, tau, p: np.array([z0[0] + tau, z0[1] + tau]),
-                 sample_step=0.1) if exact else {}
-    fs = FilippovSystem(("x", "y"), lambda z, p: np.array([0.0, 1.0]),
-                        lambda z, p: np.array([1.0, 1.0]), switch, grad, **flows)
-    ret = first_returns(fs, [[0.0, -0.5]], section, 10.0, engine=engine)
+    fs = gs.phantom_system(piece, exact)
+    ret = first_returns(fs, [[0.0, -0.5]], gs.phantom_section, 10.0, engine=engine)
     assert ret.n_switches[0] == 1
     _close(ret.time[0], 2.5, 1e-10, "return time")
     _close(ret.state[0], [2.0, 2.0], 1e-10, "P")
