@@ -552,17 +552,16 @@ def test_a_piece_that_turns_nan_on_the_way_stops_the_run_by_name(flows, piece, d
         assert region.m @ state - region.level > -TOL[flows], where
 
 
-# PHANTOM_NAN, found by the property above (issue 57, 1): a NaN met past a switch on
-# samples of the old field's flow continued through H -- a state the orbit never visits --
-# stops the run in the old mode there. x' = 0 below H = {y = 0} and 1 above, y' = 1: from (0, -0.5) the
+# PHANTOM_NAN, found by the property above (issue 57, 1), mended: a NaN met past a switch
+# on samples of the old field's flow continued through H -- a state the orbit never
+# visits -- stopped the run in the old mode there; a window's samples are now searched up
+# to the first that is not finite, and an event before it stands. x' = 0 below H = {y = 0} and 1 above, y' = 1: from (0, -0.5) the
 # orbit crosses at t = 0.5, then runs along y - x = 0.5 - 0.5 = 0 to the section x = 2 at
 # t = 2.5, state (2, 2). The piece is NaN where y - x > 0.25, which only the continued
 # flow of region - reaches (at t = 0.75, x = 0). Both engines, with either flows and any
 # of the three pieces, raised "non-finite ... mode minus (<piece> returned a non-finite
 # value there)" at t = 0.775-0.93, state (0, 0.27-0.43) (y > 0: region +, in mode
 # minus). At 1e0caeb (before the NaN check) all twelve returned (2, 2) at t = 2.5.
-@pytest.mark.xfail(strict=True, reason="a NaN on the old field's flow continued past a "
-                   "switch (a state the orbit never visits) stops the run (PHANTOM_NAN)")
 @pytest.mark.parametrize("exact", [False, True], ids=["integrated", "exact"])
 @pytest.mark.parametrize("engine", ENGINES)
 @pytest.mark.parametrize("piece", gs.NAN_PIECES)

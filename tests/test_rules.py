@@ -31,7 +31,11 @@ def test_every_rule_compiles_as_it_is(name):
     gives what Python gives."""
     rule = kernel.rule_book()[name]
     compiled = numba.njit(rule)
-    assert np.array_equal(compiled(*_sample_args(rule)), rule(*_sample_args(rule)))
+    got, want = compiled(*_sample_args(rule)), rule(*_sample_args(rule))
+    # (nan, nan) is geometric_accumulation's "no": equal to itself here
+    assert np.array_equal(got, want) or np.array_equal(np.asarray(got, dtype=float),
+                                                       np.asarray(want, dtype=float),
+                                                       equal_nan=True)
 
 
 def _src_files():

@@ -950,22 +950,36 @@ class _Scan:
             self.rates = _speed_rates(system, Z, np.asarray(zs[:, 0], dtype=float))
             if self.rates is not None:
                 self.R = self.rates(ts)
-        self._check_finite()
+        self.not_finite = self._first_not_finite()
+        if self.not_finite is not None:
+            self._cut(self.not_finite[0])
 
-    def _check_finite(self):
-        """Every sampled value is finite, or the run stops at the first sample that is
-        not, naming the piece: a NaN sample shows no sign change, so a switch or a
-        section hit there would be missed, not found (the kernel: scan._sample)."""
+    def _first_not_finite(self):
+        """(k, t, z): the first sample k where a sampled value is not finite, with the time
+        and state where the piece gave it (the rates of a and b evaluate them a step
+        ahead), or None. A NaN sample shows no sign change: a switch or a section hit
+        there would be missed, not found (the kernel: scan._sample)."""
         sampled = self.raw + self.svals + ([self.D] if self.D is not None else [])
-        ahead = len(sampled)  # the rates' differences evaluate a and b a step ahead
+        ahead = len(sampled)
         sampled += list(self.R) if self.R is not None else []
+        first = None
         for j, v in enumerate(sampled):
             if not math.isfinite(float(np.sum(v))) and not np.all(np.isfinite(v)):
                 k = int(np.flatnonzero(~np.isfinite(v))[0])
-                if j < ahead:
-                    raise self._non_finite(self.ts[k], self.zs[:, k])
-                t = self.ts[k] + self.rates.step
-                raise self._non_finite(t, self.Z(t))
+                if first is None or k < first[0] or (k == first[0] and j < ahead):
+                    t = self.ts[k] if j < ahead else self.ts[k] + self.rates.step
+                    first = (k, t, self.zs[:, k] if j < ahead else self.Z(t))
+        return first
+
+    def _cut(self, k):
+        """The samples before k only: an event among them stands (past an event the
+        samples follow this mode's field, not the orbit); with none, :meth:`earliest`
+        stops the run at sample k."""
+        self.ts, self.zs = self.ts[:k], self.zs[:, :k]
+        self.vals, self.raw = [v[:k] for v in self.vals], [v[:k] for v in self.raw]
+        self.svals = [v[:k] for v in self.svals]
+        self.D = None if self.D is None else self.D[:k]
+        self.R = None if self.R is None else tuple(r[:k] for r in self.R)
 
     def _non_finite(self, t, z):
         z = np.asarray(z, dtype=float).reshape(-1)
@@ -981,6 +995,8 @@ class _Scan:
         above their rounding where 64 ulps of the samples fall short of it (measured at
         the samples only then: :func:`_rounding`; engines.py asymmetry 12)."""
         ts, n = self.ts, self.ts.size
+        if self.not_finite is not None:  # cut short: searched as it is (earliest)
+            return True
         if self.mode == SLIDING:
             judged = [(v, v, False, func) for v, (func, _, _) in zip(self.raw, self.leave)]
         else:
@@ -1026,8 +1042,12 @@ class _Scan:
     def earliest(self):
         """(t, z, what, section index) of the earliest event in the segment, or None; and
         the band still in force after it."""
+        if self.not_finite is not None and self.ts.size < 2:
+            raise self._non_finite(*self.not_finite[1:])
         self.order = np.flatnonzero(self.candidates())
         _, r, what, k = _window_event(self, self.mode)
+        if what == interval.NONE and self.not_finite is not None:
+            raise self._non_finite(*self.not_finite[1:])
         if what == interval.NONE:
             return None, self.band
         return (r, np.asarray(self.Z(r), dtype=float).reshape(-1).copy(), what, k), self.band

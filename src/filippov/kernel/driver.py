@@ -153,20 +153,20 @@ def _window(mode, ta, tb, first, may_split, ctx):
     if k0 == 1:
         _carry_sample(ns, w.seg, sm)
     bad, speed2_a = _sample(mode, ta, tb, frac, k0, o, sm, sc)
-    if bad >= 0:
-        if _all_finite(sc.wz):  # a piece's value, not the state: the run stops there
-            for c in range(w.z.size):
-                w.z[c] = sc.wz[c]
-            return NON_FINITE, sm.ts[bad], _W_NONE
-        return NON_FINITE, ta, _W_NONE  # the state itself: stopped at the last finite one
+    # a sample whose state or value is not finite (bad >= 0) ends the samples searched:
+    # an event before it stands (past an event the samples follow this mode's field, not
+    # the orbit), and with none the run stops there (_stop_non_finite)
+    piece = bad >= 0 and _all_finite(sc.wz)  # a piece's value, not the state
+    if bad >= 0 and bad < 2:
+        return _stop_non_finite(bad, piece, ta, mode, o, sm, w)
     # an exact flow (SEG_INTEGRATED == 0) must follow its field over the window: from the
     # state at ta (w.z) to that at tb (w.ynew), the field at tb left in w.wf by the last
     # sample; else the run stops at ta (w.z)
-    if exact and not _flow_follows(w.z, w.ynew, tb - ta, speed2_a, w.wf):
+    if bad < 0 and exact and not _flow_follows(w.z, w.ynew, tb - ta, speed2_a, w.wf):
         return FLOW_OFF_FIELD, ta, _W_NONE
-    if may_split and not exact and not _resolved(mode, ns, sm):
+    if bad < 0 and may_split and not exact and not _resolved(mode, ns, sm):
         return UNRESOLVED, ta, _W_NONE
-    st, te, what = _find(mode, ns, first, s, o, sm, sc)
+    st, te, what = _find(mode, ns if bad < 0 else bad, first, s, o, sm, sc)
     # P is not differentiable where the orbit touches H
     if _DERIVATIVES and s.jac and w.touched[0]:
         for i in range(w.z.size):
@@ -174,12 +174,24 @@ def _window(mode, ta, tb, first, may_split, ctx):
                 w.deriv.M[i, j] = np.nan
     if st != OK:
         return st, ta, _W_NONE
+    if what == _W_NONE and bad >= 0:
+        return _stop_non_finite(bad, piece, ta, mode, o, sm, w)
     if what == _W_NONE:
         for c in range(w.z.size):
             w.z[c] = w.ynew[c]
         return (NO_RETURN if tb >= s.t_max else _GO_ON), tb, _W_NONE
     _zat(te, mode, o, w.z)
     return OK, te, what
+
+
+@_jit_inline
+def _stop_non_finite(bad, piece, ta, mode, o, sm, w):
+    """NON_FINITE: at sample ``bad`` (its time; the state there in w.z) where a piece's
+    value was not finite, or at ta (w.z the last finite state) where the state was not."""
+    if piece:
+        _zat(sm.ts[bad], mode, o, w.z)
+        return NON_FINITE, sm.ts[bad], _W_NONE
+    return NON_FINITE, ta, _W_NONE
 
 
 def _build_step_windows(ns):
