@@ -39,23 +39,19 @@ build (tests/conftest.py; ``FILIPPOV_TEST_BUILD=DIR`` reuses a finished build of
 tree). Chromium and chromedriver: as tests/test_docs_browser.py (skipped without them,
 a failure with ``FILIPPOV_BROWSER_TEST=1``).
 """
-import functools
-import http.server
 import json
 import os
 import struct
-import threading
 import time
 from pathlib import Path
 
 import pytest
 
 # the same browser, the same skip-or-fail when it is missing (at import), the same flags
-from test_docs_browser import CHROMEDRIVER, CHROMIUM, FLAGS, SHOTS, _Quiet, console_errors
+from test_docs_browser import SHOTS, chromium, console_errors, served
 
 from conftest import run_snakemake
 from filippov_paper.report_html import INTERNAL_LABEL
-from selenium import webdriver  # noqa: E402  (test_docs_browser has skipped without it)
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 from selenium.webdriver.support.ui import WebDriverWait  # noqa: E402
@@ -110,30 +106,17 @@ def shots(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def server(report):
-    handler = functools.partial(_Quiet, directory=str(report["path"].parent))
-    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
-    thread = threading.Thread(target=httpd.serve_forever, daemon=True)
-    thread.start()
-    yield f"http://127.0.0.1:{httpd.server_address[1]}/"
-    httpd.shutdown()
-    httpd.server_close()
+    with served(report["path"].parent) as url:
+        yield url
 
 
 @pytest.fixture(scope="module")
 def browser(tmp_path_factory):
     """test_docs_browser's browser, with the DevTools network log and no name resolved
     but 127.0.0.1's."""
-    options = webdriver.ChromeOptions()
-    options.binary_location = CHROMIUM
-    for flag in FLAGS:
-        options.add_argument(flag)
-    options.add_argument("--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1")
-    options.add_argument(f"--user-data-dir={tmp_path_factory.mktemp('chromium-profile')}")
-    options.set_capability("goog:loggingPrefs", {"browser": "ALL", "performance": "ALL"})
-    driver = webdriver.Chrome(options=options,
-                              service=webdriver.ChromeService(executable_path=CHROMEDRIVER))
-    driver.set_page_load_timeout(120)
-    driver.set_script_timeout(60)
+    driver = chromium(tmp_path_factory.mktemp("chromium-profile"),
+                      "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1",
+                      logs=("browser", "performance"), page_load_timeout=120)
     yield driver
     driver.quit()
 
