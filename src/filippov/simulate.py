@@ -1021,8 +1021,10 @@ class _Scan:
             return v
         return along
 
-    def _dH(self, tt):
-        return self._along(lambda z: self.system.speed_of_switch(self.mode, z))(tt)
+    @functools.cached_property
+    def _dH(self):
+        """dH/dt along the segment, a function of time (built once: Brent calls it)."""
+        return self._along(lambda z: self.system.speed_of_switch(self.mode, z))
 
     def candidates(self):
         """Sample intervals that may hold an event, found with array operations; only
