@@ -19,19 +19,22 @@ section, two narrow dips of h between two samples; and (a review of the referenc
 measured rounding) a dip whose run of samples must not be judged above another sample's
 rounding.
 
-Known and not yet mended, marked xfail(strict=True): it runs, it fails today, and it turns
-the suite red the day a change mends it, so that its mark and the limitation written in
-the tutorial go.
+Mended by the run's units (docs/decisions.md#units, filippov.scale: the tolerances and
+the central-difference steps measured in a state scale, a time scale and H's scale,
+declared by the system or measured at the start):
 
-3. ``touch_tol`` is absolute, in h's units: in a system written in micrometres a real
-   crossing 2.3e-10 of the state's scale deep (2.25e-16 in h) is taken for a touch.
-4. Central differences behind dP/dz step by max(1, |z_k|) times 1e-6 (reference) or
-   6e-6 (compiled): on a limit cycle of radius 1e-5 the steps are of the cycle's size and
-   the multiplier comes out 0.031 (reference) and 0.014 (compiled) for 0.0316. Taking the
+3. ``touch_tol`` was absolute, in h's units: in a system written in micrometres a real
+   crossing 2.3e-10 of the state's scale deep (2.25e-16 in h) was taken for a touch.
+4. Central differences behind dP/dz stepped by max(1, |z_k|) times 1e-6 (reference) or
+   6e-6 (compiled): on a limit cycle of radius 1e-5 the steps were of the cycle's size and
+   the multiplier came out 0.031 (reference) and 0.014 (compiled) for 0.0316. Taking the
    step relative to the state's own size instead was tried and dropped: at a state on the
    origin up to rounding (a crossing of H at z = 0) it differenced at 1e-22 and read the
-   Jacobian of an affine field as 0 (the property tests found it). What is needed is the
-   system's scale, declared or measured along the orbit, not the state's.
+   Jacobian of an affine field as 0 (the property tests found it). The steps now grow
+   from the system's scale, not from 1 nor from the state's own size.
+
+A limitation found later and not yet mended would be marked xfail(strict=True) here: it
+runs, it fails, and it turns the suite red the day a change mends it.
 """
 import numpy as np
 import pytest
@@ -160,7 +163,6 @@ def test_a_steep_sample_does_not_lift_the_rounding_of_a_run_that_shows_a_dip():
     assert out.time[0] == pytest.approx(c - w * np.sqrt(np.log(2.0)) - x0, rel=1e-9)
 
 
-@_miss("touch_tol is absolute in h's units: a shallow real crossing is taken for a touch")
 @pytest.mark.parametrize("engine", ENGINES)
 def test_a_shallow_crossing_in_small_units_is_a_crossing(engine):
     # x'' = -x, and -x - L where h = x - L >= 0 (L = 1e-6: metres); from (-A, 0), A = L
@@ -208,7 +210,6 @@ def test_a_limit_cycle_of_order_one_has_its_multiplier(engine):
     assert _multiplier(1.0, engine) == pytest.approx(MULTIPLIER, rel=1e-6)
 
 
-@_miss("central differences step by at least 1e-6 whatever the state's size")
 @pytest.mark.parametrize("engine", ENGINES)
 def test_a_small_limit_cycle_has_the_multiplier_of_a_large_one(engine):
     assert _multiplier(1e-5, engine) == pytest.approx(MULTIPLIER, rel=1e-6)

@@ -13,6 +13,7 @@ from typing import Any, Mapping
 import numpy as np
 from numba import njit, types
 
+from .scale import UNIT
 from .spelling import one_spelling
 
 _vec = types.float64[::1]
@@ -100,6 +101,9 @@ class CompiledModel:
     #: what numba compiled into the user's pieces from globals and closures, checked by
     #: the compiled engine's front doors before every call (:mod:`filippov.frozen`)
     frozen_reads: tuple = field(default=(), compare=False, repr=False)
+    #: the run's units (filippov.scale; None: measured at the starts); a model written
+    #: here by hand is taken in units of its own size
+    scale: Any = UNIT
 
     @property
     def dim(self) -> int:

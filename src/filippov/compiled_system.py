@@ -19,6 +19,7 @@ from numba import njit
 from numba.core.errors import NumbaError
 
 from . import frozen
+from . import scale as scale_mod
 from .checks import SystemContractError
 from .spelling import one_spelling
 from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, always, no_flow
@@ -330,14 +331,23 @@ class FilippovSystem:
     reference driver instead of central differences (each compared with central
     differences of its field at the first state it is asked at: a wrong one is refused);
     :mod:`filippov.symbolic` generates all three from the expressions.
+    ``scale`` gives the units the engines measure their tolerances in
+    (:mod:`filippov.scale`: a number is the state's size, a mapping or a
+    :class:`~filippov.scale.Scale` also the time's and H's); None (the default)
+    measures them at each run's start, so that the same system in other units gives the
+    same results.
     """
 
     def __init__(self, names, field_minus, field_plus, switch, switch_grad, *, params=(),
                  flow_minus=None, flow_plus=None, sample_step: float = np.inf,
                  sliding: bool = True, name: str = "user", jacobians=None,
                  slow_sample_step: float = np.nan, transient_time: float = np.inf,
-                 probe=None):
+                 probe=None, scale=None):
         self.names = tuple(str(x) for x in names)
+        # the run's units (filippov.scale): checked here, measured at each run's start
+        # where not declared (docs/decisions.md#units)
+        scale_mod.declared(scale)
+        self.scale = scale
         self._probe = probe   # where both engines' pieces are run once when built
         self.slow_sample_step, self.transient_time = float(slow_sample_step), float(transient_time)
         self.params = np.ascontiguousarray(np.asarray(params, dtype=float).reshape(-1))
@@ -402,7 +412,8 @@ class FilippovSystem:
                 params=self.params, sample_step=self.sample_step, sliding=self.sliding,
                 name=self.name, probe=self._probe if probe is None else probe,
                 **self._user_pieces()),
-                slow_sample_step=self.slow_sample_step, transient_time=self.transient_time)
+                slow_sample_step=self.slow_sample_step, transient_time=self.transient_time,
+                scale=self.scale)
             return self._compiled
         return with_section(self._compiled, section, direction=direction, where=where)
 
@@ -468,8 +479,9 @@ class FilippovSystem:
         from .variational import fd_jacobian
 
         field = getattr(self.python(), f"field_{key}")
-        size = max(1.0, float(np.abs(z).max()))
-        fd = fd_jacobian(field, z, np.cbrt(np.finfo(float).eps)).astype(float)
+        floor = self._state_scale(z)
+        size = max(floor, float(np.abs(z).max()))
+        fd = fd_jacobian(field, z, np.cbrt(np.finfo(float).eps), floor).astype(float)
         scale = max(np.abs(fd).max(), float(np.abs(field(z)).max()) / size, 1e-300)
         bad = np.abs(J - fd) > 1e-6 * scale
         if not np.all(np.isfinite(J)) or bad.any():
@@ -479,6 +491,12 @@ class FilippovSystem:
                 f"{float(J[i, k])!r}, central differences of field_{key} give "
                 f"{float(fd[i, k])!r}: a wrong Jacobian gives wrong multipliers and dP/dz "
                 f"(the flow's multiplier stays 1)")
+
+    def _state_scale(self, z: np.ndarray) -> float:
+        """The state scale (filippov.scale): declared, or measured at z."""
+        from .simulate import run_scale
+
+        return run_scale(self.python(), z).state
 
     def _sliding_jacobian(self, z: np.ndarray) -> np.ndarray:
         """dF_s/dz of Filippov's sliding field F_s = (a F_+ - b F_-)/(a - b), a = g.F_-,
@@ -492,7 +510,7 @@ class FilippovSystem:
         Fm, Fp = (np.asarray(sysp.field_minus(z), float), np.asarray(sysp.field_plus(z), float))
         g = np.asarray(sysp.switch_grad(z), dtype=float)
         Jm, Jp = (self._jacobian_value(k, z).reshape(n, n) for k in ("minus", "plus"))
-        step = np.cbrt(np.finfo(float).eps) * max(1.0, float(np.abs(z).max()))
+        step = np.cbrt(np.finfo(float).eps) * max(self._state_scale(z), float(np.abs(z).max()))
         Hh = np.empty((n, n))   # Hh[:, k] = d g / d z_k
         for k in range(n):
             e = np.zeros(n)
@@ -547,5 +565,5 @@ class FilippovSystem:
                                switch_grad=vector(bp["switch_grad"]), flows=flows,
                                sliding=self.sliding, sample_step=self.sample_step,
                                slow_sample_step=self.slow_sample_step,
-                               transient_time=self.transient_time,
+                               transient_time=self.transient_time, scale=self.scale,
                                description=f"{self.name} (one definition, compiled pieces)")

@@ -67,6 +67,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import engines, frozen, options, rules
+from . import scale as scale_mod
+from .scale import UNIT
 # what a model hands the engine (its pieces' signatures, CompiledModel), re-exported here
 from .abi import (FIELD_SIG, FLOW_SIG, PIECES, SCALAR_SIG, WHERE_SIG,  # noqa: F401
                   CompiledModel, no_flow, no_jacobian)
@@ -280,7 +282,7 @@ def _fractions(n: int) -> np.ndarray:
 
 def _settings(cmodel: CompiledModel, t_max, *, rtol, atol, max_step, max_events, max_steps,
               samples_per_step, touch_tol, event_xtol, zeno_count, zeno_span, min_time,
-              iterations, jacobian) -> Settings:
+              iterations, jacobian, scale=UNIT) -> Settings:
     """The kernel's settings of one :func:`compute_returns` call (its options already
     checked there)."""
     hwin = min(EXACT_BLOCK * cmodel.sample_step, max_step, t_max) if cmodel.exact else np.inf
@@ -302,7 +304,8 @@ def _settings(cmodel: CompiledModel, t_max, *, rtol, atol, max_step, max_events,
         touch_tol=float(touch_tol), xtol=float(event_xtol), zeno_span=float(zeno_span),
         max_step=float(max_step), min_time=float(min_time), max_events=int(max_events),
         max_steps=int(max_steps), zeno_count=int(zeno_count), jac=jac_mode,
-        iterations=int(iterations))
+        iterations=int(iterations), state_scale=float(scale.state),
+        time_scale=float(scale.time))
 
 
 def _outputs(starts, keep: int, jacobian: bool) -> Outputs:
@@ -325,7 +328,7 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
                     touch_tol: float = 1e-15, event_xtol: float = 1e-15, zeno_count: int = 64,
                     zeno_span: float = 1e-10, min_time: float = 0.0, iterations: int = 1,
                     keep: int = 0, jacobian: bool = False, start_age=0.0,
-                    workers: int | None = None) -> BatchReturns:
+                    workers: int | None = None, scale=None) -> BatchReturns:
     """First returns of ``starts`` (``(m, dim)``) to the model's section, one compiled call.
 
     Options mean what they mean for :func:`filippov.simulate.simulate`, except that
@@ -366,6 +369,10 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     environment variable ``FILIPPOV_WORKERS``, else the cores available). A batch of
     few returns (starts x iterations, :data:`MIN_RETURNS_PER_SLICE` a slice) uses
     fewer threads, down to the calling thread alone.
+
+    Units as :func:`filippov.simulate.simulate`'s (:mod:`filippov.scale`): ``scale``
+    (None: the model's, declared or measured) holds for the whole batch, its open parts
+    measured at the largest start.
     """
     starts, ages = _checked_starts(cmodel, starts, start_age)
     frozen.check(cmodel.frozen_reads)   # no piece run with a value changed since compiled
@@ -380,14 +387,15 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
                     samples_per_step=samples_per_step, touch_tol=touch_tol,
                     event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span,
                     min_time=min_time, iterations=iterations, keep=keep, jacobian=jacobian,
-                    workers=workers)
+                    workers=workers, scale=scale)
 
 
 #: what the models of one sweep must share (all but their parameter values): the pieces
 #: (the same compiled functions), the section's direction and the settings they set
 SWEEP_SHARED = ("names", "flow_plus", "flow_minus", "field_plus", "field_minus", "switch",
                 "switch_grad", "section", "section_where", "jacobian", "section_direction",
-                "sample_step", "sliding", "exact", "slow_sample_step", "transient_time")
+                "sample_step", "sliding", "exact", "slow_sample_step", "transient_time",
+                "scale")
 
 
 def _same(a, b) -> bool:
@@ -430,8 +438,9 @@ def sweep_returns(cmodels, starts, t_max: float, *, start_age=0.0, workers=None,
     one compiled call. The models must be one model at different parameter values (the
     same pieces, section and sampling: :data:`SWEEP_SHARED`), as a model's constructor
     builds them (its checks of the parameters apply); each start's returns are those of
-    :func:`compute_returns` with its own model, bit for bit, whatever ``workers``.
-    ``options`` as there."""
+    :func:`compute_returns` with its own model, bit for bit, whatever ``workers`` (where
+    the scale is measured, filippov.scale, once for the sweep at its largest start: give
+    ``scale=`` to both to compare them). ``options`` as there."""
     params = _sweep_params(cmodels)
     cmodels = list(cmodels)
     first = cmodels[0]
@@ -456,7 +465,7 @@ def sweep_returns(cmodels, starts, t_max: float, *, start_age=0.0, workers=None,
 def _returns(cmodel: CompiledModel, pieces, params, starts, ages, t_max, *, rtol, atol,
              max_step, max_events, max_steps, samples_per_step, touch_tol, event_xtol,
              zeno_count, zeno_span, min_time, iterations, keep, jacobian,
-             workers) -> BatchReturns:
+             workers, scale) -> BatchReturns:
     """compute_returns and sweep_returns after their own checks of the starts: the
     options checked, one kernel call over the batch (``pieces``: the model's addresses,
     :func:`_pieces`; ``params``: one row for all the starts, or one row a start)."""
@@ -465,17 +474,32 @@ def _returns(cmodel: CompiledModel, pieces, params, starts, ages, t_max, *, rtol
                   max_steps=max_steps, samples_per_step=samples_per_step, touch_tol=touch_tol,
                   event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span)
     _check_options(cmodel, t_max, iterations, keep, min_time)
-    settings = _settings(cmodel, t_max, rtol=rtol, atol=atol, max_step=max_step,
+    sc = batch_scale(cmodel, starts, scale)
+    settings = _settings(cmodel, t_max, rtol=rtol, atol=atol * sc.state, max_step=max_step,
                          max_events=max_events, max_steps=max_steps,
-                         samples_per_step=samples_per_step, touch_tol=touch_tol,
-                         event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span,
-                         min_time=min_time, iterations=iterations, jacobian=jacobian)
+                         samples_per_step=samples_per_step, touch_tol=touch_tol * sc.switch,
+                         event_xtol=event_xtol * sc.time, zeno_count=zeno_count,
+                         zeno_span=zeno_span, min_time=min_time, iterations=iterations,
+                         jacobian=jacobian, scale=sc)
     out = _outputs(starts, keep, jacobian)
     # the build without the dP/dz code unless it is asked for (kernel.driver)
     _run_batch(kernel(derivatives=bool(jacobian)), pieces, params, starts, ages, settings,
                out, workers)
     return BatchReturns(**dict(out._asdict(), jacobian=out.jacobian if jacobian else None,
                                orbit_jacobian=out.orbit_jacobian if jacobian else None))
+
+
+def batch_scale(cmodel: CompiledModel, starts, value=None):
+    """The units of a batch (filippov.scale): ``value``, else the model's declaration,
+    the parts left open measured at the largest start (the model's first parameter row)."""
+    def measure_at(state):
+        if not starts.shape[0]:
+            return UNIT
+        z = starts[int(np.argmax(np.max(np.abs(starts), axis=1)))]
+        pc = _Pieces(cmodel)
+        return scale_mod.measure(z, (pc.field_minus(z), pc.field_plus(z)), pc.switch_grad(z),
+                                 state)
+    return scale_mod.resolve(cmodel.scale if value is None else value, measure_at)
 
 
 class _Pieces:

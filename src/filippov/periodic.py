@@ -97,10 +97,11 @@ def _finite_derivative(J: np.ndarray, z: np.ndarray) -> None:
             "dP/dz and the reference derives it along the slide; filippov.engines, item 11)")
 
 
-def _section_normal(value, z: np.ndarray) -> np.ndarray:
+def _section_normal(value, z: np.ndarray, floor: float = 1.0) -> np.ndarray:
     """The gradient of the section function at z by central differences (step eps^(1/3)
-    times the state's size: ~1e-11 relative for a section that varies on that size)."""
-    h = np.cbrt(np.finfo(float).eps) * max(1.0, float(np.abs(z).max()))
+    times the state's size, at least ``floor``, the state scale: ~1e-11 relative for a
+    section that varies on that size)."""
+    h = np.cbrt(np.finfo(float).eps) * max(floor, float(np.abs(z).max()))
     g = np.empty(z.size)
     for k in range(z.size):
         e = np.zeros(z.size)
@@ -109,13 +110,13 @@ def _section_normal(value, z: np.ndarray) -> np.ndarray:
     return g
 
 
-def _onto_section(value, z: np.ndarray) -> np.ndarray:
+def _onto_section(value, z: np.ndarray, floor: float = 1.0) -> np.ndarray:
     """z moved along the section's gradient onto it (one Newton step on the section
     function: exact for a planar section, O(offset^2) off for a curved one)."""
     s = value(z)
     if s == 0.0 or not np.isfinite(s):
         return z
-    g = _section_normal(value, z)
+    g = _section_normal(value, z, floor)
     gg = float(g @ g)
     return z - (s / gg) * g if gg > 0 else z
 
@@ -199,14 +200,50 @@ def floquet_from_return(J: np.ndarray, f: np.ndarray, *, normal=None,
 SHORTEST_PATH = 1e-9
 
 
-def _refuse_the_start_itself(z, period, f) -> None:
+def _refuse_the_start_itself(z, period, f, floor: float = 1.0) -> None:
     path = period * float(np.abs(f).max())
-    if not path > SHORTEST_PATH * (1.0 + float(np.abs(z).max())):
+    if not path > SHORTEST_PATH * (floor + float(np.abs(z).max())):
         raise PeriodicOrbitError(
             f"the return from {z.tolist()} came back after t = {period:.3g} (a path of "
             f"length {path:.3g}): the start itself, a hair before the section by the "
             "rounding of the flow or the section, not a periodic orbit. Start Newton from "
             "a guess off the section, or make the exact flow's rounding smaller")
+
+
+#: Newton has run away when an iterate is this many times farther from the guess than
+#: the guess's size (or the state scale): the guess is not near an orbit, or dP/dz is
+#: wrong there -- said as such, not as the failure of a return from far away
+RUNAWAY = 1e3
+
+
+def _orbit_scale(python, z, value):
+    """The units of every return of one Newton iteration (filippov.scale): ``value``, else
+    the system's, the parts left open measured at the guess -- once, so that the
+    tolerances, and with them P, stay the same map at every iterate."""
+    from .simulate import run_scale
+
+    return run_scale(python, z, value)
+
+
+def _newton_step(z, Pz, J, guess, floor: float) -> np.ndarray:
+    """The Newton iterate after z for P(z) - z = 0 (dP/dz = J), refused where J is not
+    finite or J - I singular, or where it ran away from the guess (RUNAWAY)."""
+    _finite_derivative(J, z)   # a Newton step from a NaN would leave the state
+    try:
+        new = z - np.linalg.solve(J - np.eye(z.size), Pz - z)
+    except np.linalg.LinAlgError:
+        raise PeriodicOrbitError(f"dP/dz - I is singular at {z.tolist()}: a multiplier "
+                                 "1 besides the flow's (a bifurcation)") from None
+    g = np.asarray(guess, dtype=float).reshape(-1)
+    size = max(floor, float(np.abs(g).max()))
+    away = float(np.abs(new - g).max()) / size
+    if not away <= RUNAWAY:
+        raise PeriodicOrbitError(
+            f"Newton ran away from the guess: the iterate {new.tolist()} lies {away:.3g} "
+            f"times the guess's size {size:.3g} from it (from {z.tolist()}, residual "
+            f"{float(np.abs(Pz - z).max()):.3g}); the guess is not near a periodic orbit "
+            "through the section, or dP/dz is wrong there")
+    return new
 
 
 def _checked_start(system, guess, returns, engine) -> np.ndarray:
@@ -256,7 +293,9 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
     t_max : float
         Longest time a return may take.
     tol : float
-        Converged when ``max |P(z) - z| <= tol (1 + max |z|)``.
+        Converged when ``max |P(z) - z| <= tol (S + max |z|)``, S the state scale
+        (:mod:`filippov.scale`: the system's, or measured at the guess, and kept for
+        every return of the iteration, so that P is one map).
     max_iter : int
         Newton steps at most.
     **options
@@ -271,33 +310,31 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
     ------
     PeriodicOrbitError
         No convergence within ``max_iter``, a failed return, a derivative that does
-        not annihilate the flow direction at the fixed point, or a "fixed point" whose
+        not annihilate the flow direction at the fixed point, a "fixed point" whose
         return is the start itself (a path shorter than ``SHORTEST_PATH`` of the state's
-        size: the start a hair before the section by rounding).
+        size: the start a hair before the section by rounding), or an iterate that ran
+        away from the guess (``RUNAWAY`` times its size).
     """
     z = _checked_start(system, guess, returns, engine)
+    python = engines.reference_system(system, "periodic_orbit")
+    sc = _orbit_scale(python, z, options.get("scale"))
+    options = {**options, "scale": sc}
     ret, section_value = _returns(system, section, direction, where, engine, t_max,
                                   int(returns), options)
     for it in range(1, max_iter + 1):
         Pz, period, J = ret(z)
         residual = float(np.abs(Pz - z).max())
-        if residual <= tol * (1.0 + np.abs(z).max()):
-            f = _field_at(engines.reference_system(system, "periodic_orbit"), z,
-                          options.get("touch_tol", 1e-15))
-            _refuse_the_start_itself(z, period, f)
-            mult = floquet_from_return(J, f, normal=_section_normal(section_value, z))
+        if residual <= tol * (sc.state + np.abs(z).max()):
+            f = _field_at(python, z, options.get("touch_tol", 1e-15) * sc.switch)
+            _refuse_the_start_itself(z, period, f, sc.state)
+            mult = floquet_from_return(J, f, normal=_section_normal(section_value, z,
+                                                                    sc.state))
             return PeriodicOrbit(z, period, mult, J, it - 1, residual)
-        _finite_derivative(J, z)   # a Newton step from a NaN would leave the state
-        A = J - np.eye(z.size)
-        try:
-            z = z - np.linalg.solve(A, Pz - z)
-        except np.linalg.LinAlgError:
-            raise PeriodicOrbitError(f"dP/dz - I is singular at {z.tolist()}: a multiplier "
-                                     "1 besides the flow's (a bifurcation)") from None
+        z = _newton_step(z, Pz, J, guess, sc.state)
         # the fixed point lies on the section, and so does the next iterate up to the
         # error of dP/dz times the step (1e-10 x 1e-3 from variational equations at rtol
         # 1e-10): back onto it, or an iterate a hair before the section "returns" at once
         # and Newton converges to that (tests/test_properties.py)
-        z = _onto_section(section_value, z)
+        z = _onto_section(section_value, z, sc.state)
     raise PeriodicOrbitError(f"Newton did not converge in {max_iter} steps (last residual "
                              f"{residual:.3g} at {z.tolist()})")

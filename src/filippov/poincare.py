@@ -81,6 +81,8 @@ def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
     section = _reference_section(system, section, direction, where, options)
     system = python
     starts = np.atleast_2d(np.asarray(starts, dtype=float))
+    if options.get("scale") is None and starts.size and np.all(np.isfinite(starts)):
+        options["scale"] = _batch_scale(system, starts)
     m = starts.shape[0]
     state = np.empty_like(starts)
     time = np.empty(m)
@@ -103,6 +105,19 @@ def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
         if progress is not None:
             progress.step()
     return Returns(state, time, n_switches, sliding, first)
+
+
+def _batch_scale(system, starts):
+    """One scale for every start of a map (filippov.scale), as the compiled engine
+    takes it: the system's, with the parts it leaves open measured at the largest start
+    (None where the pieces cannot be evaluated there: each run's check then names the
+    piece)."""
+    from .simulate import run_scale
+
+    try:
+        return run_scale(system, starts[int(np.argmax(np.max(np.abs(starts), axis=1)))])
+    except Exception:   # noqa: BLE001 -- the run's contract check says what is wrong
+        return None
 
 
 def sliding_time(events) -> float:

@@ -219,10 +219,11 @@ def speed_graze(pred: int, vm: float, d0: float, d1: float, dt: float,
 RATE_STEP = float(np.sqrt(np.finfo(float).eps))
 
 
-def rate_step(z, fm, fp, a: float, b: float) -> float:
+def rate_step(z, fm, fp, a: float, b: float, floor: float = 1.0) -> float:
     """The time step d of the forward differences (v(t + d) - v(t)) / d on the orbit that
     give the rates of a and b along a slide, from a sample (state z, F_-, F_+, a and b
-    there): the orbit moves RATE_STEP max(1, |z|_inf) along Filippov's field
+    there): the orbit moves RATE_STEP max(floor, |z|_inf) (floor: the run's state scale,
+    filippov.scale) along Filippov's field
     (a F_+ - b F_-)/(a - b) over it, so truncation and rounding of the rates are ~u^(1/2)
     of them, plenty for their signs; a forward difference is the rate at t + d/2, which
     moves a located extremum by d/2 and its value by ~u |z|^2 |v''| / |F|^2: nothing. One
@@ -232,7 +233,7 @@ def rate_step(z, fm, fp, a: float, b: float) -> float:
     den = a - b
     if not den > 0.0:  # not sliding at this sample (a <= b): no Filippov field
         return 0.0
-    size, speed = 1.0, 0.0
+    size, speed = floor, 0.0
     for k in range(z.size):
         size = max(size, abs(z[k]))
         speed = max(speed, abs((a * fp[k] - b * fm[k]) / den))
@@ -243,7 +244,8 @@ def rate_step(z, fm, fp, a: float, b: float) -> float:
 
 def central_step(size: float, speed: float) -> float:
     """The central-difference step along a direction (largest component ``speed``: a
-    field, a column of a derivative) at a state of size ``size`` (>= 1); 0 where the
+    field, a column of a derivative) at a state of size ``size`` (at least the run's
+    state scale, filippov.scale); 0 where the
     direction is zero or not finite. Truncation and rounding are then both ~u^(2/3)
     of the derivative (the sliding test, the compiled engine's dP/dz)."""
     if not (np.isfinite(speed) and speed > 0.0):
@@ -382,16 +384,16 @@ FLOW_SPEED_FACTOR = 100.0
 
 
 def flow_consistent(dz: float, dt: float, speed_a: float, speed_b: float,
-                    size: float) -> bool:
+                    size: float, floor: float = 1.0) -> bool:
     """Whether an exact flow's move |dz| over a window dt agrees with its own field:
     |dz| <= FLOW_SPEED_FACTOR dt max(|f(z_a)|, |f(z_b)|) plus the rounding of the
-    states (1e3 ulps of their size). A closed form that fails this computes something
+    states (1e3 ulps of their size, at least of ``floor``: the state scale). A closed form that fails this computes something
     else than the field's flow (the Hopf example at eps = 1e6: y from 0 to 1e9 in
     8e-10 time units, the field's speed there 1e3), and the run must not go on."""
-    return dz <= FLOW_SPEED_FACTOR * dt * max(speed_a, speed_b) + 1e3 * _EPS * max(1.0, size)
+    return dz <= FLOW_SPEED_FACTOR * dt * max(speed_a, speed_b) + 1e3 * _EPS * max(floor, size)
 
 
-def exit_band(z, z_flow, grad) -> float:
+def exit_band(z, z_flow, grad, floor: float = 1.0) -> float:
     """The rounding of H along the stay that begins at the sliding exit ``z``: H cannot
     be read closer to its value at z than this while the orbit is still next to z.
     The stay's states are z + d(tau), d the rounding of the flow that gives them (for
@@ -406,7 +408,8 @@ def exit_band(z, z_flow, grad) -> float:
     exact flows, tau in [0, 1e-7]) the noise of H was at most 8.9 times
     |grad| max(eps |z|, |z_flow - z|) (p99 5.5), but 43 times |grad| eps |z| alone.
     At the fold exit of FOLD_EXIT (tests/test_properties.py) H read -1.1e-15 at tau = 0,
-    where z = 0.68 and |z*| = 10: the flow's own rounding, and 7 roundings of |z|."""
+    where z = 0.68 and |z*| = 10: the flow's own rounding, and 7 roundings of |z|.
+    ``floor``: the state scale (filippov.scale) below which the cap does not shrink."""
     g2, z2, d2 = 0.0, 0.0, 0.0
     for k in range(z.size):
         g2 += grad[k] * grad[k]
@@ -416,7 +419,7 @@ def exit_band(z, z_flow, grad) -> float:
     # state's size is no rounding to step over (eps = 1e6 in the Hopf example: the band
     # would swallow genuine crossings and the run drift to y ~ 1e16 without a word):
     # the band stays at that size, and the crossings it cannot hide are seen
-    d = min(np.sqrt(d2), EXIT_BAND_FLOW_MAX * max(1.0, np.sqrt(z2)))
+    d = min(np.sqrt(d2), EXIT_BAND_FLOW_MAX * max(floor, np.sqrt(z2)))
     return EXIT_BAND_ULPS * np.sqrt(g2) * max(_EPS * np.sqrt(z2), d)
 
 
@@ -438,11 +441,12 @@ def clears_band(mode: int, v: float, band: float) -> bool:
     return v < -2.0 * band
 
 
-def accumulates(oldest: float, newest: float, zeno_span: float) -> bool:
+def accumulates(oldest: float, newest: float, zeno_span: float,
+                time_scale: float = 1.0) -> bool:
     """The last zeno_count switches, from ``oldest`` to ``newest``, fall within
-    zeno_span (relative to |t| beyond 1): a Zeno point or chatter below the time
-    resolution."""
-    return newest - oldest <= zeno_span * max(1.0, abs(newest))
+    zeno_span (relative to |t| beyond the run's time scale, filippov.scale): a Zeno
+    point or chatter below the time resolution."""
+    return newest - oldest <= zeno_span * max(time_scale, abs(newest))
 
 
 #: An integration step's samples must resolve what is sampled on them (the leave functions,
@@ -602,7 +606,8 @@ def at_two_fold(a: float, b: float, a_in: float, b_in: float) -> bool:
     return abs(a) <= TWO_FOLD_SHARE * abs(a_in) and abs(b) <= TWO_FOLD_SHARE * abs(b_in)
 
 
-def note_switch(recent, entries: int, t: float, zeno_count: int, zeno_span: float):
+def note_switch(recent, entries: int, t: float, zeno_count: int, zeno_span: float,
+                time_scale: float = 1.0):
     """The Zeno ring both engines keep: enters the switch at ``t`` in ``recent`` (an array
     of zeno_count times, entry k at k % zeno_count; ``entries`` so far) and says whether
     the last zeno_count switches, from the oldest the ring holds to ``t``, accumulate
@@ -610,7 +615,8 @@ def note_switch(recent, entries: int, t: float, zeno_count: int, zeno_span: floa
     (:func:`geometric_accumulation`). Returns (entries, zeno)."""
     recent[entries % zeno_count] = t
     entries += 1
-    if entries >= zeno_count and accumulates(recent[entries % zeno_count], t, zeno_span):
+    if entries >= zeno_count and accumulates(recent[entries % zeno_count], t, zeno_span,
+                                             time_scale):
         return entries, True
     if entries < GEOMETRIC_MIN_RATIOS + 3 or zeno_count < GEOMETRIC_MIN_RATIOS + 3:
         return entries, False
@@ -653,14 +659,14 @@ def section_first(r: float, t_min: float, best_t: float, best_is_section: bool,
 START_ULPS = 64
 
 
-def starts_on_section(s0: float, z0, sr: float, zr, z_start) -> bool:
+def starts_on_section(s0: float, z0, sr: float, zr, z_start, floor: float = 1.0) -> bool:
     """The start ``z0`` (section value ``s0``) lies on the section up to rounding,
     given the refined root ``zr`` (section value ``sr``); 1-D float arrays. ``z0`` is
     the first sample as the stay's stepper gives it -- for an exact flow, the closed
     form at tau = 0 from the run's start ``z_start`` (else z_start itself) --, whose
     rounding counts too, as in :func:`exit_band`: a closed form built around another
     point (z* + V e^{B tau} V^-1 (z - z*)) rounds at the scale of |z*|, not of |z|
-    (docs/decisions.md#start-on-section)."""
+    (docs/decisions.md#start-on-section). ``floor``: the state scale, as exit_band's."""
     # linear interpolation to the crossing; sr is on the far side, so the fraction is <= 1
     frac = min(1.0, abs(s0) / abs(s0 - sr)) if s0 != sr else 1.0
     size, moved, flow = 0.0, 0.0, 0.0
@@ -669,7 +675,7 @@ def starts_on_section(s0: float, z0, sr: float, zr, z_start) -> bool:
         moved = max(moved, abs(zr[k] - z0[k]))
         flow = max(flow, abs(z0[k] - z_start[k]))
     # a closed form that misses its start by more than exit_band accepts is no rounding
-    flow = min(flow, EXIT_BAND_FLOW_MAX * max(1.0, size))
+    flow = min(flow, EXIT_BAND_FLOW_MAX * max(floor, size))
     return frac * moved <= START_ULPS * max(_EPS * size, flow)
 
 

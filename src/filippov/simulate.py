@@ -31,6 +31,8 @@ from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
 from . import checks, engines, options, rules, variational
+from . import scale as scale_mod
+from .scale import UNIT, Scale
 from .loop import interval, refine
 from .radau_iia import RadauIIA
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
@@ -120,6 +122,8 @@ class Trajectory:
     # rounding noise (see NOISE_STEPS) lifted it above atol: the local accuracy the
     # field's conditioning allowed
     atol_raised: dict = field(default_factory=dict)
+    # the units the run's tolerances were measured in (filippov.scale.Scale)
+    scale: object = UNIT
 
     def section_hits(self, name: str) -> list:
         return [e for e in self.events if e.kind == "section" and e.name == name]
@@ -342,7 +346,7 @@ def _refine(fun, pred, ta, tb, va, vb, xtol):
 def _slide_fields(run):
     z = np.asarray(run.z, dtype=float)
     return (z, np.asarray(run.system.field_minus(z), float),
-            np.asarray(run.system.field_plus(z), float))
+            np.asarray(run.system.field_plus(z), float), getattr(run, "state_scale", 1.0))
 
 
 def _section_along(k, mode, d, run):
@@ -438,7 +442,7 @@ def simulate(system, z0, t_end: float, *, engine: str = "reference", t0: float =
              max_events: int = 100_000, max_steps: int = 5_000_000,
              dense: bool = True, samples_per_step: int = 4, touch_tol: float = 1e-15,
              event_xtol: float = 1e-15, zeno_count: int = 64,
-             zeno_span: float = 1e-10, stiff: bool = True) -> Trajectory:
+             zeno_span: float = 1e-10, stiff: bool = True, scale=None) -> Trajectory:
     """Integrate ``system`` from ``z0`` at ``t0`` to ``t_end`` (or a terminal section).
 
     ``system`` is a :class:`~filippov.system.PiecewiseSystem` or a system defined once
@@ -457,12 +461,17 @@ def simulate(system, z0, t_end: float, *, engine: str = "reference", t0: float =
     listed in ``Trajectory.stiff_modes``), whose absolute
     tolerance is kept above the field's rounding noise (``NOISE_STEPS``; where that
     lifted it above ``atol``, ``Trajectory.atol_raised`` says by how much).
+
+    Units (:mod:`filippov.scale`): ``atol`` is in units of the state scale S,
+    ``touch_tol`` of H's scale, ``event_xtol`` (and the time below which ``zeno_span`` is
+    absolute) of the time scale T; ``scale`` (None: the system's, declared or measured
+    at ``z0``) sets them, and ``Trajectory.scale`` says which were used.
     """
     run = engines.runner("simulate", engine)
     opts = dict(t0=t0, t_end=t_end, method=method, rtol=rtol, atol=atol, max_step=max_step,
                 max_events=max_events, max_steps=max_steps, dense=dense,
                 samples_per_step=samples_per_step, touch_tol=touch_tol, event_xtol=event_xtol,
-                zeno_count=zeno_count, zeno_span=zeno_span, stiff=stiff)
+                zeno_count=zeno_count, zeno_span=zeno_span, stiff=stiff, scale=scale)
     return run(engines.reference_system(system, "simulate"), z0, sections, opts)
 
 
@@ -480,14 +489,24 @@ def _simulate(system: PiecewiseSystem, z0, sections: Sequence[Section], opts: di
     if not (np.isfinite(t0) and np.isfinite(t_end) and t_end >= t0):
         raise ValueError(f"need finite t0 <= t_end, got t0={t0!r}, t_end={t_end!r}")
     options.check(**{k: v for k, v in opts.items() if k not in ("t0", "t_end", "method",
-                                                                   "dense")})
+                                                                   "dense", "scale")})
     for k, sec in enumerate(sections):
         if not isinstance(sec, Section):
             raise TypeError(f"sections[{k}]: expected a filippov.simulate.Section, got "
                             f"{type(sec).__name__}")
     checks.check_system(system, z, method=method)  # the pieces keep the class's contract
+    sc = run_scale(system, z, opts.get("scale"))
+    return _Run(system, z, list(sections), scale_mod.tolerances(opts, sc), sc).go()
 
-    return _Run(system, z, list(sections), opts).go()
+
+def run_scale(system: PiecewiseSystem, z, value=None) -> Scale:
+    """The units of a run of ``system`` from ``z`` (filippov.scale): ``value`` (an
+    option), else the system's declaration, each part it leaves open measured at z."""
+    def measure_at(state):
+        z1 = np.asarray(z, dtype=float).reshape(-1)
+        return scale_mod.measure(z1, (system.field_minus(z1), system.field_plus(z1)),
+                                 system.switch_grad(z1), state)
+    return scale_mod.resolve(system.scale if value is None else value, measure_at)
 
 
 class _Run:
@@ -495,10 +514,12 @@ class _Run:
     :meth:`go` runs the shared loop (:data:`_RUN`), :meth:`stay` follows one mode until
     its next event; the functions under "one event" are what the loop does there."""
 
-    def __init__(self, system, z, sections, opts):
+    def __init__(self, system, z, sections, opts, scale=UNIT):
         self.system, self.sections = system, sections
+        self.state_scale = self.time_scale = 1.0
         self.__dict__.update(opts)
-        self.traj = Trajectory(system=system, t0=self.t0, z0=z.copy(), t=self.t0, z=z.copy())
+        self.traj = Trajectory(system=system, t0=self.t0, z0=z.copy(), t=self.t0, z=z.copy(),
+                               scale=scale)
         self.t, self.z = self.t0, z
         status, self.mode, kind = _start(self, self.touch_tol)
         self.traj.mode = self.mode
@@ -701,7 +722,8 @@ class _Run:
         dz = float(np.linalg.norm(zb - za))
         if not rules.flow_consistent(dz, tb - ta, float(np.linalg.norm(fa)),
                                      float(np.linalg.norm(fb)),
-                                     float(max(np.abs(za).max(), np.abs(zb).max()))):
+                                     float(max(np.abs(za).max(), np.abs(zb).max())),
+                                     self.state_scale):
             raise run_error(
                 FLOW_OFF_FIELD, ta, za, f": the exact flow of mode {MODE_NAMES[self.mode]} "
                 f"moved the state by {dz:.3g} to t={tb!r} (state {zb.tolist()}), but its "
@@ -853,7 +875,8 @@ _RUN = make_run(RunOps(
     slides_in_section=_slides_in_a_section,
     record_switch=_record_switch,
     count_switch=_count_switch,
-    limits=lambda run: (run.max_events, run.zeno_count, run.zeno_span, run.touch_tol),
+    limits=lambda run: (run.max_events, run.zeno_count, run.zeno_span, run.touch_tol,
+                        run.state_scale, run.time_scale),
     ring=lambda run: (run.ring, run.ring_entries),
     store_ring=_store_ring,
     over_budget=lambda t, new_mode, switches, run: run._over_budget(t, new_mode, switches),
@@ -862,14 +885,14 @@ _RUN = make_run(RunOps(
     entered=_entered))
 
 
-def _speed_rates(system, Z, z0):
+def _speed_rates(system, Z, z0, floor=1.0):
     """While sliding: ``rates(t) -> (da/dt, db/dt)`` on the segment ``Z`` (forward
     differences on the orbit, of the step rules.rate_step gives at its first sample z0),
     or None where that step is 0."""
     fm = np.asarray(system.field_minus(z0), dtype=float)
     fp = np.asarray(system.field_plus(z0), dtype=float)
     a, b = (float(v) for v in system.normal_speeds(z0))
-    d = rules.rate_step(z0, fm, fp, a, b)
+    d = rules.rate_step(z0, fm, fp, a, b, floor)
     if d == 0.0:
         return None
 
@@ -947,7 +970,8 @@ class _Scan:
         self.svals = [np.asarray(s.func(zs), dtype=float) for s in sections]
         self.rates = self.R = None
         if mode == SLIDING:  # the rates of a and b along the orbit: their extrema are roots (rules)
-            self.rates = _speed_rates(system, Z, np.asarray(zs[:, 0], dtype=float))
+            self.rates = _speed_rates(system, Z, np.asarray(zs[:, 0], dtype=float),
+                                      traj.scale.state)
             if self.rates is not None:
                 self.R = self.rates(ts)
         self.not_finite = self._first_not_finite()
@@ -1186,7 +1210,8 @@ class _Scan:
         z_first = np.asarray(self.zs[:, 0], dtype=float)
         z_root = np.asarray(zr, dtype=float).reshape(-1)
         return (rules.starts_on_section(float(sv[0]), z_first, float(sec.func(zr)), z_root,
-                                        np.asarray(self.traj.z0, dtype=float).reshape(-1))
+                                        np.asarray(self.traj.z0, dtype=float).reshape(-1),
+                                        self.traj.scale.state)
                 or _in_section_rounding(sec.func, float(sv[0]), z_first, z_root))
 
 

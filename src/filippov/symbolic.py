@@ -30,6 +30,7 @@ import numpy as np
 import sympy as sp
 
 from . import codegen
+from . import scale as scale_mod
 from .abi import CompiledModel, no_flow
 from .compiled_system import FilippovSystem, _scalar_piece, _where_piece
 from .errors import SymbolicError  # noqa: F401  (re-exported)
@@ -75,7 +76,7 @@ def _check_free(exprs, allowed: set, piece: str) -> None:
 
 
 _OPTIONS = {"sample_step": float, "slow_sample_step": float, "transient_time": float,
-            "sliding": bool}
+            "sliding": bool, "scale": lambda v: v}
 
 
 @one_spelling
@@ -108,6 +109,9 @@ class SymbolicSystem:
         (see :class:`filippov.system.PiecewiseSystem`).
     sliding : bool
         Follow attracting sliding (Filippov's convex combination).
+    scale : None, number, mapping or filippov.scale.Scale
+        The units the engines measure tolerances in (:mod:`filippov.scale`): None
+        measures them at each run's start; a number is the state's scale.
     name : str
 
     Attributes
@@ -124,8 +128,11 @@ class SymbolicSystem:
     def __init__(self, states: Sequence, field_minus, field_plus, switch, *,
                  params: Optional[Mapping] = None, time=None, flows: Optional[Mapping] = None,
                  sample_step: float = np.inf, slow_sample_step: float = np.nan,
-                 transient_time: float = np.inf, sliding: bool = True, name: str = "user"):
+                 transient_time: float = np.inf, sliding: bool = True, name: str = "user",
+                 scale=None):
         self.states = _symbols(states, "states")
+        scale_mod.declared(scale)
+        self.scale = scale   # the run's units (filippov.scale; None: measured)
         n = len(self.states)
         if n < 1:
             raise SymbolicError("states: at least one state")
@@ -285,7 +292,8 @@ class GeneratedSystem(FilippovSystem):
                          params=symbolic.param_values, sample_step=symbolic.sample_step,
                          slow_sample_step=symbolic.slow_sample_step,
                          transient_time=symbolic.transient_time,
-                         sliding=symbolic.sliding, name=symbolic.name)
+                         sliding=symbolic.sliding, name=symbolic.name,
+                         scale=symbolic.scale)
 
     def _user_pieces(self) -> dict:
         raise AssertionError("a generated system has no user pieces")  # never called

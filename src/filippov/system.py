@@ -19,6 +19,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 
+from .scale import UNIT
 from .spelling import one_spelling
 
 MINUS, SLIDING, PLUS = -1, 0, 1
@@ -86,6 +87,10 @@ class PiecewiseSystem:
     transient_time: float = np.inf
     units: Mapping[str, str] = field(default_factory=dict)
     description: str = ""
+    #: the run's units (filippov.scale): a Scale, a number or a mapping as
+    #: filippov.scale.declared reads them, or None (measured at each run's start); a
+    #: system written here by hand is taken in units of its own size
+    scale: object = UNIT
 
     @property
     def dim(self) -> int:

@@ -30,12 +30,13 @@ from .errors import VariationalError  # noqa: F401  (re-exported)
 
 
 def fd_jacobian(fun: Callable[[np.ndarray], np.ndarray], u: np.ndarray,
-                step: float = 1e-7) -> np.ndarray:
-    """Central differences; ``step`` is relative to ``max(1, |u_i|)``."""
+                step: float = 1e-7, floor: float = 1.0) -> np.ndarray:
+    """Central differences; ``step`` is relative to ``max(floor, |u_i|)`` (``floor``: the
+    state scale, filippov.scale)."""
     u = np.asarray(u, dtype=float)
     cols = []
     for i in range(u.size):
-        d = step * max(1.0, abs(u[i]))
+        d = step * max(floor, abs(u[i]))
         up, um = u.copy(), u.copy()
         up[i] += d
         um[i] -= d
@@ -43,11 +44,12 @@ def fd_jacobian(fun: Callable[[np.ndarray], np.ndarray], u: np.ndarray,
     return np.stack(cols, axis=-1)
 
 
-def field_jacobian(system, mode: int, z: np.ndarray, step: float = 1e-6) -> np.ndarray:
+def field_jacobian(system, mode: int, z: np.ndarray, step: float = 1e-6,
+                   floor: float = 1.0) -> np.ndarray:
     """Jacobian of the field of ``mode`` by central differences. The step is well
     above the noise level: the variational equation must see a smooth matrix, or
-    DOP853's step control chases rounding noise."""
-    return fd_jacobian(lambda zz: system.field(mode, zz), z, step)
+    DOP853's step control chases rounding noise. ``floor`` as :func:`fd_jacobian`'s."""
+    return fd_jacobian(lambda zz: system.field(mode, zz), z, step, floor)
 
 
 def saltation(f_before, f_after, grad):
@@ -81,6 +83,12 @@ def switch_matrix(system, before: int, after: int, z: np.ndarray):
     return saltation(system.field(before, z), system.field(after, z), system.switch_grad(z))
 
 
+def _state_scale(traj) -> float:
+    """The state scale the run of ``traj`` measured its tolerances in (filippov.scale)."""
+    scale = getattr(traj, "scale", None)
+    return 1.0 if scale is None else float(scale.state)
+
+
 def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
                       jacobian: Optional[Callable] = None) -> np.ndarray:
     """dz(t_end)/dz0 along ``traj`` (a Trajectory of :func:`filippov.simulate`):
@@ -94,7 +102,8 @@ def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
     traj : Trajectory
         Its events (``traj.events``) and end (``traj.t``, ``traj.z``) are used.
     rtol, atol : float
-        Tolerances of the variational integration (DOP853). With the default
+        Tolerances of the variational integration (DOP853); ``atol`` of the state in
+        units of the run's state scale (``traj.scale``, filippov.scale). With the default
         finite-difference Jacobians keep rtol >= ~1e-10: tighter, DOP853 chases
         their rounding noise (a stiff sliding segment of the Hopf example took 94 s
         at rtol 1e-12 and 0.2 s at 1e-10).
@@ -109,7 +118,10 @@ def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
     """
     system, jacobian = reference_view(system, jacobian, "transition_matrix")
     n = system.dim
-    jac = jacobian or (lambda mode, z: field_jacobian(system, mode, z))
+    floor = _state_scale(traj)
+    jac = jacobian or (lambda mode, z: field_jacobian(system, mode, z, floor=floor))
+    # the state's error in its own units, the derivative's (dimensionless) as it is
+    atols = np.concatenate([np.full(n, atol * floor), np.full(n * n, atol)])
     M = np.eye(n)
     ev = traj.events
     for k, e in enumerate(ev):
@@ -133,7 +145,7 @@ def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
             return np.concatenate([system.field(mode, x), (jac(mode, x) @ Phi).ravel()])
 
         sol = solve_ivp(rhs, (0.0, dt), np.concatenate([e.state, np.eye(n).ravel()]),
-                        method="DOP853", rtol=rtol, atol=atol)
+                        method="DOP853", rtol=rtol, atol=atols)
         if not sol.success:
             raise VariationalError(f"variational integration failed: {sol.message}")
         M = sol.y[n:, -1].reshape(n, n) @ M
@@ -173,8 +185,9 @@ def return_jacobian(system, traj, section, *, rtol: float = 1e-10, atol: float =
     system, jacobian = reference_view(system, jacobian, "return_jacobian")
     Phi = transition_matrix(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
     z = np.asarray(traj.z, dtype=float)
+    floor = _state_scale(traj)
     grad = (np.asarray(section_grad(z), dtype=float) if section_grad is not None else
-            fd_jacobian(lambda zz: np.atleast_1d(section.func(zz)), z)[0])
+            fd_jacobian(lambda zz: np.atleast_1d(section.func(zz)), z, floor=floor)[0])
     f = np.asarray(system.field(traj.mode, z), dtype=float)
     speed = grad @ f
     if speed == 0:

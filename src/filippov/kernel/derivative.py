@@ -48,12 +48,14 @@ def _rank_one(M, u, g, speed):
 
 
 @_jit
-def _flow_jacobian(mode, za, tau, fns, p, J, z1, z2):
-    """J = d flow(za, tau) / d za by central differences of the closed-form flow (step
-    rules.central_step per component; za is restored bit for bit)."""
+def _flow_jacobian(mode, za, tau, fns, p, dv):
+    """dv.Mt = d flow(za, tau) / d za by central differences of the closed-form flow (step
+    rules.central_step per component, from the state scale up; za is restored bit for
+    bit)."""
+    J, z1, z2 = dv.Mt, dv.jz1, dv.jz2
     for k in range(za.size):
         orig = za[k]
-        d = rules.central_step(max(1.0, abs(orig)), 1.0)
+        d = rules.central_step(max(dv.floor, abs(orig)), 1.0)
         za[k] = orig + d
         up = za[k]
         if mode == PLUS:
@@ -76,7 +78,7 @@ def _jvp(mode, y, v, out, fns, p, fl, dv):
     """out = J(y) v, the field's Jacobian along v, by a central difference
     (rules.central_step along v)."""
     n = y.size
-    size, vmax = 1.0, 0.0
+    size, vmax = dv.floor, 0.0
     for k in range(n):
         size = max(size, abs(y[k]))
         vmax = max(vmax, abs(v[k]))
@@ -158,7 +160,7 @@ def _section_derivative(mode, fns, p, z, fl, dv):
     _checked_field(z, mode, _TRIAL, fns, p, fl, dv.jf1)
     for k in range(z.size):
         orig = z[k]
-        d = rules.central_step(max(1.0, abs(orig)), 1.0)
+        d = rules.central_step(max(dv.floor, abs(orig)), 1.0)
         z[k] = orig + d
         up = z[k]
         s1 = _section(fns, z, p)

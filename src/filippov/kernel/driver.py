@@ -47,15 +47,16 @@ from ..loop.status import GO_ON
 
 # ------------------------------------------------------------------ sliding in the section
 # For filippov.loop.stay.make_slides_in (at the start and at an arrival on H): each takes
-# at = (fns, p, z, wg, wf, wp, wz): the model, the state on H and the scratch vectors, no
-# more (docs/decisions.md#kernel-small-records).
+# at = (fns, p, z, wg, wf, wp, wz, floor): the model, the state on H, the scratch vectors
+# and the run's state scale (filippov.scale), no more
+# (docs/decisions.md#kernel-small-records).
 
 @_jit_inline
 def _slide_fields(at):
     """(z, F_-, F_+) at z, in wf and wp (grad h left in wg)."""
-    fns, p, z, wg, wf, wp, _ = at
+    fns, p, z, wg, wf, wp, _, floor = at
     _speeds(z, fns, p, wg, wf, wp)
-    return z, wf, wp
+    return z, wf, wp, floor
 
 
 @_jit_inline
@@ -71,7 +72,7 @@ def _section_along(k, mode, d, at):
 
 @_jit  # a call: make_slides_in asks it seven times (inlined, it grew the cold compile)
 def _section_along_at(k, mode, d, at):
-    fns, p, z, wg, wm, wp, wz = at
+    fns, p, z, wg, wm, wp, wz, _ = at
     if d == 0.0:
         return _section(fns, z, p)
     if mode == MINUS:
@@ -142,7 +143,7 @@ def _window(mode, ta, tb, first, may_split, ctx):
     resolve what they sample (loop.stay.make_step_windows; an exact flow's window is the
     flow's own, rules.exact_window: never split)."""
     fns, p, s, w = ctx
-    o = Orbit(fns, p, w.seg, w.za, w.F, w.y_old, s.xtol)
+    o = Orbit(fns, p, w.seg, w.za, w.F, w.y_old, s.xtol, s.state_scale)
     exact = mode != SLIDING and w.seg[SEG_INTEGRATED] == 0.0
     frac = s.frac_ex if exact else s.frac_in
     ns = frac.size
@@ -162,7 +163,8 @@ def _window(mode, ta, tb, first, may_split, ctx):
     # an exact flow (SEG_INTEGRATED == 0) must follow its field over the window: from the
     # state at ta (w.z) to that at tb (w.ynew), the field at tb left in w.wf by the last
     # sample; else the run stops at ta (w.z)
-    if bad < 0 and exact and not _flow_follows(w.z, w.ynew, tb - ta, speed2_a, w.wf):
+    if bad < 0 and exact and not _flow_follows(w.z, w.ynew, tb - ta, speed2_a, w.wf,
+                                               s.state_scale):
         return FLOW_OFF_FIELD, ta, _W_NONE
     if bad < 0 and may_split and not exact and not _resolved(mode, ns, sm):
         return UNRESOLVED, ta, _W_NONE
@@ -279,8 +281,7 @@ def _end_step(mode, ta, tb, st, te, ctx):
         dv = w.deriv
         if w.seg[SEG_INTEGRATED] == 0.0:
             if st == OK:
-                _flow_jacobian(mode, w.za, te - w.seg[SEG_ENTRY], fns, p, dv.Mt, dv.jz1,
-                               dv.jz2)
+                _flow_jacobian(mode, w.za, te - w.seg[SEG_ENTRY], fns, p, dv)
                 _apply(dv.Mt, dv.M, dv.KP[0])
         elif st == _GO_ON or (st == OK and te > ta):
             _var_step(mode, w.y_old, (tb if st == _GO_ON else te) - ta, fns, p,
@@ -360,7 +361,7 @@ def _event_sliding_built(ctx):
 @_jit_inline
 def _event_slides_in(ctx):
     fns, p, s, w = ctx
-    return _slides_in((fns, p, w.z, w.wg, w.wf, w.wp, w.wz))
+    return _slides_in((fns, p, w.z, w.wg, w.wf, w.wp, w.wz, s.state_scale))
 
 
 @_jit_inline
@@ -388,7 +389,7 @@ def _count_switch(changed, t, ctx):
 @_jit_inline
 def _event_limits(ctx):
     s = ctx[2]
-    return s.max_events, s.zeno_count, s.zeno_span, s.touch_tol
+    return s.max_events, s.zeno_count, s.zeno_span, s.touch_tol, s.state_scale, s.time_scale
 
 
 @_jit_inline
@@ -550,7 +551,8 @@ def _batch(fns, params, starts, ages, s, out):
     if _DERIVATIVES:
         deriv = Deriv(np.zeros((n, n)), np.zeros((n, n)), np.zeros((_NS, n)),
                       np.zeros((_NS, n, n)), np.zeros(n), np.zeros(n), np.zeros(n),
-                      np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n * n))
+                      np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n * n),
+                      s.state_scale)
     else:
         deriv = 0  # the build without the dP/dz code carries no derivative
     w = Work(ts, vals, dvals, svals, recent, seg, za, y, f, y_old, f_old, K, ynew, ytmp, scale,

@@ -51,7 +51,7 @@ def _sample(mode, ta, tb, frac, k0, o, sm, sc):
             vals[0, k] = a
             vals[1, k] = b
             if k == 0:  # one difference step for the window (wf, wp: F_-, F_+ at wz)
-                sg[SEG_RATE_STEP] = rules.rate_step(wz, wf, wp, a, b)
+                sg[SEG_RATE_STEP] = rules.rate_step(wz, wf, wp, a, b, o.floor)
             if not np.isfinite(svals[k] + a + b):  # one test: finite where each term is
                 return k, speed2_a                  # (or on overflow)
             if sg[SEG_RATE_STEP] > 0.0:  # (overwrites wz: the state at tk + the step)
@@ -93,7 +93,7 @@ def _carry_sample(ns, seg, sm):
 
 
 @_jit
-def _flow_follows(za, zb, dt, speed2_a, fb):
+def _flow_follows(za, zb, dt, speed2_a, fb, floor):
     """rules.flow_consistent for an exact flow's window of length dt from za to zb, the
     field's |f|^2 at ta and f at zb given (the values _sample evaluated for dh/dt): as
     simulate._Run._check_flow, from the same field values, no evaluation of its own."""
@@ -101,7 +101,8 @@ def _flow_follows(za, zb, dt, speed2_a, fb):
     for c in range(za.size):
         d2 += (zb[c] - za[c]) * (zb[c] - za[c])
         size = max(size, abs(za[c]), abs(zb[c]))
-    return rules.flow_consistent(np.sqrt(d2), dt, np.sqrt(speed2_a), np.sqrt(_dot(fb, fb)), size)
+    return rules.flow_consistent(np.sqrt(d2), dt, np.sqrt(speed2_a), np.sqrt(_dot(fb, fb)), size,
+                                 floor)
 
 
 @_jit
@@ -294,7 +295,7 @@ def _section_counts(ctx, k, i, r, mode):
     # crossings within 64 x 1e-10 for the start)
     exact = mode != SLIDING and o.seg[SEG_INTEGRATED] == 0.0
     return not (rules.starts_on_section(sm.svals[i], wg, _section(o.fns, wz, o.p), wz,
-                                   o.za if exact else wg)
+                                   o.za if exact else wg, o.floor)
                 or _in_section_rounding(o.fns, o.p, sm.svals[i], wg, wz, sc.wf))
 
 

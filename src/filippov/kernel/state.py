@@ -22,13 +22,14 @@ _f8, _i8, _b1 = types.float64, types.int64, types.boolean
 #: in windows hwin (hwin_slow after the transient time); the section predicate; sliding
 #: declared; sample fractions of an exact window and of an integration step; tolerances and
 #: limits as compute_returns' options; iterations: returns per start; jac: dP/dz (0 none,
-#: 1 Jacobian-vector products by differences, 2 the model's Jacobians)
+#: 1 Jacobian-vector products by differences, 2 the model's Jacobians); the run's state and
+#: time scales (filippov.scale: the floors of the rules, atol etc. already scaled)
 SETTINGS = (
     ("t_max", _f8), ("exact", _b1), ("hwin", _f8), ("hwin_slow", _f8), ("transient", _f8),
     ("sec_pred", _i8), ("sliding", _b1), ("frac_ex", _vec), ("frac_in", _vec), ("rtol", _f8),
     ("atol", _f8), ("touch_tol", _f8), ("xtol", _f8), ("zeno_span", _f8), ("max_step", _f8),
     ("min_time", _f8), ("max_events", _i8), ("max_steps", _i8), ("zeno_count", _i8),
-    ("jac", _i8), ("iterations", _i8))
+    ("jac", _i8), ("iterations", _i8), ("state_scale", _f8), ("time_scale", _f8))
 
 #: what a batch returns, per start (m) -- fastmap.BatchReturns' fields: state (m, n), time,
 #: n_switches, sliding_time, status, first_switch, sliding_displacement (m, n), orbit
@@ -72,9 +73,10 @@ Work = namedtuple("Work", [
     "deriv"])
 
 #: dP/dz's arrays: the derivative so far (M), workspaces, the variational stages; a record
-#: of their own (docs/decisions.md#kernel-small-records)
+#: of their own (docs/decisions.md#kernel-small-records); the run's state scale, from which
+#: the central differences step (filippov.scale)
 Deriv = namedtuple("Deriv", ["M", "Mt", "KV", "KP", "ys", "jv", "jo", "jz1", "jz2", "jf1",
-                             "jf2", "Jm"])
+                             "jf2", "Jm", "floor"])
 
 # ----------------------------------------------------------------- w.seg (float64)
 # The current segment of the orbit and its stay. The state on it is the exact flow from
@@ -111,8 +113,9 @@ SEG_SIZE, COUNT_SIZE, TALLY_SIZE = len(SEG), len(COUNT), len(TALLY)
 
 # ----------------------------------------------------------------- groups for the helpers
 #: what the event functions are evaluated on: the model (its pieces' addresses, params),
-#: the current segment (w.seg, w.za, w.F, w.y_old) and the tolerance events are refined to
-Orbit = namedtuple("Orbit", ["fns", "p", "seg", "za", "F", "y_old", "xtol"])
+#: the current segment (w.seg, w.za, w.F, w.y_old), the tolerance events are refined to and
+#: the run's state scale (filippov.scale: the floor of the rules' state sizes)
+Orbit = namedtuple("Orbit", ["fns", "p", "seg", "za", "F", "y_old", "xtol", "floor"])
 #: the scratch vectors a model evaluation fills (a state, grad h, F_- or the mode's field,
 #: F_+)
 Scratch = namedtuple("Scratch", ["wz", "wg", "wf", "wp"])

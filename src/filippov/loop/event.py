@@ -63,7 +63,7 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: from as it evaluates it (rules.exit_band); sliding_built(ctx) -> bool;
 #: slides_in_section(ctx) -> bool; record_switch(mode, new_mode, what, t, ctx);
 #: count_switch(changed, t, ctx) -> switches so far; limits(ctx) -> (max_events,
-#: zeno_count, zeno_span, touch_tol); ring(ctx) -> (times, entries);
+#: zeno_count, zeno_span, touch_tol, state scale, time scale: filippov.scale); ring(ctx) -> (times, entries);
 #: store_ring(entries, ctx); over_budget(t, new_mode, switches, ctx) -> bool, asked once
 #: the ring is full; store_exit(new_mode, shift, band, ctx): the next stay's shift of H
 #: and rounding band; switch_derivative(mode, new_mode, ctx): dP/dz across a crossing;
@@ -125,7 +125,7 @@ def make_run(ops: RunOps):
                 return NO_SLIDING, t, mode
             if new_mode == SLIDING and mode != SLIDING and slides_in_section(ctx):
                 return SECTION_SLIDING, t, mode
-            max_events, zeno_count, zeno_span, touch_tol = limits(ctx)
+            max_events, zeno_count, zeno_span, touch_tol, floor, time_scale = limits(ctx)
             shift, band = 0.0, 0.0
             if mode == SLIDING and new_mode != SLIDING:
                 # the end of a slide: a state the slide left off H beyond rounding is
@@ -135,14 +135,15 @@ def make_run(ops: RunOps):
                 if drift:
                     rules.onto_switch(z, h0, grad)
                     h0 = h(ctx)  # what rounding left
-                band = rules.exit_band(z, flow_at_zero(new_mode, z, ctx), grad)
+                band = rules.exit_band(z, flow_at_zero(new_mode, z, ctx), grad, floor)
                 shift = rules.exit_shift(new_mode, h0, touch_tol, drift)
             record_switch(mode, new_mode, what, t, ctx)
             switches = count_switch(new_mode != mode, t, ctx)
             if switches > max_events:
                 return EVENT_LIMIT, t, mode
             recent, entries = ring(ctx)
-            entries, zeno = rules.note_switch(recent, entries, t, zeno_count, zeno_span)
+            entries, zeno = rules.note_switch(recent, entries, t, zeno_count, zeno_span,
+                                              time_scale)
             store_ring(entries, ctx)
             if zeno:
                 return ZENO, t, mode

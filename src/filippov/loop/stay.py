@@ -52,13 +52,13 @@ def make_slides_in(fields, section_along):
     """``slides_in(k, ctx) -> bool``: does the sliding flow at the state (on H) stay in
     section k? rules.slides_in_section from the section's value there and its rates along
     F_-, F_+ and the sliding field, by central differences of the step rules.central_step
-    gives (0: no). The engine's operations: ``fields(ctx) -> (z, F_-, F_+)`` at the
-    state, arrays; ``section_along(k, mode, d, ctx)``: section k at z + d times the field
+    gives (0: no). The engine's operations: ``fields(ctx) -> (z, F_-, F_+, floor)`` at
+    the state, arrays, and the run's state scale (filippov.scale); ``section_along(k, mode, d, ctx)``: section k at z + d times the field
     of ``mode`` (MINUS, PLUS, SLIDING; d = 0: at z)."""
 
     def slides_in(k, ctx):
-        z, fm, fp = fields(ctx)
-        speed, size = 0.0, 1.0
+        z, fm, fp, floor = fields(ctx)
+        speed, size = 0.0, floor
         for c in range(z.size):
             speed = max(speed, abs(fm[c]), abs(fp[c]))
             size = max(size, abs(z[c]))

@@ -1,0 +1,135 @@
+"""The units a run is measured in: one state scale, one time scale, one scale of H.
+
+Every tolerance and floor of the engines that is not relative to something already is one
+of these three: ``atol`` is a state error (times the state scale S), ``touch_tol`` a value
+of H (times H's scale G), ``event_xtol`` and the time floor of the Zeno test are times
+(times the time scale T), and the central-difference steps, the rate step and the
+rounding floors of the rules grow with the state from S (where they grew from 1). A system
+written in micrometres or in microseconds then gets the results of the same system in
+metres and seconds, to rounding: docs/decisions.md#units.
+
+A system declares its scale (``FilippovSystem(..., scale=...)``, the paper's models
+declare :data:`UNIT`) or has it measured at the run's start (:func:`measure`): the
+largest start component, the fields' speed there and the gradient of H, each rounded to a
+power of two, and taken as 1 within :data:`DEAD_BAND` of 1 -- the defaults were chosen at
+unit scale, and a system in its natural units runs exactly as before. A measured scale is
+a power of two, so scaling a tolerance by it is exact.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+#: measured scales within this factor of 1 are 1 (a system in its natural units)
+DEAD_BAND = 16.0
+#: the exponents a measured scale is clamped to (a power of two stays a normal float with
+#: room for the tolerances scaled by it: 1e-15 x 2^-900 ~ 1e-286)
+MAX_EXPONENT = 900
+
+
+@dataclass(frozen=True)
+class Scale:
+    """A run's units: ``state`` (the size of the state), ``time`` (the time the state
+    takes to move by ``state``), ``switch`` (the size of H at states of size ``state``);
+    ``how``: "declared", "measured" or "unit"."""
+
+    state: float = 1.0
+    time: float = 1.0
+    switch: float = 1.0
+    how: str = "declared"
+
+    @property
+    def is_unit(self) -> bool:
+        return self.state == 1.0 and self.time == 1.0 and self.switch == 1.0
+
+
+#: the scale of a system written in units of its own size (the paper's models)
+UNIT = Scale(1.0, 1.0, 1.0, "unit")
+
+
+def power_of_two(x: float) -> float:
+    """The power of two nearest ``x`` (> 0, finite; else 1), 1 within DEAD_BAND of 1."""
+    if not (math.isfinite(x) and x > 0.0):
+        return 1.0
+    e = round(math.log2(x))
+    e = max(-MAX_EXPONENT, min(MAX_EXPONENT, e))
+    p = math.ldexp(1.0, e)
+    return 1.0 if 1.0 / DEAD_BAND <= p <= DEAD_BAND else p
+
+
+def _inf_norm(v) -> float:
+    v = np.asarray(v, dtype=float)
+    return float(np.max(np.abs(v))) if v.size else 0.0
+
+
+def measure(z0, fields=None, grad=None, state=None) -> Scale:
+    """The scale measured at a start ``z0`` (or at the largest of several, rows): S from
+    its largest component (or ``state``, when declared); T from S over the fields' largest
+    component there (``fields``: the values of F_- and F_+, or None); G from S times the
+    largest component of H's gradient (``grad``, or None). Non-finite or zero measures
+    give 1."""
+    S = power_of_two(_inf_norm(z0)) if state is None else state
+    speed = max((_inf_norm(f) for f in fields), default=0.0) if fields is not None else 0.0
+    T = power_of_two(S / speed) if math.isfinite(speed) and speed > 0.0 else 1.0
+    g = _inf_norm(grad) if grad is not None else 0.0
+    G = power_of_two(S * g) if math.isfinite(g) and g > 0.0 else 1.0
+    return Scale(S, T, G, "measured")
+
+
+def declared(value, field: str = "scale"):
+    """A user's ``scale=``: None (measured at the start), a :class:`Scale`, a positive
+    number (the state's scale; time and H measured) or a mapping with any of "state",
+    "time", "switch" (the rest measured). Returns a Scale, or a dict of the declared
+    parts (possibly empty: all measured). A bad value is a ValueError naming the field."""
+    if value is None:
+        return {}
+    if isinstance(value, Scale):
+        parts = {"state": value.state, "time": value.time, "switch": value.switch}
+    elif isinstance(value, dict):
+        unknown = set(value) - {"state", "time", "switch"}
+        if unknown:
+            raise ValueError(f"{field}: unknown part(s) {sorted(unknown)}; a scale has "
+                             f"'state', 'time' and 'switch'")
+        parts = dict(value)
+    else:
+        parts = {"state": value}
+    for k, v in parts.items():
+        ok = (not isinstance(v, (bool, np.bool_)) and isinstance(v, (int, float, np.integer,
+                                                                     np.floating))
+              and math.isfinite(float(v)) and float(v) > 0.0)
+        if not ok:
+            raise ValueError(f"{field}.{k} must be a finite number > 0, got {v!r}")
+    parts = {k: float(v) for k, v in parts.items()}
+    if isinstance(value, Scale):
+        return Scale(parts["state"], parts["time"], parts["switch"], value.how)
+    return parts
+
+
+def resolve(value, measure_at) -> Scale:
+    """The scale a run uses: ``value`` as :func:`declared` reads it, with the parts it
+    leaves open taken from ``measure_at(state)`` (called only then, with the declared
+    state scale or None; returns a Scale)."""
+    parts = declared(value)
+    if isinstance(parts, Scale):
+        return parts
+    if len(parts) == 3:
+        return Scale(parts["state"], parts["time"], parts["switch"], "declared")
+    m = measure_at(parts.get("state"))
+    how = "measured" if not parts else "declared+measured"
+    return Scale(parts.get("state", m.state), parts.get("time", m.time),
+                 parts.get("switch", m.switch), how)
+
+
+def tolerances(opts: dict, scale: Scale) -> dict:
+    """``opts`` with the absolute tolerances in the run's units: atol x S, touch_tol x G,
+    event_xtol x T (those present), and the floors the rules take (state_scale,
+    time_scale)."""
+    out = dict(opts)
+    for name, factor in (("atol", scale.state), ("touch_tol", scale.switch),
+                         ("event_xtol", scale.time)):
+        if name in out:
+            out[name] = out[name] * factor
+    out["state_scale"], out["time_scale"] = scale.state, scale.time
+    return out
