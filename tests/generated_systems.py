@@ -198,18 +198,40 @@ class _Cached(FilippovSystem):
 _SYSTEMS: dict = {}
 
 
-def system(n: int, exact: bool) -> FilippovSystem:
+def system(n: int, exact: bool, time_unit: float = 1.0) -> FilippovSystem:
     """The structure of dimension ``n``, with (``exact``) or without exact flows; built
-    once per process. Give it numbers with :func:`load`."""
-    key = (n, exact)
+    once per process. Give it numbers with :func:`load`. ``time_unit``: the system's
+    time is measured in units that many times as large (:func:`rescaled`), and so is
+    its sample step."""
+    key = (n, exact) if time_unit == 1.0 else (n, exact, time_unit)
     if key not in _SYSTEMS:
         p = np.zeros(layout(n)["size"])
         flows = dict(flow_minus=flow_minus, flow_plus=flow_plus,
-                     sample_step=SAMPLE_STEP) if exact else {}
+                     sample_step=SAMPLE_STEP / time_unit) if exact else {}
         _SYSTEMS[key] = _Cached(tuple(f"x{i + 1}" for i in range(n)), field_minus, field_plus,
                                 switch, switch_grad, params=p, name=f"generated{n}",
                                 jacobians={"minus": jac_minus, "plus": jac_plus}, **flows)
     return _SYSTEMS[key]
+
+
+def rescaled(p: np.ndarray, n: int, state: float = 1.0, time: float = 1.0) -> np.ndarray:
+    """The parameters of the same system in other units: a state u = z / ``state`` and a
+    time s = t / ``time`` (units ``state`` and ``time`` times as large; run it with
+    ``system(n, exact, time)``). In closed form, for each side: A -> A time, b -> b time /
+    state, the eigenvalues (re, im) -> times ``time``, the rest point z* -> z* / state, the
+    eigenvectors V as they are; h(z) = c.z - d + k (e.z)^2 -> c state, d, k state^2, e
+    (h keeps its values); the section's level sigma as it is."""
+    lay, q = layout(n), np.array(p, dtype=float)
+    for base in (lay["minus"], lay["plus"]):
+        A, b = base, base + n * n
+        q[A:A + n * n] *= time
+        q[b:b + n] *= time / state
+        ore = base + 3 * n * n + n
+        q[ore:ore + 2 * n] *= time                     # re, im
+        q[ore + 2 * n:ore + 3 * n] /= state            # z*
+    q[lay["c"]:lay["c"] + n] *= state
+    q[lay["k"]] *= state * state
+    return q
 
 
 def load(fs: FilippovSystem, p: np.ndarray) -> None:

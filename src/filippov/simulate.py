@@ -272,23 +272,25 @@ STIFF_STAGES = 5
 NOISE_STEPS = 10.0
 
 
-def field_noise(fun, t, z) -> np.ndarray:
+def field_noise(fun, t, z, floor: float = 1.0) -> np.ndarray:
     """Per component, how far the field moves when the state is rounded: |J| (u |z|)
-    plus the rounding of the field itself (u = unit roundoff)."""
+    plus the rounding of the field itself (u = unit roundoff; J by differences stepping
+    from ``floor``, the state scale, up)."""
     z = np.asarray(z, dtype=float)
     f = np.asarray(fun(t, z), dtype=float)
-    jac = variational.fd_jacobian(lambda zz: fun(t, zz), z)
+    jac = variational.fd_jacobian(lambda zz: fun(t, zz), z, floor=floor)
     u = np.finfo(float).eps
     return np.abs(jac) @ (u * np.abs(z)) + u * np.abs(f)
 
 
-def spectral_radius(fun, t, z, iterations: int = 6) -> float:
+def spectral_radius(fun, t, z, iterations: int = 6, floor: float = 1.0) -> float:
     """Largest |eigenvalue| of the field's Jacobian at ``z``, by power iteration on
-    finite differences (iterations + 1 field evaluations)."""
+    finite differences (iterations + 1 field evaluations; steps from ``floor``, the
+    state scale, up)."""
     z = np.asarray(z, dtype=float)
     f0 = np.asarray(fun(t, z), dtype=float)
     v = np.ones_like(z) / np.sqrt(z.size)
-    delta = 1e-7 * (1.0 + np.linalg.norm(z))
+    delta = 1e-7 * (floor + np.linalg.norm(z))
     rho = 0.0
     for _ in range(iterations):
         w = (np.asarray(fun(t, z + delta * v), dtype=float) - f0) / delta
@@ -749,12 +751,13 @@ class _Run:
         if not (self.stiff and stepper.method is DOP853 and steps_in_mode % STIFF_AFTER == 0):
             return stepper
         field = stepper.fun
-        if h * spectral_radius(field, self.t, self.z) <= 1.0:
+        if h * spectral_radius(field, self.t, self.z, floor=self.state_scale) <= 1.0:
             return stepper
         self.traj.stiff_modes.add(MODE_NAMES[self.mode])
         return _IntegratingStepper(field, self.z, self.t, self.t_end, self.rtol, self.atol,
                                    self.max_step, method=RadauIIA, piece=stepper.piece,
-                                   noise=field_noise(field, self.t, self.z))
+                                   noise=field_noise(field, self.t, self.z,
+                                                     self.state_scale))
 
     # ------------------------------------------------------------------ one event
     def _event_error(self, status):

@@ -50,6 +50,7 @@ from scipy.integrate import solve_ivp
 
 from .. import codegen
 from ..model import SlowFastModel
+from ..scale import UNIT
 from ..symbolic import SymbolicSlowFast
 
 CONVENTIONS = ("stribeck", "literal")
@@ -267,7 +268,8 @@ def system(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck", *
         raise ValueError("eps must be > 0 for the slow-fast system")
     if "full" not in _FULL:
         _FULL["full"] = DEFINITION.full()
-    return _FULL["full"].with_params(**values).with_options(sliding=sliding).system()
+    return _FULL["full"].with_params(**values).with_options(sliding=sliding,
+                                                            scale=UNIT).system()
 
 
 # --------------------------------------------------------------------------- slow manifold
@@ -403,7 +405,8 @@ def reduced_jacobian(v, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck"):
     a, c = _coefficients(f0, fc, convention)
     if "reduced" not in _FULL:
         _FULL["reduced"] = DEFINITION.reduced()
-    return _FULL["reduced"].with_params(v0=v, s0=a, sc=c, fv=fv).system().jacobian
+    return _FULL["reduced"].with_params(v0=v, s0=a, sc=c, fv=fv).with_options(
+        scale=UNIT).system().jacobian
 
 
 def full_system(eps, v0, gamma=2.0, f0=-2.0, fv=0.3, fc=2.5, convention="stribeck",

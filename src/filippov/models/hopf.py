@@ -40,6 +40,7 @@ from sympy.codegen.cfunctions import expm1
 
 from .. import codegen
 from ..model import TRANSIENT, SlowFastModel
+from ..scale import UNIT
 from ..symbolic import SymbolicSlowFast
 
 #: the model's name in the registry (filippov.models.get) and in a scene's ``model:`` key
@@ -194,7 +195,7 @@ def system(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi, 
     period = 2 * np.pi / abs(omega)
     return _FULL[exact].with_params(**values).with_options(
         sample_step=min(eps / 4, period / 64), slow_sample_step=period / 64,
-        transient_time=TRANSIENT * eps, sliding=sliding).system()
+        transient_time=TRANSIENT * eps, sliding=sliding, scale=UNIT).system()
 
 
 def compiled(eps: float, theta: float, mu: float = 1.0, omega: float = 8 * np.pi, *,

@@ -15,6 +15,7 @@ import numpy as np
 import sympy as sp
 
 from ..model import TRANSIENT, SlowFastModel
+from ..scale import UNIT
 from ..symbolic import SymbolicSlowFast
 from ..system import SLIDING
 
@@ -78,7 +79,8 @@ def system(eps: float, theta: float):
     if not _FULL:
         _FULL[True] = DEFINITION.full()
     return _FULL[True].with_params(eps=eps, theta=theta).with_options(
-        sample_step=eps / 4, slow_sample_step=0.25, transient_time=TRANSIENT * eps).system()
+        sample_step=eps / 4, slow_sample_step=0.25, transient_time=TRANSIENT * eps,
+        scale=UNIT).system()
 
 
 def compiled(eps: float, theta: float, *, section_x: float = 10.0):
