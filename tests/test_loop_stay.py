@@ -45,7 +45,7 @@ def _plane(section):
     section_along as the engines' operation (the field of a mode at z + d f)."""
     z, fm, fp = np.array([0.3, 0.0]), np.array([1.0, 1.0]), np.array([1.0, -1.0])
     fields = {MINUS: fm, PLUS: fp, SLIDING: np.array([1.0, 0.0])}
-    return (lambda ctx: (z, fm, fp),
+    return (lambda ctx: (z, fm, fp, 1.0),
             lambda k, mode, d, ctx: section(z + d * fields[mode]))
 
 

@@ -497,8 +497,8 @@ def batch_scale(cmodel: CompiledModel, starts, value=None):
             return UNIT
         z = starts[int(np.argmax(np.max(np.abs(starts), axis=1)))]
         pc = _Pieces(cmodel)
-        return scale_mod.measure(z, (pc.field_minus(z), pc.field_plus(z)), pc.switch_grad(z),
-                                 state)
+        return scale_mod.measure_system(z, pc.field_minus, pc.field_plus, pc.switch_grad,
+                                        state)
     return scale_mod.resolve(cmodel.scale if value is None else value, measure_at)
 
 

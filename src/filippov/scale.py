@@ -24,9 +24,9 @@ import numpy as np
 
 #: measured scales within this factor of 1 are 1 (a system in its natural units)
 DEAD_BAND = 16.0
-#: the exponents a measured scale is clamped to (a power of two stays a normal float with
-#: room for the tolerances scaled by it: 1e-15 x 2^-900 ~ 1e-286)
-MAX_EXPONENT = 900
+#: the exponents a measured scale is clamped to: products of a scale with tolerances and
+#: with each other stay normal floats far from underflow and overflow
+MAX_EXPONENT = 300
 
 
 @dataclass(frozen=True)
@@ -64,18 +64,68 @@ def _inf_norm(v) -> float:
     return float(np.max(np.abs(v))) if v.size else 0.0
 
 
-def measure(z0, fields=None, grad=None, state=None) -> Scale:
+def field_length(field, z0) -> float:
+    """The length over which ``field`` (a function of one state) changes by its own size
+    near ``z0``: |F| / |dF/dz u| along u = F / |F|, from the shortest step 2^k (k found by
+    bisection, from sqrt(eps) |z0| up to 2^MAX_EXPONENT: a dozen evaluations) that changes
+    F by sqrt(eps) |F|, above its rounding. A length of the system, not of the start: a
+    start at the origin (up to rounding) of a system whose orbits are of size one has the
+    length of those orbits, where its own size would make every tolerance absurdly tight.
+    inf where F is zero, constant along u or not finite there."""
+    z0 = np.asarray(z0, dtype=float)
+    f0 = np.asarray(field(z0), dtype=float)
+    speed = _inf_norm(f0)
+    if not (math.isfinite(speed) and speed > 0.0):
+        return math.inf
+    u, root = f0 / speed, math.sqrt(np.finfo(float).eps)
+
+    def change(k):   # |F(z0 + 2^k u) - F(z0)|, inf where not finite
+        c = _inf_norm(np.asarray(field(z0 + math.ldexp(1.0, k) * u), dtype=float) - f0)
+        return c if math.isfinite(c) else math.inf
+
+    size = root * _inf_norm(z0)
+    lo = max(-MAX_EXPONENT, math.frexp(size)[1] - 1) if size > 0.0 else -MAX_EXPONENT
+    hi = MAX_EXPONENT
+    if change(hi) < root * speed:
+        return math.inf
+    if change(lo) >= root * speed:
+        hi = lo
+    while hi - lo > 1:   # change(lo) below the threshold, change(hi) at or above it
+        mid = (lo + hi) // 2
+        if change(mid) >= root * speed:
+            hi = mid
+        else:
+            lo = mid
+    c = change(hi)
+    return speed * math.ldexp(1.0, hi) / c if math.isfinite(c) else math.inf
+
+
+def measure(z0, fields=None, grad=None, state=None, length=math.inf) -> Scale:
     """The scale measured at a start ``z0`` (or at the largest of several, rows): S from
-    its largest component (or ``state``, when declared); T from S over the fields' largest
+    its largest component or the fields' ``length`` there (:func:`field_length`),
+    whichever is larger (or ``state``, when declared); T from S over the fields' largest
     component there (``fields``: the values of F_- and F_+, or None); G from S times the
     largest component of H's gradient (``grad``, or None). Non-finite or zero measures
     give 1."""
-    S = power_of_two(_inf_norm(z0)) if state is None else state
+    size = max(_inf_norm(z0), length if math.isfinite(length) else 0.0)
+    S = power_of_two(size) if state is None else state
     speed = max((_inf_norm(f) for f in fields), default=0.0) if fields is not None else 0.0
     T = power_of_two(S / speed) if math.isfinite(speed) and speed > 0.0 else 1.0
     g = _inf_norm(grad) if grad is not None else 0.0
     G = power_of_two(S * g) if math.isfinite(g) and g > 0.0 else 1.0
     return Scale(S, T, G, "measured")
+
+
+def measure_system(z0, field_minus, field_plus, switch_grad, state=None) -> Scale:
+    """:func:`measure` at ``z0`` of a system given by its pieces (functions of one
+    state): the fields and H's gradient there, and the shorter of the fields' lengths
+    (:func:`field_length`)."""
+    z0 = np.asarray(z0, dtype=float).reshape(-1)
+    fields = (field_minus(z0), field_plus(z0))
+    length = math.inf
+    if state is None:
+        length = min(field_length(field_minus, z0), field_length(field_plus, z0))
+    return measure(z0, fields, switch_grad(z0), state, length)
 
 
 def declared(value, field: str = "scale"):

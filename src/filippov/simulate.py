@@ -505,9 +505,8 @@ def run_scale(system: PiecewiseSystem, z, value=None) -> Scale:
     """The units of a run of ``system`` from ``z`` (filippov.scale): ``value`` (an
     option), else the system's declaration, each part it leaves open measured at z."""
     def measure_at(state):
-        z1 = np.asarray(z, dtype=float).reshape(-1)
-        return scale_mod.measure(z1, (system.field_minus(z1), system.field_plus(z1)),
-                                 system.switch_grad(z1), state)
+        return scale_mod.measure_system(z, system.field_minus, system.field_plus,
+                                        system.switch_grad, state)
     return scale_mod.resolve(system.scale if value is None else value, measure_at)
 
 
