@@ -92,7 +92,7 @@ def test_every_python_block_of_the_page_runs(page, tutorial):
 
 def test_the_tutorial_has_the_blocks_it_describes():
     codes = python_blocks(DOCS / "tutorial.md")
-    assert len(codes) == 5
+    assert len(codes) == 6
     assert len(codes[0].strip().splitlines()) <= 30   # the first system fits a screen
 
 

@@ -64,40 +64,50 @@ def _inf_norm(v) -> float:
     return float(np.max(np.abs(v))) if v.size else 0.0
 
 
+def _rate(field, z0, f0, k: int, size: float) -> float:
+    """|dF/dz_k| near z0, by the shortest step 2^j along coordinate k (j by bisection,
+    from sqrt(eps) ``size`` up to 2^MAX_EXPONENT: a dozen evaluations) that changes F by
+    sqrt(eps) |F(z0)|, above its rounding; 0 where no step does, or F is not finite."""
+    root, target = math.sqrt(np.finfo(float).eps), math.sqrt(np.finfo(float).eps) * _inf_norm(f0)
+
+    def change(j):
+        z = z0.copy()
+        z[k] += math.ldexp(1.0, j)
+        c = _inf_norm(np.asarray(field(z), dtype=float) - f0)
+        return c if math.isfinite(c) else math.inf
+
+    lo = max(-MAX_EXPONENT, math.frexp(root * size)[1] - 1) if size > 0.0 else -MAX_EXPONENT
+    hi = MAX_EXPONENT
+    if not change(hi) >= target:
+        return 0.0
+    if change(lo) >= target:
+        hi = lo
+    while hi - lo > 1:   # change(lo) below the target, change(hi) at or above it
+        mid = (lo + hi) // 2
+        if change(mid) >= target:
+            hi = mid
+        else:
+            lo = mid
+    c = change(hi)
+    return c / math.ldexp(1.0, hi) if math.isfinite(c) else 0.0
+
+
 def field_length(field, z0) -> float:
     """The length over which ``field`` (a function of one state) changes by its own size
-    near ``z0``: |F| / |dF/dz u| along u = F / |F|, from the shortest step 2^k (k found by
-    bisection, from sqrt(eps) |z0| up to 2^MAX_EXPONENT: a dozen evaluations) that changes
-    F by sqrt(eps) |F|, above its rounding. A length of the system, not of the start: a
-    start at the origin (up to rounding) of a system whose orbits are of size one has the
-    length of those orbits, where its own size would make every tolerance absurdly tight.
-    inf where F is zero, constant along u or not finite there."""
+    near ``z0``: |F| / max_k |dF/dz_k|, each rate from the shortest step that changes F
+    above its rounding (:func:`_rate`). A length of the system, not of the start: a start
+    at the origin (up to rounding) of a system whose orbits are of size one has the length
+    of those orbits, where its own size would make every tolerance absurdly tight; and the
+    largest rate, not the rate along F, so that a component nothing depends on (an
+    integral of a cost) does not make it long. inf where F is zero, constant or not
+    finite there."""
     z0 = np.asarray(z0, dtype=float)
     f0 = np.asarray(field(z0), dtype=float)
     speed = _inf_norm(f0)
     if not (math.isfinite(speed) and speed > 0.0):
         return math.inf
-    u, root = f0 / speed, math.sqrt(np.finfo(float).eps)
-
-    def change(k):   # |F(z0 + 2^k u) - F(z0)|, inf where not finite
-        c = _inf_norm(np.asarray(field(z0 + math.ldexp(1.0, k) * u), dtype=float) - f0)
-        return c if math.isfinite(c) else math.inf
-
-    size = root * _inf_norm(z0)
-    lo = max(-MAX_EXPONENT, math.frexp(size)[1] - 1) if size > 0.0 else -MAX_EXPONENT
-    hi = MAX_EXPONENT
-    if change(hi) < root * speed:
-        return math.inf
-    if change(lo) >= root * speed:
-        hi = lo
-    while hi - lo > 1:   # change(lo) below the threshold, change(hi) at or above it
-        mid = (lo + hi) // 2
-        if change(mid) >= root * speed:
-            hi = mid
-        else:
-            lo = mid
-    c = change(hi)
-    return speed * math.ldexp(1.0, hi) / c if math.isfinite(c) else math.inf
+    rate = max(_rate(field, z0, f0, k, _inf_norm(z0)) for k in range(z0.size))
+    return speed / rate if rate > 0.0 else math.inf
 
 
 def measure(z0, fields=None, grad=None, state=None, length=math.inf) -> Scale:
