@@ -65,9 +65,10 @@ def _inf_norm(v) -> float:
 
 
 def _rate(field, z0, f0, k: int, size: float) -> float:
-    """|dF/dz_k| near z0, by the shortest step 2^j along coordinate k (j by bisection,
-    from sqrt(eps) ``size`` up to 2^MAX_EXPONENT: a dozen evaluations) that changes F by
-    sqrt(eps) |F(z0)|, above its rounding; 0 where no step does, or F is not finite."""
+    """``|dF/dz_k|`` near z0, by the shortest step ``2^j`` along coordinate k (j by
+    bisection, from ``sqrt(eps) size`` up to ``2^MAX_EXPONENT``: a dozen evaluations) that
+    changes F by ``sqrt(eps) |F(z0)|``, above its rounding; 0 where no step does, or F is
+    not finite."""
     root, target = math.sqrt(np.finfo(float).eps), math.sqrt(np.finfo(float).eps) * _inf_norm(f0)
 
     def change(j):
@@ -94,7 +95,7 @@ def _rate(field, z0, f0, k: int, size: float) -> float:
 
 def field_length(field, z0) -> float:
     """The length over which ``field`` (a function of one state) changes by its own size
-    near ``z0``: |F| / max_k |dF/dz_k|, each rate from the shortest step that changes F
+    near ``z0``: ``|F| / max_k |dF/dz_k|``, each rate from the shortest step that changes F
     above its rounding (:func:`_rate`). A length of the system, not of the start: a start
     at the origin (up to rounding) of a system whose orbits are of size one has the length
     of those orbits, where its own size would make every tolerance absurdly tight; and the
@@ -114,7 +115,7 @@ def measure(z0, fields=None, grad=None, state=None, length=math.inf) -> Scale:
     """The scale measured at a start ``z0`` (or at the largest of several, rows): S from
     its largest component or the fields' ``length`` there (:func:`field_length`),
     whichever is larger (or ``state``, when declared); T from S over the fields' largest
-    component there (``fields``: the values of F_- and F_+, or None); G from S times the
+    component there (``fields``: the values of ``F_-`` and ``F_+``, or None); G from S times the
     largest component of H's gradient (``grad``, or None). Non-finite or zero measures
     give 1."""
     size = max(_inf_norm(z0), length if math.isfinite(length) else 0.0)
