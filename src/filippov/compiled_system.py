@@ -494,9 +494,7 @@ class FilippovSystem:
 
     def _state_scale(self, z: np.ndarray) -> float:
         """The state scale (filippov.scale): declared, or measured at z."""
-        from .simulate import run_scale
-
-        return run_scale(self.python(), z).state
+        return scale_mod.of_system(self.python(), z).state
 
     def _sliding_jacobian(self, z: np.ndarray) -> np.ndarray:
         """dF_s/dz of Filippov's sliding field F_s = (a F_+ - b F_-)/(a - b), a = g.F_-,

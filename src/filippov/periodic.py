@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from . import engines
+from .scale import of_system
 from .errors import PeriodicOrbitError  # noqa: F401  (re-exported)
 
 
@@ -220,9 +221,7 @@ def _orbit_scale(python, z, value):
     """The units of every return of one Newton iteration (filippov.scale): ``value``, else
     the system's, the parts left open measured at the guess -- once, so that the
     tolerances, and with them P, stay the same map at every iterate."""
-    from .simulate import run_scale
-
-    return run_scale(python, z, value)
+    return of_system(python, z, value)
 
 
 def _newton_step(z, Pz, J, guess, floor: float) -> np.ndarray:

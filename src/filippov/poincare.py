@@ -16,6 +16,7 @@ from . import engines
 from .errors import run_error
 from .loop.status import NO_RETURN
 from .progress import Progress
+from .scale import of_system
 from .simulate import Section, simulate
 from .system import SLIDING
 
@@ -112,10 +113,8 @@ def _batch_scale(system, starts):
     takes it: the system's, with the parts it leaves open measured at the largest start
     (None where the pieces cannot be evaluated there: each run's check then names the
     piece)."""
-    from .simulate import run_scale
-
     try:
-        return run_scale(system, starts[int(np.argmax(np.max(np.abs(starts), axis=1)))])
+        return of_system(system, starts[int(np.argmax(np.max(np.abs(starts), axis=1)))])
     except Exception:   # noqa: BLE001 -- the run's contract check says what is wrong
         return None
 

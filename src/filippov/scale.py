@@ -139,6 +139,16 @@ def measure_system(z0, field_minus, field_plus, switch_grad, state=None) -> Scal
     return measure(z0, fields, switch_grad(z0), state, length)
 
 
+def of_system(system, z, value=None) -> Scale:
+    """The units of a run of ``system`` (a :class:`~filippov.system.PiecewiseSystem`: its
+    ``scale`` and its pieces) from ``z``: ``value`` (a run's option), else the system's
+    declaration, each part it leaves open measured at z (:func:`measure_system`)."""
+    def measure_at(state):
+        return measure_system(z, system.field_minus, system.field_plus, system.switch_grad,
+                              state)
+    return resolve(system.scale if value is None else value, measure_at)
+
+
 def declared(value, field: str = "scale"):
     """A user's ``scale=``: None (measured at the start), a :class:`Scale`, a positive
     number (the state's scale; time and H measured) or a mapping with any of "state",

@@ -32,7 +32,7 @@ from scipy.optimize import brentq
 
 from . import checks, engines, options, rules, variational
 from . import scale as scale_mod
-from .scale import UNIT, Scale
+from .scale import UNIT
 from .loop import interval, refine
 from .radau_iia import RadauIIA
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
@@ -497,17 +497,8 @@ def _simulate(system: PiecewiseSystem, z0, sections: Sequence[Section], opts: di
             raise TypeError(f"sections[{k}]: expected a filippov.simulate.Section, got "
                             f"{type(sec).__name__}")
     checks.check_system(system, z, method=method)  # the pieces keep the class's contract
-    sc = run_scale(system, z, opts.get("scale"))
+    sc = scale_mod.of_system(system, z, opts.get("scale"))
     return _Run(system, z, list(sections), scale_mod.tolerances(opts, sc), sc).go()
-
-
-def run_scale(system: PiecewiseSystem, z, value=None) -> Scale:
-    """The units of a run of ``system`` from ``z`` (filippov.scale): ``value`` (an
-    option), else the system's declaration, each part it leaves open measured at z."""
-    def measure_at(state):
-        return scale_mod.measure_system(z, system.field_minus, system.field_plus,
-                                        system.switch_grad, state)
-    return scale_mod.resolve(system.scale if value is None else value, measure_at)
 
 
 class _Run:
