@@ -212,3 +212,31 @@ def test_a_batch_takes_one_scale_from_its_largest_start():
         out = first_returns(_rotor(), [[0.0, -1e-6], [0.0, -3e-6]], lambda z, p: z[0],
                             10.0, direction=1, engine=engine)
         assert np.allclose(out.time, 2 * np.pi, rtol=TOL_UNITS, atol=0), out.time
+
+
+def _wrapped(z, p):
+    # an angle wrapped by a loop: asked at 2^300 it would never return
+    th = z[0]
+    while th > np.pi:
+        th -= 2.0 * np.pi
+    if abs(z[1]) > 10.0:
+        raise ValueError("outside the table")
+    return np.array([1.0, np.cos(th) - 0.5 * z[1]])
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_measuring_the_scale_never_fails_nor_hangs_a_run(engine):
+    # the measurement probes the fields away from the start: a probe that raises or is
+    # not finite tells nothing, and the probes stay within 2^20 of the start's size
+    from filippov.scale import measure_system
+
+    fs = FilippovSystem(("th", "v"), _wrapped, _wrapped, lambda z, p: z[1] - 5.0,
+                        lambda z, p: np.array([0.0, 1.0]))
+    out = first_returns(fs, [[0.0, 0.0]], lambda z, p: z[0] - 3.0, 10.0, direction=1,
+                        engine=engine)
+    assert out.time[0] == pytest.approx(3.0, rel=1e-12)
+    bad = lambda z: np.array([np.nan, 1.0]) if z[0] != 0.0 else np.array([1.0, 1.0])  # noqa: E731
+    sc = measure_system(np.zeros(2), bad, bad, lambda z: np.array([0.0, 1.0]))
+    assert sc.state == 1.0
+    boom = lambda z: 1 / 0  # noqa: E731
+    assert measure_system(np.array([3e-6, 0.0]), boom, boom, boom).state == 2.0 ** -18

@@ -339,7 +339,7 @@ class GeneratedSystem(FilippovSystem):
             flow_plus=m.flow_plus if exact else no_flow,
             flow_minus=m.flow_minus if exact else no_flow,
             field_plus=m.field_plus, field_minus=m.field_minus, switch=m.switch,
-            switch_grad=m.switch_grad, section=sec, section_where=wh or always,
+            switch_grad=m.switch_grad, section=sec, section_where=wh or always, scale=self.scale,
             section_direction=int(direction), sample_step=self.sample_step,
             slow_sample_step=self.slow_sample_step, transient_time=self.transient_time,
             sliding=self.sliding, exact=exact, jacobian=m.jacobian,
