@@ -619,6 +619,17 @@ def merge(parts: list[xr.Dataset]) -> xr.Dataset:
     names = np.concatenate([ds.problem.values for ds in parts])
     if len(set(names)) != len(names):
         raise ValueError(f"a problem appears in more than one part: {list(names)}")
+    # what the parts measured of the machine (its load before and after each part's
+    # timing) differs from part to part: the merged dataset states the largest
+    attrs = dict(first.attrs)
+    for key in attrs:
+        values = [ds.attrs.get(key) for ds in parts]
+        if any(not np.array_equal(v, values[0]) for v in values[1:]):
+            numbers = [v for v in values if isinstance(v, (int, float, np.number))]
+            attrs[key] = max(numbers) if len(numbers) == len(values) else values[0]
+    parts = [ds.copy() for ds in parts]
+    for ds in parts:
+        ds.attrs = dict(attrs)
     return xr.concat(parts, dim="problem", data_vars="minimal", coords="minimal",
                      compat="identical", combine_attrs="override")
 
