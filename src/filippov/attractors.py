@@ -257,8 +257,12 @@ def _cycle_newton(cmodel: CompiledModel, z: np.ndarray, d: int, age: float, t_ma
     """Newton on P^d(z) - z with the engine's dP/dz (the product over the d returns):
     (point, d(P^d)/dz there) or None. Each iterate is put back on the section (one
     gradient step on the section function, as periodic_orbit does)."""
+    from .fastmap import batch_scale
     from .periodic import _onto_section
 
+    # the run's state scale (filippov.scale), fixed at the first iterate as periodic_orbit
+    # fixes it at its guess: the stopping test and the step onto the section grow from it
+    floor = batch_scale(cmodel, np.atleast_2d(z), options.get("scale")).state
     value = lambda x: float(cmodel.section(np.ascontiguousarray(x, dtype=float),  # noqa: E731
                                            cmodel.params))
     z = np.array(z, dtype=float)
@@ -271,7 +275,7 @@ def _cycle_newton(cmodel: CompiledModel, z: np.ndarray, d: int, age: float, t_ma
         for Jk in run.orbit_jacobian[0]:
             J = Jk @ J
         r = run.orbit[0, -1] - z
-        if np.abs(r).max() <= tol * (1.0 + np.abs(z).max()):
+        if np.abs(r).max() <= tol * (floor + np.abs(z).max()):
             return z, J      # J may be non-finite: the orbit touches H (a grazing cycle)
         if not np.all(np.isfinite(J)):
             return None
@@ -279,7 +283,7 @@ def _cycle_newton(cmodel: CompiledModel, z: np.ndarray, d: int, age: float, t_ma
             z = z - np.linalg.solve(J - np.eye(z.size), r)
         except np.linalg.LinAlgError:
             return None
-        z = _onto_section(value, z)
+        z = _onto_section(value, z, floor)
     return None
 
 

@@ -74,7 +74,8 @@ def _how(name, kind):
     return f"{name} {_CONTRACT[kind]} (see PiecewiseSystem); {_HINT[kind]}"
 
 
-def check_system(system: PiecewiseSystem, z0: np.ndarray, *, method: str) -> None:
+def check_system(system: PiecewiseSystem, z0: np.ndarray, *, method: str,
+                 floor: float = 1.0) -> None:
     """Raise :class:`SystemContractError` if ``system`` breaks its contract near ``z0``.
 
     Checked: a finite positive ``sample_step`` when exact flows will be used
@@ -82,26 +83,27 @@ def check_system(system: PiecewiseSystem, z0: np.ndarray, *, method: str) -> Non
     used) evaluates a batch of states as it does each state alone, with the
     right shape; that ``switch_grad`` is the gradient of ``switch`` at ``z0``.
     A system object that passed is not checked again (for the same use of its
-    flows), whatever ``z0``.
+    flows), whatever ``z0``. ``floor``: the run's state scale (filippov.scale), the
+    smallest size the gradient's differences step from.
     """
     exact = method == "exact" and len(system.flows) > 0
     key = (id(system), exact)
     ref = _PASSED.get(key)
     if ref is not None and ref() is system:
         return
-    _check(system, z0, exact)
+    _check(system, z0, exact, floor)
     try:
         _PASSED[key] = weakref.ref(system, lambda _, key=key: _PASSED.pop(key, None))
     except TypeError:  # an object without weak references is checked every time
         pass
 
 
-def _check(system, z0, exact):
+def _check(system, z0, exact, floor):
     if exact:
         check_sample_step(system)
     n = system.dim
     m = n + 2  # neither 1 nor n: a broadcast along the wrong axis cannot pass unseen
-    Z = probe_states(z0, m)
+    Z = probe_states(z0, m, floor)
     for name, fn, kind in (("field_minus", system.field_minus, "vector"),
                            ("field_plus", system.field_plus, "vector"),
                            ("switch", system.switch, "scalar"),
@@ -113,7 +115,7 @@ def _check(system, z0, exact):
             name = FLOW_NAMES.get(mode, f"flows[{mode!r}]")
             _probe_piece(name, lambda tau, f=flow: f(z0, tau), taus,
                          [np.float64(t) for t in taus], n, "flow")
-    check_switch_grad(system, z0)
+    check_switch_grad(system, z0, floor)
 
 
 def check_sample_step(system: PiecewiseSystem) -> None:
@@ -140,12 +142,13 @@ def _positive(v) -> bool:
         return False
 
 
-def probe_states(z0: np.ndarray, m: int) -> np.ndarray:
-    """``m`` distinct states next to ``z0`` (the first is ``z0`` itself), shape (n, m)."""
+def probe_states(z0: np.ndarray, m: int, floor: float = 1.0) -> np.ndarray:
+    """``m`` distinct states next to ``z0`` (the first is ``z0`` itself), shape (n, m),
+    a spread of each component's size (at least ``floor``, the run's state scale) away."""
     n = z0.size
     i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
     pattern = np.where(j == 0, 0.0, np.cos(1.0 + 1.7 * i + 2.3 * j))
-    scale = PROBE_SPREAD * np.maximum(np.abs(z0), 1.0)
+    scale = PROBE_SPREAD * np.maximum(np.abs(z0), floor)
     return z0[:, None] + scale[:, None] * pattern
 
 
@@ -195,18 +198,20 @@ def _probe_piece(name, fn, batch, columns, n, kind):
             f"{_how(name, kind)}")
 
 
-def check_switch_grad(system: PiecewiseSystem, z0: np.ndarray) -> None:
+def check_switch_grad(system: PiecewiseSystem, z0: np.ndarray, floor: float = 1.0) -> None:
     """``switch_grad(z0)`` against central differences of ``switch`` along two
     directions: the gradient's own and a fixed one (see :data:`GRAD_RTOL`)."""
     g = np.asarray(system.switch_grad(z0), dtype=float).reshape(-1)
-    gradient_check(lambda Z: np.asarray(system.switch(Z), dtype=float), g, z0)
+    gradient_check(lambda Z: np.asarray(system.switch(Z), dtype=float), g, z0, floor=floor)
 
 
 def gradient_check(switch_at, g: np.ndarray, z0: np.ndarray, *, piece: str = "switch_grad",
-                   of: str = "switch") -> None:
+                   of: str = "switch", floor: float = 1.0) -> None:
     """Raise :class:`SystemContractError` unless ``g`` is the gradient at ``z0`` of the
     function ``switch_at`` (states (n, k) -> values (k,)) -- the check of both engines
-    (:func:`check_switch_grad`, :func:`check_compiled`); ``piece``/``of`` name them."""
+    (:func:`check_switch_grad`, :func:`check_compiled`); ``piece``/``of`` name them.
+    The differences step from ``floor`` (the run's state scale, filippov.scale) or the
+    start's size, whichever is larger."""
     if not np.all(np.isfinite(g)):
         return
     n = z0.size
@@ -215,7 +220,7 @@ def gradient_check(switch_at, g: np.ndarray, z0: np.ndarray, *, piece: str = "sw
     gnorm = float(np.linalg.norm(g))
     if gnorm > 0:
         dirs.insert(0, g / gnorm)
-    size = max(1.0, float(np.max(np.abs(z0))))
+    size = max(floor, float(np.max(np.abs(z0))))
     h0 = np.cbrt(np.finfo(float).eps) * size
     steps = [h0 * f for f in GRAD_STEPS]
     pts = [z0 + sign * h * d for h in steps for d in dirs for sign in (1.0, -1.0)]
@@ -256,7 +261,7 @@ def gradient_check(switch_at, g: np.ndarray, z0: np.ndarray, *, piece: str = "sw
 _PASSED_COMPILED: dict = {}
 
 
-def check_compiled(cmodel, z0: np.ndarray) -> None:
+def check_compiled(cmodel, z0: np.ndarray, floor: float = 1.0) -> None:
     """The compiled engine's start check (:func:`filippov.fastmap.compute_returns`), the
     same as the reference driver's :func:`check_switch_grad`: ``grad_h`` is the gradient
     of ``h`` at the first start point; once per model object. (The pieces' output sizes
@@ -275,7 +280,7 @@ def check_compiled(cmodel, z0: np.ndarray) -> None:
             return np.array([cmodel.switch(np.ascontiguousarray(Z[:, j]), p)
                              for j in range(Z.shape[1])])
 
-        gradient_check(switch_at, g, z0)  # the user's names (compile_system's arguments)
+        gradient_check(switch_at, g, z0, floor=floor)  # the user's names
     try:
         _PASSED_COMPILED[key] = weakref.ref(cmodel,
                                             lambda _, key=key: _PASSED_COMPILED.pop(key, None))

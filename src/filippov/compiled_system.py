@@ -493,8 +493,14 @@ class FilippovSystem:
                 f"(the flow's multiplier stays 1)")
 
     def _state_scale(self, z: np.ndarray) -> float:
-        """The state scale (filippov.scale): declared, or measured at z."""
-        return scale_mod.of_system(self.python(), z).state
+        """The state scale (filippov.scale): declared, or measured at the first state a
+        Jacobian is asked at and kept (the floor of a difference step: not worth the
+        measurement's 24n evaluations at every sliding state)."""
+        kept = getattr(self, "_kept_scale", None)
+        if kept is None or kept[0] is not self.scale:
+            kept = (self.scale, scale_mod.of_system(self.python(), z).state)
+            self._kept_scale = kept
+        return kept[1]
 
     def _sliding_jacobian(self, z: np.ndarray) -> np.ndarray:
         """dF_s/dz of Filippov's sliding field F_s = (a F_+ - b F_-)/(a - b), a = g.F_-,

@@ -57,10 +57,17 @@ class Branch:
     stopped: str = ""
 
 
-def newton(G, J, u, *, tol=1e-12, max_iter=12, extra=None):
+def newton(G, J, u, *, tol=1e-12, max_iter=12, extra=None, floor=None):
     """Newton for the square system [G(u); extra(u)] = 0 (``extra`` returns a
-    (value, gradient) pair for one more scalar equation)."""
+    (value, gradient) pair for one more scalar equation). Converged when a step is below
+    ``tol max(floor, |u|)``; ``floor``: the unknowns' scale (None: the guess's largest
+    component as :func:`filippov.scale.power_of_two` rounds it, at most 1: the test is
+    relative beyond)."""
+    from .scale import power_of_two
+
     u = np.asarray(u, dtype=float).copy()
+    if floor is None:
+        floor = min(1.0, power_of_two(float(np.max(np.abs(u))))) if u.size else 1.0
     for it in range(max_iter):
         r = np.atleast_1d(G(u))
         A = np.atleast_2d(J(u))
@@ -70,7 +77,7 @@ def newton(G, J, u, *, tol=1e-12, max_iter=12, extra=None):
             A = np.vstack([A, de])
         du = np.linalg.solve(A, -r)
         u += du
-        if np.max(np.abs(du)) <= tol * max(1.0, np.max(np.abs(u))):
+        if np.max(np.abs(du)) <= tol * max(floor, np.max(np.abs(u))):
             return u, it + 1
     raise ContinuationError(f"Newton did not converge in {max_iter} iterations "
                             f"(last step {np.max(np.abs(du)):.3e}) at u={u.tolist()}")
@@ -257,8 +264,9 @@ def monodromy(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None):
       it started in: that switch is applied once, at the end, so the result
       does not depend on where on the orbit the period starts.
 
-    Returns (M, multipliers sorted by modulus, descending). ``system`` and ``jacobian``
-    as for :func:`filippov.variational.transition_matrix`."""
+    Returns (M, multipliers sorted by modulus, descending). ``system``, ``jacobian`` and
+    ``atol`` (in units of the run's state scale, ``traj.scale``) as for
+    :func:`filippov.variational.transition_matrix`."""
     system, jacobian = reference_view(system, jacobian, "monodromy")
     try:
         M = transition_matrix(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)

@@ -372,15 +372,18 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
 
     Units as :func:`filippov.simulate.simulate`'s (:mod:`filippov.scale`): ``scale``
     (None: the model's, declared or measured) holds for the whole batch, its open parts
-    measured at the largest start.
+    measured at the smallest and the largest start (the smaller of the two:
+    :func:`filippov.scale.of_batch`). Explicit ``atol``, ``touch_tol`` and
+    ``event_xtol`` are in units of that scale's S, G and T.
     """
     starts, ages = _checked_starts(cmodel, starts, start_age)
     frozen.check(cmodel.frozen_reads)   # no piece run with a value changed since compiled
     # the pieces checked before anything calls them: check_compiled's Python call would
     # compile a lazy njit piece (one the kernel cannot call at an address) on the spot
     pieces = _pieces(cmodel)
-    if starts.shape[0]:
-        check_compiled(cmodel, starts[0])  # the reference driver's start check, once a model
+    scale = batch_scale(cmodel, starts, scale)
+    if starts.shape[0]:   # the reference driver's start check, once a model
+        check_compiled(cmodel, starts[0], floor=scale.state)
     params = np.ascontiguousarray(np.atleast_2d(np.asarray(cmodel.params, dtype=float)))
     return _returns(cmodel, pieces, params, starts, ages, t_max, rtol=rtol, atol=atol,
                     max_step=max_step, max_events=max_events, max_steps=max_steps,
@@ -450,8 +453,9 @@ def sweep_returns(cmodels, starts, t_max: float, *, start_age=0.0, workers=None,
                          f"for {len(cmodels)} cmodels")
     frozen.check(first.frozen_reads)   # the models share their pieces (_sweep_params)
     pieces = _pieces(first)  # before check_compiled calls them (see compute_returns)
+    scale = batch_scale(cmodels, starts, options.pop("scale", None))
     for i, c in enumerate(cmodels):  # once a model object (checks.check_compiled)
-        check_compiled(c, starts[i])
+        check_compiled(c, starts[i], floor=scale.state)
     defaults = {name: par.default for name, par in
                 inspect.signature(compute_returns).parameters.items()
                 if par.kind is par.KEYWORD_ONLY and name not in ("start_age", "workers")}
@@ -459,7 +463,7 @@ def sweep_returns(cmodels, starts, t_max: float, *, start_age=0.0, workers=None,
     if unknown:
         raise TypeError(f"sweep_returns() got unexpected options {sorted(unknown)}")
     return _returns(first, pieces, params, starts, ages, t_max, workers=workers,
-                    **{**defaults, **options})
+                    **{**defaults, **options, "scale": scale})
 
 
 def _returns(cmodel: CompiledModel, pieces, params, starts, ages, t_max, *, rtol, atol,
@@ -489,17 +493,16 @@ def _returns(cmodel: CompiledModel, pieces, params, starts, ages, t_max, *, rtol
                                orbit_jacobian=out.orbit_jacobian if jacobian else None))
 
 
-def batch_scale(cmodel: CompiledModel, starts, value=None):
-    """The units of a batch (filippov.scale): ``value``, else the model's declaration,
-    the parts left open measured at the largest start (the model's first parameter row)."""
-    def measure_at(state):
-        if not starts.shape[0]:
-            return UNIT
-        z = starts[int(np.argmax(np.max(np.abs(starts), axis=1)))]
-        pc = _Pieces(cmodel)
-        return scale_mod.measure_system(z, pc.field_minus, pc.field_plus, pc.switch_grad,
-                                        state)
-    return scale_mod.resolve(cmodel.scale if value is None else value, measure_at)
+def batch_scale(cmodels, starts, value=None):
+    """The units of a batch (filippov.scale.of_batch): ``value``, else the model's
+    declaration, the parts left open measured at the smallest and the largest start
+    (``cmodels``: one model, or one per start -- a sweep -- each start measured with
+    its own)."""
+    def pieces(i):
+        pc = _Pieces(cmodels[i] if isinstance(cmodels, (list, tuple)) else cmodels)
+        return pc.field_minus, pc.field_plus, pc.switch_grad
+    first = cmodels[0] if isinstance(cmodels, (list, tuple)) else cmodels
+    return scale_mod.of_batch(first.scale if value is None else value, starts, pieces)
 
 
 class _Pieces:

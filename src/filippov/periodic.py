@@ -298,7 +298,9 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
     max_iter : int
         Newton steps at most.
     **options
-        For the engine (``rtol``, ``atol``, ``min_time``, ...).
+        For the engine (``rtol``, ``atol``, ``min_time``, ...); ``atol``, ``touch_tol``
+        and ``event_xtol`` in units of the scale's S, G and T, and ``scale=``
+        (:mod:`filippov.scale`) declares it.
 
     Returns
     -------

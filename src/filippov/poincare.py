@@ -16,7 +16,7 @@ from . import engines
 from .errors import run_error
 from .loop.status import NO_RETURN
 from .progress import Progress
-from .scale import of_system
+from .scale import of_batch
 from .simulate import Section, simulate
 from .system import SLIDING
 
@@ -47,8 +47,11 @@ def first_returns(system, starts, section, t_max: float, *, engine: str = "refer
     call of :func:`filippov.fastmap.compute_returns`), chosen by
     :func:`filippov.engines.runner`.
 
-    ``options`` go to the engine. A start point that does not return within
-    ``t_max`` is an error naming it: a return map with holes is not a return map.
+    ``options`` go to the engine; ``atol``, ``touch_tol`` and ``event_xtol`` are in units
+    of the batch's scale (:mod:`filippov.scale`: declared with ``scale=`` or by the
+    system, else measured at the smallest and the largest start, the smaller taken). A
+    start point that does not return within ``t_max`` is an error naming it: a return map
+    with holes is not a return map.
     A start on the section (up to rounding) returns at its next crossing;
     ``min_time`` (a Section's, or an option) skips crossings closer to the start than
     that. ``progress`` is stepped once per start point.
@@ -82,8 +85,11 @@ def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
     section = _reference_section(system, section, direction, where, options)
     system = python
     starts = np.atleast_2d(np.asarray(starts, dtype=float))
-    if options.get("scale") is None and starts.size and np.all(np.isfinite(starts)):
-        options["scale"] = _batch_scale(system, starts)
+    if starts.size and np.all(np.isfinite(starts)):   # one scale, as the compiled engine's
+        options["scale"] = of_batch(system.scale if options.get("scale") is None
+                                    else options["scale"], starts,
+                                    lambda i: (system.field_minus, system.field_plus,
+                                               system.switch_grad))
     m = starts.shape[0]
     state = np.empty_like(starts)
     time = np.empty(m)
@@ -108,17 +114,6 @@ def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
     return Returns(state, time, n_switches, sliding, first)
 
 
-def _batch_scale(system, starts):
-    """One scale for every start of a map (filippov.scale), as the compiled engine
-    takes it: the system's, with the parts it leaves open measured at the largest start
-    (None where the pieces cannot be evaluated there: each run's check then names the
-    piece)."""
-    try:
-        return of_system(system, starts[int(np.argmax(np.max(np.abs(starts), axis=1)))])
-    except Exception:   # noqa: BLE001 -- the run's contract check says what is wrong
-        return None
-
-
 def sliding_time(events) -> float:
     """Time spent sliding along an event log (a stretch open at the start -- a run that
     starts sliding -- or still open at the end counts), as the compiled engine counts."""
@@ -134,15 +129,26 @@ def sliding_time(events) -> float:
     return total
 
 
-def fixed_points(grid: np.ndarray, values: np.ndarray, refine=None, xtol: float = 1e-14):
+def fixed_points(grid: np.ndarray, values: np.ndarray, refine=None, xtol: float = 1e-14,
+                 floor: float | None = None):
     """Fixed points of a 1-D map sampled as ``values = P(grid)``.
 
     Grid points where ``P(x) = x`` exactly are fixed points; a sign change of
     ``P(x) - x`` between neighbours is refined with Brent's method on
     ``refine(x) - x`` if given. A sign change across a jump of ``P`` is not a
-    fixed point, so a refined root is kept only if ``|P(r) - r|`` is small.
+    fixed point, so a refined root is kept only if ``|P(r) - r| <= 1e-9 max(floor,
+    |r|)``; ``floor``: the map's state scale (None: the grid's largest value as
+    :func:`filippov.scale.power_of_two` rounds it, at most 1: the test is relative
+    beyond), and ``xtol`` is in its units.
     """
     from scipy.optimize import brentq
+
+    from .scale import power_of_two
+
+    grid, values = np.asarray(grid, dtype=float), np.asarray(values, dtype=float)
+    if floor is None:
+        finite = np.abs(grid[np.isfinite(grid)])
+        floor = min(1.0, power_of_two(float(finite.max()))) if finite.size else 1.0
 
     d = values - grid
     out = list(grid[d == 0.0])
@@ -153,7 +159,7 @@ def fixed_points(grid: np.ndarray, values: np.ndarray, refine=None, xtol: float 
             out.append(r)
             continue
         g = lambda x: float(refine(x)) - x
-        r = brentq(g, a, b, xtol=xtol)
-        if abs(g(r)) <= 1e-9 * max(1.0, abs(r)):
+        r = brentq(g, a, b, xtol=xtol * floor)
+        if abs(g(r)) <= 1e-9 * max(floor, abs(r)):
             out.append(r)
     return np.unique(np.asarray(out, dtype=float))

@@ -8,12 +8,17 @@ rounding floors of the rules grow with the state from S (where they grew from 1)
 written in micrometres or in microseconds then gets the results of the same system in
 metres and seconds, to rounding: docs/decisions.md#units.
 
-A system declares its scale (``FilippovSystem(..., scale=...)``, the paper's models
-declare :data:`UNIT`) or has it measured at the run's start (:func:`measure`): the
-largest start component, the fields' speed there and the gradient of H, each rounded to a
-power of two, and taken as 1 within :data:`DEAD_BAND` of 1 -- the defaults were chosen at
-unit scale, and a system in its natural units runs exactly as before. A measured scale is
-a power of two, so scaling a tolerance by it is exact.
+A system declares its scale (``FilippovSystem(..., scale=...)``; the paper's models
+declare :data:`UNIT`, the only value that restores the unit-scale arithmetic of before:
+``scale=1.0`` declares S alone and still measures T and G) or has it measured at the
+run's start (:func:`measure_system`, about 24n evaluations of the pieces): S is the
+larger of the start's size and the fields' own length there, T the time the fields take
+to move the state by S (at the start's speed, or the fields' own rate where that is
+faster), G the change of H over S; each is rounded to a power of two and taken as 1
+within :data:`DEAD_BAND` of 1 -- the defaults were chosen at unit scale, and a system in
+its natural units runs exactly as before. A measured scale is a power of two, so scaling
+a tolerance by it is exact. A batch (a map, a sweep) runs at one scale, the smaller of
+those of its smallest and its largest start (:func:`of_batch`).
 """
 from __future__ import annotations
 
@@ -102,54 +107,86 @@ def _rate(field, z0, f0, k: int, size: float) -> float:
     return c / math.ldexp(1.0, hi) if math.isfinite(c) else 0.0
 
 
-def field_length(field, z0) -> float:
-    """The length over which ``field`` (a function of one state) changes by its own size
-    near ``z0``: ``|F| / max_k |dF/dz_k|``, each rate from the shortest step that changes F
-    above its rounding (:func:`_rate`). A length of the system, not of the start: a start
-    at the origin (up to rounding) of a system whose orbits are of size one has the length
-    of those orbits, where its own size would make every tolerance absurdly tight; and the
-    largest rate, not the rate along F, so that a component nothing depends on (an
-    integral of a cost) does not make it long. inf where F is zero, constant or not
-    finite there."""
+def field_rates(field, z0) -> tuple[float, float]:
+    """``(|F(z0)|, max_k |dF/dz_k|)`` of ``field`` (a function of one state) near ``z0``,
+    each rate from the shortest step that changes F above its rounding (:func:`_rate`;
+    at a zero of F, the change of F over the shortest probe). (0, 0) where F is not
+    finite at z0."""
     z0 = np.asarray(z0, dtype=float)
     f0 = np.asarray(field(z0), dtype=float)
     speed = _inf_norm(f0)
-    if not (math.isfinite(speed) and speed > 0.0):
-        return math.inf
-    rate = max(_rate(field, z0, f0, k, _inf_norm(z0)) for k in range(z0.size))
-    return speed / rate if rate > 0.0 else math.inf
+    if not math.isfinite(speed):
+        return 0.0, 0.0
+    return speed, max((_rate(field, z0, f0, k, _inf_norm(z0)) for k in range(z0.size)),
+                      default=0.0)
 
 
-def measure(z0, fields=None, grad=None, state=None, length=math.inf) -> Scale:
-    """The scale measured at a start ``z0`` (or at the largest of several, rows): S from
-    its largest component or the fields' ``length`` there (:func:`field_length`),
-    whichever is larger (or ``state``, when declared); T from S over the fields' largest
-    component there (``fields``: the values of ``F_-`` and ``F_+``, or None); G from S times the
-    largest component of H's gradient (``grad``, or None). Non-finite or zero measures
-    give 1."""
+def field_length(field, z0) -> float:
+    """The length over which ``field`` (a function of one state) changes by its own size
+    near ``z0``: ``|F| / max_k |dF/dz_k|`` (:func:`field_rates`). A length of the
+    system, not of the start: a start at the origin (up to rounding) of a system whose
+    orbits are of size one has the length of those orbits, where its own size would make
+    every tolerance absurdly tight; and the largest rate, not the rate along F, so that a
+    component nothing depends on (an integral of a cost) does not make it long. inf where
+    F is zero, constant or not finite there."""
+    speed, rate = field_rates(field, z0)
+    return speed / rate if speed > 0.0 and rate > 0.0 else math.inf
+
+
+def measure(z0, fields=None, grad=None, state=None, length=math.inf, rate=0.0) -> Scale:
+    """The scale measured at a start ``z0``.
+
+    - S: the larger of the start's largest component and the fields' ``length`` there
+      (:func:`field_length`), or ``state`` where declared;
+    - T: the time the fields take to move the state by S, ``S / max(|F|, rate S)``
+      (``fields``: the values of ``F_-`` and ``F_+`` at z0, or None; ``rate``: their
+      largest ``|dF/dz_k|``) -- the shorter of the time at the start's speed and the
+      fields' own time ``1 / rate``, so that a start next to an equilibrium (speed near
+      0) does not make every time long;
+    - G: S times the largest component of H's gradient (``grad``: at z0, or rows at z0
+      and at probes a distance S away, so that a start where the gradient vanishes (the
+      centre of a circle) still measures H's size).
+
+    Non-finite or zero measures give 1."""
     size = max(_inf_norm(z0), length if math.isfinite(length) else 0.0)
     S = power_of_two(size) if state is None else state
     speed = max((_inf_norm(f) for f in fields), default=0.0) if fields is not None else 0.0
-    T = power_of_two(S / speed) if math.isfinite(speed) and speed > 0.0 else 1.0
+    moves = max(speed if math.isfinite(speed) else 0.0,
+                rate * S if math.isfinite(rate) else 0.0)
+    T = power_of_two(S / moves) if moves > 0.0 else 1.0
     g = _inf_norm(grad) if grad is not None else 0.0
     G = power_of_two(S * g) if math.isfinite(g) and g > 0.0 else 1.0
     return Scale(S, T, G, "measured")
 
 
+def _finite_at(fn, z):
+    """``fn(z)`` as an array, or None where it raises or is not finite (a probe that
+    tells nothing)."""
+    try:
+        v = np.asarray(fn(z), dtype=float)
+    except Exception:   # noqa: BLE001 -- a piece undefined there: the run never goes
+        return None
+    return v if np.all(np.isfinite(v)) else None
+
+
 def measure_system(z0, field_minus, field_plus, switch_grad, state=None) -> Scale:
     """:func:`measure` at ``z0`` of a system given by its pieces (functions of one
-    state): the fields and H's gradient there, and the shorter of the fields' lengths
-    (:func:`field_length`)."""
+    state): the fields there, their shorter length and largest rate
+    (:func:`field_rates`), and H's gradient at z0 and at ``z0 + S e_k``. About
+    ``2 (12 n + 1) + n + 1`` evaluations of the pieces."""
     z0 = np.asarray(z0, dtype=float).reshape(-1)
     try:
         fields = (field_minus(z0), field_plus(z0))
-        grad = switch_grad(z0)
-        length = math.inf
-        if state is None:
-            length = min(field_length(field_minus, z0), field_length(field_plus, z0))
+        rates = [field_rates(f, z0) for f in (field_minus, field_plus)]
     except Exception:   # noqa: BLE001 -- the run's own checks name a piece that fails
         return measure(z0, state=state)   # the start's size alone
-    return measure(z0, fields, grad, state, length)
+    length = min((s / r if s > 0.0 and r > 0.0 else math.inf) for s, r in rates)
+    rate = max(r for _, r in rates)
+    S = measure(z0, state=state, length=length).state
+    probes = [z0] + [z0 + S * e for e in np.eye(z0.size)]
+    grads = [g for g in (_finite_at(switch_grad, z) for z in probes)
+             if g is not None and g.shape == z0.shape]
+    return measure(z0, fields, np.array(grads) if grads else None, S, length, rate)
 
 
 def of_system(system, z, value=None) -> Scale:
@@ -160,6 +197,27 @@ def of_system(system, z, value=None) -> Scale:
         return measure_system(z, system.field_minus, system.field_plus, system.switch_grad,
                               state)
     return resolve(system.scale if value is None else value, measure_at)
+
+
+def of_batch(value, starts, pieces) -> Scale:
+    """The units of a batch of runs (a map, a sweep): ``value`` (the run's option, else
+    the system's declaration) with the parts it leaves open measured
+    (:func:`measure_system`) at the batch's smallest and at its largest finite start
+    (by largest component), and the smaller of the two taken part by part: a small start
+    is never run at the tolerances of a large one. ``pieces(i)``: ``(field_minus,
+    field_plus, switch_grad)`` of start i's system (functions of one state)."""
+    starts = np.atleast_2d(np.asarray(starts, dtype=float))
+
+    def measure_at(state):
+        finite = np.flatnonzero(np.all(np.isfinite(starts), axis=1)) if starts.size else []
+        if not len(finite):
+            return measure(np.zeros(0), state=state)
+        norms = np.max(np.abs(starts[finite]), axis=1) if starts.shape[1] else np.zeros(len(finite))
+        rows = sorted({int(finite[np.argmin(norms)]), int(finite[np.argmax(norms)])})
+        found = [measure_system(starts[i], *pieces(i), state) for i in rows]
+        return Scale(min(s.state for s in found), min(s.time for s in found),
+                     min(s.switch for s in found), "measured")
+    return resolve(value, measure_at)
 
 
 def declared(value, field: str = "scale"):

@@ -496,8 +496,8 @@ def _simulate(system: PiecewiseSystem, z0, sections: Sequence[Section], opts: di
         if not isinstance(sec, Section):
             raise TypeError(f"sections[{k}]: expected a filippov.simulate.Section, got "
                             f"{type(sec).__name__}")
-    checks.check_system(system, z, method=method)  # the pieces keep the class's contract
-    sc = scale_mod.of_system(system, z, opts.get("scale"))
+    sc = scale_mod.of_system(system, z, opts.get("scale"))   # never raises: checked next
+    checks.check_system(system, z, method=method, floor=sc.state)   # the class's contract
     return _Run(system, z, list(sections), scale_mod.tolerances(opts, sc), sc).go()
 
 
