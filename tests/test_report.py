@@ -229,7 +229,11 @@ def test_no_number_typed_in_the_figure_prose():
                "10^{-2}", "10^{-3}", "10^{-4}",  # parameters of named tests
                "-3"}  # exponent of the jump estimate e^{-3 pi mu/omega}
     allowed |= {"10^{-6}"}  # sec_instabilities: the hard-case eps of named tests
-    for name in ("sec_figures.tex", "sec_pdm.tex", "sec_hardcases.tex", "sec_instabilities.tex"):
+    # sec_dryfriction: a named test's threshold; sec_bench: the references' rtol and the
+    # manifest's floors (filippov_paper.benchmarks.work_precision.tolerances)
+    allowed |= {"10^{-9}", "10^{-13}", "10^{-8}"}
+    for name in ("sec_figures.tex", "sec_pdm.tex", "sec_hardcases.tex", "sec_instabilities.tex",
+                 "sec_dryfriction.tex", "sec_bench.tex"):
         text = (ROOT / "paper" / name).read_text()
         text = re.sub(r"\\paperfig\{[^}]*\}\{[^}]*\}", "", text)
         text = re.sub(r"\\(pref|pnum|testref|label|ref|figref|eqref|includegraphics|input)(\[[^]]*\])?\{[^}]*\}",
@@ -438,6 +442,12 @@ def test_derived_macros_match_the_datasets(built):
         assert val["rpFourJump"] == pytest.approx(1 - P[j], rel=1e-3)
         assert val["rpFourJumpOverEps"] == pytest.approx((1 - P[j]) / ds.attrs["eps"], rel=1e-2)
         assert val["rpFourSlopeSmooth"] == pytest.approx(np.exp(-4 * np.pi / (8 * np.pi)), rel=1e-3)
+    with xr.open_dataset(work / "results/fig11_dfo_retmaps.nc") as ds, \
+            xr.open_dataset(work / "results/fig10_dfo.nc") as d10:
+        # "both above the reduced model's grazing-sliding point, by ... eps"
+        for k, key in enumerate("AB"):
+            shift = (float(ds.v0_sn[k]) - float(d10.v_gs)) / float(ds.eps[k])
+            assert shift > 0 and val[f"rpElevenSNShift{key}"] == pytest.approx(shift, rel=6e-3)
     with xr.open_dataset(work / "results/fig02_cases.nc") as ds:
         assert val["rpTwoPeriodOverEps"] == pytest.approx(float(ds.period) / ds.attrs["eps"], rel=1e-2)
     with xr.open_dataset(work / "results/fig07_pdm_theta_neg.nc") as ds:

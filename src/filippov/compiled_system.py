@@ -422,7 +422,7 @@ class FilippovSystem:
         """The section ``section(z, p) = 0`` for the reference driver: a terminal
         :class:`~filippov.simulate.Section` whose function is compiled like the pieces
         and evaluated on one state or a batch of samples."""
-        from .simulate import Section
+        from .section import Section
 
         n, p = len(self.names), self.params
         batch = self._section_batch(section)
@@ -476,7 +476,7 @@ class FilippovSystem:
         (that of J, and of F over the state's size)."""
         if key == "sliding":
             return   # Filippov's field off H is the caller's extension: not compared
-        from .variational import fd_jacobian
+        from .differences import fd_jacobian
 
         field = getattr(self.python(), f"field_{key}")
         floor = self._state_scale(z)

@@ -66,7 +66,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import engines, frozen, options, rules
+from . import frozen, options, rules, views
 from . import scale as scale_mod
 from .scale import UNIT
 # what a model hands the engine (its pieces' signatures, CompiledModel), re-exported here
@@ -81,7 +81,7 @@ from .kernel.state import Outputs, Settings
 from .checks import check_compiled
 from .errors import accumulation_detail, run_error
 from .system import MINUS, MODE_NAMES, PLUS
-from .poincare import Returns
+from .section import Returns
 from .progress import Progress
 from .simulate import (EXACT_BLOCK, EventLimitError, SimulationError,  # noqa: F401
                        SlidingNotBuiltError, ZenoError, slow_window)
@@ -598,10 +598,7 @@ def first_returns_compiled(cmodel: CompiledModel, starts, t_max: float, *,
                            progress: Progress | None = None, **options) -> Returns:
     """Replaced by the front door ``first_returns(cmodel, starts, None, t_max,
     engine="compiled")`` (:func:`filippov.first_returns`); kept for its callers."""
-    from .poincare import first_returns
-
-    return first_returns(cmodel, starts, None, t_max, engine="compiled", progress=progress,
-                         **options)
+    return _first_returns(cmodel, starts, None, t_max, progress=progress, **options)
 
 
 def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
@@ -613,7 +610,7 @@ def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
     the words of its status (:func:`filippov.errors.run_error`, one table for both
     engines), then the failure's detail (:func:`failure`).
     """
-    cmodel = engines.compiled_model(system, "first_returns", section, direction=direction,
+    cmodel = views.compiled_model(system, "first_returns", section, direction=direction,
                                     where=where)
     out = compute_returns(cmodel, starts, t_max, **options)
     if progress is not None:

@@ -15,7 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from . import engines
+from . import views
+from .contracts import DefinedOnce
 from .scale import of_system
 from .errors import PeriodicOrbitError  # noqa: F401  (re-exported)
 
@@ -38,7 +39,7 @@ def _compiled_return(system, section, direction: int, where, t_max: float, optio
     carried across a hit, as an iterated run does."""
     from .fastmap import OK, compute_returns, failure
 
-    cm = engines.compiled_model(system, "periodic_orbit", section, direction=direction,
+    cm = views.compiled_model(system, "periodic_orbit", section, direction=direction,
                                 where=where)
 
     def single(z, age):
@@ -72,12 +73,16 @@ def _reference_return(system, section, direction: int, where, t_max: float, opti
     return single, value
 
 
+#: what runs one return of :func:`periodic_orbit`'s Newton iteration on each engine
+RUNS = {views.REFERENCE: _reference_return, views.COMPILED: _compiled_return}
+
+
 def _returns(system, section, direction: int, where, engine: str, t_max: float, returns: int,
              options: dict):
     """(z -> (P^returns(z), its time, its dP/dz), z -> section value) on the chosen engine
-    (:func:`filippov.engines.runner`): ``returns`` single returns, each from the last
-    one's state, their derivatives multiplied."""
-    single, value = engines.runner("periodic_orbit", engine)(system, section, direction,
+    (:func:`filippov.views.pick` from :data:`RUNS`): ``returns`` single returns, each
+    from the last one's state, their derivatives multiplied."""
+    single, value = views.pick(RUNS, "periodic_orbit", engine)(system, section, direction,
                                                               where, t_max, options)
 
     def one(z):
@@ -247,8 +252,8 @@ def _newton_step(z, Pz, J, guess, floor: float) -> np.ndarray:
 
 def _checked_start(system, guess, returns, engine) -> np.ndarray:
     """periodic_orbit's arguments checked (each refused naming it); the guess as a vector."""
-    engines.checked(engine)
-    if not callable(getattr(system, "python_section", None)):
+    views.checked(engine)
+    if not isinstance(system, DefinedOnce):   # filippov.contracts
         raise TypeError(f"system: periodic_orbit expected a FilippovSystem or a "
                         f"SymbolicSystem (a system defined once: both engines' views), "
                         f"got {type(system).__name__}")
@@ -288,7 +293,7 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
     engine : {"compiled", "reference"}
         The compiled engine (numba, dP/dz carried along the return) or the reference
         driver (dP/dz from the variational equations afterwards); chosen by
-        :func:`filippov.engines.runner`.
+        :func:`filippov.views.pick` from :data:`RUNS`.
     t_max : float
         Longest time a return may take.
     tol : float
@@ -317,7 +322,7 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
         away from the guess (``RUNAWAY`` times its size).
     """
     z = _checked_start(system, guess, returns, engine)
-    python = engines.reference_system(system, "periodic_orbit")
+    python = views.reference_system(system, "periodic_orbit")
     sc = _orbit_scale(python, z, options.get("scale"))
     options = {**options, "scale": sc}
     ret, section_value = _returns(system, section, direction, where, engine, t_max,

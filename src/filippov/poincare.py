@@ -12,24 +12,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import engines
+from . import views
+from .contracts import ReferenceView
+from .section import Returns  # noqa: F401  (re-exported: filippov.poincare.Returns)
 from .errors import run_error
 from .loop.status import NO_RETURN
 from .progress import Progress
 from .scale import of_batch
 from .simulate import Section, simulate
 from .system import SLIDING
-
-
-@dataclass(frozen=True)
-class Returns:
-    """First returns of ``starts`` (shape ``(m, dim)``) to one section."""
-
-    state: np.ndarray         # (m, dim) state at the return
-    time: np.ndarray          # (m,) time of flight
-    n_switches: np.ndarray    # (m,) changes of mode on the way
-    sliding_time: np.ndarray  # (m,) time spent sliding on the way
-    first_switch: np.ndarray  # (m,) time of the first change of mode (NaN: none)
 
 
 def first_returns(system, starts, section, t_max: float, *, engine: str = "reference",
@@ -45,7 +36,7 @@ def first_returns(system, starts, section, t_max: float, *, engine: str = "refer
     ``where(z, p) -> bool``; None: a CompiledModel's own section.
     ``engine``: "reference" (:func:`simulate` once per start) or "compiled" (one batch
     call of :func:`filippov.fastmap.compute_returns`), chosen by
-    :func:`filippov.engines.runner`.
+    :func:`filippov.views.pick` from :data:`RUNS`.
 
     ``options`` go to the engine; ``atol``, ``touch_tol`` and ``event_xtol`` are in units
     of the batch's scale (:mod:`filippov.scale`: declared with ``scale=`` or by the
@@ -56,9 +47,9 @@ def first_returns(system, starts, section, t_max: float, *, engine: str = "refer
     ``min_time`` (a Section's, or an option) skips crossings closer to the start than
     that. ``progress`` is stepped once per start point.
     """
-    return engines.runner("first_returns", engine)(system, starts, section, t_max,
-                                                   direction=direction, where=where,
-                                                   progress=progress, **options)
+    return views.pick(RUNS, "first_returns", engine)(system, starts, section, t_max,
+                                                     direction=direction, where=where,
+                                                     progress=progress, **options)
 
 
 def _reference_section(system, section, direction: int, where, options: dict) -> Section:
@@ -69,19 +60,18 @@ def _reference_section(system, section, direction: int, where, options: dict) ->
             raise ValueError("direction, where: a Section carries its own; give them to "
                              "the Section")
         return section if section.terminal == 1 else dataclasses.replace(section, terminal=1)
-    build = getattr(system, "python_section", None)
-    if section is None or not callable(build):
+    if section is None or not isinstance(system, ReferenceView):   # filippov.contracts
         raise TypeError(f"section: first_returns(engine='reference') of a "
                         f"{type(system).__name__} expected a filippov.Section, got "
                         f"{type(section).__name__}")
-    return build(section, direction=direction, where=where,
-                 min_time=options.pop("min_time", 0.0))
+    return system.python_section(section, direction=direction, where=where,
+                                 min_time=options.pop("min_time", 0.0))
 
 
 def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
                    where=None, progress: Progress | None = None, **options) -> Returns:
     """:func:`first_returns` on the reference driver."""
-    python = engines.reference_system(system, "first_returns")
+    python = views.reference_system(system, "first_returns")
     section = _reference_section(system, section, direction, where, options)
     system = python
     starts = np.atleast_2d(np.asarray(starts, dtype=float))
@@ -112,6 +102,18 @@ def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
         if progress is not None:
             progress.step()
     return Returns(state, time, n_switches, sliding, first)
+
+
+def _first_returns_compiled(*args, **kwargs):
+    """:func:`first_returns` on the compiled engine (:func:`filippov.fastmap._first_returns`,
+    imported when first asked: the reference engine never imports numba)."""
+    from .fastmap import _first_returns as run
+
+    return run(*args, **kwargs)
+
+
+#: what runs :func:`first_returns` on each engine
+RUNS = {views.REFERENCE: _first_returns, views.COMPILED: _first_returns_compiled}
 
 
 def sliding_time(events) -> float:

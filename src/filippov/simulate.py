@@ -24,13 +24,13 @@ import functools
 import math
 from collections import namedtuple
 from dataclasses import dataclass, field
-from typing import Callable, Optional, Sequence
+from typing import Sequence
 
 import numpy as np
 from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
-from . import checks, engines, options, rules, variational
+from . import checks, options, rules, variational, views
 from . import scale as scale_mod
 from .scale import UNIT
 from .loop import interval, refine
@@ -39,54 +39,11 @@ from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
 from .errors import accumulation_detail, run_error
 from .loop.event import SECTION, RunOps, make_run
+from .section import Section  # noqa: F401  (re-exported: filippov.simulate.Section)
 from .loop.stay import UNRESOLVED, make_slides_in, make_start, make_step_windows
 from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
                           NO_SLIDING, OK,
                           ROOT_FAILED, SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO)
-
-
-@dataclass(frozen=True)
-class Section:
-    """A user event ``func(z) = 0``; ``direction`` -1 counts decreasing crossings
-    only, +1 increasing, 0 both; ``where(z)`` must hold at the hit;
-    ``terminal`` stops the run after that many hits (None: never); hits earlier
-    than ``t0 + min_time`` are ignored.
-
-    A start point on the section is not a hit, also when rounding puts it a hair
-    before the section (a crossing in the run's first sample interval within
-    ``rules.START_ULPS`` rounding errors of the start): a return map started on its
-    section gives the next return, never ``P(z) = z`` at t ~ 1e-17. ``min_time``
-    skips crossings that are genuinely close to the start.
-
-    A section may lie on the switching surface H: where the orbit crosses H, or
-    arrives on it to slide, the hit is logged there, before the switch. Sliding
-    along H inside the section (whatever ``where`` says) is an error, since its
-    crossings there would be rounding noise: a terminal hit at the arrival ends
-    the run first; else use a section transverse to the sliding flow.
-    """
-
-    name: str
-    func: Callable[[np.ndarray], np.ndarray]
-    direction: int = 0
-    where: Optional[Callable[[np.ndarray], bool]] = None
-    terminal: Optional[int] = None
-    min_time: float = 0.0
-
-    def __post_init__(self):
-        if self.direction not in (-1, 0, 1):
-            raise ValueError(f"Section {self.name!r}: direction must be -1, 0 or +1, got "
-                             f"{self.direction!r}")
-        if not callable(self.func):
-            raise TypeError(f"Section {self.name!r}: func must be callable")
-        if self.terminal is not None and (isinstance(self.terminal, bool)
-                                          or not isinstance(self.terminal, (int, np.integer))
-                                          or self.terminal < 1):
-            raise ValueError(f"Section {self.name!r}: terminal must be None or an integer "
-                             f">= 1, got {self.terminal!r}")
-        m = self.min_time
-        if not (options.finite(m) and m >= 0):
-            raise ValueError(f"Section {self.name!r}: min_time must be a finite number >= 0, "
-                             f"got {self.min_time!r}")
 
 
 @dataclass(frozen=True)
@@ -469,12 +426,12 @@ def simulate(system, z0, t_end: float, *, engine: str = "reference", t0: float =
     absolute) of the time scale T; ``scale`` (None: the system's, declared or measured
     at ``z0``) sets them, and ``Trajectory.scale`` says which were used.
     """
-    run = engines.runner("simulate", engine)
+    run = views.pick(RUNS, "simulate", engine)
     opts = dict(t0=t0, t_end=t_end, method=method, rtol=rtol, atol=atol, max_step=max_step,
                 max_events=max_events, max_steps=max_steps, dense=dense,
                 samples_per_step=samples_per_step, touch_tol=touch_tol, event_xtol=event_xtol,
                 zeno_count=zeno_count, zeno_span=zeno_span, stiff=stiff, scale=scale)
-    return run(engines.reference_system(system, "simulate"), z0, sections, opts)
+    return run(views.reference_system(system, "simulate"), z0, sections, opts)
 
 
 def _simulate(system: PiecewiseSystem, z0, sections: Sequence[Section], opts: dict) -> Trajectory:
@@ -499,6 +456,11 @@ def _simulate(system: PiecewiseSystem, z0, sections: Sequence[Section], opts: di
     sc = scale_mod.of_system(system, z, opts.get("scale"))   # never raises: checked next
     checks.check_system(system, z, method=method, floor=sc.state)   # the class's contract
     return _Run(system, z, list(sections), scale_mod.tolerances(opts, sc), sc).go()
+
+
+#: what runs :func:`simulate` on each engine (the compiled one has no trajectory
+#: output: :data:`filippov.views.LACKS`)
+RUNS = {views.REFERENCE: _simulate, views.COMPILED: None}
 
 
 class _Run:

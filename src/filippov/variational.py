@@ -27,21 +27,7 @@ from scipy.integrate import solve_ivp
 
 from .system import PLUS, SLIDING
 from .errors import VariationalError  # noqa: F401  (re-exported)
-
-
-def fd_jacobian(fun: Callable[[np.ndarray], np.ndarray], u: np.ndarray,
-                step: float = 1e-7, floor: float = 1.0) -> np.ndarray:
-    """Central differences; ``step`` is relative to ``max(floor, |u_i|)`` (``floor``: the
-    state scale, filippov.scale)."""
-    u = np.asarray(u, dtype=float)
-    cols = []
-    for i in range(u.size):
-        d = step * max(floor, abs(u[i]))
-        up, um = u.copy(), u.copy()
-        up[i] += d
-        um[i] -= d
-        cols.append((np.asarray(fun(up)) - np.asarray(fun(um))) / (2 * d))
-    return np.stack(cols, axis=-1)
+from .differences import fd_jacobian  # noqa: F401  (re-exported)
 
 
 def field_jacobian(system, mode: int, z: np.ndarray, step: float = 1e-6,
@@ -64,15 +50,16 @@ def saltation(f_before, f_after, grad):
 
 def reference_view(system, jacobian, capability: str):
     """The :class:`~filippov.system.PiecewiseSystem` the reference driver ran for
-    ``system`` (any system the front doors take: :func:`filippov.engines.reference_system`)
+    ``system`` (any system the front doors take: :func:`filippov.views.reference_system`)
     and the Jacobian to use: the caller's ``jacobian``, else the system's own (a
     FilippovSystem or SymbolicSystem that has its fields' Jacobians), else None
     (central differences)."""
-    from . import engines
+    from . import views
+    from .contracts import DefinedOnce
 
-    if jacobian is None and getattr(system, "has_jacobians", False):
+    if jacobian is None and isinstance(system, DefinedOnce) and system.has_jacobians:
         jacobian = system.jacobian
-    return engines.reference_system(system, capability), jacobian
+    return views.reference_system(system, capability), jacobian
 
 
 def switch_matrix(system, before: int, after: int, z: np.ndarray):

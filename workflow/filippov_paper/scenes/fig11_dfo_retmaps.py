@@ -765,6 +765,14 @@ def report(ds, m: Macros) -> str:
                                     ("sliding_time_sn", "SlideTimeSN", 3)):
             if name_var in ds:
                 var(m, f"rpEleven{name}{key}", ds, "fig11_dfo_retmaps", name_var, sig, panel=k)
+        # the saddle-node's distance above the reduced model's grazing-sliding point
+        # (fig10's report, made before this one), in units of eps
+        gs = m.values().get("rpTenVGS", (None,))[0]
+        if gs is not None and {"v0_sn", "eps"} <= set(ds.variables):
+            shift = (float(ds.v0_sn[k]) - gs) / float(ds.eps[k])
+            m.add(f"rpElevenSNShift{key}", shift,
+                  f"derived:(fig11_dfo_retmaps:v0_sn[panel={k}] - fig10_dfo:v_gs)"
+                  f" / fig11_dfo_retmaps:eps[panel={k}]", 3)
     return scalar_table(ds)
 
 

@@ -1,0 +1,140 @@
+"""The contracts between the library's parts, written as types (:class:`typing.Protocol`).
+
+A front door takes a system through a view of it (:mod:`filippov.views`); an engine runs
+what the view gives; a model module of the paper builds the three. Each contract here is
+what one side may ask of the other, no more: tests/test_contracts.py checks every
+implementation in the library against it, the names and the parameters of each method
+(:func:`missing`), so that a change to one side that the other would meet at run time
+fails there first.
+
+- :class:`ReferenceView` and :class:`CompiledView`: what a system defined once hands each
+  engine (``python()``, ``python_section(...)``; ``compiled(...)``), and
+  :class:`DefinedOnce`, both with the Jacobians (:class:`~filippov.FilippovSystem`, and
+  the system a :class:`~filippov.SymbolicSystem` generates);
+- :class:`ReferenceSystem`: what the reference driver runs
+  (:class:`~filippov.system.PiecewiseSystem`);
+- :class:`ModelModule`: a model of the paper (:mod:`filippov.models.hopf`,
+  :mod:`filippov.models.dry_friction`, :mod:`filippov.models.pseudo_equilibrium`).
+"""
+from __future__ import annotations
+
+import inspect
+from typing import Any, Callable, Mapping, Protocol, runtime_checkable
+
+import numpy as np
+
+
+@runtime_checkable
+class ReferenceView(Protocol):
+    """A system the reference driver can run: its piecewise-smooth view and a section of
+    it as the driver's :class:`~filippov.section.Section`."""
+
+    def python(self) -> "ReferenceSystem": ...
+
+    def python_section(self, section, *, direction: int = 0, where=None,
+                       name: str = "section", min_time: float = 0.0): ...
+
+
+@runtime_checkable
+class CompiledView(Protocol):
+    """A system the compiled engine can run: its :class:`~filippov.abi.CompiledModel`
+    with the section ``section(z, p) = 0``."""
+
+    def compiled(self, section, *, direction: int = 0, where=None): ...
+
+
+@runtime_checkable
+class DefinedOnce(ReferenceView, CompiledView, Protocol):
+    """A system defined once, run by both engines, with its fields' Jacobians where it has
+    them (``jacobian(mode, z)``: the ``jacobian=`` of the derivatives' functions)."""
+
+    names: tuple
+    scale: Any
+
+    @property
+    def has_jacobians(self) -> bool: ...
+
+    def jacobian(self, mode: int, z) -> np.ndarray: ...
+
+
+@runtime_checkable
+class ReferenceSystem(Protocol):
+    """What the reference driver runs: the pieces as functions of one state (or of a
+    batch of states, columns), the exact flows it has, and how to sample them."""
+
+    names: tuple
+    field_minus: Callable   # the user's functions of z: their parameters are theirs to name
+    field_plus: Callable
+    switch: Callable
+    switch_grad: Callable
+    flows: Mapping
+    sliding: bool
+    sample_step: float
+    scale: Any
+
+    @property
+    def dim(self) -> int: ...
+
+    def field(self, mode: int, z): ...
+
+
+@runtime_checkable
+class ModelModule(Protocol):
+    """A model module of the paper: its name, its symbolic definition, and the model, the
+    system and the compiled model at given parameter values."""
+
+    NAME: str
+    DEFINITION: Any
+
+    def model(self, *args, **kwargs): ...
+
+    def system(self, *args, **kwargs): ...
+
+    def compiled(self, *args, **kwargs): ...
+
+
+def _members(protocol) -> dict:
+    """The protocol's members: name -> its function (methods, properties) or None (data)."""
+    out = {}
+    for klass in reversed(protocol.__mro__):
+        if klass in (object, Protocol) or not getattr(klass, "_is_protocol", False):
+            continue
+        out.update({name: None for name in getattr(klass, "__annotations__", {})})
+        for name, value in vars(klass).items():
+            if name.startswith("_"):
+                continue
+            if isinstance(value, property):
+                out[name] = "property"
+            elif callable(value):
+                out[name] = value
+    return out
+
+
+def missing(obj, protocol) -> list[str]:
+    """What ``obj`` lacks of ``protocol``: members it does not have, and methods whose
+    parameters (name, kind and default, past ``self``) it does not take as the protocol
+    writes them; a method written ``(*args, **kwargs)`` in the protocol takes anything.
+    Empty when ``obj`` keeps the contract."""
+    out = []
+    for name, spec in _members(protocol).items():
+        if not hasattr(obj, name):
+            out.append(f"{name}: missing")
+            continue
+        if spec is None or spec == "property":
+            continue
+        want = list(inspect.signature(spec).parameters.values())[1:]
+        if any(p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD) for p in want):
+            continue
+        got = inspect.signature(getattr(obj, name)).parameters
+        for p in want:
+            q = got.get(p.name)
+            if q is None:
+                out.append(f"{name}: no parameter {p.name!r}")
+            elif q.kind != p.kind and not (p.kind == p.POSITIONAL_OR_KEYWORD
+                                            and q.kind == q.POSITIONAL_ONLY):
+                out.append(f"{name}: parameter {p.name!r} is {q.kind.description}, the "
+                           f"contract has it {p.kind.description}")
+            elif p.default is not p.empty and q.default != p.default:
+                out.append(f"{name}: parameter {p.name!r} defaults to {q.default!r}, the "
+                           f"contract to {p.default!r}")
+    return out

@@ -1,0 +1,23 @@
+"""Central differences of a function of one state: the Jacobian checks of a system
+defined once, Newton's Jacobians and the variational equations' fallback. Engine-free:
+imported by both engines and by the system definitions below them."""
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+
+def fd_jacobian(fun: Callable[[np.ndarray], np.ndarray], u: np.ndarray,
+                step: float = 1e-7, floor: float = 1.0) -> np.ndarray:
+    """Central differences; ``step`` is relative to ``max(floor, |u_i|)`` (``floor``: the
+    state scale, filippov.scale)."""
+    u = np.asarray(u, dtype=float)
+    cols = []
+    for i in range(u.size):
+        d = step * max(floor, abs(u[i]))
+        up, um = u.copy(), u.copy()
+        up[i] += d
+        um[i] -= d
+        cols.append((np.asarray(fun(up)) - np.asarray(fun(um))) / (2 * d))
+    return np.stack(cols, axis=-1)

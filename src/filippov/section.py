@@ -1,0 +1,66 @@
+"""A section of the state space, where a run stops or logs a hit (user events, return
+maps), and the first returns to one. The problem's definition, engine-free: both
+engines and the front doors import it from here, and it imports nothing of theirs."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Optional
+
+import numpy as np
+
+from . import options
+
+
+@dataclass(frozen=True)
+class Section:
+    """A user event ``func(z) = 0``; ``direction`` -1 counts decreasing crossings
+    only, +1 increasing, 0 both; ``where(z)`` must hold at the hit;
+    ``terminal`` stops the run after that many hits (None: never); hits earlier
+    than ``t0 + min_time`` are ignored.
+
+    A start point on the section is not a hit, also when rounding puts it a hair
+    before the section (a crossing in the run's first sample interval within
+    ``rules.START_ULPS`` rounding errors of the start): a return map started on its
+    section gives the next return, never ``P(z) = z`` at t ~ 1e-17. ``min_time``
+    skips crossings that are genuinely close to the start.
+
+    A section may lie on the switching surface H: where the orbit crosses H, or
+    arrives on it to slide, the hit is logged there, before the switch. Sliding
+    along H inside the section (whatever ``where`` says) is an error, since its
+    crossings there would be rounding noise: a terminal hit at the arrival ends
+    the run first; else use a section transverse to the sliding flow.
+    """
+
+    name: str
+    func: Callable[[np.ndarray], np.ndarray]
+    direction: int = 0
+    where: Optional[Callable[[np.ndarray], bool]] = None
+    terminal: Optional[int] = None
+    min_time: float = 0.0
+
+    def __post_init__(self):
+        if self.direction not in (-1, 0, 1):
+            raise ValueError(f"Section {self.name!r}: direction must be -1, 0 or +1, got "
+                             f"{self.direction!r}")
+        if not callable(self.func):
+            raise TypeError(f"Section {self.name!r}: func must be callable")
+        if self.terminal is not None and (isinstance(self.terminal, bool)
+                                          or not isinstance(self.terminal, (int, np.integer))
+                                          or self.terminal < 1):
+            raise ValueError(f"Section {self.name!r}: terminal must be None or an integer "
+                             f">= 1, got {self.terminal!r}")
+        m = self.min_time
+        if not (options.finite(m) and m >= 0):
+            raise ValueError(f"Section {self.name!r}: min_time must be a finite number >= 0, "
+                             f"got {self.min_time!r}")
+
+
+@dataclass(frozen=True)
+class Returns:
+    """First returns of ``starts`` (shape ``(m, dim)``) to one section."""
+
+    state: np.ndarray         # (m, dim) state at the return
+    time: np.ndarray          # (m,) time of flight
+    n_switches: np.ndarray    # (m,) changes of mode on the way
+    sliding_time: np.ndarray  # (m,) time spent sliding on the way
+    first_switch: np.ndarray  # (m,) time of the first change of mode (NaN: none)

@@ -1,0 +1,83 @@
+"""The contracts between the library's parts as types (issue 58; filippov.contracts): every
+implementation in the library keeps the Protocol it is run through, member by member and
+parameter by parameter, and a class that breaks one is named with what it lacks."""
+import numpy as np
+import pytest
+
+from filippov import FilippovSystem, SymbolicSystem
+from filippov.contracts import (CompiledView, DefinedOnce, ModelModule, ReferenceSystem,
+                                ReferenceView, missing)
+from filippov.models import dry_friction, hopf, pseudo_equilibrium
+
+
+def _defined_once():
+    f = lambda z, p: -z  # noqa: E731
+    return FilippovSystem(("x",), f, f, lambda z, p: z[0], lambda z, p: np.ones(1))
+
+
+def _generated():
+    import sympy as sp
+
+    x = sp.Symbol("x")
+    return SymbolicSystem([x], [-x], [-x], x).system()
+
+
+@pytest.mark.parametrize("build", [_defined_once, _generated,
+                                   lambda: hopf.system(1e-2, 0.2),
+                                   lambda: dry_friction.system(1e-2, 1.5)],
+                         ids=["FilippovSystem", "SymbolicSystem.system", "hopf", "dry_friction"])
+def test_every_system_defined_once_keeps_its_contract(build):
+    system = build()
+    assert missing(system, DefinedOnce) == []
+    assert isinstance(system, DefinedOnce)
+    view = system.python()
+    assert missing(view, ReferenceSystem) == [] and isinstance(view, ReferenceSystem)
+
+
+@pytest.mark.parametrize("module", [hopf, dry_friction, pseudo_equilibrium],
+                         ids=lambda m: m.__name__)
+def test_every_model_module_keeps_its_contract(module):
+    assert missing(module, ModelModule) == [] and isinstance(module, ModelModule)
+
+
+def test_a_system_that_breaks_the_contract_is_named_with_what_it_lacks():
+    class Half:
+        names, scale = ("x",), None
+
+        def python(self):
+            return None
+
+        def python_section(self, section, *, direction=1, where=None, name="section"):
+            return None
+
+        def compiled(self, section, direction=0, where=None):
+            return None
+
+    got = missing(Half(), DefinedOnce)
+    assert "has_jacobians: missing" in got and "jacobian: missing" in got
+    assert "python_section: no parameter 'min_time'" in got
+    assert "python_section: parameter 'direction' defaults to 1, the contract to 0" in got
+    assert any(m.startswith("compiled: parameter 'direction' is positional or keyword")
+               for m in got)
+    assert missing(Half(), ReferenceView)   # the same faults through the smaller contract
+    assert not isinstance(object(), CompiledView)
+
+
+def test_the_front_doors_take_a_system_by_its_views():
+    # a class of the user's own that keeps ReferenceView runs on the reference engine
+    from filippov import simulate
+
+    inner = _defined_once()
+
+    class Wrapped:
+        def python(self):
+            return inner.python()
+
+        def python_section(self, section, *, direction=0, where=None, name="section",
+                           min_time=0.0):
+            return inner.python_section(section, direction=direction, where=where,
+                                        name=name, min_time=min_time)
+
+    assert missing(Wrapped(), ReferenceView) == []
+    traj = simulate(Wrapped(), [1.0], 1.0)
+    assert traj.z[0] == pytest.approx(np.exp(-1.0), rel=1e-12)
