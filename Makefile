@@ -161,7 +161,7 @@ report: $(VENV)/.done
 
 report-html: $(VENV)/.done
 	$(VENV_PATH) $(VENV)/bin/snakemake --cores all $(SNAKEFLAGS)
-	$(VENV_PATH) $(VENV)/bin/snakemake --cores 1 --report report.html
+	$(VENV_PATH) $(VENV)/bin/snakemake --cores 1 --report report.html --report-stylesheet workflow/report/report.css
 
 # Work-precision of every method on the fig04 maps, and what each ingredient costs.
 bench: $(VENV)/.done

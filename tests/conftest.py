@@ -42,7 +42,7 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 # one definition of "a fresh copy of the project" and "run snakemake there",
 # shared with `make verify`
 sys.path.insert(0, str(ROOT / "workflow" / "scripts"))
-from verify import copy_project, run_snakemake  # noqa: E402
+from verify import copy_project, report_args, run_snakemake  # noqa: E402
 
 
 #: a finished clean build of this tree to reuse (CI: verify's first build), instead of

@@ -17,7 +17,7 @@ import pytest
 import xarray as xr
 import yaml
 
-from conftest import run_snakemake
+from conftest import report_args, run_snakemake
 from filippov_paper import report, scenes
 from filippov_paper.config import scene_files
 
@@ -530,7 +530,7 @@ def test_html_report_links_every_figure_to_its_rule(workflow_build, tmp_path):
     work, run = workflow_build["work"], workflow_build["run"]
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     out = tmp_path / "report.html"
-    rep = _snakemake(work, "--report", str(out))
+    rep = _snakemake(work, *report_args(out))
     assert rep.returncode == 0, rep.stdout[-3000:] + rep.stderr[-3000:]
     html = out.read_text(errors="replace")
     scenes = scene_files(work / "config" / "scenes")

@@ -29,7 +29,7 @@ import yaml
 from docutils.core import publish_parts
 from jinja2 import Environment
 
-from conftest import ROOT, copy_project, run_snakemake
+from conftest import ROOT, copy_project, report_args, run_snakemake
 from filippov_paper import report_html
 from filippov_paper.config import scene_files
 from filippov_paper.paper_labels import read_tex
@@ -328,7 +328,7 @@ def placeholder_build(tmp_path_factory):
         else:
             path.write_bytes(b"")
     out = work / "report.html"
-    run = run_snakemake(work, "--report", str(out), timeout=600)
+    run = run_snakemake(work, *report_args(out), timeout=600)
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     return {"work": work, "outputs": outputs, "report": out, "log": run.stderr}
 
@@ -359,7 +359,7 @@ def test_html_report_of_the_build(workflow_build, tmp_path):
     work, run = workflow_build["work"], workflow_build["run"]
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     out = tmp_path / "report.html"
-    rep = run_snakemake(work, "--report", str(out), timeout=600)
+    rep = run_snakemake(work, *report_args(out), timeout=600)
     assert rep.returncode == 0, rep.stdout[-3000:] + rep.stderr[-3000:]
     assert "ERROR/" not in rep.stderr, rep.stderr[-3000:]
     check_report(out, work, summary(work))

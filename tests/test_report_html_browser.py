@@ -29,10 +29,11 @@ server has none, so the console shows a 404 for it: not the report's doing. The
 inlined Tailwind script warns (a warning, not an error) that cdn.tailwindcss.com should
 not be used in production: that is the Play CDN script, inlined, and nothing is fetched.
 
-Known and marked xfail (strict): the template centres a figure in a pane as high as
-the window, so the top of a figure taller than the window (the tallest of the build:
-fig12_period_adding.png, 1000 px, in a viewport about 860 px high) lies above the
-pane, out of reach of its scroll bar.
+The template centres a figure in a pane as high as the window, so the top of a figure
+taller than the window (the tallest of the build: fig12_period_adding.png, 1000 px, in
+a viewport about 860 px high) lay above the pane, out of reach of its scroll bar; the
+project's stylesheet (workflow/report/report.css, ``--report-stylesheet``) centres it
+"safe" instead, and test_a_tall_figure_shows_its_top holds.
 
 The report is made here with `snakemake --report` from the `workflow_build` fixture's
 build (tests/conftest.py; ``FILIPPOV_TEST_BUILD=DIR`` reuses a finished build of this
@@ -50,7 +51,7 @@ import pytest
 # the same browser, the same skip-or-fail when it is missing (at import), the same flags
 from test_docs_browser import SHOTS, chromium, console_errors, served
 
-from conftest import run_snakemake
+from conftest import report_args, run_snakemake
 from filippov_paper.report_html import INTERNAL_LABEL
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
@@ -91,7 +92,7 @@ def report(workflow_build, tmp_path_factory):
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     out = tmp_path_factory.mktemp("report-html-browser") / "report.html"
     t0 = time.perf_counter()
-    rep = run_snakemake(work, "--report", str(out), timeout=900)
+    rep = run_snakemake(work, *report_args(out), timeout=900)
     seconds = time.perf_counter() - t0
     assert rep.returncode == 0, rep.stdout[-3000:] + rep.stderr[-3000:]
     return {"path": out, "work": work, "seconds": seconds}
@@ -359,10 +360,6 @@ def test_the_checks_see_tex_labels_and_broken_images():
     assert problems_in({"text": "Fig. 5, Eq. (18), M_+ = {y = x1}", "images": []}) == []
 
 
-@pytest.mark.xfail(strict=True, reason="Snakemake's template centres a figure in a pane as "
-                   "high as the window (flex items-center): a figure taller than the window "
-                   "(fig12, 1000 px; work_precision, 960 px; a viewport about 860 px high) "
-                   "spills over the top, where no scrolling reaches it")
 def test_a_tall_figure_shows_its_top(report, server, browser, shots):
     work = report["work"]
     tallest = max((p.relative_to(work).as_posix() for p in (work / "figures").glob("*.png")),

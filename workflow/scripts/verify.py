@@ -60,6 +60,16 @@ def copy_project(dest: Path) -> Path:
     return dest
 
 
+#: the HTML report's own stylesheet (``make report-html`` passes it too)
+REPORT_STYLESHEET = "workflow/report/report.css"
+
+
+def report_args(out) -> tuple:
+    """The arguments that make Snakemake's HTML report at ``out``, as ``make report-html``
+    makes it (with the project's stylesheet; paths relative to the project)."""
+    return ("--report", str(out), "--report-stylesheet", REPORT_STYLESHEET)
+
+
 def run_snakemake(work: Path, *args, cores: str = "1", timeout: float = 3000, capture=True,
                   env: dict | None = None):
     """`snakemake` in ``work`` with the project's library; ``env`` adds variables."""
