@@ -14,9 +14,13 @@ the two measured scales (powers of two: at most a factor 2 DEAD_BAND), so the tw
 by the integration's error, not by rounding: TOL_UNITS (1e-10) for exact flows (rounding
 of the closed forms, events refined to 1e-15 of the time scale) and for integrated stays
 (DOP853 at rtol 1e-12 over t <= 16 on states of order one: its global errors at nearby
-tolerances differ by less than 1e-10 on these systems). dP/dz differs by the truncation of
-central differences at steps that differ by that ratio (~eps^(2/3) relative to the
-factors' product, as in test_properties' TOL_JAC): TOL_UNITS_JAC.
+tolerances differ by less than 1e-10 on these systems). dP/dz and the multipliers are held
+to the same 1e-10 (relative to the product of dP/dz's factors' norms; the multipliers
+times the conditioning of their eigenvectors): the compiled engine's central differences
+of the exact flows step from each run's own S (truncation and rounding ~eps^(2/3)), and
+the reference's section gradient steps eps^(1/3) (variational.SECTION_STEP: at 1e-7 its
+rounding alone moved dP/dz by 3e-10). Measured over 80 generated returns per engine:
+compiled 6.3e-11, reference 8.9e-12 (largest differences).
 """
 import numpy as np
 import pytest
@@ -33,7 +37,13 @@ FLOWS = ("exact", "integrate")
 #: (state unit, time unit)
 UNITS = ((1e-6, 1.0), (1e6, 1.0), (1.0, 1e-6), (1.0, 1e6))
 TOL_UNITS = 1e-10
-TOL_UNITS_JAC = 1e-8
+TOL_UNITS_JAC = 1e-10
+#: dP/dz of a whole periodic orbit on the compiled engine: the kernel differentiates each
+#: exact-flow stay by central differences and multiplies the factors, so their rounding
+#: (~eps^(2/3) each) adds up over a period; measured, 5-8e-9 between units and 8e-10
+#: against the reference's variational equations in the same units (which agree across
+#: units to 2.5e-12). Issue 57 asks 1e-10 here: not met (the note says so)
+TOL_UNITS_JAC_COMPILED_ORBIT = 1e-8
 
 
 def _return(n, engine, flows, z0, p, time_unit=1.0):
@@ -125,13 +135,14 @@ def test_a_relay_orbit_in_other_units_has_its_period_and_multipliers(engine, uni
     got = orbit(gs.rescaled(case.g.p, n, state, time), state, time)
     _same(got.point * state, want.point, TOL_UNITS, "fixed point")
     _same(got.period * time, want.period, TOL_UNITS, "period")
-    _same(got.jacobian, want.jacobian, TOL_UNITS_JAC, "dP/dz")
+    tol = TOL_UNITS_JAC_COMPILED_ORBIT if engine == "compiled" else TOL_UNITS_JAC
+    _same(got.jacobian, want.jacobian, tol, "dP/dz")
     # an eigenvalue moves by at most the condition number of the eigenvector matrix times
     # the change of the matrix (Bauer-Fike)
     cond = np.linalg.cond(np.linalg.eig(want.jacobian)[1])
     for part in (np.real, np.imag):
         _same(part(np.sort_complex(got.multipliers)), part(np.sort_complex(want.multipliers)),
-              TOL_UNITS_JAC * cond, "multipliers")
+              tol * cond, "multipliers")
 
 
 # ----------------------------------------------------------------------------- the scale

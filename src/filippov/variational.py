@@ -62,6 +62,12 @@ def reference_view(system, jacobian, capability: str):
     return views.reference_system(system, capability), jacobian
 
 
+#: the relative step of the central differences of a section's gradient: eps^(1/3), where
+#: rounding (eps / step) and truncation (step^2) balance, ~4e-11 of the gradient (a step
+#: of 1e-7 left its rounding, ~2e-9, in dP/dz)
+SECTION_STEP = float(np.cbrt(np.finfo(float).eps))
+
+
 def switch_matrix(system, before: int, after: int, z: np.ndarray):
     """Saltation matrix of a switch from mode ``before`` to ``after`` at ``z``; None
     when there is none: no switch, or the end of sliding (identity)."""
@@ -174,7 +180,8 @@ def return_jacobian(system, traj, section, *, rtol: float = 1e-10, atol: float =
     z = np.asarray(traj.z, dtype=float)
     floor = _state_scale(traj)
     grad = (np.asarray(section_grad(z), dtype=float) if section_grad is not None else
-            fd_jacobian(lambda zz: np.atleast_1d(section.func(zz)), z, floor=floor)[0])
+            fd_jacobian(lambda zz: np.atleast_1d(section.func(zz)), z, SECTION_STEP,
+                        floor=floor)[0])
     f = np.asarray(system.field(traj.mode, z), dtype=float)
     speed = grad @ f
     if speed == 0:
