@@ -81,3 +81,27 @@ def test_the_front_doors_take_a_system_by_its_views():
     assert missing(Wrapped(), ReferenceView) == []
     traj = simulate(Wrapped(), [1.0], 1.0)
     assert traj.z[0] == pytest.approx(np.exp(-1.0), rel=1e-12)
+
+
+def test_several_switching_functions_are_refused_by_name():
+    # issue 59 builds several surfaces; until then a vector of switching functions is
+    # refused as such, not with numba's error about a vector where a scalar goes
+    import sympy as sp
+
+    from filippov import PiecewiseSystem, simulate
+    from filippov.checks import SystemContractError
+
+    f = lambda z, p: np.array([1.0, 1.0])  # noqa: E731
+    with pytest.raises(ValueError, match=r"switch: returned 2 values .*several switching "
+                                         r"surfaces .* not supported"):
+        FilippovSystem(("x", "y"), f, f, lambda z, p: np.array([z[0], z[1]]),
+                       lambda z, p: np.eye(2))
+    x, y = sp.symbols("x y")
+    with pytest.raises(ValueError, match=r"switch: 2 expressions: .*several switching"):
+        SymbolicSystem([x, y], [1, 1], [1, 1], [x, y])
+    assert SymbolicSystem([x, y], [1, 1], [1, 1], [x]).switch == x   # a list of one is one
+    g = lambda z: np.ones_like(z)  # noqa: E731
+    piecewise = PiecewiseSystem(("x", "y"), g, g, lambda z: np.asarray(z)[:2],
+                                lambda z: np.ones_like(z))
+    with pytest.raises(SystemContractError, match=r"switch returned 2 values .*several"):
+        simulate(piecewise, [-1.0, -0.5], 1.0)

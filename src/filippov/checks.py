@@ -19,7 +19,7 @@ import weakref
 
 import numpy as np
 
-from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
+from .system import MINUS, MODE_NAMES, ONE_SURFACE, PLUS, SLIDING, PiecewiseSystem
 from .errors import SystemContractError  # noqa: F401  (re-exported)
 
 FLOW_NAMES = {MINUS: "flows[MINUS]", PLUS: "flows[PLUS]", SLIDING: "flows[SLIDING]"}
@@ -164,6 +164,9 @@ def _probe_piece(name, fn, batch, columns, n, kind):
     single_shape = () if kind == "scalar" else (n,)
     what = "time" if kind == "flow" else "state"
     for s in singles:
+        if kind == "scalar" and name == "switch" and s.size > 1:
+            raise SystemContractError(f"switch returned {s.size} values for a single state: "
+                                      f"{ONE_SURFACE}")
         if s.shape != single_shape and not (kind == "scalar" and s.size == 1):
             raise SystemContractError(
                 f"{name} returned shape {s.shape} for a single {what} "

@@ -34,6 +34,24 @@ def _jit(fn: Callable, piece: str):
     return fn if hasattr(fn, "py_func") else njit(fn)
 
 
+def _one_surface(switch, n: int, params, probe) -> None:
+    """Refuse a ``switch`` that gives several values at a state (several switching
+    surfaces) by name, before numba's error about a vector where a scalar goes; a switch
+    that fails at the probe state (zeros, or ``probe``) is left to the engines' checks."""
+    if not callable(switch):
+        return
+    z = np.zeros(n) if probe is None else np.asarray(probe, dtype=float).reshape(-1)
+    try:
+        with np.errstate(all="ignore"):
+            size = np.asarray(getattr(switch, "py_func", switch)(z, params)).size
+    except Exception:   # noqa: BLE001 -- not this check's to judge
+        return
+    if size > 1:
+        from .system import ONE_SURFACE
+
+        raise ValueError(f"switch: returned {size} values at z={z.tolist()}: {ONE_SURFACE}")
+
+
 def _compile(adapter_src: Callable, sig, piece: str):
     """``adapter_src`` compiled with ``sig``; a numba failure becomes one readable line."""
     try:
@@ -324,7 +342,9 @@ class FilippovSystem:
     reference driver (:func:`filippov.simulate`) runs, its pieces evaluated by
     numba-compiled loops over the samples; :meth:`compiled` gives the compiled
     engine's :class:`~filippov.abi.CompiledModel` with a section of the
-    caller's choosing. Sections belong to the caller, not to the system.
+    caller's choosing. Sections belong to the caller, not to the system. One
+    switching function: a ``switch`` that gives several values at a state (several
+    switching surfaces) is refused by name.
     ``jacobians`` (optional, ``{"minus"|"sliding"|"plus": J(z, p) -> (n, n)}``)
     gives :meth:`jacobian` (that of sliding derived from the two fields' where it is
     not given), used for Floquet multipliers and dP/dz on the
@@ -354,6 +374,7 @@ class FilippovSystem:
         self.name, self.sliding, self.sample_step = name, bool(sliding), float(sample_step)
         self._pieces = dict(field_minus=field_minus, field_plus=field_plus, switch=switch,
                             switch_grad=switch_grad, flow_minus=flow_minus, flow_plus=flow_plus)
+        _one_surface(switch, len(self.names), self.params, probe)
         jacobians = dict(jacobians or {})
         unknown = set(jacobians) - set(_JAC_MODES)
         if unknown:

@@ -90,7 +90,8 @@ class SymbolicSystem:
     field_minus, field_plus : sequence of sympy expressions
         ``F_-``, ``F_+`` (one expression per state).
     switch : sympy expression
-        The switching function ``h``; region + is ``h >= 0``.
+        The switching function ``h``; region + is ``h >= 0``. One only: a list of
+        several (several switching surfaces) is refused by name.
     params : mapping sympy.Symbol -> float, optional
         The parameters and their values (the generated pieces read them from the
         parameter array, in this order: :meth:`with_params` changes values without
@@ -149,7 +150,12 @@ class SymbolicSystem:
         allowed = set(self.states) | set(self.param_symbols)
         self.field_minus = _vector(field_minus, n, "field_minus")
         self.field_plus = _vector(field_plus, n, "field_plus")
-        self.switch = sp.sympify(switch)
+        if isinstance(switch, (list, tuple, sp.MatrixBase)) and len(switch) != 1:
+            from .system import ONE_SURFACE
+
+            raise SymbolicError(f"switch: {len(switch)} expressions: {ONE_SURFACE}")
+        self.switch = sp.sympify(switch[0] if isinstance(switch, (list, tuple, sp.MatrixBase))
+                                 else switch)
         for piece, exprs in (("field_minus", self.field_minus),
                              ("field_plus", self.field_plus), ("switch", (self.switch,))):
             _check_free(exprs, allowed, piece)
@@ -407,7 +413,12 @@ class SymbolicSlowFast:
         self.f_plus = _vector(f_plus, len(self.slow), "f_plus")
         self.g_minus = _vector(g_minus, len(self.fast), "g_minus")
         self.g_plus = _vector(g_plus, len(self.fast), "g_plus")
-        self.switch = sp.sympify(switch)
+        if isinstance(switch, (list, tuple, sp.MatrixBase)) and len(switch) != 1:
+            from .system import ONE_SURFACE
+
+            raise SymbolicError(f"switch: {len(switch)} expressions: {ONE_SURFACE}")
+        self.switch = sp.sympify(switch[0] if isinstance(switch, (list, tuple, sp.MatrixBase))
+                                 else switch)
         if not isinstance(eps, sp.Symbol) or eps not in params:
             raise SymbolicError("eps: the small parameter must be a symbol among params")
         self.eps, self.params, self.name = eps, dict(params), name
