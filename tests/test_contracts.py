@@ -6,7 +6,7 @@ import pytest
 
 from filippov import FilippovSystem, SymbolicSystem
 from filippov.contracts import (CompiledView, DefinedOnce, ModelModule, ReferenceSystem,
-                                ReferenceView, missing)
+                                ReferenceView, WithJacobians, missing, provides)
 from filippov.models import dry_friction, hopf, pseudo_equilibrium
 
 
@@ -22,14 +22,22 @@ def _generated():
     return SymbolicSystem([x], [-x], [-x], x).system()
 
 
-@pytest.mark.parametrize("build", [_defined_once, _generated,
+def _symbolic():
+    import sympy as sp
+
+    x = sp.Symbol("x")
+    return SymbolicSystem([x], [-x], [-x], x)
+
+
+@pytest.mark.parametrize("build", [_defined_once, _generated, _symbolic,
                                    lambda: hopf.system(1e-2, 0.2),
                                    lambda: dry_friction.system(1e-2, 1.5)],
-                         ids=["FilippovSystem", "SymbolicSystem.system", "hopf", "dry_friction"])
+                         ids=["FilippovSystem", "SymbolicSystem.system", "SymbolicSystem",
+                              "hopf", "dry_friction"])
 def test_every_system_defined_once_keeps_its_contract(build):
     system = build()
-    assert missing(system, DefinedOnce) == []
-    assert isinstance(system, DefinedOnce)
+    assert missing(system, DefinedOnce) == [] and missing(system, WithJacobians) == []
+    assert isinstance(system, DefinedOnce) and provides(system, DefinedOnce)
     view = system.python()
     assert missing(view, ReferenceSystem) == [] and isinstance(view, ReferenceSystem)
 
@@ -42,7 +50,7 @@ def test_every_model_module_keeps_its_contract(module):
 
 def test_a_system_that_breaks_the_contract_is_named_with_what_it_lacks():
     class Half:
-        names, scale = ("x",), None
+        names = ("x",)
 
         def python(self):
             return None
@@ -54,18 +62,20 @@ def test_a_system_that_breaks_the_contract_is_named_with_what_it_lacks():
             return None
 
     got = missing(Half(), DefinedOnce)
-    assert "has_jacobians: missing" in got and "jacobian: missing" in got
     assert "python_section: no parameter 'min_time'" in got
     assert "python_section: parameter 'direction' defaults to 1, the contract to 0" in got
     assert any(m.startswith("compiled: parameter 'direction' is positional or keyword")
                for m in got)
-    assert missing(Half(), ReferenceView)   # the same faults through the smaller contract
-    assert not isinstance(object(), CompiledView)
+    assert missing(Half(), WithJacobians) == ["has_jacobians: missing", "jacobian: missing"]
+    assert missing(Half(), ReferenceView) == []   # python() alone is a reference view
+    assert not isinstance(object(), CompiledView) and not provides(object(), CompiledView)
 
 
 def test_the_front_doors_take_a_system_by_its_views():
-    # a class of the user's own that keeps ReferenceView runs on the reference engine
-    from filippov import simulate
+    # a class of the user's own with python() alone runs on the reference engine, and so
+    # does a proxy that delegates through __getattr__ (which isinstance on a Protocol
+    # does not see from Python 3.12 on); a SymbolicSystem runs as it is
+    from filippov import monodromy, simulate
 
     inner = _defined_once()
 
@@ -73,14 +83,16 @@ def test_the_front_doors_take_a_system_by_its_views():
         def python(self):
             return inner.python()
 
-        def python_section(self, section, *, direction=0, where=None, name="section",
-                           min_time=0.0):
-            return inner.python_section(section, direction=direction, where=where,
-                                        name=name, min_time=min_time)
+    class Proxy:
+        def __getattr__(self, name):
+            return getattr(inner, name)
 
-    assert missing(Wrapped(), ReferenceView) == []
-    traj = simulate(Wrapped(), [1.0], 1.0)
-    assert traj.z[0] == pytest.approx(np.exp(-1.0), rel=1e-12)
+    for system in (Wrapped(), Proxy(), _symbolic()):
+        assert provides(system, ReferenceView)
+        traj = simulate(system, [1.0], 1.0)
+        assert traj.z[0] == pytest.approx(np.exp(-1.0), rel=1e-12)
+    M, _ = monodromy(Proxy(), simulate(Proxy(), [1.0], 1.0))
+    assert M[0, 0] == pytest.approx(np.exp(-1.0), rel=1e-8)
 
 
 def test_several_switching_functions_are_refused_by_name():

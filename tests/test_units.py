@@ -347,47 +347,75 @@ def test_fixed_points_of_a_map_in_micrometres_skip_its_jumps():
 def test_newton_of_the_continuation_converges_in_the_unknowns_units():
     from filippov.continuation import newton
 
-    a = 1e-9   # u^2 = a^2 from 2a: steps below 1e-12 absolute came at 4.5e-8 relative
-    u, _ = newton(lambda u: u * u - a * a, lambda u: np.diag(2.0 * u), np.array([2 * a]))
+    a = 1e-9   # u^2 = a^2 from 2a: steps below 1e-12 absolute came at 4.6e-8 relative
+    u, _ = newton(lambda u: u * u - a * a, lambda u: np.diag(2.0 * u), np.array([2 * a]),
+                  floor=a)
     assert u[0] == pytest.approx(a, rel=1e-14, abs=0)
+    # the default floor stays 1: the guess's size cannot tell the unknowns' scale (a small
+    # guess near a root at 0 of a residual with terms of order one never met a test at
+    # its own size; a review's reproducer)
+    G = lambda u: np.array([np.cos(u[0]) - 1 + u[0] + 0.3 * u[1], u[1] - 0.5 * u[0]])  # noqa: E731
+    J = lambda u: np.array([[1 - np.sin(u[0]), 0.3], [-0.5, 1.0]])  # noqa: E731
+    assert np.abs(newton(G, J, [1e-6, 1e-6])[0]).max() < 1e-12
 
 
-def test_sliding_jacobians_measure_the_scale_once(monkeypatch):
-    # each sliding state's Jacobian measured the scale again (24n evaluations): a
-    # transition matrix at n = 8 took 3.5 times as long
-    import filippov.scale as scale_mod
+def _sine_wall(a, good=True):
+    # H = y - a/2 sin(x/a) crossed by F_- = (1, 1), F_+ = (1, -1): a slide along a wiggly
+    # wall; zero Jacobians, so the sliding Jacobian is the curvature of H alone
+    grad = ((lambda z, p: np.array([-0.5 * np.cos(z[0] / a), 1.0])) if good
+            else (lambda z, p: np.array([0.0, 1.0])))
+    return FilippovSystem(("x", "y"), lambda z, p: np.array([1.0, 1.0]),
+                          lambda z, p: np.array([1.0, -1.0]),
+                          lambda z, p: z[1] - 0.5 * a * np.sin(z[0] / a), grad,
+                          jacobians={"minus": lambda z, p: np.zeros((2, 2)),
+                                     "plus": lambda z, p: np.zeros((2, 2))})
 
-    calls, orig = [], scale_mod.of_system
-    monkeypatch.setattr(scale_mod, "of_system",
-                        lambda *a, **k: calls.append(1) or orig(*a, **k))
-    fs = _circle(1e-6)
-    floors = {fs._state_scale(np.array(z) * 1e-6) for z in ([1.0, 0.0], [0.0, 1.0], [0.6, 0.8])}
-    assert len(calls) == 1 and floors == {2.0 ** -20}
+
+def test_a_sliding_jacobian_does_not_depend_on_what_was_asked_before():
+    # a review's reproducer: a kept first scale made the sliding Jacobian's difference
+    # step depend on the first state ever asked (-0.402 against -0.495 for dz/dz0)
+    from filippov import transition_matrix
+    from filippov.system import SLIDING
+
+    a, z = 1e-3, np.array([0.0, 0.0])
+    fresh = _sine_wall(a).jacobian(SLIDING, z)
+    fs = _sine_wall(a)
+    transition_matrix(fs, simulate(fs, [100.0, -1.0], 2.0))   # an orbit far away first
+    assert np.array_equal(fs.jacobian(SLIDING, z), fresh)
+    traj = simulate(fs, [0.0, -2e-4], 3e-3)
+    got = transition_matrix(fs, traj)
+    want = transition_matrix(_sine_wall(a), simulate(_sine_wall(a), [0.0, -2e-4], 3e-3))
+    assert np.array_equal(got, want)
 
 
-def _wrapped(z, p):
-    # an angle wrapped by a loop: asked at 2^300 it would never return
-    th = z[0]
-    while th > np.pi:
-        th -= 2.0 * np.pi
-    if abs(z[1]) > 10.0:
-        raise ValueError("outside the table")
-    return np.array([1.0, np.cos(th) - 0.5 * z[1]])
+def test_the_gradient_check_steps_from_the_start_not_from_a_huge_field_length():
+    # a nearly uniform field (length 1e6) made S = 2^20, and the gradient check stepped
+    # over H's wiggles: it refused a correct switch_grad and took a wrong one
+    w = 2 * np.pi * 50
+    fm = lambda z, p: np.array([1.0, -1e-6 * z[1]])  # noqa: E731
+    fp = lambda z, p: np.array([1.0, -1e-6 * z[1] - 1e-3])  # noqa: E731
+    H = lambda z, p: z[1] - 0.5 - 0.01 * np.sin(w * z[0])  # noqa: E731
+    good = lambda z, p: np.array([-0.01 * w * np.cos(w * z[0]), 1.0])  # noqa: E731
+    bad = lambda z, p: np.array([0.0, 1.0])  # noqa: E731
+    traj = simulate(FilippovSystem(("t", "y"), fm, fp, H, good), [0.0, 0.4], 1.0)
+    assert traj.scale.state == 1.0 and traj.status == "t_end"
+    from filippov.checks import SystemContractError
+    with pytest.raises(SystemContractError, match="switch_grad does not match"):
+        simulate(FilippovSystem(("t", "y"), fm, fp, H, bad), [0.0, 0.4], 1.0)
 
 
 @pytest.mark.parametrize("engine", ENGINES)
-def test_measuring_the_scale_never_fails_nor_hangs_a_run(engine):
-    # the measurement probes the fields away from the start: a probe that raises or is
-    # not finite tells nothing, and the probes stay within 2^20 of the start's size
-    from filippov.scale import measure_system
-
-    fs = FilippovSystem(("th", "v"), _wrapped, _wrapped, lambda z, p: z[1] - 5.0,
-                        lambda z, p: np.array([0.0, 1.0]))
-    out = first_returns(fs, [[0.0, 0.0]], lambda z, p: z[0] - 3.0, 10.0, direction=1,
-                        engine=engine)
-    assert out.time[0] == pytest.approx(3.0, rel=1e-12)
-    bad = lambda z: np.array([np.nan, 1.0]) if z[0] != 0.0 else np.array([1.0, 1.0])  # noqa: E731
-    sc = measure_system(np.zeros(2), bad, bad, lambda z: np.array([0.0, 1.0]))
-    assert sc.state == 1.0
-    boom = lambda z: 1 / 0  # noqa: E731
-    assert measure_system(np.array([3e-6, 0.0]), boom, boom, boom).state == 2.0 ** -18
+def test_a_steep_switching_function_crosses_where_it_crosses(engine):
+    # H = exp(k (x - 1)) - 1, k = 50, is steep beyond H = 0: G from its gradient a
+    # distance S away was 4.4e12 (touch_tol 4.4e-3), and an orbit that crosses H (to
+    # H = +1e-3) was taken for a touch and came back round its circle unswitched
+    k = 50.0
+    fs = FilippovSystem(("x", "y"), lambda z, p: np.array([-z[1], z[0] - 0.5]),
+                        lambda z, p: np.array([1.0, 1.0]),
+                        lambda z, p: np.exp(k * (z[0] - 1)) - 1,
+                        lambda z, p: np.array([k * np.exp(k * (z[0] - 1)), 0.0]))
+    assert simulate(fs, [0.5, -0.50002], 1.0).scale.switch < 1e-9   # grad H at the start
+    # it switches to F_+ and leaves: no return (or H overflows on the way out)
+    with pytest.raises(Exception, match="did not return|switch returned a non-finite"):
+        first_returns(fs, [[0.5, -0.50002]], lambda z, p: z[0] - 0.5, 20.0, direction=1,
+                      engine=engine)

@@ -466,16 +466,18 @@ class FilippovSystem:
         sliding may be absent where the system cannot slide)."""
         return {"minus", "plus"} <= self._jacobian_modes()
 
-    def jacobian(self, mode: int, z) -> np.ndarray:
+    def jacobian(self, mode: int, z, *, floor: float | None = None) -> np.ndarray:
         """``dF/dz`` (n, n) of the field of ``mode`` (MINUS, SLIDING, PLUS) at one state,
         from the ``jacobians`` pieces: the ``jacobian=`` of :func:`filippov.monodromy`,
-        :func:`filippov.variational.return_jacobian` and friends."""
+        :func:`filippov.variational.return_jacobian` and friends. ``floor``: the run's
+        state scale, from which the sliding field's differences step (None: measured at
+        z, filippov.scale)."""
         from .system import MODE_NAMES
 
         self._frozen_unchanged()
         key = MODE_NAMES.get(mode)
         if key == "sliding" and key not in self._jacobian_modes() and self.has_jacobians:
-            return self._sliding_jacobian(np.ascontiguousarray(z, dtype=float))
+            return self._sliding_jacobian(np.ascontiguousarray(z, dtype=float), floor)
         if key not in self._jacobian_modes():
             raise ValueError(f"jacobian: no Jacobian of mode {mode!r} was given "
                              f"(have {sorted(self._jacobian_modes())})")
@@ -514,16 +516,11 @@ class FilippovSystem:
                 f"(the flow's multiplier stays 1)")
 
     def _state_scale(self, z: np.ndarray) -> float:
-        """The state scale (filippov.scale): declared, or measured at the first state a
-        Jacobian is asked at and kept (the floor of a difference step: not worth the
-        measurement's 24n evaluations at every sliding state)."""
-        kept = getattr(self, "_kept_scale", None)
-        if kept is None or kept[0] is not self.scale:
-            kept = (self.scale, scale_mod.of_system(self.python(), z).state)
-            self._kept_scale = kept
-        return kept[1]
+        """The state scale (filippov.scale): declared, or measured at z (about 24n
+        evaluations: a run passes its own to :meth:`jacobian` as ``floor``)."""
+        return scale_mod.of_system(self.python(), z).state
 
-    def _sliding_jacobian(self, z: np.ndarray) -> np.ndarray:
+    def _sliding_jacobian(self, z: np.ndarray, floor: float | None = None) -> np.ndarray:
         """dF_s/dz of Filippov's sliding field F_s = (a F_+ - b F_-)/(a - b), a = g.F_-,
         b = g.F_+ (g = switch_grad), from the Jacobians of the two fields; the Hessian
         of the switching function (it moves g) by central differences of switch_grad
@@ -535,7 +532,8 @@ class FilippovSystem:
         Fm, Fp = (np.asarray(sysp.field_minus(z), float), np.asarray(sysp.field_plus(z), float))
         g = np.asarray(sysp.switch_grad(z), dtype=float)
         Jm, Jp = (self._jacobian_value(k, z).reshape(n, n) for k in ("minus", "plus"))
-        step = np.cbrt(np.finfo(float).eps) * max(self._state_scale(z), float(np.abs(z).max()))
+        floor = self._state_scale(z) if floor is None else floor
+        step = np.cbrt(np.finfo(float).eps) * max(floor, float(np.abs(z).max()))
         Hh = np.empty((n, n))   # Hh[:, k] = d g / d z_k
         for k in range(n):
             e = np.zeros(n)

@@ -57,17 +57,14 @@ class Branch:
     stopped: str = ""
 
 
-def newton(G, J, u, *, tol=1e-12, max_iter=12, extra=None, floor=None):
+def newton(G, J, u, *, tol=1e-12, max_iter=12, extra=None, floor=1.0):
     """Newton for the square system [G(u); extra(u)] = 0 (``extra`` returns a
     (value, gradient) pair for one more scalar equation). Converged when a step is below
-    ``tol max(floor, |u|)``; ``floor``: the unknowns' scale (None: the guess's largest
-    component as :func:`filippov.scale.power_of_two` rounds it, at most 1: the test is
-    relative beyond)."""
-    from .scale import power_of_two
-
+    ``tol max(floor, |u|)``; ``floor``: the unknowns' scale, 1 unless given -- the
+    guess's size alone cannot tell it (a small guess near a root at 0 of a residual with
+    terms of order one never meets a test at its own size): give it for unknowns in
+    other units (filippov.scale)."""
     u = np.asarray(u, dtype=float).copy()
-    if floor is None:
-        floor = min(1.0, power_of_two(float(np.max(np.abs(u))))) if u.size else 1.0
     for it in range(max_iter):
         r = np.atleast_1d(G(u))
         A = np.atleast_2d(J(u))
@@ -267,7 +264,8 @@ def monodromy(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None):
     Returns (M, multipliers sorted by modulus, descending). ``system``, ``jacobian`` and
     ``atol`` (in units of the run's state scale, ``traj.scale``) as for
     :func:`filippov.variational.transition_matrix`."""
-    system, jacobian = reference_view(system, jacobian, "monodromy")
+    system, jacobian = reference_view(system, jacobian, "monodromy",
+                                      getattr(getattr(traj, "scale", None), "state", None))
     try:
         M = transition_matrix(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
         # simulate logs a start on H = 0 as 'start' in the mode it leaves in, and the
@@ -308,7 +306,8 @@ def floquet_multipliers(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None,
       maps f(z0) to f(z_T), so the trivial multiplier is off by that much.
 
     A missing saltation matrix shifts it by O(1)."""
-    system, jacobian = reference_view(system, jacobian, "floquet_multipliers")
+    system, jacobian = reference_view(system, jacobian, "floquet_multipliers",
+                                      getattr(getattr(traj, "scale", None), "state", None))
     M, _ = monodromy(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
     lam, wl, vr = scipy.linalg.eig(M, left=True, right=True)
     order = np.argsort(-np.abs(lam))

@@ -5,12 +5,16 @@ what the view gives; a model module of the paper builds the three. Each contract
 what one side may ask of the other, no more: tests/test_contracts.py checks every
 implementation in the library against it, the names and the parameters of each method
 (:func:`missing`), so that a change to one side that the other would meet at run time
-fails there first.
+fails there first. The library asks a system whether it keeps one with :func:`provides`
+(its members found as ``getattr`` finds them: an object that delegates through
+``__getattr__`` keeps a contract too, which ``isinstance`` on a Protocol does not see
+from Python 3.12 on).
 
-- :class:`ReferenceView` and :class:`CompiledView`: what a system defined once hands each
-  engine (``python()``, ``python_section(...)``; ``compiled(...)``), and
-  :class:`DefinedOnce`, both with the Jacobians (:class:`~filippov.FilippovSystem`, and
-  the system a :class:`~filippov.SymbolicSystem` generates);
+- :class:`ReferenceView`, :class:`SectionView` and :class:`CompiledView`: what a system
+  defined once hands each engine (``python()``, ``python_section(...)``;
+  ``compiled(...)``); :class:`DefinedOnce`, all three (:class:`~filippov.FilippovSystem`,
+  :class:`~filippov.SymbolicSystem`); :class:`WithJacobians`, the fields' Jacobians it
+  may carry;
 - :class:`ReferenceSystem`: what the reference driver runs
   (:class:`~filippov.system.PiecewiseSystem`);
 - :class:`ModelModule`: a model of the paper (:mod:`filippov.models.hopf`,
@@ -26,10 +30,15 @@ import numpy as np
 
 @runtime_checkable
 class ReferenceView(Protocol):
-    """A system the reference driver can run: its piecewise-smooth view and a section of
-    it as the driver's :class:`~filippov.section.Section`."""
+    """A system the reference driver can run: its piecewise-smooth view."""
 
     def python(self) -> "ReferenceSystem": ...
+
+
+@runtime_checkable
+class SectionView(Protocol):
+    """A section ``section(z, p) = 0`` of a system defined once, as the reference
+    driver's :class:`~filippov.section.Section` (a section given as a function)."""
 
     def python_section(self, section, *, direction: int = 0, where=None,
                        name: str = "section", min_time: float = 0.0): ...
@@ -44,12 +53,17 @@ class CompiledView(Protocol):
 
 
 @runtime_checkable
-class DefinedOnce(ReferenceView, CompiledView, Protocol):
-    """A system defined once, run by both engines, with its fields' Jacobians where it has
-    them (``jacobian(mode, z)``: the ``jacobian=`` of the derivatives' functions)."""
+class DefinedOnce(ReferenceView, SectionView, CompiledView, Protocol):
+    """A system defined once, run by both engines (what :func:`filippov.periodic_orbit`
+    takes)."""
 
     names: tuple
-    scale: Any
+
+
+@runtime_checkable
+class WithJacobians(Protocol):
+    """A system that may carry its fields' Jacobians (``jacobian(mode, z)``: the
+    ``jacobian=`` of the derivatives' functions, where ``has_jacobians``)."""
 
     @property
     def has_jacobians(self) -> bool: ...
@@ -108,6 +122,19 @@ def _members(protocol) -> dict:
             elif callable(value):
                 out[name] = value
     return out
+
+
+def provides(obj, protocol) -> bool:
+    """Whether ``obj`` has every member of ``protocol`` (methods callable), as ``getattr``
+    finds them (delegation through ``__getattr__`` included)."""
+    for name, spec in _members(protocol).items():
+        try:
+            value = getattr(obj, name)
+        except Exception:   # noqa: BLE001 -- a property that fails: not provided
+            return False
+        if spec not in (None, "property") and not callable(value):
+            return False
+    return True
 
 
 def missing(obj, protocol) -> list[str]:

@@ -442,8 +442,9 @@ def sweep_returns(cmodels, starts, t_max: float, *, start_age=0.0, workers=None,
     same pieces, section and sampling: :data:`SWEEP_SHARED`), as a model's constructor
     builds them (its checks of the parameters apply); each start's returns are those of
     :func:`compute_returns` with its own model, bit for bit, whatever ``workers`` (where
-    the scale is measured, filippov.scale, once for the sweep at its largest start: give
-    ``scale=`` to both to compare them). ``options`` as there."""
+    the scale is measured, filippov.scale, once for the sweep, at its smallest and its
+    largest start, each with its own model: give ``scale=`` to both to compare them).
+    ``options`` as there."""
     params = _sweep_params(cmodels)
     cmodels = list(cmodels)
     first = cmodels[0]

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from . import views
-from .contracts import DefinedOnce
+from .contracts import DefinedOnce, provides
 from .scale import of_system
 from .errors import PeriodicOrbitError  # noqa: F401  (re-exported)
 
@@ -59,7 +59,9 @@ def _reference_return(system, section, direction: int, where, t_max: float, opti
     from .variational import reference_view, return_jacobian
 
     # exact field Jacobians where the system has them (filippov.symbolic), else differences
-    python, jac = reference_view(system, None, "periodic_orbit")
+    scale = options.get("scale")   # the orbit's, fixed at the guess (_orbit_scale)
+    python, jac = reference_view(system, None, "periodic_orbit",
+                                 floor=getattr(scale, "state", None))
     sec = system.python_section(section, direction=direction, where=where)
 
     def single(z, age):
@@ -253,7 +255,7 @@ def _newton_step(z, Pz, J, guess, floor: float) -> np.ndarray:
 def _checked_start(system, guess, returns, engine) -> np.ndarray:
     """periodic_orbit's arguments checked (each refused naming it); the guess as a vector."""
     views.checked(engine)
-    if not isinstance(system, DefinedOnce):   # filippov.contracts
+    if not provides(system, DefinedOnce):   # filippov.contracts
         raise TypeError(f"system: periodic_orbit expected a FilippovSystem or a "
                         f"SymbolicSystem (a system defined once: both engines' views), "
                         f"got {type(system).__name__}")

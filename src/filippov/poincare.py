@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import views
-from .contracts import ReferenceView
+from .contracts import SectionView, provides
 from .section import Returns  # noqa: F401  (re-exported: filippov.poincare.Returns)
 from .errors import run_error
 from .loop.status import NO_RETURN
@@ -60,7 +60,7 @@ def _reference_section(system, section, direction: int, where, options: dict) ->
             raise ValueError("direction, where: a Section carries its own; give them to "
                              "the Section")
         return section if section.terminal == 1 else dataclasses.replace(section, terminal=1)
-    if section is None or not isinstance(system, ReferenceView):   # filippov.contracts
+    if section is None or not provides(system, SectionView):   # filippov.contracts
         raise TypeError(f"section: first_returns(engine='reference') of a "
                         f"{type(system).__name__} expected a filippov.Section, got "
                         f"{type(section).__name__}")

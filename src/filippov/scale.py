@@ -12,13 +12,14 @@ A system declares its scale (``FilippovSystem(..., scale=...)``; the paper's mod
 declare :data:`UNIT`, the only value that restores the unit-scale arithmetic of before:
 ``scale=1.0`` declares S alone and still measures T and G) or has it measured at the
 run's start (:func:`measure_system`, about 24n evaluations of the pieces): S is the
-larger of the start's size and the fields' own length there, T the time the fields take
-to move the state by S (at the start's speed, or the fields' own rate where that is
-faster), G the change of H over S; each is rounded to a power of two and taken as 1
-within :data:`DEAD_BAND` of 1 -- the defaults were chosen at unit scale, and a system in
-its natural units runs exactly as before. A measured scale is a power of two, so scaling
-a tolerance by it is exact. A batch (a map, a sweep) runs at one scale, the smaller of
-those of its smallest and its largest start (:func:`of_batch`).
+larger of the start's size and the fields' own length there (the length up to 1), T the
+time the fields take to move the state by S (at the start's speed, or the fields' own
+rate where that is faster), G the change of H over S (H's gradient at the start times
+S); each is rounded to a power of two and taken as 1 within :data:`DEAD_BAND` of 1 --
+the defaults were chosen at unit scale, and a system in its natural units runs exactly
+as before. A measured scale is a power of two, so scaling a tolerance by it is exact. A
+batch (a map, a sweep) runs at one scale, the smaller of those of its smallest and its
+largest start (:func:`of_batch`).
 """
 from __future__ import annotations
 
@@ -137,18 +138,22 @@ def measure(z0, fields=None, grad=None, state=None, length=math.inf, rate=0.0) -
     """The scale measured at a start ``z0``.
 
     - S: the larger of the start's largest component and the fields' ``length`` there
-      (:func:`field_length`), or ``state`` where declared;
+      (:func:`field_length`) up to 1, or ``state`` where declared: the length lifts a
+      start at the origin (up to rounding) to its system's size, never above the unit
+      scale -- a nearly uniform field, whose length is huge, must not loosen the
+      tolerances of a start of size one;
     - T: the time the fields take to move the state by S, ``S / max(|F|, rate S)``
       (``fields``: the values of ``F_-`` and ``F_+`` at z0, or None; ``rate``: their
       largest ``|dF/dz_k|``) -- the shorter of the time at the start's speed and the
       fields' own time ``1 / rate``, so that a start next to an equilibrium (speed near
       0) does not make every time long;
-    - G: S times the largest component of H's gradient (``grad``: at z0, or rows at z0
-      and at probes a distance S away, so that a start where the gradient vanishes (the
-      centre of a circle) still measures H's size).
+    - G: S times the largest component of H's gradient (``grad``: at z0, or, where it
+      vanishes there (the centre of a circle), rows at probes a distance S away, so that
+      such a start still measures H's size; never the probes' where z0's is not 0: H may
+      grow steeply beyond the surface, and G would loosen touch_tol by as much).
 
     Non-finite or zero measures give 1."""
-    size = max(_inf_norm(z0), length if math.isfinite(length) else 0.0)
+    size = max(_inf_norm(z0), min(length, 1.0) if math.isfinite(length) else 0.0)
     S = power_of_two(size) if state is None else state
     speed = max((_inf_norm(f) for f in fields), default=0.0) if fields is not None else 0.0
     moves = max(speed if math.isfinite(speed) else 0.0,
@@ -172,8 +177,8 @@ def _finite_at(fn, z):
 def measure_system(z0, field_minus, field_plus, switch_grad, state=None) -> Scale:
     """:func:`measure` at ``z0`` of a system given by its pieces (functions of one
     state): the fields there, their shorter length and largest rate
-    (:func:`field_rates`), and H's gradient at z0 and at ``z0 + S e_k``. About
-    ``2 (12 n + 1) + n + 1`` evaluations of the pieces."""
+    (:func:`field_rates`), and H's gradient at z0 (where it vanishes, at ``z0 + S
+    e_k``). About ``2 (12 n + 1) + 1`` evaluations of the pieces."""
     z0 = np.asarray(z0, dtype=float).reshape(-1)
     try:
         fields = (field_minus(z0), field_plus(z0))
@@ -183,10 +188,14 @@ def measure_system(z0, field_minus, field_plus, switch_grad, state=None) -> Scal
     length = min((s / r if s > 0.0 and r > 0.0 else math.inf) for s, r in rates)
     rate = max(r for _, r in rates)
     S = measure(z0, state=state, length=length).state
-    probes = [z0] + [z0 + S * e for e in np.eye(z0.size)]
-    grads = [g for g in (_finite_at(switch_grad, z) for z in probes)
-             if g is not None and g.shape == z0.shape]
-    return measure(z0, fields, np.array(grads) if grads else None, S, length, rate)
+    grad = _finite_at(switch_grad, z0)
+    if grad is None or grad.shape != z0.shape or not np.any(grad):
+        # no gradient at the start (the centre of a circle): H's size a distance S away
+        probes = [z0 + S * e for e in np.eye(z0.size)]
+        grads = [g for g in (_finite_at(switch_grad, z) for z in probes)
+                 if g is not None and g.shape == z0.shape]
+        grad = np.array(grads) if grads else None
+    return measure(z0, fields, grad, S, length, rate)
 
 
 def of_system(system, z, value=None) -> Scale:

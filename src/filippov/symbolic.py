@@ -247,6 +247,31 @@ class SymbolicSystem:
             self._system = GeneratedSystem(self)
         return self._system
 
+    # the views of a system defined once (filippov.contracts.DefinedOnce,
+    # WithJacobians), those of :meth:`system`: the front doors take a SymbolicSystem as
+    # they take the FilippovSystem it generates
+    @property
+    def names(self) -> tuple:
+        return self.system().names
+
+    def python(self):
+        return self.system().python()
+
+    def python_section(self, section, *, direction: int = 0, where=None,
+                       name: str = "section", min_time: float = 0.0):
+        return self.system().python_section(section, direction=direction, where=where,
+                                            name=name, min_time=min_time)
+
+    def compiled(self, section, *, direction: int = 0, where=None, probe=None):
+        return self.system().compiled(section, direction=direction, where=where, probe=probe)
+
+    @property
+    def has_jacobians(self) -> bool:
+        return self.system().has_jacobians
+
+    def jacobian(self, mode: int, z, *, floor: float | None = None):
+        return self.system().jacobian(mode, z, floor=floor)
+
     def with_params(self, **values) -> "SymbolicSystem":
         """The same expressions with other parameter values (by parameter name): a copy
         sharing the derivatives and the generated pieces (nothing is generated or

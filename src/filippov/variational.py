@@ -48,17 +48,23 @@ def saltation(f_before, f_after, grad):
     return np.eye(f_before.size) + np.outer(f_after - f_before, grad) / speed
 
 
-def reference_view(system, jacobian, capability: str):
+def reference_view(system, jacobian, capability: str, floor: float | None = None):
     """The :class:`~filippov.system.PiecewiseSystem` the reference driver ran for
     ``system`` (any system the front doors take: :func:`filippov.views.reference_system`)
     and the Jacobian to use: the caller's ``jacobian``, else the system's own (a
-    FilippovSystem or SymbolicSystem that has its fields' Jacobians), else None
-    (central differences)."""
-    from . import views
-    from .contracts import DefinedOnce
+    FilippovSystem or SymbolicSystem that has its fields' Jacobians; told the run's
+    state scale ``floor`` where it takes one, so that it need not measure it at every
+    sliding state), else None (central differences)."""
+    import functools
+    import inspect
 
-    if jacobian is None and isinstance(system, DefinedOnce) and system.has_jacobians:
+    from . import views
+    from .contracts import WithJacobians, provides
+
+    if jacobian is None and provides(system, WithJacobians) and system.has_jacobians:
         jacobian = system.jacobian
+        if floor is not None and "floor" in inspect.signature(jacobian).parameters:
+            jacobian = functools.partial(jacobian, floor=floor)
     return views.reference_system(system, capability), jacobian
 
 
@@ -109,9 +115,9 @@ def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
     -------
     ndarray, shape (n, n)
     """
-    system, jacobian = reference_view(system, jacobian, "transition_matrix")
-    n = system.dim
     floor = _state_scale(traj)
+    system, jacobian = reference_view(system, jacobian, "transition_matrix", floor)
+    n = system.dim
     jac = jacobian or (lambda mode, z: field_jacobian(system, mode, z, floor=floor))
     # the state's error in its own units, the derivative's (dimensionless) as it is
     atols = np.concatenate([np.full(n, atol * floor), np.full(n * n, atol)])
@@ -175,7 +181,7 @@ def return_jacobian(system, traj, section, *, rtol: float = 1e-10, atol: float =
     if traj.status != f"section:{section.name}":
         raise VariationalError(f"the trajectory ended with status {traj.status!r}, not at a "
                                f"hit of section {section.name!r}")
-    system, jacobian = reference_view(system, jacobian, "return_jacobian")
+    system, jacobian = reference_view(system, jacobian, "return_jacobian", _state_scale(traj))
     Phi = transition_matrix(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
     z = np.asarray(traj.z, dtype=float)
     floor = _state_scale(traj)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import sys
 
-from .contracts import CompiledView, ReferenceView
+from .contracts import CompiledView, ReferenceView, provides
 
 #: the engines, by the name the front doors' ``engine=`` takes
 REFERENCE, COMPILED = "reference", "compiled"
@@ -61,10 +61,11 @@ def reference_system(system, capability: str):
         raise TypeError(f"system: {capability}(engine='reference') cannot run a "
                         "CompiledModel (numba pieces for the compiled engine only); "
                         f"use engine='compiled', or {_HOW_TO_COMPILE}")
-    if isinstance(system, ReferenceView):   # filippov.contracts
+    if provides(system, ReferenceView):   # filippov.contracts
         return system.python()
-    raise TypeError(f"system: {capability} expected a PiecewiseSystem, a FilippovSystem "
-                    f"or a SymbolicSystem, got {type(system).__name__}")
+    raise TypeError(f"system: {capability} expected a PiecewiseSystem, a FilippovSystem, "
+                    f"a SymbolicSystem or an object with python() (filippov.contracts."
+                    f"ReferenceView), got {type(system).__name__}")
 
 
 def compiled_model(system, capability: str, section=None, *, direction: int = 0,
@@ -84,7 +85,7 @@ def compiled_model(system, capability: str, section=None, *, direction: int = 0,
 
         return with_section(system, _section_function(section, capability),
                             direction=direction, where=where)
-    if not isinstance(system, CompiledView):   # filippov.contracts
+    if not provides(system, CompiledView):   # filippov.contracts
         raise TypeError(f"system: {capability}(engine='compiled') expected a "
                         f"FilippovSystem, a SymbolicSystem or a CompiledModel, got "
                         f"{type(system).__name__}")
