@@ -70,6 +70,10 @@ def _inf_norm(v) -> float:
     return float(np.max(np.abs(v))) if v.size else 0.0
 
 
+#: a measured state size outside [2^-MAX_EXPONENT, 2^MAX_EXPONENT] (Scale.how begins so):
+#: the run's tolerances cannot be measured in it, and :func:`resolve` refuses the run
+OUT_OF_RANGE = "out of range: size"
+
 #: how far (in powers of two) beyond the start's size, or 1, the probes of _rate reach
 PROBE_REACH = 20
 
@@ -155,13 +159,17 @@ def measure(z0, fields=None, grad=None, state=None, length=math.inf, rate=0.0) -
     Non-finite or zero measures give 1."""
     size = max(_inf_norm(z0), min(length, 1.0) if math.isfinite(length) else 0.0)
     S = power_of_two(size) if state is None else state
+    how = "measured"
+    if state is None and not 2.0 ** -MAX_EXPONENT <= size <= 2.0 ** MAX_EXPONENT \
+            and size > 0.0:
+        how = f"{OUT_OF_RANGE} {size:.3g}"   # resolve refuses it by name
     speed = max((_inf_norm(f) for f in fields), default=0.0) if fields is not None else 0.0
     moves = max(speed if math.isfinite(speed) else 0.0,
                 rate * S if math.isfinite(rate) else 0.0)
     T = power_of_two(S / moves) if moves > 0.0 else 1.0
     g = _inf_norm(grad) if grad is not None else 0.0
     G = power_of_two(S * g) if math.isfinite(g) and g > 0.0 else 1.0
-    return Scale(S, T, G, "measured")
+    return Scale(S, T, G, how)
 
 
 def _finite_at(fn, z):
@@ -187,7 +195,8 @@ def measure_system(z0, field_minus, field_plus, switch_grad, state=None) -> Scal
         return measure(z0, state=state)   # the start's size alone
     length = min((s / r if s > 0.0 and r > 0.0 else math.inf) for s, r in rates)
     rate = max(r for _, r in rates)
-    S = measure(z0, state=state, length=length).state
+    sized = measure(z0, state=state, length=length)   # S, or a size out of range
+    S = sized.state
     grad = _finite_at(switch_grad, z0)
     if grad is None or grad.shape != z0.shape or not np.any(grad):
         # no gradient at the start (the centre of a circle): H's size a distance S away
@@ -195,7 +204,8 @@ def measure_system(z0, field_minus, field_plus, switch_grad, state=None) -> Scal
         grads = [g for g in (_finite_at(switch_grad, z) for z in probes)
                  if g is not None and g.shape == z0.shape]
         grad = np.array(grads) if grads else None
-    return measure(z0, fields, grad, S, length, rate)
+    out = measure(z0, fields, grad, S, length, rate)
+    return Scale(out.state, out.time, out.switch, sized.how)
 
 
 def of_system(system, z, value=None) -> Scale:
@@ -224,8 +234,10 @@ def of_batch(value, starts, pieces) -> Scale:
         norms = np.max(np.abs(starts[finite]), axis=1) if starts.shape[1] else np.zeros(len(finite))
         rows = sorted({int(finite[np.argmin(norms)]), int(finite[np.argmax(norms)])})
         found = [measure_system(starts[i], *pieces(i), state) for i in rows]
-        return Scale(min(s.state for s in found), min(s.time for s in found),
-                     min(s.switch for s in found), "measured")
+        bad = [s for s in found if s.how.startswith(OUT_OF_RANGE)]
+        return bad[0] if bad else Scale(min(s.state for s in found),
+                                        min(s.time for s in found),
+                                        min(s.switch for s in found), "measured")
     return resolve(value, measure_at)
 
 
@@ -261,13 +273,21 @@ def declared(value, field: str = "scale"):
 def resolve(value, measure_at) -> Scale:
     """The scale a run uses: ``value`` as :func:`declared` reads it, with the parts it
     leaves open taken from ``measure_at(state)`` (called only then, with the declared
-    state scale or None; returns a Scale)."""
+    state scale or None; returns a Scale). A measured size out of range
+    (:data:`OUT_OF_RANGE`) is a ValueError naming the initial state."""
     parts = declared(value)
     if isinstance(parts, Scale):
         return parts
     if len(parts) == 3:
         return Scale(parts["state"], parts["time"], parts["switch"], "declared")
     m = measure_at(parts.get("state"))
+    if m.how.startswith(OUT_OF_RANGE):
+        size = m.how[len(OUT_OF_RANGE):].strip()
+        raise ValueError(
+            f"initial state: its size {size} (or the fields' length there) lies outside "
+            f"2^-{MAX_EXPONENT} .. 2^{MAX_EXPONENT} (about 4.9e-91 .. 2e90), where a run's "
+            f"tolerances can be measured (filippov.scale): write the system in other "
+            f"units, or declare its scale (scale=...)")
     how = "measured" if not parts else "declared+measured"
     return Scale(parts.get("state", m.state), parts.get("time", m.time),
                  parts.get("switch", m.switch), how)
