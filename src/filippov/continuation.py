@@ -34,8 +34,8 @@ from scipy.optimize import minimize_scalar
 from .progress import Progress
 # the derivatives live in filippov.variational; fd_jacobian and saltation stay
 # importable from here, where the continuation code and its users reach for them
-from .variational import (VariationalError, fd_jacobian, reference_view, saltation,  # noqa: F401
-                          switch_matrix, transition_matrix)
+from .variational import (VariationalError, _state_scale, fd_jacobian,  # noqa: F401
+                          reference_view, saltation, switch_matrix, transition_matrix)
 from .errors import ContinuationError  # noqa: F401  (re-exported)
 
 
@@ -264,8 +264,7 @@ def monodromy(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None):
     Returns (M, multipliers sorted by modulus, descending). ``system``, ``jacobian`` and
     ``atol`` (in units of the run's state scale, ``traj.scale``) as for
     :func:`filippov.variational.transition_matrix`."""
-    system, jacobian = reference_view(system, jacobian, "monodromy",
-                                      getattr(getattr(traj, "scale", None), "state", None))
+    system, jacobian = reference_view(system, jacobian, "monodromy", _state_scale(traj))
     try:
         M = transition_matrix(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
         # simulate logs a start on H = 0 as 'start' in the mode it leaves in, and the
@@ -306,8 +305,7 @@ def floquet_multipliers(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None,
       maps f(z0) to f(z_T), so the trivial multiplier is off by that much.
 
     A missing saltation matrix shifts it by O(1)."""
-    system, jacobian = reference_view(system, jacobian, "floquet_multipliers",
-                                      getattr(getattr(traj, "scale", None), "state", None))
+    system, jacobian = reference_view(system, jacobian, "floquet_multipliers", _state_scale(traj))
     M, _ = monodromy(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
     lam, wl, vr = scipy.linalg.eig(M, left=True, right=True)
     order = np.argsort(-np.abs(lam))

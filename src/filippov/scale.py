@@ -134,7 +134,11 @@ def field_length(field, z0) -> float:
     every tolerance absurdly tight; and the largest rate, not the rate along F, so that a
     component nothing depends on (an integral of a cost) does not make it long. inf where
     F is zero, constant or not finite there."""
-    speed, rate = field_rates(field, z0)
+    return _length(*field_rates(field, z0))
+
+
+def _length(speed: float, rate: float) -> float:
+    """A field's length from its speed and its largest rate (inf where either is 0)."""
     return speed / rate if speed > 0.0 and rate > 0.0 else math.inf
 
 
@@ -193,7 +197,7 @@ def measure_system(z0, field_minus, field_plus, switch_grad, state=None) -> Scal
         rates = [field_rates(f, z0) for f in (field_minus, field_plus)]
     except Exception:   # noqa: BLE001 -- the run's own checks name a piece that fails
         return measure(z0, state=state)   # the start's size alone
-    length = min((s / r if s > 0.0 and r > 0.0 else math.inf) for s, r in rates)
+    length = min(_length(s, r) for s, r in rates)
     rate = max(r for _, r in rates)
     sized = measure(z0, state=state, length=length)   # S, or a size out of range
     S = sized.state

@@ -181,10 +181,10 @@ def return_jacobian(system, traj, section, *, rtol: float = 1e-10, atol: float =
     if traj.status != f"section:{section.name}":
         raise VariationalError(f"the trajectory ended with status {traj.status!r}, not at a "
                                f"hit of section {section.name!r}")
-    system, jacobian = reference_view(system, jacobian, "return_jacobian", _state_scale(traj))
+    floor = _state_scale(traj)
+    system, jacobian = reference_view(system, jacobian, "return_jacobian", floor)
     Phi = transition_matrix(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
     z = np.asarray(traj.z, dtype=float)
-    floor = _state_scale(traj)
     grad = (np.asarray(section_grad(z), dtype=float) if section_grad is not None else
             fd_jacobian(lambda zz: np.atleast_1d(section.func(zz)), z, SECTION_STEP,
                         floor=floor)[0])
