@@ -473,19 +473,19 @@ def _returns(cmodel: CompiledModel, pieces, params, starts, ages, t_max, *, rtol
              workers, scale) -> BatchReturns:
     """compute_returns and sweep_returns after their own checks of the starts: the
     options checked, one kernel call over the batch (``pieces``: the model's addresses,
-    :func:`_pieces`; ``params``: one row for all the starts, or one row a start)."""
+    :func:`_pieces`; ``params``: one row for all the starts, or one row a start;
+    ``scale``: the batch's, resolved by the caller, :func:`batch_scale`)."""
     workers = _checked_workers(workers)
     options.check(rtol=rtol, atol=atol, max_step=max_step, max_events=max_events,
                   max_steps=max_steps, samples_per_step=samples_per_step, touch_tol=touch_tol,
                   event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span)
     _check_options(cmodel, t_max, iterations, keep, min_time)
-    sc = batch_scale(cmodel, starts, scale)
-    settings = _settings(cmodel, t_max, rtol=rtol, atol=atol * sc.state, max_step=max_step,
+    settings = _settings(cmodel, t_max, rtol=rtol, atol=atol * scale.state, max_step=max_step,
                          max_events=max_events, max_steps=max_steps,
-                         samples_per_step=samples_per_step, touch_tol=touch_tol * sc.switch,
-                         event_xtol=event_xtol * sc.time, zeno_count=zeno_count,
+                         samples_per_step=samples_per_step, touch_tol=touch_tol * scale.switch,
+                         event_xtol=event_xtol * scale.time, zeno_count=zeno_count,
                          zeno_span=zeno_span, min_time=min_time, iterations=iterations,
-                         jacobian=jacobian, scale=sc)
+                         jacobian=jacobian, scale=scale)
     out = _outputs(starts, keep, jacobian)
     # the build without the dP/dz code unless it is asked for (kernel.driver)
     _run_batch(kernel(derivatives=bool(jacobian)), pieces, params, starts, ages, settings,
