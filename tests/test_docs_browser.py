@@ -193,9 +193,13 @@ def test_the_gallery_shows_three_figures(server, browser):
 
 def test_search_finds_pages(server, browser):
     browser.get(server + "search.html?q=" + QUERY.replace(" ", "+"))
+    # Sphinx lists the hits one at a time (a 5 ms timer each) and writes its summary
+    # after the last: read the list only then, not at its first entry
     links = WebDriverWait(browser, 30).until(lambda d: d.execute_script(
-        "const a = [...document.querySelectorAll('#search-results ul.search li a')];"
-        "return a.length ? a.map(x => x.getAttribute('href')) : false"))
+        "const s = document.querySelector('#search-results .search-summary');"
+        "if (!s || !/Search finished|did not match/.test(s.innerText)) return false;"
+        "return [...document.querySelectorAll('#search-results ul.search li a')]"
+        ".map(x => x.getAttribute('href'))"))
     hits = {link.split("?")[0].split("#")[0] for link in links}
     assert QUERY_HITS <= hits, sorted(hits)
     assert not console_errors(browser)
