@@ -159,6 +159,13 @@ def graze(mode: int, hm: float, touch_tol: float, band: float = 0.0) -> int:
 #: differences are ~1e-10 relative
 FD_STEP = float(np.cbrt(np.finfo(float).eps))
 SLIDE_TANGENT = 1e-6
+#: the larger step (relative to the state's size) of the compiled engine's Richardson
+#: differences (:func:`richardson_step`): truncation ~step^4, rounding ~kappa u / step with
+#: kappa the closed form's own conditioning. u^(1/5) = 7.4e-4 balances kappa ~ 1; the
+#: closed forms here carry kappa ~ 1e2 (affine flows with offsets), and on the paper's
+#: polar flow 1.5e-3 was the measured optimum (9e-14 against its variational equations;
+#: 6e-3: 1.6e-11 from truncation): 2^-9 = 1.95e-3, a power of two, between them
+RICHARDSON_STEP = 2.0 ** -9
 
 
 # ------------------------------------------------------------- the end of sliding, hidden
@@ -251,6 +258,14 @@ def central_step(size: float, speed: float) -> float:
     if not (np.isfinite(speed) and speed > 0.0):
         return 0.0
     return FD_STEP * size / speed
+
+
+def richardson_step(size: float) -> float:
+    """The larger of the two central-difference steps whose Richardson extrapolation
+    (4 D(d/2) - D(d)) / 3 differentiates a closed-form flow or a section in the compiled
+    engine's dP/dz, at a state of size ``size`` (at least the run's state scale): error
+    ~1e-12 of the derivative where one central difference of step u^(1/3) left ~1e-10."""
+    return RICHARDSON_STEP * size
 
 
 def slides_in_section(s_at_z: float, d: float, rate_minus: float, rate_plus: float,

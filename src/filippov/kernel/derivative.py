@@ -10,13 +10,14 @@ from .dop853 import (_A, _B, _NS, _TRIAL, _checked_field, _stage)
 from .state import Stages
 
 
-# The derivative of a return, carried in w.deriv.M while the orbit runs (Settings.jac), as the
-# reference driver's filippov.variational composes it: an exact-flow stay by central
-# differences of the closed-form flow from its mode entry; an integrated stay (sliding,
-# or a model without flows) by the variational equation taken through the very DOP853
-# steps of the state (internal differentiation: the derivative of the computed
-# solution, the step sizes held); a switch by its saltation matrix; the end of sliding
-# by the identity; the section hit by the projection along the field.
+# The derivative of a return, carried in w.deriv.M while the orbit runs (Settings.jac), as
+# the reference driver's filippov.variational composes it: an exact-flow stay by
+# Richardson's extrapolation of central differences of the closed-form flow from its mode
+# entry; an integrated stay (sliding, or a model without flows) by the variational
+# equation taken through the very DOP853 steps of the state (internal differentiation:
+# the derivative of the computed solution, the step sizes held); a switch by its
+# saltation matrix; the end of sliding by the identity; the section hit by the projection
+# along the field.
 @_jit
 def _apply(J, M, T):
     """M <- J M (T: workspace)."""
@@ -48,29 +49,41 @@ def _rank_one(M, u, g, speed):
 
 
 @_jit
+def _flow_quotient(mode, za, k, d, tau, fns, p, dv):
+    """dv.jz1 <- (flow(za + d e_k) - flow(za - d e_k)) / (up - down), the central
+    difference of the closed-form flow over the steps as represented (za is restored bit
+    for bit)."""
+    orig = za[k]
+    za[k] = orig + d
+    up = za[k]
+    if mode == PLUS:
+        _flow_plus(fns, za, tau, p, dv.jz1)
+    else:
+        _flow_minus(fns, za, tau, p, dv.jz1)
+    za[k] = orig - d
+    down = za[k]
+    if mode == PLUS:
+        _flow_plus(fns, za, tau, p, dv.jz2)
+    else:
+        _flow_minus(fns, za, tau, p, dv.jz2)
+    za[k] = orig
+    for i in range(za.size):
+        dv.jz1[i] = (dv.jz1[i] - dv.jz2[i]) / (up - down)
+
+
+@_jit
 def _flow_jacobian(mode, za, tau, fns, p, dv):
-    """dv.Mt = d flow(za, tau) / d za by central differences of the closed-form flow (step
-    rules.central_step per component, from the state scale up; za is restored bit for
-    bit)."""
-    J, z1, z2 = dv.Mt, dv.jz1, dv.jz2
+    """dv.Mt = d flow(za, tau) / d za, column by column by Richardson's extrapolation of
+    two central differences of the closed-form flow (rules.richardson_step from the state
+    scale up, and half of it)."""
     for k in range(za.size):
-        orig = za[k]
-        d = rules.central_step(max(dv.floor, abs(orig)), 1.0)
-        za[k] = orig + d
-        up = za[k]
-        if mode == PLUS:
-            _flow_plus(fns, za, tau, p, z1)
-        else:
-            _flow_minus(fns, za, tau, p, z1)
-        za[k] = orig - d
-        down = za[k]
-        if mode == PLUS:
-            _flow_plus(fns, za, tau, p, z2)
-        else:
-            _flow_minus(fns, za, tau, p, z2)
-        za[k] = orig
+        d = rules.richardson_step(max(dv.floor, abs(za[k])))
+        _flow_quotient(mode, za, k, d, tau, fns, p, dv)
         for i in range(za.size):
-            J[i, k] = (z1[i] - z2[i]) / (up - down)
+            dv.Mt[i, k] = dv.jz1[i]
+        _flow_quotient(mode, za, k, 0.5 * d, tau, fns, p, dv)
+        for i in range(za.size):
+            dv.Mt[i, k] = (4.0 * dv.jz1[i] - dv.Mt[i, k]) / 3.0
 
 
 @_jit
@@ -154,19 +167,28 @@ def _switch_derivative(mode, new_mode, fns, p, z, fl, dv):
 
 
 @_jit
+def _section_quotient(fns, p, z, k, d):
+    """(s(z + d e_k) - s(z - d e_k)) / (up - down), s the section (z restored bit for
+    bit)."""
+    orig = z[k]
+    z[k] = orig + d
+    up = z[k]
+    s1 = _section(fns, z, p)
+    z[k] = orig - d
+    down = z[k]
+    s2 = _section(fns, z, p)
+    z[k] = orig
+    return (s1 - s2) / (up - down)
+
+
+@_jit
 def _section_derivative(mode, fns, p, z, fl, dv):
     """dv.M <- (I - f g^T / (g . f)) dv.M at the section hit z: f the field there, g the
-    section's gradient (central differences; z is restored bit for bit)."""
+    section's gradient (Richardson's extrapolation of two central differences, as
+    _flow_jacobian)."""
     _checked_field(z, mode, _TRIAL, fns, p, fl, dv.jf1)
     for k in range(z.size):
-        orig = z[k]
-        d = rules.central_step(max(dv.floor, abs(orig)), 1.0)
-        z[k] = orig + d
-        up = z[k]
-        s1 = _section(fns, z, p)
-        z[k] = orig - d
-        down = z[k]
-        s2 = _section(fns, z, p)
-        z[k] = orig
-        dv.jz1[k] = (s1 - s2) / (up - down)
+        d = rules.richardson_step(max(dv.floor, abs(z[k])))
+        coarse = _section_quotient(fns, p, z, k, d)
+        dv.jz1[k] = (4.0 * _section_quotient(fns, p, z, k, 0.5 * d) - coarse) / 3.0
     _rank_one(dv.M, dv.jf1, dv.jz1, -_dot(dv.jz1, dv.jf1))
