@@ -387,8 +387,8 @@ def test_a_dataset_names_the_paper_s_numbers_not_its_labels():
 
 def test_no_dataset_attribute_holds_a_latex_label(workflow_build):
     """The datasets of the shared build, as a reader of the netCDF files meets them: no
-    attribute (global or of a variable, the scene as computed in ``scene_config``
-    included) names one of the paper's LaTeX labels (``fig:retmaps``); a scene that
+    attribute (global or of a variable, coordinates included: netCDF stores them as
+    variables; the scene as computed in ``scene_config`` included) names one of the paper's LaTeX labels (``fig:retmaps``); a scene that
     reproduces a figure of the paper says which by its printed number ("Fig. 4")."""
     work, run = workflow_build["work"], workflow_build["run"]
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
@@ -415,3 +415,111 @@ def test_no_dataset_attribute_holds_a_latex_label(workflow_build):
         with netCDF4.Dataset(work / "results" / f"{scene}.nc") as nc:
             computed = json.loads(nc.getncattr("scene_config"))
         assert computed["paper_figure"] == PRINTED[data["paper_figure"]], scene
+
+
+# ----------------------------------------------------------------------------- the code's text
+#: attributes whose value a reader of a dataset meets as text (CF's and ours)
+ATTRIBUTE_TEXT = {"title", "long_name", "description", "comment", "references", "equation",
+                  "source", "history", "summary", "caption"}
+#: a whole label as written (INTERNAL_LABEL finds only its start)
+WHOLE_LABEL = re.compile(report_html.INTERNAL_LABEL.pattern + r"[A-Za-z0-9:_-]*")
+#: the code that writes datasets, draws figures and prints messages; paper_labels.py
+#: writes the LaTeX that defines the labels' printed numbers, so it names labels
+SPEAKING_CODE = sorted(
+    set((ROOT / "src" / "filippov").rglob("*.py")) | set((ROOT / "workflow").rglob("*.py"))
+    - {ROOT / "workflow" / "filippov_paper" / "paper_labels.py"})
+
+
+def _docstrings(tree) -> set[int]:
+    # the API's text, which tests/test_docs.py checks
+    kinds = (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)
+    return {id(node.body[0].value) for node in ast.walk(tree)
+            if isinstance(node, kinds) and node.body and isinstance(node.body[0], ast.Expr)
+            and isinstance(node.body[0].value, ast.Constant)}
+
+
+def _given_as(node, parents) -> str | None:
+    """The attribute a string literal is given as: {"long_name": s}, f(title=s),
+    ds.attrs["title"] = s; None for any other place."""
+    parent = parents.get(id(node))
+    if isinstance(parent, ast.keyword):
+        return parent.arg
+    if isinstance(parent, ast.Dict):
+        return next((key.value for key, value in zip(parent.keys, parent.values)
+                     if value is node and isinstance(key, ast.Constant)), None)
+    if isinstance(parent, ast.Assign) and parent.value is node:
+        return next((target.slice.value for target in parent.targets
+                     if isinstance(target, ast.Subscript)
+                     and isinstance(target.slice, ast.Constant)), None)
+    return None
+
+
+def label_literals(source: str, name: str) -> list[str]:
+    """The string literals of ``source`` that would show a reader one of the paper's
+    LaTeX labels: text with a label in it (a title, a long name, a message), and a bare
+    label given as a text attribute. A bare label anywhere else is a key the printed
+    number is looked up by."""
+    tree = ast.parse(source)
+    parents = {id(child): node for node in ast.walk(tree) for child in ast.iter_child_nodes(node)}
+    docs = _docstrings(tree)
+    found = []
+    for node in ast.walk(tree):
+        if not (isinstance(node, ast.Constant) and isinstance(node.value, str)) \
+                or id(node) in docs or not report_html.INTERNAL_LABEL.search(node.value):
+            continue
+        if WHOLE_LABEL.fullmatch(node.value.strip()) \
+                and _given_as(node, parents) not in ATTRIBUTE_TEXT:
+            continue
+        found.append((node.lineno, node.col_offset, node.value))
+    return [f"{name}:{line}: {text[:70]!r}" for line, _, text in sorted(found)]
+
+
+def test_the_label_finder_tells_text_from_keys():
+    source = textwrap.dedent('''
+        """Module fig:retmaps (a docstring: tests/test_docs.py)."""
+        ds["x"] = (d, v, {"long_name": "M_-: expansion eq:ymm", "units": "1"})
+        ds["y"] = (d, v, {"equation": "eq:xi1r"})
+        ds.attrs["title"] = "fig:retmaps"
+        finalize(ds, scene, title="return map (fig:retmaps)")
+        VARIABLE_ATTRS = {"r": ("left side of eq:s0def", "1")}
+        log(f"solving eq:red for {mu}")
+        number = labels["fig:retmaps"]
+        KEYS = {"eq:ymm": "Eq. (18)"}
+        ds["z"] = (d, v, {"long_name": "Eq. (18) as printed", "equation": "Eq. (23)"})
+        ''')
+    found = [hit.split(": ", 1)[1] for hit in label_literals(source, "m.py")]
+    assert found == [repr(s) for s in [
+        "M_-: expansion eq:ymm", "eq:xi1r", "fig:retmaps", "return map (fig:retmaps)",
+        "left side of eq:s0def", "solving eq:red for "]], found
+
+
+def _descriptions(node):
+    """The ``description`` texts of a JSON schema, at any depth."""
+    if isinstance(node, dict):
+        for key, value in node.items():
+            if key == "description" and isinstance(value, str):
+                yield value
+            else:   # a property named "description" holds a schema, not text
+                yield from _descriptions(value)
+    elif isinstance(node, list):
+        for item in node:
+            yield from _descriptions(item)
+
+
+def test_no_code_gives_a_reader_a_latex_label():
+    """Without a build: the text the code gives datasets (every attribute of every
+    variable, coordinate and dataset), figures and messages cites the paper by the
+    numbers it prints ("Eq. (18)", "Fig. 4"), never by its LaTeX labels. (scenes.printed
+    maps labels when a dataset is written, but only in some attributes, and only when
+    it finds paper/paper_labels.tex; the text itself has none.)"""
+    assert len(SPEAKING_CODE) > 50
+    leaks = [hit for path in SPEAKING_CODE
+             for hit in label_literals(path.read_text(encoding="utf-8"),
+                                       str(path.relative_to(ROOT)))]
+    # the schemas' descriptions document the scene files (their parameters too: the
+    # scene modules' PARAMETERS_SCHEMA, which the literals above cover)
+    leaks += [f"{path.relative_to(ROOT)}: {text[:70]!r}"
+              for path in sorted((ROOT / "config" / "schema").glob("*.json"))
+              for text in _descriptions(json.loads(path.read_text(encoding="utf-8")))
+              if report_html.INTERNAL_LABEL.search(text)]
+    assert not leaks, "the paper's LaTeX labels in text for readers:\n" + "\n".join(leaks)

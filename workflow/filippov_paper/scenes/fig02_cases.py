@@ -99,7 +99,7 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
                                          "sliding_x_min", "sliding_x_max", "slide_start_x",
                                          "slide_start_y", "x_final") else max(thetas)})
     return finalize(ds, scene, eps=eps, theta=theta_neg, theta_sliding=max(thetas),
-                    title="pseudo-equilibrium example eq:peqslow/eq:peqfast")
+                    title="pseudo-equilibrium example Eq. (7)/Eq. (8)")
 
 
 def _chatter(system, traj, opts, eps, theta, extra):

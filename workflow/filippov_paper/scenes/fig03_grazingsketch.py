@@ -230,7 +230,7 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     return finalize(ds, scene, method=opts["method"], switching_line="x1 = -1",
                     degenerate_slide=DEGENERATE_SLIDE,
                     section_L1="x1 = 0, x2 > 0",
-                    title="grazing-sliding of the reduced Hopf example eq:red (fig:grazingsketch)")
+                    title="grazing-sliding of the reduced Hopf example Eq. (11) (Fig. 3)")
 
 
 # ============================================================================= report

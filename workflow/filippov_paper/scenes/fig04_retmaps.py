@@ -209,17 +209,17 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
          "fixed_point": (("theta", "fixed"), fp,
                          {"long_name": "fixed points of P on the grid (NaN: none)", "units": "1"}),
          "sigma_minus": ("theta", np.array(sig), {
-             "long_name": "dh/dt along (f_-, g/eps) at p_g (eq:eminus); > 0: case 1 of thm:gen",
+             "long_name": "dh/dt along (f_-, g/eps) at p_g (Eq. (A.3)); > 0: case 1 of Lemma 2",
              "units": "1"}),
          "chi_minus": ("theta", np.array(chi), {
-             "long_name": "dh/dx f_- - dh/dx f_+ at p_g (eq:chiminus)", "units": "1"}),
+             "long_name": "dh/dx f_- - dh/dx f_+ at p_g (Eq. (A.5))", "units": "1"}),
          "slope_smooth": ((), float(np.exp(-4 * np.pi * mu / omega)), {
              "long_name": "slope of the smooth return map at x2=1, exp(-4 pi mu/omega)",
              "units": "1"})},
         coords={"theta": ("theta", thetas, {"units": "1"}),
                 "x2": ("x2", x2, {"long_name": "x2 of the start point on L1", "units": "1"})})
     return finalize(ds, scene, method=method, engine=kernel,
-                    title="return map P to L1 of the slow-fast Hopf example (fig:retmaps)")
+                    title="return map P to L1 of the slow-fast Hopf example (Fig. 4)")
 
 
 # ============================================================================= report

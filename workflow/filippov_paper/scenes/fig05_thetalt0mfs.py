@@ -171,7 +171,7 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
                                                    "units": "1"}),
         })
     return finalize(ds, scene, title="manifolds near the grazing point, theta < 0 "
-                    "(eq:exslow2/eq:exfast2)", p_g=P_G.tolist(),
+                    "(Eq. (15)/Eq. (16))", p_g=P_G.tolist(),
                     t_return=float(traj.t), x2_return=float(traj.z[1]))
 
 
@@ -285,18 +285,18 @@ def _surface_vars(s: dict) -> dict:
     """The surfaces of :func:`surfaces` on the grid and the convergence of M_-."""
     grid = ("x1_grid", "x2_grid")
     return {
-        "y_M_plus": (grid, s["X1"].copy(), {"long_name": "M_+ (eq:ymp): y = x1", "units": "1"}),
+        "y_M_plus": (grid, s["X1"].copy(), {"long_name": "M_+ (Eq. (17)): y = x1", "units": "1"}),
         "y_M_minus": (grid, s["y_num"], {
             "long_name": "M_-: y from E_- trajectories integrated (DOP853) onto the grid",
             "units": "1", "settle_over_eps": s["settle"]}),
         "y_M_minus_exact": (grid, s["y_exact"], {
             "long_name": "M_-: exact cubic (hopf.slow_manifold_minus)", "units": "1"}),
         "y_M_minus_expansion": (grid, s["y_exp"], {
-            "long_name": "M_-: O(eps) expansion eq:ymm", "units": "1"}),
+            "long_name": "M_-: O(eps) expansion Eq. (18)", "units": "1"}),
         "M_minus_error": (grid, s["y_num"] - s["y_exact"], {
             "long_name": "numerical M_- minus exact cubic", "units": "1"}),
         "M_minus_expansion_error": (grid, s["y_exact"] - s["y_exp"], {
-            "long_name": "exact M_- minus expansion eq:ymm (O(eps^2))", "units": "1"}),
+            "long_name": "exact M_- minus expansion Eq. (18) (O(eps^2))", "units": "1"}),
         "M_minus_invariance_residual": (grid, s["resid"], {
             "long_name": "eps dy/dx . f_- - g_- on the exact cubic (complex step)",
             "units": "1"}),
@@ -321,7 +321,7 @@ def _number_vars(family, eps: float, rate: float, s: dict, touches, z_orb) -> di
         "M_minus_max_error": one(np.max(np.abs(s["y_num"] - s["y_exact"])),
                                  "max |numerical M_- - exact cubic| on the grid"),
         "M_minus_max_expansion_error": one(np.max(np.abs(s["y_exact"] - s["y_exp"])),
-                                           "max |exact M_- - eq:ymm| on the grid"),
+                                           "max |exact M_- - Eq. (18)| on the grid"),
         "orbit_touch_t": one(touches[0].t if touches else np.nan,
                              "time of the grazing orbit's touch of H_s"),
         "orbit_min_x1": one(z_orb[0].min(), "min x1 on the grazing orbit"),

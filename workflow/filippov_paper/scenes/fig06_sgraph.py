@@ -46,10 +46,10 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     s_direct = sgraph.slope(t, theta, omega)
     s = img / xi1
     ds = xr.Dataset(
-        {"xi1": ("t_s", xi1, {"long_name": "xi1, rescaled x1 before sliding (eq:xi1r)",
-                              "units": "1", "equation": "eq:xi1r"}),
-         "image": ("t_s", img, {"long_name": "s(theta, omega, xi1, 0) xi1 = P_DM(xi1) (eq:xi1r)",
-                                "units": "1", "equation": "eq:xi1r"}),
+        {"xi1": ("t_s", xi1, {"long_name": "xi1, rescaled x1 before sliding (Eq. (23))",
+                              "units": "1", "equation": "Eq. (23)"}),
+         "image": ("t_s", img, {"long_name": "s(theta, omega, xi1, 0) xi1 = P_DM(xi1) (Eq. (23))",
+                                "units": "1", "equation": "Eq. (23)"}),
          "s": ("t_s", s, {"long_name": "slope s(theta, omega, xi1, 0) = image / xi1",
                           "units": "1"}),
          "slope_at_zero": ((), sgraph.slope_at_zero(theta), {
@@ -58,7 +58,7 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
              "long_name": "limit of s xi1 as t_s -> infinity: omega^2 (1 - theta)", "units": "1"})},
         coords={"t_s": ("t_s", t, {"long_name": "sliding time t_s", "units": "1",
                                    "spacing": "geometric from t_min joined to uniform"})})
-    return finalize(ds, scene, title="graph of s(theta, omega, ., 0) from eq:xi1r (fig:p:xi12)",
+    return finalize(ds, scene, title="graph of s(theta, omega, ., 0) from Eq. (23) (Fig. 6)",
                     max_abs_difference_s=float(np.max(np.abs(s - s_direct))))
 
 

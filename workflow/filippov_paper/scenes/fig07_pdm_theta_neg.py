@@ -25,7 +25,7 @@ from filippov_paper.report import Macros, head, num, per_eps_rows, rate_cell, so
 PARAMETERS_SCHEMA = {
   "properties": {
     "parameters": {
-      "description": "theta < 0: P_DM in xi1 = (x1 + 1)/eps (eq:scal), one curve per eps.",
+      "description": "theta < 0: P_DM in xi1 = (x1 + 1)/eps (Eq. (B.2)), one curve per eps.",
       "required": ["eps", "mu", "omega", "theta", "xi1_min", "xi1_max", "n_uniform",
                    "n_geometric", "closest"],
       "$ref": "#/$defs/pdm_sweep",
@@ -104,17 +104,17 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     d2 = ("eps", "xi1")
     ds["P_first_order"] = (d2, first, {
         "long_name": "xi1 + s0 + sqrt(eps) s0 sqrt(-2 xi1) (omega/(theta+s0) - 2/omega): "
-                     "eq:pdmdisc with Pi_3 corrected", **u})
+                     "Eq. (B.20) with Pi_3 corrected", **u})
     ds["P_zero_order"] = (d2, zero, {"long_name": "xi1 + s0(theta) for xi1 < 0 (corrected "
                                                   "zero order)", **u})
-    ds["P_printed"] = (d2, printed, {"long_name": "eq:pdmdisc / eq:pdmtlt0 as printed", **u})
+    ds["P_printed"] = (d2, printed, {"long_name": "Eq. (B.20) / Eq. (21) as printed", **u})
     ds["xi2_entry_asym"] = (d2, asym.xi2_entry_theta_neg(x, omega, e2), {
-        "long_name": "xi2 at H_s from eq:xi2int", **u})
+        "long_name": "xi2 at H_s from Eq. (B.12)", **u})
     ds["excursion_time_asym"] = (d2, asym.hit_time_theta_neg(f["xi2_entry"], theta, omega, e2), {
-        "long_name": "s_* from eq:hittime at the numerical xi2_entry", **u})
+        "long_name": "s_* from Eq. (B.14) at the numerical xi2_entry", **u})
     ds["pi3_drop_asym"] = (d2, 0.5 * f["xi2_exit"] ** 2, {
         "long_name": "xi2(p2)^2 / 2: leading-order drop of xi1 under Pi_3 (the printed "
-                     "eq:xi14 has 0)", **u})
+                     "Eq. (B.18) has 0)", **u})
 
     neg = xi < 0
     err1 = max_error(f["P"], first, neg)
@@ -125,28 +125,28 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     for name, val, what in [
             ("error_first_order", err1, "first-order corrected expansion"),
             ("error_zero_order", err0, "xi1 + s0"),
-            ("error_printed", errp, "eq:pdmdisc as printed")]:
+            ("error_printed", errp, "Eq. (B.20) as printed")]:
         ds[name] = ("eps", val, {"long_name": f"max over xi1 < 0 of |P_DM - ({what})|", **u})
     ds["rate_first_order"] = ("eps", loc1, {"long_name": "local slope of log error_first_order "
                                                          "against log eps", **u})
     ds["rate_zero_order"] = ("eps", loc0, {"long_name": "local slope of log error_zero_order "
                                                         "against log eps", **u})
     ds["error_xi2_entry"] = ("eps", max_error(f["xi2_entry"], ds["xi2_entry_asym"].values, neg),
-                             {"long_name": "max |xi2_entry - eq:xi2int|", **u})
+                             {"long_name": "max |xi2_entry - Eq. (B.12)|", **u})
     ds["error_excursion_time"] = ("eps", max_error(f["excursion_time"],
                                                    ds["excursion_time_asym"].values, neg),
-                                  {"long_name": "max |s_* - eq:hittime|", **u})
+                                  {"long_name": "max |s_* - Eq. (B.14)|", **u})
     k = int(np.argmax(neg & (xi == xi[neg].max())))  # the grid point closest to 0-
     ds["xi1_left"] = ((), float(xi[k]), {"long_name": "grid point closest to 0 from below", **u})
     ds["P_left"] = ("eps", f["P"][:, k], {"long_name": "numerical P_DM at xi1_left", **u})
     ds["left_limit_error"] = ("eps", np.abs(f["P"][:, k] - s0), {
         "long_name": "|P_DM(xi1_left) - s0(theta)|", **u})
-    ds["s0"] = ((), s0, {"long_name": "s0(theta), eq:s0def", **u})
+    ds["s0"] = ((), s0, {"long_name": "s0(theta), Eq. (B.15)", **u})
     ds["jump_x1"] = ("eps", eps * s0, {"long_name": "jump of P_DM at 0 in original units, "
                                                     "eps s0", **u})
     return finalize(ds, scene, method=scene["ingredients"]["flow"],
                     rate_first_order_fit=fit1, rate_zero_order_fit=fit0,
-                    title="discontinuity map P_DM for theta < 0 (fig:pdmthlt0)")
+                    title="discontinuity map P_DM for theta < 0 (Fig. B.1)")
 
 
 # ============================================================================= report

@@ -19,7 +19,7 @@ class S0ClosedForm(Protocol):
 
 MODEL = S0ClosedForm
 
-VARIABLE_ATTRS = {"residual": ("left side of eq:s0def at the closed-form s0", "1")}
+VARIABLE_ATTRS = {"residual": ("left side of Eq. (B.15) at the closed-form s0", "1")}
 from filippov_paper.tolerance import U, Tolerance
 
 
@@ -47,15 +47,15 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
     diff = np.abs(closed - root)
     ds = xr.Dataset(
         {"s0": ("theta", closed, {"long_name": "s0(theta), closed form via Lambert W_0",
-                                  "units": "1", "equation": "eq:s0def"}),
-         "s0_root": ("theta", root, {"long_name": "s0(theta) by Brent root finding on eq:s0def",
+                                  "units": "1", "equation": "Eq. (B.15)"}),
+         "s0_root": ("theta", root, {"long_name": "s0(theta) by Brent root finding on Eq. (B.15)",
                                      "units": "1"}),
          "residual": ("theta", s0.residual(closed, theta),
-                      {"long_name": "left side of eq:s0def at the closed-form s0"})},
+                      {"long_name": "left side of Eq. (B.15) at the closed-form s0"})},
         coords={"theta": ("theta", theta, {"long_name": "theta", "units": "1",
                                             "spacing": "geometric in -theta"})})
     return finalize(ds, scene, max_abs_difference=float(diff.max()),
-                    title="s0(theta), the positive root of eq:s0def")
+                    title="s0(theta), the positive root of Eq. (B.15)")
 
 
 # ============================================================================= report

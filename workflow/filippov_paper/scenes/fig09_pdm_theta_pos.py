@@ -24,7 +24,7 @@ from filippov_paper.report import Macros, head, num, per_eps_rows, rate_cell, so
 PARAMETERS_SCHEMA = {
   "properties": {
     "parameters": {
-      "description": "0 < theta < 1: P_DM in xi1 = (x1 + 1)/eps^2 (eq:p:scal), one curve per eps; core: half-width of the fixed xi1 window for the convergence rate.",
+      "description": "0 < theta < 1: P_DM in xi1 = (x1 + 1)/eps^2 (Eq. (B.24)), one curve per eps; core: half-width of the fixed xi1 window for the convergence rate.",
       "required": ["eps", "mu", "omega", "theta", "xi1_min", "xi1_max", "n_uniform",
                    "n_geometric", "closest", "core"],
       "$ref": "#/$defs/pdm_sweep",
@@ -105,20 +105,20 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     d2 = ("eps", "xi1")
     ds["P_zero_order"] = (d2, corrected, {
         "long_name": "zero-order P_DM, xi_{1,2} - xi_{1,2}^2/(2 omega^2) along the sliding "
-                     "time (eq:p:xi14t2 with Pi_3 corrected)", **u})
-    ds["P_printed"] = (d2, printed, {"long_name": "eq:p:xi14t2 as printed (= s xi1 of eq:xi1r)",
+                     "time (Eq. (B.34) with Pi_3 corrected)", **u})
+    ds["P_printed"] = (d2, printed, {"long_name": "Eq. (B.34) as printed (= s xi1 of Eq. (23))",
                                      **u})
     ds["P_linear"] = ("xi1", asym.pdm_theta_pos_linear(xi, theta), {
-        "long_name": "eq:p:pdm: slope (theta-1)/theta for xi1 < 0", **u})
+        "long_name": "Eq. (B.23): slope (theta-1)/theta for xi1 < 0", **u})
     ds["P_reduced"] = ("xi1", asym.pdm_reduced(xi), {"long_name": "reduced model (eps = 0)",
                                                      **u})
-    ds["excursion_time_asym"] = (d2, t2, {"long_name": "sliding time t2 from eq:p:xi10t2", **u})
+    ds["excursion_time_asym"] = (d2, t2, {"long_name": "sliding time t2 from Eq. (B.33)", **u})
     ds["xi2_entry_asym"] = (d2, np.where(x < 0, xi21, np.nan),
-                            {"long_name": "xi_{2,1} from eq:p:xi21", **u})
+                            {"long_name": "xi_{2,1} from Eq. (B.30)", **u})
     ds["xi1_exit_asym"] = (d2, np.where(x < 0, xi12, np.nan),
-                           {"long_name": "xi_{1,2} from eq:p:xi12", **u})
+                           {"long_name": "xi_{1,2} from Eq. (B.31)", **u})
     ds["pi3_drop_asym"] = (d2, 0.5 * f["xi2_exit"] ** 2, {
-        "long_name": "xi2(p2)^2 / 2: leading-order drop of xi1 under Pi_3 (eq:p:xi14t2 "
+        "long_name": "xi2(p2)^2 / 2: leading-order drop of xi1 under Pi_3 (Eq. (B.34) "
                      "as printed has 0)", **u})
 
     core = float(p["core"])
@@ -133,28 +133,28 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
     for name, val, what in [
             ("error", err, "max over xi1 < 0 of |P_DM - zero-order corrected|"),
             ("error_core", err_core, f"the same over -{core:g} <= xi1 < 0"),
-            ("error_printed", errp, "max over xi1 < 0 of |P_DM - eq:p:xi14t2 as printed|"),
+            ("error_printed", errp, "max over xi1 < 0 of |P_DM - Eq. (B.34) as printed|"),
             ("error_slope", rel, "max over xi1 < 0 of |P_DM/xi1 - zero-order s|")]:
         ds[name] = ("eps", val, {"long_name": what, **u})
     ds["rate"] = ("eps", loc, {"long_name": "local slope of log error against log eps", **u})
     ds["rate_core"] = ("eps", loc_c, {"long_name": "local slope of log error_core against "
                                                    "log eps", **u})
     ds["error_xi1_exit"] = ("eps", max_error(f["xi1_exit"], ds["xi1_exit_asym"].values, in_core),
-                            {"long_name": "max over the core |xi1(p2) - eq:p:xi12|", **u})
+                            {"long_name": "max over the core |xi1(p2) - Eq. (B.31)|", **u})
     k = int(np.flatnonzero(neg)[-1])  # grid point closest to 0 from below
     slope = f["P"][:, k] / xi[k]
     ds["xi1_left"] = ((), float(xi[k]), {"long_name": "grid point closest to 0 from below", **u})
     ds["P_left"] = ("eps", f["P"][:, k], {"long_name": "numerical P_DM at xi1_left "
                                                        "(continuity: -> 0)", **u})
     ds["slope_left"] = ("eps", slope, {"long_name": "P_DM(xi1_left)/xi1_left", **u})
-    ds["slope_theory"] = ((), (theta - 1) / theta, {"long_name": "(theta-1)/theta (eq:p:pdm)",
+    ds["slope_theory"] = ((), (theta - 1) / theta, {"long_name": "(theta-1)/theta (Eq. (B.23))",
                                                     **u})
     ds["sliding_limit_xi2"] = ("eps", theta / ((1 - theta) * omega * eps), {
-        "long_name": "xi2 above which f_- no longer points to H_s (eq:p:tangency): end of the "
+        "long_name": "xi2 above which f_- no longer points to H_s (Eq. (B.27)): end of the "
                      "sliding regime", **u})
     return finalize(ds, scene, method=scene["ingredients"]["flow"], rate_fit=fit,
                     rate_core_fit=fit_c, core=core,
-                    title="discontinuity map P_DM for theta > 0 (fig:pdmthgt0)")
+                    title="discontinuity map P_DM for theta > 0 (Fig. B.3)")
 
 
 # ============================================================================= report

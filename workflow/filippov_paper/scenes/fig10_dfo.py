@@ -44,7 +44,7 @@ from filippov_paper.report import Macros, absent, scalar_table, var
 PARAMETERS_SCHEMA = {
   "properties": {
     "parameters": {
-      "description": "Reduced dry-friction oscillator eq:dfo1 over the belt speed v.",
+      "description": "Reduced dry-friction oscillator Eq. (C.1) over the belt speed v.",
       "required": ["f0", "fv", "fc", "v_min", "v_max", "n_stick_slip", "gs_closest",
                    "amp_min", "ds", "nu_max"],
       "$ref": "#/$defs/friction_law",
@@ -427,8 +427,8 @@ def assemble(scene: dict, raw: xr.Dataset) -> xr.Dataset:
          **_friction_vars(model, law, p)},
     )
     return finalize(ds, scene, method="integrate", friction_convention=law["convention"],
-                    title="dry-friction oscillator eq:dfo1: friction law and bifurcation "
-                          "diagram (fig:dfo)")
+                    title="dry-friction oscillator Eq. (C.1): friction law and bifurcation "
+                          "diagram (Fig. C.1)")
 
 
 def unstable_cycles(raw: xr.Dataset):

@@ -76,7 +76,7 @@ MODEL = FrictionReturns
 PARAMETERS_SCHEMA = {
   "properties": {
     "parameters": {
-      "description": "Slow-fast dry-friction oscillator eq:dfo-sf; one v0 per eps (panels).",
+      "description": "Slow-fast dry-friction oscillator Eq. (C.3); one v0 per eps (panels).",
       "required": ["gamma", "f0", "fv", "fc", "eps", "v0", "x1_min", "x1_max", "n_x1",
                    "sn_x1_range"],
       "$ref": "#/$defs/friction_law",
@@ -559,7 +559,7 @@ def compute(scene: dict, *, progress: bool = False) -> xr.Dataset:
                                                             "units": "1"}),
                 "x1": ("x1", x1, {"long_name": "x1 of the start point on L", "units": "1"})})
     return finalize(ds, scene, method="integrate", friction_convention=c.law["convention"],
-                    title="return maps of the slow-fast dry-friction oscillator (fig:dfo-retmap)")
+                    title="return maps of the slow-fast dry-friction oscillator (Fig. C.2)")
 
 
 @dataclass(frozen=True)
@@ -727,8 +727,8 @@ def _lemma_vars(c: _Settings) -> dict:
     one = "1"
     return {
         "chi_minus": ((), chi, {"long_name": "dh/dx f_- - dh/dx f_+ at the grazing point "
-                                "(eq:chiminus); > 0: case 1 of thm:gen", "units": one}),
-        "chi_minus_literal": ((), chi_l, {"long_name": "eq:chiminus for the printed law "
+                                "(Eq. (A.5)); > 0: case 1 of Lemma 2", "units": one}),
+        "chi_minus_literal": ((), chi_l, {"long_name": "Eq. (A.5) for the printed law "
                                           "read literally", "units": one}),
         "sticking_a": ((), a, {"long_name": "dh/dt along f_- at (0, v0), reduced", "units": one}),
         "sticking_b": ((), b, {"long_name": "dh/dt along f_+ at (0, v0), reduced", "units": one}),

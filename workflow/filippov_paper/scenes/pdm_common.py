@@ -145,7 +145,7 @@ def base_dataset(eps, xi, f, theta: float) -> xr.Dataset:
     u = {"units": "1"}
     ds = xr.Dataset(
         {"P_DM": (d2, f["P"], {"long_name": "P_DM(xi1), numerical: Pi_3 o P_3 o Pi_2 o Pi_1 "
-                                            "by the solver (eq:pdmdiscdef)", **u}),
+                                            "by the solver (Eq. (B.1))", **u}),
          "P_flow": (d2, f["P_flow"], {"long_name": "xi1 where the true trajectory first reaches "
                                                    "L2 (differs from P_DM where it re-crosses H_s)",
                                       **u}),
