@@ -72,6 +72,12 @@ def num(x, sig: int = 3) -> str:
     return rf"{mant}\times10^{{{exp}}}"
 
 
+def num_range(lo, hi, sig: int = 3) -> str:
+    """A range of two measured numbers as a table cell, '$0.52$--$0.81$': the spread of a
+    time (first to third quartile) or the range of a ratio of two times."""
+    return f"${num(lo, sig)}$--${num(hi, sig)}$"
+
+
 def parse_num(text: str) -> float:
     """Inverse of :func:`num` (used by the tests to read macros back)."""
     t = text.replace(r"\ensuremath", "").replace("{", "").replace("}", "").replace(" ", "")

@@ -24,7 +24,11 @@ without their machinery):
 
 A per-call time cap is the caller's business (the work-precision runners raise
 :class:`filippov_paper.benchmarks.baseline.TimeCapExceeded` themselves). Write
-:func:`describe` into a dataset's attributes to say which statistic it shows.
+:func:`describe` into a dataset's attributes to say which statistic it shows, and
+:func:`variables` for the data variables of a timed quantity: the median under its own
+name, its spread and extremes under ``_q1``, ``_q3``, ``_min`` and ``_max`` (the naming of
+the work-precision dataset); a ratio of two timed quantities is a range
+(:func:`ratio_range`), never one number alone.
 """
 from __future__ import annotations
 
@@ -35,6 +39,8 @@ import statistics
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence, Union
+
+import numpy as np
 
 #: the statistic a benchmark table shows (the min is stored next to it)
 STATISTIC = "median"
@@ -154,6 +160,56 @@ def measure_interleaved(fns: Sequence[Callable[[], Any]], *,
                 failed[k] = exc
     return [failed[k] if k in failed else of_rounds(times[k], warmed[k], values[k])
             for k in range(n)]
+
+
+#: the data variables of a timed quantity ``name`` (:func:`variables`): (suffix, the
+#: Timing's field, long_name with ``{what}`` and ``{name}`` to fill in)
+STORED = (("", "median", "median {what} over the timed rounds"),
+          ("_q1", "q1", "first quartile of the {what} over the timed rounds (the spread of "
+                        "{name}: q1 to q3)"),
+          ("_q3", "q3", "third quartile of the {what} over the timed rounds"),
+          ("_min", "min", "min {what} (the fastest timed round)"),
+          ("_max", "max", "max {what} (the slowest timed round)"))
+
+
+def variables(name: str, dims, timings, what: str, *, per: float = 1.0,
+              units: str = "s") -> dict:
+    """The data variables of the timed quantity ``name`` over ``dims``: ``name`` the
+    median of the rounds, ``name_q1`` and ``name_q3`` its spread, ``name_min`` and
+    ``name_max`` the fastest and slowest round (:data:`STORED`), each with long_name,
+    units and ``statistic`` as in the work-precision dataset. ``timings``: nested lists
+    (the shape of ``dims``) of :class:`Timing`, or of anything else (an exception, None)
+    for what was not timed (NaN); ``per``: each time divided by it (e.g. the returns of a
+    call, for a time per return); ``what``: the quantity in words ("wall time per return")."""
+    cells = np.asarray(timings, dtype=object)  # a Timing is one cell (not a sequence)
+    out = {}
+    for suffix, stat, long_name in STORED:
+        values = np.full(cells.shape, np.nan)
+        for idx in np.ndindex(cells.shape):
+            if isinstance(cells[idx], Timing):
+                values[idx] = getattr(cells[idx], stat) / per
+        out[name + suffix] = (tuple(dims), values, {
+            "long_name": long_name.format(what=what, name=name), "units": units,
+            "statistic": stat})
+    return out
+
+
+def rounds(timings) -> np.ndarray:
+    """The timed rounds of each of ``timings`` (nested lists as for :func:`variables`;
+    0 for what was not timed)."""
+    cells = np.asarray(timings, dtype=object)
+    out = np.zeros(cells.shape, dtype=np.int32)
+    for idx in np.ndindex(cells.shape):
+        if isinstance(cells[idx], Timing):
+            out[idx] = cells[idx].rounds
+    return out
+
+
+def ratio_range(num: Timing, den: Timing) -> tuple[float, float, float]:
+    """``num`` over ``den``: the ratio of the medians, and its range from the spread (the
+    work-precision speed-ups' rule): ``num``'s first quartile over ``den``'s third, its
+    third over ``den``'s first. The medians' ratio lies in the range."""
+    return num.median / den.median, num.q1 / den.q3, num.q3 / den.q1
 
 
 def describe(*, warmup: int = WARMUP, min_rounds: int = MIN_ROUNDS, min_time: float = MIN_TIME,
