@@ -217,6 +217,9 @@ def test_return_floor_counts_without_changing_returns(monkeypatch):
     assert flows == ds.samples.values[0] + ds.root_flows.values[0]
     assert 0 < ds.flow_floor.values[0] < ds.floor.values[0]
     assert ds.target.values[0] == 5e-6 and "floor" in lines[0]
+    # a CPU-time benchmark (min of the thread's clock), but it names the machine and its load
+    for key in MACHINE:
+        assert key in ds.attrs, key
 
 
 def test_instruction_cost_reads_callgrind_s_dumps_in_order(tmp_path):
@@ -265,3 +268,319 @@ def test_instruction_cost_s_probes_mark_their_phases_with_the_one_function_callg
         calls = re.findall(r"\bos\.(\w+)\(", probe)
         assert calls == [ic.MARK] * marks
     assert ic.MARK != "getppid"  # entered by the cold compile itself (see MARK)
+
+
+# ----------------------------------------------------------------------------- the timing
+# convention in every wall-clock benchmark (filippov_paper.benchmarks.timing): the things
+# timed against each other get their rounds in passes, every time is stored with its
+# spread and extremes in the work-precision dataset's naming, the dataset names the machine
+# and its load, and whatever is printed shows the stored median with its quartiles and a
+# ratio as a range.
+MACHINE = ("machine_cpu", "cpus", "load_average_before", "load_average_after",
+           "python_version", "numpy_version", "scipy_version", "numba_version")
+
+
+def _passes(cells, repeat):
+    """The order of calls of measure_interleaved with min_time 0: in pass 1 each cell's
+    warm-up call and its first round, then one round of each per pass."""
+    return [c for c in cells for _ in range(2)] + list(cells) * (repeat - 1)
+
+
+def _check_spread(ds, name, dims, units="s"):
+    """``name`` stored with its spread and extremes (work_precision's naming: _q1, _q3,
+    _min, _max; long_name, units, statistic), in order min <= q1 <= median <= q3 <= max."""
+    from filippov_paper.benchmarks import timing
+
+    for suffix, stat, _ in timing.STORED:
+        var = ds[name + suffix]
+        assert var.dims == dims and var.attrs["units"] == units, name + suffix
+        assert var.attrs["statistic"] == stat and var.attrs["long_name"], name + suffix
+    order = [ds[name + s].values for s in ("_min", "_q1", "", "_q3", "_max")]
+    for lo, hi in zip(order, order[1:]):
+        assert np.all((lo <= hi) | np.isnan(lo) & np.isnan(hi)), name
+
+
+def _check_timed_dataset(ds, passes):
+    assert ds.attrs["timing_order"] == "interleaved" and ds.attrs["timing_passes"] == passes
+    assert ds.attrs["timing_statistic"] == "median"
+    for key in MACHINE:
+        assert key in ds.attrs, key
+
+
+def test_attractor_cost_interleaves_plain_and_dpdz_and_prints_the_spread(monkeypatch):
+    from filippov_paper import report
+    from filippov_paper.benchmarks import attractor_cost as ac
+
+    cases = [(-0.5, 1e-2, 1.0), (0.2, 1e-3, 2.0)]
+    monkeypatch.setattr(ac, "CASES", cases)
+    monkeypatch.setattr(ac, "MIN_TIME", 0.0)
+    calls, real = [], ac.compute_returns
+
+    def recording(cm, start, t_max, **kw):
+        if kw.get("iterations", 1) > 1:  # a timed call (the switches are counted one by one)
+            calls.append((float(start[0, 1]), kw["jacobian"]))
+        return real(cm, start, t_max, **kw)
+
+    monkeypatch.setattr(ac, "compute_returns", recording)
+    lines = []
+    ds = ac.run(returns=5, repeat=3, log=lines.append)
+    starts = list(dict.fromkeys(x for x, _ in calls))   # the cases' start points, in order
+    assert len(starts) == 2
+    cells = [(x, jac) for x in starts for jac in (False, True)]
+    assert calls == _passes(cells, 3)
+    _check_timed_dataset(ds, 3)
+    for name in ("time_per_return", "time_per_return_jacobian"):
+        _check_spread(ds, name, ("case",))
+    assert np.all(ds.runs.values == 3) and np.all(ds.runs_jacobian.values == 3)
+    # the table: per case the stored medians, each with its first to third quartile
+    m = report.Macros()
+    rows = [r for r in ac.report(ds, m).splitlines() if r.startswith("$") and "theta" not in r]
+    assert m.flags["rpHaveReturnCost"] and len(rows) == 2
+    for k, row in enumerate(rows):
+        cells = [c.strip() for c in row.removesuffix(r"\\").split("&")]
+        for col, name in ((3, "time_per_return"), (5, "time_per_return_jacobian")):
+            us = {q: 1e6 * float(ds[name + q].values[k]) for q in ("", "_q1", "_q3")}
+            assert cells[col] == f"${report.num(us[''], 3)}$"
+            assert cells[col + 1] == report.num_range(us["_q1"], us["_q3"], 3)
+    # the printed log: the ratio with dP/dz as a range (low..high)
+    assert "ratio (q1..q3)" in lines[1] and lines[2].count("..") == 3
+    # a dataset of before (no spread): not quoted
+    m = report.Macros()
+    assert ac.report(ds.drop_vars("time_per_return_q1"), m) is None
+    assert not m.flags["rpHaveReturnCost"]
+
+
+# a variant's process for the test below: the protocol of effect_cost._CHILD (the scene on
+# the first line, then a compute call per line), the scene telling it what to do; each call
+# is written to the log file $EFFECT_LOG, and the seconds a call "took" grow by 10% a call
+FAKE_VARIANT = r"""
+import json, os, sys, time
+scene = json.loads(sys.stdin.readline())
+calls = 0
+while sys.stdin.readline():
+    calls += 1
+    with open(os.environ["EFFECT_LOG"], "a") as f:
+        f.write(scene["label"] + "\n")
+    if scene.get("hang"):
+        time.sleep(60)
+    if scene.get("crash"):
+        sys.stderr.write("boom\n")
+        sys.exit(3)
+    out = ({"error": "ValueError: needs sliding"} if scene.get("fail")
+           else {"seconds": scene["seconds"] * (1 + 0.1 * calls)})
+    sys.stdout.write(json.dumps(out) + "\n")
+    sys.stdout.flush()
+"""
+
+
+def test_effect_cost_interleaves_the_variants_processes_and_prints_the_spread(monkeypatch,
+                                                                               tmp_path):
+    """A scene's variants each in a process of its own, kept for all its calls, their
+    rounds interleaved in passes (a round: the seconds the process measured); a variant
+    that fails, crashes or runs over the cap is listed with its status and dropped from
+    the later passes."""
+    from filippov_paper import report
+    from filippov_paper.benchmarks import effect_cost as ec
+
+    log = tmp_path / "calls.log"
+    monkeypatch.setenv("EFFECT_LOG", str(log))
+    monkeypatch.setattr(ec, "_CHILD", FAKE_VARIANT)
+    monkeypatch.setattr(ec, "load_scene", lambda path, schema: {"id": path.stem})
+    toy = [("as declared", {"label": "a", "seconds": 0.5}),
+           ("flow: exact -> integrate", {"label": "b", "seconds": 1.0}),
+           ("sliding: True -> False", {"label": "c", "fail": True}),
+           ("engine: compiled -> reference", {"label": "d", "hang": True}),
+           ("system: slow_fast -> reduced", {"label": "e", "crash": True})]
+    monkeypatch.setattr(ec, "variants", lambda scene: toy)
+    ds = ec.measure(["toy_scene"], cap=2.0, log=lambda s: None, repeat=3, min_time=0.0)
+    assert log.read_text().split() == _passes("ab", 3)[:4] + ["c", "d", "e"] + ["a", "b"] * 2
+    assert list(ds.status.values) == ["ok", "ok", "ValueError: needs sliding",
+                                      "time cap (2 s)", "crashed: ['boom']"]
+    _check_timed_dataset(ds, 3)
+    _check_spread(ds, "seconds", ("variant",))
+    # the rounds are the seconds the processes measured: calls 2..4 after the warm-up
+    for k, base in enumerate((0.5, 1.0)):
+        rounds = base * np.array([1.2, 1.3, 1.4])
+        assert ds.seconds.values[k] == pytest.approx(np.median(rounds))
+        assert ds.seconds_q1.values[k] == pytest.approx(np.percentile(rounds, 25))
+        assert ds.seconds_q3.values[k] == pytest.approx(np.percentile(rounds, 75))
+    assert list(ds.runs.values) == [3, 3, 0, 0, 0] and np.all(np.isnan(ds.seconds.values[2:]))
+    # the ratio to the scene as declared: the medians', and its range from the quartiles
+    assert ds.relative.values[:2] == pytest.approx([1.0, 2.0])
+    assert ds.relative_low.values[1] == pytest.approx(ds.seconds_q1[1] / ds.seconds_q3[0])
+    assert ds.relative_high.values[1] == pytest.approx(ds.seconds_q3[1] / ds.seconds_q1[0])
+    m = report.Macros()
+    rows = [r for r in ec.report(ds, m).splitlines() if r.startswith(r"\texttt")]
+    assert m.flags["rpHaveEffects"] and len(rows) == len(toy)
+    for k, row in enumerate(rows[:2]):
+        cells = [c.strip() for c in row.removesuffix(r"\\").split("&")]
+        assert cells[2] == f"${report.num(float(ds.seconds.values[k]), 3)}$"
+        assert cells[3] == report.num_range(float(ds.seconds_q1.values[k]),
+                                            float(ds.seconds_q3.values[k]), 3)
+        assert cells[4] == report.num_range(float(ds.relative_low.values[k]),
+                                            float(ds.relative_high.values[k]), 3)
+
+
+def test_parallel_scaling_interleaves_the_worker_counts_and_keeps_the_spread(monkeypatch):
+    from filippov_paper.benchmarks import parallel_scaling as ps
+
+    monkeypatch.setattr(ps, "MIN_TIME", 0.0)
+    monkeypatch.setattr(ps, "cores", lambda: 2)
+    calls, real = [], ps.compute_returns
+
+    def recording(cm, z0, t_max, **kw):
+        calls.append((float(z0[0, 1]), kw["workers"]))
+        return real(cm, z0, t_max, **kw)
+
+    monkeypatch.setattr(ps, "compute_returns", recording)
+    lines = []
+    ds = ps.run(starts=40, returns=2, repeat=3, log=lines.append)
+    starts = list(dict.fromkeys(x for x, _ in calls))
+    assert calls == _passes([(x, n) for x in starts for n in (1, 2)], 3)
+    _check_timed_dataset(ds, 3)
+    for name in ("wall_time", "cpu_time", "span"):
+        _check_spread(ds, name, ("case", "workers"))
+    assert np.all(ds.runs.values == 3)
+    # the speed-up over one worker: the medians' ratio inside its range from the quartiles
+    assert np.all(ds.speedup_low.values <= ds.speedup.values)
+    assert np.all(ds.speedup.values <= ds.speedup_high.values)
+    assert ds.speedup_low.values[0, 1] == pytest.approx(
+        float(ds.wall_time_q1[0, 0] / ds.wall_time_q3[0, 1]))
+    # the printed table: the wall time's median (q1..q3) as stored, ratios as ranges
+    row = lines[2].split()
+    assert float(row[3]) == pytest.approx(1e3 * float(ds.wall_time[0, 0]), abs=0.006)
+    assert "wall ms (q1..q3)" in lines[1] and lines[2].count("..") == 4
+
+
+def test_sweep_cost_interleaves_its_three_ways_and_keeps_the_spread(monkeypatch):
+    from filippov_paper.benchmarks import sweep_cost as sc
+
+    monkeypatch.setattr(sc, "MIN_TIME", 0.0)
+    monkeypatch.setattr(sc, "cores", lambda: 2)
+    calls = []
+    loop, sweep = sc.compute_returns, sc.sweep_returns
+
+    def loop_call(*a, **kw):
+        calls.append("loop")
+        return loop(*a, **kw)
+
+    def sweep_call(*a, **kw):
+        calls.append(f"sweep {kw['workers']}")
+        return sweep(*a, **kw)
+
+    monkeypatch.setattr(sc, "compute_returns", loop_call)
+    monkeypatch.setattr(sc, "sweep_returns", sweep_call)
+    points, lines = 4, []
+    ds = sc.run(points=points, returns=2, repeat=3, log=lines.append)
+    # a round of the loop is a call per point: one entry per round
+    rounds, k = [], 0
+    while k < len(calls):
+        rounds.append(calls[k])
+        k += points if calls[k] == "loop" else 1
+    assert rounds == _passes(["loop", "sweep 1", "sweep 2"] * 2, 3)
+    _check_timed_dataset(ds, 3)
+    for name in ("wall_time", "cpu_time"):
+        _check_spread(ds, name, ("case", "variant"))
+    row = lines[2].split()   # theta eps loop  median (q1..q3) ...
+    assert float(row[3]) == pytest.approx(float(ds.wall_time[0, 0]), abs=0.0006)
+    assert "median (q1..q3)" in lines[0] and lines[2].count("..") == 4
+
+
+def test_sliding_cost_interleaves_its_returns_and_keeps_the_spread(monkeypatch):
+    from filippov_paper.benchmarks import sliding_cost as sl
+
+    monkeypatch.setattr(sl, "EPS", [1e-2])
+    monkeypatch.setattr(sl, "MIN_TIME", 0.0)
+    stages, real = [], sl.driver.simulate
+
+    def recording(*a, **kw):
+        stages.append(sl.driver.STIFF_STAGES)
+        return real(*a, **kw)
+
+    monkeypatch.setattr(sl.driver, "simulate", recording)
+    default = sl.driver.STIFF_STAGES
+    lines = []
+    ds = sl.run(repeat=3, log=lines.append)
+    assert stages == _passes(sl.STAGES, 3) and sl.driver.STIFF_STAGES == default
+    _check_timed_dataset(ds, 3)
+    _check_spread(ds, "time", ("eps", "stages"))
+    assert np.all(ds.runs.values == 3) and np.all(ds.steps.values > 0)
+    # the printed table: the median (q1..q3) in ms as stored, the ratio as a range
+    cells = lines[2].split()
+    assert float(cells[2]) == pytest.approx(1e3 * float(ds.time[0, 0]), abs=0.06)
+    assert "ms (q1..q3)" in lines[1] and lines[2].count("..") == 4
+
+
+def test_fig04_speed_interleaves_the_methods_and_prints_the_spread(monkeypatch, capsys):
+    from filippov_paper.benchmarks import fig04_speed as f4, timing, work_precision as wp
+
+    calls = []
+
+    def fake_runner(problem, family, tol, time_cap):   # P = tol everywhere
+        def run():
+            calls.append((problem.name, family, tol))
+            return np.full(problem.x2.size, tol), None
+        return run
+
+    base = wp.fig04_problems(every=97)[0]
+    probs = [wp.Problem(f"p{k}", np.array([0.5, 2.0]), base.model, np.ones(2, bool))
+             for k in range(2)]
+    monkeypatch.setattr(f4, "runner", fake_runner)
+    monkeypatch.setattr(f4, "fig04_problems", lambda every: probs)
+    monkeypatch.setattr(f4, "compile_kernel", lambda: None)
+    f4.main(["--repeat", "3", "--min-time", "0"])
+    out = capsys.readouterr().out
+    for p in probs:   # its methods' runs interleaved, then the untimed reference check
+        mine = [c[1:] for c in calls if c[0] == p.name]
+        # one untimed run per family: the second RK45 tolerance has none
+        first = [m for m in f4.METHODS for _ in range(1 if m == f4.METHODS[3] else 2)]
+        assert mine == first + f4.METHODS * 2 + [("project DOP853", 1e-13)]
+    assert "(q1..q3)" in out and "load average" in out and "machine:" in out
+    # a row: median (first..third quartile) and the ratio to the project's as a range
+    t = timing.of_rounds([1.0, 2.0, 3.0, 4.0])
+    row = f4._row("p", "m", t, 1e-9, timing.ratio_range(t, timing.of_rounds([0.5, 1.0])))
+    assert "2.500 (    1.750..    3.250)" in row and "2.0..     5.2" in row
+
+
+def test_compile_cost_keeps_the_spread_of_its_pairs_of_processes(monkeypatch):
+    """A cold process, then a warm one on the caches it wrote, pair after pair (the one
+    order there is: no interleaving); per stage the median over the pairs, its quartiles
+    and extremes; the report quotes the quartiles when there is more than one pair."""
+    from filippov_paper import report
+    from filippov_paper.benchmarks import compile_cost as cc
+
+    caches, seconds = [], iter([3.0, 1.0, 2.0, 6.0, 4.0, 5.0])
+
+    def fake_process(cache):
+        warm = cache in caches
+        caches.append(cache)
+        t = next(seconds)
+        return {**{s: (0.01 if warm else 1.0) * t for s, _ in cc.STAGES}, "loaded": warm,
+                "dpdz_before": 0, "ok": 8}
+
+    monkeypatch.setattr(cc, "_process", fake_process)
+    ds = cc.run(repeat=3, log=lambda *a, **k: None)
+    assert caches[0::2] == caches[1::2] and len(set(caches)) == 3   # a pair per cache
+    for name in ("cold", "warm"):
+        _check_spread(ds, name, ("stage",))
+    assert ds.cold.sel(stage="kernel").item() == 3.0            # the cold ones: 3, 2, 4
+    assert ds.cold_q1.sel(stage="kernel").item() == 2.5
+    assert ds.cold_q3.sel(stage="kernel").item() == 3.5
+    assert ds.warm_max.sel(stage="kernel").item() == pytest.approx(0.06)
+    assert np.all(ds.runs.values == 3) and ds.attrs["timing_warmup"] == 0
+    for key in MACHINE:
+        assert key in ds.attrs, key
+    m = report.Macros()
+    cc.report(ds, m)
+    got = report.read_macros(m.tex())
+    assert m.flags["rpHaveCompileSpread"] and got["rpCompilePairs"][0] == \
+        "three pairs of fresh processes"
+    body, src = got["rpCompileKernelColdFirstQuartile"]
+    assert report.parse_num(body) == 2.5 and src.startswith(
+        "bench_compile_cost:cold_q1[stage='kernel']")
+    assert report.parse_num(got["rpCompileModelWarmThirdQuartile"][0]) == pytest.approx(0.055)
+    # one pair: no spread to quote
+    m = report.Macros()
+    cc.report(ds.assign(runs=("stage", np.ones(ds.sizes["stage"], int))), m)
+    assert not m.flags["rpHaveCompileSpread"]
+    assert "rpCompileKernelColdFirstQuartile" not in report.read_macros(m.tex())

@@ -53,7 +53,8 @@ def test_absent_optional_results_say_not_yet_computed():
                        "rpHaveBenchTiming": False, "rpHaveBenchSpread": False,
                        "rpHaveBenchPasses": False, "rpHaveBenchMachine": False,
                        "rpHaveHardCases": False,
-                       "rpHaveCompileCost": False, "rpHaveEffects": False,
+                       "rpHaveCompileCost": False, "rpHaveCompileSpread": False,
+                       "rpHaveEffects": False,
                        "rpHaveReturnCost": False}
     assert m.items == []
 

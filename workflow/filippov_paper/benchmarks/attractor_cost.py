@@ -2,14 +2,23 @@
 
 Run ``python -m filippov_paper.benchmarks.attractor_cost`` (part of ``make bench``). For each
 case (theta, eps, s) the map is iterated ``--returns`` times from the cycle's point in
-one compiled call (:func:`filippov.fastmap.compute_returns` with ``iterations``), timed
-by the benchmarks' convention (:mod:`filippov_paper.benchmarks.timing`): one untimed call
+one compiled call (:func:`filippov.fastmap.compute_returns` with ``iterations``), without
+and with dP/dz, timed by the benchmarks' convention (:mod:`filippov_paper.benchmarks.timing`):
+the calls of every case and variant interleaved in ``--repeat`` passes
+(:func:`~filippov_paper.benchmarks.timing.measure_interleaved`: a spell of load falls on
+all of them alike, not on the cases timed while it lasted), each with one untimed call
 first (it compiles or loads the kernel, and the build with the dP/dz code for the
-timing with dP/dz), then at least ``--repeat`` timed calls, more until
-:data:`MIN_TIME` seconds were timed. The table gives the median wall time per return
-(the min is stored too) and the mean number of switches per return (what a return does).
+calls with dP/dz), then at least ``--repeat`` timed calls, more until :data:`MIN_TIME`
+seconds were timed. The dataset keeps the median wall time per return with its
+spread (``time_per_return_q1`` to ``_q3``) and the fastest and slowest call
+(``_min``, ``_max``), the same for dP/dz (``time_per_return_jacobian...``), the machine
+and its load average before and after; the table gives the median and the quartiles,
+the cost of dP/dz as a range (the calls with it over those without, from the
+quartiles) and the mean number of switches per return (what a return does).
 """
 from __future__ import annotations
+
+import os
 
 import numpy as np
 import xarray as xr
@@ -19,13 +28,13 @@ from filippov.fastmap import OK, compute_returns
 from filippov_paper.benchmarks import command_line, timing
 from filippov.io import finalize
 from filippov.models import hopf
-from filippov_paper.report import FIT_BEGIN, FIT_END, Macros, num
+from filippov_paper.report import FIT_BEGIN, FIT_END, Macros, num, num_range
 
 #: (theta, eps, s): the cascade (theta < 0) and the chaos (theta > 0) at the scenes' eps
 CASES = [(-0.5, 1e-2, 1.0), (-0.5, 1e-4, 1.0), (-0.5, 1e-6, 1.0),
          (0.2, 1e-2, 2.0), (0.2, 1e-3, 2.0), (0.2, 1e-4, 2.0), (0.7, 1e-4, 2.0)]
 OMEGA = 8 * np.pi
-#: seconds timed per case and variant at least (timing.measure's min_time)
+#: seconds timed per case and variant at least (measure_interleaved's min_time)
 MIN_TIME = 0.2
 
 
@@ -39,64 +48,81 @@ def case_coords(cases) -> dict:
                    "units": "1"})}
 
 
-def measure(theta: float, eps: float, s: float, returns: int, repeat: int) -> dict:
+def iterate(theta: float, eps: float, s: float, returns: int):
+    """The case's timed call, without and with dP/dz (``call(jac)``: ``returns`` returns
+    from the cycle's point in one compiled call), and its model and start point."""
     mu = 1.0 + s * limit_map.scale(eps, theta)
     cm = hopf.compiled(eps, theta, mu, OMEGA, sliding=theta > 0)
     start = np.array([[0.0, np.sqrt(mu), 0.0]])
 
-    def iterate(jac: bool):
-        def call():
+    def call(jac: bool):
+        def one():
             out = compute_returns(cm, start, 1.0, iterations=returns, keep=1, jacobian=jac)
             if out.status[0] != OK:
                 raise RuntimeError(f"theta={theta}, eps={eps}, s={s}: a return failed")
             return out
-        return call
+        return one
+    return call, cm, start
 
-    # each with its own untimed warm-up call (the dP/dz build is compiled or loaded there)
-    plain = timing.measure(iterate(False), min_rounds=repeat, min_time=MIN_TIME)
-    jac = timing.measure(iterate(True), min_rounds=repeat, min_time=MIN_TIME)
-    switches = 0.0
-    # switches per return: one more call, returns counted one by one
-    z = start
+
+def switches_per_return(cm, start, returns: int) -> float:
+    """The mean mode changes per return over the first ``returns`` (at most 200) returns,
+    counted one return at a time (not timed)."""
+    switches, z = 0.0, start
     for _ in range(min(returns, 200)):
         r = compute_returns(cm, z, 1.0)
         switches += r.n_switches[0]
         z = r.state
-    return {"per_return": plain.median / returns, "per_return_jac": jac.median / returns,
-            "per_return_min": plain.min / returns, "per_return_jac_min": jac.min / returns,
-            "rounds": plain.rounds, "rounds_jac": jac.rounds,
-            "switches": switches / min(returns, 200)}
+    return switches / min(returns, 200)
+
+
+def measure(cases, returns: int, repeat: int) -> tuple[list, list]:
+    """Per case the Timings of its call without and with dP/dz, all interleaved (each
+    with its own untimed warm-up call: the dP/dz build is compiled or loaded there), and
+    the switches per return. A failed call raises."""
+    built = [iterate(t, e, s, returns) for t, e, s in cases]
+    calls = [call(jac) for call, _, _ in built for jac in (False, True)]
+    got = timing.measure_interleaved(calls, min_rounds=repeat, min_time=MIN_TIME,
+                                     passes=repeat)
+    for t in got:
+        if not isinstance(t, timing.Timing):
+            raise t
+    timings = [got[2 * k:2 * k + 2] for k in range(len(cases))]
+    return timings, [switches_per_return(cm, start, returns) for _, cm, start in built]
 
 
 def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
-    rows = [measure(t, e, s, returns, repeat) for t, e, s in CASES]
+    load_before = os.getloadavg()
+    timings, switches = measure(CASES, returns, repeat)
+    load_after = os.getloadavg()
+    plain, jac = [t[0] for t in timings], [t[1] for t in timings]
     ds = xr.Dataset(
-        {"time_per_return": ("case", [r["per_return"] for r in rows],
-                             {"long_name": "median wall time per return", "units": "s"}),
-         "time_per_return_jacobian": ("case", [r["per_return_jac"] for r in rows],
-                                      {"long_name": "median wall time per return with dP/dz",
-                                       "units": "s"}),
-         "time_per_return_min": ("case", [r["per_return_min"] for r in rows],
-                                 {"long_name": "min wall time per return (fastest call)",
-                                  "units": "s"}),
-         "time_per_return_jacobian_min": ("case", [r["per_return_jac_min"] for r in rows], {
-             "long_name": "min wall time per return with dP/dz (fastest call)", "units": "s"}),
-         "runs": ("case", [r["rounds"] for r in rows],
+        {**timing.variables("time_per_return", ("case",), plain, "wall time per return",
+                            per=returns),
+         **timing.variables("time_per_return_jacobian", ("case",), jac,
+                            "wall time per return with dP/dz", per=returns),
+         "runs": ("case", timing.rounds(plain),
                   {"long_name": "timed calls (after a warm-up call)", "units": "1"}),
-         "runs_jacobian": ("case", [r["rounds_jac"] for r in rows],
+         "runs_jacobian": ("case", timing.rounds(jac),
                            {"long_name": "timed calls with dP/dz (after a warm-up call)",
                             "units": "1"}),
-         "switches_per_return": ("case", [r["switches"] for r in rows],
+         "switches_per_return": ("case", switches,
                                  {"long_name": "mean mode changes per return", "units": "1"})},
         coords=case_coords(CASES))
-    log(f"{'theta':>6} {'eps':>7} {'s':>4} {'us/return':>10} {'with dP/dz':>11} "
-        f"{'ratio':>6} {'switches':>9}")
-    for (t, e, s), r in zip(CASES, rows):
-        log(f"{t:6.2f} {e:7.0e} {s:4.1f} {1e6 * r['per_return']:10.1f} "
-            f"{1e6 * r['per_return_jac']:11.1f} {r['per_return_jac'] / r['per_return']:6.2f} "
-            f"{r['switches']:9.2f}")
+    log(f"load average {load_before[0]:.2f} before, {load_after[0]:.2f} after; "
+        f"us/return: median (q1..q3)")
+    log(f"{'theta':>6} {'eps':>7} {'s':>4} {'us/return':>22} {'with dP/dz':>22} "
+        f"{'ratio (q1..q3)':>14} {'switches':>9}")
+    us = 1e6 / returns
+    for (t, e, s), (a, b), sw in zip(CASES, timings, switches):
+        _, low, high = timing.ratio_range(b, a)
+        log(f"{t:6.2f} {e:7.0e} {s:4.1f} "
+            + " ".join(f"{us * x.median:8.2f} ({us * x.q1:5.2f}..{us * x.q3:5.2f})"
+                       for x in (a, b))
+            + f" {low:6.2f}..{high:6.2f} {sw:9.2f}")
     return finalize(ds, None, returns=returns, repeat=repeat,
-                    **timing.describe(min_rounds=repeat, min_time=MIN_TIME),
+                    **timing.describe(min_rounds=repeat, min_time=MIN_TIME, passes=repeat),
+                    **{**timing.machine_attrs(), **timing.load_attrs(load_before, load_after)},
                     title="cost per return of the iterated Hopf return map (compiled engine)")
 
 
@@ -112,23 +138,33 @@ WORKFLOW = {"args": []}
 REPORT = {"dataset": "bench_attractor_cost", "table": "tab_bench.tex", "order": 40}
 
 
+#: the timed quantities of the table: (variable, its column head)
+_REPORT_TIMES = (("time_per_return", r"$\mu$s/return"), ("time_per_return_jacobian", "with $DP$"))
+
+
 def report(ds, m: Macros) -> str | None:
     """The cost of one iterated return: the last block of Table tab:bench (None when not
-    measured)."""
+    measured, or measured before the benchmark kept the spread of its times). Each time is
+    the stored median with its spread, the first to third quartile of the calls."""
+    spread = [f"{v}_{q}" for v, _ in _REPORT_TIMES for q in ("q1", "q3")]
+    if ds is not None and not all(name in ds for name in spread):
+        ds = None  # measured by an older benchmark: measured again by make bench
     m.flag("rpHaveReturnCost", ds is not None)
     if ds is None:
         return None
-    lines = [r"\medskip", "", FIT_BEGIN, r"\begin{tabular}{rrrrrr}", r"\toprule",
-             r"$\theta$ & $\epsilon$ & $s$ & $\mu$s/return & with $DP$ & "
-             r"switches/return \\", r"\midrule"]
+    heads = " & ".join(f"{head} & $Q_1$--$Q_3$" for _, head in _REPORT_TIMES)
+    lines = [r"\medskip", "", FIT_BEGIN, r"\begin{tabular}{rrrrrrrr}", r"\toprule",
+             rf"$\theta$ & $\epsilon$ & $s$ & {heads} & switches/return \\", r"\midrule"]
     for k in range(ds.sizes["case"]):
-        lines.append(" & ".join([
-            f"${num(float(ds.theta.values[k]), 2)}$",
-            f"${num(float(ds.eps.values[k]), 1)}$",
-            f"${num(float(ds.s.values[k]), 2)}$",
-            f"${num(1e6 * float(ds.time_per_return.values[k]), 3)}$",
-            f"${num(1e6 * float(ds.time_per_return_jacobian.values[k]), 3)}$",
-            f"${num(float(ds.switches_per_return.values[k]), 3)}$"]) + r" \\")
+        cells = [f"${num(float(ds.theta.values[k]), 2)}$",
+                 f"${num(float(ds.eps.values[k]), 1)}$",
+                 f"${num(float(ds.s.values[k]), 2)}$"]
+        for v, _ in _REPORT_TIMES:
+            cells += [f"${num(1e6 * float(ds[v].values[k]), 3)}$",
+                      num_range(1e6 * float(ds[f"{v}_q1"].values[k]),
+                                1e6 * float(ds[f"{v}_q3"].values[k]), 3)]
+        cells.append(f"${num(float(ds.switches_per_return.values[k]), 3)}$")
+        lines.append(" & ".join(cells) + r" \\")
     return "\n".join(lines + [r"\bottomrule", r"\end{tabular}", FIT_END, ""])
 
 

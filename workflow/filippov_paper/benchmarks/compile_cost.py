@@ -7,23 +7,30 @@ kernel (:func:`filippov.fastmap.compile_kernel`: the build without the dP/dz cod
 the Hopf model's compiled pieces, makes one batch call of first returns, then compiles the
 kernel's build with the dP/dz code (what ``jacobian=True`` runs on; the helpers both builds
 share are compiled by then). A second process on the same caches does the same: the loads
-a user sees from the second session on. Each stage is timed on its own
-(wall time, median over ``--repeat`` pairs of processes); the kernel is one numba
-compilation, so a second core does not help it.
+a user sees from the second session on. Each stage is timed on its own (wall time); the
+kernel is one numba compilation, so a second core does not help it.
+
+Of the benchmarks' convention (:mod:`filippov_paper.benchmarks.timing`) this one keeps
+the statistic and its spread: per stage the median over ``--repeat`` pairs of processes
+(``cold``, ``warm``) with its first and third quartile (``_q1``, ``_q3``) and the fastest
+and slowest process (``_min``, ``_max``), the machine and its load average before and
+after. It has no warm-up and no interleaving, by design: what it times is the first
+call of a process (a warm-up would pay exactly that), and a round is a cold process and
+then a warm one on the caches the cold one wrote, so the two alternate already and
+cannot be reordered; every round needs fresh processes and fresh caches.
 """
 from __future__ import annotations
 
 import json
 import os
-import statistics
 import subprocess
 import sys
 import tempfile
 
 import xarray as xr
 
-from filippov_paper.benchmarks import command_line
-from filippov_paper.report import Macros, var
+from filippov_paper.benchmarks import command_line, timing
+from filippov_paper.report import Macros, count_phrase, var
 from filippov.io import finalize
 
 #: the stages one process times, in order (name, what it is)
@@ -71,7 +78,7 @@ def _process(cache: str) -> dict:
 
 
 def measure(repeat: int = 3, log=print) -> dict:
-    """{"cold": {stage: s}, "warm": {stage: s}}: medians over ``repeat`` pairs of
+    """{"cold": {stage: Timing}, "warm": {stage: Timing}} over ``repeat`` pairs of
     processes (the first on empty caches, the second on what the first left)."""
     runs = {"cold": [], "warm": []}
     for k in range(repeat):
@@ -90,26 +97,37 @@ def measure(repeat: int = 3, log=print) -> dict:
         log(f"  pair {k + 1}/{repeat}: kernel {cold['kernel']:.1f} s cold, "
             f"{warm['kernel']:.2f} s warm; with dP/dz +{cold['kernel_dpdz']:.1f} s cold",
             flush=True)
-    return {kind: {s: statistics.median(r[s] for r in rows) for s, _ in STAGES}
+    return {kind: {s: timing.of_rounds([r[s] for r in rows]) for s, _ in STAGES}
             for kind, rows in runs.items()}
 
 
 def run(repeat: int = 3, log=print) -> xr.Dataset:
+    load_before = os.getloadavg()
     m = measure(repeat, log)
+    load_after = os.getloadavg()
     names = [s for s, _ in STAGES]
     ds = xr.Dataset(
-        {"cold": ("stage", [m["cold"][s] for s in names],
-                  {"long_name": "wall time, empty caches (median)", "units": "s"}),
-         "warm": ("stage", [m["warm"][s] for s in names],
-                  {"long_name": "wall time, caches written by an earlier process (median)",
-                   "units": "s"}),
+        {**timing.variables("cold", ("stage",), [m["cold"][s] for s in names],
+                            "wall time of the stage, empty caches (a fresh process a round)"),
+         **timing.variables("warm", ("stage",), [m["warm"][s] for s in names],
+                            "wall time of the stage, caches written by an earlier process"),
+         "runs": ("stage", timing.rounds([m["cold"][s] for s in names]), {
+             "long_name": "pairs of processes timed (a cold one, then a warm one)",
+             "units": "1"}),
          "description": ("stage", [d for _, d in STAGES], {"long_name": "what the stage does"})},
         coords={"stage": ("stage", names, {"long_name": "stage of a process's first return"})})
-    log(f"{'stage':12s} {'cold [s]':>9s} {'warm [s]':>9s}  what")
+    log(f"{'stage':12s} {'cold [s] (q1..q3)':>24s} {'warm [s] (q1..q3)':>24s}  what")
     for s, d in STAGES:
-        log(f"{s:12s} {m['cold'][s]:9.2f} {m['warm'][s]:9.2f}  {d}")
-    log(f"{'total':12s} {sum(m['cold'].values()):9.2f} {sum(m['warm'].values()):9.2f}")
+        log(f"{s:12s} " + " ".join(f"{t.median:9.2f} ({t.q1:5.2f}..{t.q3:5.2f})"
+                                   for t in (m["cold"][s], m["warm"][s])) + f"  {d}")
+    log(f"{'total':12s} " + " ".join(f"{sum(t.median for t in m[kind].values()):9.2f} {'':14s}"
+                                     for kind in ("cold", "warm")) + "  (sum of the medians)")
     return finalize(ds, None, repeat=repeat, cpu_count=os.cpu_count() or 0,
+                    **timing.describe(warmup=0, min_rounds=repeat, min_time=0.0,
+                                      max_rounds=repeat),
+                    timing_order="per round a process on empty caches, then one on the "
+                                 "caches it wrote",
+                    **{**timing.machine_attrs(), **timing.load_attrs(load_before, load_after)},
                     title="compile and load times of the compiled engine")
 
 
@@ -129,15 +147,29 @@ _REPORT_QUOTED = (("kernel", "Kernel"), ("kernel_dpdz", "KernelDpdz"), ("model",
 
 
 def report(ds, m: Macros) -> None:
-    """The compiled engine's cold and warm compile/load times of the quoted stages."""
+    """The compiled engine's cold and warm compile/load times of the quoted stages: the
+    medians, and their spread (first and third quartile) when the benchmark timed more
+    than one pair of processes and kept it (``rpHaveCompileSpread``)."""
     if ds is not None and not {s for s, _ in _REPORT_QUOTED} <= set(ds.stage.values):
         ds = None  # measured by an older benchmark: measured again by make bench
     m.flag("rpHaveCompileCost", ds is not None)
-    if ds is not None:
-        for stage, tag in _REPORT_QUOTED:
-            for kind in ("cold", "warm"):
-                var(m, f"rpCompile{tag}{kind.title()}", ds, REPORT["dataset"], kind, sig=2,
-                    stage=stage)
+    pairs = int(ds.runs.values.min()) if ds is not None and "runs" in ds else 1
+    spread = ds is not None and pairs > 1 and all(f"{kind}_{q}" in ds for kind in
+                                                  ("cold", "warm") for q in ("q1", "q3"))
+    m.flag("rpHaveCompileSpread", spread)
+    if ds is None:
+        return None
+    sid = REPORT["dataset"]
+    for stage, tag in _REPORT_QUOTED:
+        for kind in ("cold", "warm"):
+            name = f"rpCompile{tag}{kind.title()}"
+            var(m, name, ds, sid, kind, sig=2, stage=stage)
+            if spread:
+                var(m, f"{name}FirstQuartile", ds, sid, f"{kind}_q1", sig=2, stage=stage)
+                var(m, f"{name}ThirdQuartile", ds, sid, f"{kind}_q3", sig=2, stage=stage)
+    m.add("rpCompilePairs", None, f"{sid}:runs" if "runs" in ds else
+          "derived: one pair (the dataset predates the count)",
+          text=count_phrase(pairs, "pair of fresh processes", "pairs of fresh processes"))
     return None
 
 

@@ -33,6 +33,13 @@ Run ``python -m filippov_paper.benchmarks.return_floor`` (part of ``make bench``
 
 The table says, per case, the CPU time, the evaluations, the floor and the distance.
 
+Not a wall-clock benchmark, so not timed by the convention of
+:mod:`filippov_paper.benchmarks.timing` (median, quartiles, interleaved rounds): it reads
+the CPU time of the calling thread and keeps the min, because it compares a call with
+the sum of its parts measured alone -- the least-disturbed call of each, on a clock that
+another process's work does not advance. The machine and its load average before and
+after are dataset attributes all the same.
+
 What the rest is (perf with a symbol map of the kernel, commit 92c2930 on the 2-core
 development machine, share of the CPU time of 2000-return calls): at theta = -0.5,
 eps = 1e-2 the flow of region + is half of a return (flow_plus 15%, and in libm expm1
@@ -50,6 +57,7 @@ would move the floor, and the datasets with it.
 from __future__ import annotations
 
 import dataclasses
+import os
 import time
 
 import numpy as np
@@ -61,7 +69,7 @@ from filippov.analytic import limit_map
 from filippov.fastmap import OK, compute_returns, no_jacobian
 from filippov.io import finalize
 from filippov.models import hopf
-from filippov_paper.benchmarks import command_line
+from filippov_paper.benchmarks import command_line, timing
 from filippov_paper.benchmarks.attractor_cost import CASES, OMEGA, case_coords
 
 NAMES = [name for name, _ in PIECES]
@@ -249,7 +257,9 @@ def measure(theta: float, eps: float, s: float, returns: int, repeat: int) -> di
 
 
 def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
+    load_before = os.getloadavg()
     rows = [measure(t, e, s, returns, repeat) for t, e, s in CASES]
+    load_after = os.getloadavg()
     ds = xr.Dataset(
         {"cpu_per_return": ("case", [r["per_return"] for r in rows],
                             {"long_name": "CPU time per return (one thread, min of calls)",
@@ -302,6 +312,7 @@ def run(returns: int = 2000, repeat: int = 5, log=print) -> xr.Dataset:
     return finalize(ds, None, returns=returns, repeat=repeat,
                     timing="CPU time of the calling thread (time.thread_time), min over "
                            "repeat calls after a warm-up call, workers=1",
+                    **{**timing.machine_attrs(), **timing.load_attrs(load_before, load_after)},
                     title="cost per return of the iterated Hopf map and its floor "
                           "(compiled engine)")
 

@@ -11,11 +11,18 @@ iterated ``--returns`` times from the start the sweeps use, the first phase of
   what the calls' own cost was (argument checks, unboxing, the kernel's work arrays);
 * ``sweep N``: the same call with the cores this process may use.
 
-Each is timed by the benchmarks' convention (:mod:`filippov_paper.benchmarks.timing`:
-an untimed warm-up, then at least ``--repeat`` timed calls; median), with the CPU time
-of the process (all threads) beside the wall clock; the results of the three are
-checked to be the same bit for bit. The models are built outside the timing (each
-sweep point needs its model either way).
+Each is timed by the benchmarks' convention (:mod:`filippov_paper.benchmarks.timing`):
+the calls of the three ways and of every case interleaved in ``--repeat`` passes
+(:func:`~filippov_paper.benchmarks.timing.measure_interleaved`: a spell of load falls on
+all of them alike), each with an untimed warm-up call, then at least ``--repeat`` timed
+calls, more until :data:`MIN_TIME` s were timed; with the CPU time of the process (all
+threads) beside the wall clock. Both are stored as the median of the calls with its
+spread (``_q1`` to ``_q3``) and the fastest and slowest call (``_min``, ``_max``); the
+table gives the median with its quartiles, and each way against the loop as a range
+(the loop's first quartile over the way's third, its third over the way's first); the
+machine and its load average before and after are dataset attributes. The results of
+the three are checked to be the same bit for bit. The models are built outside the
+timing (each sweep point needs its model either way).
 """
 from __future__ import annotations
 
@@ -26,7 +33,7 @@ import numpy as np
 import xarray as xr
 
 from filippov.analytic import limit_map
-from filippov.attractors import row
+from filippov.attractors import row as row_of
 from filippov.fastmap import compute_returns, sweep_returns
 from filippov.io import finalize
 from filippov.models import hopf
@@ -39,7 +46,7 @@ from filippov_paper.benchmarks.parallel_scaling import cores
 CASES = [(-0.5, 1e-2, (-1.0, 5.0)), (0.3, 1e-3, (-1.0, 5.0))]
 OMEGA = 8 * np.pi
 T_RETURN = 1.0  # each return well within (the period is 2 pi / OMEGA = 0.25)
-MIN_TIME = 1.0  # seconds timed per variant at least
+MIN_TIME = 1.0  # seconds timed per variant at least (measure_interleaved's min_time)
 
 
 def _points(theta, eps, s_range, points):
@@ -55,74 +62,96 @@ def _same(a, b) -> bool:
                for x, y in zip(vars(a).values(), vars(b).values()) if x is not None)
 
 
-def measure(theta, eps, s_range, points, returns, repeat) -> list:
+class Way:
+    """One way of running a case's sweep (``call``, ``threads``): a call of it runs the
+    sweep once and records the process's CPU time (``cpu``: one entry a call, the
+    warm-up call's first)."""
+
+    def __init__(self, name: str, call, threads: int):
+        self.name, self.call, self.threads, self.cpu = name, call, threads, []
+
+    def __call__(self):
+        c0 = time.process_time()
+        out = self.call()
+        self.cpu.append(time.process_time() - c0)
+        return out
+
+
+def ways(theta, eps, s_range, points, returns) -> list:
+    """The case's three ways: a compute_returns call per point (``loop``), one
+    sweep_returns call on one thread (``sweep 1``) and on every core (``sweep N``)."""
     cms, starts = _points(theta, eps, s_range, points)
     n = cores()
 
     def loop():
-        outs = [compute_returns(c, z[None], T_RETURN, iterations=returns, keep=1, workers=1)
+        return [compute_returns(c, z[None], T_RETURN, iterations=returns, keep=1, workers=1)
                 for c, z in zip(cms, starts)]
-        return outs
 
     def sweep(workers):
         return lambda: sweep_returns(cms, starts, T_RETURN, iterations=returns, keep=1,
                                      workers=workers)
+    return [Way("loop", loop, 1), Way("sweep 1", sweep(1), 1), Way("sweep N", sweep(n), n)]
 
-    rows, reference = [], None
-    for name, call, threads in (("loop", loop, 1), ("sweep 1", sweep(1), 1),
-                                ("sweep N", sweep(n), n)):
-        cpu = []
 
-        def timed(call=call):
-            c0 = time.process_time()
-            out = call()
-            cpu.append(time.process_time() - c0)
-            return out
-
-        t = timing.measure(timed, min_rounds=repeat, min_time=MIN_TIME)
-        out = t.value
-        if name == "loop":
-            reference = out
-        elif not all(_same(alone, row(out, i)) for i, alone in enumerate(reference)):
-            raise RuntimeError(f"theta={theta}: {name} changed the results")
-        rows.append({"variant": name, "threads": threads, "wall": t.median,
-                     "cpu": float(np.median(cpu[t.warmup:])), "rounds": t.rounds})
+def measure(cases, points, returns, repeat) -> list:
+    """Per case, per way: the Timings of its wall time and CPU time (the timed calls),
+    its threads. The calls of all cases and ways are interleaved; a failed call, or a
+    sweep whose results differ from the loop's, raise."""
+    table = [ways(t, e, s, points, returns) for t, e, s in cases]
+    got = iter(timing.measure_interleaved([w for row in table for w in row],
+                                          min_rounds=repeat, min_time=MIN_TIME, passes=repeat))
+    rows = []
+    for (theta, _, _), row in zip(cases, table):
+        rows.append([])
+        for way in row:
+            t = next(got)
+            if not isinstance(t, timing.Timing):
+                raise t
+            if way.name == "loop":
+                reference = t.value
+            elif not all(_same(alone, row_of(t.value, i)) for i, alone in enumerate(reference)):
+                raise RuntimeError(f"theta={theta}: {way.name} changed the results")
+            rows[-1].append({"variant": way.name, "threads": way.threads, "wall": t,
+                             "cpu": timing.of_rounds(way.cpu[t.warmup:])})
     return rows
 
 
 def run(points: int = 200, returns: int = 40, repeat: int = 3, log=print) -> xr.Dataset:
     load_before = os.getloadavg()
-    table = [measure(t, e, s, points, returns, repeat) for t, e, s in CASES]
+    table = measure(CASES, points, returns, repeat)
     load_after = os.getloadavg()
     variants = [r["variant"] for r in table[0]]
+    dims = ("case", "variant")
 
-    def var(key, attrs):
-        return (("case", "variant"), np.array([[r[key] for r in rows] for rows in table]),
-                attrs)
+    def of(key):
+        return [[r[key] for r in rows] for rows in table]
 
     ds = xr.Dataset(
-        {"wall_time": var("wall", {"long_name": "median wall time of the sweep",
-                                   "units": "s"}),
-         "cpu_time": var("cpu", {"long_name": "median CPU time of the sweep, all threads",
-                                 "units": "s"}),
-         "threads": var("threads", {"long_name": "threads the variant used", "units": "1"}),
-         "runs": var("rounds", {"long_name": "timed calls (after a warm-up call)",
-                                "units": "1"})},
+        {**timing.variables("wall_time", dims, of("wall"), "wall time of the sweep"),
+         **timing.variables("cpu_time", dims, of("cpu"), "CPU time of the sweep, all threads"),
+         "threads": (dims, np.array(of("threads")),
+                     {"long_name": "threads the variant used", "units": "1"}),
+         "runs": (dims, timing.rounds(of("wall")),
+                  {"long_name": "timed calls (after a warm-up call)", "units": "1"})},
         coords={"variant": ("variant", variants),
                 **case_coords([(t, e, 0.0) for t, e, _ in CASES])})
     log(f"sweep: {points} points x {returns} returns; load average {load_before[0]:.2f} "
-        f"before, {load_after[0]:.2f} after; {cores()} usable cores")
-    log(f"{'theta':>6} {'eps':>7} {'variant':>8} {'wall s':>8} {'cpu s':>8} "
+        f"before, {load_after[0]:.2f} after; {cores()} usable cores; median (q1..q3)")
+    log(f"{'theta':>6} {'eps':>7} {'variant':>8} {'wall s':>24} {'cpu s':>24} "
         f"{'us/point cpu':>12} {'vs loop (cpu)':>13} {'vs loop (wall)':>14}")
     for (t, e, _), rows in zip(CASES, table):
         loop = rows[0]
         for r in rows:
-            log(f"{t:6.2f} {e:7.0e} {r['variant']:>8} {r['wall']:8.3f} {r['cpu']:8.3f} "
-                f"{1e6 * r['cpu'] / points:12.1f} {loop['cpu'] / r['cpu']:13.2f} "
-                f"{loop['wall'] / r['wall']:14.2f}")
+            times = " ".join(f"{x.median:8.3f} ({x.q1:6.3f}..{x.q3:6.3f})"
+                             for x in (r["wall"], r["cpu"]))
+            vs = " ".join(f"{lo:6.2f}..{hi:6.2f}" for _, lo, hi in (
+                timing.ratio_range(loop["cpu"], r["cpu"]),
+                timing.ratio_range(loop["wall"], r["wall"])))
+            log(f"{t:6.2f} {e:7.0e} {r['variant']:>8} {times} "
+                f"{1e6 * r['cpu'].median / points:12.1f} {vs}")
     return finalize(ds, None, points=points, returns=returns, repeat=repeat,
-                    **timing.load_attrs(load_before, load_after),
-                    **timing.describe(min_rounds=repeat, min_time=MIN_TIME),
+                    **timing.describe(min_rounds=repeat, min_time=MIN_TIME, passes=repeat),
+                    **{**timing.machine_attrs(), **timing.load_attrs(load_before, load_after)},
                     title="a parameter sweep of the Hopf return map: one call per point "
                           "against one sweep_returns call (compiled engine)")
 

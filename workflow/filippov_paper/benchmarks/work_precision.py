@@ -314,14 +314,6 @@ def runner(problem: Problem, family: str, tol: float, time_cap: float) -> Callab
     return run
 
 
-def timed(fn, repeat: int, min_time: float = timing.MIN_TIME, warmup: int = 1
-          ) -> timing.Timing:
-    """``fn`` timed by the benchmarks' convention (:func:`filippov_paper.benchmarks.timing.measure`):
-    ``warmup`` untimed runs, then at least ``repeat`` timed runs, more until ``min_time``
-    seconds were timed. The result of the last run is the Timing's ``value``."""
-    return timing.measure(fn, warmup=warmup, min_rounds=repeat, min_time=min_time)
-
-
 def max_dev(a, b, mask):
     """Max |a - b| where both are finite, and how many points only one has."""
     a, b = np.asarray(a)[mask], np.asarray(b)[mask]
