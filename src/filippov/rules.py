@@ -161,10 +161,8 @@ FD_STEP = float(np.cbrt(np.finfo(float).eps))
 SLIDE_TANGENT = 1e-6
 #: the larger step (relative to the state's size) of the compiled engine's Richardson
 #: differences (:func:`richardson_step`): truncation ~step^4, rounding ~kappa u / step with
-#: kappa the closed form's own conditioning. u^(1/5) = 7.4e-4 balances kappa ~ 1; the
-#: closed forms here carry kappa ~ 1e2 (affine flows with offsets), and on the paper's
-#: polar flow 1.5e-3 was the measured optimum (9e-14 against its variational equations;
-#: 6e-3: 1.6e-11 from truncation): 2^-9 = 1.95e-3, a power of two, between them
+#: kappa the closed form's own conditioning; a power of two a little above u^(1/5)
+#: (docs/decisions.md#richardson-dpdz)
 RICHARDSON_STEP = 2.0 ** -9
 
 
