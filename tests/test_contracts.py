@@ -117,3 +117,53 @@ def test_several_switching_functions_are_refused_by_name():
                                 lambda z: np.ones_like(z))
     with pytest.raises(SystemContractError, match=r"switch returned 2 values .*several"):
         simulate(piecewise, [-1.0, -0.5], 1.0)
+
+
+# ----------------------------------------------------------------------------- the seam
+#: what issue 58 asks of the seam: at most this many operations per engine
+SEAM_TARGET = 8
+#: the operations the seam has today (23 before the loop kept its own record and the
+#: stay's start, the event's records and the entry were folded): never more
+SEAM_NOW = 12
+
+
+def _engines_operations():
+    import importlib
+    reference = importlib.import_module("filippov.simulate")  # the module, not the function
+    from filippov.kernel import driver
+    return {"reference": reference.RUN_OPERATIONS, "compiled": driver.RUN_OPERATIONS}
+
+
+@pytest.mark.parametrize("engine", ["reference", "compiled"])
+def test_each_engine_hands_the_run_the_seams_operations_and_no_more(engine):
+    from filippov.contracts import RunOperations, operations, positional_mismatches
+    from filippov.loop.event import RunOps
+    ops = _engines_operations()[engine]
+    assert type(ops) is RunOps and RunOps._fields == operations(RunOperations)
+    assert positional_mismatches(ops, RunOperations) == []
+    assert len(RunOps._fields) <= SEAM_NOW, (len(RunOps._fields), SEAM_TARGET)
+    # what the run keeps is the loop's record, never an operation
+    from filippov.loop.run_state import Limits, RunState
+    kept = set(Limits._fields) | set(RunState._fields) | {"end_time", "count_switch", "ring",
+                                                          "store_ring", "sliding_built"}
+    assert kept.isdisjoint(RunOps._fields)
+
+
+def test_an_operation_of_the_wrong_arity_is_named():
+    from filippov.contracts import RunOperations, positional_mismatches
+    from filippov.loop.event import RunOps
+    good = _engines_operations()["reference"]
+    bad = good._replace(enter=lambda mode, new_mode, t, ctx: None)
+    assert positional_mismatches(bad, RunOperations) == [
+        "enter: takes 4 positional parameters, the seam 7"]
+    assert positional_mismatches(object(), RunOperations)[0] == "begin: missing"
+    assert len(RunOps._fields) > 0
+
+
+def test_the_kernel_keeps_the_loops_counters_where_the_record_has_them():
+    # w.count is the run record's count: the loop's positions first, the kernel's after
+    from filippov.kernel import state
+    from filippov.loop import run_state
+    assert state.COUNT[:len(run_state.COUNT)] == run_state.COUNT
+    assert (state.N_SWITCHES, state.N_RING) == (run_state.SWITCHES, run_state.RING)
+    assert state.N_STEPS >= len(run_state.COUNT)

@@ -18,7 +18,9 @@ from Python 3.12 on).
 - :class:`ReferenceSystem`: what the reference driver runs
   (:class:`~filippov.system.PiecewiseSystem`);
 - :class:`ModelModule`: a model of the paper (:mod:`filippov.models.hopf`,
-  :mod:`filippov.models.dry_friction`, :mod:`filippov.models.pseudo_equilibrium`).
+  :mod:`filippov.models.dry_friction`, :mod:`filippov.models.pseudo_equilibrium`);
+- :class:`RunOperations`: the engine seam, what each engine hands the run the loop owns
+  (:func:`filippov.loop.event.make_run`), checked by :func:`positional_mismatches`.
 """
 from __future__ import annotations
 
@@ -105,6 +107,68 @@ class ModelModule(Protocol):
     def system(self, *args, **kwargs): ...
 
     def compiled(self, *args, **kwargs): ...
+
+
+class RunOperations(Protocol):
+    """The engine seam: the operations an engine hands the run of
+    :func:`filippov.loop.event.make_run`, which calls them positionally with the engine's
+    own state ``ctx`` last (its name and the others' are the engine's business; their
+    number and order are the contract: :func:`positional_mismatches`). What the run itself
+    keeps -- its limits, counters, Zeno ring -- is the loop's record
+    (:mod:`filippov.loop.run_state`), not an operation. What each returns:
+    filippov.loop.event's doc."""
+
+    def begin(self, z0, age0, ctx): ...
+
+    def next_step(self, mode, ta, first, ctx): ...
+
+    def step_windows(self, mode, ta, tb, first, ctx): ...
+
+    def end_step(self, mode, ta, tb, status, t, ctx): ...
+
+    def record(self, mode, new_mode, what, t, ctx): ...
+
+    def speeds(self, ctx): ...
+
+    def h(self, ctx): ...
+
+    def exit_state(self, ctx): ...
+
+    def flow_at_zero(self, mode, z, ctx): ...
+
+    def slides_in_section(self, ctx): ...
+
+    def over_budget(self, t, new_mode, switches, ctx): ...
+
+    def enter(self, mode, new_mode, t, shift, band, crossed, ctx): ...
+
+
+def operations(protocol) -> tuple:
+    """The names of ``protocol``'s methods, in the order it declares them."""
+    return tuple(name for name, spec in _members(protocol).items()
+                 if spec not in (None, "property"))
+
+
+def positional_mismatches(ops, protocol) -> list[str]:
+    """How ``ops`` (an object whose members are plain functions, or numba dispatchers of
+    them, called positionally) differs from ``protocol``: a member missing, or one that
+    does not take exactly the protocol's number of positional parameters (past
+    ``self``). Empty when ``ops`` keeps the contract."""
+    out = []
+    for name, spec in _members(protocol).items():
+        if spec in (None, "property"):
+            continue
+        if not hasattr(ops, name):
+            out.append(f"{name}: missing")
+            continue
+        f = getattr(ops, name)
+        f = getattr(f, "py_func", f)   # a numba dispatcher: the function it compiles
+        want = len(inspect.signature(spec).parameters) - 1
+        got = [p for p in inspect.signature(f).parameters.values()
+               if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+        if len(got) != want or any(p.default is not p.empty for p in got):
+            out.append(f"{name}: takes {len(got)} positional parameters, the seam {want}")
+    return out
 
 
 def _members(protocol) -> dict:

@@ -39,6 +39,7 @@ from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
 from .errors import accumulation_detail, run_error
 from .loop.event import SECTION, RunOps, make_run
+from .loop.run_state import RING, SWITCHES, Limits, new_run_state
 from .section import Section  # noqa: F401  (re-exported: filippov.simulate.Section)
 from .loop.stay import UNRESOLVED, make_slides_in, make_start, make_step_windows
 from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
@@ -482,12 +483,12 @@ class _Run:
             raise self._event_error(status)
         self.preds = [rules.section_pred(sec.direction) for sec in sections]
         self.hits = [0] * len(sections)
-        # the Zeno ring (filippov.rules.note_switch): the last zeno_count
-        # switch times, entry k at k % zeno_count
-        self.ring, self.ring_entries = np.empty(self.zeno_count), 0
+        # what the loop keeps: limits, switches, the Zeno ring (filippov.loop.run_state)
+        self.rs = new_run_state(Limits(self.t_end, system.sliding, self.max_events,
+                                       self.zeno_count, self.zeno_span, self.touch_tol,
+                                       self.state_scale, self.time_scale))
         self.hit_section, self.projected = None, None
         self._flow_field = None  # (mode, f, z) at the end of the last exact window
-        self.n_switch = 0
         self.shift = 0.0  # subtracted from H in this stay (rules.exit_shift)
         self.band = 0.0   # the rounding band of the exit the stay began at (rules.exit_band)
         self.frac_integrated = np.linspace(0.0, 1.0, self.samples_per_step + 1)
@@ -503,7 +504,7 @@ class _Run:
     def go(self) -> Trajectory:
         """The run from the start, in the shared order of :mod:`filippov.loop.event`; a
         status that ends it becomes the trajectory's end or its exception."""
-        status, _, _ = _RUN(self.z, 0.0, self)
+        status, _, _ = _RUN(self.z, 0.0, self, self.rs)
         if status == NO_RETURN:
             return self.stop("t_end")
         if status == OK:
@@ -541,8 +542,9 @@ class _Run:
         return [(lambda zz: system.normal_speeds(zz)[0], rules.TO_NONPOS, "exit_minus"),
                 (lambda zz: system.normal_speeds(zz)[1], rules.TO_NONNEG, "exit_plus")]
 
-    # A stay, in the shared order of filippov.loop.event: start_stay, then per step
-    # next_step, its windows (window, walked by loop.stay.make_step_windows), end_step.
+    # A stay, in the shared order of filippov.loop.event: per step next_step (the first
+    # begins the stay: start_stay), its windows (window, walked by
+    # loop.stay.make_step_windows), end_step.
     def start_stay(self):
         """The stay in the current mode begins: its stepper and leave functions."""
         self.stepper = self._stepper(self.mode)
@@ -550,8 +552,11 @@ class _Run:
         self.steps_in_mode = 0
         return GO_ON
 
-    def next_step(self):
-        """The stay's next step (its dense output in self.step_Z): (GO_ON, its end)."""
+    def next_step(self, first):
+        """The stay's next step (its dense output in self.step_Z): (GO_ON, its end);
+        ``first``: the stay begins (:meth:`start_stay`)."""
+        if first:
+            self.start_stay()
         ta, tb, self.step_Z = self._step(self.stepper)
         if self.dense:
             self.traj.segments.append((ta, tb, self.mode, self.step_Z))
@@ -719,16 +724,16 @@ class _Run:
             return _no_sliding(te, ze)
         if status == SECTION_SLIDING:
             _refuse_sliding_in_sections(self.system, self.sections, ze, te)
+        ring, entries = self.rs.ring, self.rs.count[RING]
         if status == ZENO:
-            ratio, t_star = rules.geometric_accumulation(self.ring, self.ring_entries,
-                                                         self.zeno_count)
+            ratio, t_star = rules.geometric_accumulation(ring, entries, self.zeno_count)
             if ratio == ratio:
                 return run_error(ZENO, te, ze, accumulation_detail(ratio, t_star))
-            oldest = self.ring[self.ring_entries % self.zeno_count]
+            oldest = ring[entries % self.zeno_count]
             return run_error(ZENO, te, ze, f": {self.zeno_count} switches within "
                                            f"{te - oldest:.3e} time units (Zeno point or "
                                            "chattering below the time resolution)")
-        if status == EVENT_LIMIT and self.n_switch > self.max_events:
+        if status == EVENT_LIMIT and self.rs.count[SWITCHES] > self.max_events:
             return run_error(EVENT_LIMIT, te, ze, f": event limit {self.max_events} hit "
                                                   "(rapid switching)")
         if status == EVENT_LIMIT:
@@ -752,7 +757,7 @@ class _Run:
     def _over_budget(self, te, new_mode, switches):
         """At the rate of the last zeno_count switches, the event budget must last to
         t_end (the reference's projection: :mod:`filippov.engines`, item 2)."""
-        oldest = self.ring[self.ring_entries % self.zeno_count]
+        oldest = self.rs.ring[self.rs.count[RING] % self.zeno_count]
         if not te > oldest:
             return False
         ahead = (self.t_end - te) * (self.zeno_count - 1) / (te - oldest)
@@ -774,36 +779,27 @@ def _section_hit(mode, t, run):
     return OK if sec.terminal is not None and run.hits[idx] >= sec.terminal else GO_ON
 
 
-def _switch_state(run):
-    """The event's state, a copy of its own: the event may move it onto H."""
+def _exit_state(run):
+    """The event's state, a copy of its own (the event may move it onto H), and grad H
+    there."""
     run.z = run.z.copy()
-    return run.z
+    return run.z, run.system.switch_grad(run.z[:, None])[:, 0]
 
 
-def _record_switch(mode, new_mode, what, t, run):
+def _record(mode, new_mode, what, t, run):
+    """A section hit (:func:`_section_hit`) or a switch, logged: OK, or GO_ON."""
+    if what == SECTION:
+        return _section_hit(mode, t, run)
     kind = ("slide_end" if what != rules.SWITCH
             else "crossing" if new_mode != SLIDING else "slide_start")
     run.traj.events.append(Event(t, kind, run.z.copy(), mode, new_mode))
+    return GO_ON
 
 
-def _count_switch(changed, t, run):
-    run.n_switch += changed
-    return run.n_switch
-
-
-def _store_exit(new_mode, shift, band, run):
+def _enter(mode, new_mode, t, shift, band, crossed, run):
+    """The next stay's shift and band; the mode the run goes on in (dP/dz across a
+    crossing: filippov.variational, from the trajectory)."""
     run.shift, run.band = shift, band
-
-
-def _store_ring(entries, run):
-    run.ring_entries = entries
-
-
-def _nothing(*args):
-    return None
-
-
-def _entered(mode, new_mode, t, run):
     run.mode = run.traj.mode = new_mode
 
 
@@ -811,33 +807,23 @@ def _entered(mode, new_mode, t, run):
 _STEP_WINDOWS = make_step_windows(
     lambda mode, t0, t1, first, may_split, run: run.window(t0, t1, first, may_split))
 
-#: the reference driver's run (filippov.loop.event) on its Python operations; ctx: the
-#: _Run, which made its start when it was built (begin: the state it made)
-_RUN = make_run(RunOps(
+#: the reference driver's side of the seam (filippov.contracts.RunOperations) and its
+#: run (filippov.loop.event) on them; ctx: the _Run, which made its start when it was
+#: built (begin: the state it made)
+RUN_OPERATIONS = RunOps(
     begin=lambda z0, age0, run: (GO_ON, run.t, run.mode),
-    end_time=lambda run: run.t_end,
-    start_stay=lambda mode, t, run: run.start_stay(),
-    next_step=lambda mode, ta, run: run.next_step(),
+    next_step=lambda mode, ta, first, run: run.next_step(first),
     step_windows=_STEP_WINDOWS,
     end_step=lambda mode, ta, tb, status, t, run: run.end_step(ta, tb, status),
-    section_hit=_section_hit,
+    record=_record,
     speeds=_normal_speeds,
     h=lambda run: float(run.system.switch(run.z)),
-    grad_h=lambda run: run.system.switch_grad(run.z[:, None])[:, 0],
-    state=_switch_state,
+    exit_state=_exit_state,
     flow_at_zero=lambda mode, z, run: run._flow_at_zero(mode, z),
-    sliding_built=lambda run: run.system.sliding,
     slides_in_section=_slides_in_a_section,
-    record_switch=_record_switch,
-    count_switch=_count_switch,
-    limits=lambda run: (run.max_events, run.zeno_count, run.zeno_span, run.touch_tol,
-                        run.state_scale, run.time_scale),
-    ring=lambda run: (run.ring, run.ring_entries),
-    store_ring=_store_ring,
     over_budget=lambda t, new_mode, switches, run: run._over_budget(t, new_mode, switches),
-    store_exit=_store_exit,
-    switch_derivative=_nothing,  # dP/dz: filippov.variational, from the trajectory
-    entered=_entered))
+    enter=_enter)
+_RUN = make_run(RUN_OPERATIONS)
 
 
 def _speed_rates(system, Z, z0, floor=1.0):

@@ -41,6 +41,7 @@ from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
 from ..loop.event import SECTION, RunOps, make_run
+from ..loop.run_state import Limits, RunState
 from ..loop.stay import UNRESOLVED, before_stay, make_slides_in, make_start, make_step_windows
 from ..loop.status import GO_ON
 
@@ -241,11 +242,16 @@ def _start_stay(mode, t, ctx):
 
 
 @_jit_inline
-def _next_step(mode, ta, ctx):
-    """The stay's next step from ta, within the step budget: (GO_ON, its end tb), or
-    (STEP_LIMIT, NON_FINITE, STEP_FAILED: why not, ta). An exact flow's step is its
-    window; an integrated one leaves its dense output in w.F."""
+def _next_step(mode, ta, first, ctx):
+    """The stay's next step from ta (``first``: the stay begins there, _start_stay),
+    within the step budget: (GO_ON, its end tb), or (STEP_LIMIT, NON_FINITE,
+    STEP_FAILED: why not, ta). An exact flow's step is its window; an integrated one
+    leaves its dense output in w.F."""
     fns, p, s, w = ctx
+    if first:
+        st = _start_stay(mode, ta, ctx)
+        if st != _GO_ON:
+            return st, ta
     w.count[N_STEPS] += 1
     if rules.step_budget_spent(w.count[N_STEPS], s.max_steps):
         return STEP_LIMIT, ta
@@ -329,14 +335,9 @@ def _event_h(ctx):
 
 
 @_jit_inline
-def _event_grad(ctx):
-    """grad h at w.z: left in w.wg by _event_speeds."""
-    return ctx[3].wg
-
-
-@_jit_inline
-def _event_state(ctx):
-    return ctx[3].z
+def _exit_state(ctx):
+    """The event's state w.z and grad h there (left in w.wg by _event_speeds)."""
+    return ctx[3].z, ctx[3].wg
 
 
 @_jit_inline
@@ -351,11 +352,6 @@ def _event_flow_at_zero(mode, z, ctx):
         else:
             _flow_minus(fns, z, 0.0, p, w.wz)
     return w.wz
-
-
-@_jit_inline
-def _event_sliding_built(ctx):
-    return ctx[2].sliding
 
 
 @_jit_inline
@@ -377,30 +373,12 @@ def _record_switch(mode, new_mode, what, t, ctx):
 
 
 @_jit_inline
-def _count_switch(changed, t, ctx):
-    w = ctx[3]
-    if changed:
-        w.count[N_SWITCHES] += 1
-        if w.count[N_SWITCHES] == 1:
-            w.first_sw[0] = t
-    return w.count[N_SWITCHES]
-
-
-@_jit_inline
-def _event_limits(ctx):
-    s = ctx[2]
-    return s.max_events, s.zeno_count, s.zeno_span, s.touch_tol, s.state_scale, s.time_scale
-
-
-@_jit_inline
-def _event_ring(ctx):
-    w = ctx[3]
-    return w.recent, w.count[N_RING]
-
-
-@_jit_inline
-def _store_ring(entries, ctx):
-    ctx[3].count[N_RING] = entries
+def _record(mode, new_mode, what, t, ctx):
+    """A section hit (_at_section) or a switch (_record_switch): OK, or GO_ON."""
+    if what == SECTION:
+        return _at_section(mode, t, ctx)
+    _record_switch(mode, new_mode, what, t, ctx)
+    return _GO_ON
 
 
 @_jit_inline
@@ -433,6 +411,16 @@ def _entered(mode, new_mode, t, ctx):
         w.tally[T_AGE] = 0.0  # an entry: the fast transient starts again
     elif mode != SLIDING and s.exact:
         w.tally[T_AGE] += t - w.seg[SEG_ENTRY]  # the stay goes on from here
+
+
+@_jit_inline
+def _enter(mode, new_mode, t, shift, band, crossed, ctx):
+    """The orbit goes on in new_mode after the event at t: the next stay's shift and band
+    (_store_exit), dP/dz across a crossing (``crossed``), the age (_entered)."""
+    _store_exit(new_mode, shift, band, ctx)
+    if crossed:
+        _event_switch_derivative(mode, new_mode, ctx)
+    _entered(mode, new_mode, t, ctx)
 
 
 #: the start's mode and its refusal to slide in the section (filippov.loop.stay), on the
@@ -479,27 +467,29 @@ def _begin(z0, age0, ctx):
     return _GO_ON, 0.0, mode
 
 
-@_jit_inline
-def _end_time(ctx):
-    return ctx[2].t_max
+#: the kernel's side of the seam (filippov.contracts.RunOperations): each operation's
+#: function by name
+_RUN_OPS = {"begin": "_begin", "next_step": "_next_step", "step_windows": "_step_windows",
+            "end_step": "_end_step", "record": "_record", "speeds": "_event_speeds",
+            "h": "_event_h", "exit_state": "_exit_state",
+            "flow_at_zero": "_event_flow_at_zero", "slides_in_section": "_event_slides_in",
+            "over_budget": "_over_budget", "enter": "_enter"}
 
 
-#: the operations by their place in filippov.loop.event.RunOps
-_RUN_OPS = ("_begin", "_end_time", "_start_stay", "_next_step", "_step_windows",
-            "_end_step", "_at_section", "_event_speeds", "_event_h",
-            "_event_grad", "_event_state", "_event_flow_at_zero", "_event_sliding_built", "_event_slides_in",
-            "_record_switch", "_count_switch", "_event_limits", "_event_ring",
-            "_store_ring", "_over_budget", "_store_exit", "_event_switch_derivative",
-            "_entered")
+def _operations(ns) -> RunOps:
+    """The run's operations from the namespace ``ns`` (this module's globals, or the
+    plain build's copies of them)."""
+    return RunOps(**{op: ns[name] for op, name in _RUN_OPS.items()})
 
 
 def _build_run(ns):
     """The first return of one start (filippov.loop.event.make_run) on the operations of
     the namespace ``ns`` (this module's globals, or the plain build's copies of them):
-    ``_one(z0, age0, (fns, p, s, w)) -> (status, t, mode)``, the state at the return (or
+    ``_one(z0, age0, (fns, p, s, w), rs) -> (status, t, mode)`` (rs: the loop's record,
+    filippov.loop.run_state, on the batch's arrays), the state at the return (or
     where the run stopped) in w.z. A call _batch makes per return, the run's loop and its
     operations inlined into it."""
-    run = make_run(RunOps(*(ns[name] for name in _RUN_OPS)))
+    run = make_run(_operations(ns))
     if not ns["_DERIVATIVES"]:  # numba names a cache file by the qualified name
         run.__qualname__ += "_plain"
     return _jit(run)
@@ -507,9 +497,20 @@ def _build_run(ns):
 
 _build_run.builds = True  # _without_derivatives builds it, not copies it
 _one = _build_run(globals())
+#: the seam as the kernel fills it (tests/test_contracts.py checks it against the Protocol)
+RUN_OPERATIONS = _operations(globals())
 
 
 _KERNEL_SIG = kernel_signature()
+
+
+@_jit_inline
+def _run_record(s, w):
+    """The loop's record of a run (filippov.loop.run_state) on the batch's own arrays: its
+    counters are w.count's first, its ring w.recent, its first switch w.first_sw."""
+    return RunState(Limits(s.t_max, s.sliding, s.max_events, s.zeno_count, s.zeno_span,
+                           s.touch_tol, s.state_scale, s.time_scale), w.count, w.recent,
+                    w.first_sw)
 
 
 @_jit_inline
@@ -559,6 +560,7 @@ def _batch(fns, params, starts, ages, s, out):
              F, wz, wg, wf, wp, np.zeros(n), first, np.zeros(n), np.zeros(n),
              np.zeros(COUNT_SIZE, dtype=np.int64), np.zeros(TALLY_SIZE),
              np.zeros(1, dtype=np.bool_), deriv)
+    rs = _run_record(s, w)
     keep_jac = out.orbit_jacobian.shape[1]
     n_iter, keep = s.iterations, out.orbit.shape[1]
     zin = np.empty(n)
@@ -572,7 +574,7 @@ def _batch(fns, params, starts, ages, s, out):
         ctx = (fns, p, s, w)
         while True:
             first[0] = np.nan
-            st, t, mode = _one(zin, age, ctx)
+            st, t, mode = _one(zin, age, ctx, rs)
             if st != OK:
                 break
             done += 1
@@ -641,7 +643,9 @@ def _without_derivatives(decorated):
 _PLAIN = _without_derivatives({"_window": _jit_inline,
                                "_step_windows": _build_step_windows,
                                "_end_step": _jit_inline, "_at_section": _jit_inline,
+                               "_record": _jit_inline,
                                "_event_switch_derivative": _jit_inline,
+                               "_enter": _jit_inline,
                                "_begin": _jit, "_one": _build_run,
                                "_batch": njit(cache=True, nogil=True)})
 _one_plain, _batch_plain = _PLAIN["_one"], _PLAIN["_batch"]

@@ -3,16 +3,19 @@ what order, against the event budget and the Zeno ring: written once for both en
 
 :func:`make_run` builds the run from the engine's own operations (:class:`RunOps`: how
 it starts, follows a stay to its event, evaluates the speeds, h and grad h at the
-event's state, the exact flow over time 0, records a hit or a switch, keeps its counters
-and the next stay's shift, updates dP/dz); the rules it asks it calls as
-``rules.<name>`` on both engines (the kernel registers every rule as compilable:
-:mod:`filippov.kernel.base`). The result, ``run(z0, age0, ctx) -> (status, t, mode)``,
+event's state, the exact flow over time 0, records a hit or a switch, keeps the next
+stay's shift, updates dP/dz); what the run itself keeps -- its limits, the switches
+counted, the Zeno ring, the first switch's time -- is the loop's own record
+(:mod:`filippov.loop.run_state`), which each engine builds and the loop reads and
+writes. The rules it asks it calls as ``rules.<name>`` on both engines (the kernel
+registers every rule as compilable: :mod:`filippov.kernel.base`). The result,
+``run(z0, age0, ctx, rs) -> (status, t, mode)``,
 is plain scalar Python in the subset numba compiles: the reference driver
 (:mod:`filippov.simulate`) calls it as it is, with ``ctx`` its run, and turns a status
 into its end or its exception; the compiled kernel (:mod:`filippov.kernel.driver`)
-compiles it as the call its batch makes per return, with ``ctx`` its records. The Zeno
-ring both engines keep, an array of the last ``zeno_count`` switch times, is
-rules.note_switch.
+compiles it as the call its batch makes per return, with ``ctx`` its records; ``rs``
+is the run's record on both. The Zeno ring, an array of the last ``zeno_count`` switch
+times in ``rs``, is rules.note_switch.
 
 Before each stay: filippov.loop.stay.before_stay (the end time; sliding the system does
 not build). The order at a switch: the decision (rules.next_mode); sliding that the
@@ -34,8 +37,10 @@ from __future__ import annotations
 from collections import namedtuple
 
 from .. import rules
+from ..contracts import RunOperations, operations
 from ..system import SLIDING
 from .status import EVENT_LIMIT, GO_ON, NO_SLIDING, OK, SECTION_SLIDING, TWO_FOLD, ZENO
+from .run_state import RING, SWITCHES
 from .stay import before_stay
 
 #: what an event is: a crossing of H or an end of sliding (rules.SWITCH, EXIT_MINUS,
@@ -43,65 +48,58 @@ from .stay import before_stay
 SECTION = 3
 assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 
-#: the engine's operations in a run (``ctx``: the engine's state; the state at an event
-#: is the engine's, each operation evaluates at it):
+#: the engine's operations in a run, in the order of
+#: :class:`filippov.contracts.RunOperations` (the seam; ``ctx``: the engine's state; the
+#: state at an event is the engine's, each operation evaluates at it):
 #: begin(z0, age0, ctx) -> (status, t, mode): the run's start from z0 (its age in its
-#: region age0: rules.carried_age), GO_ON or why it cannot start; end_time(ctx) -> the
-#: run's end time; a stay, in the order the run holds: start_stay(mode, t, ctx) ->
-#: status (GO_ON, or why it cannot begin), then per step next_step(mode, ta, ctx) ->
-#: (status, tb) (GO_ON and the step's end, or why there is none: the step budget, a
-#: failed step), step_windows(mode, ta, tb, first, ctx) -> (status, t, what) (the step
-#: searched window by window: filippov.loop.stay.make_step_windows on the engine's
-#: window), end_step(mode, ta, tb, status, t, ctx) -> status (GO_ON to the next step;
-#: OK at an event, its time t and ``what``; NO_RETURN at the end time, or an error): the
-#: stay written in the run, as the event is, so that the kernel copies no composed stay
+#: region age0: rules.carried_age), GO_ON or why it cannot start; a stay, in the order the
+#: run holds: per step next_step(mode, ta, first, ctx) -> (status, tb) (the stay begun
+#: at its first step; GO_ON and the step's end, or why there is none: the stay cannot
+#: begin, the step budget, a failed step), step_windows(mode, ta, tb, first, ctx) ->
+#: (status, t, what) (the step searched window by window:
+#: filippov.loop.stay.make_step_windows on the engine's window), end_step(mode, ta, tb,
+#: status, t, ctx) -> status (GO_ON to the next step; OK at an event, its time t and
+#: ``what``; NO_RETURN at the end time, or an error): the stay written in the run, as the
+#: event is, so that the kernel copies no composed stay
 #: (docs/decisions.md#kernel-inlined-driver);
-#: section_hit(mode, t, ctx) -> status: records a hit (OK ends the run, GO_ON goes on);
-#: speeds(ctx) -> (a, b); h(ctx) -> H; grad_h(ctx) -> grad H, an array (called after
-#: speeds, before the state moves); state(ctx) -> the state as an array the event may
-#: move onto H; flow_at_zero(mode, z, ctx) -> the state the next stay in ``mode`` starts
-#: from as it evaluates it (rules.exit_band); sliding_built(ctx) -> bool;
-#: slides_in_section(ctx) -> bool; record_switch(mode, new_mode, what, t, ctx);
-#: count_switch(changed, t, ctx) -> switches so far; limits(ctx) -> (max_events,
-#: zeno_count, zeno_span, touch_tol, state scale, time scale: filippov.scale); ring(ctx) -> (times, entries);
-#: store_ring(entries, ctx); over_budget(t, new_mode, switches, ctx) -> bool, asked once
-#: the ring is full; store_exit(new_mode, shift, band, ctx): the next stay's shift of H
-#: and rounding band; switch_derivative(mode, new_mode, ctx): dP/dz across a crossing;
-#: entered(mode, new_mode, t, ctx): the engine's bookkeeping as the orbit goes on
-RunOps = namedtuple("RunOps", [
-    "begin", "end_time", "start_stay", "next_step", "step_windows", "end_step",
-    "section_hit", "speeds", "h", "grad_h", "state", "flow_at_zero", "sliding_built",
-    "slides_in_section", "record_switch", "count_switch", "limits", "ring", "store_ring",
-    "over_budget", "store_exit", "switch_derivative", "entered"])
+#: record(mode, new_mode, what, t, ctx) -> status: an event recorded, a section hit
+#: (what == SECTION: OK ends the run, GO_ON goes on) or a switch (before the budgets
+#: are asked); speeds(ctx) -> (a, b); h(ctx) -> H; exit_state(ctx) -> (the state as an
+#: array the event may move onto H, grad H there); flow_at_zero(mode, z, ctx) -> the
+#: state the next stay in ``mode`` starts from as it evaluates it (rules.exit_band);
+#: slides_in_section(ctx) -> bool; over_budget(t, new_mode, switches, ctx) -> bool,
+#: asked once the ring is full; enter(mode, new_mode, t, shift, band, crossed, ctx): the
+#: orbit goes on in new_mode -- the next stay's shift of H and rounding band, dP/dz
+#: across a crossing (``crossed``), the engine's bookkeeping
+RunOps = namedtuple("RunOps", operations(RunOperations))
 
 
 def make_run(ops: RunOps):
-    """``run(z0, age0, ctx) -> (status, t, mode)``: the orbit from z0, stay by stay and
-    event by event in the order of this module's doc, with the rule book's rules and
+    """``run(z0, age0, ctx, rs) -> (status, t, mode)``: the orbit from z0, stay by stay
+    and event by event in the order of this module's doc, with the rule book's rules and
     ``ops``'s operations, until a status ends it: OK at a terminal section hit,
     NO_RETURN at the end time, or why it stopped (the start's, a stay's or an event's
-    status); t and ``mode`` where it ended."""
-    (begin, end_time, start_stay, next_step, step_windows, end_step, section_hit, speeds,
-     h, grad_h, state, flow_at_zero, sliding_built, slides_in_section, record_switch,
-     count_switch, limits, ring, store_ring, over_budget, store_exit, switch_derivative,
-     entered) = ops
+    status); t and ``mode`` where it ended. ``rs``: the run's record
+    (:class:`~filippov.loop.run_state.RunState`), its counters cleared first."""
+    (begin, next_step, step_windows, end_step, record, speeds, h, exit_state, flow_at_zero,
+     slides_in_section, over_budget, enter) = ops
 
-    def run(z0, age0, ctx):
+    def run(z0, age0, ctx, rs):
+        limits = rs.limits
+        rs.count[SWITCHES], rs.count[RING] = 0, 0
         status, t, mode = begin(z0, age0, ctx)
         if status != GO_ON:
             return status, t, mode
         # the normal speeds where the current slide began (rules.at_two_fold)
         a_in, b_in = speeds(ctx) if mode == SLIDING else (0.0, 0.0)
         while True:
-            status = before_stay(mode, t, end_time(ctx), sliding_built(ctx))
+            status = before_stay(mode, t, limits.t_end, limits.sliding)
             if status != GO_ON:
                 return status, t, mode
             # the stay, step by step, to its event (OK) or to why it ends
-            what = -1  # what the stay ends at (its event's)
-            status = start_stay(mode, t, ctx)
-            ta, first = t, True
+            status, ta, first, what = GO_ON, t, True, -1  # what: the event it ends at
             while status == GO_ON:
-                status, tb = next_step(mode, ta, ctx)
+                status, tb = next_step(mode, ta, first, ctx)
                 if status != GO_ON:
                     t = ta
                     break
@@ -111,7 +109,7 @@ def make_run(ops: RunOps):
             if status != OK:
                 return status, t, mode
             if what == SECTION:
-                status = section_hit(mode, t, ctx)
+                status = record(mode, mode, what, t, ctx)
                 if status != GO_ON:
                     return status, t, mode
                 continue
@@ -121,37 +119,38 @@ def make_run(ops: RunOps):
                 return TWO_FOLD, t, mode
             if new_mode == SLIDING and mode != SLIDING:
                 a_in, b_in = a, b
-            if new_mode == SLIDING and not sliding_built(ctx):
+            if new_mode == SLIDING and not limits.sliding:
                 return NO_SLIDING, t, mode
             if new_mode == SLIDING and mode != SLIDING and slides_in_section(ctx):
                 return SECTION_SLIDING, t, mode
-            max_events, zeno_count, zeno_span, touch_tol, floor, time_scale = limits(ctx)
             shift, band = 0.0, 0.0
             if mode == SLIDING and new_mode != SLIDING:
                 # the end of a slide: a state the slide left off H beyond rounding is
                 # moved onto it; the next stay measures H from the exit's rounding
-                z, grad, h0 = state(ctx), grad_h(ctx), h(ctx)
-                drift = rules.exit_drift(new_mode, h0, z, grad, touch_tol)
+                z, grad = exit_state(ctx)
+                h0 = h(ctx)
+                drift = rules.exit_drift(new_mode, h0, z, grad, limits.touch_tol)
                 if drift:
                     rules.onto_switch(z, h0, grad)
                     h0 = h(ctx)  # what rounding left
-                band = rules.exit_band(z, flow_at_zero(new_mode, z, ctx), grad, floor)
-                shift = rules.exit_shift(new_mode, h0, touch_tol, drift)
-            record_switch(mode, new_mode, what, t, ctx)
-            switches = count_switch(new_mode != mode, t, ctx)
-            if switches > max_events:
+                band = rules.exit_band(z, flow_at_zero(new_mode, z, ctx), grad,
+                                       limits.state_scale)
+                shift = rules.exit_shift(new_mode, h0, limits.touch_tol, drift)
+            record(mode, new_mode, what, t, ctx)
+            if new_mode != mode:
+                rs.count[SWITCHES] += 1
+                if rs.count[SWITCHES] == 1:
+                    rs.first_switch[0] = t
+            switches = rs.count[SWITCHES]
+            if switches > limits.max_events:
                 return EVENT_LIMIT, t, mode
-            recent, entries = ring(ctx)
-            entries, zeno = rules.note_switch(recent, entries, t, zeno_count, zeno_span,
-                                              time_scale)
-            store_ring(entries, ctx)
+            entries, zeno = rules.note_switch(rs.ring, rs.count[RING], t, limits.zeno_count,
+                                              limits.zeno_span, limits.time_scale)
+            rs.count[RING] = entries
             if zeno:
                 return ZENO, t, mode
-            if entries >= zeno_count and over_budget(t, new_mode, switches, ctx):
+            if entries >= limits.zeno_count and over_budget(t, new_mode, switches, ctx):
                 return EVENT_LIMIT, t, mode
-            store_exit(new_mode, shift, band, ctx)
-            if mode != SLIDING and new_mode != mode:
-                switch_derivative(mode, new_mode, ctx)
-            entered(mode, new_mode, t, ctx)
+            enter(mode, new_mode, t, shift, band, mode != SLIDING and new_mode != mode, ctx)
             mode = new_mode
     return run
