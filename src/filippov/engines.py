@@ -118,7 +118,8 @@ ASYMMETRIES = (
         "at each switch past the Zeno ring's ``zeno_count``, projects the rate of the last "
         "ones to ``t_end`` and stops (EventLimitError, \"switching every ...\") when it "
         "would exceed ``max_events``",
-        "the hard bound only (its ``over_budget`` operation of the shared event says no)",
+        "the hard bound only (its run record says ``projects_budget = False``: "
+        "filippov.loop.run_state)",
         "deliberate", "the projection saves minutes of a Python run that will hit the "
         "bound anyway; the kernel gets there in milliseconds, and a return ends at the "
         "section, often long before ``t_max``, where a projection to ``t_max`` refuses a "

@@ -619,6 +619,25 @@ def at_two_fold(a: float, b: float, a_in: float, b_in: float) -> bool:
     return abs(a) <= TWO_FOLD_SHARE * abs(a_in) and abs(b) <= TWO_FOLD_SHARE * abs(b_in)
 
 
+def budget_projection(recent, entries: int, t: float, zeno_count: int, t_end: float):
+    """At the rate of the last zeno_count switches (the Zeno ring: :func:`note_switch`),
+    the time between switches and how many more come before t_end: (every, ahead);
+    (nan, nan) where the ring spans no time."""
+    oldest = recent[entries % zeno_count]
+    if not t > oldest:
+        return np.nan, np.nan
+    return (t - oldest) / (zeno_count - 1), (t_end - t) * (zeno_count - 1) / (t - oldest)
+
+
+def budget_runs_out(recent, entries: int, t: float, zeno_count: int, t_end: float,
+                    switches: int, max_events: int) -> bool:
+    """The event budget would not last to t_end at the rate of the last zeno_count
+    switches (:func:`budget_projection`); asked by the loop of an engine whose record
+    says it projects (:mod:`filippov.engines`, item 2)."""
+    _, ahead = budget_projection(recent, entries, t, zeno_count, t_end)
+    return ahead == ahead and switches + ahead > max_events
+
+
 def note_switch(recent, entries: int, t: float, zeno_count: int, zeno_span: float,
                 time_scale: float = 1.0):
     """The Zeno ring both engines keep: enters the switch at ``t`` in ``recent`` (an array

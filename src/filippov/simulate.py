@@ -486,8 +486,8 @@ class _Run:
         # what the loop keeps: limits, switches, the Zeno ring (filippov.loop.run_state)
         self.rs = new_run_state(Limits(self.t_end, system.sliding, self.max_events,
                                        self.zeno_count, self.zeno_span, self.touch_tol,
-                                       self.state_scale, self.time_scale))
-        self.hit_section, self.projected = None, None
+                                       self.state_scale, self.time_scale, True))
+        self.hit_section = None
         self._flow_field = None  # (mode, f, z) at the end of the last exact window
         self.shift = 0.0  # subtracted from H in this stay (rules.exit_shift)
         self.band = 0.0   # the rounding band of the exit the stay began at (rules.exit_band)
@@ -736,8 +736,10 @@ class _Run:
         if status == EVENT_LIMIT and self.rs.count[SWITCHES] > self.max_events:
             return run_error(EVENT_LIMIT, te, ze, f": event limit {self.max_events} hit "
                                                   "(rapid switching)")
-        if status == EVENT_LIMIT:
-            every, ahead, new_mode = self.projected
+        if status == EVENT_LIMIT:  # projected (rules.budget_runs_out) at the switch recorded
+            every, ahead = rules.budget_projection(ring, entries, te, self.zeno_count,
+                                                   self.t_end)
+            new_mode = self.traj.events[-1].mode_after
             return run_error(
                 EVENT_LIMIT, te, ze, f", mode {MODE_NAMES[new_mode]}: switching every "
                 f"{every:.3g} time units: ~{ahead:.3g} more switches to t_end={self.t_end!r} "
@@ -753,16 +755,6 @@ class _Run:
             zf = self.system.flows[mode](z, np.zeros(1))
             return np.asarray(zf, dtype=float).reshape(-1)
         return z
-
-    def _over_budget(self, te, new_mode, switches):
-        """At the rate of the last zeno_count switches, the event budget must last to
-        t_end (the reference's projection: :mod:`filippov.engines`, item 2)."""
-        oldest = self.rs.ring[self.rs.count[RING] % self.zeno_count]
-        if not te > oldest:
-            return False
-        ahead = (self.t_end - te) * (self.zeno_count - 1) / (te - oldest)
-        self.projected = ((te - oldest) / (self.zeno_count - 1), ahead, new_mode)
-        return switches + ahead > self.max_events
 
 
 def _no_sliding(t, z) -> SlidingNotBuiltError:
@@ -780,10 +772,11 @@ def _section_hit(mode, t, run):
 
 
 def _exit_state(run):
-    """The event's state, a copy of its own (the event may move it onto H), and grad H
+    """The event's state, a copy of its own (the event may move it onto H), grad H and H
     there."""
     run.z = run.z.copy()
-    return run.z, run.system.switch_grad(run.z[:, None])[:, 0]
+    return (run.z, run.system.switch_grad(run.z[:, None])[:, 0],
+            float(run.system.switch(run.z)))
 
 
 def _record(mode, new_mode, what, t, run):
@@ -817,11 +810,9 @@ RUN_OPERATIONS = RunOps(
     end_step=lambda mode, ta, tb, status, t, run: run.end_step(ta, tb, status),
     record=_record,
     speeds=_normal_speeds,
-    h=lambda run: float(run.system.switch(run.z)),
     exit_state=_exit_state,
     flow_at_zero=lambda mode, z, run: run._flow_at_zero(mode, z),
     slides_in_section=_slides_in_a_section,
-    over_budget=lambda t, new_mode, switches, run: run._over_budget(t, new_mode, switches),
     enter=_enter)
 _RUN = make_run(RUN_OPERATIONS)
 

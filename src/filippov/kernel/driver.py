@@ -329,15 +329,10 @@ def _event_speeds(ctx):
 
 
 @_jit_inline
-def _event_h(ctx):
-    fns, p, s, w = ctx
-    return _h(fns, w.z, p)
-
-
-@_jit_inline
 def _exit_state(ctx):
-    """The event's state w.z and grad h there (left in w.wg by _event_speeds)."""
-    return ctx[3].z, ctx[3].wg
+    """The event's state w.z, grad h there (left in w.wg by _event_speeds) and h."""
+    fns, p, s, w = ctx
+    return w.z, w.wg, _h(fns, w.z, p)
 
 
 @_jit_inline
@@ -379,12 +374,6 @@ def _record(mode, new_mode, what, t, ctx):
         return _at_section(mode, t, ctx)
     _record_switch(mode, new_mode, what, t, ctx)
     return _GO_ON
-
-
-@_jit_inline
-def _over_budget(t, new_mode, switches, ctx):
-    """The hard bound only (filippov.engines, item 2)."""
-    return False
 
 
 @_jit_inline
@@ -471,9 +460,8 @@ def _begin(z0, age0, ctx):
 #: function by name
 _RUN_OPS = {"begin": "_begin", "next_step": "_next_step", "step_windows": "_step_windows",
             "end_step": "_end_step", "record": "_record", "speeds": "_event_speeds",
-            "h": "_event_h", "exit_state": "_exit_state",
-            "flow_at_zero": "_event_flow_at_zero", "slides_in_section": "_event_slides_in",
-            "over_budget": "_over_budget", "enter": "_enter"}
+            "exit_state": "_exit_state", "flow_at_zero": "_event_flow_at_zero",
+            "slides_in_section": "_event_slides_in", "enter": "_enter"}
 
 
 def _operations(ns) -> RunOps:
@@ -507,10 +495,12 @@ _KERNEL_SIG = kernel_signature()
 @_jit_inline
 def _run_record(s, w):
     """The loop's record of a run (filippov.loop.run_state) on the batch's own arrays: its
-    counters are w.count's first, its ring w.recent, its first switch w.first_sw."""
+    counters are w.count's first, its ring w.recent, its first switch w.first_sw; the
+    event budget is the hard bound only (projects_budget False: filippov.engines,
+    item 2)."""
     return RunState(Limits(s.t_max, s.sliding, s.max_events, s.zeno_count, s.zeno_span,
-                           s.touch_tol, s.state_scale, s.time_scale), w.count, w.recent,
-                    w.first_sw)
+                           s.touch_tol, s.state_scale, s.time_scale, False), w.count,
+                    w.recent, w.first_sw)
 
 
 @_jit_inline

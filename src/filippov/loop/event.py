@@ -22,10 +22,9 @@ not build). The order at a switch: the decision (rules.next_mode); sliding that 
 system does not build (NO_SLIDING); an arrival on H that would slide inside a section
 (SECTION_SLIDING); the end of a slide (rules.exit_drift, onto_switch, exit_band,
 exit_shift: the exact flow over time 0); the switch recorded and counted; the hard
-bound max_events (EVENT_LIMIT); the Zeno ring (rules.note_switch: ZENO); the engine's own
-budget verdict (the reference's projection of the switching rate, :mod:`filippov.engines`
-item 2);
-then the next stay's shift and band, dP/dz across the switch and the engine's entry
+bound max_events (EVENT_LIMIT); the Zeno ring (rules.note_switch: ZENO); where the run's
+record says so (the reference engine: :mod:`filippov.engines` item 2), the budget
+projected from the switching rate (rules.budget_runs_out); then the next stay's shift and band, dP/dz across the switch and the engine's entry
 into the new mode.
 
 The event is written in the run's loop, not as a function the loop calls: numba inlines
@@ -64,11 +63,10 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: (docs/decisions.md#kernel-inlined-driver);
 #: record(mode, new_mode, what, t, ctx) -> status: an event recorded, a section hit
 #: (what == SECTION: OK ends the run, GO_ON goes on) or a switch (before the budgets
-#: are asked); speeds(ctx) -> (a, b); h(ctx) -> H; exit_state(ctx) -> (the state as an
-#: array the event may move onto H, grad H there); flow_at_zero(mode, z, ctx) -> the
-#: state the next stay in ``mode`` starts from as it evaluates it (rules.exit_band);
-#: slides_in_section(ctx) -> bool; over_budget(t, new_mode, switches, ctx) -> bool,
-#: asked once the ring is full; enter(mode, new_mode, t, shift, band, crossed, ctx): the
+#: are asked); speeds(ctx) -> (a, b); exit_state(ctx) -> (the state as an array the
+#: event may move onto H, grad H and H there); flow_at_zero(mode, z, ctx) -> the state
+#: the next stay in ``mode`` starts from as it evaluates it (rules.exit_band);
+#: slides_in_section(ctx) -> bool; enter(mode, new_mode, t, shift, band, crossed, ctx): the
 #: orbit goes on in new_mode -- the next stay's shift of H and rounding band, dP/dz
 #: across a crossing (``crossed``), the engine's bookkeeping
 RunOps = namedtuple("RunOps", operations(RunOperations))
@@ -81,8 +79,8 @@ def make_run(ops: RunOps):
     NO_RETURN at the end time, or why it stopped (the start's, a stay's or an event's
     status); t and ``mode`` where it ended. ``rs``: the run's record
     (:class:`~filippov.loop.run_state.RunState`), its counters cleared first."""
-    (begin, next_step, step_windows, end_step, record, speeds, h, exit_state, flow_at_zero,
-     slides_in_section, over_budget, enter) = ops
+    (begin, next_step, step_windows, end_step, record, speeds, exit_state, flow_at_zero,
+     slides_in_section, enter) = ops
 
     def run(z0, age0, ctx, rs):
         limits = rs.limits
@@ -127,12 +125,11 @@ def make_run(ops: RunOps):
             if mode == SLIDING and new_mode != SLIDING:
                 # the end of a slide: a state the slide left off H beyond rounding is
                 # moved onto it; the next stay measures H from the exit's rounding
-                z, grad = exit_state(ctx)
-                h0 = h(ctx)
+                z, grad, h0 = exit_state(ctx)
                 drift = rules.exit_drift(new_mode, h0, z, grad, limits.touch_tol)
                 if drift:
                     rules.onto_switch(z, h0, grad)
-                    h0 = h(ctx)  # what rounding left
+                    h0 = exit_state(ctx)[2]  # what rounding left (grad H as before)
                 band = rules.exit_band(z, flow_at_zero(new_mode, z, ctx), grad,
                                        limits.state_scale)
                 shift = rules.exit_shift(new_mode, h0, limits.touch_tol, drift)
@@ -141,15 +138,16 @@ def make_run(ops: RunOps):
                 rs.count[SWITCHES] += 1
                 if rs.count[SWITCHES] == 1:
                     rs.first_switch[0] = t
-            switches = rs.count[SWITCHES]
-            if switches > limits.max_events:
+            if rs.count[SWITCHES] > limits.max_events:
                 return EVENT_LIMIT, t, mode
             entries, zeno = rules.note_switch(rs.ring, rs.count[RING], t, limits.zeno_count,
                                               limits.zeno_span, limits.time_scale)
             rs.count[RING] = entries
             if zeno:
                 return ZENO, t, mode
-            if entries >= limits.zeno_count and over_budget(t, new_mode, switches, ctx):
+            if entries >= limits.zeno_count and limits.projects_budget and \
+                    rules.budget_runs_out(rs.ring, entries, t, limits.zeno_count,
+                                          limits.t_end, rs.count[SWITCHES], limits.max_events):
                 return EVENT_LIMIT, t, mode
             enter(mode, new_mode, t, shift, band, mode != SLIDING and new_mode != mode, ctx)
             mode = new_mode
