@@ -79,9 +79,17 @@ def _in_other_units(case, engine, flows, units, jac_scale, kinked):
     P, t, t1, k, J = _return(n, engine, flows, z0, p)
     Pu, tu, t1u, ku, Ju = _return(n, engine, flows, z0 / state, gs.rescaled(p, n, state, time),
                                   time)
-    assert ku == k
     _same(Pu * state, P, TOL_UNITS, "return point")
     _same(tu * time, t, TOL_UNITS, "return time")
+    if kinked and ku != k:
+        # a start on H up to rounding (|h(z0)| ~ 1e-17): one run reads it as on H (within
+        # touch_tol x G) and slides from t = 0, the other as a rounding off H and slides
+        # in at once -- one switch more, at t ~ 0, and the same return. G is not the same
+        # in both units: the fields' length lifts S only up to 1 (filippov.scale)
+        extra = t1u * time if ku > k else t1
+        assert abs(ku - k) == 1 and extra <= 1e-12, (k, ku, t1, t1u * time)
+        return
+    assert ku == k
     _same(t1u * time, t1, TOL_UNITS, "first switch")
     # dP/dz is dimensionless when every component has the same unit; time does not enter
     # (none where P has a kink: a start on H)
