@@ -84,6 +84,16 @@ def test_no_page_cites_a_latex_label_of_the_paper(pages, docs_site):
     assert not leaks, leaks
 
 
+def test_no_page_shows_where_the_site_was_built(pages, docs_site):
+    # a module constant's value rendered by autodoc showed the build's checkout folder
+    # (filippov_paper.product.PACKAGE = PosixPath('/tmp/ci-.../workflow/...')): a page
+    # that changes with the machine and says nothing to a reader
+    folders = (str(ROOT), str(docs_site.parent), "PosixPath(")  # the tree, the build's copy
+    shown = {p.relative_to(docs_site).as_posix(): [f for f in folders if f in p.read_text()]
+             for p in pages}
+    assert not any(shown.values()), {k: v for k, v in shown.items() if v}
+
+
 def test_no_page_loads_a_script_or_style_from_the_web(pages, docs_site):
     # offline, a script from a CDN (MathJax's default) does not load: every formula would
     # show its raw TeX. Every script and stylesheet is a file of the site.

@@ -33,6 +33,9 @@ from pathlib import Path
 from typing import Any
 
 #: the pipeline package's folder (scenes/, plotting/, benchmarks/, hard_cases.py)
+#: (its value, a path on the machine that built the docs, is not shown)
+#:
+#: :meta hide-value:
 PACKAGE = Path(__file__).parent
 
 
@@ -149,7 +152,9 @@ HARD_CASES = (
        "the report part: adds its flags and macros, returns one text per REPORT['tables']"),
 )
 
-#: kind -> its hooks
+#: kind -> its hooks (the tuples above; its value is not repeated here)
+#:
+#: :meta hide-value:
 HOOKS = {"scene": SCENE, "figure": FIGURE, "benchmark": BENCHMARK, "hard_cases": HARD_CASES}
 
 
