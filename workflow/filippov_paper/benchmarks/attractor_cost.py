@@ -81,13 +81,9 @@ def measure(cases, returns: int, repeat: int) -> tuple[list, list]:
     with its own untimed warm-up call: the dP/dz build is compiled or loaded there), and
     the switches per return. A failed call raises."""
     built = [iterate(t, e, s, returns) for t, e, s in cases]
-    calls = [call(jac) for call, _, _ in built for jac in (False, True)]
-    got = timing.measure_interleaved(calls, min_rounds=repeat, min_time=MIN_TIME,
-                                     passes=repeat)
-    for t in got:
-        if not isinstance(t, timing.Timing):
-            raise t
-    timings = [got[2 * k:2 * k + 2] for k in range(len(cases))]
+    timings = timing.interleaved_rows([[call(jac) for jac in (False, True)]
+                                       for call, _, _ in built],
+                                      min_rounds=repeat, min_time=MIN_TIME, passes=repeat)
     return timings, [switches_per_return(cm, start, returns) for _, cm, start in built]
 
 

@@ -129,16 +129,12 @@ def measure(cases, starts: int, returns: int, repeat: int, workers: list) -> lis
     cases and worker counts are interleaved; a failed call, or results that differ
     between worker counts, raise."""
     table = [batches(t, e, s, starts, returns, workers) for t, e, s in cases]
-    flat = [b for row in table for b in row]
-    got = iter(timing.measure_interleaved(flat, min_rounds=repeat, min_time=MIN_TIME,
-                                          passes=repeat))
+    timings = timing.interleaved_rows(table, min_rounds=repeat, min_time=MIN_TIME,
+                                      passes=repeat)
     rows = []
-    for (theta, _, _), row in zip(cases, table):
+    for (theta, _, _), row, row_t in zip(cases, table, timings):
         rows.append([])
-        for b in row:
-            t = next(got)
-            if not isinstance(t, timing.Timing):
-                raise t
+        for b, t in zip(row, row_t):
             first = rows[-1][0]["out"] if rows[-1] else t.value
             if not all(np.array_equal(a, c, equal_nan=True) for a, c in
                        zip(vars(first).values(), vars(t.value).values()) if a is not None):

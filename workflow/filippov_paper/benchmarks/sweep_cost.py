@@ -98,15 +98,12 @@ def measure(cases, points, returns, repeat) -> list:
     its threads. The calls of all cases and ways are interleaved; a failed call, or a
     sweep whose results differ from the loop's, raise."""
     table = [ways(t, e, s, points, returns) for t, e, s in cases]
-    got = iter(timing.measure_interleaved([w for row in table for w in row],
-                                          min_rounds=repeat, min_time=MIN_TIME, passes=repeat))
+    timings = timing.interleaved_rows(table, min_rounds=repeat, min_time=MIN_TIME,
+                                      passes=repeat)
     rows = []
-    for (theta, _, _), row in zip(cases, table):
+    for (theta, _, _), row, row_t in zip(cases, table, timings):
         rows.append([])
-        for way in row:
-            t = next(got)
-            if not isinstance(t, timing.Timing):
-                raise t
+        for way, t in zip(row, row_t):
             if way.name == "loop":
                 reference = t.value
             elif not all(_same(alone, row_of(t.value, i)) for i, alone in enumerate(reference)):

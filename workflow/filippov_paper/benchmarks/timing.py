@@ -162,6 +162,19 @@ def measure_interleaved(fns: Sequence[Callable[[], Any]], *,
             for k in range(n)]
 
 
+def interleaved_rows(rows: Sequence[Sequence[Callable[[], Any]]], **options) -> list:
+    """:func:`measure_interleaved` over a table of functions (``rows``: one list per case),
+    all of them interleaved; the Timings in the table's shape. The first function that
+    failed raises its exception (a benchmark's table has no hole). ``options`` as
+    there."""
+    got = iter(measure_interleaved([fn for row in rows for fn in row], **options))
+    table = [[next(got) for _ in row] for row in rows]
+    for t in (t for row in table for t in row):
+        if not isinstance(t, Timing):
+            raise t
+    return table
+
+
 #: the data variables of a timed quantity ``name`` (:func:`variables`): (suffix, the
 #: Timing's field, long_name with ``{what}`` and ``{name}`` to fill in)
 STORED = (("", "median", "median {what} over the timed rounds"),
