@@ -152,6 +152,74 @@ def test_generated_exact_flows_equal_the_closed_form_and_the_integration():
     assert abs(traj.t - got[0].time[1]) < 1e-9
 
 
+def _richardson_flow_jacobian(flow, z0, tau, p):
+    """d flow / d z0 by Richardson's extrapolation of central differences (the compiled
+    engine's way without flow Jacobians), an independent check of the generated ones."""
+    n = z0.size
+    J = np.empty((n, n))
+
+    def quotient(k, d):
+        up, down = z0.copy(), z0.copy()
+        up[k] += d
+        down[k] -= d
+        a, b = np.empty(n), np.empty(n)
+        flow(up, tau, p, a)
+        flow(down, tau, p, b)
+        return (a - b) / (up[k] - down[k])
+    for k in range(n):
+        d = 2.0 ** -9 * max(1.0, abs(z0[k]))
+        J[:, k] = (4 * quotient(k, d / 2) - quotient(k, d)) / 3
+    return J
+
+
+def test_generated_flow_jacobians_equal_differences_of_the_flows():
+    """The flow Jacobians generated for the compiled engine's dP/dz (row by row, d flow /
+    d z0) against Richardson differences of the generated flows, the paper's slow-fast
+    flows in both regions (their truncation and rounding: below 1e-10 here)."""
+    cm = hopf.compiled(1e-2, -0.5)
+    rng = np.random.default_rng(5)
+    for mode in ("plus", "minus"):
+        flow, jac = getattr(cm, f"flow_{mode}"), getattr(cm, f"flow_jacobian_{mode}")
+        for _ in range(5):
+            z0, tau = rng.uniform(-1.2, 1.2, 3), float(rng.uniform(0.0, 0.1))
+            got = np.empty(9)
+            jac(z0, tau, cm.params, got)
+            want = _richardson_flow_jacobian(flow, z0, tau, cm.params)
+            assert np.max(np.abs(got.reshape(3, 3) - want)) < 1e-10 * np.max(np.abs(want)), \
+                (mode, z0, tau)
+
+
+def test_compiled_dpdz_takes_the_generated_flow_jacobians():
+    """dP/dz of the compiled engine through exact stays comes from the model's flow
+    Jacobians where it has them: with them and without (Richardson) the same to 1e-10
+    (Richardson's error: 1.4e-12 here), and a wrong flow
+    Jacobian (region -'s given for region +) changes it; one without the other is refused
+    by name."""
+    import dataclasses
+
+    from filippov.fastmap import OK, compute_returns
+
+    # four crossings, no sliding: dP/dz of order 0.3 (sliding's projection leaves 1e-5
+    # of the factors' product, so that 1e-12 of Richardson's error reads as 1e-7)
+    cm = hopf.compiled(1e-2, -0.5)
+    start = np.array([[0.0, 1.3, 0.0]])
+    runs = {"exact": cm,
+            "richardson": dataclasses.replace(cm, flow_jacobian_plus=None,
+                                              flow_jacobian_minus=None),
+            "wrong": dataclasses.replace(cm, flow_jacobian_plus=cm.flow_jacobian_minus)}
+    out = {k: compute_returns(m, start, 5.0, jacobian=True)
+           for k, m in runs.items()}
+    assert all(o.status[0] == OK for o in out.values())
+    assert out["exact"].n_switches[0] == 4
+    J = out["exact"].jacobian[0]
+    assert np.array_equal(out["exact"].state, out["richardson"].state)
+    assert np.max(np.abs(J - out["richardson"].jacobian[0])) < 1e-10 * np.max(np.abs(J))
+    assert np.max(np.abs(J - out["wrong"].jacobian[0])) > 1e-3 * np.max(np.abs(J))
+    half = dataclasses.replace(cm, flow_jacobian_minus=None)
+    with pytest.raises(ValueError, match="flow_jacobian_plus, flow_jacobian_minus"):
+        compute_returns(half, start, 5.0, jacobian=True)
+
+
 def test_with_params_shares_the_generated_pieces():
     M = hopf_symbolic()
     a = M.full()

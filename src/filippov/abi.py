@@ -25,6 +25,9 @@ FIELD_SIG = types.void(_vec, _vec, _vec)
 SCALAR_SIG = types.float64(_vec, _vec)
 #: ``where(z, params)``: the condition a section hit must satisfy.
 WHERE_SIG = types.boolean(_vec, _vec)
+#: ``flow_jacobian(z0, tau, params, out)`` (a flow's signature, ``out`` n*n): the
+#: derivative of a region's exact flow from ``z0`` over ``tau`` with respect to ``z0``, row
+#: by row.
 #: ``jacobian(mode, z, params, out)``: dF/dz of the field of ``mode`` (-1 region -,
 #: 0 Filippov's sliding field, +1 region +) at z, row by row into ``out`` (n*n).
 JAC_SIG = types.void(types.int64, _vec, _vec, _vec)
@@ -34,7 +37,8 @@ JAC_SIG = types.void(types.int64, _vec, _vec, _vec)
 #: compiled engine takes them (its kernel's arguments, and the index it calls each by)
 PIECES = (("flow_plus", FLOW_SIG), ("flow_minus", FLOW_SIG), ("field_plus", FIELD_SIG),
           ("field_minus", FIELD_SIG), ("switch", SCALAR_SIG), ("switch_grad", FIELD_SIG),
-          ("section", SCALAR_SIG), ("section_where", WHERE_SIG), ("jacobian", JAC_SIG))
+          ("section", SCALAR_SIG), ("section_where", WHERE_SIG), ("jacobian", JAC_SIG),
+          ("flow_jacobian_plus", FLOW_SIG), ("flow_jacobian_minus", FLOW_SIG))
 
 
 @njit(FLOW_SIG, cache=True)
@@ -98,6 +102,11 @@ class CompiledModel:
     #: optional :data:`JAC_SIG` piece: exact Jacobians for dP/dz through integrated stays
     #: (None: Jacobian-vector products by central differences of the field)
     jacobian: Any = None
+    #: optional :data:`FLOW_SIG` pieces, both or neither (with exact flows): the exact
+    #: flows' derivatives d flow / d z0, n*n row by row, for dP/dz through exact stays
+    #: (None: Richardson's extrapolation of central differences of the flows)
+    flow_jacobian_plus: Any = None
+    flow_jacobian_minus: Any = None
     #: what numba compiled into the user's pieces from globals and closures, checked by
     #: the compiled engine's front doors before every call (:mod:`filippov.frozen`)
     frozen_reads: tuple = field(default=(), compare=False, repr=False)

@@ -175,12 +175,15 @@ def _pieces(cmodel: CompiledModel) -> tuple:
     """The compiled addresses of the model's pieces in the kernel's order
     (filippov.abi.PIECES), each piece a numba-compiled function with its signature: the
     kernel calls them at their address (kernel.base._piece), which anything else lacks.
-    A model without Jacobians hands :func:`no_jacobian`."""
+    A model without Jacobians hands :func:`no_jacobian`, one without flow Jacobians
+    :func:`no_flow` (neither is called)."""
     pieces = []
     for name, sig in PIECES:
         piece = getattr(cmodel, name)
         if name == "jacobian" and piece is None:
             piece = no_jacobian
+        elif name.startswith("flow_jacobian_") and piece is None:
+            piece = no_flow
         pieces.append(_address(piece, name, sig))
     return tuple(pieces)
 
@@ -196,6 +199,9 @@ def _check_options(cmodel, t_max, iterations, keep, min_time) -> None:
         raise ValueError(f"keep must be an integer in [0, iterations={iterations}], got {keep!r}")
     if not (options.finite(min_time) and min_time >= 0):
         raise ValueError(f"min_time must be a finite number >= 0, got {min_time!r}")
+    if (cmodel.flow_jacobian_plus is None) != (cmodel.flow_jacobian_minus is None):
+        raise ValueError("flow_jacobian_plus, flow_jacobian_minus: give both flow "
+                         "Jacobians or neither")
     if cmodel.exact and not (options.finite(cmodel.sample_step) and cmodel.sample_step > 0):
         raise ValueError(f"the compiled model needs a finite sample_step > 0, "
                          f"got {cmodel.sample_step!r}")
@@ -293,6 +299,8 @@ def _settings(cmodel: CompiledModel, t_max, *, rtol, atol, max_step, max_events,
     frac_in = _fractions(samples_per_step)
     # dP/dz: 0 none, 1 Jacobian-vector products by differences, 2 the model's Jacobians
     jac_mode = (2 if cmodel.jacobian is not None else 1) if jacobian else 0
+    # an exact stay's dP/dz: the model's flow Jacobians, else Richardson (kernel.derivative)
+    flow_jac = bool(jacobian and cmodel.exact and cmodel.flow_jacobian_plus is not None)
     # the kernel's ABI (abi.PIECES; kernel.state: Settings, Outputs, declared there with
     # their numba types, from which the kernel's one signature is built: Python floats,
     # ints and bools as such)
@@ -303,7 +311,7 @@ def _settings(cmodel: CompiledModel, t_max, *, rtol, atol, max_step, max_events,
         frac_ex=frac_ex, frac_in=frac_in, rtol=float(rtol), atol=float(atol),
         touch_tol=float(touch_tol), xtol=float(event_xtol), zeno_span=float(zeno_span),
         max_step=float(max_step), min_time=float(min_time), max_events=int(max_events),
-        max_steps=int(max_steps), zeno_count=int(zeno_count), jac=jac_mode,
+        max_steps=int(max_steps), zeno_count=int(zeno_count), jac=jac_mode, flow_jac=flow_jac,
         iterations=int(iterations), state_scale=float(scale.state),
         time_scale=float(scale.time))
 

@@ -199,8 +199,14 @@ class SymbolicSystem:
                   "switch_grad": ("vector", self.switch_grad)}
         for mode, J in self.jacobians.items():
             pieces[f"jacobian_{mode}"] = ("matrix", [J[k // n, k % n] for k in range(n * n)])
+        z = list(self.states)
         for mode, exprs in self.flows.items():
             pieces[f"flow_{mode}"] = ("flow", exprs)
+            # d flow / d z0, differentiated here: dP/dz through an exact stay without
+            # differences (the compiled engine's flow_jacobian pieces)
+            J = sp.Matrix(exprs).jacobian(z)
+            pieces[f"flow_jacobian_{mode}"] = ("flow_matrix", [J[k // n, k % n]
+                                                               for k in range(n * n)])
         return pieces
 
     def source(self) -> str:
@@ -374,6 +380,8 @@ class GeneratedSystem(FilippovSystem):
             section_direction=int(direction), sample_step=self.sample_step,
             slow_sample_step=self.slow_sample_step, transient_time=self.transient_time,
             sliding=self.sliding, exact=exact, jacobian=m.jacobian,
+            flow_jacobian_plus=m.flow_jacobian_plus if exact else None,
+            flow_jacobian_minus=m.flow_jacobian_minus if exact else None,
             parameters={str(k): float(v) for k, v in zip(self.symbolic.param_symbols,
                                                          self.params)})
 

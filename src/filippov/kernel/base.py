@@ -122,7 +122,7 @@ def _piece(name):
 
 # the piece at fns[k] by name: (z0, tau, p, out), (z, p, out), (z, p) -> float or bool, (mode, z, p, out)
 (_flow_plus, _flow_minus, _field_plus, _field_minus, _h, _grad_h, _section, _where,
- _jacobian) = (_piece(name) for name, _ in PIECES)
+ _jacobian, _flow_jacobian_plus, _flow_jacobian_minus) = (_piece(name) for name, _ in PIECES)
 
 
 @_jit

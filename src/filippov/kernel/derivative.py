@@ -5,15 +5,16 @@ import numpy as np
 
 from .. import rules
 from ..system import PLUS
-from .base import (_dot, _flow_minus, _flow_plus, _grad_h, _jacobian, _jit, _section)
+from .base import (_dot, _flow_jacobian_minus, _flow_jacobian_plus, _flow_minus, _flow_plus,
+                   _grad_h, _jacobian, _jit, _section)
 from .dop853 import (_A, _B, _NS, _TRIAL, _checked_field, _stage)
 from .state import Stages
 
 
 # The derivative of a return, carried in w.deriv.M while the orbit runs (Settings.jac), as
-# the reference driver's filippov.variational composes it: an exact-flow stay by
-# Richardson's extrapolation of central differences of the closed-form flow from its mode
-# entry; an integrated stay (sliding, or a model without flows) by the variational
+# the reference driver's filippov.variational composes it: an exact-flow stay by the
+# model's flow Jacobian from its mode entry where it has one (a SymbolicSystem's, generated),
+# else by Richardson's extrapolation of central differences of the closed-form flow; an integrated stay (sliding, or a model without flows) by the variational
 # equation taken through the very DOP853 steps of the state (internal differentiation:
 # the derivative of the computed solution, the step sizes held); a switch by its
 # saltation matrix; the end of sliding by the identity; the section hit by the projection
@@ -72,11 +73,21 @@ def _flow_quotient(mode, za, k, d, tau, fns, p, dv):
 
 
 @_jit
-def _flow_jacobian(mode, za, tau, fns, p, dv):
-    """dv.Mt = d flow(za, tau) / d za, column by column by Richardson's extrapolation of
-    two central differences of the closed-form flow (rules.richardson_step from the state
-    scale up, and half of it)."""
-    for k in range(za.size):
+def _flow_jacobian(mode, za, tau, fns, p, dv, exact):
+    """dv.Mt = d flow(za, tau) / d za: the model's flow Jacobian (``exact``), else column
+    by column by Richardson's extrapolation of two central differences of the closed-form
+    flow (rules.richardson_step from the state scale up, and half of it)."""
+    n = za.size
+    if exact:
+        if mode == PLUS:
+            _flow_jacobian_plus(fns, za, tau, p, dv.Jm)
+        else:
+            _flow_jacobian_minus(fns, za, tau, p, dv.Jm)
+        for i in range(n):
+            for k in range(n):
+                dv.Mt[i, k] = dv.Jm[i * n + k]
+        return
+    for k in range(n):
         d = rules.richardson_step(max(dv.floor, abs(za[k])))
         _flow_quotient(mode, za, k, d, tau, fns, p, dv)
         for i in range(za.size):

@@ -287,7 +287,7 @@ def _end_step(mode, ta, tb, st, te, ctx):
         dv = w.deriv
         if w.seg[SEG_INTEGRATED] == 0.0:
             if st == OK:
-                _flow_jacobian(mode, w.za, te - w.seg[SEG_ENTRY], fns, p, dv)
+                _flow_jacobian(mode, w.za, te - w.seg[SEG_ENTRY], fns, p, dv, s.flow_jac)
                 _apply(dv.Mt, dv.M, dv.KP[0])
         elif st == _GO_ON or (st == OK and te > ta):
             _var_step(mode, w.y_old, (tb if st == _GO_ON else te) - ta, fns, p,

@@ -24,14 +24,16 @@ _f8, _i8, _b1 = types.float64, types.int64, types.boolean
 #: in windows hwin (hwin_slow after the transient time); the section predicate; sliding
 #: declared; sample fractions of an exact window and of an integration step; tolerances and
 #: limits as compute_returns' options; iterations: returns per start; jac: dP/dz (0 none,
-#: 1 Jacobian-vector products by differences, 2 the model's Jacobians); the run's state and
+#: 1 Jacobian-vector products by differences, 2 the model's Jacobians); flow_jac: an exact
+#: stay's dP/dz from the model's flow Jacobians (else Richardson); the run's state and
 #: time scales (filippov.scale: the floors of the rules, atol etc. already scaled)
 SETTINGS = (
     ("t_max", _f8), ("exact", _b1), ("hwin", _f8), ("hwin_slow", _f8), ("transient", _f8),
     ("sec_pred", _i8), ("sliding", _b1), ("frac_ex", _vec), ("frac_in", _vec), ("rtol", _f8),
     ("atol", _f8), ("touch_tol", _f8), ("xtol", _f8), ("zeno_span", _f8), ("max_step", _f8),
     ("min_time", _f8), ("max_events", _i8), ("max_steps", _i8), ("zeno_count", _i8),
-    ("jac", _i8), ("iterations", _i8), ("state_scale", _f8), ("time_scale", _f8))
+    ("jac", _i8), ("flow_jac", _b1), ("iterations", _i8), ("state_scale", _f8),
+    ("time_scale", _f8))
 
 #: what a batch returns, per start (m) -- fastmap.BatchReturns' fields: state (m, n), time,
 #: n_switches, sliding_time, status, first_switch, sliding_displacement (m, n), orbit
