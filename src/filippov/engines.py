@@ -222,6 +222,20 @@ ASYMMETRIES = (
         "engine steps explicitly, at the stability limit, where that rounding is not what "
         "fails its windows, and keeps the kernel free of the probes",
         ("tests/test_engine_asymmetries.py::test_the_reference_measures_the_rounding_a_function_carries",)),
+    Asymmetry(
+        13, "dP/dz through an exact-flow stay",
+        "integrates the variational equation along the stay (the field's Jacobian: the "
+        "system's own, or central differences), at ``rtol``",
+        "differentiates the closed-form flow from the mode entry: the model's flow "
+        "Jacobians (``flow_jacobian_plus``/``_minus``, which a ``SymbolicSystem`` "
+        "generates) where it has them, else Richardson's extrapolation of central "
+        "differences of the flow (``rules.richardson_step``)",
+        "deliberate", "the kernel follows an exact stay in one closed-form evaluation per "
+        "sample, with no steps a variational equation could ride on; the three agree to "
+        "1e-10 (tests/test_units.py, across units; the Richardson error 1.4e-12 on a "
+        "return of the paper's flow)",
+        ("tests/test_symbolic.py::test_compiled_dpdz_takes_the_generated_flow_jacobians",
+         "tests/test_units.py::test_a_relay_orbit_in_other_units_has_its_period_and_multipliers")),
 )
 
 
