@@ -124,8 +124,10 @@ def test_several_switching_functions_are_refused_by_name():
 SEAM_TARGET = 8
 #: the operations the seam has today (23 before the loop kept its own record, the
 #: budget's projection became a rule the record switches on, and the stay's start, the
-#: event's records, H at the exit and the entry were folded): never more
-SEAM_NOW = 10
+#: event's records, H at the exit and the entry were folded; then the flow over time 0
+#: into the exit's state and the refusal to slide in a section into the record): never
+#: more
+SEAM_NOW = 8
 
 
 def _engines_operations():

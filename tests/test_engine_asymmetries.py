@@ -91,7 +91,9 @@ def test_the_compiled_model_has_no_sliding_flow():
     from filippov.abi import PIECES
 
     names = [name for name, _ in PIECES]
-    assert [n for n in names if n.startswith("flow")] == ["flow_plus", "flow_minus"]
+    assert [n for n in names if n.startswith("flow")] == [
+        "flow_plus", "flow_minus", "flow_jacobian_plus", "flow_jacobian_minus"]
+    assert not [n for n in names if "slid" in n]
 
 
 # ------------------------------------------------------------------ root finding

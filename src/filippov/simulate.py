@@ -771,18 +771,21 @@ def _section_hit(mode, t, run):
     return OK if sec.terminal is not None and run.hits[idx] >= sec.terminal else GO_ON
 
 
-def _exit_state(run):
+def _exit_state(new_mode, run):
     """The event's state, a copy of its own (the event may move it onto H), grad H and H
-    there."""
+    there, and the state the next stay in new_mode starts from as it evaluates it."""
     run.z = run.z.copy()
     return (run.z, run.system.switch_grad(run.z[:, None])[:, 0],
-            float(run.system.switch(run.z)))
+            float(run.system.switch(run.z)), run._flow_at_zero(new_mode, run.z))
 
 
 def _record(mode, new_mode, what, t, run):
-    """A section hit (:func:`_section_hit`) or a switch, logged: OK, or GO_ON."""
+    """A section hit (:func:`_section_hit`: OK, or GO_ON) or a switch, logged: GO_ON, or
+    SECTION_SLIDING (nothing logged) where it slides into a section."""
     if what == SECTION:
         return _section_hit(mode, t, run)
+    if new_mode == SLIDING and mode != SLIDING and _slides_in_a_section(run):
+        return SECTION_SLIDING
     kind = ("slide_end" if what != rules.SWITCH
             else "crossing" if new_mode != SLIDING else "slide_start")
     run.traj.events.append(Event(t, kind, run.z.copy(), mode, new_mode))
@@ -811,8 +814,6 @@ RUN_OPERATIONS = RunOps(
     record=_record,
     speeds=_normal_speeds,
     exit_state=_exit_state,
-    flow_at_zero=lambda mode, z, run: run._flow_at_zero(mode, z),
-    slides_in_section=_slides_in_a_section,
     enter=_enter)
 _RUN = make_run(RUN_OPERATIONS)
 

@@ -43,7 +43,7 @@ from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_de
 from ..loop.event import SECTION, RunOps, make_run
 from ..loop.run_state import Limits, RunState
 from ..loop.stay import UNRESOLVED, before_stay, make_slides_in, make_start, make_step_windows
-from ..loop.status import GO_ON
+from ..loop.status import GO_ON, SECTION_SLIDING
 
 
 # ------------------------------------------------------------------ sliding in the section
@@ -329,24 +329,19 @@ def _event_speeds(ctx):
 
 
 @_jit_inline
-def _exit_state(ctx):
-    """The event's state w.z, grad h there (left in w.wg by _event_speeds) and h."""
+def _exit_state(new_mode, ctx):
+    """The event's state w.z, grad h there (left in w.wg by _event_speeds), h, and the
+    exact flow of w.z in new_mode over time 0 (its rounding, in w.wz), or w.z itself when
+    integrated."""
     fns, p, s, w = ctx
-    return w.z, w.wg, _h(fns, w.z, p)
-
-
-@_jit_inline
-def _event_flow_at_zero(mode, z, ctx):
-    """The exact flow of z over time 0 (its rounding), or z itself when integrated."""
-    fns, p, s, w = ctx
-    for k in range(z.size):
-        w.wz[k] = z[k]
+    for k in range(w.z.size):
+        w.wz[k] = w.z[k]
     if s.exact:
-        if mode == PLUS:
-            _flow_plus(fns, z, 0.0, p, w.wz)
+        if new_mode == PLUS:
+            _flow_plus(fns, w.z, 0.0, p, w.wz)
         else:
-            _flow_minus(fns, z, 0.0, p, w.wz)
-    return w.wz
+            _flow_minus(fns, w.z, 0.0, p, w.wz)
+    return w.z, w.wg, _h(fns, w.z, p), w.wz
 
 
 @_jit_inline
@@ -369,9 +364,12 @@ def _record_switch(mode, new_mode, what, t, ctx):
 
 @_jit_inline
 def _record(mode, new_mode, what, t, ctx):
-    """A section hit (_at_section) or a switch (_record_switch): OK, or GO_ON."""
+    """A section hit (_at_section: OK, or GO_ON) or a switch (_record_switch: GO_ON, or
+    SECTION_SLIDING where it slides into the section)."""
     if what == SECTION:
         return _at_section(mode, t, ctx)
+    if new_mode == SLIDING and mode != SLIDING and _event_slides_in(ctx):
+        return SECTION_SLIDING
     _record_switch(mode, new_mode, what, t, ctx)
     return _GO_ON
 
@@ -460,8 +458,7 @@ def _begin(z0, age0, ctx):
 #: function by name
 _RUN_OPS = {"begin": "_begin", "next_step": "_next_step", "step_windows": "_step_windows",
             "end_step": "_end_step", "record": "_record", "speeds": "_event_speeds",
-            "exit_state": "_exit_state", "flow_at_zero": "_event_flow_at_zero",
-            "slides_in_section": "_event_slides_in", "enter": "_enter"}
+            "exit_state": "_exit_state", "enter": "_enter"}
 
 
 def _operations(ns) -> RunOps:

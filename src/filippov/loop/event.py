@@ -3,7 +3,7 @@ what order, against the event budget and the Zeno ring: written once for both en
 
 :func:`make_run` builds the run from the engine's own operations (:class:`RunOps`: how
 it starts, follows a stay to its event, evaluates the speeds, h and grad h at the
-event's state, the exact flow over time 0, records a hit or a switch, keeps the next
+event's state and the exact flow over time 0, records a hit or a switch, keeps the next
 stay's shift, updates dP/dz); what the run itself keeps -- its limits, the switches
 counted, the Zeno ring, the first switch's time -- is the loop's own record
 (:mod:`filippov.loop.run_state`), which each engine builds and the loop reads and
@@ -19,9 +19,9 @@ times in ``rs``, is rules.note_switch.
 
 Before each stay: filippov.loop.stay.before_stay (the end time; sliding the system does
 not build). The order at a switch: the decision (rules.next_mode); sliding that the
-system does not build (NO_SLIDING); an arrival on H that would slide inside a section
-(SECTION_SLIDING); the end of a slide (rules.exit_drift, onto_switch, exit_band,
-exit_shift: the exact flow over time 0); the switch recorded and counted; the hard
+system does not build (NO_SLIDING); the end of a slide (rules.exit_drift, onto_switch, exit_band,
+exit_shift: the exact flow over time 0); the switch recorded (an arrival on H that would
+slide inside a section refused there: SECTION_SLIDING) and counted; the hard
 bound max_events (EVENT_LIMIT); the Zeno ring (rules.note_switch: ZENO); where the run's
 record says so (the reference engine: :mod:`filippov.engines` item 2), the budget
 projected from the switching rate (rules.budget_runs_out); then the next stay's shift and band, dP/dz across the switch and the engine's entry
@@ -38,7 +38,7 @@ from collections import namedtuple
 from .. import rules
 from ..contracts import RunOperations, operations
 from ..system import SLIDING
-from .status import EVENT_LIMIT, GO_ON, NO_SLIDING, OK, SECTION_SLIDING, TWO_FOLD, ZENO
+from .status import EVENT_LIMIT, GO_ON, NO_SLIDING, OK, TWO_FOLD, ZENO
 from .run_state import RING, SWITCHES
 from .stay import before_stay
 
@@ -63,10 +63,12 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: (docs/decisions.md#kernel-inlined-driver);
 #: record(mode, new_mode, what, t, ctx) -> status: an event recorded, a section hit
 #: (what == SECTION: OK ends the run, GO_ON goes on) or a switch (before the budgets
-#: are asked); speeds(ctx) -> (a, b); exit_state(ctx) -> (the state as an array the
-#: event may move onto H, grad H and H there); flow_at_zero(mode, z, ctx) -> the state
-#: the next stay in ``mode`` starts from as it evaluates it (rules.exit_band);
-#: slides_in_section(ctx) -> bool; enter(mode, new_mode, t, shift, band, crossed, ctx): the
+#: are asked; GO_ON, or SECTION_SLIDING, nothing recorded, where an entry into sliding
+#: would slide inside one of the engine's sections, which the loop does not see);
+#: speeds(ctx) -> (a, b); exit_state(new_mode, ctx) -> (the state as an array the event
+#: may move onto H, grad H and H there, and the state the next stay in new_mode starts
+#: from as it evaluates it: the exact flow over time 0, rules.exit_band);
+#: enter(mode, new_mode, t, shift, band, crossed, ctx): the
 #: orbit goes on in new_mode -- the next stay's shift of H and rounding band, dP/dz
 #: across a crossing (``crossed``), the engine's bookkeeping
 RunOps = namedtuple("RunOps", operations(RunOperations))
@@ -79,8 +81,7 @@ def make_run(ops: RunOps):
     NO_RETURN at the end time, or why it stopped (the start's, a stay's or an event's
     status); t and ``mode`` where it ended. ``rs``: the run's record
     (:class:`~filippov.loop.run_state.RunState`), its counters cleared first."""
-    (begin, next_step, step_windows, end_step, record, speeds, exit_state, flow_at_zero,
-     slides_in_section, enter) = ops
+    begin, next_step, step_windows, end_step, record, speeds, exit_state, enter = ops
 
     def run(z0, age0, ctx, rs):
         limits = rs.limits
@@ -119,21 +120,22 @@ def make_run(ops: RunOps):
                 a_in, b_in = a, b
             if new_mode == SLIDING and not limits.sliding:
                 return NO_SLIDING, t, mode
-            if new_mode == SLIDING and mode != SLIDING and slides_in_section(ctx):
-                return SECTION_SLIDING, t, mode
             shift, band = 0.0, 0.0
             if mode == SLIDING and new_mode != SLIDING:
                 # the end of a slide: a state the slide left off H beyond rounding is
                 # moved onto it; the next stay measures H from the exit's rounding
-                z, grad, h0 = exit_state(ctx)
+                z, grad, h0, z_next = exit_state(new_mode, ctx)
                 drift = rules.exit_drift(new_mode, h0, z, grad, limits.touch_tol)
                 if drift:
                     rules.onto_switch(z, h0, grad)
-                    h0 = exit_state(ctx)[2]  # what rounding left (grad H as before)
-                band = rules.exit_band(z, flow_at_zero(new_mode, z, ctx), grad,
-                                       limits.state_scale)
+                    # what rounding left, and the next stay's start from there (grad H
+                    # as before)
+                    z, _, h0, z_next = exit_state(new_mode, ctx)
+                band = rules.exit_band(z, z_next, grad, limits.state_scale)
                 shift = rules.exit_shift(new_mode, h0, limits.touch_tol, drift)
-            record(mode, new_mode, what, t, ctx)
+            status = record(mode, new_mode, what, t, ctx)
+            if status != GO_ON:  # SECTION_SLIDING
+                return status, t, mode
             if new_mode != mode:
                 rs.count[SWITCHES] += 1
                 if rs.count[SWITCHES] == 1:
