@@ -120,6 +120,47 @@ def flow_plus(z0, tau, p):
 
 
 @njit(cache=True)
+def _flow_jacobian(tau, p, base, n):
+    """d flow / d z0 = V exp(B tau) V^-1, column by column as _flow maps z0 - z* (its
+    own closed form, not differences)."""
+    oV, oW = base + n * n + n, base + 2 * n * n + n
+    ore, oim = base + 3 * n * n + n, base + 3 * n * n + 2 * n
+    out = np.empty((n, n))
+    for k in range(n):
+        y = np.empty(n)
+        for i in range(n):
+            y[i] = p[oW + i * n + k]
+        w = np.empty(n)
+        i = 0
+        while i < n:
+            g = math.exp(p[ore + i] * tau)
+            if p[oim + i] > 0.0 and i + 1 < n:
+                co, si = math.cos(p[oim + i] * tau), math.sin(p[oim + i] * tau)
+                w[i] = g * (co * y[i] - si * y[i + 1])
+                w[i + 1] = g * (si * y[i] + co * y[i + 1])
+                i += 2
+            else:
+                w[i] = g * y[i]
+                i += 1
+        for i in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += p[oV + i * n + j] * w[j]
+            out[i, k] = acc
+    return out
+
+
+@njit(cache=True)
+def flow_jacobian_minus(z0, tau, p):
+    return _flow_jacobian(tau, p, 0, z0.size)
+
+
+@njit(cache=True)
+def flow_jacobian_plus(z0, tau, p):
+    return _flow_jacobian(tau, p, _offsets(z0.size)[0], z0.size)
+
+
+@njit(cache=True)
 def switch(z, p):
     n = z.size
     oc = _offsets(n)[1]
@@ -198,16 +239,20 @@ class _Cached(FilippovSystem):
 _SYSTEMS: dict = {}
 
 
-def system(n: int, exact: bool, time_unit: float = 1.0) -> FilippovSystem:
+def system(n: int, exact: bool, time_unit: float = 1.0,
+           flow_jacobians: bool = False) -> FilippovSystem:
     """The structure of dimension ``n``, with (``exact``) or without exact flows; built
     once per process. Give it numbers with :func:`load`. ``time_unit``: the system's
     time is measured in units that many times as large (:func:`rescaled`), and so is
-    its sample step."""
-    key = (n, exact) if time_unit == 1.0 else (n, exact, time_unit)
+    its sample step. ``flow_jacobians``: with the exact flows' Jacobians too."""
+    key = (n, exact, time_unit, flow_jacobians)
     if key not in _SYSTEMS:
         p = np.zeros(layout(n)["size"])
         flows = dict(flow_minus=flow_minus, flow_plus=flow_plus,
                      sample_step=SAMPLE_STEP / time_unit) if exact else {}
+        if flow_jacobians:
+            flows["flow_jacobians"] = {"minus": flow_jacobian_minus,
+                                       "plus": flow_jacobian_plus}
         _SYSTEMS[key] = _Cached(tuple(f"x{i + 1}" for i in range(n)), field_minus, field_plus,
                                 switch, switch_grad, params=p, name=f"generated{n}",
                                 jacobians={"minus": jac_minus, "plus": jac_plus}, **flows)

@@ -97,6 +97,67 @@ def _flow_piece(fn, piece: str, n: int):
     return _compile(adapter, FLOW_SIG, piece)
 
 
+def _flow_matrix_piece(fn, piece: str, n: int):
+    """A flow's Jacobian ``J(z0, tau, p) -> (n, n)`` as the ABI's ``flow_jacobian``
+    piece (row by row into ``out``)."""
+    user = _jit(fn, piece)
+
+    def adapter(z0, tau, p, out):
+        v = user(z0, tau, p)
+        if v.shape[0] != n or v.shape[1] != n:
+            raise ValueError("a flow's Jacobian returned the wrong shape")
+        for i in range(n):
+            for k in range(n):
+                out[i * n + k] = v[i, k]
+
+    return _compile(adapter, FLOW_SIG, piece)
+
+
+def _richardson_flow_jacobian(flow, z0, tau, p, floor):
+    """d flow / d z0 by Richardson's extrapolation of central differences of a compiled
+    flow piece, as the kernel takes it without a flow Jacobian (rules.richardson_step)."""
+    from . import rules
+
+    n = z0.size
+    J = np.empty((n, n))
+
+    def quotient(k, d):
+        up, down = z0.copy(), z0.copy()
+        up[k] += d
+        down[k] -= d
+        a, b = np.empty(n), np.empty(n)
+        flow(up, tau, p, a)
+        flow(down, tau, p, b)
+        return (a - b) / (up[k] - down[k])
+    for k in range(n):
+        d = rules.richardson_step(max(floor, abs(z0[k])))
+        J[:, k] = (4 * quotient(k, d / 2) - quotient(k, d)) / 3
+    return J
+
+
+def _check_flow_jacobians(cm: CompiledModel, probe: np.ndarray) -> None:
+    """The flow Jacobians a user gave, against Richardson differences of their flows at
+    the probe state over one sample step: a wrong one would give wrong dP/dz and
+    multipliers with every return right. Refused where an entry is off by 1e-6 of the
+    scale (that of J), or where one is not finite."""
+    n, p, tau = cm.dim, cm.params, float(cm.sample_step)
+    floor = max(1.0, float(np.abs(probe).max()))
+    for mode in ("minus", "plus"):
+        got = np.full(n * n, np.nan)
+        getattr(cm, f"flow_jacobian_{mode}")(probe, tau, p, got)
+        J = got.reshape(n, n)
+        want = _richardson_flow_jacobian(getattr(cm, f"flow_{mode}"), probe, tau, p, floor)
+        scale = max(float(np.abs(want).max()), 1e-300)
+        bad = ~np.isfinite(J) | (np.abs(J - want) > 1e-6 * scale)
+        if bad.any():
+            i, k = np.argwhere(bad)[0]
+            raise SystemContractError(
+                f"flow_jacobian_{mode}: at z0={probe.tolist()}, tau={tau!r} its entry "
+                f"[{i}, {k}] is {float(J[i, k])!r}, differences of flow_{mode} give "
+                f"{float(want[i, k])!r}: a wrong flow Jacobian gives wrong dP/dz and "
+                f"multipliers")
+
+
 def _scalar_piece(fn, piece: str):
     user = _jit(fn, piece)
 
@@ -187,7 +248,9 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
                    section_direction: int = 0, section_where: Optional[Callable] = None,
                    params=(), flow_minus: Optional[Callable] = None,
                    flow_plus: Optional[Callable] = None, sample_step: float = np.inf,
-                   sliding: bool = True, name: str = "user", probe=None) -> CompiledModel:
+                   sliding: bool = True, name: str = "user", probe=None,
+                   flow_jacobian_minus: Optional[Callable] = None,
+                   flow_jacobian_plus: Optional[Callable] = None) -> CompiledModel:
     """A piecewise system (region + is ``switch(z, p) >= 0``) for the compiled engine.
 
     Parameters
@@ -219,6 +282,12 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
         Follow attracting sliding (Filippov's convex combination) where it occurs.
     probe : array (n,), optional
         A state at which every piece is run once to check its output (default: 0.5).
+    flow_jacobian_minus, flow_jacobian_plus : callable, optional
+        With exact flows, their derivatives ``J(z0, tau, p) -> array (n, n)``, d flow /
+        d z0 (both or neither): dP/dz through an exact stay from one evaluation instead
+        of Richardson's differences of the flow (four flows per component). Each is
+        compared with those differences at the probe over one sample step; a wrong one
+        is refused.
 
     Returns
     -------
@@ -238,12 +307,21 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
     if (flow_minus is None) != (flow_plus is None):
         raise ValueError("flow_minus and flow_plus: give both exact flows or neither")
     exact = flow_plus is not None
+    if (flow_jacobian_minus is None) != (flow_jacobian_plus is None):
+        raise ValueError("flow_jacobian_minus and flow_jacobian_plus: give both flow "
+                         "Jacobians or neither")
+    flow_jac = flow_jacobian_plus is not None
+    if flow_jac and not exact:
+        raise ValueError("flow_jacobian_minus, flow_jacobian_plus: flow Jacobians need "
+                         "the exact flows (flow_minus, flow_plus)")
     if exact and not (np.isfinite(sample_step) and sample_step > 0):
         raise ValueError(f"sample_step: exact flows need a finite sample_step > 0 (the "
                          f"longest time between samples), got {sample_step!r}")
     p = np.ascontiguousarray(np.asarray(params, dtype=float).reshape(-1))
     user = dict(field_minus=field_minus, field_plus=field_plus, switch=switch,
-                switch_grad=switch_grad, flow_minus=flow_minus, flow_plus=flow_plus)
+                switch_grad=switch_grad, flow_minus=flow_minus, flow_plus=flow_plus,
+                flow_jacobian_minus=flow_jacobian_minus,
+                flow_jacobian_plus=flow_jacobian_plus)
     reads = tuple(frozen.record({k: f for k, f in user.items() if f is not None}))
     cm = CompiledModel(
         name=name, names=names, params=p,
@@ -256,8 +334,14 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
         section=_scalar_piece(section, "section"),
         section_where=_where_piece(section_where, "section_where"),
         section_direction=int(section_direction), sample_step=float(sample_step),
-        sliding=bool(sliding), exact=exact, parameters={}, frozen_reads=reads)
+        sliding=bool(sliding), exact=exact, parameters={}, frozen_reads=reads,
+        flow_jacobian_minus=(_flow_matrix_piece(flow_jacobian_minus, "flow_jacobian_minus", n)
+                             if flow_jac else None),
+        flow_jacobian_plus=(_flow_matrix_piece(flow_jacobian_plus, "flow_jacobian_plus", n)
+                            if flow_jac else None))
     _check_shapes(cm, _probe_state(probe, n))
+    if flow_jac:
+        _check_flow_jacobians(cm, _probe_state(probe, n))
     return cm
 
 
@@ -351,6 +435,11 @@ class FilippovSystem:
     reference driver instead of central differences (each compared with central
     differences of its field at the first state it is asked at: a wrong one is refused);
     :mod:`filippov.symbolic` generates all three from the expressions.
+    ``flow_jacobians`` (optional, with exact flows: ``{"minus", "plus": J(z0, tau, p) ->
+    (n, n)}``, d flow / d z0) give the compiled engine's dP/dz through an exact stay in
+    one evaluation instead of Richardson's differences of the flow (compared with those
+    differences when the compiled model is built: a wrong one is refused); a
+    ``SymbolicSystem`` generates them from its flows.
     ``scale`` gives the units the engines measure their tolerances in
     (:mod:`filippov.scale`: a number is the state's size, a mapping or a
     :class:`~filippov.scale.Scale` also the time's and H's); None (the default)
@@ -362,7 +451,7 @@ class FilippovSystem:
                  flow_minus=None, flow_plus=None, sample_step: float = np.inf,
                  sliding: bool = True, name: str = "user", jacobians=None,
                  slow_sample_step: float = np.nan, transient_time: float = np.inf,
-                 probe=None, scale=None):
+                 probe=None, scale=None, flow_jacobians=None):
         self.names = tuple(str(x) for x in names)
         # the run's units (filippov.scale): checked here, measured at each run's start
         # where not declared (docs/decisions.md#units)
@@ -372,8 +461,17 @@ class FilippovSystem:
         self.slow_sample_step, self.transient_time = float(slow_sample_step), float(transient_time)
         self.params = np.ascontiguousarray(np.asarray(params, dtype=float).reshape(-1))
         self.name, self.sliding, self.sample_step = name, bool(sliding), float(sample_step)
+        flow_jacobians = dict(flow_jacobians or {})
+        if flow_jacobians and set(flow_jacobians) != {"minus", "plus"}:
+            raise ValueError(f"flow_jacobians: give those of both regions ('minus' and "
+                             f"'plus'), got {sorted(flow_jacobians)}")
+        if flow_jacobians and (flow_minus is None or flow_plus is None):
+            raise ValueError("flow_jacobians: flow Jacobians need the exact flows "
+                             "(flow_minus, flow_plus)")
         self._pieces = dict(field_minus=field_minus, field_plus=field_plus, switch=switch,
-                            switch_grad=switch_grad, flow_minus=flow_minus, flow_plus=flow_plus)
+                            switch_grad=switch_grad, flow_minus=flow_minus, flow_plus=flow_plus,
+                            flow_jacobian_minus=flow_jacobians.get("minus"),
+                            flow_jacobian_plus=flow_jacobians.get("plus"))
         _one_surface(switch, len(self.names), self.params, probe)
         jacobians = dict(jacobians or {})
         unknown = set(jacobians) - set(_JAC_MODES)
