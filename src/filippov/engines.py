@@ -227,14 +227,15 @@ ASYMMETRIES = (
         "integrates the variational equation along the stay (the field's Jacobian: the "
         "system's own, or central differences), at ``rtol``",
         "differentiates the closed-form flow from the mode entry: the model's flow "
-        "Jacobians (``flow_jacobian_plus``/``_minus``, which a ``SymbolicSystem`` "
-        "generates) where it has them, else Richardson's extrapolation of central "
+        "Jacobians (``flow_jacobian_plus``/``_minus``: a ``SymbolicSystem`` generates "
+        "them, a ``FilippovSystem`` takes them as ``flow_jacobians``) where it has them, else Richardson's extrapolation of central "
         "differences of the flow (``rules.richardson_step``)",
         "deliberate", "the kernel follows an exact stay in one closed-form evaluation per "
         "sample, with no steps a variational equation could ride on; the three agree to "
         "1e-10 (tests/test_units.py, across units; the Richardson error 1.4e-12 on a "
         "return of the paper's flow)",
         ("tests/test_symbolic.py::test_compiled_dpdz_takes_the_generated_flow_jacobians",
+         "tests/test_flow_jacobians.py::test_dpdz_from_given_flow_jacobians_is_the_closed_form",
          "tests/test_units.py::test_a_relay_orbit_in_other_units_has_its_period_and_multipliers")),
 )
 
