@@ -243,6 +243,30 @@ def _probe_state(probe, n: int) -> np.ndarray:
 _SCALARS = ("switch", "section")
 
 
+def _check_options(n, section_direction, flow_minus, flow_plus, flow_jacobian_minus,
+                   flow_jacobian_plus, sample_step) -> tuple[bool, bool]:
+    """compile_system's options, each refused by name where out of range: (exact flows,
+    flow Jacobians)."""
+    if n < 1:
+        raise ValueError("names: at least one state component")
+    if section_direction not in (-1, 0, 1):
+        raise ValueError(f"section_direction must be -1, 0 or +1, got {section_direction!r}")
+    if (flow_minus is None) != (flow_plus is None):
+        raise ValueError("flow_minus and flow_plus: give both exact flows or neither")
+    exact = flow_plus is not None
+    if (flow_jacobian_minus is None) != (flow_jacobian_plus is None):
+        raise ValueError("flow_jacobian_minus and flow_jacobian_plus: give both flow "
+                         "Jacobians or neither")
+    flow_jac = flow_jacobian_plus is not None
+    if flow_jac and not exact:
+        raise ValueError("flow_jacobian_minus, flow_jacobian_plus: flow Jacobians need "
+                         "the exact flows (flow_minus, flow_plus)")
+    if exact and not (np.isfinite(sample_step) and sample_step > 0):
+        raise ValueError(f"sample_step: exact flows need a finite sample_step > 0 (the "
+                         f"longest time between samples), got {sample_step!r}")
+    return exact, flow_jac
+
+
 @one_spelling
 def compile_system(names, field_minus, field_plus, switch, switch_grad, *, section,
                    section_direction: int = 0, section_where: Optional[Callable] = None,
@@ -283,11 +307,8 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
     probe : array (n,), optional
         A state at which every piece is run once to check its output (default: 0.5).
     flow_jacobian_minus, flow_jacobian_plus : callable, optional
-        With exact flows, their derivatives ``J(z0, tau, p) -> array (n, n)``, d flow /
-        d z0 (both or neither): dP/dz through an exact stay from one evaluation instead
-        of Richardson's differences of the flow (four flows per component). Each is
-        compared with those differences at the probe over one sample step; a wrong one
-        is refused.
+        d flow / d z0 of the exact flows, ``J(z0, tau, p) -> array (n, n)`` (both or
+        neither; a wrong one is refused): dP/dz without differences of the flows.
 
     Returns
     -------
@@ -300,23 +321,8 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
     """
     names = tuple(str(x) for x in names)
     n = len(names)
-    if n < 1:
-        raise ValueError("names: at least one state component")
-    if section_direction not in (-1, 0, 1):
-        raise ValueError(f"section_direction must be -1, 0 or +1, got {section_direction!r}")
-    if (flow_minus is None) != (flow_plus is None):
-        raise ValueError("flow_minus and flow_plus: give both exact flows or neither")
-    exact = flow_plus is not None
-    if (flow_jacobian_minus is None) != (flow_jacobian_plus is None):
-        raise ValueError("flow_jacobian_minus and flow_jacobian_plus: give both flow "
-                         "Jacobians or neither")
-    flow_jac = flow_jacobian_plus is not None
-    if flow_jac and not exact:
-        raise ValueError("flow_jacobian_minus, flow_jacobian_plus: flow Jacobians need "
-                         "the exact flows (flow_minus, flow_plus)")
-    if exact and not (np.isfinite(sample_step) and sample_step > 0):
-        raise ValueError(f"sample_step: exact flows need a finite sample_step > 0 (the "
-                         f"longest time between samples), got {sample_step!r}")
+    exact, flow_jac = _check_options(n, section_direction, flow_minus, flow_plus,
+                                     flow_jacobian_minus, flow_jacobian_plus, sample_step)
     p = np.ascontiguousarray(np.asarray(params, dtype=float).reshape(-1))
     user = dict(field_minus=field_minus, field_plus=field_plus, switch=switch,
                 switch_grad=switch_grad, flow_minus=flow_minus, flow_plus=flow_plus,
@@ -335,10 +341,8 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
         section_where=_where_piece(section_where, "section_where"),
         section_direction=int(section_direction), sample_step=float(sample_step),
         sliding=bool(sliding), exact=exact, parameters={}, frozen_reads=reads,
-        flow_jacobian_minus=(_flow_matrix_piece(flow_jacobian_minus, "flow_jacobian_minus", n)
-                             if flow_jac else None),
-        flow_jacobian_plus=(_flow_matrix_piece(flow_jacobian_plus, "flow_jacobian_plus", n)
-                            if flow_jac else None))
+        **{k: _flow_matrix_piece(user[k], k, n) if flow_jac else None
+           for k in ("flow_jacobian_minus", "flow_jacobian_plus")})
     _check_shapes(cm, _probe_state(probe, n))
     if flow_jac:
         _check_flow_jacobians(cm, _probe_state(probe, n))
