@@ -217,6 +217,11 @@ def test_return_floor_counts_without_changing_returns(monkeypatch):
     assert flows == ds.samples.values[0] + ds.root_flows.values[0]
     assert 0 < ds.flow_floor.values[0] < ds.floor.values[0]
     assert ds.target.values[0] == 5e-6 and "floor" in lines[0]
+    # the generated flow Jacobians are timed too (with an output of n*n: one of n was a
+    # heap overflow that aborted a later test); a plain return never calls them
+    for name in ("flow_jacobian_plus", "flow_jacobian_minus"):
+        assert 0 < ds[f"cost_{name}"].values[0] < 1e-3
+        assert ds[f"calls_{name}"].values[0] == 0.0
     # a CPU-time benchmark (min of the thread's clock), but it names the machine and its load
     for key in MACHINE:
         assert key in ds.attrs, key

@@ -79,9 +79,22 @@ TARGET = {False: 5e-6, True: 10e-6}
 
 def _functions(cm) -> dict:
     """The model's compiled pieces by name (abi.PIECES order; no_jacobian where the model
-    has none) -- the functions themselves, which the kernel is handed as addresses."""
-    return {name: (no_jacobian if name == "jacobian" and cm.jacobian is None
-                   else getattr(cm, name)) for name in NAMES}
+    has none, no flow Jacobians where it has none: the kernel never calls those) -- the
+    functions themselves, which the kernel is handed as addresses."""
+    out = {}
+    for name in NAMES:
+        f = getattr(cm, name)
+        if name == "jacobian" and f is None:
+            f = no_jacobian
+        if f is not None:
+            out[name] = f
+    return out
+
+
+def _outputs(name: str, n: int) -> int:
+    """How many values the piece ``name`` writes: n*n for a flow's Jacobian (abi), n for
+    a flow or a field."""
+    return n * n if name.startswith("flow_jacobian") else n
 
 
 def _counted_piece(f, sig, slot):
@@ -112,7 +125,7 @@ def counted_model(cm):
     pieces = _functions(cm)
     new = {name: _counted_piece(pieces[name], sig, base + k)
            for k, (name, sig) in enumerate(PIECES)
-           if not (name == "jacobian" and cm.jacobian is None)}
+           if name in pieces and not (name == "jacobian" and cm.jacobian is None)}
     params = np.concatenate([np.asarray(cm.params, dtype=float), np.zeros(len(PIECES))])
     return dataclasses.replace(cm, params=params, **new), base
 
@@ -173,11 +186,16 @@ def piece_costs(cm, states, window, reps: int = 100, repeat: int = 21) -> dict:
     zs = np.ascontiguousarray(states, dtype=float)
     taus = np.random.default_rng(0).uniform(0.0, window, zs.shape[0])
     p = np.ascontiguousarray(cm.params, dtype=float)
-    z, out = np.zeros(zs.shape[1]), np.zeros(zs.shape[1])
+    z = np.zeros(zs.shape[1])
     pieces = _functions(cm)
     costs = {}
     for name, sig in PIECES:
+        if name not in pieces:
+            continue
         f = pieces[name]
+        # sized for what the piece writes (a flow's Jacobian n*n: an out of n was a heap
+        # overflow, which numba does not check)
+        out = np.zeros(_outputs(name, zs.shape[1]))
         if sig is FLOW_SIG:
             def call(): return _loop_flow(f, zs, taus, p, z, out, reps)
         elif sig is FIELD_SIG:
