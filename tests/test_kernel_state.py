@@ -2,7 +2,8 @@
 positions of its small state vectors are distinct and inside the arrays _batch allocates,
 the kernel's signature is built from the Settings and Outputs declarations (a field added
 there changes it), the values fastmap hands over have the declared types, and no kernel
-helper takes more than 8 arguments or runs over 80 lines."""
+helper takes more than 8 arguments or runs over 80 lines; the states its operations are
+handed are read by name."""
 import ast
 from pathlib import Path
 
@@ -44,6 +45,19 @@ def bare_indices(kernel_dir=KERNEL_DIR):
 
 def test_no_kernel_source_indexes_its_state_vectors_by_a_bare_number():
     assert not bare_indices()
+
+
+def test_no_kernel_source_reads_a_state_it_is_handed_by_position():
+    """The states the kernel's operations are handed (the run's, the window walk's, an
+    interval's, a refinement's: kernel.state.RunCtx, Walk, Interval, Eval, Band) are
+    named records, read by name: a ``ctx[N]`` read (56 of them when the seam was a
+    positional tuple, issue 58) is refused."""
+    import re
+
+    found = [f"{path.name}:{k}: {line.strip()}" for path in sorted(KERNEL_DIR.glob("*.py"))
+             for k, line in enumerate(path.read_text().splitlines(), 1)
+             if re.search(r"\b(ctx|at)\[\d+\]", line)]
+    assert not found, found
 
 
 def _sig_args():

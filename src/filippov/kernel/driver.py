@@ -36,7 +36,7 @@ from .scan import (_carry_sample, _find, _flow_follows, _sample)
 from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY,
                     SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_NEXT_STEP, SEG_SHIFT, SEG_SIZE,
                     SEG_STEP_H, SEG_STEP_T, T_AGE, T_SLID, T_SLIDE_START, TALLY_SIZE, Control, Deriv, Dop,
-                    Fill, Orbit, Outputs, Samples, Scratch, Settings, Work,
+                    Fill, Orbit, Outputs, RunCtx, Samples, Scratch, Settings, Work,
                     kernel_signature)  # noqa: F401
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
@@ -136,7 +136,7 @@ def _all_finite(z):
 
 @_jit_inline
 def _window(mode, ta, tb, first, may_split, ctx):
-    """Samples the segment [ta, tb] of the current mode (ctx: the run's (fns, p, s, w);
+    """Samples the segment [ta, tb] of the current mode (ctx: the run's RunCtx (fns, p, s, w);
     at the fractions of an exact window or of an integration step) and finds its earliest
     event: (_GO_ON, tb, _W_NONE) if there is none (the state at tb in w.z), (OK, te, what)
     at an event (its state in w.z), NO_RETURN at t_max, or an error (status, ta);
@@ -305,7 +305,7 @@ def _end_slide(t, w):
 
 # ------------------------------------------------------------------ the run's operations
 # What the kernel does in a run, for filippov.loop.event, which holds the order: each
-# takes ctx = (fns, p, s, w) (the model's pieces, its parameters, kernel.state's Settings
+# takes ctx = RunCtx(fns, p, s, w) (the model's pieces, its parameters, kernel.state's Settings
 # and Work); at an event it works at the event's state w.z.
 
 @_jit_inline
@@ -353,7 +353,7 @@ def _event_slides_in(ctx):
 @_jit_inline
 def _record_switch(mode, new_mode, what, t, ctx):
     """The sliding tallies: the slide that ends, the one that starts."""
-    w = ctx[3]
+    w = ctx.w
     if mode == SLIDING:
         _end_slide(t, w)
     if new_mode == SLIDING:
@@ -377,7 +377,7 @@ def _record(mode, new_mode, what, t, ctx):
 @_jit_inline
 def _store_exit(new_mode, shift, band, ctx):
     """The next stay's shift of H: rules.exit_shift, moved by the band while inside it."""
-    seg = ctx[3].seg
+    seg = ctx.w.seg
     seg[SEG_EXIT_SHIFT] = shift
     seg[SEG_BAND] = band
     seg[SEG_SHIFT] = rules.banded_shift(new_mode, shift, band) if band > 0.0 else shift
@@ -393,7 +393,7 @@ def _event_switch_derivative(mode, new_mode, ctx):
 @_jit_inline
 def _entered(mode, new_mode, t, ctx):
     """The age in the mode the orbit goes on in (rules.exact_window's transient)."""
-    s, w = ctx[2], ctx[3]
+    s, w = ctx.s, ctx.w
     if new_mode != mode:
         w.tally[T_AGE] = 0.0  # an entry: the fast transient starts again
     elif mode != SLIDING and s.exact:
@@ -470,7 +470,7 @@ def _operations(ns) -> RunOps:
 def _build_run(ns):
     """The first return of one start (filippov.loop.event.make_run) on the operations of
     the namespace ``ns`` (this module's globals, or the plain build's copies of them):
-    ``_one(z0, age0, (fns, p, s, w), rs) -> (status, t, mode)`` (rs: the loop's record,
+    ``_one(z0, age0, RunCtx(fns, p, s, w), rs) -> (status, t, mode)`` (rs: the loop's record,
     filippov.loop.run_state, on the batch's arrays), the state at the return (or
     where the run stopped) in w.z. A call _batch makes per return, the run's loop and its
     operations inlined into it."""
@@ -558,7 +558,7 @@ def _batch(fns, params, starts, ages, s, out):
         age = ages[i]
         p = params[i] if per_start else params[0]  # a C-contiguous row, as pieces take
         # once per start: built, the tuple increfs its 30 (42) arrays (_batch counts refs)
-        ctx = (fns, p, s, w)
+        ctx = RunCtx(fns, p, s, w)
         while True:
             first[0] = np.nan
             st, t, mode = _one(zin, age, ctx, rs)

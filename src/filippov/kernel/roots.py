@@ -83,17 +83,18 @@ def _brentq_f(sel, xa, xb, maxiter, mode, o, sc):
 
 
 # the refinement of a crossing (loop.refine, written once for both engines) on the
-# kernel's operations; its state ctx is (o, sc): the segment (state.Orbit) and its scratch
+# kernel's operations; its state ctx is a state.Eval: the segment (state.Orbit) and its
+# scratch
 
 @_jit_inline
 def _bracket_root(ctx, sel, ta, tb, mode):
-    r, fr, ok = _brentq_f(sel, ta, tb, _MAXITER_EVENT, mode, ctx[0], ctx[1])
+    r, fr, ok = _brentq_f(sel, ta, tb, _MAXITER_EVENT, mode, ctx.o, ctx.sc)
     return ok, r, fr
 
 
 @_jit_inline
 def _value_at(ctx, sel, t, mode):
-    return _fval(sel, t, mode, ctx[0], ctx[1])
+    return _fval(sel, t, mode, ctx.o, ctx.sc)
 
 
 @_jit_inline

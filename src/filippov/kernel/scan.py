@@ -15,7 +15,7 @@ from .base import (OK, ROOT_FAILED, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB,
                    _where)
 from .segment import (_fval, _rates, _zat)
 from .state import (SEG_BAND, SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_LAST_H, SEG_LAST_SPEED2,
-                    SEG_RATE_STEP, SEG_SHIFT)
+                    SEG_RATE_STEP, SEG_SHIFT, Band, Eval, Interval, Walk)
 from .roots import (_brentq, _refine)
 
 
@@ -137,7 +137,7 @@ def _leave_of(mode):
 
 @_jit_inline
 def _banded_h(ctx, t, mode):
-    return _fval(_S_H, t, mode, ctx[1], ctx[2])
+    return _fval(_S_H, t, mode, ctx.o, ctx.sc)
 
 
 @_jit_inline
@@ -148,7 +148,7 @@ def _refine_unbanded(ctx, lo, hi, mode):
     banded = sg[SEG_SHIFT]
     sg[SEG_SHIFT] = sg[SEG_EXIT_SHIFT]
     # vb: not sampled here, and the kernel's refinement never reads it (roots._lost_bracket)
-    ok, r = _refine((o, sc), lv.sel, lv.pred, lo, hi, _fval(_S_H, lo, mode, o, sc), np.nan,
+    ok, r = _refine(Eval(o, sc), lv.sel, lv.pred, lo, hi, _fval(_S_H, lo, mode, o, sc), np.nan,
                     mode)
     sg[SEG_SHIFT] = banded
     return r if ok else hi
@@ -169,11 +169,11 @@ def _leave_root(i, mode, first, lv, o, sm, sc):
         hm = _fval(_S_H, tm, mode, o, sc)
         if ok and not rules.after(lv.pred, hm):  # refine beyond the dip (rules)
             lo, vlo = tm, hm
-    ok, r = _refine((o, sc), lv.sel, lv.pred, lo, tb, vlo, sm.vals[0, i + 1], mode)
+    ok, r = _refine(Eval(o, sc), lv.sel, lv.pred, lo, tb, vlo, sm.vals[0, i + 1], mode)
     if not ok:
         return r, False
     if o.seg[SEG_BAND] > 0.0:  # found beyond the exit's band: again on H itself
-        r = _past_band((lv, o, sc), r, lo, mode, o.seg[SEG_BAND])
+        r = _past_band(Band(lv, o, sc), r, lo, mode, o.seg[SEG_BAND])
     return r, True
 
 
@@ -181,30 +181,29 @@ def _leave_root(i, mode, first, lv, o, sm, sc):
 # The order of the questions in one sample interval and its ties, and the walk over the
 # window's intervals, are the one event search (filippov.loop.interval); what follows is
 # how the kernel answers each, on its samples (sm) and its segment (o). The walk's state
-# is the tuple (first, lv, s, o, sm, sc, ns): the window's records and its number of
-# samples; the event search's (first, lv, s, o, sm, sc, c0, c1, cd, cs, ha, hb): the
-# window's records and the sign changes _candidate_at saw in the interval.
+# is a state.Walk (the window's records and its number of samples), the event search's a
+# state.Interval (the window's records and the sign changes _candidate_at saw there).
 
 @_jit_inline
 def _leave_crosses(ctx, q, i):
-    return ctx[6] if q == 0 else ctx[7]
+    return ctx.c0 if q == 0 else ctx.c1
 
 
 @_jit_inline
 def _leave_root_at(ctx, q, i, mode):
     """The root of leave function q (h or a; b) between samples i and i + 1."""
-    first, lv, s, o, sm, sc = ctx[0], ctx[1], ctx[2], ctx[3], ctx[4], ctx[5]
+    first, lv, o, sm, sc = ctx.first, ctx.lv, ctx.o, ctx.sm, ctx.sc
     if q == 0:
         r, ok = _leave_root(i, mode, first, lv, o, sm, sc)
     else:
-        ok, r = _refine((o, sc), _S_B, _TO_NONNEG, sm.ts[i], sm.ts[i + 1], sm.vals[1, i],
+        ok, r = _refine(Eval(o, sc), _S_B, _TO_NONNEG, sm.ts[i], sm.ts[i + 1], sm.vals[1, i],
                         sm.vals[1, i + 1], mode)
     return (OK if ok else ROOT_FAILED), r
 
 
 @_jit_inline
 def _slide_end_between(ctx, q, i):
-    return ctx[10] if q == 0 else ctx[11]
+    return ctx.ha if q == 0 else ctx.hb
 
 
 @_jit_inline
@@ -212,7 +211,7 @@ def _speed_exit(ctx, q, i, mode):
     """The extremum of a (q = 0) or b hidden between samples i and i + 1, judged by
     rules.speed_graze: (status, the speed's root before it, GRAZE_CROSSES), (status, its
     time, GRAZE_TOUCHES) or GRAZE_NONE."""
-    s, o, sm, sc = ctx[2], ctx[3], ctx[4], ctx[5]
+    s, o, sm, sc = ctx.s, ctx.o, ctx.sm, ctx.sc
     ta, tb = sm.ts[i], sm.ts[i + 1]
     sel_v, sel_r = (_S_A, _S_DA) if q == 0 else (_S_B, _S_DB)
     pred = _TO_NONPOS if q == 0 else _TO_NONNEG
@@ -222,14 +221,14 @@ def _speed_exit(ctx, q, i, mode):
     vm = _fval(sel_v, tm, mode, o, sc)
     kind = rules.speed_graze(pred, vm, sm.dvals[q, i], sm.dvals[q, i + 1], tb - ta, s.touch_tol)
     if kind == rules.GRAZE_CROSSES:
-        ok, r = _refine((o, sc), sel_v, pred, ta, tm, sm.vals[q, i], vm, mode)
+        ok, r = _refine(Eval(o, sc), sel_v, pred, ta, tm, sm.vals[q, i], vm, mode)
         return (OK if ok else ROOT_FAILED), r, kind
     return OK, tm, kind
 
 
 @_jit_inline
 def _extremum_between_at(ctx, i):
-    return ctx[8]
+    return ctx.cd
 
 
 @_jit_inline
@@ -237,7 +236,7 @@ def _h_extremum(ctx, i, mode):
     """A minimum (in +) or maximum (in -) of h hidden between samples i and i + 1, judged
     by rules.graze (the exit's band): (status, h's root before it, GRAZE_CROSSES),
     (status, its time, GRAZE_TOUCHES) or GRAZE_NONE."""
-    lv, s, o, sm, sc = ctx[1], ctx[2], ctx[3], ctx[4], ctx[5]
+    lv, s, o, sm, sc = ctx.lv, ctx.s, ctx.o, ctx.sm, ctx.sc
     ta, tb = sm.ts[i], sm.ts[i + 1]
     tm, ok = _brentq(lv.sel_d, ta, tb, _MAXITER_EXTREMUM, mode, o, sc)
     if not ok:
@@ -245,14 +244,14 @@ def _h_extremum(ctx, i, mode):
     hm = _fval(_S_H, tm, mode, o, sc)
     kind = rules.graze(mode, hm, s.touch_tol, o.seg[SEG_BAND])
     if kind == rules.GRAZE_CROSSES:
-        ok, r = _refine((o, sc), _S_H, lv.pred, ta, tm, sm.vals[0, i], hm, mode)
+        ok, r = _refine(Eval(o, sc), _S_H, lv.pred, ta, tm, sm.vals[0, i], hm, mode)
         return (OK if ok else ROOT_FAILED), r, kind
     return OK, tm, kind
 
 
 @_jit_inline
 def _touch(ctx, t, mode):
-    ctx[4].touched[0] = True  # no event; P has a kink here
+    ctx.sm.touched[0] = True  # no event; P has a kink here
 
 
 @_jit_inline
@@ -262,27 +261,27 @@ def _n_sections(ctx):
 
 @_jit_inline
 def _section_crosses(ctx, k, i):
-    return ctx[9]
+    return ctx.cs
 
 
 @_jit_inline
 def _section_root(ctx, k, i, mode):
-    s, o, sm, sc = ctx[2], ctx[3], ctx[4], ctx[5]
-    ok, r = _refine((o, sc), _S_SEC, s.sec_pred, sm.ts[i], sm.ts[i + 1], sm.svals[i],
+    s, o, sm, sc = ctx.s, ctx.o, ctx.sm, ctx.sc
+    ok, r = _refine(Eval(o, sc), _S_SEC, s.sec_pred, sm.ts[i], sm.ts[i + 1], sm.svals[i],
                     sm.svals[i + 1], mode)
     return (OK if ok else ROOT_FAILED), r
 
 
 @_jit_inline
 def _section_bounds(ctx, k):
-    return ctx[2].min_time, ctx[3].xtol  # the run starts at t = 0
+    return ctx.s.min_time, ctx.o.xtol  # the run starts at t = 0
 
 
 @_jit_inline
 def _section_counts(ctx, k, i, r, mode):
     """The section's crossing at r is a hit: ``where`` holds there, and it is not the
     start on the section up to rounding."""
-    o, sm, sc = ctx[3], ctx[4], ctx[5]
+    o, sm, sc = ctx.o, ctx.sm, ctx.sc
     wz, wg = sc.wz, sc.wg
     _zat(r, mode, o, wz)
     if not _where(o.fns, wz, o.p):
@@ -330,18 +329,18 @@ def _candidate_at(ctx, i, mode):
     hb = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and rules.speed_extremum_between(
         _TO_NONNEG, dvals[1, i], dvals[1, i + 1])
     return ((c0 or c1 or cd or cs or ha or hb),
-            (first, lv, s, o, sm, sc, c0, c1, cd, cs, ha, hb))
+            Interval(first, lv, s, o, sm, sc, c0, c1, cd, cs, ha, hb))
 
 
 @_jit_inline
 def _clears_band_at(ctx, i, mode):
-    sg = ctx[3].seg
-    return sg[SEG_BAND] > 0.0 and rules.clears_band(mode, ctx[4].vals[0, i], sg[SEG_BAND])
+    sg = ctx.o.seg
+    return sg[SEG_BAND] > 0.0 and rules.clears_band(mode, ctx.sm.vals[0, i], sg[SEG_BAND])
 
 
 @_jit_inline
 def _last_sample(ctx):
-    return ctx[6] - 1
+    return ctx.ns - 1
 
 
 @_jit_inline
@@ -350,7 +349,7 @@ def _unband(ctx, i, mode):
     is ns: none left to sample): from there h is unbiased (rules.clears_band), so a
     return across H is refined at H = 0: the shift dropped and h sampled again from ts[i]
     on."""
-    o, sm, sc, ns = ctx[3], ctx[4], ctx[5], ctx[6]
+    o, sm, sc, ns = ctx.o, ctx.sm, ctx.sc, ctx.ns
     o.seg[SEG_SHIFT] = o.seg[SEG_EXIT_SHIFT]
     o.seg[SEG_BAND] = 0.0
     for k in range(i, ns):
@@ -373,5 +372,5 @@ def _find(mode, ns, first, s, o, sm, sc):
         sm.vals[0, 0] = rules.clamp(lv.pred, sm.vals[0, 0])
         if lv.n == 2:
             sm.vals[1, 0] = rules.clamp(_TO_NONNEG, sm.vals[1, 0])
-    st, t, what, _ = _window_event((first, lv, s, o, sm, sc, ns), mode)
+    st, t, what, _ = _window_event(Walk(first, lv, s, o, sm, sc, ns), mode)
     return st, t, what

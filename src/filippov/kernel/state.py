@@ -122,6 +122,9 @@ SEG_SIZE, COUNT_SIZE, TALLY_SIZE = len(SEG), len(COUNT), len(TALLY)
 #: the current segment (w.seg, w.za, w.F, w.y_old), the tolerance events are refined to and
 #: the run's state scale (filippov.scale: the floor of the rules' state sizes)
 Orbit = namedtuple("Orbit", ["fns", "p", "seg", "za", "F", "y_old", "xtol", "floor"])
+#: what a crossing's refinement (filippov.loop.refine) and the extremum searches evaluate
+#: on: the segment and its scratch vectors
+Eval = namedtuple("Eval", ["o", "sc"])
 #: the scratch vectors a model evaluation fills (a state, grad h, F_- or the mode's field,
 #: F_+)
 Scratch = namedtuple("Scratch", ["wz", "wg", "wf", "wp"])
@@ -137,3 +140,19 @@ Control = namedtuple("Control", ["t_bound", "max_step", "rtol", "atol"])
 #: DOP853's arrays: the state and its field after (y, f) and before (y_old, f_old) the
 #: last step, its stages, the new state, a stage state, the error scale, the interpolant
 Dop = namedtuple("Dop", ["y", "f", "y_old", "f_old", "K", "ynew", "ytmp", "scale", "F"])
+
+# ----------------------------------------------------------------- the loop's states
+#: the run's state as the engine seam's operations take it (filippov.contracts.
+#: RunOperations' ``ctx``): the model's pieces, its parameters, the Settings, the Work
+RunCtx = namedtuple("RunCtx", ["fns", "p", "s", "w"])
+#: the window walk's state (filippov.loop.interval.WalkOps): whether the stay just began,
+#: its leave functions (scan._Leave), the Settings, the segment, the samples, the scratch
+#: vectors and the number of samples
+Walk = namedtuple("Walk", ["first", "lv", "s", "o", "sm", "sc", "ns"])
+#: the event search's state at a sample interval (filippov.loop.interval.IntervalOps):
+#: the walk's records and the sign changes scan._candidate_at saw there (h or a, b, an
+#: extremum of h, the section, a hidden extremum of a, of b)
+Interval = namedtuple("Interval", ["first", "lv", "s", "o", "sm", "sc", "c0", "c1", "cd",
+                                   "cs", "ha", "hb"])
+#: a crossing found beyond the exit's band, refined again (loop.interval.make_past_band)
+Band = namedtuple("Band", ["lv", "o", "sc"])
