@@ -256,3 +256,34 @@ def test_compiled_start_sliding_inside_a_section_on_H_is_a_status(direction):
     # a section across the sliding stretch is still fine from there
     assert fastmap.compute_returns(hopf.compiled(EPS, 0.5, MU, OMEGA), z0, T_MAX,
                                    **OPTS).status[0] == fastmap.OK
+
+
+def test_an_arrival_that_would_slide_inside_a_section_is_refused_before_it_is_recorded():
+    """An orbit that arrives on H and would slide there, inside a section on H whose hit
+    does not count there (``where`` fails): both engines stop at the arrival with
+    SECTION_SLIDING (the engine's record refuses it, the sections being the engine's:
+    the seam's ``record``), the crossing before it counted and the arrival not."""
+    from numba import njit
+
+    from filippov.abi import WHERE_SIG
+
+    @njit(WHERE_SIG)
+    def far_below(z, p):
+        return z[1] < -5.0
+
+    cm = dataclasses.replace(_on_h(0.5, +1), section_where=far_below)
+    z0 = np.array([[0.0, 1.02, 0.0]])
+    out = fastmap.compute_returns(cm, z0, T_MAX, **OPTS)
+    assert out.status[0] == fastmap.SECTION_SLIDING and out.n_switches[0] == 1
+    system = hopf.model(EPS, 0.5, MU, OMEGA).full()
+    sec = Section("H", system.switch, direction=+1, where=lambda z: z[1] < -5.0, terminal=1)
+    with pytest.raises(SimulationError, match="slides along H inside the section"):
+        first_returns(system, z0, sec, T_MAX, **OPTS)
+    # where the compiled engine stopped: the reference's arrival into sliding (without
+    # the section), after one crossing
+    events = simulate(system, z0[0], T_MAX, dense=False, **OPTS).events
+    kinds = [e.kind for e in events]
+    arrival = events[kinds.index("slide_start")]
+    assert kinds[:kinds.index("slide_start")].count("crossing") == 1
+    assert abs(arrival.t - out.time[0]) < 1e-12
+
