@@ -99,7 +99,7 @@ def _slides_in(at):
 
 
 # The kernel's ABI: _batch(fns, params, starts, ages, settings, out): the compiled
-# addresses of the model's nine pieces (a tuple of integers in the order of
+# addresses of the model's pieces (a tuple of integers in the order of
 # filippov.abi.PIECES: base._PIECE_ADDRS), arrays and two named tuples (kernel.state:
 # Settings, Outputs; their types and the signature declared there once);
 # fastmap.compute_returns builds them.
