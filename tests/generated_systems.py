@@ -65,19 +65,11 @@ def _affine(z, p, base):
 
 
 @njit(cache=True)
-def _flow(z0, tau, p, base):
-    """z* + V exp(B tau) V^-1 (z0 - z*), B block diagonal: exp of a 2x2 block
-    [[re, -im], [im, re]] (marked by im > 0 on its first index) is
-    e^(re tau) [[cos, -sin], [sin, cos]](im tau)."""
-    n = z0.size
-    oV, oW = base + n * n + n, base + 2 * n * n + n
-    ore, oim, ozs = base + 3 * n * n + n, base + 3 * n * n + 2 * n, base + 3 * n * n + 3 * n
-    y = np.empty(n)
-    for i in range(n):
-        acc = 0.0
-        for j in range(n):
-            acc += p[oW + i * n + j] * (z0[j] - p[ozs + j])
-        y[i] = acc
+def _exp_blocks(y, tau, p, ore, oim):
+    """exp(B tau) y for the block-diagonal B of the parameters at ore (real parts) and
+    oim (imaginary parts): a 2x2 block [[re, -im], [im, re]] (marked by im > 0 on its
+    first index) maps to e^(re tau) [[cos, -sin], [sin, cos]](im tau)."""
+    n = y.size
     w = np.empty(n)
     i = 0
     while i < n:
@@ -90,6 +82,22 @@ def _flow(z0, tau, p, base):
         else:
             w[i] = g * y[i]
             i += 1
+    return w
+
+
+@njit(cache=True)
+def _flow(z0, tau, p, base):
+    """z* + V exp(B tau) V^-1 (z0 - z*), B block diagonal (_exp_blocks)."""
+    n = z0.size
+    oV, oW = base + n * n + n, base + 2 * n * n + n
+    ore, oim, ozs = base + 3 * n * n + n, base + 3 * n * n + 2 * n, base + 3 * n * n + 3 * n
+    y = np.empty(n)
+    for i in range(n):
+        acc = 0.0
+        for j in range(n):
+            acc += p[oW + i * n + j] * (z0[j] - p[ozs + j])
+        y[i] = acc
+    w = _exp_blocks(y, tau, p, ore, oim)
     out = np.empty(n)
     for i in range(n):
         acc = p[ozs + i]
@@ -130,18 +138,7 @@ def _flow_jacobian(tau, p, base, n):
         y = np.empty(n)
         for i in range(n):
             y[i] = p[oW + i * n + k]
-        w = np.empty(n)
-        i = 0
-        while i < n:
-            g = math.exp(p[ore + i] * tau)
-            if p[oim + i] > 0.0 and i + 1 < n:
-                co, si = math.cos(p[oim + i] * tau), math.sin(p[oim + i] * tau)
-                w[i] = g * (co * y[i] - si * y[i + 1])
-                w[i + 1] = g * (si * y[i] + co * y[i + 1])
-                i += 2
-            else:
-                w[i] = g * y[i]
-                i += 1
+        w = _exp_blocks(y, tau, p, ore, oim)
         for i in range(n):
             acc = 0.0
             for j in range(n):

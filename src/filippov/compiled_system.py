@@ -21,6 +21,7 @@ from numba.core.errors import NumbaError
 from . import frozen
 from . import scale as scale_mod
 from .checks import SystemContractError
+from .differences import richardson_jacobian
 from .spelling import one_spelling
 from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, always, no_flow
 
@@ -113,26 +114,13 @@ def _flow_matrix_piece(fn, piece: str, n: int):
     return _compile(adapter, FLOW_SIG, piece)
 
 
-def _richardson_flow_jacobian(flow, z0, tau, p, floor):
-    """d flow / d z0 by Richardson's extrapolation of central differences of a compiled
-    flow piece, as the kernel takes it without a flow Jacobian (rules.richardson_step)."""
-    from . import rules
-
-    n = z0.size
-    J = np.empty((n, n))
-
-    def quotient(k, d):
-        up, down = z0.copy(), z0.copy()
-        up[k] += d
-        down[k] -= d
-        a, b = np.empty(n), np.empty(n)
-        flow(up, tau, p, a)
-        flow(down, tau, p, b)
-        return (a - b) / (up[k] - down[k])
-    for k in range(n):
-        d = rules.richardson_step(max(floor, abs(z0[k])))
-        J[:, k] = (4 * quotient(k, d / 2) - quotient(k, d)) / 3
-    return J
+def _flow_of(flow, tau, p, n):
+    """A compiled flow piece as the function z0 -> flow(z0, tau) of differences."""
+    def fun(z0):
+        out = np.empty(n)
+        flow(z0, tau, p, out)
+        return out
+    return fun
 
 
 def _check_flow_jacobians(cm: CompiledModel, probe: np.ndarray) -> None:
@@ -146,7 +134,8 @@ def _check_flow_jacobians(cm: CompiledModel, probe: np.ndarray) -> None:
         got = np.full(n * n, np.nan)
         getattr(cm, f"flow_jacobian_{mode}")(probe, tau, p, got)
         J = got.reshape(n, n)
-        want = _richardson_flow_jacobian(getattr(cm, f"flow_{mode}"), probe, tau, p, floor)
+        want = richardson_jacobian(_flow_of(getattr(cm, f"flow_{mode}"), tau, p, n),
+                                   probe, floor)
         scale = max(float(np.abs(want).max()), 1e-300)
         bad = ~np.isfinite(J) | (np.abs(J - want) > 1e-6 * scale)
         if bad.any():
