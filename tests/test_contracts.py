@@ -152,6 +152,26 @@ def test_each_engine_hands_the_run_the_seams_operations_and_no_more(engine):
     assert kept.isdisjoint(RunOps._fields)
 
 
+#: the operations of the window seam (issue 58): 19 when the engines answered the
+#: questions and decided them (WalkOps 5, IntervalOps 12, the band's second refinement 2);
+#: 10 since they report samples, values and roots and the loop decides: never more
+WINDOW_NOW = 10
+
+
+@pytest.mark.parametrize("engine", ["reference", "compiled"])
+def test_each_engine_reports_its_windows_through_the_window_seam_and_no_more(engine):
+    import importlib
+
+    from filippov.contracts import WindowOperations, operations, positional_mismatches
+    from filippov.loop.interval import WindowOps
+    module = importlib.import_module({"reference": "filippov.simulate",
+                                      "compiled": "filippov.kernel.scan"}[engine])
+    ops = module.WINDOW_OPERATIONS
+    assert type(ops) is WindowOps and WindowOps._fields == operations(WindowOperations)
+    assert positional_mismatches(ops, WindowOperations) == []
+    assert len(WindowOps._fields) <= WINDOW_NOW
+
+
 def test_an_operation_of_the_wrong_arity_is_named():
     from filippov.contracts import RunOperations, positional_mismatches
     from filippov.loop.event import RunOps

@@ -1,111 +1,201 @@
 """The event search of a window's sample intervals is written once
-(filippov.loop.interval): its order and ties on scripted operations, and both engines
-running that one function."""
+(filippov.loop.interval): its order, ties and decisions on a scripted engine (functions of
+time given in closed form, roots by bisection), and both engines running that one
+function, neither deciding anything of it."""
 import ast
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from filippov import rules
 from filippov.loop import interval
-from filippov.loop.interval import NONE, OK, SECTION, make_window_event
+from filippov.loop.interval import (F_LEAVE, F_RATE, F_SECTION, F_TIME, F_UNBANDED, NONE, OK,
+                                    SECTION, make_window_event)
 from filippov.system import MINUS, PLUS, SLIDING
 
 SRC = Path(interval.__file__).resolve().parents[1]
 XTOL = 1e-15
 
 
-class Script:
-    """An engine whose answers are given: ``leave`` {q: root}, ``slide`` {q: (t, kind)},
-    ``extremum`` (t, kind) or None, ``sections`` [(root, t_min, counts)], ``fail`` the
-    question that fails; ``asked`` records the questions in the order they came."""
+class Engine:
+    """An engine whose functions are given as callables of time by the loop's codes
+    (``funcs``), sampled at ``ts``; roots and extrema by bisection. ``sections``: (pred,
+    t_min, counts) per section, whose values are funcs[F_SECTION + k]; ``fail`` the
+    function whose root or extremum fails; ``asked`` records the roots and extrema asked
+    in order, ``touches`` the touches, ``unbands`` the samples the band ended at."""
 
-    def __init__(self, leave=(), slide=(), extremum=None, sections=(), fail=None):
-        self.leave, self.slide, self.extremum = dict(leave), dict(slide), extremum
-        self.sections, self.fail = list(sections), fail
-        self.asked, self.touches = [], []
+    def __init__(self, funcs, ts, first=False, band=0.0, rates=True, sections=(), fail=None,
+                 unbanded=None):
+        self.funcs, self.ts, self.first, self.band, self.rates = dict(funcs), list(ts), first, \
+            band, rates
+        self.sections, self.fail, self.unbanded = list(sections), fail, unbanded
+        self.asked, self.touches, self.unbands = [], [], []
 
-    def answer(self, name, *value):
-        self.asked.append(name)
-        return (7 if self.fail == name else OK,) + value
+    def window(self):
+        return interval.Window(len(self.ts) - 1, len(self.sections), self.first, self.band,
+                               self.rates, 1e-9, XTOL)
+
+    def sampled(self, f, i):
+        return self.ts[i] if f == F_TIME else self.funcs[f](self.ts[i]) if f in self.funcs \
+            else math.nan
+
+    def value(self, f, t, mode):
+        return self.funcs[f](t)
+
+    def _bisect(self, g, lo, hi):
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            if g(mid):
+                hi = mid
+            else:
+                lo = mid
+        return hi
+
+    def root(self, f, pred, lo, hi, vlo, vhi, mode):
+        self.asked.append(("root", f))
+        if self.fail == f:
+            return 7, lo
+        pred = rules.far_side(pred, vlo)
+        return OK, self._bisect(lambda t: bool(rules.after(pred, self.funcs[f](t))), lo, hi)
+
+    def extremum(self, f, i, mode):
+        self.asked.append(("extremum", f))
+        if self.fail == ("extremum", f):
+            return 7, self.ts[i]
+        d0 = self.funcs[f](self.ts[i])
+        return OK, self._bisect(lambda t: (self.funcs[f](t) > 0) != (d0 > 0), self.ts[i],
+                                self.ts[i + 1])
+
+    def section(self, k):
+        return self.sections[k][0], self.sections[k][1]
+
+    def counts(self, k, i, t, mode):
+        return self.sections[k][2]
+
+    def touch(self, t, mode):
+        self.touches.append(t)
+
+    def unband(self, i, mode):
+        self.unbands.append(i)
+        self.funcs[F_LEAVE] = self.unbanded
 
 
-ASK = interval.IntervalOps(
-    leave_crosses=lambda c, q, i: q in c.leave,
-    leave_root=lambda c, q, i, mode: c.answer(f"leave{q}", c.leave[q]),
-    slide_end_between=lambda c, q, i: q in c.slide,
-    hidden_slide_end=lambda c, q, i, mode: c.answer(f"slide{q}", *c.slide[q]),
-    extremum_between=lambda c, i: c.extremum is not None,
-    hidden_extremum=lambda c, i, mode: c.answer("extremum", *c.extremum),
-    touch=lambda c, t, mode: c.touches.append(t),
-    n_sections=lambda c: len(c.sections),
-    section_crosses=lambda c, k, i: c.sections[k] is not None,
-    section_root=lambda c, k, i, mode: c.answer(f"section{k}", c.sections[k][0]),
-    section_bounds=lambda c, k: (c.sections[k][1], XTOL),
-    section_counts=lambda c, k, i, r, mode: c.sections[k][2])
-#: a window of one sample interval, the questions asked on it
-ONE_INTERVAL = make_window_event(
-    interval.WalkOps(skip_to=lambda c, i, mode: i,
-                     candidate_at=lambda c, i, mode: (True, c), last_sample=lambda c: 1,
-                     clears_band_at=lambda c, i, mode: False, unband=None),
-    ASK)
-
-
-def EVENT(c, i, mode):
-    """The event of sample interval i = 0 on the scripted engine c."""
-    assert i == 0
-    return ONE_INTERVAL(c, mode)
+OPS = interval.WindowOps(Engine.window, lambda c, i, mode: i, Engine.sampled, Engine.value,
+                         Engine.root, Engine.extremum, Engine.section, Engine.counts,
+                         Engine.touch, Engine.unband)
+EVENT = make_window_event(OPS)
+#: a window of one sample interval [0, 2]
+T2 = (0.0, 2.0)
 
 
 def test_the_earliest_leave_crossing_is_the_event_and_hidden_extrema_are_not_asked():
-    c = Script(leave={0: 2.0, 1: 1.5}, slide={0: (1.0, rules.GRAZE_CROSSES)})
-    assert EVENT(c, 0, SLIDING) == (OK, 1.5, rules.EXIT_PLUS, -1)
-    assert c.asked == ["leave0", "leave1"]
-    c = Script(leave={0: 2.0}, extremum=(1.0, rules.GRAZE_CROSSES))
-    assert EVENT(c, 0, PLUS) == (OK, 2.0, rules.SWITCH, -1)
-    assert c.asked == ["leave0"]
+    # while sliding: a reaches 0 at 1.8, b at 1.5; b's rate also shows a maximum between
+    # the samples, not asked
+    c = Engine({F_LEAVE: lambda t: 1.8 - t, F_LEAVE + 1: lambda t: t - 1.5,
+                F_RATE: lambda t: -1.0, F_RATE + 1: lambda t: 1 - 2 * (t - 1)}, T2)
+    st, t, what, k = EVENT(c, SLIDING)
+    assert (st, what, k) == (OK, rules.EXIT_PLUS, -1) and abs(t - 1.5) < 1e-12
+    assert c.asked == [("root", F_LEAVE), ("root", F_LEAVE + 1)]
+    c = Engine({F_LEAVE: lambda t: 1.5 - t, F_RATE: lambda t: -1.0}, T2)
+    st, t, what, _ = EVENT(c, PLUS)
+    assert what == rules.SWITCH and abs(t - 1.5) < 1e-12
 
 
 def test_a_hidden_end_of_sliding_the_earliest_exit_and_the_touches_before_it():
-    c = Script(slide={0: (3.0, rules.GRAZE_CROSSES), 1: (2.5, rules.GRAZE_CROSSES)})
-    assert EVENT(c, 0, SLIDING) == (OK, 2.5, rules.EXIT_PLUS, -1)
-    c = Script(slide={0: (2.0, rules.GRAZE_TOUCHES), 1: (1.0, rules.GRAZE_TOUCHES)})
-    assert EVENT(c, 0, SLIDING) == (OK, math.inf, NONE, -1)
-    assert c.touches == [1.0, 2.0]                      # in time order
-    c = Script(slide={0: (2.0, rules.GRAZE_TOUCHES), 1: (1.0, rules.GRAZE_CROSSES)})
-    assert EVENT(c, 0, SLIDING) == (OK, 1.0, rules.EXIT_PLUS, -1)
-    assert c.touches == []                              # after the exit: none
+    # b has its maximum 0.5 at t = 1 between samples where it is -0.5: an exit at its
+    # root before the maximum, 1 - sqrt(0.5)
+    exit_b = {F_LEAVE: lambda t: 1.0, F_RATE: lambda t: 0.0,
+              F_LEAVE + 1: lambda t: 0.5 - (t - 1) ** 2, F_RATE + 1: lambda t: -2 * (t - 1)}
+    c = Engine(exit_b, T2)
+    st, t, what, _ = EVENT(c, SLIDING)
+    assert what == rules.EXIT_PLUS and abs(t - (1 - math.sqrt(0.5))) < 1e-12
+    # ... unless the rates of a and b are not sampled: nothing seen
+    c = Engine(exit_b, T2, rates=False)
+    assert EVENT(c, SLIDING) == (OK, math.inf, NONE, -1) and c.asked == []
+    # maxima within the touch tolerance: touches, recorded in time order
+    touch = {F_LEAVE: lambda t: 1e-12 + (t - 1.5) ** 2, F_RATE: lambda t: 2 * (t - 1.5),
+             F_LEAVE + 1: lambda t: -1e-12 - (t - 0.5) ** 2, F_RATE + 1: lambda t: -2 * (t - 0.5)}
+    c = Engine(touch, T2)
+    assert EVENT(c, SLIDING) == (OK, math.inf, NONE, -1)
+    assert len(c.touches) == 2 and abs(c.touches[0] - 0.5) < 1e-12 \
+        and abs(c.touches[1] - 1.5) < 1e-12
+    # a touch after an exit: none
+    touch_after_exit = {**touch, F_LEAVE + 1: exit_b[F_LEAVE + 1],
+                        F_RATE + 1: exit_b[F_RATE + 1]}
+    c = Engine(touch_after_exit, T2)
+    assert EVENT(c, SLIDING)[2] == rules.EXIT_PLUS and c.touches == []
 
 
 @pytest.mark.parametrize("mode", (PLUS, MINUS))
 def test_a_hidden_extremum_of_h_is_a_switch_or_a_touch_in_a_region(mode):
-    c = Script(extremum=(1.0, rules.GRAZE_CROSSES))
-    assert EVENT(c, 0, mode) == (OK, 1.0, rules.SWITCH, -1)
-    c = Script(extremum=(1.0, rules.GRAZE_TOUCHES))
-    assert EVENT(c, 0, mode) == (OK, math.inf, NONE, -1) and c.touches == [1.0]
-    c = Script(extremum=(1.0, rules.GRAZE_CROSSES), slide={0: (0.5, rules.GRAZE_CROSSES)})
-    assert EVENT(c, 0, mode)[2] == rules.SWITCH and "slide0" not in c.asked
+    sign = 1.0 if mode == PLUS else -1.0  # h's minimum in +, maximum in -
+    for hm, kind in ((-0.25, "switch"), (-1e-12, "touch"), (0.25, "nothing")):
+        c = Engine({F_LEAVE: lambda t: sign * (hm + (t - 1) ** 2),
+                    F_RATE: lambda t: sign * 2 * (t - 1)}, T2)
+        st, t, what, _ = EVENT(c, mode)
+        if kind == "switch":
+            assert what == rules.SWITCH and abs(t - (1 - math.sqrt(0.25))) < 1e-12
+        else:
+            assert what == NONE and len(c.touches) == (kind == "touch")
+    # within the exit's band the extremum is the exit's own tangency: no touch
+    c = Engine({F_LEAVE: lambda t: sign * (1e-12 + 1e-4 * (t - 1) ** 2),
+                F_RATE: lambda t: sign * 2e-4 * (t - 1)}, T2, band=1e-3)
+    assert EVENT(c, mode)[2] == NONE and c.touches == []
 
 
 def test_a_section_wins_at_the_instant_of_a_switch_and_the_first_of_two_hits_stays():
-    tie = rules.same_instant(XTOL, 2.0)
-    c = Script(leave={0: 2.0}, sections=[(2.0 + 0.5 * tie, 0.0, True)])
-    assert EVENT(c, 0, PLUS) == (OK, 2.0 + 0.5 * tie, SECTION, 0)
-    c = Script(leave={0: 2.0}, sections=[(2.0 + 2.0 * tie, 0.0, True)])
-    assert EVENT(c, 0, PLUS) == (OK, 2.0, rules.SWITCH, -1)
-    c = Script(sections=[(2.0, 0.0, True), (2.0, 0.0, True), (1.0, 0.0, False)])
-    assert EVENT(c, 0, MINUS) == (OK, 2.0, SECTION, 0)
-    assert c.asked == ["section0", "section1", "section2"]
-    c = Script(sections=[(2.0, 0.0, True), (1.0, 0.0, True)])
-    assert EVENT(c, 0, MINUS) == (OK, 1.0, SECTION, 1)
-    c = Script(sections=[(1.0, 1.5, True)])                    # before min_time
-    assert EVENT(c, 0, PLUS) == (OK, math.inf, NONE, -1)
+    tie = rules.same_instant(XTOL, 1.0)
+    h = {F_LEAVE: lambda t: 1.0 - t, F_RATE: lambda t: -1.0}
+
+    def sec(root):
+        return lambda t: t - root
+    up = rules.TO_NONNEG
+    c = Engine({**h, F_SECTION: sec(1.0 + 0.25 * tie)}, T2, sections=[(up, 0.0, True)])
+    st, t, what, k = EVENT(c, PLUS)
+    assert (what, k) == (SECTION, 0) and t > 1.0
+    c = Engine({**h, F_SECTION: sec(1.0 + 4 * tie)}, T2, sections=[(up, 0.0, True)])
+    assert EVENT(c, PLUS)[2:] == (rules.SWITCH, -1)
+    c = Engine({F_LEAVE: lambda t: 1.0, F_RATE: lambda t: 0.0, F_SECTION: sec(1.0),
+                F_SECTION + 1: sec(1.0), F_SECTION + 2: sec(0.5)}, T2,
+               sections=[(up, 0.0, True), (up, 0.0, True), (up, 0.0, False)])
+    assert EVENT(c, MINUS)[2:] == (SECTION, 0)
+    assert c.asked == [("root", F_SECTION), ("root", F_SECTION + 1), ("root", F_SECTION + 2)]
+    c = Engine({F_LEAVE: lambda t: 1.0, F_RATE: lambda t: 0.0, F_SECTION: sec(1.0)}, T2,
+               sections=[(up, 1.5, True)])                       # before min_time
+    assert EVENT(c, PLUS) == (OK, math.inf, NONE, -1)
 
 
 def test_a_failed_question_ends_the_search_with_its_status():
-    c = Script(leave={0: 1.0}, sections=[(0.5, 0.0, True)], fail="leave0")
-    assert EVENT(c, 0, PLUS) == (7, 1.0, NONE, -1) and c.asked == ["leave0"]
+    c = Engine({F_LEAVE: lambda t: 1.0 - t, F_RATE: lambda t: -1.0,
+                F_SECTION: lambda t: t - 0.5}, T2, sections=[(rules.TO_NONNEG, 0.0, True)],
+               fail=F_LEAVE)
+    assert EVENT(c, PLUS)[:1] == (7,) and EVENT(c, PLUS)[2:] == (NONE, -1)
+    assert c.asked[0] == ("root", F_LEAVE) and ("root", F_SECTION) not in c.asked
+
+
+def test_a_just_entered_modes_start_sample_is_clamped_inside():
+    # h a hair below 0 at the entry in region +, falling: the samples show no sign
+    # change, the clamped start does (a switch at once)
+    h = {F_LEAVE: lambda t: -1e-17 - 0.25 * t, F_RATE: lambda t: -0.25}
+    assert EVENT(Engine(h, T2), PLUS) == (OK, math.inf, NONE, -1)
+    st, t, what, _ = EVENT(Engine(h, T2, first=True), PLUS)
+    assert what == rules.SWITCH and t < 1e-12
+    c = Engine({**h, F_LEAVE: lambda t: -1e-17 + t * (1.5 - t)}, T2, first=True)
+    st, t, what, _ = EVENT(c, PLUS)
+    assert what == rules.SWITCH and abs(t - 1.5) < 1e-12
+
+
+def test_the_root_of_h_after_an_entry_at_h_is_refined_beyond_its_dip():
+    # entered at H: h rises from rounding noise and comes back across H at 1.5; a bracket
+    # from the entry would be lost in the noise, so the root is searched from h's maximum
+    noise = {F_LEAVE: lambda t: t * (1.5 - t) if t > 1e-9 else -1e-18,
+             F_RATE: lambda t: 1.5 - 2 * t}
+    c = Engine(noise, T2, first=True)
+    st, t, what, _ = EVENT(c, PLUS)
+    assert what == rules.SWITCH and abs(t - 1.5) < 1e-12
+    assert c.asked[:1] == [("extremum", F_RATE)]
 
 
 # ------------------------------------------------------------------ written once
@@ -130,160 +220,146 @@ def test_the_tie_break_is_called_only_by_the_one_event_search():
 
 
 def test_both_engines_run_the_one_event_search():
-    """The kernel compiles the very function the reference driver runs, and each engine's
-    scan asks it; the old per-engine orders are gone."""
+    """The kernel compiles the very function the reference driver runs, each engine's
+    scan asks it with its own operations, and both refine a leave function's root with
+    the one function of the loop."""
     import importlib
 
     simulate = importlib.import_module("filippov.simulate")  # the module, not the function
     from filippov.kernel import scan
 
     assert scan._window_event.py_func.__code__ is simulate._window_event.__code__
-    # each engine's window walk asks its own operations
-    for walk, ops in ((simulate._window_event, (simulate._Scan._leave_root,
-                                                simulate._Scan._section_counts)),
-                      (scan._window_event.py_func, (scan._leave_root_at,
-                                                    scan._section_counts))):
+    for walk, ops in ((simulate._window_event, (simulate._Scan._root, simulate._Scan._counts)),
+                      (scan._window_event.py_func, (scan._root, scan._counts))):
         cells = [cell.cell_contents for cell in walk.__closure__]
-        assert all(op in cells for op in ops)
-    for gone in ("_event_in", "_leave_crossing", "_section_hit", "_interval_event"):
-        assert not hasattr(simulate._Scan, gone) and not hasattr(scan, gone)
-    assert not hasattr(simulate, "_interval_event")  # the questions are in the walk
+        assert all(any(op is c for c in cells) for op in ops)
+        roots = [getattr(c, "py_func", c) for c in cells
+                 if getattr(getattr(c, "py_func", c), "__name__", "") == "leave_root"]
+        assert len(roots) == 1 and roots[0].__module__ == interval.__name__
+    for gone in ("_leave_root", "_hidden_slide_end", "_hidden_extremum", "_past_band",
+                 "_banded_h", "_refine_unbanded", "_candidate_at", "_clears_band_at"):
+        assert not hasattr(simulate._Scan, gone) and not hasattr(scan, gone), gone
+    for gone in ("_leave_root_at", "_speed_exit", "_h_extremum", "_leave_of"):
+        assert not hasattr(scan, gone), gone
+
+
+#: the rules that decide the event search: asked by the loop only
+DECISIONS = ("crosses", "after", "clamp", "graze", "speed_graze", "extremum_between",
+             "speed_extremum_between", "clears_band", "dips_and_returns", "band_probe",
+             "section_first", "ended_by", "leave_pred")
+
+
+def _rule_calls(tree):
+    return sorted({node.func.attr for node in ast.walk(tree)
+                   if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+                   and isinstance(node.func.value, ast.Name) and node.func.value.id == "rules"
+                   and node.func.attr in DECISIONS})
+
+
+def test_no_engine_takes_a_decision_of_the_event_search():
+    """The engines report samples, values and roots; every decision of the search (a sign
+    change, a hidden extremum and what it is, the clamped start, the band's end, the dip
+    after an entry, the tie of a section and a switch) is the loop's."""
+    kernel = ast.parse((SRC / "kernel/scan.py").read_text())
+    assert _rule_calls(kernel) == []
+    reference = next(node for node in ast.parse((SRC / "simulate.py").read_text()).body
+                     if isinstance(node, ast.ClassDef) and node.name == "_Scan")
+    assert _rule_calls(reference) == []
+    loop = ast.parse((SRC / "loop/interval.py").read_text())
+    assert set(_rule_calls(loop)) == set(DECISIONS)
 
 
 # ----------------------------------------------------------- the walk over a window
-class Window:
-    """A window of ``n`` samples whose intervals are scripted: ``cand`` the candidate
-    intervals (banded), ``unbanded`` those once the band ends, ``clear`` the first sample
-    out of the band, ``events`` {i: t}; ``asked`` the intervals the event search was
-    asked, ``unbands`` the samples the band ended at."""
-
-    def __init__(self, cand, events, clear=None, unbanded=(), n=12, fail=False):
-        self.cand, self.events, self.clear, self.unbanded = list(cand), events, clear, unbanded
-        self.n, self.band, self.asked, self.unbands = n, clear is not None, [], []
-        self.fail = fail
-
-    def crosses(self, q, i):
-        """The scripted interval: h changes sign at an event (or the search fails)."""
-        if q == 0:
-            self.asked.append(i)
-        return q == 0 and (i in self.events or self.fail)
-
-    def root(self, q, i, mode):
-        return (7, 0.25) if self.fail else (OK, self.events[i])
+def _piecewise(values):
+    """A function of time through ``values`` at t = 0, 1, 2, ... (linear between)."""
+    return lambda t: float(np.interp(t, np.arange(len(values)), values))
 
 
-def _walk(skip=True):
-    """The walk on a scripted Window; ``skip``: jump to the next candidate (as the
-    reference does) or test every interval (as the kernel does)."""
-    return interval.make_window_event(
-        interval.WalkOps(
-            skip_to=lambda c, i, mode: (min((j for j in c.cand if j >= i), default=c.n - 1)
-                                        if skip else i),
-            candidate_at=lambda c, i, mode: (i in c.cand, c),
-            last_sample=lambda c: c.n - 1,
-            clears_band_at=lambda c, i, mode: c.band and i >= c.clear,
-            unband=lambda c, i, mode: (c.unbands.append(i), setattr(c, "band", False),
-                                       setattr(c, "cand", [j for j in c.unbanded if j >= i]))),
-        interval.IntervalOps(
-            leave_crosses=Window.crosses, leave_root=Window.root,
-            slide_end_between=lambda c, q, i: False, hidden_slide_end=None,
-            extremum_between=lambda c, i: False, hidden_extremum=None, touch=None,
-            n_sections=lambda c: 0, section_crosses=None, section_root=None,
-            section_bounds=None, section_counts=None))
+TS = [float(t) for t in range(12)]
 
 
-WALKS = [_walk(), _walk(skip=False)]
+def _skipping(c, i, mode):
+    """The reference's hint: the next interval its array operations found."""
+    mask = interval.candidate_mask(
+        mode, [np.array([c.sampled(F_LEAVE, j) for j in range(len(c.ts))])],
+        [np.array([c.sampled(F_RATE, j) for j in range(len(c.ts))])],
+        [(c.sections[k][0], np.array([c.sampled(F_SECTION + k, j) for j in range(len(c.ts))]))
+         for k in range(len(c.sections))], c.first)
+    return next((j for j in range(i, len(c.ts) - 1) if mask[j]), len(c.ts) - 1)
+
+
+WALKS = [make_window_event(OPS._replace(skip_to=_skipping)), EVENT]
 walks = pytest.mark.parametrize("WALK", WALKS, ids=["skipping", "every-interval"])
 
 
 @walks
 def test_the_window_asks_its_candidates_in_time_order_up_to_the_first_event(WALK):
-    c = Window(cand=[2, 5, 9, 11], events={9: 4.5, 11: 5.5})
-    assert WALK(c, PLUS) == (OK, 4.5, rules.SWITCH, -1)
-    assert c.asked == [2, 5, 9] and c.unbands == []
-    c = Window(cand=[], events={})
+    h = [1.0] * 10 + [-1.0, -1.0]                      # crosses in interval 9, at 9.5
+    sec = [-1.0] * 3 + [1.0] * 9                       # crosses in interval 2, no hit
+    c = Engine({F_LEAVE: _piecewise(h), F_RATE: lambda t: 0.0, F_SECTION: _piecewise(sec)},
+               TS, sections=[(rules.TO_NONNEG, 0.0, False)])
+    st, t, what, _ = WALK(c, PLUS)
+    assert what == rules.SWITCH and abs(t - 9.5) < 1e-12
+    assert c.asked == [("root", F_SECTION), ("root", F_LEAVE)]
+    c = Engine({F_LEAVE: lambda t: 1.0, F_RATE: lambda t: 0.0}, TS)
     assert WALK(c, MINUS) == (OK, math.inf, NONE, -1) and c.asked == []
 
 
 @walks
 def test_the_band_ends_at_the_first_candidate_out_of_it_and_that_interval_is_asked_again(WALK):
-    # out of the band at interval 5: h unbiased from there shows no change at 5 any more
-    c = Window(cand=[2, 5, 9], events={7: 3.5}, clear=5, unbanded=[0, 7, 9])
-    assert WALK(c, PLUS) == (OK, 3.5, rules.SWITCH, -1)
-    assert c.unbands == [5] and c.asked == [2, 7]  # 0 lies before the band's end
-    # ... or still does: then that interval is asked at once
-    c = Window(cand=[2, 5], events={5: 2.5}, clear=5, unbanded=[5])
-    assert WALK(c, PLUS) == (OK, 2.5, rules.SWITCH, -1)
-    assert c.unbands == [5] and c.asked == [2, 5]
+    # banded h (band 0.1 in region +: out of it above 0.2) crosses in interval 5 at 5.5;
+    # the section's crossing in interval 1 lies in the band, the one in 5 out of it
+    banded = [0.05, 0.1, 0.15, 0.3, 0.3, 0.3, -0.3] + [-0.3] * 5
+    sec = [-1.0, -1.0] + [1.0] * 10
+    c = Engine({F_LEAVE: _piecewise(banded), F_RATE: lambda t: 0.0,
+                F_SECTION: _piecewise(sec)}, TS, band=0.1,
+               sections=[(rules.TO_NONNEG, 0.0, False)],
+               unbanded=_piecewise([v - 0.1 for v in banded]))
+    st, t, what, _ = WALK(c, PLUS)
+    # asked again on h unbiased: its root 5 + 0.2 / 0.6
+    assert what == rules.SWITCH and abs(t - (5 + 0.2 / 0.6)) < 1e-12
+    assert c.unbands == [5]
 
 
 @walks
 def test_a_window_with_no_event_ends_the_band_at_its_last_sample_out_of_it(WALK):
     # no candidate out of the band, but the last sample (11) is: the band ends there,
     # with no sample after it to take again
-    c = Window(cand=[2], events={}, clear=8)
-    assert WALK(c, PLUS) == (OK, math.inf, NONE, -1)
-    assert c.asked == [2] and c.unbands == [12] and not c.band
+    rising = [0.05 + 0.05 * k for k in range(12)]
+    c = Engine({F_LEAVE: _piecewise(rising), F_RATE: lambda t: 0.0}, TS, band=0.1,
+               unbanded=_piecewise(rising))
+    assert WALK(c, PLUS) == (OK, math.inf, NONE, -1) and c.unbands == [12]
     # still in the band at the last sample: it stays in force for the next window
-    c = Window(cand=[2], events={}, clear=20)
-    assert WALK(c, PLUS) == (OK, math.inf, NONE, -1) and c.unbands == [] and c.band
-    # an event in the window: the window ends there, the band with it only if passed
-    c = Window(cand=[2], events={2: 1.0}, clear=8)
-    assert WALK(c, PLUS) == (OK, 1.0, rules.SWITCH, -1) and c.unbands == [] and c.band
+    c = Engine({F_LEAVE: lambda t: 0.1, F_RATE: lambda t: 0.0}, TS, band=0.1)
+    assert WALK(c, PLUS) == (OK, math.inf, NONE, -1) and c.unbands == []
 
 
 def test_a_failed_search_stops_the_walk():
-    c = Window(cand=[1, 3], events={}, fail=True)
-    assert WALKS[0](c, SLIDING) == (7, 0.25, NONE, -1) and c.asked == [1]
-
-
-def test_both_engines_walk_their_windows_with_the_one_function():
-    import importlib
-
-    simulate = importlib.import_module("filippov.simulate")
-    from filippov.kernel import scan
-
-    assert scan._window_event.py_func.__code__ is simulate._window_event.__code__
-    assert "_window_event" in _calls(SRC / "simulate.py")
-    assert "_window_event" in _calls(SRC / "kernel/scan.py")
+    h = [1.0, 1.0, -1.0, -1.0] + [1.0] * 8
+    c = Engine({F_LEAVE: _piecewise(h), F_RATE: lambda t: 0.0}, TS, fail=F_LEAVE)
+    assert WALKS[0](c, PLUS)[0] == 7 and c.asked == [("root", F_LEAVE)]
 
 
 def test_a_switch_beyond_the_band_is_refined_again_from_the_first_probe_out_of_it():
-    """make_past_band probes back from r toward lo (rules.band_probe) and refines the
-    unbiased h from the first probe whose banded h clears the band; none: r stands."""
-    band, asked = 0.1, []
-
-    def walk(clear_before):  # banded h in region +: clears the band before clear_before
-        refined = []
-        past = interval.make_past_band(
-            lambda c, t, mode: (asked.append(t), 1.0 if t < clear_before else 0.0)[1],
-            lambda c, lo, hi, mode: (refined.append((lo, hi)), 0.5 * (lo + hi))[1])
-        return past(None, 2.0, 1.0, PLUS, band), refined
-
-    t, refined = walk(clear_before=1.5)
-    assert asked[0] == 2.0 and all(b < a for a, b in zip(asked, asked[1:]))
-    tq = asked[-1]
-    assert tq < 1.5 <= asked[-2] and refined == [(tq, 2.0)] and t == 0.5 * (tq + 2.0)
-    asked.clear()
-    t, refined = walk(clear_before=1.0)  # never out of the band after lo: r stands
-    assert t == 2.0 and refined == [] and asked[-1] == 1.0
-
-
-def test_both_engines_probe_past_the_band_with_the_one_function():
-    import importlib
-
-    simulate = importlib.import_module("filippov.simulate")
-    from filippov.kernel import scan
-
-    assert scan._past_band.py_func.__code__ is simulate._past_band.__code__
-    for gone in ("_band_root",):
-        assert not hasattr(scan, gone)
-    assert not hasattr(simulate._Scan, "_past_band")
+    """The root of banded h (band 0.1 in region +: h unbiased is banded h - 0.1) is
+    probed back toward the bracket's start (rules.band_probe) to a time out of the band
+    (banded h > 0.2, before t = 0.3), and refined again from there on h unbiased: its root
+    0.4, not the banded one at 0.5. If no probe after the start clears, r stands."""
+    leave_root = interval.make_leave_root(OPS)
+    c = Engine({F_LEAVE: lambda t: 0.5 - t, F_UNBANDED: lambda t: 0.4 - t,
+                F_RATE: lambda t: -1.0}, T2, band=0.1)
+    st, t = leave_root(c, 0, 0, PLUS, False, 0.1, 0.5, -1.5)
+    assert st == OK and abs(t - 0.4) < 1e-12
+    assert c.asked == [("root", F_LEAVE), ("root", F_UNBANDED)]
+    c = Engine({F_LEAVE: lambda t: 0.15 - t, F_UNBANDED: lambda t: 0.05 - t,
+                F_RATE: lambda t: -1.0}, T2, band=0.1)
+    st, t = leave_root(c, 0, 0, PLUS, False, 0.1, 0.15, -1.85)
+    assert st == OK and abs(t - 0.15) < 1e-12 and c.asked == [("root", F_LEAVE)]
 
 
 def test_the_walk_is_one_loop_asking_each_question_in_one_place():
     """The kernel inlines every call of an operation (numba, inline="always"): the walk
-    asks each question in one place (a touch: while sliding and in a region), is one loop
+    asks each question in one place (a touch: sliding or in a region alike), is one loop
     over the intervals (a walk that restarted an inner loop of candidates after each
     interval cost the kernel about 2% of its instructions per return), and its only other
     loops are the questions' own (the leave functions q, the two touches, the sections k):
@@ -294,12 +370,10 @@ def test_the_walk_is_one_loop_asking_each_question_in_one_place():
     tree = ast.parse(textwrap.dedent(inspect.getsource(interval.make_window_event)))
     calls = [node.func.id for node in ast.walk(tree)
              if isinstance(node, ast.Call) and isinstance(node.func, ast.Name)]
-    for op in interval.IntervalOps._fields:
-        assert calls.count(op) == (2 if op == "touch" else 1), op
-    assert calls.count("last_sample") == 1
-    # an interval is asked once: after the band's end the loop asks it again itself
-    assert calls.count("candidate_at") == 1
-    for op in ("skip_to", "clears_band_at", "unband"):
+    for op in ("window", "candidate", "leave_root", "hidden_end", "touch", "root", "counts",
+               "section"):
+        assert calls.count(op) == 1, op
+    for op in ("skip_to", "unband"):
         assert calls.count(op) == 2, op  # at the start and after the band's end
     assert sum(isinstance(node, ast.While) for node in ast.walk(tree)) == 1
     assert sorted(node.target.id for node in ast.walk(tree)

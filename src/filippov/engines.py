@@ -24,17 +24,19 @@ The reference driver (:mod:`filippov.simulate`) and the compiled engine
 (:mod:`filippov.fastmap`, :mod:`filippov.kernel`) take every decision from one rule book
 (:mod:`filippov.rules`), and the event loop's structure is written once, beside it, in
 :mod:`filippov.loop` (the reference runs it as Python, the kernel compiles it, each
-with its own operations). Over a window both walk its candidate intervals in
-time order with one function (``make_window_event``: the exit's rounding band ended at
-the first candidate whose start is out of it, ``rules.clears_band``, and that interval
-asked again, or at the last sample of a window with no event; a switch found beyond
-the band refined again on H, ``make_past_band``), each finding its candidates its own
-way (the reference with array operations, the kernel with scalars). In a sample
-interval both run one event search, :mod:`filippov.loop.interval`, which asks in one
-order -- the crossing of H (or of a or b while sliding), the end of sliding hidden
-between the samples, then a hidden extremum of H, then each section, whose root at the
-instant of a switch wins the tie (``rules.section_first``) -- each engine answering with
-its own samples and root finder; a crossing becomes an event time by one function,
+with its own operations). Over a window both run one event search,
+:mod:`filippov.loop.interval` (``make_window_event``), which takes every decision of it
+from what the engine reports (the window seam, ``contracts.WindowOperations``: the
+samples of the window's functions, their values and roots between samples, a touch, the
+band's end): the intervals where a sign change shows, in time order (the reference sends
+it to the next candidate its array operations found, ``candidate_mask``; the kernel
+tests each); the exit's rounding band ended at the first of them whose start is out of
+it (``rules.clears_band``) and that interval asked again, or at the last sample of a
+window with no event; then in one order -- the crossing of H (or of a or b while
+sliding; after an entry at H beyond its dip, and a switch found beyond the band refined
+again on H, ``make_leave_root``), the extremum of H or of a, b hidden between the
+samples (``rules.graze``, ``rules.speed_graze``), then each section, whose root at the
+instant of a switch wins the tie (``rules.section_first``); a crossing becomes an event time by one function,
 :mod:`filippov.loop.refine` (a sample exactly on it, the bracketing root, an event at
 once where a clamped start is already past it, then the walk to its far side). What is
 done at an event is written once, in the run's loop both engines run,

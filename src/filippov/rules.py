@@ -283,6 +283,17 @@ def slides_in_section(s_at_z: float, d: float, rate_minus: float, rate_plus: flo
 SWITCH, EXIT_MINUS, EXIT_PLUS = 0, 1, 2
 
 
+def leave_pred(mode: int, q: int) -> int:
+    """The sign change of leave function ``q`` that ends a stay in ``mode``: in region +
+    H turning negative, in region - H reaching 0 or above (q = 0); while sliding a
+    reaching 0 or below (q = 0), b reaching 0 or above (q = 1)."""
+    if mode == PLUS:
+        return TO_NEG
+    if mode == MINUS:
+        return TO_NONNEG
+    return TO_NONPOS if q == 0 else TO_NONNEG
+
+
 def ended_by(mode: int, q: int) -> int:
     """What a sign change of leave function ``q`` ends a stay in ``mode`` with (the
     ``ended_by`` of :func:`next_mode`): in a region q = 0 is H, a SWITCH; while sliding

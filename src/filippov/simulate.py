@@ -889,14 +889,10 @@ class _Scan:
         self.touch_tol, self.xtol, self.traj = touch_tol, xtol, traj
         self.band, self.unbanded = band, unbanded
         self.order = None  # the candidate intervals still to ask (earliest, _unband)
-        self.vals, self.raw = [], []
-        for func, pred, what in leave:
-            v = np.asarray(func(zs), dtype=float)
-            self.raw.append(v)
-            if first:  # just entered this mode: its start is inside by construction
-                v = v.copy()
-                v[0] = rules.clamp(pred, v[0])
-            self.vals.append(v)
+        # the leave functions as sampled (raw) and as the search reads them (vals: h
+        # sampled again unbiased once the band ends, _unband)
+        self.raw = [np.asarray(func(zs), dtype=float) for func, _, _ in leave]
+        self.vals = list(self.raw)
         self.D = None
         if mode != SLIDING:  # dH/dt along the mode's field: extrema of H are its roots
             self.D = np.asarray(system.speed_of_switch(mode, zs), dtype=float)
@@ -984,19 +980,12 @@ class _Scan:
         return self._along(lambda z: self.system.speed_of_switch(self.mode, z))
 
     def candidates(self):
-        """Sample intervals that may hold an event, found with array operations; only
-        those are examined one by one (a scan of many samples costs a few numpy calls)."""
-        cand = np.zeros(self.ts.size - 1, dtype=bool)
-        for (_, pred, _), v in zip(self.leave, self.vals):
-            cand |= rules.crosses(pred, v[:-1], v[1:])
-        if self.mode != SLIDING:
-            cand |= rules.extremum_between(self.mode, self.D[:-1], self.D[1:])
-        elif self.rates is not None:
-            for (_, pred, _), Dv in zip(self.leave, self.R):
-                cand |= rules.speed_extremum_between(pred, Dv[:-1], Dv[1:])
-        for pred, sv in zip(self.preds, self.svals):
-            cand |= rules.crosses(pred, sv[:-1], sv[1:])
-        return cand
+        """Sample intervals that may hold an event (loop.interval.candidate_mask, array
+        operations); only those are examined one by one (a scan of many samples costs a
+        few numpy calls)."""
+        rates = [self.D] if self.mode != SLIDING else self.R
+        return interval.candidate_mask(self.mode, self.vals, rates,
+                                       list(zip(self.preds, self.svals)), self.first)
 
     def earliest(self):
         """(t, z, what, section index) of the earliest event in the segment, or None; and
@@ -1011,23 +1000,71 @@ class _Scan:
             return None, self.band
         return (r, np.asarray(self.Z(r), dtype=float).reshape(-1).copy(), what, k), self.band
 
-    # -------------------------------------------- the window walk's operations on it
-    # (filippov.loop.interval.make_window_event, _window_event below)
+    # -------------------------------------------- the event search's operations on it
+    # The walk over the window's intervals, the questions of each and every decision
+    # among them are the one event search (filippov.loop.interval, _window_event below);
+    # these methods report this engine's samples and the values of its functions on its
+    # dense output Z, each function by the loop's code (F_*). Its failures raise, so each
+    # returns the status OK.
+
+    def _window(self):
+        return interval.Window(self.ts.size - 1, len(self.sections), self.first, self.band,
+                               self.rates is not None, self.touch_tol, self.xtol)
 
     def _skip_to(self, i, mode):
         """The first candidate interval from i on (the last sample's index: none)."""
         pos = int(np.searchsorted(self.order, i))
-        return int(self.order[pos]) if pos < self.order.size else self._last_sample()
+        return int(self.order[pos]) if pos < self.order.size else self.ts.size - 1
 
-    def _candidate_at(self, i, mode):
-        pos = int(np.searchsorted(self.order, i))
-        return bool(pos < self.order.size and self.order[pos] == i), self
+    def _sampled(self, f, i):
+        if f == interval.F_TIME:
+            return self.ts[i]
+        if f >= interval.F_SECTION:
+            return self.svals[f - interval.F_SECTION][i]
+        if f >= interval.F_RATE:
+            if self.mode != SLIDING:
+                return self.D[i]
+            return math.nan if self.R is None else self.R[f - interval.F_RATE][i]
+        return self.vals[f][i]
 
-    def _last_sample(self):
-        return self.ts.size - 1
+    def _function(self, f):
+        """Function f (the loop's code) of time on the segment."""
+        if f >= interval.F_SECTION:
+            return self._along(self.sections[f - interval.F_SECTION].func)
+        if f == interval.F_UNBANDED:
+            return self._along(self.unbanded[0][0])
+        if f >= interval.F_RATE:
+            if self.mode != SLIDING:
+                return self._dH
+            q = f - interval.F_RATE
+            return lambda tt: float(self.rates(tt)[q])
+        return self._along(self.leave[f][0])
 
-    def _clears_band_at(self, i, mode):
-        return self.band > 0.0 and bool(rules.clears_band(mode, self.vals[0][i], self.band))
+    def _value(self, f, t, mode):
+        return self._function(f)(t)
+
+    def _root(self, f, pred, lo, hi, vlo, vhi, mode):
+        return interval.OK, _refine(self._function(f), pred, lo, hi, vlo, vhi, self.xtol)
+
+    def _extremum(self, f, i, mode):
+        return interval.OK, _brent(self._function(f), self.ts[i], self.ts[i + 1],
+                                   self._sampled(f, i), self._sampled(f, i + 1), self.xtol)
+
+    def _section(self, k):
+        return self.preds[k], self.traj.t0 + self.sections[k].min_time
+
+    def _counts(self, k, i, r, mode):
+        """The crossing of section k at r is a hit: ``where`` holds there, and it is not
+        the run's start on the section up to rounding."""
+        sec, zr = self.sections[k], self.Z(r)
+        if sec.where is not None and not sec.where(zr):
+            return False
+        return not (i == 0 and self.ts[i] == self.traj.t0
+                    and self._starts_on(sec, self.svals[k], zr))
+
+    def _touch(self, tm, mode):
+        """A touch of H at tm: no event for the orbit, a kink of P (recorded)."""
+        self.traj.events.append(Event(tm, "touch", self.Z(tm).copy(), mode, mode))
 
     def _unband(self, i, mode):
         """Out of the exit's rounding band at ts[i] (at the last sample when i is
@@ -1040,103 +1077,6 @@ class _Scan:
         again[:i] = False
         self.order = np.flatnonzero(again)
 
-    # -------------------------------------------- the event search's operations on it
-    # The order of the questions in one sample interval and its ties are the one event
-    # search (filippov.loop.interval, _window_event below); these methods are how this
-    # engine answers each, on its samples and its dense output Z. Its failures raise, so
-    # each returns the status OK.
-
-    def _leave_crosses(self, q, i):
-        v = self.vals[q]
-        return bool(rules.crosses(self.leave[q][1], v[i], v[i + 1]))
-
-    def _leave_root(self, q, i, mode):
-        """The root of leave function q between the samples (beyond the dip after an
-        entry; again on H itself when found beyond the exit's band)."""
-        func, pred, what = self.leave[q]
-        ta, tb, v = self.ts[i], self.ts[i + 1], self.vals[q]
-        lo, vlo = ta, v[i]
-        if (mode != SLIDING and self.first and i == 0
-                and rules.dips_and_returns(mode, self.D[0], self.D[1])):
-            # refine beyond the dip: next to the entry H is noise (rules)
-            tm = _brent(self._dH, ta, tb, self.D[0], self.D[1], self.xtol)
-            hm = float(func(self.Z(tm)))
-            if not rules.after(pred, hm):
-                lo, vlo = tm, hm
-        r = _refine(self._along(func), pred, lo, tb, vlo, v[i + 1], self.xtol)
-        if self.band > 0.0 and what == "switch":
-            r = _past_band(self, r, lo, mode, self.band)
-        return interval.OK, r
-
-    def _banded_h(self, t, mode):
-        return float(self.leave[0][0](self.Z(t)))
-
-    def _refine_unbanded(self, lo, hi, mode):
-        h = self._along(self.unbanded[0][0])
-        return _refine(h, self.leave[0][1], lo, hi, h(lo), h(hi), self.xtol)
-
-    def _slide_end_between(self, q, i):
-        Dv = self.R[q] if self.rates is not None else None
-        return Dv is not None and bool(
-            rules.speed_extremum_between(self.leave[q][1], Dv[i], Dv[i + 1]))
-
-    def _hidden_slide_end(self, q, i, mode):
-        """The extremum of a (q = 0) or b hidden between the samples, judged by
-        rules.speed_graze: the speed's root before it (an exit), or its time (a touch)."""
-        func, pred, _ = self.leave[q]
-        ta, tb, Dv = self.ts[i], self.ts[i + 1], self.R[q]
-        tm = _brent(lambda tt: float(self.rates(tt)[q]), ta, tb, Dv[i], Dv[i + 1], self.xtol)
-        vm = float(func(self.Z(tm)))
-        kind = rules.speed_graze(pred, vm, Dv[i], Dv[i + 1], tb - ta, self.touch_tol)
-        if kind == rules.GRAZE_CROSSES:
-            return (interval.OK, _refine(self._along(func), pred, ta, tm, self.vals[q][i], vm,
-                                         self.xtol), kind)
-        return interval.OK, tm, kind
-
-    def _extremum_between(self, i):
-        return bool(rules.extremum_between(self.mode, self.D[i], self.D[i + 1]))
-
-    def _hidden_extremum(self, i, mode):
-        """A minimum (in +) or maximum (in -) of H hidden between the samples, judged by
-        rules.graze: H's root before it (a switch), or its time (a touch)."""
-        func, pred, _ = self.leave[0]
-        ta, tb = self.ts[i], self.ts[i + 1]
-        tm = _brent(self._dH, ta, tb, self.D[i], self.D[i + 1], self.xtol)
-        Hm = float(func(self.Z(tm)))
-        kind = rules.graze(mode, Hm, self.touch_tol, self.band)
-        if kind == rules.GRAZE_CROSSES:
-            return (interval.OK, _refine(self._along(func), pred, ta, tm, self.vals[0][i], Hm,
-                                         self.xtol), kind)
-        return interval.OK, tm, kind
-
-    def _touch(self, tm, mode):
-        """A touch of H at tm: no event for the orbit, a kink of P (recorded)."""
-        self.traj.events.append(Event(tm, "touch", self.Z(tm).copy(), mode, mode))
-
-    def _n_sections(self):
-        return len(self.sections)
-
-    def _section_crosses(self, k, i):
-        sv = self.svals[k]
-        return bool(rules.crosses(self.preds[k], sv[i], sv[i + 1]))
-
-    def _section_root(self, k, i, mode):
-        sv = self.svals[k]
-        return interval.OK, _refine(self._along(self.sections[k].func), self.preds[k],
-                                    self.ts[i], self.ts[i + 1], sv[i], sv[i + 1], self.xtol)
-
-    def _section_bounds(self, k):
-        return self.traj.t0 + self.sections[k].min_time, self.xtol
-
-    def _section_counts(self, k, i, r, mode):
-        """The crossing of section k at r is a hit: ``where`` holds there, and it is not
-        the run's start on the section up to rounding."""
-        sec, zr = self.sections[k], self.Z(r)
-        if sec.where is not None and not sec.where(zr):
-            return False
-        return not (i == 0 and self.ts[i] == self.traj.t0
-                    and self._starts_on(sec, self.svals[k], zr))
-
     def _starts_on(self, sec, sv, zr) -> bool:
         """The start on the section, up to its rounding (rules.starts_on_section,
         rules.on_section_by_value): no hit."""
@@ -1148,17 +1088,12 @@ class _Scan:
                 or _in_section_rounding(sec.func, float(sv[0]), z_first, z_root))
 
 
-_past_band = interval.make_past_band(_Scan._banded_h, _Scan._refine_unbanded)
-#: the one event search over a window's sample intervals (filippov.loop.interval), asked
-#: through this engine's operations
-_window_event = interval.make_window_event(
-    interval.WalkOps(_Scan._skip_to, _Scan._candidate_at, _Scan._last_sample,
-                     _Scan._clears_band_at, _Scan._unband),
-    interval.IntervalOps(
-        _Scan._leave_crosses, _Scan._leave_root, _Scan._slide_end_between,
-        _Scan._hidden_slide_end, _Scan._extremum_between, _Scan._hidden_extremum,
-        _Scan._touch, _Scan._n_sections, _Scan._section_crosses, _Scan._section_root,
-        _Scan._section_bounds, _Scan._section_counts))
+#: what this engine reports of a window to the event search (the window seam:
+#: filippov.contracts.WindowOperations), and that one search (filippov.loop.interval)
+WINDOW_OPERATIONS = interval.WindowOps(
+    _Scan._window, _Scan._skip_to, _Scan._sampled, _Scan._value, _Scan._root,
+    _Scan._extremum, _Scan._section, _Scan._counts, _Scan._touch, _Scan._unband)
+_window_event = interval.make_window_event(WINDOW_OPERATIONS)
 
 # the event search and what is done at an event speak the same codes
 assert interval.SECTION == SECTION and interval.OK == OK

@@ -2,20 +2,18 @@
 order of the questions in a sample interval: filippov.loop.interval)."""
 from __future__ import annotations
 
-from collections import namedtuple
-
 import numpy as np
 
 from .. import rules
-from ..loop.interval import IntervalOps, WalkOps, make_past_band, make_window_event
+from ..loop.interval import (F_LEAVE, F_RATE, F_SECTION, F_TIME, F_UNBANDED, Window, WindowOps,
+                             make_window_event)
 from ..system import MINUS, PLUS, SLIDING
 from .base import (OK, ROOT_FAILED, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB, _S_H,
-                   _S_SEC, _TO_NEG, _TO_NONNEG, _TO_NONPOS, _W_NONE, _dot, _jit,
-                   _jit_inline, _speeds, _field_minus, _field_plus, _grad_h, _h, _section,
-                   _where)
+                   _S_SEC, _dot, _jit, _jit_inline, _speeds, _field_minus, _field_plus,
+                   _grad_h, _h, _section, _where)
 from .segment import (_fval, _rates, _zat)
 from .state import (SEG_BAND, SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_LAST_H, SEG_LAST_SPEED2,
-                    SEG_RATE_STEP, SEG_SHIFT, Band, Eval, Interval, Walk)
+                    SEG_RATE_STEP, SEG_SHIFT, Eval, Walk)
 from .roots import (_brentq, _refine)
 
 
@@ -120,165 +118,98 @@ def _in_section_rounding(fns, p, s0, z0, zr, probe):
     return rules.on_section_by_value(s0, noise)
 
 
-#: how an orbit leaves its mode: through n leave functions (1: h; 2 while sliding: a and
-#: b), the first of them ``sel`` crossing by ``pred``, and the rate ``sel_d`` whose zero
-#: is the first one's extremum (which event a crossing is: loop.interval)
-_Leave = namedtuple("_Leave", ["n", "sel", "pred", "sel_d"])
+# ------------------------------------------------------------------ the event search
+# The walk over the window's intervals and the questions of each, every decision among
+# them, are the one event search (filippov.loop.interval); what follows is how the
+# kernel reports its samples (sm) and values on its segment (o), each function by the
+# loop's code (F_*) mapped to the kernel's selector (_S_*). The walk's state is a
+# state.Walk: the window's records and its number of samples.
+
+@_jit_inline
+def _sel(f, mode):
+    """The kernel's selector of the window's function f (loop.interval.F_*) in mode."""
+    if f == F_LEAVE:
+        return _S_H if mode != SLIDING else _S_A
+    if f == F_LEAVE + 1:
+        return _S_B
+    if f == F_RATE:  # dh/dt along F_+ is b, along F_- a; while sliding the rate of a
+        return _S_DA if mode == SLIDING else (_S_B if mode == PLUS else _S_A)
+    if f == F_RATE + 1:
+        return _S_DB
+    if f == F_UNBANDED:
+        return _S_H
+    return _S_SEC
 
 
 @_jit_inline
-def _leave_of(mode):
-    if mode == PLUS:
-        return _Leave(1, _S_H, _TO_NEG, _S_B)
-    if mode == MINUS:
-        return _Leave(1, _S_H, _TO_NONNEG, _S_A)
-    return _Leave(2, _S_A, _TO_NONPOS, _S_A)
+def _window_of(ctx):
+    sg = ctx.o.seg
+    return Window(ctx.ns - 1, 1, ctx.first, sg[SEG_BAND], sg[SEG_RATE_STEP] > 0.0,
+                  ctx.touch_tol, ctx.o.xtol)
 
 
 @_jit_inline
-def _banded_h(ctx, t, mode):
-    return _fval(_S_H, t, mode, ctx.o, ctx.sc)
+def _skip_to(ctx, i, mode):
+    # each interval is tested as the walk comes to it; i + 0, not i: the walk starts at
+    # the constant 0, and a call given that literal i would be compiled twice
+    # (docs/decisions.md#kernel-codes-are-numpy-integers)
+    return i + 0
 
 
 @_jit_inline
-def _refine_unbanded(ctx, lo, hi, mode):
-    """h's root in [lo, hi] on H itself: the exit's shift in force of the banded one."""
-    lv, o, sc = ctx
+def _sampled(ctx, f, i):
+    sm = ctx.sm
+    if f == F_TIME:
+        return sm.ts[i]
+    if f >= F_SECTION:
+        return sm.svals[i]
+    if f >= F_RATE:
+        return sm.dvals[f - F_RATE, i]
+    return sm.vals[f, i]
+
+
+@_jit_inline
+def _value(ctx, f, t, mode):
+    """f at t; h unbiased (F_UNBANDED): the exit's shift in force of the banded one."""
+    o, sc = ctx.o, ctx.sc
+    if f != F_UNBANDED:
+        return _fval(_sel(f, mode), t, mode, o, sc)
     sg = o.seg
     banded = sg[SEG_SHIFT]
     sg[SEG_SHIFT] = sg[SEG_EXIT_SHIFT]
-    # vb: not sampled here, and the kernel's refinement never reads it (roots._lost_bracket)
-    ok, r = _refine(Eval(o, sc), lv.sel, lv.pred, lo, hi, _fval(_S_H, lo, mode, o, sc), np.nan,
-                    mode)
+    v = _fval(_S_H, t, mode, o, sc)
     sg[SEG_SHIFT] = banded
-    return r if ok else hi
-
-
-#: a crossing of H found beyond the exit's band, refined again on H itself (loop.interval)
-_past_band = _jit_inline(make_past_band(_banded_h, _refine_unbanded))
-
-
-@_jit
-def _leave_root(i, mode, first, lv, o, sm, sc):
-    """The crossing of the first leave function between samples i and i + 1; (t, ok)."""
-    ta, tb = sm.ts[i], sm.ts[i + 1]
-    lo, vlo = ta, sm.vals[0, i]
-    if (first and i == 0 and mode != SLIDING
-            and rules.dips_and_returns(mode, sm.dvals[0, 0], sm.dvals[0, 1])):
-        tm, ok = _brentq(lv.sel_d, ta, tb, _MAXITER_EXTREMUM, mode, o, sc)
-        hm = _fval(_S_H, tm, mode, o, sc)
-        if ok and not rules.after(lv.pred, hm):  # refine beyond the dip (rules)
-            lo, vlo = tm, hm
-    ok, r = _refine(Eval(o, sc), lv.sel, lv.pred, lo, tb, vlo, sm.vals[0, i + 1], mode)
-    if not ok:
-        return r, False
-    if o.seg[SEG_BAND] > 0.0:  # found beyond the exit's band: again on H itself
-        r = _past_band(Band(lv, o, sc), r, lo, mode, o.seg[SEG_BAND])
-    return r, True
-
-
-# ------------------------------------------------------------------ the event search
-# The order of the questions in one sample interval and its ties, and the walk over the
-# window's intervals, are the one event search (filippov.loop.interval); what follows is
-# how the kernel answers each, on its samples (sm) and its segment (o). The walk's state
-# is a state.Walk (the window's records and its number of samples), the event search's a
-# state.Interval (the window's records and the sign changes _candidate_at saw there).
-
-@_jit_inline
-def _leave_crosses(ctx, q, i):
-    return ctx.c0 if q == 0 else ctx.c1
+    return v
 
 
 @_jit_inline
-def _leave_root_at(ctx, q, i, mode):
-    """The root of leave function q (h or a; b) between samples i and i + 1."""
-    first, lv, o, sm, sc = ctx.first, ctx.lv, ctx.o, ctx.sm, ctx.sc
-    if q == 0:
-        r, ok = _leave_root(i, mode, first, lv, o, sm, sc)
-    else:
-        ok, r = _refine(Eval(o, sc), _S_B, _TO_NONNEG, sm.ts[i], sm.ts[i + 1], sm.vals[1, i],
-                        sm.vals[1, i + 1], mode)
+def _root(ctx, f, pred, lo, hi, vlo, vhi, mode):
+    o, sc = ctx.o, ctx.sc
+    sg = o.seg
+    banded = sg[SEG_SHIFT]
+    if f == F_UNBANDED:  # h on H itself: the exit's shift in force of the banded one
+        sg[SEG_SHIFT] = sg[SEG_EXIT_SHIFT]
+    ok, r = _refine(Eval(o, sc), _sel(f, mode), pred, lo, hi, vlo, vhi, mode)
+    if f == F_UNBANDED:
+        sg[SEG_SHIFT] = banded
     return (OK if ok else ROOT_FAILED), r
 
 
 @_jit_inline
-def _slide_end_between(ctx, q, i):
-    return ctx.ha if q == 0 else ctx.hb
+def _extremum(ctx, f, i, mode):
+    sm = ctx.sm
+    tm, ok = _brentq(_sel(f, mode), sm.ts[i], sm.ts[i + 1], _MAXITER_EXTREMUM, mode, ctx.o,
+                     ctx.sc)
+    return (OK if ok else ROOT_FAILED), tm
 
 
 @_jit_inline
-def _speed_exit(ctx, q, i, mode):
-    """The extremum of a (q = 0) or b hidden between samples i and i + 1, judged by
-    rules.speed_graze: (status, the speed's root before it, GRAZE_CROSSES), (status, its
-    time, GRAZE_TOUCHES) or GRAZE_NONE."""
-    s, o, sm, sc = ctx.s, ctx.o, ctx.sm, ctx.sc
-    ta, tb = sm.ts[i], sm.ts[i + 1]
-    sel_v, sel_r = (_S_A, _S_DA) if q == 0 else (_S_B, _S_DB)
-    pred = _TO_NONPOS if q == 0 else _TO_NONNEG
-    tm, ok = _brentq(sel_r, ta, tb, _MAXITER_EXTREMUM, mode, o, sc)
-    if not ok:
-        return ROOT_FAILED, tm, rules.GRAZE_NONE
-    vm = _fval(sel_v, tm, mode, o, sc)
-    kind = rules.speed_graze(pred, vm, sm.dvals[q, i], sm.dvals[q, i + 1], tb - ta, s.touch_tol)
-    if kind == rules.GRAZE_CROSSES:
-        ok, r = _refine(Eval(o, sc), sel_v, pred, ta, tm, sm.vals[q, i], vm, mode)
-        return (OK if ok else ROOT_FAILED), r, kind
-    return OK, tm, kind
+def _section_of(ctx, k):
+    return ctx.sec_pred, ctx.min_time  # the run starts at t = 0
 
 
 @_jit_inline
-def _extremum_between_at(ctx, i):
-    return ctx.cd
-
-
-@_jit_inline
-def _h_extremum(ctx, i, mode):
-    """A minimum (in +) or maximum (in -) of h hidden between samples i and i + 1, judged
-    by rules.graze (the exit's band): (status, h's root before it, GRAZE_CROSSES),
-    (status, its time, GRAZE_TOUCHES) or GRAZE_NONE."""
-    lv, s, o, sm, sc = ctx.lv, ctx.s, ctx.o, ctx.sm, ctx.sc
-    ta, tb = sm.ts[i], sm.ts[i + 1]
-    tm, ok = _brentq(lv.sel_d, ta, tb, _MAXITER_EXTREMUM, mode, o, sc)
-    if not ok:
-        return ROOT_FAILED, tm, rules.GRAZE_NONE
-    hm = _fval(_S_H, tm, mode, o, sc)
-    kind = rules.graze(mode, hm, s.touch_tol, o.seg[SEG_BAND])
-    if kind == rules.GRAZE_CROSSES:
-        ok, r = _refine(Eval(o, sc), _S_H, lv.pred, ta, tm, sm.vals[0, i], hm, mode)
-        return (OK if ok else ROOT_FAILED), r, kind
-    return OK, tm, kind
-
-
-@_jit_inline
-def _touch(ctx, t, mode):
-    ctx.sm.touched[0] = True  # no event; P has a kink here
-
-
-@_jit_inline
-def _n_sections(ctx):
-    return 1
-
-
-@_jit_inline
-def _section_crosses(ctx, k, i):
-    return ctx.cs
-
-
-@_jit_inline
-def _section_root(ctx, k, i, mode):
-    s, o, sm, sc = ctx.s, ctx.o, ctx.sm, ctx.sc
-    ok, r = _refine(Eval(o, sc), _S_SEC, s.sec_pred, sm.ts[i], sm.ts[i + 1], sm.svals[i],
-                    sm.svals[i + 1], mode)
-    return (OK if ok else ROOT_FAILED), r
-
-
-@_jit_inline
-def _section_bounds(ctx, k):
-    return ctx.s.min_time, ctx.o.xtol  # the run starts at t = 0
-
-
-@_jit_inline
-def _section_counts(ctx, k, i, r, mode):
+def _counts(ctx, k, i, r, mode):
     """The section's crossing at r is a hit: ``where`` holds there, and it is not the
     start on the section up to rounding."""
     o, sm, sc = ctx.o, ctx.sm, ctx.sc
@@ -298,49 +229,9 @@ def _section_counts(ctx, k, i, r, mode):
                 or _in_section_rounding(o.fns, o.p, sm.svals[i], wg, wz, sc.wf))
 
 
-#: how the kernel answers the questions of a sample interval (loop.interval.IntervalOps)
-_INTERVAL_OPS = IntervalOps(
-    _leave_crosses, _leave_root_at, _slide_end_between, _speed_exit, _extremum_between_at,
-    _h_extremum, _touch, _n_sections, _section_crosses, _section_root, _section_bounds,
-    _section_counts)
-
-
 @_jit_inline
-def _skip_to(ctx, i, mode):
-    # each interval is tested as the walk comes to it (_candidate_at); i + 0, not i: the
-    # walk starts at the constant 0, and a call given that literal i would be compiled
-    # twice (docs/decisions.md#kernel-codes-are-numpy-integers)
-    return i + 0
-
-
-@_jit_inline
-def _candidate_at(ctx, i, mode):
-    """Sample interval i shows a sign change, and the event search's state there: the
-    window's records and the sign changes seen."""
-    first, lv, s, o, sm, sc, ns = ctx
-    vals, dvals, svals, sg = sm.vals, sm.dvals, sm.svals, o.seg
-    c0 = rules.crosses(lv.pred, vals[0, i], vals[0, i + 1])
-    c1 = lv.n == 2 and rules.crosses(_TO_NONNEG, vals[1, i], vals[1, i + 1])
-    cd = mode != SLIDING and rules.extremum_between(mode, dvals[0, i], dvals[0, i + 1])
-    cs = rules.crosses(s.sec_pred, svals[i], svals[i + 1])
-    # while sliding: a minimum of a, a maximum of b between the samples (rules)
-    ha = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and rules.speed_extremum_between(
-        _TO_NONPOS, dvals[0, i], dvals[0, i + 1])
-    hb = lv.n == 2 and sg[SEG_RATE_STEP] > 0.0 and rules.speed_extremum_between(
-        _TO_NONNEG, dvals[1, i], dvals[1, i + 1])
-    return ((c0 or c1 or cd or cs or ha or hb),
-            Interval(first, lv, s, o, sm, sc, c0, c1, cd, cs, ha, hb))
-
-
-@_jit_inline
-def _clears_band_at(ctx, i, mode):
-    sg = ctx.o.seg
-    return sg[SEG_BAND] > 0.0 and rules.clears_band(mode, ctx.sm.vals[0, i], sg[SEG_BAND])
-
-
-@_jit_inline
-def _last_sample(ctx):
-    return ctx.ns - 1
+def _touch(ctx, t, mode):
+    ctx.sm.touched[0] = True  # no event; P has a kink here
 
 
 @_jit_inline
@@ -356,21 +247,19 @@ def _unband(ctx, i, mode):
         sm.vals[0, k] = _fval(_S_H, sm.ts[k], mode, o, sc)
 
 
-#: a call with its pieces inlined, as _find was (docs/decisions.md#kernel-inlined-driver)
-_window_event = _jit(make_window_event(
-    WalkOps(_skip_to, _candidate_at, _last_sample, _clears_band_at, _unband),
-    _INTERVAL_OPS))
+#: what the kernel reports of a window to the event search (the window seam:
+#: filippov.contracts.WindowOperations)
+WINDOW_OPERATIONS = WindowOps(_window_of, _skip_to, _sampled, _value, _root, _extremum,
+                              _section_of, _counts, _touch, _unband)
+#: the one event search (loop.interval) on them: a call, its operations inlined, the root
+#: of a leave function a call of its own (docs/decisions.md#kernel-inlined-driver)
+_window_event = _jit(make_window_event(WINDOW_OPERATIONS, call=_jit, inline=_jit_inline))
 
 
 @_jit_inline
 def _find(mode, ns, first, s, o, sm, sc):
-    """The earliest event on the samples (the one event search of loop.interval, asked in
-    each interval where a sign change shows); (status, t, what). A touch of H on the way
-    (no event) sets sm.touched[0]."""
-    lv = _leave_of(mode)
-    if first:  # just entered this mode: its start is inside by construction
-        sm.vals[0, 0] = rules.clamp(lv.pred, sm.vals[0, 0])
-        if lv.n == 2:
-            sm.vals[1, 0] = rules.clamp(_TO_NONNEG, sm.vals[1, 0])
-    st, t, what, _ = _window_event(Walk(first, lv, s, o, sm, sc, ns), mode)
+    """The earliest event on the samples (the one event search of loop.interval); (status,
+    t, what). A touch of H on the way (no event) sets sm.touched[0]."""
+    st, t, what, _ = _window_event(Walk(first, o, sm, sc, ns, s.touch_tol, s.min_time,
+                                        s.sec_pred), mode)
     return st, t, what

@@ -145,14 +145,9 @@ Dop = namedtuple("Dop", ["y", "f", "y_old", "f_old", "K", "ynew", "ytmp", "scale
 #: the run's state as the engine seam's operations take it (filippov.contracts.
 #: RunOperations' ``ctx``): the model's pieces, its parameters, the Settings, the Work
 RunCtx = namedtuple("RunCtx", ["fns", "p", "s", "w"])
-#: the window walk's state (filippov.loop.interval.WalkOps): whether the stay just began,
-#: its leave functions (scan._Leave), the Settings, the segment, the samples, the scratch
-#: vectors and the number of samples
-Walk = namedtuple("Walk", ["first", "lv", "s", "o", "sm", "sc", "ns"])
-#: the event search's state at a sample interval (filippov.loop.interval.IntervalOps):
-#: the walk's records and the sign changes scan._candidate_at saw there (h or a, b, an
-#: extremum of h, the section, a hidden extremum of a, of b)
-Interval = namedtuple("Interval", ["first", "lv", "s", "o", "sm", "sc", "c0", "c1", "cd",
-                                   "cs", "ha", "hb"])
-#: a crossing found beyond the exit's band, refined again (loop.interval.make_past_band)
-Band = namedtuple("Band", ["lv", "o", "sc"])
+#: the window walk's state (filippov.loop.interval.WindowOps' ``ctx``): whether the
+#: stay just began, the segment, the samples, the scratch vectors, the number of samples
+#: and of the Settings only what the search asks (the Settings whole, 24 fields, would be
+#: handed to each call made with this state)
+Walk = namedtuple("Walk", ["first", "o", "sm", "sc", "ns", "touch_tol", "min_time",
+                           "sec_pred"])

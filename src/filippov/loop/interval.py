@@ -1,39 +1,40 @@
 """The event search of one sample interval, and the walk over a window's intervals,
-written once for both engines.
+written once for both engines: every decision is taken here, from the samples and
+values the engine reports, by the rule book.
 
-Between two samples of a stay the scan asks, in this order:
+Between two samples of a stay the search asks, in this order:
 
 1. does a leave function change sign (h: a switch; while sliding, a or b: an exit into
-   region - or +: ``rules.ended_by``)? Its root, refined; the earliest of them is the
-   event so far;
-2. none, and sliding: has a or b an extremum toward its sign change hidden between the
-   samples (``rules.speed_extremum_between``)? The engine refines it and
-   ``rules.speed_graze`` tells an exit (the earliest wins) from a touch, which is
-   recorded when it comes before any exit;
-3. none, and in a region: has h an extremum hidden between the samples
-   (``rules.extremum_between``)? ``rules.graze``: a switch at h's root before it, or a
-   touch (recorded);
-4. each section that changes sign, in order: its root is the event when it comes first
+   region - or +: ``rules.leave_pred``, ``rules.ended_by``)? Its root, refined; the
+   earliest of them is the event so far. The root of h is refined beyond the dip after
+   an entry at H (``rules.dips_and_returns``), and again on h itself when found beyond the
+   exit's band (:func:`make_leave_root`);
+2. none: has a leave function an extremum toward its sign change hidden between the
+   samples (h in a region: ``rules.extremum_between``; a or b while sliding, where their
+   rates are sampled: ``rules.speed_extremum_between``)? Its time is the root of the
+   rate, and the value there decides (``rules.graze``, ``rules.speed_graze``): an exit or
+   switch at the function's root before it (the earliest wins), or a touch, recorded
+   when it comes before any such event, in time order;
+3. each section that changes sign, in order: its root is the event when it comes first
    (``rules.section_first``: not before its min_time; before the event so far, or at its
    instant when that is a switch or an exit -- a section on H is hit where the orbit
    arrives on H) and the engine counts it there (``where`` holds, and it is not the run's
    start on the section up to rounding).
 
-A window's intervals are asked in time order (:func:`make_window_event`), only those
-where a sign change shows; while the exit's rounding band is in force, the first such
-interval whose start is out of the band (``rules.clears_band``) ends it: h is sampled
-again unbiased from there and that interval is asked again whether it still holds a
-sign change; a window with no event ends it when its last sample is out of the band.
-A switch found while the band is in force, at a time where the orbit is
-already out of it, is refined again on h itself (:func:`make_past_band`).
+A window's intervals are asked in time order, only those where a sign change shows (the
+start sample of a just-entered mode clamped inside: ``rules.clamp``); while the exit's
+rounding band is in force, the first such interval whose start is out of the band
+(``rules.clears_band``) ends it: h is sampled again unbiased from there and that
+interval is asked again whether it still holds a sign change; a window with no event
+ends it when its last sample is out of the band.
 
-:func:`make_window_event` builds the search from the engine's own operations -- how it
-tests its samples, refines a root, finds a hidden extremum, records a touch --, each a
-function of the engine's state ``ctx`` first. The reference driver
-(:class:`filippov.simulate._Scan`) passes its Python methods and runs the result as it
-is; the compiled kernel (:mod:`filippov.kernel.scan`) passes its compiled pieces and
-compiles the result with numba (``inline="always"``), so this module is plain scalar
-Python in the subset numba compiles.
+The engine reports, on its state ``ctx`` (:data:`WindowOps`), the samples of the
+window's functions, their values and roots between the samples, and the touches; the
+functions are named by the codes below, which each engine maps to its own. The
+reference driver (:class:`filippov.simulate._Scan`) runs the result as it is; the
+compiled kernel (:mod:`filippov.kernel.scan`) compiles it with numba, its operations
+inlined (``inline="always"``), so this module is plain scalar Python in the subset numba
+compiles.
 
 An event is ``(status, t, what, k)``: ``status`` OK or the engine's failure code (the
 reference raises instead, so its operations always return OK); ``what`` one of
@@ -46,8 +47,10 @@ from __future__ import annotations
 import math
 from collections import namedtuple
 
+import numpy as np
+
 from .. import rules
-from ..rules import GRAZE_CROSSES, GRAZE_TOUCHES, SWITCH
+from ..rules import GRAZE_CROSSES, GRAZE_NONE, GRAZE_TOUCHES
 from ..system import SLIDING
 
 #: the status of an operation that succeeded (the kernel's OK)
@@ -57,143 +60,231 @@ OK = 0
 NONE, SECTION = -1, 3
 
 
-#: How an engine walks a window's sample intervals, each a function of its state ``ctx``:
+#: the functions of a window, by the codes the engine's operations take: the sample
+#: times; the leave functions (F_LEAVE + q: h in a region, a and b while sliding) and
+#: their rates (F_RATE + q: dh/dt along the mode's field; while sliding the rates of a and
+#: b, where sampled); h measured from the exit shift alone, without the band (its second
+#: refinement); the sections (F_SECTION + k)
+F_TIME, F_LEAVE, F_RATE, F_UNBANDED, F_SECTION = -1, 0, 2, 4, 5
+
+#: what the engine reports of a window as it begins: the index of its last sample, its
+#: number of sections, whether the stay just began (its start sample is then clamped
+#: inside), the exit's band in force (0: none), whether the rates of a and b are sampled
+#: (while sliding), the touch tolerance and the tolerance roots are located to
+Window = namedtuple("Window", (
+    "last", "n_sections", "first", "band", "rates", "touch_tol", "xtol"))
+
+#: The engine's operations on a window, each a function of its state ``ctx``:
 #:
+#: * ``window(ctx) -> Window``;
 #: * ``skip_to(ctx, i, mode)``: the first interval from i on that may show a sign change
-#:   (``last_sample(ctx)`` if none): an engine that found its candidates with array
-#:   operations jumps to the next one, an engine that tests each interval as it comes
-#:   answers i itself;
-#: * ``candidate_at(ctx, i, mode) -> (hit, at)``: interval i shows a sign change (one of
-#:   the questions may hold), and the state ``at`` the questions are asked on there (ctx
-#:   itself, or ctx with what the engine saw at i);
-#: * ``last_sample(ctx)``: the index of the window's last sample;
-#: * ``clears_band_at(ctx, i, mode)``: the exit's band is in force and the orbit is out
-#:   of it at sample i; ``unband(ctx, i, mode)``: the band ends, h is sampled again
-#:   unbiased from sample i on and the candidates from i on are found again (none when i
-#:   is past the last sample).
-WalkOps = namedtuple("WalkOps", (
-    "skip_to", "candidate_at", "last_sample", "clears_band_at", "unband"))
-
-#: How an engine answers the questions of sample interval i, each on the state ``at``:
-#:
-#: * ``leave_crosses(at, q, i)``: leave function q (0: h, or a while sliding; 1: b)
-#:   changes sign; ``leave_root(at, q, i, mode) -> (status, t)``: its root;
-#: * ``slide_end_between(at, q, i)``: while sliding, speed q has an extremum toward its
-#:   sign change; ``hidden_slide_end(at, q, i, mode) -> (status, t, kind)``: judged by
-#:   rules.speed_graze, GRAZE_CROSSES with the speed's root before it, GRAZE_TOUCHES with
-#:   the extremum's time, or GRAZE_NONE; ``extremum_between(at, i)``,
-#:   ``hidden_extremum(at, i, mode)``: the same for h in a region (rules.graze);
-#: * ``touch(at, t, mode)``: a touch of H at t (no event; the return map has a kink);
-#: * ``n_sections(at)``, ``section_crosses(at, k, i)``, ``section_root(at, k, i, mode)
-#:   -> (status, t)``, ``section_bounds(at, k) -> (t_min, xtol)``, ``section_counts(at,
-#:   k, i, t, mode)``: the crossing at t is a hit (where holds, not the start itself).
-IntervalOps = namedtuple("IntervalOps", (
-    "leave_crosses", "leave_root", "slide_end_between", "hidden_slide_end",
-    "extremum_between", "hidden_extremum", "touch", "n_sections", "section_crosses",
-    "section_root", "section_bounds", "section_counts"))
+#:   (the last sample's index if none), a hint: an engine that found its candidates with
+#:   array operations jumps to the next one, one that tests each interval answers i;
+#: * ``sampled(ctx, f, i)``: function f (the codes above) at sample i;
+#: * ``value(ctx, f, t, mode)``: f at time t on the window;
+#: * ``root(ctx, f, pred, lo, hi, vlo, vhi, mode) -> (status, t)``: f's sign change
+#:   ``pred`` in [lo, hi] (vlo, vhi: f there as the search read it), refined to its far
+#:   side (:mod:`filippov.loop.refine`);
+#: * ``extremum(ctx, f, i, mode) -> (status, t)``: the root of the rate f between samples
+#:   i and i + 1 (an extremum of the function it is the rate of);
+#: * ``section(ctx, k) -> (pred, t_min)``: section k's sign change and the earliest time
+#:   it may be hit; ``counts(ctx, k, i, t, mode)``: its crossing at t in interval i is a
+#:   hit (``where`` holds; not the run's start on it up to rounding);
+#: * ``touch(ctx, t, mode)``: H touched at t (no event; the return map has a kink);
+#: * ``unband(ctx, i, mode)``: the band ends; h is sampled again unbiased from sample i
+#:   on (none when i is past the last sample) and the hint's candidates found again.
+WindowOps = namedtuple("WindowOps", (
+    "window", "skip_to", "sampled", "value", "root", "extremum", "section", "counts",
+    "touch", "unband"))
 
 
-def make_window_event(walk: WalkOps, ask: IntervalOps):
+def _as_is(f):
+    return f
+
+
+def make_leave_root(ops: WindowOps):
+    """``leave_root(ctx, q, i, mode, first, band, va, vb) -> (status, t)``: the sign
+    change of leave function q between samples i and i + 1 (va, vb as read there). The
+    root of h in the first interval of a stay entered at H, where h dips and returns
+    (``rules.dips_and_returns``), is refined beyond the extremum of h; one found while the
+    exit's band is in force is probed back toward the bracket's start
+    (``rules.band_probe``) to a time out of the band (``rules.clears_band``) and refined
+    again from there on h itself (r stands if none clears, or if that refinement fails)."""
+    sampled, value, root, extremum = ops.sampled, ops.value, ops.root, ops.extremum
+
+    def leave_root(ctx, q, i, mode, first, band, va, vb):
+        pred = rules.leave_pred(mode, q)
+        lo, vlo = sampled(ctx, F_TIME, i), va
+        if (first and i == 0 and mode != SLIDING and rules.dips_and_returns(
+                mode, sampled(ctx, F_RATE, 0), sampled(ctx, F_RATE, 1))):
+            st, tm = extremum(ctx, F_RATE, 0, mode)
+            if st == OK:
+                hm = value(ctx, F_LEAVE, tm, mode)
+                if not rules.after(pred, hm):  # next to the entry h is noise (rules)
+                    lo, vlo = tm, hm
+        st, r = root(ctx, F_LEAVE + q, pred, lo, sampled(ctx, F_TIME, i + 1), vlo, vb, mode)
+        if st != OK or band == 0.0 or mode == SLIDING:
+            return st, r
+        tq, step, done, clear = r, 0.0, False, False
+        while not done:
+            clear = rules.clears_band(mode, value(ctx, F_LEAVE, tq, mode), band)
+            done, tq, step = rules.band_probe(tq, step, lo, clear)
+        if not clear:
+            return OK, r
+        st, r2 = root(ctx, F_UNBANDED, pred, tq, r, value(ctx, F_UNBANDED, tq, mode),
+                      value(ctx, F_UNBANDED, r, mode), mode)
+        return OK, (r2 if st == OK else r)
+
+    return leave_root
+
+
+def make_hidden_end(ops: WindowOps):
+    """``hidden_end(ctx, q, i, mode, w, band, va) -> (status, t, kind)``: the extremum of
+    leave function q hidden between samples i and i + 1 (va: its value at i as read),
+    judged by ``rules.graze`` in a region, ``rules.speed_graze`` while sliding: the
+    function's root before it (GRAZE_CROSSES), the extremum's time (GRAZE_TOUCHES), or
+    GRAZE_NONE."""
+    sampled, value, root, extremum = ops.sampled, ops.value, ops.root, ops.extremum
+
+    def hidden_end(ctx, q, i, mode, w, band, va):
+        pred = rules.leave_pred(mode, q)
+        ta, tb = sampled(ctx, F_TIME, i), sampled(ctx, F_TIME, i + 1)
+        st, tm = extremum(ctx, F_RATE + q, i, mode)
+        if st != OK:
+            return st, tm, GRAZE_NONE
+        vm = value(ctx, F_LEAVE + q, tm, mode)
+        if mode == SLIDING:
+            kind = rules.speed_graze(pred, vm, sampled(ctx, F_RATE + q, i),
+                                     sampled(ctx, F_RATE + q, i + 1), tb - ta, w.touch_tol)
+        else:
+            kind = rules.graze(mode, vm, w.touch_tol, band)
+        if kind == GRAZE_CROSSES:
+            st, r = root(ctx, F_LEAVE + q, pred, ta, tm, va, vm, mode)
+            return st, r, kind
+        return OK, tm, kind
+
+    return hidden_end
+
+
+def make_candidate(ops: WindowOps):
+    """``candidate(ctx, i, mode, w, clamp_at, pred0, pred1) -> (hit, va0, vb0, va1, vb1, c0,
+    c1, x0, x1)``: the sign changes sample interval i shows -- the leave functions' (q = 0,
+    1; va, vb as read at its ends, the start clamped inside at i = ``clamp_at``, 0 when the
+    stay just began, else -1: c0, c1), a
+    hidden extremum of one (x0, x1), a section's -- and whether any does (``hit``). Each
+    function by a constant code: the kernel asks this of every interval."""
+    sampled, section = ops.sampled, ops.section
+
+    def candidate(ctx, i, mode, w, clamp_at, pred0, pred1):
+        va0, vb0 = sampled(ctx, F_LEAVE, i), sampled(ctx, F_LEAVE, i + 1)
+        if i == clamp_at:
+            va0 = rules.clamp(pred0, va0)
+        da, db = sampled(ctx, F_RATE, i), sampled(ctx, F_RATE, i + 1)
+        va1, vb1, c1, x1 = 0.0, 0.0, False, False
+        if mode != SLIDING:
+            x0 = rules.extremum_between(mode, da, db)
+        else:
+            x0 = w.rates and rules.speed_extremum_between(pred0, da, db)
+            va1, vb1 = sampled(ctx, F_LEAVE + 1, i), sampled(ctx, F_LEAVE + 1, i + 1)
+            if i == clamp_at:
+                va1 = rules.clamp(pred1, va1)
+            c1 = rules.crosses(pred1, va1, vb1)
+            x1 = w.rates and rules.speed_extremum_between(
+                pred1, sampled(ctx, F_RATE + 1, i), sampled(ctx, F_RATE + 1, i + 1))
+        c0 = rules.crosses(pred0, va0, vb0)
+        cs = False
+        for k in range(w.n_sections):
+            cs = cs or rules.crosses(section(ctx, k)[0], sampled(ctx, F_SECTION + k, i),
+                                     sampled(ctx, F_SECTION + k, i + 1))
+        return (c0 or c1 or x0 or x1 or cs), va0, vb0, va1, vb1, c0, c1, x0, x1
+
+    return candidate
+
+
+def make_window_event(ops: WindowOps, call=_as_is, inline=_as_is):
     """``window_event(ctx, mode) -> (status, t, what, k)``: the earliest event over a
-    window's sample intervals in time order, each interval's questions in the order of
-    this module's docstring, from the engine's operations (:data:`WalkOps`,
-    :data:`IntervalOps`). The questions are written in the walk's loop, not called: the
-    kernel inlines each operation here, and a composed function inlined whole costs the
-    cold compile a copy of all of it (docs/decisions.md#kernel-inlined-driver)."""
-    skip_to, candidate_at, last_sample, clears_band_at, unband = walk
-    (leave_crosses, leave_root, slide_end_between, hidden_slide_end, extremum_between,
-     hidden_extremum, touch, n_sections, section_crosses, section_root, section_bounds,
-     section_counts) = ask
+    window's intervals (this module's docstring) on the engine's :data:`WindowOps`; a
+    leave function's root compiled by ``call``, a hidden extremum by ``inline``."""
+    (window, skip_to, sampled, value, root, extremum, section, counts, touch, unband) = ops
+    leave_root, hidden_end = call(make_leave_root(ops)), inline(make_hidden_end(ops))
+    candidate = inline(make_candidate(ops))
 
     def window_event(ctx, mode):
-        n = last_sample(ctx)
+        w = window(ctx)
+        n, band, nl = w.last, w.band, (2 if mode == SLIDING else 1)
+        clamp_at = 0 if w.first else -1
+        pred0, pred1 = rules.leave_pred(mode, 0), rules.leave_pred(mode, 1)
         i = skip_to(ctx, 0, mode)
         while i < n:
-            hit, at = candidate_at(ctx, i, mode)
-            if hit and clears_band_at(ctx, i, mode):
+            hit, va0, vb0, va1, vb1, c0, c1, x0, x1 = candidate(ctx, i, mode, w, clamp_at,
+                                                                pred0, pred1)
+            if hit and band > 0.0 and rules.clears_band(mode, va0, band):
                 unband(ctx, i, mode)  # interval i asked again, h unbiased (band now 0)
+                band, clamp_at = 0.0, -1
                 continue
             if hit:
-                best_t, best_w = math.inf, NONE
+                best_t, best_w, best_k, touch_0, touch_1 = math.inf, NONE, -1, math.inf, math.inf
                 # 1. the leave functions' crossings: the earliest
-                for q in range(2 if mode == SLIDING else 1):
-                    if leave_crosses(at, q, i):
-                        st, r = leave_root(at, q, i, mode)
-                        if st != OK:
-                            return st, r, NONE, -1
-                        if best_w == NONE or r < best_t:
-                            best_t, best_w = r, rules.ended_by(mode, q)
-                # 2. none while sliding: the end of sliding hidden between the samples
-                if mode == SLIDING and best_w == NONE:
-                    touch_a, touch_b = math.inf, math.inf
-                    for q in range(2):
-                        if not slide_end_between(at, q, i):
-                            continue
-                        st, r, kind = hidden_slide_end(at, q, i, mode)
-                        if st != OK:
-                            return st, r, NONE, -1
-                        if kind == GRAZE_CROSSES:
-                            if best_w == NONE or r < best_t:
-                                best_t, best_w = r, rules.ended_by(mode, q)
-                        elif kind == GRAZE_TOUCHES:
-                            if q == 0:
-                                touch_a = r
-                            else:
-                                touch_b = r
-                    # a touch before any exit, in time order: P has a kink there
-                    for tm in (min(touch_a, touch_b), max(touch_a, touch_b)):
-                        if tm < best_t:
-                            touch(at, tm, mode)
-                # 3. none in a region: an extremum of h hidden between the samples
-                if mode != SLIDING and best_w == NONE and extremum_between(at, i):
-                    st, r, kind = hidden_extremum(at, i, mode)
-                    if st != OK:
-                        return st, r, NONE, -1
-                    if kind == GRAZE_CROSSES:
-                        best_t, best_w = r, SWITCH
-                    elif kind == GRAZE_TOUCHES:
-                        touch(at, r, mode)
-                # 4. the sections in order: a hit that comes first, or at a switch
-                best_k = -1
-                for k in range(n_sections(at)):
-                    if not section_crosses(at, k, i):
+                for q in range(nl):
+                    if not (c0 if q == 0 else c1):
                         continue
-                    st, r = section_root(at, k, i, mode)
+                    st, r = leave_root(ctx, q, i, mode, w.first, band, va0 if q == 0 else va1,
+                                       vb0 if q == 0 else vb1)
                     if st != OK:
                         return st, r, NONE, -1
-                    t_min, xtol = section_bounds(at, k)
-                    if (rules.section_first(r, t_min, best_t, best_w == SECTION, xtol)
-                            and section_counts(at, k, i, r, mode)):
-                        best_t, best_w, best_k = r, SECTION, k
+                    if best_w == NONE or r < best_t:
+                        best_t, best_w = r, rules.ended_by(mode, q)
+                # 2. none: an extremum of a leave function hidden between the samples
+                for q in range(nl if best_w == NONE else 0):
+                    if not (x0 if q == 0 else x1):
+                        continue
+                    st, r, kind = hidden_end(ctx, q, i, mode, w, band, va0 if q == 0 else va1)
+                    if st != OK:
+                        return st, r, NONE, -1
+                    if kind == GRAZE_CROSSES and (best_w == NONE or r < best_t):
+                        best_t, best_w = r, rules.ended_by(mode, q)
+                    elif kind == GRAZE_TOUCHES:
+                        touch_0, touch_1 = (r, touch_1) if q == 0 else (touch_0, r)
+                for tm in (min(touch_0, touch_1), max(touch_0, touch_1)):
+                    if tm < best_t:  # a touch before any exit, in time order: P has a kink
+                        touch(ctx, tm, mode)
+                # 3. the sections in order: a hit that comes first, or at a switch
+                for k in range(w.n_sections):
+                    pred, t_min = section(ctx, k)
+                    sa, sb = sampled(ctx, F_SECTION + k, i), sampled(ctx, F_SECTION + k, i + 1)
+                    if rules.crosses(pred, sa, sb):
+                        st, r = root(ctx, F_SECTION + k, pred, sampled(ctx, F_TIME, i),
+                                     sampled(ctx, F_TIME, i + 1), sa, sb, mode)
+                        if st != OK:
+                            return st, r, NONE, -1
+                        if (rules.section_first(r, t_min, best_t, best_w == SECTION, w.xtol)
+                                and counts(ctx, k, i, r, mode)):
+                            best_t, best_w, best_k = r, SECTION, k
                 if best_w != NONE:
                     return OK, best_t, best_w, best_k
             i = skip_to(ctx, i + 1, mode)
-        if clears_band_at(ctx, n, mode):
+        if band > 0.0 and rules.clears_band(mode, sampled(ctx, F_LEAVE, n), band):
             unband(ctx, n + 1, mode)  # no sample after the last one to take again
         return OK, math.inf, NONE, -1
 
     return window_event
 
 
-def make_past_band(banded_h, refine_unbanded):
-    """``past_band(ctx, r, lo, mode, band) -> t``: a switch found at r (the root of h as
-    biased by the exit's band, searched from lo) refined again on h itself when the orbit
-    is out of the band before r: probed back from r toward lo (``rules.band_probe``)
-    until a time out of the band (``rules.clears_band``), the root of the unbiased h
-    between it and r; r itself if no probe clears the band. The engine's operations:
-
-    * ``banded_h(ctx, t, mode)``: h as biased by the band, at t;
-    * ``refine_unbanded(ctx, lo, hi, mode)``: the root of the unbiased h in [lo, hi]
-      (hi if the engine's refinement fails).
-    """
-
-    def past_band(ctx, r, lo, mode, band):
-        tq, step, done, clear = r, 0.0, False, False
-        while not done:
-            clear = rules.clears_band(mode, banded_h(ctx, tq, mode), band)
-            done, tq, step = rules.band_probe(tq, step, lo, clear)
-        if clear:
-            return refine_unbanded(ctx, tq, r, mode)
-        return r
-
-    return past_band
+def candidate_mask(mode, leaves, rates, sections, first):
+    """The sample intervals where the event search may find something, by array
+    operations (an engine's ``skip_to`` hint; the search tests each one it is sent to
+    again): a leave function's sign change (``leaves``: their samples), an extremum of
+    one hidden between samples (``rates``: the samples of their rates, None while
+    sliding without them), a section's sign change (``sections``: (pred, samples)
+    pairs); interval 0 whenever the stay just began (its start sample is clamped)."""
+    cand = np.zeros(leaves[0].size - 1, dtype=bool)
+    for q, v in enumerate(leaves):
+        cand |= rules.crosses(rules.leave_pred(mode, q), v[:-1], v[1:])
+    for q, d in enumerate(rates if rates is not None else ()):
+        cand |= (rules.extremum_between(mode, d[:-1], d[1:]) if mode != SLIDING else
+                 rules.speed_extremum_between(rules.leave_pred(mode, q), d[:-1], d[1:]))
+    for pred, sv in sections:
+        cand |= rules.crosses(pred, sv[:-1], sv[1:])
+    if first and cand.size:
+        cand[0] = True
+    return cand
