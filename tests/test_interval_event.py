@@ -128,6 +128,30 @@ def test_a_hidden_end_of_sliding_the_earliest_exit_and_the_touches_before_it():
     assert EVENT(c, SLIDING)[2] == rules.EXIT_PLUS and c.touches == []
 
 
+def test_an_exit_hidden_before_the_other_speeds_crossing_ends_the_slide_first():
+    """rules.asks_hidden_end: while sliding, b crossing 0 at 1.5 does not stop the search
+    for a hidden minimum of a, which dips below 0 around t = 0.5: the slide ends into
+    region - at a's root 0.5 - sqrt(0.01), not into region + at 1.5 (before the rule the
+    hidden end was asked only where neither speed crossed)."""
+    dip = {F_LEAVE: lambda t: (t - 0.5) ** 2 - 0.01, F_RATE: lambda t: 2 * (t - 0.5),
+           F_LEAVE + 1: lambda t: t - 1.5, F_RATE + 1: lambda t: 1.0}
+    c = Engine(dip, (0.0, 2.0))
+    st, t, what, _ = EVENT(c, SLIDING)
+    assert what == rules.EXIT_MINUS and abs(t - 0.4) < 1e-12
+    assert c.asked == [("root", F_LEAVE + 1), ("extremum", F_RATE), ("root", F_LEAVE)]
+    # a touch of a before b's crossing is recorded, one after it is not
+    touch = {**dip, F_LEAVE: lambda t: (t - 0.5) ** 2 + 1e-12}
+    c = Engine(touch, (0.0, 2.0))
+    assert EVENT(c, SLIDING)[2] == rules.EXIT_PLUS and len(c.touches) == 1
+    c = Engine({**touch, F_LEAVE: lambda t: (t - 1.75) ** 2 + 1e-12,
+                F_RATE: lambda t: 2 * (t - 1.75)}, (0.0, 2.0))
+    assert EVENT(c, SLIDING)[2] == rules.EXIT_PLUS and c.touches == []
+    # in a region the crossing of h is the event: its extremum is not asked
+    c = Engine({F_LEAVE: lambda t: 1.5 - t - 0.1 * (t - 1) ** 2,
+                F_RATE: lambda t: -1.0 - 0.2 * (t - 1) if t < 1 else 1.0}, (0.0, 2.0))
+    assert EVENT(c, PLUS)[2] == rules.SWITCH and [a for a, _ in c.asked] == ["root"]
+
+
 @pytest.mark.parametrize("mode", (PLUS, MINUS))
 def test_a_hidden_extremum_of_h_is_a_switch_or_a_touch_in_a_region(mode):
     sign = 1.0 if mode == PLUS else -1.0  # h's minimum in +, maximum in -
@@ -246,7 +270,7 @@ def test_both_engines_run_the_one_event_search():
 #: the rules that decide the event search: asked by the loop only
 DECISIONS = ("crosses", "after", "clamp", "graze", "speed_graze", "extremum_between",
              "speed_extremum_between", "clears_band", "dips_and_returns", "band_probe",
-             "section_first", "ended_by", "leave_pred")
+             "section_first", "ended_by", "leave_pred", "asks_hidden_end")
 
 
 def _rule_calls(tree):

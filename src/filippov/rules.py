@@ -174,6 +174,19 @@ RICHARDSON_STEP = 2.0 ** -9
 # b at the samples show an extremum toward the exit between two of them; it is refined
 # (a root of the rate), and the speed there decides: an exit, a touch, or nothing.
 
+def asks_hidden_end(mode: int, own_crossed: bool, crossed: bool) -> bool:
+    """Is an extremum of a leave function hidden between two samples looked for? In a
+    region, only where h shows no sign change (``crossed``: the crossing is then the event,
+    and its root is refined on the way past any extremum). While sliding, wherever the
+    speed's own sign change does not show (``own_crossed``), whether or not the other
+    speed's does: an exit hidden before the other speed's crossing ends the slide first
+    (a dips below 0 and back between the samples while b crosses 0 later in the same
+    interval: the orbit leaves into region - at a's root, not into + at b's)."""
+    if mode != SLIDING:
+        return not crossed
+    return not own_crossed
+
+
 def speed_extremum_between(pred: int, d0, d1):
     """While sliding: the normal speed whose sign change ``pred`` ends the slide (a:
     TO_NONPOS, b: TO_NONNEG) has an extremum toward that change between two samples where

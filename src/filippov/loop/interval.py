@@ -9,12 +9,14 @@ Between two samples of a stay the search asks, in this order:
    earliest of them is the event so far. The root of h is refined beyond the dip after
    an entry at H (``rules.dips_and_returns``), and again on h itself when found beyond the
    exit's band (:func:`make_leave_root`);
-2. none: has a leave function an extremum toward its sign change hidden between the
-   samples (h in a region: ``rules.extremum_between``; a or b while sliding, where their
-   rates are sampled: ``rules.speed_extremum_between``)? Its time is the root of the
-   rate, and the value there decides (``rules.graze``, ``rules.speed_graze``): an exit or
-   switch at the function's root before it (the earliest wins), or a touch, recorded
-   when it comes before any such event, in time order;
+2. has a leave function an extremum toward its sign change hidden between the samples
+   (h in a region: ``rules.extremum_between``; a or b while sliding, where their rates
+   are sampled: ``rules.speed_extremum_between``), asked where ``rules.asks_hidden_end``
+   says (in a region when h shows no crossing; while sliding when the speed's own does
+   not)? Its time is the root of the rate, and the value there decides
+   (``rules.graze``, ``rules.speed_graze``): an exit or switch at the function's root
+   before it (the earliest event wins), or a touch, recorded when it comes before any
+   event, in time order;
 3. each section that changes sign, in order: its root is the event when it comes first
    (``rules.section_first``: not before its min_time; before the event so far, or at its
    instant when that is a switch or an exit -- a section on H is hit where the orbit
@@ -234,9 +236,10 @@ def make_window_event(ops: WindowOps, call=_as_is, inline=_as_is):
                         return st, r, NONE, -1
                     if best_w == NONE or r < best_t:
                         best_t, best_w = r, rules.ended_by(mode, q)
-                # 2. none: an extremum of a leave function hidden between the samples
-                for q in range(nl if best_w == NONE else 0):
-                    if not (x0 if q == 0 else x1):
+                # 2. an extremum of a leave function hidden between the samples
+                for q in range(nl):
+                    if not ((x0 if q == 0 else x1) and rules.asks_hidden_end(
+                            mode, c0 if q == 0 else c1, best_w != NONE)):
                         continue
                     st, r, kind = hidden_end(ctx, q, i, mode, w, band, va0 if q == 0 else va1)
                     if st != OK:
