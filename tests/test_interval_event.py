@@ -10,9 +10,10 @@ import numpy as np
 import pytest
 
 from filippov import rules
-from filippov.loop import interval
+from filippov.loop import interval, refine
 from filippov.loop.interval import (F_LEAVE, F_RATE, F_SECTION, F_TIME, F_UNBANDED, NONE, OK,
                                     SECTION, make_window_event)
+from filippov.loop.status import ROOT_FAILED
 from filippov.system import MINUS, PLUS, SLIDING
 
 SRC = Path(interval.__file__).resolve().parents[1]
@@ -53,12 +54,18 @@ class Engine:
                 lo = mid
         return hi
 
-    def root(self, f, pred, lo, hi, vlo, vhi, mode):
+    def bracket_root(self, f, lo, hi, mode):
+        """Bisection to the side of the sign change f has at hi (the refinement, the
+        loop's, walks the root to its far side)."""
         self.asked.append(("root", f))
-        if self.fail == f:
-            return 7, lo
-        pred = rules.far_side(pred, vlo)
-        return OK, self._bisect(lambda t: bool(rules.after(pred, self.funcs[f](t))), lo, hi)
+        g = self.funcs[f]
+        if self.fail == f or (g(lo) > 0) == (g(hi) > 0):
+            return False, lo, math.nan
+        r = self._bisect(lambda t: (g(t) > 0) == (g(hi) > 0), lo, hi)
+        return True, r, g(r)
+
+    def lost_bracket(self, f, lo, hi, vlo, vhi, mode):
+        return False, lo, vlo
 
     def extremum(self, f, i, mode):
         self.asked.append(("extremum", f))
@@ -83,8 +90,8 @@ class Engine:
 
 
 OPS = interval.WindowOps(Engine.window, lambda c, i, mode: i, Engine.sampled, Engine.value,
-                         Engine.root, Engine.extremum, Engine.section, Engine.counts,
-                         Engine.touch, Engine.unband)
+                         Engine.bracket_root, Engine.lost_bracket, Engine.extremum,
+                         Engine.section, Engine.counts, Engine.touch, Engine.unband)
 EVENT = make_window_event(OPS)
 #: a window of one sample interval [0, 2]
 T2 = (0.0, 2.0)
@@ -195,7 +202,7 @@ def test_a_failed_question_ends_the_search_with_its_status():
     c = Engine({F_LEAVE: lambda t: 1.0 - t, F_RATE: lambda t: -1.0,
                 F_SECTION: lambda t: t - 0.5}, T2, sections=[(rules.TO_NONNEG, 0.0, True)],
                fail=F_LEAVE)
-    assert EVENT(c, PLUS)[:1] == (7,) and EVENT(c, PLUS)[2:] == (NONE, -1)
+    assert EVENT(c, PLUS)[:1] == (ROOT_FAILED,) and EVENT(c, PLUS)[2:] == (NONE, -1)
     assert c.asked[0] == ("root", F_LEAVE) and ("root", F_SECTION) not in c.asked
 
 
@@ -206,7 +213,8 @@ def test_a_just_entered_modes_start_sample_is_clamped_inside():
     assert EVENT(Engine(h, T2), PLUS) == (OK, math.inf, NONE, -1)
     st, t, what, _ = EVENT(Engine(h, T2, first=True), PLUS)
     assert what == rules.SWITCH and t < 1e-12
-    c = Engine({**h, F_LEAVE: lambda t: -1e-17 + t * (1.5 - t)}, T2, first=True)
+    c = Engine({F_LEAVE: lambda t: -1e-17 + t * (1.5 - t), F_RATE: lambda t: 1.5 - 2 * t}, T2,
+               first=True)
     st, t, what, _ = EVENT(c, PLUS)
     assert what == rules.SWITCH and abs(t - 1.5) < 1e-12
 
@@ -253,8 +261,8 @@ def test_both_engines_run_the_one_event_search():
     from filippov.kernel import scan
 
     assert scan._window_event.py_func.__code__ is simulate._window_event.__code__
-    for walk, ops in ((simulate._window_event, (simulate._Scan._root, simulate._Scan._counts)),
-                      (scan._window_event.py_func, (scan._root, scan._counts))):
+    for walk, ops in ((simulate._window_event, (simulate._Scan._counts,)),
+                      (scan._window_event.py_func, (scan._counts,))):
         cells = [cell.cell_contents for cell in walk.__closure__]
         assert all(any(op is c for c in cells) for op in ops)
         roots = [getattr(c, "py_func", c) for c in cells
@@ -304,11 +312,12 @@ TS = [float(t) for t in range(12)]
 
 def _skipping(c, i, mode):
     """The reference's hint: the next interval its array operations found."""
+    def samples(f):
+        return np.array([c.sampled(f, j) for j in range(len(c.ts))])
+    nl = 2 if mode == SLIDING else 1
     mask = interval.candidate_mask(
-        mode, [np.array([c.sampled(F_LEAVE, j) for j in range(len(c.ts))])],
-        [np.array([c.sampled(F_RATE, j) for j in range(len(c.ts))])],
-        [(c.sections[k][0], np.array([c.sampled(F_SECTION + k, j) for j in range(len(c.ts))]))
-         for k in range(len(c.sections))], c.first)
+        mode, [samples(F_LEAVE + q) for q in range(nl)], [samples(F_RATE + q) for q in range(nl)],
+        [(c.sections[k][0], samples(F_SECTION + k)) for k in range(len(c.sections))], c.first)
     return next((j for j in range(i, len(c.ts) - 1) if mask[j]), len(c.ts) - 1)
 
 
@@ -361,7 +370,7 @@ def test_a_window_with_no_event_ends_the_band_at_its_last_sample_out_of_it(WALK)
 def test_a_failed_search_stops_the_walk():
     h = [1.0, 1.0, -1.0, -1.0] + [1.0] * 8
     c = Engine({F_LEAVE: _piecewise(h), F_RATE: lambda t: 0.0}, TS, fail=F_LEAVE)
-    assert WALKS[0](c, PLUS)[0] == 7 and c.asked == [("root", F_LEAVE)]
+    assert WALKS[0](c, PLUS)[0] == ROOT_FAILED and c.asked == [("root", F_LEAVE)]
 
 
 def test_a_switch_beyond_the_band_is_refined_again_from_the_first_probe_out_of_it():
@@ -369,7 +378,8 @@ def test_a_switch_beyond_the_band_is_refined_again_from_the_first_probe_out_of_i
     probed back toward the bracket's start (rules.band_probe) to a time out of the band
     (banded h > 0.2, before t = 0.3), and refined again from there on h unbiased: its root
     0.4, not the banded one at 0.5. If no probe after the start clears, r stands."""
-    leave_root = interval.make_leave_root(OPS)
+    leave_root = interval.make_leave_root(
+        OPS, refine.make_refine(OPS.bracket_root, OPS.value, OPS.lost_bracket))
     c = Engine({F_LEAVE: lambda t: 0.5 - t, F_UNBANDED: lambda t: 0.4 - t,
                 F_RATE: lambda t: -1.0}, T2, band=0.1)
     st, t = leave_root(c, 0, 0, PLUS, False, 0.1, 0.5, -1.5)
@@ -394,7 +404,7 @@ def test_the_walk_is_one_loop_asking_each_question_in_one_place():
     tree = ast.parse(textwrap.dedent(inspect.getsource(interval.make_window_event)))
     calls = [node.func.id for node in ast.walk(tree)
              if isinstance(node, ast.Call) and isinstance(node.func, ast.Name)]
-    for op in ("window", "candidate", "leave_root", "hidden_end", "touch", "root", "counts",
+    for op in ("window", "candidate", "leave_root", "hidden_end", "touch", "refine", "counts",
                "section"):
         assert calls.count(op) == 1, op
     for op in ("skip_to", "unband"):
@@ -402,3 +412,54 @@ def test_the_walk_is_one_loop_asking_each_question_in_one_place():
     assert sum(isinstance(node, ast.While) for node in ast.walk(tree)) == 1
     assert sorted(node.target.id for node in ast.walk(tree)
                   if isinstance(node, ast.For)) == ["k", "q", "q", "tm"]
+
+
+# ------------------------------------------- the search against brute force, drawn at random
+from hypothesis import assume, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+SAMPLE = st.floats(-1.0, 1.0, allow_nan=False).filter(lambda v: abs(v) > 1e-3)
+
+
+def _first_crossing(values, pred):
+    """The first sign change ``pred`` of the piecewise-linear function through ``values``
+    at t = 0, 1, ... (linear interpolation), or inf."""
+    for i in range(len(values) - 1):
+        if rules.crosses(pred, values[i], values[i + 1]):
+            return i + values[i] / (values[i] - values[i + 1])
+    return math.inf
+
+
+@settings(max_examples=60)
+@given(mode=st.sampled_from((PLUS, MINUS, SLIDING)), data=st.data(),
+       n=st.integers(2, 9), with_section=st.booleans())
+def test_the_search_finds_the_earliest_sign_change_of_piecewise_linear_samples(
+        mode, data, n, with_section):
+    """On functions linear between their samples (no extremum hidden between two: their
+    rates are 0), the walk's event is the earliest sign change that ends the mode (h; a
+    or b while sliding) or crosses the section, found by brute force; the walk that skips
+    to the reference's candidates and the one that tests every interval agree."""
+    leave = [data.draw(st.lists(SAMPLE, min_size=n + 1, max_size=n + 1))
+             for _ in range(2 if mode == SLIDING else 1)]
+    sec = data.draw(st.lists(SAMPLE, min_size=n + 1, max_size=n + 1))
+    funcs = {F_LEAVE + q: _piecewise(v) for q, v in enumerate(leave)}
+    funcs.update({F_RATE: lambda t: 0.0, F_RATE + 1: lambda t: 0.0})
+    sections = []
+    if with_section:
+        funcs[F_SECTION] = _piecewise(sec)
+        sections = [(rules.TO_NONNEG, 0.0, True)]
+    ends = [_first_crossing(v, rules.leave_pred(mode, q)) for q, v in enumerate(leave)]
+    hit = _first_crossing(sec, rules.TO_NONNEG) if with_section else math.inf
+    first = min(ends)
+    assume(abs(hit - first) > 1e-6 or first == hit == math.inf)
+    ts = [float(k) for k in range(n + 1)]
+    got = [walk(Engine(dict(funcs), ts, sections=sections), mode) for walk in WALKS]
+    assert got[0] == got[1]
+    st_, t, what, k = got[0]
+    assert st_ == OK
+    if hit < first:
+        assert (what, k) == (SECTION, 0) and abs(t - hit) < 1e-12
+    elif first < math.inf:
+        assert what == rules.ended_by(mode, ends.index(first)) and abs(t - first) < 1e-12
+    else:
+        assert (t, what) == (math.inf, NONE)

@@ -133,3 +133,14 @@ def test_the_plain_builds_own_copies_are_dropped_too(tmp_path):
     out = subprocess.run([sys.executable, "-c", _PLAIN_RUN], env=env, capture_output=True,
                          text=True, check=True)
     assert set(out.stdout.split()) == set(driver._PLAIN)   # _begin among them
+
+
+def test_the_loops_pieces_compiled_inside_a_factory_are_dropped_with_the_kernel():
+    """The event search's refinement and root of a leave function are compiled by the
+    kernel inside loop.interval.make_window_event (no module's attribute): a stale cache
+    of theirs is flushed with the kernel's, reached through the closures (an index that
+    names a type since removed would fail to unpickle before numba checks its stamp)."""
+    from filippov.kernel import driver, scan
+
+    names = {f.py_func.__name__ for f in driver._compiled([scan._window_event])}
+    assert {"window_event", "refine", "leave_root"} <= names

@@ -71,22 +71,36 @@ def test_a_lost_bracket_otherwise_is_the_engines_to_answer():
 
 
 def test_both_engines_refine_with_the_one_function():
+    """Each engine's event search refines with the loop's refinement, built by the loop
+    (loop.interval.make_window_event) on the engine's root finder."""
     simulate = importlib.import_module("filippov.simulate")
-    from filippov.kernel import roots
+    from filippov.kernel import scan
 
-    assert roots._refine.py_func.__code__ is simulate._refine_at.__code__
-    ops = {cell.cell_contents for cell in roots._refine.py_func.__closure__}
-    assert roots._lost_bracket in ops and roots._bracket_root in ops
-    ops = {cell.cell_contents for cell in simulate._refine_at.__closure__}
-    assert simulate._lost_bracket in ops and simulate._bracket_root in ops
+    for walk, ops in ((simulate._window_event, simulate.WINDOW_OPERATIONS),
+                      (scan._window_event.py_func, scan.WINDOW_OPERATIONS)):
+        cells = {name: cell.cell_contents
+                 for name, cell in zip(walk.__code__.co_freevars, walk.__closure__)}
+        refine = getattr(cells["refine"], "py_func", cells["refine"])
+        assert refine.__code__ is make_refine(None, None, None).__code__
+        inner = {cell.cell_contents for cell in refine.__closure__}
+        assert ops.bracket_root in inner and ops.lost_bracket in inner and ops.value in inner
+
+
+def _reference_refine(fun, pred, ta, tb, va, vb, xtol):
+    """The loop's refinement on the reference's root finder (scipy's brentq)."""
+    simulate = importlib.import_module("filippov.simulate")
+    refine = make_refine(lambda c, f, lo, hi, mode: simulate._bracket_root(xtol, f, lo, hi),
+                         lambda c, f, t, mode: f(t),
+                         lambda c, f, lo, hi, vlo, vhi, mode: simulate._lost_bracket(
+                             xtol, f, lo, hi, vlo, vhi))
+    return refine(None, fun, pred, ta, tb, va, vb, None)[1]
 
 
 def test_the_reference_refines_a_crossing_to_its_far_side():
     """The reference's operations (scipy's brentq) through the shared function."""
-    simulate = importlib.import_module("filippov.simulate")
     root = 0.1 + 0.2  # not exactly representable: brentq stops on either side of it
-    r = simulate._refine(lambda t: t - root, rules.TO_NONNEG, 0.0, 1.0, -root, 1.0 - root,
-                         1e-12)
+    r = _reference_refine(lambda t: t - root, rules.TO_NONNEG, 0.0, 1.0, -root, 1.0 - root,
+                          1e-12)
     assert r - root >= 0.0 and r - root < 1e-11
-    r = simulate._refine(lambda t: root - t, rules.TO_NEG, 0.0, 1.0, root, root - 1.0, 1e-12)
+    r = _reference_refine(lambda t: root - t, rules.TO_NEG, 0.0, 1.0, root, root - 1.0, 1e-12)
     assert root - r < 0.0 and r - root < 1e-11

@@ -138,7 +138,8 @@ class RunOperations(Protocol):
 class WindowOperations(Protocol):
     """The window seam: what an engine reports of one window's samples to the event
     search of :func:`filippov.loop.interval.make_window_event`, which takes every decision
-    itself and calls these positionally with the engine's state ``ctx`` first; a function
+    and refines every root itself (on the engine's root finder), calling these
+    positionally with the engine's state ``ctx`` first; a function
     of the window is named by the loop's code (``interval.F_*``). What each returns:
     filippov.loop.interval's doc (:data:`filippov.loop.interval.WindowOps`)."""
 
@@ -150,7 +151,9 @@ class WindowOperations(Protocol):
 
     def value(self, ctx, f, t, mode): ...
 
-    def root(self, ctx, f, pred, lo, hi, vlo, vhi, mode): ...
+    def bracket_root(self, ctx, f, lo, hi, mode): ...
+
+    def lost_bracket(self, ctx, f, lo, hi, vlo, vhi, mode): ...
 
     def extremum(self, ctx, f, i, mode): ...
 

@@ -33,7 +33,7 @@ from scipy.optimize import brentq
 from . import checks, options, rules, variational, views
 from . import scale as scale_mod
 from .scale import UNIT
-from .loop import interval, refine
+from .loop import interval
 from .radau_iia import RadauIIA
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
@@ -274,10 +274,11 @@ def _brent(fun, ta, tb, fa, fb, xtol):
     return brentq(pinned, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps, maxiter=rules.BRENT_MAXITER)
 
 
-# the refinement of a crossing (filippov.loop.refine, written once for both engines) on
-# this engine's operations: f a callable of time, ctx the tolerance xtol, scipy's brentq
+# the refinement of a crossing (filippov.loop.refine, written once for both engines,
+# asked by the event search) on this engine's root finder: f a callable of time, scipy's
+# brentq to the tolerance xtol
 
-def _bracket_root(xtol, fun, ta, tb, mode):
+def _bracket_root(xtol, fun, ta, tb):
     try:
         r = brentq(fun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps,
                    maxiter=rules.BRENT_MAXITER)
@@ -286,21 +287,9 @@ def _bracket_root(xtol, fun, ta, tb, mode):
     return True, r, fun(r)
 
 
-def _value_at(xtol, fun, t, mode):
-    return fun(t)
-
-
-def _lost_bracket(xtol, fun, ta, tb, va, vb, mode):
+def _lost_bracket(xtol, fun, ta, tb, va, vb):
     r = _brent(fun, ta, tb, va, vb, xtol)  # the bracket pinned to the samples (see there)
     return True, r, fun(r)
-
-
-_refine_at = refine.make_refine(_bracket_root, _value_at, _lost_bracket)
-
-
-def _refine(fun, pred, ta, tb, va, vb, xtol):
-    """Root of ``fun`` in [ta, tb], returned on the far side of the crossing."""
-    return _refine_at(xtol, fun, pred, ta, tb, va, vb, None)[1]
 
 
 def _slide_fields(run):
@@ -1043,8 +1032,11 @@ class _Scan:
     def _value(self, f, t, mode):
         return self._function(f)(t)
 
-    def _root(self, f, pred, lo, hi, vlo, vhi, mode):
-        return interval.OK, _refine(self._function(f), pred, lo, hi, vlo, vhi, self.xtol)
+    def _bracket_root(self, f, lo, hi, mode):
+        return _bracket_root(self.xtol, self._function(f), lo, hi)
+
+    def _lost_bracket(self, f, lo, hi, vlo, vhi, mode):
+        return _lost_bracket(self.xtol, self._function(f), lo, hi, vlo, vhi)
 
     def _extremum(self, f, i, mode):
         return interval.OK, _brent(self._function(f), self.ts[i], self.ts[i + 1],
@@ -1091,8 +1083,9 @@ class _Scan:
 #: what this engine reports of a window to the event search (the window seam:
 #: filippov.contracts.WindowOperations), and that one search (filippov.loop.interval)
 WINDOW_OPERATIONS = interval.WindowOps(
-    _Scan._window, _Scan._skip_to, _Scan._sampled, _Scan._value, _Scan._root,
-    _Scan._extremum, _Scan._section, _Scan._counts, _Scan._touch, _Scan._unband)
+    _Scan._window, _Scan._skip_to, _Scan._sampled, _Scan._value, _Scan._bracket_root,
+    _Scan._lost_bracket, _Scan._extremum, _Scan._section, _Scan._counts, _Scan._touch,
+    _Scan._unband)
 _window_event = interval.make_window_event(WINDOW_OPERATIONS)
 
 # the event search and what is done at an event speak the same codes

@@ -645,6 +645,23 @@ def _kernel_stamp() -> str:
     return digest.hexdigest()
 
 
+def _compiled(objects) -> list:
+    """The compiled functions among ``objects`` and every one reachable from them through
+    their closures: the loop's pieces the kernel compiles inside a factory (the event
+    search's refinement, loop.interval) are no module's attribute, and a cache of theirs
+    written by other sources would be read (numba unpickles an index before it checks its
+    stamp: a type since removed fails to load)."""
+    out, seen, todo = [], set(), list(objects)
+    while todo:
+        obj = todo.pop()
+        if id(obj) in seen or not (hasattr(obj, "py_func") and hasattr(obj, "_cache")):
+            continue
+        seen.add(id(obj))
+        out.append(obj)
+        todo.extend(cell.cell_contents for cell in obj.py_func.__closure__ or ())
+    return out
+
+
 def _fresh_cache() -> None:
     """Drop every cached compiled function of the kernel (the rules compiled for it
     included) when the kernel's sources changed since the cache was written."""
@@ -658,9 +675,8 @@ def _fresh_cache() -> None:
     from . import base, derivative, dop853, roots, scan, segment
     # the plain build's copies (_PLAIN) too: _begin's is a call with a cache of its own
     modules = (base, derivative, dop853, roots, scan, segment, sys.modules[__name__])
-    for obj in [o for m in modules for o in vars(m).values()] + list(_PLAIN.values()):
-        if hasattr(obj, "py_func") and hasattr(obj, "_cache"):
-            obj._cache.flush()
+    for obj in _compiled([o for m in modules for o in vars(m).values()] + list(_PLAIN.values())):
+        obj._cache.flush()
     try:
         stamp_file.parent.mkdir(parents=True, exist_ok=True)
         stamp_file.write_text(stamp)

@@ -1,11 +1,10 @@
-"""Root finding: a port of scipy's brentq, and the refinement of a crossing to its far
-side (filippov.loop.refine on the kernel's operations)."""
+"""Root finding: a port of scipy's brentq (the kernel's root finder; the refinement of a
+crossing to its far side is the loop's, filippov.loop.refine, asked by the event search)."""
 from __future__ import annotations
 
 import numpy as np
 
-from ..loop.refine import make_refine
-from .base import (_EPS, _MAXITER_EVENT, _jit, _jit_inline)
+from .base import _EPS, _jit
 from .segment import _fval
 
 # brentq's relative tolerance: scipy's default (4 eps), the reference driver's
@@ -80,29 +79,3 @@ def _brentq_f(sel, xa, xb, maxiter, mode, o, sc):
         if np.isnan(fcur):
             return xcur, fcur, False
     return xcur, fcur, False
-
-
-# the refinement of a crossing (loop.refine, written once for both engines) on the
-# kernel's operations; its state ctx is a state.Eval: the segment (state.Orbit) and its
-# scratch
-
-@_jit_inline
-def _bracket_root(ctx, sel, ta, tb, mode):
-    r, fr, ok = _brentq_f(sel, ta, tb, _MAXITER_EVENT, mode, ctx.o, ctx.sc)
-    return ok, r, fr
-
-
-@_jit_inline
-def _value_at(ctx, sel, t, mode):
-    return _fval(sel, t, mode, ctx.o, ctx.sc)
-
-
-@_jit_inline
-def _lost_bracket(ctx, sel, ta, tb, va, vb, mode):
-    # the kernel samples and refines through the same compiled scalar functions: a lost
-    # sign change is a failure (ROOT_FAILED), not pinned (filippov.engines, item 5)
-    return False, ta, va
-
-
-#: (ok, t): the root in [ta, tb] on the far side of the crossing, to o.xtol
-_refine = _jit(make_refine(_bracket_root, _value_at, _lost_bracket))

@@ -8,13 +8,13 @@ from .. import rules
 from ..loop.interval import (F_LEAVE, F_RATE, F_SECTION, F_TIME, F_UNBANDED, Window, WindowOps,
                              make_window_event)
 from ..system import MINUS, PLUS, SLIDING
-from .base import (OK, ROOT_FAILED, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB, _S_H,
+from .base import (OK, ROOT_FAILED, _MAXITER_EVENT, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB, _S_H,
                    _S_SEC, _dot, _jit, _jit_inline, _speeds, _field_minus, _field_plus,
                    _grad_h, _h, _section, _where)
 from .segment import (_fval, _rates, _zat)
 from .state import (SEG_BAND, SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_LAST_H, SEG_LAST_SPEED2,
-                    SEG_RATE_STEP, SEG_SHIFT, Eval, Walk)
-from .roots import (_brentq, _refine)
+                    SEG_RATE_STEP, SEG_SHIFT, Walk)
+from .roots import (_brentq, _brentq_f)
 
 
 @_jit
@@ -183,16 +183,26 @@ def _value(ctx, f, t, mode):
 
 
 @_jit_inline
-def _root(ctx, f, pred, lo, hi, vlo, vhi, mode):
+def _bracket_root(ctx, f, lo, hi, mode):
+    """brentq's root of f in [lo, hi] and f there (roots._brentq_f): h unbiased
+    (F_UNBANDED) with the exit's shift in force of the banded one."""
     o, sc = ctx.o, ctx.sc
+    if f != F_UNBANDED:
+        r, fr, ok = _brentq_f(_sel(f, mode), lo, hi, _MAXITER_EVENT, mode, o, sc)
+        return ok, r, fr
     sg = o.seg
     banded = sg[SEG_SHIFT]
-    if f == F_UNBANDED:  # h on H itself: the exit's shift in force of the banded one
-        sg[SEG_SHIFT] = sg[SEG_EXIT_SHIFT]
-    ok, r = _refine(Eval(o, sc), _sel(f, mode), pred, lo, hi, vlo, vhi, mode)
-    if f == F_UNBANDED:
-        sg[SEG_SHIFT] = banded
-    return (OK if ok else ROOT_FAILED), r
+    sg[SEG_SHIFT] = sg[SEG_EXIT_SHIFT]
+    r, fr, ok = _brentq_f(_S_H, lo, hi, _MAXITER_EVENT, mode, o, sc)
+    sg[SEG_SHIFT] = banded
+    return ok, r, fr
+
+
+@_jit_inline
+def _lost_bracket(ctx, f, lo, hi, vlo, vhi, mode):
+    # the kernel samples and refines through the same compiled scalar functions: a lost
+    # sign change is a failure (ROOT_FAILED), not pinned (filippov.engines, item 5)
+    return False, lo, vlo
 
 
 @_jit_inline
@@ -249,8 +259,8 @@ def _unband(ctx, i, mode):
 
 #: what the kernel reports of a window to the event search (the window seam:
 #: filippov.contracts.WindowOperations)
-WINDOW_OPERATIONS = WindowOps(_window_of, _skip_to, _sampled, _value, _root, _extremum,
-                              _section_of, _counts, _touch, _unband)
+WINDOW_OPERATIONS = WindowOps(_window_of, _skip_to, _sampled, _value, _bracket_root,
+                              _lost_bracket, _extremum, _section_of, _counts, _touch, _unband)
 #: the one event search (loop.interval) on them: a call, its operations inlined, the root
 #: of a leave function a call of its own (docs/decisions.md#kernel-inlined-driver)
 _window_event = _jit(make_window_event(WINDOW_OPERATIONS, call=_jit, inline=_jit_inline))

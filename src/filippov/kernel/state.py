@@ -122,9 +122,6 @@ SEG_SIZE, COUNT_SIZE, TALLY_SIZE = len(SEG), len(COUNT), len(TALLY)
 #: the current segment (w.seg, w.za, w.F, w.y_old), the tolerance events are refined to and
 #: the run's state scale (filippov.scale: the floor of the rules' state sizes)
 Orbit = namedtuple("Orbit", ["fns", "p", "seg", "za", "F", "y_old", "xtol", "floor"])
-#: what a crossing's refinement (filippov.loop.refine) and the extremum searches evaluate
-#: on: the segment and its scratch vectors
-Eval = namedtuple("Eval", ["o", "sc"])
 #: the scratch vectors a model evaluation fills (a state, grad h, F_- or the mode's field,
 #: F_+)
 Scratch = namedtuple("Scratch", ["wz", "wg", "wf", "wp"])
@@ -147,7 +144,6 @@ Dop = namedtuple("Dop", ["y", "f", "y_old", "f_old", "K", "ynew", "ytmp", "scale
 RunCtx = namedtuple("RunCtx", ["fns", "p", "s", "w"])
 #: the window walk's state (filippov.loop.interval.WindowOps' ``ctx``): whether the
 #: stay just began, the segment, the samples, the scratch vectors, the number of samples
-#: and of the Settings only what the search asks (the Settings whole, 24 fields, would be
-#: handed to each call made with this state)
+#: and of the Settings only what the search asks (docs/decisions.md#window-seam)
 Walk = namedtuple("Walk", ["first", "o", "sm", "sc", "ns", "touch_tol", "min_time",
                            "sec_pred"])

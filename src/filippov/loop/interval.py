@@ -36,7 +36,7 @@ functions are named by the codes below, which each engine maps to its own. The
 reference driver (:class:`filippov.simulate._Scan`) runs the result as it is; the
 compiled kernel (:mod:`filippov.kernel.scan`) compiles it with numba, its operations
 inlined (``inline="always"``), so this module is plain scalar Python in the subset numba
-compiles.
+compiles (what the split costs: docs/decisions.md#window-seam).
 
 An event is ``(status, t, what, k)``: ``status`` OK or the engine's failure code (the
 reference raises instead, so its operations always return OK); ``what`` one of
@@ -54,6 +54,8 @@ import numpy as np
 from .. import rules
 from ..rules import GRAZE_CROSSES, GRAZE_NONE, GRAZE_TOUCHES
 from ..system import SLIDING
+from .refine import make_refine
+from .status import ROOT_FAILED
 
 #: the status of an operation that succeeded (the kernel's OK)
 OK = 0
@@ -84,9 +86,10 @@ Window = namedtuple("Window", (
 #:   array operations jumps to the next one, one that tests each interval answers i;
 #: * ``sampled(ctx, f, i)``: function f (the codes above) at sample i;
 #: * ``value(ctx, f, t, mode)``: f at time t on the window;
-#: * ``root(ctx, f, pred, lo, hi, vlo, vhi, mode) -> (status, t)``: f's sign change
-#:   ``pred`` in [lo, hi] (vlo, vhi: f there as the search read it), refined to its far
-#:   side (:mod:`filippov.loop.refine`);
+#: * ``bracket_root(ctx, f, lo, hi, mode) -> (ok, t, f(t))``, ``lost_bracket(ctx, f, lo, hi,
+#:   vlo, vhi, mode) -> (ok, t, f(t))``: the engine's root finder on f in [lo, hi] and what
+#:   it does with a sign change the samples vlo, vhi saw and f at the ends lost; the loop
+#:   refines a sign change with them (:mod:`filippov.loop.refine`: to its far side);
 #: * ``extremum(ctx, f, i, mode) -> (status, t)``: the root of the rate f between samples
 #:   i and i + 1 (an extremum of the function it is the rate of);
 #: * ``section(ctx, k) -> (pred, t_min)``: section k's sign change and the earliest time
@@ -96,23 +99,24 @@ Window = namedtuple("Window", (
 #: * ``unband(ctx, i, mode)``: the band ends; h is sampled again unbiased from sample i
 #:   on (none when i is past the last sample) and the hint's candidates found again.
 WindowOps = namedtuple("WindowOps", (
-    "window", "skip_to", "sampled", "value", "root", "extremum", "section", "counts",
-    "touch", "unband"))
+    "window", "skip_to", "sampled", "value", "bracket_root", "lost_bracket", "extremum",
+    "section", "counts", "touch", "unband"))
 
 
 def _as_is(f):
     return f
 
 
-def make_leave_root(ops: WindowOps):
+def make_leave_root(ops: WindowOps, refine):
     """``leave_root(ctx, q, i, mode, first, band, va, vb) -> (status, t)``: the sign
     change of leave function q between samples i and i + 1 (va, vb as read there). The
     root of h in the first interval of a stay entered at H, where h dips and returns
     (``rules.dips_and_returns``), is refined beyond the extremum of h; one found while the
     exit's band is in force is probed back toward the bracket's start
     (``rules.band_probe``) to a time out of the band (``rules.clears_band``) and refined
-    again from there on h itself (r stands if none clears, or if that refinement fails)."""
-    sampled, value, root, extremum = ops.sampled, ops.value, ops.root, ops.extremum
+    again from there on h itself (r stands if none clears, or if that refinement fails).
+    ``refine``: the loop's refinement on the engine's root finder (loop.refine)."""
+    sampled, value, extremum = ops.sampled, ops.value, ops.extremum
 
     def leave_root(ctx, q, i, mode, first, band, va, vb):
         pred = rules.leave_pred(mode, q)
@@ -124,29 +128,29 @@ def make_leave_root(ops: WindowOps):
                 hm = value(ctx, F_LEAVE, tm, mode)
                 if not rules.after(pred, hm):  # next to the entry h is noise (rules)
                     lo, vlo = tm, hm
-        st, r = root(ctx, F_LEAVE + q, pred, lo, sampled(ctx, F_TIME, i + 1), vlo, vb, mode)
-        if st != OK or band == 0.0 or mode == SLIDING:
-            return st, r
+        ok, r = refine(ctx, F_LEAVE + q, pred, lo, sampled(ctx, F_TIME, i + 1), vlo, vb, mode)
+        if not ok or band == 0.0 or mode == SLIDING:
+            return (OK if ok else ROOT_FAILED), r
         tq, step, done, clear = r, 0.0, False, False
         while not done:
             clear = rules.clears_band(mode, value(ctx, F_LEAVE, tq, mode), band)
             done, tq, step = rules.band_probe(tq, step, lo, clear)
         if not clear:
             return OK, r
-        st, r2 = root(ctx, F_UNBANDED, pred, tq, r, value(ctx, F_UNBANDED, tq, mode),
-                      value(ctx, F_UNBANDED, r, mode), mode)
-        return OK, (r2 if st == OK else r)
+        ok, r2 = refine(ctx, F_UNBANDED, pred, tq, r, value(ctx, F_UNBANDED, tq, mode),
+                        value(ctx, F_UNBANDED, r, mode), mode)
+        return OK, (r2 if ok else r)
 
     return leave_root
 
 
-def make_hidden_end(ops: WindowOps):
+def make_hidden_end(ops: WindowOps, refine):
     """``hidden_end(ctx, q, i, mode, w, band, va) -> (status, t, kind)``: the extremum of
     leave function q hidden between samples i and i + 1 (va: its value at i as read),
     judged by ``rules.graze`` in a region, ``rules.speed_graze`` while sliding: the
     function's root before it (GRAZE_CROSSES), the extremum's time (GRAZE_TOUCHES), or
     GRAZE_NONE."""
-    sampled, value, root, extremum = ops.sampled, ops.value, ops.root, ops.extremum
+    sampled, value, extremum = ops.sampled, ops.value, ops.extremum
 
     def hidden_end(ctx, q, i, mode, w, band, va):
         pred = rules.leave_pred(mode, q)
@@ -161,8 +165,8 @@ def make_hidden_end(ops: WindowOps):
         else:
             kind = rules.graze(mode, vm, w.touch_tol, band)
         if kind == GRAZE_CROSSES:
-            st, r = root(ctx, F_LEAVE + q, pred, ta, tm, va, vm, mode)
-            return st, r, kind
+            ok, r = refine(ctx, F_LEAVE + q, pred, ta, tm, va, vm, mode)
+            return (OK if ok else ROOT_FAILED), r, kind
         return OK, tm, kind
 
     return hidden_end
@@ -207,8 +211,11 @@ def make_window_event(ops: WindowOps, call=_as_is, inline=_as_is):
     """``window_event(ctx, mode) -> (status, t, what, k)``: the earliest event over a
     window's intervals (this module's docstring) on the engine's :data:`WindowOps`; a
     leave function's root compiled by ``call``, a hidden extremum by ``inline``."""
-    (window, skip_to, sampled, value, root, extremum, section, counts, touch, unband) = ops
-    leave_root, hidden_end = call(make_leave_root(ops)), inline(make_hidden_end(ops))
+    window, skip_to, sampled, section, counts, touch, unband = (
+        ops.window, ops.skip_to, ops.sampled, ops.section, ops.counts, ops.touch, ops.unband)
+    refine = call(make_refine(ops.bracket_root, ops.value, ops.lost_bracket))
+    leave_root = call(make_leave_root(ops, refine))
+    hidden_end = inline(make_hidden_end(ops, refine))
     candidate = inline(make_candidate(ops))
 
     def window_event(ctx, mode):
@@ -256,10 +263,10 @@ def make_window_event(ops: WindowOps, call=_as_is, inline=_as_is):
                     pred, t_min = section(ctx, k)
                     sa, sb = sampled(ctx, F_SECTION + k, i), sampled(ctx, F_SECTION + k, i + 1)
                     if rules.crosses(pred, sa, sb):
-                        st, r = root(ctx, F_SECTION + k, pred, sampled(ctx, F_TIME, i),
-                                     sampled(ctx, F_TIME, i + 1), sa, sb, mode)
-                        if st != OK:
-                            return st, r, NONE, -1
+                        ok, r = refine(ctx, F_SECTION + k, pred, sampled(ctx, F_TIME, i),
+                                       sampled(ctx, F_TIME, i + 1), sa, sb, mode)
+                        if not ok:
+                            return ROOT_FAILED, r, NONE, -1
                         if (rules.section_first(r, t_min, best_t, best_w == SECTION, w.xtol)
                                 and counts(ctx, k, i, r, mode)):
                             best_t, best_w, best_k = r, SECTION, k
