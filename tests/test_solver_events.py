@@ -123,20 +123,16 @@ def test_a_sign_change_the_samples_saw_survives_refinement():
     round differently (numpy's SIMD loops, another CPU: found by the emulated CPU on
     fig09, where dH/dt near the grazing point changed sign in the samples but not at the
     ends of the bracket). The bracket keeps the sampled end values instead of failing."""
-    from filippov import rules
-    from filippov.loop.refine import make_refine
-    from filippov.simulate import _bracket_root, _brent, _lost_bracket
+    from test_loop_refine import _reference_refine
 
-    xtol = 1e-12
-    refine = make_refine(  # the loop's refinement on the reference's root finder
-        lambda c, f, lo, hi, mode: _bracket_root(xtol, f, lo, hi), lambda c, f, t, mode: f(t),
-        lambda c, f, lo, hi, vlo, vhi, mode: _lost_bracket(xtol, f, lo, hi, vlo, vhi))
+    from filippov import rules
+    from filippov.simulate import _brent
 
     fun = lambda t: 1e-17 + 0.0 * t          # noqa: E731  (scalar: positive at both ends)
     # the samples saw +1e-17 at t = 0 and -1e-17 at t = 1: a root in [0, 1], not an error
     r = _brent(fun, 0.0, 1.0, 1e-17, -1e-17, 1e-12)
     assert 0.0 <= r <= 1.0
-    ok, r = refine(None, fun, rules.TO_NEG, 0.0, 1.0, 1e-17, -1e-17, None)
-    assert ok and r == 1.0                   # the scalar never crosses: the sampled end
+    r = _reference_refine(fun, rules.TO_NEG, 0.0, 1.0, 1e-17, -1e-17, 1e-12)
+    assert r == 1.0                          # the scalar never crosses: the sampled end
     with pytest.raises(ValueError):          # no sign change anywhere: still an error
         _brent(fun, 0.0, 1.0, 1e-17, 2e-17, 1e-12)

@@ -518,18 +518,17 @@ class _Run:
                                    piece=lambda zz: checks.non_finite_piece(system, mode, zz))
 
     def _leave(self, mode, banded=True):
-        """Functions whose crossing ends this mode, with what that crossing is (H
-        measured from the exit's rounding band while the stay is inside it, unless not
-        ``banded``)."""
+        """The functions whose sign change ends this mode (rules.leave_pred: H, measured
+        from the exit's rounding band while the stay is inside it unless not ``banded``;
+        while sliding a and b)."""
         system = self.system
         if mode != SLIDING:
             shift = (rules.banded_shift(mode, self.shift, self.band)
                      if banded and self.band > 0.0 else self.shift)
             switch = (system.switch if shift == 0.0
                       else (lambda zz, c=shift: system.switch(zz) - c))
-            return [(switch, rules.TO_NEG if mode == PLUS else rules.TO_NONNEG, "switch")]
-        return [(lambda zz: system.normal_speeds(zz)[0], rules.TO_NONPOS, "exit_minus"),
-                (lambda zz: system.normal_speeds(zz)[1], rules.TO_NONNEG, "exit_plus")]
+            return [switch]
+        return [lambda zz: system.normal_speeds(zz)[0], lambda zz: system.normal_speeds(zz)[1]]
 
     # A stay, in the shared order of filippov.loop.event: per step next_step (the first
     # begins the stay: start_stay), its windows (window, walked by
@@ -880,7 +879,7 @@ class _Scan:
         self.order = None  # the candidate intervals still to ask (earliest, _unband)
         # the leave functions as sampled (raw) and as the search reads them (vals: h
         # sampled again unbiased once the band ends, _unband)
-        self.raw = [np.asarray(func(zs), dtype=float) for func, _, _ in leave]
+        self.raw = [np.asarray(func(zs), dtype=float) for func in leave]
         self.vals = list(self.raw)
         self.D = None
         if mode != SLIDING:  # dH/dt along the mode's field: extrema of H are its roots
@@ -940,9 +939,9 @@ class _Scan:
         if self.not_finite is not None:  # cut short: searched as it is (earliest)
             return True
         if self.mode == SLIDING:
-            judged = [(v, v, False, func) for v, (func, _, _) in zip(self.raw, self.leave)]
+            judged = [(v, v, False, func) for v, func in zip(self.raw, self.leave)]
         else:
-            judged = [(self.raw[0], self.D, True, self.leave[0][0])]
+            judged = [(self.raw[0], self.D, True, self.leave[0])]
         judged += [(v, v, False, s.func) for v, s in zip(self.svals, self.sections)]
         for v, d, slopes, func in judged:
             if (not rules.resolves(v, d, ts, n, slopes, 0.0)
@@ -1021,13 +1020,13 @@ class _Scan:
         if f >= interval.F_SECTION:
             return self._along(self.sections[f - interval.F_SECTION].func)
         if f == interval.F_UNBANDED:
-            return self._along(self.unbanded[0][0])
+            return self._along(self.unbanded[0])
         if f >= interval.F_RATE:
             if self.mode != SLIDING:
                 return self._dH
             q = f - interval.F_RATE
             return lambda tt: float(self.rates(tt)[q])
-        return self._along(self.leave[f][0])
+        return self._along(self.leave[f])
 
     def _value(self, f, t, mode):
         return self._function(f)(t)
@@ -1064,7 +1063,7 @@ class _Scan:
         refined at H = 0 (as in the compiled engine). The candidate intervals from i on,
         again."""
         self.band, self.leave = 0.0, self.unbanded
-        self.vals[0] = np.asarray(self.leave[0][0](self.zs), dtype=float)
+        self.vals[0] = np.asarray(self.leave[0](self.zs), dtype=float)
         again = self.candidates()  # a band is in force in a region only: h, dH/dt, sections
         again[:i] = False
         self.order = np.flatnonzero(again)

@@ -169,16 +169,23 @@ def _sampled(ctx, f, i):
 
 
 @_jit_inline
+def _unbiased(sg):
+    """h measured from the exit's shift alone (F_UNBANDED), not the band's: returns the
+    banded shift, for the caller to put back."""
+    banded = sg[SEG_SHIFT]
+    sg[SEG_SHIFT] = sg[SEG_EXIT_SHIFT]
+    return banded
+
+
+@_jit_inline
 def _value(ctx, f, t, mode):
     """f at t; h unbiased (F_UNBANDED): the exit's shift in force of the banded one."""
     o, sc = ctx.o, ctx.sc
     if f != F_UNBANDED:
         return _fval(_sel(f, mode), t, mode, o, sc)
-    sg = o.seg
-    banded = sg[SEG_SHIFT]
-    sg[SEG_SHIFT] = sg[SEG_EXIT_SHIFT]
+    banded = _unbiased(o.seg)
     v = _fval(_S_H, t, mode, o, sc)
-    sg[SEG_SHIFT] = banded
+    o.seg[SEG_SHIFT] = banded
     return v
 
 
@@ -190,11 +197,9 @@ def _bracket_root(ctx, f, lo, hi, mode):
     if f != F_UNBANDED:
         r, fr, ok = _brentq_f(_sel(f, mode), lo, hi, _MAXITER_EVENT, mode, o, sc)
         return ok, r, fr
-    sg = o.seg
-    banded = sg[SEG_SHIFT]
-    sg[SEG_SHIFT] = sg[SEG_EXIT_SHIFT]
+    banded = _unbiased(o.seg)
     r, fr, ok = _brentq_f(_S_H, lo, hi, _MAXITER_EVENT, mode, o, sc)
-    sg[SEG_SHIFT] = banded
+    o.seg[SEG_SHIFT] = banded
     return ok, r, fr
 
 
