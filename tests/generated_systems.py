@@ -1255,6 +1255,16 @@ class NanRegion:
         c = self.case
         return (c.g.minus if c.start == "below" and t < c.t1 else c.g.plus).f(self.orbit(t))
 
+    def stay(self, t):
+        """The closed-form state at time t of the stay the orbit enters the NaN region in,
+        continued: past t_nan the piece is NaN, so the system has no switch or return
+        there, and an engine that meets it one sample later names this state (which is
+        the orbit's only up to the NaN-free H's own event, which may come before)."""
+        c = self.case
+        if c.start == "below":
+            return c.g.minus.flow(c.z0, t)
+        return c.g.plus.flow(c.zc, t - c.t1)
+
 
 @st.composite
 def nan_regions(draw, dims=DIMS, pieces=NAN_PIECES):

@@ -25,7 +25,9 @@ class Engine:
     (``funcs``), sampled at ``ts``; roots and extrema by bisection. ``sections``: (pred,
     t_min, counts) per section, whose values are funcs[F_SECTION + k]; ``fail`` the
     function whose root or extremum fails; ``asked`` records the roots and extrema asked
-    in order, ``touches`` the touches, ``unbands`` the samples the band ended at."""
+    in order, ``touches`` the touches, ``unbands`` the samples the band ended at.
+    ``skip``: None, every interval asked (the kernel); a mode, the intervals flagged by
+    the reference's array operations in that mode (interval.candidate_mask)."""
 
     def __init__(self, funcs, ts, first=False, band=0.0, rates=True, sections=(), fail=None,
                  unbanded=None):
@@ -33,10 +35,27 @@ class Engine:
             band, rates
         self.sections, self.fail, self.unbanded = list(sections), fail, unbanded
         self.asked, self.touches, self.unbands = [], [], []
+        self.skip, self.from_i = None, 0
 
     def window(self):
-        return interval.Window(len(self.ts) - 1, len(self.sections), self.first, self.band,
-                               self.rates, 1e-9, XTOL)
+        return interval.Window(len(self.ts) - 1, self.first, self.band, self.rates, 1e-9, XTOL,
+                               tuple(s[0] for s in self.sections),
+                               tuple(s[1] for s in self.sections), self._cand())
+
+    def _cand(self):
+        if self.skip is None:
+            return None
+        mode, nl = self.skip, 2 if self.skip == SLIDING else 1
+
+        def samples(f):
+            return np.array([self.sampled(f, j) for j in range(len(self.ts))])
+        mask = interval.candidate_mask(
+            mode, [samples(F_LEAVE + q) for q in range(nl)],
+            [samples(F_RATE + q) for q in range(nl)],
+            [(sec[0], samples(F_SECTION + k)) for k, sec in enumerate(self.sections)],
+            self.first)
+        mask[:self.from_i] = False
+        return mask
 
     def sampled(self, f, i):
         return self.ts[i] if f == F_TIME else self.funcs[f](self.ts[i]) if f in self.funcs \
@@ -54,29 +73,26 @@ class Engine:
                 lo = mid
         return hi
 
-    def bracket_root(self, f, lo, hi, mode):
+    def root(self, f, lo, hi, vlo, vhi, mode):
         """Bisection to the side of the sign change f has at hi (the refinement, the
-        loop's, walks the root to its far side)."""
-        self.asked.append(("root", f))
+        loop's, walks the root to its far side); a rate's (F_RATE + q: an extremum, the
+        samples' values handed) to the side where the rate's sign has flipped. A bracket
+        the ends lost is not pinned (as the kernel)."""
         g = self.funcs[f]
+        if F_RATE <= f < F_UNBANDED:
+            self.asked.append(("extremum", f))
+            if self.fail == ("extremum", f):
+                return False, lo, math.nan
+            d0 = g(lo)
+            r = self._bisect(lambda t: (g(t) > 0) != (d0 > 0), lo, hi)
+            return True, r, g(r)
+        if not math.isnan(vlo):
+            return False, lo, vlo
+        self.asked.append(("root", f))
         if self.fail == f or (g(lo) > 0) == (g(hi) > 0):
             return False, lo, math.nan
         r = self._bisect(lambda t: (g(t) > 0) == (g(hi) > 0), lo, hi)
         return True, r, g(r)
-
-    def lost_bracket(self, f, lo, hi, vlo, vhi, mode):
-        return False, lo, vlo
-
-    def extremum(self, f, i, mode):
-        self.asked.append(("extremum", f))
-        if self.fail == ("extremum", f):
-            return 7, self.ts[i]
-        d0 = self.funcs[f](self.ts[i])
-        return OK, self._bisect(lambda t: (self.funcs[f](t) > 0) != (d0 > 0), self.ts[i],
-                                self.ts[i + 1])
-
-    def section(self, k):
-        return self.sections[k][0], self.sections[k][1]
 
     def counts(self, k, i, t, mode):
         return self.sections[k][2]
@@ -86,12 +102,11 @@ class Engine:
 
     def unband(self, i, mode):
         self.unbands.append(i)
-        self.funcs[F_LEAVE] = self.unbanded
+        self.funcs[F_LEAVE], self.band, self.from_i = self.unbanded, 0.0, i
 
 
-OPS = interval.WindowOps(Engine.window, lambda c, i, mode: i, Engine.sampled, Engine.value,
-                         Engine.bracket_root, Engine.lost_bracket, Engine.extremum,
-                         Engine.section, Engine.counts, Engine.touch, Engine.unband)
+OPS = interval.WindowOps(Engine.window, Engine.sampled, Engine.value, Engine.root,
+                         Engine.counts, Engine.touch, Engine.unband)
 EVENT = make_window_event(OPS)
 #: a window of one sample interval [0, 2]
 T2 = (0.0, 2.0)
@@ -310,18 +325,13 @@ def _piecewise(values):
 TS = [float(t) for t in range(12)]
 
 
-def _skipping(c, i, mode):
-    """The reference's hint: the next interval its array operations found."""
-    def samples(f):
-        return np.array([c.sampled(f, j) for j in range(len(c.ts))])
-    nl = 2 if mode == SLIDING else 1
-    mask = interval.candidate_mask(
-        mode, [samples(F_LEAVE + q) for q in range(nl)], [samples(F_RATE + q) for q in range(nl)],
-        [(c.sections[k][0], samples(F_SECTION + k)) for k in range(len(c.sections))], c.first)
-    return next((j for j in range(i, len(c.ts) - 1) if mask[j]), len(c.ts) - 1)
+def _skipping(c, mode):
+    """The walk over the intervals the reference's array operations flag."""
+    c.skip = mode
+    return EVENT(c, mode)
 
 
-WALKS = [make_window_event(OPS._replace(skip_to=_skipping)), EVENT]
+WALKS = [_skipping, EVENT]
 walks = pytest.mark.parametrize("WALK", WALKS, ids=["skipping", "every-interval"])
 
 
@@ -378,8 +388,8 @@ def test_a_switch_beyond_the_band_is_refined_again_from_the_first_probe_out_of_i
     probed back toward the bracket's start (rules.band_probe) to a time out of the band
     (banded h > 0.2, before t = 0.3), and refined again from there on h unbiased: its root
     0.4, not the banded one at 0.5. If no probe after the start clears, r stands."""
-    leave_root = interval.make_leave_root(
-        OPS, refine.make_refine(OPS.bracket_root, OPS.value, OPS.lost_bracket))
+    leave_root = interval.make_leave_root(OPS, refine.make_refine(OPS.root, OPS.value),
+                                          interval.make_extremum(OPS))
     c = Engine({F_LEAVE: lambda t: 0.5 - t, F_UNBANDED: lambda t: 0.4 - t,
                 F_RATE: lambda t: -1.0}, T2, band=0.1)
     st, t = leave_root(c, 0, 0, PLUS, False, 0.1, 0.5, -1.5)
@@ -404,11 +414,11 @@ def test_the_walk_is_one_loop_asking_each_question_in_one_place():
     tree = ast.parse(textwrap.dedent(inspect.getsource(interval.make_window_event)))
     calls = [node.func.id for node in ast.walk(tree)
              if isinstance(node, ast.Call) and isinstance(node.func, ast.Name)]
-    for op in ("window", "candidate", "leave_root", "hidden_end", "touch", "refine", "counts",
-               "section"):
+    for op in ("candidate", "leave_root", "hidden_end", "touch", "refine", "counts"):
         assert calls.count(op) == 1, op
-    for op in ("skip_to", "unband"):
+    for op in ("window", "unband"):
         assert calls.count(op) == 2, op  # at the start and after the band's end
+    assert calls.count("asks") == 1
     assert sum(isinstance(node, ast.While) for node in ast.walk(tree)) == 1
     assert sorted(node.target.id for node in ast.walk(tree)
                   if isinstance(node, ast.For)) == ["k", "q", "q", "tm"]

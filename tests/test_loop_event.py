@@ -75,7 +75,8 @@ def test_the_event_and_the_stay_are_written_in_the_run_loop():
     assert EVENT_RULES - {"accumulates"} <= asked
     steps = [n.func.id for n in ast.walk(loops[1])
              if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)]
-    assert steps == ["next_step", "step_windows", "end_step"]
+    assert steps == ["next_step", "step_windows", "end_step"]  # the walk over the step's
+    # windows (loop.stay.make_step_windows) on the engine's window
 
 
 @pytest.mark.parametrize("zeno_count", [2, 3, 7])

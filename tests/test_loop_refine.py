@@ -12,7 +12,8 @@ from filippov.loop.refine import make_refine
 class Script:
     """f on a scripted table {t: value} (a linear f elsewhere: t - root); the engine's
     root finder returns ``root`` (not ok when ``bracket`` is False); ``asked`` the times
-    f was evaluated at, ``lost`` the calls of lost_bracket."""
+    f was evaluated at, ``lost`` the calls of the root finder with the samples' values
+    handed (a bracket f at the ends lost)."""
 
     def __init__(self, values=None, root=1.0, bracket=True, pinned=None):
         self.values, self.root, self.bracket, self.pinned = values or {}, root, bracket, pinned
@@ -23,13 +24,14 @@ class Script:
         return self.values.get(t, t - self.root)
 
 
-REFINE = make_refine(
-    bracket_root=lambda c, f, ta, tb, mode: (c.bracket, c.root, f(c.root)) if c.bracket
-    else (False, ta, math.nan),
-    value_at=lambda c, f, t, mode: f(t),
-    lost_bracket=lambda c, f, ta, tb, va, vb, mode: (
-        c.lost.append((ta, tb, va, vb)),
-        (True, c.pinned, f(c.pinned)) if c.pinned is not None else (False, ta, math.nan))[1])
+def _script_root(c, f, ta, tb, va, vb, mode):
+    if math.isnan(va):  # a bracket of f's own
+        return (c.bracket, c.root, f(c.root)) if c.bracket else (False, ta, math.nan)
+    c.lost.append((ta, tb, va, vb))
+    return (True, c.pinned, f(c.pinned)) if c.pinned is not None else (False, ta, math.nan)
+
+
+REFINE = make_refine(root=_script_root, value_at=lambda c, f, t, mode: f(t))
 
 
 def test_a_sample_exactly_zero_is_the_crossing():
@@ -81,18 +83,17 @@ def test_both_engines_refine_with_the_one_function():
         cells = {name: cell.cell_contents
                  for name, cell in zip(walk.__code__.co_freevars, walk.__closure__)}
         refine = getattr(cells["refine"], "py_func", cells["refine"])
-        assert refine.__code__ is make_refine(None, None, None).__code__
+        assert refine.__code__ is make_refine(None, None).__code__
         inner = {cell.cell_contents for cell in refine.__closure__}
-        assert ops.bracket_root in inner and ops.lost_bracket in inner and ops.value in inner
+        assert ops.root in inner and ops.value in inner
 
 
 def _reference_refine(fun, pred, ta, tb, va, vb, xtol):
     """The loop's refinement on the reference's root finder (scipy's brentq)."""
     simulate = importlib.import_module("filippov.simulate")
-    refine = make_refine(lambda c, f, lo, hi, mode: simulate._bracket_root(xtol, f, lo, hi),
-                         lambda c, f, t, mode: f(t),
-                         lambda c, f, lo, hi, vlo, vhi, mode: simulate._lost_bracket(
-                             xtol, f, lo, hi, vlo, vhi))
+    refine = make_refine(lambda c, f, lo, hi, vlo, vhi, mode: simulate._root(
+                             xtol, f, lo, hi, vlo, vhi),
+                         lambda c, f, t, mode: f(t))
     return refine(None, fun, pred, ta, tb, va, vb, None)[1]
 
 

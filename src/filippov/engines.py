@@ -148,8 +148,8 @@ ASYMMETRIES = (
         5, "The pinned-bracket fallback",
         "samples with array evaluations (numpy's loops) and refines with scalar ones, which "
         "may round differently: where the scalar ends lost the sign change the samples saw, "
-        "``simulate._brent`` keeps the sampled end values (``lost_bracket`` in "
-        ":mod:`filippov.loop.refine`)",
+        "``simulate._brent`` keeps the sampled end values (the root finder asked again "
+        "with the samples' values: :mod:`filippov.loop.refine`)",
         "samples and refines through the same compiled scalar code (``kernel.scan._sample``, "
         "``kernel.segment._fval``), so its ends agree with its samples bit for bit: no "
         "fallback; a bracket that fails is status ROOT_FAILED (a SimulationError), and the "

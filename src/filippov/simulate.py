@@ -41,7 +41,7 @@ from .errors import accumulation_detail, run_error
 from .loop.event import SECTION, RunOps, make_run
 from .loop.run_state import RING, SWITCHES, Limits, new_run_state
 from .section import Section  # noqa: F401  (re-exported: filippov.simulate.Section)
-from .loop.stay import UNRESOLVED, make_slides_in, make_start, make_step_windows
+from .loop.stay import UNRESOLVED, make_slides_in, make_start
 from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
                           NO_SLIDING, OK,
                           ROOT_FAILED, SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO)
@@ -287,8 +287,13 @@ def _bracket_root(xtol, fun, ta, tb):
     return True, r, fun(r)
 
 
-def _lost_bracket(xtol, fun, ta, tb, va, vb):
-    r = _brent(fun, ta, tb, va, vb, xtol)  # the bracket pinned to the samples (see there)
+def _root(xtol, fun, lo, hi, vlo, vhi):
+    """The reference's root finder (loop.interval.WindowOps' ``root``): scipy's brentq on
+    ``fun`` in [lo, hi]; with the samples' values vlo, vhi handed (not NaN), the bracket
+    pinned to them where ``fun`` at the ends lost their sign change (_brent)."""
+    if math.isnan(vlo):
+        return _bracket_root(xtol, fun, lo, hi)
+    r = _brent(fun, lo, hi, vlo, vhi, xtol)
     return True, r, fun(r)
 
 
@@ -787,17 +792,13 @@ def _enter(mode, new_mode, t, shift, band, crossed, run):
     run.mode = run.traj.mode = new_mode
 
 
-#: a step searched in windows its samples resolve (loop.stay); ctx: the run
-_STEP_WINDOWS = make_step_windows(
-    lambda mode, t0, t1, first, may_split, run: run.window(t0, t1, first, may_split))
-
 #: the reference driver's side of the seam (filippov.contracts.RunOperations) and its
 #: run (filippov.loop.event) on them; ctx: the _Run, which made its start when it was
 #: built (begin: the state it made)
 RUN_OPERATIONS = RunOps(
     begin=lambda z0, age0, run: (GO_ON, run.t, run.mode),
     next_step=lambda mode, ta, first, run: run.next_step(first),
-    step_windows=_STEP_WINDOWS,
+    window=lambda mode, t0, t1, first, may_split, run: run.window(t0, t1, first, may_split),
     end_step=lambda mode, ta, tb, status, t, run: run.end_step(ta, tb, status),
     record=_record,
     speeds=_normal_speeds,
@@ -980,7 +981,7 @@ class _Scan:
         the band still in force after it."""
         if self.not_finite is not None and self.ts.size < 2:
             raise self._non_finite(*self.not_finite[1:])
-        self.order = np.flatnonzero(self.candidates())
+        self.cand = self.candidates()
         _, r, what, k = _window_event(self, self.mode)
         if what == interval.NONE and self.not_finite is not None:
             raise self._non_finite(*self.not_finite[1:])
@@ -996,13 +997,10 @@ class _Scan:
     # returns the status OK.
 
     def _window(self):
-        return interval.Window(self.ts.size - 1, len(self.sections), self.first, self.band,
-                               self.rates is not None, self.touch_tol, self.xtol)
-
-    def _skip_to(self, i, mode):
-        """The first candidate interval from i on (the last sample's index: none)."""
-        pos = int(np.searchsorted(self.order, i))
-        return int(self.order[pos]) if pos < self.order.size else self.ts.size - 1
+        t0 = self.traj.t0
+        return interval.Window(self.ts.size - 1, self.first, self.band, self.rates is not None,
+                               self.touch_tol, self.xtol, self.preds,
+                               tuple(t0 + sec.min_time for sec in self.sections), self.cand)
 
     def _sampled(self, f, i):
         if f == interval.F_TIME:
@@ -1031,18 +1029,8 @@ class _Scan:
     def _value(self, f, t, mode):
         return self._function(f)(t)
 
-    def _bracket_root(self, f, lo, hi, mode):
-        return _bracket_root(self.xtol, self._function(f), lo, hi)
-
-    def _lost_bracket(self, f, lo, hi, vlo, vhi, mode):
-        return _lost_bracket(self.xtol, self._function(f), lo, hi, vlo, vhi)
-
-    def _extremum(self, f, i, mode):
-        return interval.OK, _brent(self._function(f), self.ts[i], self.ts[i + 1],
-                                   self._sampled(f, i), self._sampled(f, i + 1), self.xtol)
-
-    def _section(self, k):
-        return self.preds[k], self.traj.t0 + self.sections[k].min_time
+    def _root(self, f, lo, hi, vlo, vhi, mode):
+        return _root(self.xtol, self._function(f), lo, hi, vlo, vhi)
 
     def _counts(self, k, i, r, mode):
         """The crossing of section k at r is a hit: ``where`` holds there, and it is not
@@ -1064,9 +1052,8 @@ class _Scan:
         again."""
         self.band, self.leave = 0.0, self.unbanded
         self.vals[0] = np.asarray(self.leave[0](self.zs), dtype=float)
-        again = self.candidates()  # a band is in force in a region only: h, dH/dt, sections
-        again[:i] = False
-        self.order = np.flatnonzero(again)
+        self.cand = self.candidates()  # a band is in force in a region only: h, dH/dt,
+        self.cand[:i] = False          # sections
 
     def _starts_on(self, sec, sv, zr) -> bool:
         """The start on the section, up to its rounding (rules.starts_on_section,
@@ -1082,8 +1069,7 @@ class _Scan:
 #: what this engine reports of a window to the event search (the window seam:
 #: filippov.contracts.WindowOperations), and that one search (filippov.loop.interval)
 WINDOW_OPERATIONS = interval.WindowOps(
-    _Scan._window, _Scan._skip_to, _Scan._sampled, _Scan._value, _Scan._bracket_root,
-    _Scan._lost_bracket, _Scan._extremum, _Scan._section, _Scan._counts, _Scan._touch,
+    _Scan._window, _Scan._sampled, _Scan._value, _Scan._root, _Scan._counts, _Scan._touch,
     _Scan._unband)
 _window_event = interval.make_window_event(WINDOW_OPERATIONS)
 

@@ -42,7 +42,7 @@ from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_de
                          _var_step)
 from ..loop.event import SECTION, RunOps, make_run
 from ..loop.run_state import Limits, RunState
-from ..loop.stay import UNRESOLVED, before_stay, make_slides_in, make_start, make_step_windows
+from ..loop.stay import UNRESOLVED, before_stay, make_slides_in, make_start
 from ..loop.status import GO_ON, SECTION_SLIDING
 
 
@@ -195,19 +195,6 @@ def _stop_non_finite(bad, piece, ta, mode, o, sm, w):
         _zat(sm.ts[bad], mode, o, w.z)
         return NON_FINITE, sm.ts[bad], _W_NONE
     return NON_FINITE, ta, _W_NONE
-
-
-def _build_step_windows(ns):
-    """A step searched in windows its samples resolve (loop.stay.make_step_windows) on
-    the namespace ``ns``'s _window (as _build_run)."""
-    walk = make_step_windows(ns["_window"])
-    if not ns["_DERIVATIVES"]:
-        walk.__qualname__ += "_plain"
-    return _jit_inline(walk)
-
-
-_build_step_windows.builds = True
-_step_windows = _build_step_windows(globals())
 
 
 # ------------------------------------------------------------------ a stay's operations
@@ -456,7 +443,7 @@ def _begin(z0, age0, ctx):
 
 #: the kernel's side of the seam (filippov.contracts.RunOperations): each operation's
 #: function by name
-_RUN_OPS = {"begin": "_begin", "next_step": "_next_step", "step_windows": "_step_windows",
+_RUN_OPS = {"begin": "_begin", "next_step": "_next_step", "window": "_window",
             "end_step": "_end_step", "record": "_record", "speeds": "_event_speeds",
             "exit_state": "_exit_state", "enter": "_enter"}
 
@@ -474,10 +461,14 @@ def _build_run(ns):
     filippov.loop.run_state, on the batch's arrays), the state at the return (or
     where the run stopped) in w.z. A call _batch makes per return, the run's loop and its
     operations inlined into it."""
-    run = make_run(_operations(ns))
-    if not ns["_DERIVATIVES"]:  # numba names a cache file by the qualified name
-        run.__qualname__ += "_plain"
-    return _jit(run)
+    plain = not ns["_DERIVATIVES"]
+
+    def named(f):  # numba names a cache file by the qualified name
+        if plain:
+            f.__qualname__ += "_plain"
+        return f
+    # the step's walk over its windows (loop.stay.make_step_windows) inlined into it
+    return _jit(named(make_run(_operations(ns), inline=lambda f: _jit_inline(named(f)))))
 
 
 _build_run.builds = True  # _without_derivatives builds it, not copies it
@@ -628,7 +619,6 @@ def _without_derivatives(decorated):
 
 # the functions on the way from _batch to a _DERIVATIVES branch
 _PLAIN = _without_derivatives({"_window": _jit_inline,
-                               "_step_windows": _build_step_windows,
                                "_end_step": _jit_inline, "_at_section": _jit_inline,
                                "_record": _jit_inline,
                                "_event_switch_derivative": _jit_inline,

@@ -12,18 +12,11 @@ _RTOL = 4.0 * _EPS
 
 
 @_jit
-def _brentq(sel, xa, xb, maxiter, mode, o, sc):
+def _brentq_f(sel, xa, xb, maxiter, mode, o, sc):
     """scipy.optimize.brentq (scipy/optimize/Zeros/brentq.c) of the event function sel
     on the segment o (state.Orbit), to xtol o.xtol and rtol 4 eps (scipy's default);
-    returns (root, ok)."""
-    r, _, ok = _brentq_f(sel, xa, xb, maxiter, mode, o, sc)
-    return r, ok
-
-
-@_jit
-def _brentq_f(sel, xa, xb, maxiter, mode, o, sc):
-    """_brentq, returning (root, the function's value there, ok): the value at the root
-    is the one it evaluated last (or at xa), which _refine's far-side probe needs first."""
+    returns (root, the function's value there, ok): the value at the root is the one it
+    evaluated last (or at xa), which the refinement's far-side probe needs first."""
     xtol, rtol = o.xtol, _RTOL
     xpre, xcur = xa, xb
     xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0

@@ -3,10 +3,12 @@ order of the questions in a sample interval: filippov.loop.interval)."""
 from __future__ import annotations
 
 import numpy as np
+from numba import types
+from numba.extending import overload
 
 from .. import rules
 from ..loop.interval import (F_LEAVE, F_RATE, F_SECTION, F_TIME, F_UNBANDED, Window, WindowOps,
-                             make_window_event)
+                             asks, make_window_event)
 from ..system import MINUS, PLUS, SLIDING
 from .base import (OK, ROOT_FAILED, _MAXITER_EVENT, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB, _S_H,
                    _S_SEC, _dot, _jit, _jit_inline, _speeds, _field_minus, _field_plus,
@@ -14,7 +16,7 @@ from .base import (OK, ROOT_FAILED, _MAXITER_EVENT, _MAXITER_EXTREMUM, _S_A, _S_
 from .segment import (_fval, _rates, _zat)
 from .state import (SEG_BAND, SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_LAST_H, SEG_LAST_SPEED2,
                     SEG_RATE_STEP, SEG_SHIFT, Walk)
-from .roots import (_brentq, _brentq_f)
+from .roots import _brentq_f
 
 
 @_jit
@@ -143,17 +145,20 @@ def _sel(f, mode):
 
 @_jit_inline
 def _window_of(ctx):
+    """The window as the search sees it: one section, which the run may hit from t = 0 +
+    min_time on; every interval asked (cand None: the kernel finds no candidates ahead)."""
     sg = ctx.o.seg
-    return Window(ctx.ns - 1, 1, ctx.first, sg[SEG_BAND], sg[SEG_RATE_STEP] > 0.0,
-                  ctx.touch_tol, ctx.o.xtol)
+    return Window(ctx.ns - 1, ctx.first, sg[SEG_BAND], sg[SEG_RATE_STEP] > 0.0,
+                  ctx.touch_tol, ctx.o.xtol, (ctx.sec_pred,), (ctx.min_time,), None)
 
 
-@_jit_inline
-def _skip_to(ctx, i, mode):
-    # each interval is tested as the walk comes to it; i + 0, not i: the walk starts at
-    # the constant 0, and a call given that literal i would be compiled twice
-    # (docs/decisions.md#kernel-codes-are-numpy-integers)
-    return i + 0
+@overload(asks, inline="always")
+def _asks(cand, i):
+    """loop.interval.asks compiled for the window's ``cand``: None (the kernel's) asks
+    every interval, a constant the walk's test folds away (docs/decisions.md#window-seam)."""
+    if isinstance(cand, types.NoneType):
+        return lambda cand, i: True
+    return lambda cand, i: cand[i]
 
 
 @_jit_inline
@@ -190,37 +195,24 @@ def _value(ctx, f, t, mode):
 
 
 @_jit_inline
-def _bracket_root(ctx, f, lo, hi, mode):
-    """brentq's root of f in [lo, hi] and f there (roots._brentq_f): h unbiased
-    (F_UNBANDED) with the exit's shift in force of the banded one."""
+def _root(ctx, f, lo, hi, vlo, vhi, mode):
+    """brentq's root of f in [lo, hi] and f there (roots._brentq_f; a rate's, an
+    extremum, within _MAXITER_EXTREMUM iterations): h unbiased (F_UNBANDED) with the exit's
+    shift in force of the banded one. The kernel samples and refines through the same
+    compiled scalar functions: a sign change its ends lost is a failure (ROOT_FAILED), not
+    pinned to the samples' values (filippov.engines, item 5)."""
     o, sc = ctx.o, ctx.sc
+    rate = f >= F_RATE and f < F_UNBANDED
+    if not rate and not np.isnan(vlo):
+        return False, lo, vlo
     if f != F_UNBANDED:
-        r, fr, ok = _brentq_f(_sel(f, mode), lo, hi, _MAXITER_EVENT, mode, o, sc)
+        r, fr, ok = _brentq_f(_sel(f, mode), lo, hi,
+                              _MAXITER_EXTREMUM if rate else _MAXITER_EVENT, mode, o, sc)
         return ok, r, fr
     banded = _unbiased(o.seg)
     r, fr, ok = _brentq_f(_S_H, lo, hi, _MAXITER_EVENT, mode, o, sc)
     o.seg[SEG_SHIFT] = banded
     return ok, r, fr
-
-
-@_jit_inline
-def _lost_bracket(ctx, f, lo, hi, vlo, vhi, mode):
-    # the kernel samples and refines through the same compiled scalar functions: a lost
-    # sign change is a failure (ROOT_FAILED), not pinned (filippov.engines, item 5)
-    return False, lo, vlo
-
-
-@_jit_inline
-def _extremum(ctx, f, i, mode):
-    sm = ctx.sm
-    tm, ok = _brentq(_sel(f, mode), sm.ts[i], sm.ts[i + 1], _MAXITER_EXTREMUM, mode, ctx.o,
-                     ctx.sc)
-    return (OK if ok else ROOT_FAILED), tm
-
-
-@_jit_inline
-def _section_of(ctx, k):
-    return ctx.sec_pred, ctx.min_time  # the run starts at t = 0
 
 
 @_jit_inline
@@ -264,8 +256,7 @@ def _unband(ctx, i, mode):
 
 #: what the kernel reports of a window to the event search (the window seam:
 #: filippov.contracts.WindowOperations)
-WINDOW_OPERATIONS = WindowOps(_window_of, _skip_to, _sampled, _value, _bracket_root,
-                              _lost_bracket, _extremum, _section_of, _counts, _touch, _unband)
+WINDOW_OPERATIONS = WindowOps(_window_of, _sampled, _value, _root, _counts, _touch, _unband)
 #: the one event search (loop.interval) on them: a call, its operations inlined, the root
 #: of a leave function a call of its own (docs/decisions.md#kernel-inlined-driver)
 _window_event = _jit(make_window_event(WINDOW_OPERATIONS, call=_jit, inline=_jit_inline))

@@ -40,7 +40,7 @@ from ..contracts import RunOperations, operations
 from ..system import SLIDING
 from .status import EVENT_LIMIT, GO_ON, NO_SLIDING, OK, TWO_FOLD, ZENO
 from .run_state import RING, SWITCHES
-from .stay import before_stay
+from .stay import before_stay, make_step_windows
 
 #: what an event is: a crossing of H or an end of sliding (rules.SWITCH, EXIT_MINUS,
 #: EXIT_PLUS: rules.next_mode's ``ended_by``), or a hit of a section
@@ -54,9 +54,9 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: region age0: rules.carried_age), GO_ON or why it cannot start; a stay, in the order the
 #: run holds: per step next_step(mode, ta, first, ctx) -> (status, tb) (the stay begun
 #: at its first step; GO_ON and the step's end, or why there is none: the stay cannot
-#: begin, the step budget, a failed step), step_windows(mode, ta, tb, first, ctx) ->
-#: (status, t, what) (the step searched window by window:
-#: filippov.loop.stay.make_step_windows on the engine's window), end_step(mode, ta, tb,
+#: begin, the step budget, a failed step), window(mode, t0, t1, first, may_split, ctx) ->
+#: (status, t, what) (one window of the step sampled and searched: the run searches the
+#: step window by window with it, filippov.loop.stay.make_step_windows), end_step(mode, ta, tb,
 #: status, t, ctx) -> status (GO_ON to the next step; OK at an event, its time t and
 #: ``what``; NO_RETURN at the end time, or an error): the stay written in the run, as the
 #: event is, so that the kernel copies no composed stay
@@ -74,14 +74,18 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 RunOps = namedtuple("RunOps", operations(RunOperations))
 
 
-def make_run(ops: RunOps):
+def _as_is(f):
+    return f
+
+
+def make_run(ops: RunOps, inline=_as_is):
     """``run(z0, age0, ctx, rs) -> (status, t, mode)``: the orbit from z0, stay by stay
-    and event by event in the order of this module's doc, with the rule book's rules and
-    ``ops``'s operations, until a status ends it: OK at a terminal section hit,
-    NO_RETURN at the end time, or why it stopped (the start's, a stay's or an event's
-    status); t and ``mode`` where it ended. ``rs``: the run's record
-    (:class:`~filippov.loop.run_state.RunState`), its counters cleared first."""
-    begin, next_step, step_windows, end_step, record, speeds, exit_state, enter = ops
+    and event by event in this module's order, with the rule book and ``ops``, until a
+    status ends it (OK at a terminal section hit, NO_RETURN at the end time, or the
+    start's, a stay's or an event's); t and ``mode`` where it ended. ``rs``: the run's
+    record (:class:`~filippov.loop.run_state.RunState`), counters cleared first."""
+    begin, next_step, window, end_step, record, speeds, exit_state, enter = ops
+    step_windows = inline(make_step_windows(window))  # ``inline``: the kernel's, or as is
 
     def run(z0, age0, ctx, rs):
         limits = rs.limits

@@ -71,43 +71,56 @@ NONE, SECTION = -1, 3
 #: refinement); the sections (F_SECTION + k)
 F_TIME, F_LEAVE, F_RATE, F_UNBANDED, F_SECTION = -1, 0, 2, 4, 5
 
-#: what the engine reports of a window as it begins: the index of its last sample, its
-#: number of sections, whether the stay just began (its start sample is then clamped
-#: inside), the exit's band in force (0: none), whether the rates of a and b are sampled
-#: (while sliding), the touch tolerance and the tolerance roots are located to
+#: what the engine reports of a window as it begins: the index of its last sample, whether
+#: the stay just began (its start sample is then clamped inside), the exit's band in force
+#: (0: none), whether the rates of a and b are sampled (while sliding), the touch
+#: tolerance and the tolerance roots are located to; its sections, each one's sign change
+#: (``preds``) and the earliest time it may be hit (``t_mins``); and ``cand``, which
+#: intervals the walk asks (a mask, one entry per interval: the reference flags those
+#: where its array operations saw a sign change, :func:`candidate_mask`; None: every
+#: one, the kernel's; the search tests each one it asks again: :func:`asks`)
 Window = namedtuple("Window", (
-    "last", "n_sections", "first", "band", "rates", "touch_tol", "xtol"))
+    "last", "first", "band", "rates", "touch_tol", "xtol", "preds", "t_mins", "cand"))
 
 #: The engine's operations on a window, each a function of its state ``ctx``:
 #:
 #: * ``window(ctx) -> Window``;
-#: * ``skip_to(ctx, i, mode)``: the first interval from i on that may show a sign change
-#:   (the last sample's index if none), a hint: an engine that found its candidates with
-#:   array operations jumps to the next one, one that tests each interval answers i;
 #: * ``sampled(ctx, f, i)``: function f (the codes above) at sample i;
 #: * ``value(ctx, f, t, mode)``: f at time t on the window;
-#: * ``bracket_root(ctx, f, lo, hi, mode) -> (ok, t, f(t))``, ``lost_bracket(ctx, f, lo, hi,
-#:   vlo, vhi, mode) -> (ok, t, f(t))``: the engine's root finder on f in [lo, hi] and what
-#:   it does with a sign change the samples vlo, vhi saw and f at the ends lost; the loop
-#:   refines a sign change with them (:mod:`filippov.loop.refine`: to its far side);
-#: * ``extremum(ctx, f, i, mode) -> (status, t)``: the root of the rate f between samples
-#:   i and i + 1 (an extremum of the function it is the rate of);
-#: * ``section(ctx, k) -> (pred, t_min)``: section k's sign change and the earliest time
-#:   it may be hit; ``counts(ctx, k, i, t, mode)``: its crossing at t in interval i is a
-#:   hit (``where`` holds; not the run's start on it up to rounding);
+#: * ``root(ctx, f, lo, hi, vlo, vhi, mode) -> (ok, t, f(t))``: the engine's root finder on
+#:   f in [lo, hi]; not ok where f at the ends shows no sign change, unless the loop
+#:   hands the samples' values there (vlo, vhi; NaN: none), to which the reference pins
+#:   the bracket and the kernel does not (filippov.engines, item 5). The loop refines a
+#:   sign change with it (:mod:`filippov.loop.refine`: to its far side) and finds the
+#:   extremum of a function hidden between two samples as the root of its rate (F_RATE
+#:   + q, the samples' values handed);
+#: * ``counts(ctx, k, i, t, mode)``: section k's crossing at t in interval i is a hit
+#:   (``where`` holds; not the run's start on it up to rounding);
 #: * ``touch(ctx, t, mode)``: H touched at t (no event; the return map has a kink);
 #: * ``unband(ctx, i, mode)``: the band ends; h is sampled again unbiased from sample i
-#:   on (none when i is past the last sample) and the hint's candidates found again.
+#:   on (none when i is past the last sample), and the window's ``cand`` found again.
 WindowOps = namedtuple("WindowOps", (
-    "window", "skip_to", "sampled", "value", "bracket_root", "lost_bracket", "extremum",
-    "section", "counts", "touch", "unband"))
-
+    "window", "sampled", "value", "root", "counts", "touch", "unband"))
 
 def _as_is(f):
     return f
 
 
-def make_leave_root(ops: WindowOps, refine):
+def make_extremum(ops: WindowOps):
+    """``extremum(ctx, f, i, mode) -> (status, t)``: the root of the rate f between samples
+    i and i + 1 (an extremum of the function it is the rate of), on the engine's root
+    finder with the samples' values handed (:data:`WindowOps`' ``root``)."""
+    sampled, root = ops.sampled, ops.root
+
+    def extremum(ctx, f, i, mode):
+        ok, tm, _ = root(ctx, f, sampled(ctx, F_TIME, i), sampled(ctx, F_TIME, i + 1),
+                         sampled(ctx, f, i), sampled(ctx, f, i + 1), mode)
+        return (OK if ok else ROOT_FAILED), tm
+
+    return extremum
+
+
+def make_leave_root(ops: WindowOps, refine, extremum):
     """``leave_root(ctx, q, i, mode, first, band, va, vb) -> (status, t)``: the sign
     change of leave function q between samples i and i + 1 (va, vb as read there). The
     root of h in the first interval of a stay entered at H, where h dips and returns
@@ -115,8 +128,9 @@ def make_leave_root(ops: WindowOps, refine):
     exit's band is in force is probed back toward the bracket's start
     (``rules.band_probe``) to a time out of the band (``rules.clears_band``) and refined
     again from there on h itself (r stands if none clears, or if that refinement fails).
-    ``refine``: the loop's refinement on the engine's root finder (loop.refine)."""
-    sampled, value, extremum = ops.sampled, ops.value, ops.extremum
+    ``refine``: the loop's refinement on the engine's root finder (loop.refine);
+    ``extremum``: :func:`make_extremum`'s."""
+    sampled, value = ops.sampled, ops.value
 
     def leave_root(ctx, q, i, mode, first, band, va, vb):
         pred = rules.leave_pred(mode, q)
@@ -144,13 +158,13 @@ def make_leave_root(ops: WindowOps, refine):
     return leave_root
 
 
-def make_hidden_end(ops: WindowOps, refine):
+def make_hidden_end(ops: WindowOps, refine, extremum):
     """``hidden_end(ctx, q, i, mode, w, band, va) -> (status, t, kind)``: the extremum of
     leave function q hidden between samples i and i + 1 (va: its value at i as read),
     judged by ``rules.graze`` in a region, ``rules.speed_graze`` while sliding: the
     function's root before it (GRAZE_CROSSES), the extremum's time (GRAZE_TOUCHES), or
-    GRAZE_NONE."""
-    sampled, value, extremum = ops.sampled, ops.value, ops.extremum
+    GRAZE_NONE. ``refine``, ``extremum``: as :func:`make_leave_root`'s."""
+    sampled, value = ops.sampled, ops.value
 
     def hidden_end(ctx, q, i, mode, w, band, va):
         pred = rules.leave_pred(mode, q)
@@ -179,7 +193,7 @@ def make_candidate(ops: WindowOps):
     stay just began, else -1: c0, c1), a
     hidden extremum of one (x0, x1), a section's -- and whether any does (``hit``). Each
     function by a constant code: the kernel asks this of every interval."""
-    sampled, section = ops.sampled, ops.section
+    sampled = ops.sampled
 
     def candidate(ctx, i, mode, w, clamp_at, pred0, pred1):
         va0, vb0 = sampled(ctx, F_LEAVE, i), sampled(ctx, F_LEAVE, i + 1)
@@ -199,8 +213,8 @@ def make_candidate(ops: WindowOps):
                 pred1, sampled(ctx, F_RATE + 1, i), sampled(ctx, F_RATE + 1, i + 1))
         c0 = rules.crosses(pred0, va0, vb0)
         cs = False
-        for k in range(w.n_sections):
-            cs = cs or rules.crosses(section(ctx, k)[0], sampled(ctx, F_SECTION + k, i),
+        for k in range(len(w.preds)):
+            cs = cs or rules.crosses(w.preds[k], sampled(ctx, F_SECTION + k, i),
                                      sampled(ctx, F_SECTION + k, i + 1))
         return (c0 or c1 or x0 or x1 or cs), va0, vb0, va1, vb1, c0, c1, x0, x1
 
@@ -211,11 +225,12 @@ def make_window_event(ops: WindowOps, call=_as_is, inline=_as_is):
     """``window_event(ctx, mode) -> (status, t, what, k)``: the earliest event over a
     window's intervals (this module's docstring) on the engine's :data:`WindowOps`; a
     leave function's root compiled by ``call``, a hidden extremum by ``inline``."""
-    window, skip_to, sampled, section, counts, touch, unband = (
-        ops.window, ops.skip_to, ops.sampled, ops.section, ops.counts, ops.touch, ops.unband)
-    refine = call(make_refine(ops.bracket_root, ops.value, ops.lost_bracket))
-    leave_root = call(make_leave_root(ops, refine))
-    hidden_end = inline(make_hidden_end(ops, refine))
+    window, sampled, counts, touch, unband = (
+        ops.window, ops.sampled, ops.counts, ops.touch, ops.unband)
+    refine = call(make_refine(ops.root, ops.value))
+    extremum = inline(make_extremum(ops))
+    leave_root = call(make_leave_root(ops, refine, extremum))
+    hidden_end = inline(make_hidden_end(ops, refine, extremum))
     candidate = inline(make_candidate(ops))
 
     def window_event(ctx, mode):
@@ -223,13 +238,16 @@ def make_window_event(ops: WindowOps, call=_as_is, inline=_as_is):
         n, band, nl = w.last, w.band, (2 if mode == SLIDING else 1)
         clamp_at = 0 if w.first else -1
         pred0, pred1 = rules.leave_pred(mode, 0), rules.leave_pred(mode, 1)
-        i = skip_to(ctx, 0, mode)
+        i = 0
         while i < n:
+            if not asks(w.cand, i):
+                i += 1
+                continue
             hit, va0, vb0, va1, vb1, c0, c1, x0, x1 = candidate(ctx, i, mode, w, clamp_at,
                                                                 pred0, pred1)
             if hit and band > 0.0 and rules.clears_band(mode, va0, band):
                 unband(ctx, i, mode)  # interval i asked again, h unbiased (band now 0)
-                band, clamp_at = 0.0, -1
+                w, band, clamp_at = window(ctx), 0.0, -1
                 continue
             if hit:
                 best_t, best_w, best_k, touch_0, touch_1 = math.inf, NONE, -1, math.inf, math.inf
@@ -259,8 +277,8 @@ def make_window_event(ops: WindowOps, call=_as_is, inline=_as_is):
                     if tm < best_t:  # a touch before any exit, in time order: P has a kink
                         touch(ctx, tm, mode)
                 # 3. the sections in order: a hit that comes first, or at a switch
-                for k in range(w.n_sections):
-                    pred, t_min = section(ctx, k)
+                for k in range(len(w.preds)):
+                    pred, t_min = w.preds[k], w.t_mins[k]
                     sa, sb = sampled(ctx, F_SECTION + k, i), sampled(ctx, F_SECTION + k, i + 1)
                     if rules.crosses(pred, sa, sb):
                         ok, r = refine(ctx, F_SECTION + k, pred, sampled(ctx, F_TIME, i),
@@ -272,7 +290,7 @@ def make_window_event(ops: WindowOps, call=_as_is, inline=_as_is):
                             best_t, best_w, best_k = r, SECTION, k
                 if best_w != NONE:
                     return OK, best_t, best_w, best_k
-            i = skip_to(ctx, i + 1, mode)
+            i += 1
         if band > 0.0 and rules.clears_band(mode, sampled(ctx, F_LEAVE, n), band):
             unband(ctx, n + 1, mode)  # no sample after the last one to take again
         return OK, math.inf, NONE, -1
@@ -280,10 +298,19 @@ def make_window_event(ops: WindowOps, call=_as_is, inline=_as_is):
     return window_event
 
 
+def asks(cand, i):
+    """Whether the walk asks interval i of a window whose ``cand`` is as
+    :data:`Window`'s: every interval where it is None, else those it flags. The kernel
+    compiles it for None as the constant True (kernel.scan), so its walk tests nothing
+    more per interval than it did when it asked every one (a mask of all True cost it
+    0.7% of its instructions per return: docs/decisions.md#window-seam)."""
+    return cand is None or cand[i]
+
+
 def candidate_mask(mode, leaves, rates, sections, first):
     """The sample intervals where the event search may find something, by array
-    operations (an engine's ``skip_to`` hint; the search tests each one it is sent to
-    again): a leave function's sign change (``leaves``: their samples), an extremum of
+    operations (the reference's :data:`Window` ``cand``; the search tests each one it
+    asks again): a leave function's sign change (``leaves``: their samples), an extremum of
     one hidden between samples (``rates``: the samples of their rates, None while
     sliding without them), a section's sign change (``sections``: (pred, samples)
     pairs); interval 0 whenever the stay just began (its start sample is clamped)."""

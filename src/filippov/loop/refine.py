@@ -8,9 +8,9 @@ tb). Its event time r is:
    of it, bit for bit the same steps);
 3. when f at the ends shows no sign change, ta if f(ta) is already past the crossing: the
    start sample of a just-entered mode was clamped inside while the true value is a
-   hair past it, so the event is at once; else the engine's ``lost_bracket`` (the
-   reference pins the bracket's ends to the samples, the kernel fails:
-   :mod:`filippov.engines`, item 5);
+   hair past it, so the event is at once; else the engine's root finder asked again with
+   the samples' values va, vb handed (the reference pins the bracket's ends to them, the
+   kernel fails: :mod:`filippov.engines`, item 5);
 4. then walked to the far side of the crossing (``rules.far_side``, ``far_side_probe``):
    a root finder may stop a hair before the sign flips.
 
@@ -19,20 +19,21 @@ callables, the kernel compiles it with its selectors of the segment's functions.
 """
 from __future__ import annotations
 
+import math
+
 from .. import rules
 
 
-def make_refine(bracket_root, value_at, lost_bracket):
+def make_refine(root, value_at):
     """``refine(ctx, f, pred, ta, tb, va, vb, mode) -> (ok, r)``: the event time of f's
     sign change ``pred`` between ta and tb (this module's docstring), from the engine's
     operations on its state ``ctx``:
 
-    * ``bracket_root(ctx, f, ta, tb, mode) -> (ok, r, fr)``: f's root in [ta, tb] and
+    * ``root(ctx, f, ta, tb, vlo, vhi, mode) -> (ok, r, fr)``: f's root in [ta, tb] and
       f's value there (the one the root finder evaluated last); not ok when f at the
-      ends shows no sign change;
-    * ``value_at(ctx, f, t, mode)``: f at t;
-    * ``lost_bracket(ctx, f, ta, tb, va, vb, mode) -> (ok, r, fr)``: f at the ends lost
-      the sign change the samples va, vb saw, and ta is not past it.
+      ends shows no sign change, unless the samples' values vlo, vhi are handed (NaN:
+      none) and the engine pins the bracket to them (loop.interval.WindowOps);
+    * ``value_at(ctx, f, t, mode)``: f at t.
     """
 
     def refine(ctx, f, pred, ta, tb, va, vb, mode):
@@ -41,13 +42,13 @@ def make_refine(bracket_root, value_at, lost_bracket):
             r = ta
             fr = value_at(ctx, f, r, mode)
         else:
-            ok, r, fr = bracket_root(ctx, f, ta, tb, mode)
+            ok, r, fr = root(ctx, f, ta, tb, math.nan, math.nan, mode)
             if not ok:
                 fa = value_at(ctx, f, ta, mode)
                 if rules.after(pred, fa):  # clamped start, true value past: at once
                     r, fr = ta, fa
                 else:
-                    ok, r, fr = lost_bracket(ctx, f, ta, tb, va, vb, mode)
+                    ok, r, fr = root(ctx, f, ta, tb, va, vb, mode)
                     if not ok:
                         return False, r
         done, step = False, 0.0
