@@ -102,6 +102,7 @@ Window = namedtuple("Window", (
 WindowOps = namedtuple("WindowOps", (
     "window", "sampled", "value", "root", "counts", "touch", "unband"))
 
+
 def _as_is(f):
     return f
 
