@@ -40,6 +40,7 @@ from ..contracts import RunOperations, operations
 from ..system import SLIDING
 from .status import EVENT_LIMIT, GO_ON, NO_SLIDING, OK, TWO_FOLD, ZENO
 from .run_state import RING, SWITCHES
+from .interval import as_is
 from .stay import before_stay, make_step_windows
 
 #: what an event is: a crossing of H or an end of sliding (rules.SWITCH, EXIT_MINUS,
@@ -74,11 +75,7 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 RunOps = namedtuple("RunOps", operations(RunOperations))
 
 
-def _as_is(f):
-    return f
-
-
-def make_run(ops: RunOps, inline=_as_is):
+def make_run(ops: RunOps, inline=as_is):
     """``run(z0, age0, ctx, rs) -> (status, t, mode)``: the orbit from z0, stay by stay
     and event by event in this module's order, with the rule book and ``ops``, until a
     status ends it (OK at a terminal section hit, NO_RETURN at the end time, or the

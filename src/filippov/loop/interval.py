@@ -103,7 +103,9 @@ WindowOps = namedtuple("WindowOps", (
     "window", "sampled", "value", "root", "counts", "touch", "unband"))
 
 
-def _as_is(f):
+def as_is(f):
+    """A loop piece run as it is (the reference's); the kernel hands numba's decorators
+    in its place (make_window_event's ``call`` and ``inline``, make_run's ``inline``)."""
     return f
 
 
@@ -222,7 +224,7 @@ def make_candidate(ops: WindowOps):
     return candidate
 
 
-def make_window_event(ops: WindowOps, call=_as_is, inline=_as_is):
+def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
     """``window_event(ctx, mode) -> (status, t, what, k)``: the earliest event over a
     window's intervals (this module's docstring) on the engine's :data:`WindowOps`; a
     leave function's root compiled by ``call``, a hidden extremum by ``inline``."""
