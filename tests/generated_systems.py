@@ -1456,6 +1456,87 @@ def invisible_two_fold_from(p1, p2, q2, ratio, kind, x0=1.0, s_frac=0.5, offset=
                    float(t - s + u * y + v * x), half, float(t - s), np.array([x, y, 0.0]))
 
 
+def _zeno_switches(case, n, perturb=None):
+    """The first n switch times of a "zeno" case and the states the arcs start from, arc
+    by arc in closed form at mpmath's precision, from its start a way into the first +
+    arc. Each arc begins where the last one ended, on H or off it (w != 0) when
+    ``perturb`` = (j, what, d) moved switch j: ``what`` "t" finds it d late (the state d
+    further along the arc), 0, 1, 2 adds d to that component of the state after it."""
+    import mpmath
+    p1, p2, q1, q2 = (mpmath.mpf(float(v)) for v in case.p[:4])
+    (x, y, w), t, plus, ts, starts = (mpmath.mpf(float(v)) for v in case.z0), 0, True, [], []
+    for j in range(n):
+        starts.append((x, y, w))
+        if plus:   # w + x tau + p1 tau^2 / 2 = 0, w >= 0, p1 < 0
+            tau = (x + mpmath.sqrt(x * x - 2 * p1 * w)) / -p1
+        else:      # w + y tau + q2 tau^2 / 2 = 0, w <= 0, q2 > 0
+            tau = (-y + mpmath.sqrt(y * y - 2 * q2 * w)) / q2
+        if perturb is not None and perturb[:2] == (j, "t"):
+            tau += perturb[2]
+        fx, fy, fw = (p1, p2, x) if plus else (q1, q2, y)
+        acc = p1 if plus else q2
+        x, y, w = x + fx * tau, y + fy * tau, w + fw * tau + acc * tau * tau / 2
+        if perturb is not None and perturb[0] == j and perturb[1] != "t":
+            z = [x, y, w]
+            z[perturb[1]] += perturb[2]
+            x, y, w = z
+        t += tau
+        ts.append(t)
+        plus = not plus
+    return ts, starts
+
+
+def _reported_t_star(ts):
+    """The accumulation time rules.geometric_accumulation reports from the switch times
+    ts (its newest loop, its ratio to the loop before, the geometric tail)."""
+    loop = ts[-1] - ts[-3]
+    ratio = loop / (ts[-3] - ts[-5])
+    return ts[-1] + loop * ratio / (1 - ratio)
+
+
+def zeno_rounding_bound(case, t_stop, xtol):
+    """How far the t* an engine reports for a "zeno" case may lie from the exact one by
+    the errors of its switches alone, for a run stopped at the switch at t_stop. The start
+    is on the loop map's contracting eigenvector; an error off it grows by 1 / ratio per
+    loop while the loops shrink by ratio, so an error at an early switch reaches the last
+    ones amplified ~ (d_0 / d_k) (the first loop's duration over the last one's). Summed
+    worst case over the switches, each error times its gain on the reported t* (mpmath's
+    difference quotients of :func:`_zeno_switches`, exact to their precision; the map is
+    smooth, so these are the first-order gains):
+
+    * its time, located to xtol + 4 eps |t| (brentq's tolerance) and then stepped to its
+      far side (at most as much again): 2 (xtol + 4 eps |t|);
+    * its state, evaluated by the closed-form flow from the arc's start (each component a
+      sum of at most three terms): 2 eps times the sum of the terms' sizes.
+
+    The integrated flows follow the same quadratics (DOP853 is exact on them) to rounding.
+    """
+    import mpmath
+    eps = float(np.finfo(float).eps)
+    with mpmath.workdps(60):
+        ts, starts = _zeno_switches(case, 80)
+        n = 1 + min(range(len(ts)), key=lambda j: abs(float(ts[j]) - t_stop))
+        if n < 5:
+            return math.inf
+        ts = ts[:n]
+        base, d = _reported_t_star(ts), mpmath.mpf("1e-30")
+
+        def gain(j, what):
+            moved = _zeno_switches(case, n, (j, what, d))[0]
+            return float(abs(_reported_t_star(moved) - base) / d)
+
+        p1, p2, q1, q2 = (abs(float(v)) for v in case.p[:4])
+        bound = 0.0
+        for j in range(n):
+            tj, tau = float(ts[j]), float(ts[j] - (ts[j - 1] if j else 0))
+            x, y, w = (abs(float(v)) for v in starts[j])
+            fx, fy, fw, acc = (p1, p2, x, p1) if j % 2 == 0 else (q1, q2, y, q2)
+            terms = (x + fx * tau, y + fy * tau, w + fw * tau + acc * tau * tau / 2)
+            bound += gain(j, "t") * 2.0 * (xtol + 4.0 * eps * abs(tj))
+            bound += sum(gain(j, c) * 2.0 * eps * terms[c] for c in range(3))
+    return bound
+
+
 @st.composite
 def invisible_two_folds(draw):
     p1 = -draw(st.floats(0.5, 2.0), label="-p1")
