@@ -1,5 +1,6 @@
-"""The start and the check before each stay, written once (filippov.loop.stay): the
-decisions the reference driver runs as Python and the kernel compiles."""
+"""The start (filippov.loop.event.make_start) and the check before each stay, written
+once (filippov.loop.stay): the decisions the reference driver runs as Python and the
+kernel compiles."""
 import numpy as np
 import pytest
 from numba import njit
@@ -22,7 +23,13 @@ def test_a_stay_begins_before_the_end_time_and_slides_only_if_built(before):
 
 
 def _start(slides):
-    return stay.make_start(lambda ctx: (ctx[0], ctx[1]), lambda ctx: slides)
+    """The loop's start on operations whose speeds are ctx's (a, b) and whose section
+    lies on H (slides: the sliding flow stays in it) or across it."""
+    from filippov.loop.event import RunOps, make_start
+    section = (lambda z: z[1]) if slides else (lambda z: z[0] - 0.3)
+    fields, along = _plane(section)
+    return make_start(RunOps(*[None] * 5, lambda ctx: (ctx[0], ctx[1]), fields, along,
+                             None, None))
 
 
 @pytest.mark.parametrize("h, a, b, sliding, slides, expected", [
@@ -34,7 +41,8 @@ def _start(slides):
 ])
 def test_the_start_mode_and_its_refusal_to_slide_in_a_section(h, a, b, sliding, slides,
                                                              expected):
-    status, mode, repelling = _start(slides)(h, 1e-15, sliding, (a, b))
+    status, mode, repelling = _start(slides)(h, 1e-15, sliding, 1, (a, b))
+    assert _start(True)(h, 1e-15, sliding, 0, (a, b))[0] == GO_ON  # no section
     assert (status, mode, repelling) == expected
     assert (mode, repelling) == ((rules.start_side(h, 1e-15), False) if h != 0.0
                                  else rules.start_on_switch(h, a, b, sliding))

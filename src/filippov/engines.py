@@ -47,9 +47,9 @@ slide inside a section at an arrival on H, the fold exit (``rules.exit_drift``,
 ``max_events`` before the Zeno ring (``rules.accumulates`` over the last ``zeno_count``
 switches: one array ring, ``rules.note_switch``), then the
 engine's own budget verdict (item 2). The start is one function too,
-:mod:`filippov.loop.stay` (the start mode, ``rules.start_side`` and
+:func:`filippov.loop.event.make_start` (the start mode, ``rules.start_side`` and
 ``rules.start_on_switch``, and the refusal to slide inside a section, whose test
-``make_slides_in`` is shared with the event), and so is the check before each stay (the
+``make_sliding_section`` the run asks at an arrival on H too), and so is the check before each stay (the
 run's end time; sliding the system does not build), asked by the run. A stay is written
 in the run's loop too: its start, then step by step the step, its windows (the step
 searched window by window, ``loop.stay.make_step_windows``: the first the whole step,

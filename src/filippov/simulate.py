@@ -38,10 +38,10 @@ from .radau_iia import RadauIIA
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
 from .errors import accumulation_detail, run_error
-from .loop.event import SECTION, RunOps, make_run
+from .loop.event import SECTION, RunOps, make_run, make_sliding_section, make_start
 from .loop.run_state import RING, SWITCHES, Limits, new_run_state
 from .section import Section  # noqa: F401  (re-exported: filippov.simulate.Section)
-from .loop.stay import UNRESOLVED, make_slides_in, make_start
+from .loop.stay import UNRESOLVED
 from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
                           NO_SLIDING, OK,
                           ROOT_FAILED, SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO)
@@ -314,41 +314,27 @@ def _section_along(k, mode, d, run):
     return float(func(z + d * np.asarray(f, float)))
 
 
-#: does the sliding flow at the run's state (on H) stay in section k
-#: (filippov.loop.stay.make_slides_in, on this engine's operations; ctx: the _Run)
-_slides_in = make_slides_in(_slide_fields, _section_along)
-
-
 def _normal_speeds(run):
     """(a, b) at the run's state."""
     return tuple(float(v) for v in run.system.normal_speeds(run.z))
 
 
-def _sliding_section(run):
-    """The index of the first section the sliding flow at the run's state stays in, or
-    -1 (none)."""
-    for k in range(len(run.sections)):
-        if _slides_in(k, run):
-            return k
-    return -1
-
-
-def _slides_in_a_section(run):
-    return _sliding_section(run) >= 0
-
-
-#: the start's mode and its refusal to slide in a section (filippov.loop.stay.make_start)
-_START = make_start(_normal_speeds, _slides_in_a_section)
-
-#: where a start is asked about, for the operations above (they read these fields of a _Run)
+#: where a start is asked about, for the run's operations (they read these fields of a
+#: _Run): the start's mode outside a run (initial_mode), the refusal's message
 _At = namedtuple("_At", ["system", "sections", "z"])
+
+
+def _sliding_section(at):
+    """The index of the first section the sliding flow at the state of ``at`` (an _At or a
+    _Run) stays in, or -1 (none): the loop's test (loop.event.make_sliding_section)."""
+    return _SLIDING_SECTION(len(at.sections), at)
 
 
 def _start(at, touch_tol):
     """(status, mode, what the start event is called) of a start at ``at`` (an _At or
     a _Run)."""
     status, mode, repelling = _START(float(at.system.switch(at.z)), touch_tol,
-                                     at.system.sliding, at)
+                                     at.system.sliding, len(at.sections), at)
     return status, mode, ("repelling_start" if repelling else "start")
 
 
@@ -480,7 +466,8 @@ class _Run:
         # what the loop keeps: limits, switches, the Zeno ring (filippov.loop.run_state)
         self.rs = new_run_state(Limits(self.t_end, system.sliding, self.max_events,
                                        self.zeno_count, self.zeno_span, self.touch_tol,
-                                       self.state_scale, self.time_scale, True))
+                                       self.state_scale, self.time_scale, True,
+                                       len(sections)))
         self.hit_section = None
         self._flow_field = None  # (mode, f, z) at the end of the last exact window
         self.shift = 0.0  # subtracted from H in this stay (rules.exit_shift)
@@ -773,12 +760,9 @@ def _exit_state(new_mode, run):
 
 
 def _record(mode, new_mode, what, t, run):
-    """A section hit (:func:`_section_hit`: OK, or GO_ON) or a switch, logged: GO_ON, or
-    SECTION_SLIDING (nothing logged) where it slides into a section."""
+    """A section hit (:func:`_section_hit`: OK, or GO_ON) or a switch, logged: GO_ON."""
     if what == SECTION:
         return _section_hit(mode, t, run)
-    if new_mode == SLIDING and mode != SLIDING and _slides_in_a_section(run):
-        return SECTION_SLIDING
     kind = ("slide_end" if what != rules.SWITCH
             else "crossing" if new_mode != SLIDING else "slide_start")
     run.traj.events.append(Event(t, kind, run.z.copy(), mode, new_mode))
@@ -802,9 +786,15 @@ RUN_OPERATIONS = RunOps(
     end_step=lambda mode, ta, tb, status, t, run: run.end_step(ta, tb, status),
     record=_record,
     speeds=_normal_speeds,
+    fields=_slide_fields,
+    section_along=_section_along,
     exit_state=_exit_state,
     enter=_enter)
 _RUN = make_run(RUN_OPERATIONS)
+#: the start's mode and its refusal to slide in a section, and that test alone, on the
+#: operations above (filippov.loop.event)
+_START = make_start(RUN_OPERATIONS)
+_SLIDING_SECTION = make_sliding_section(RUN_OPERATIONS)
 
 
 def _speed_rates(system, Z, z0, floor=1.0):

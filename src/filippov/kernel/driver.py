@@ -40,40 +40,42 @@ from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY
                     kernel_signature)  # noqa: F401
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
-from ..loop.event import SECTION, RunOps, make_run
+from ..loop.event import SECTION, RunOps, make_run, make_start
 from ..loop.run_state import Limits, RunState
-from ..loop.stay import UNRESOLVED, before_stay, make_slides_in, make_start
-from ..loop.status import GO_ON, SECTION_SLIDING
+from ..loop.stay import UNRESOLVED, before_stay
+from ..loop.status import GO_ON
 
 
 # ------------------------------------------------------------------ sliding in the section
-# For filippov.loop.stay.make_slides_in (at the start and at an arrival on H): each takes
-# at = (fns, p, z, wg, wf, wp, wz, floor): the model, the state on H, the scratch vectors
-# and the run's state scale (filippov.scale), no more
+# The run's fields and section_along (the test of a slide inside the section at the start
+# and at an arrival on H, filippov.loop.event.make_sliding_section) at the state w.z;
+# section_along calls _section_along_at with only what it reads
 # (docs/decisions.md#kernel-small-records).
 
 @_jit_inline
-def _slide_fields(at):
-    """(z, F_-, F_+) at z, in wf and wp (grad h left in wg)."""
-    fns, p, z, wg, wf, wp, _, floor = at
-    _speeds(z, fns, p, wg, wf, wp)
-    return z, wf, wp, floor
+def _event_fields(ctx):
+    """(z, F_-, F_+) at the state w.z, in w.wf and w.wp (grad h left in w.wg), and the
+    run's state scale."""
+    fns, p, s, w = ctx
+    _speeds(w.z, fns, p, w.wg, w.wf, w.wp)
+    return w.z, w.wf, w.wp, s.state_scale
 
 
 @_jit_inline
-def _section_along(k, mode, d, at):
-    """The section at z + d (cm F_- + cp F_+), the field of ``mode`` as its weights
-    (Filippov's while sliding, from F_-, F_+ and grad h left by _slide_fields); d = 0:
-    at z."""
-    # make_slides_in passes k and the modes as Python int constants, literals to numba:
-    # + 0 makes them int64, so the call is compiled once, not once per mode
+def _event_section_along(k, mode, d, ctx):
+    """The section at w.z + d (cm F_- + cp F_+), the field of ``mode`` as its weights
+    (Filippov's while sliding, from F_-, F_+ and grad h left by _event_fields); d = 0:
+    at w.z."""
+    fns, p, s, w = ctx
+    # the loop passes k and the modes as Python int constants, literals to numba: + 0
+    # makes them int64, so the call is compiled once, not once per mode
     # (docs/decisions.md#kernel-codes-are-numpy-integers)
-    return _section_along_at(k + 0, mode + 0, d, at)
+    return _section_along_at(k + 0, mode + 0, d, (fns, p, w.z, w.wg, w.wf, w.wp, w.wz))
 
 
-@_jit  # a call: make_slides_in asks it seven times (inlined, it grew the cold compile)
+@_jit  # a call: the test asks it seven times (inlined, it grew the cold compile)
 def _section_along_at(k, mode, d, at):
-    fns, p, z, wg, wm, wp, wz, _ = at
+    fns, p, z, wg, wm, wp, wz = at
     if d == 0.0:
         return _section(fns, z, p)
     if mode == MINUS:
@@ -86,16 +88,6 @@ def _section_along_at(k, mode, d, at):
     for c in range(z.size):
         wz[c] = z[c] + d * (cm * wm[c] + cp * wp[c])
     return _section(fns, wz, p)
-
-
-_slides_in_section = _jit_inline(make_slides_in(_slide_fields, _section_along))
-
-
-@_jit
-def _slides_in(at):
-    """The sliding flow at z (on H) stays in the section: filippov.loop.stay; at: as
-    _section_along's."""
-    return _slides_in_section(0, at)
 
 
 # The kernel's ABI: _batch(fns, params, starts, ages, settings, out): the compiled
@@ -332,12 +324,6 @@ def _exit_state(new_mode, ctx):
 
 
 @_jit_inline
-def _event_slides_in(ctx):
-    fns, p, s, w = ctx
-    return _slides_in((fns, p, w.z, w.wg, w.wf, w.wp, w.wz, s.state_scale))
-
-
-@_jit_inline
 def _record_switch(mode, new_mode, what, t, ctx):
     """The sliding tallies: the slide that ends, the one that starts."""
     w = ctx.w
@@ -351,12 +337,9 @@ def _record_switch(mode, new_mode, what, t, ctx):
 
 @_jit_inline
 def _record(mode, new_mode, what, t, ctx):
-    """A section hit (_at_section: OK, or GO_ON) or a switch (_record_switch: GO_ON, or
-    SECTION_SLIDING where it slides into the section)."""
+    """A section hit (_at_section: OK, or GO_ON) or a switch (_record_switch: GO_ON)."""
     if what == SECTION:
         return _at_section(mode, t, ctx)
-    if new_mode == SLIDING and mode != SLIDING and _event_slides_in(ctx):
-        return SECTION_SLIDING
     _record_switch(mode, new_mode, what, t, ctx)
     return _GO_ON
 
@@ -397,12 +380,9 @@ def _enter(mode, new_mode, t, shift, band, crossed, ctx):
     _entered(mode, new_mode, t, ctx)
 
 
-#: the start's mode and its refusal to slide in the section (filippov.loop.stay), on the
-#: event's operations at the state w.z
-_start = _jit_inline(make_start(_event_speeds, _event_slides_in))
-
-
-@_jit
+# inlined into the run: as a call it took the run's whole ctx member by member once per
+# return (+0.7% instructions per return, docs/decisions.md#kernel-start-inlined)
+@_jit_inline
 def _begin(z0, age0, ctx):
     """The run's start from z0 (its state in w.z): (status, 0.0, its mode); the counters
     cleared first, so a start refused reports none. w.first_sw[0]: time of the first
@@ -421,7 +401,7 @@ def _begin(z0, age0, ctx):
         w.z[k] = z0[k]
         if not np.isfinite(z0[k]):
             return BAD_START, 0.0, 0
-    st, mode, _ = _start(_h(fns, w.z, p), s.touch_tol, s.sliding, ctx)
+    st, mode, _ = _start(_h(fns, w.z, p), s.touch_tol, s.sliding, 1, ctx)
     if st != _GO_ON:
         return st, 0.0, mode
     w.touched[0] = False
@@ -445,6 +425,7 @@ def _begin(z0, age0, ctx):
 #: function by name
 _RUN_OPS = {"begin": "_begin", "next_step": "_next_step", "window": "_window",
             "end_step": "_end_step", "record": "_record", "speeds": "_event_speeds",
+            "fields": "_event_fields", "section_along": "_event_section_along",
             "exit_state": "_exit_state", "enter": "_enter"}
 
 
@@ -468,13 +449,17 @@ def _build_run(ns):
             f.__qualname__ += "_plain"
         return f
     # the step's walk over its windows (loop.stay.make_step_windows) inlined into it
-    return _jit(named(make_run(_operations(ns), inline=lambda f: _jit_inline(named(f)))))
+    return _jit(named(make_run(_operations(ns), inline=lambda f: _jit_inline(named(f)),
+                               call=lambda f: _jit(named(f)))))
 
 
 _build_run.builds = True  # _without_derivatives builds it, not copies it
 _one = _build_run(globals())
 #: the seam as the kernel fills it (tests/test_contracts.py checks it against the Protocol)
 RUN_OPERATIONS = _operations(globals())
+#: the start's mode and its refusal to slide in the section (filippov.loop.event), on the
+#: run's operations at the state w.z (_begin asks it; both builds share it)
+_start = _jit_inline(make_start(RUN_OPERATIONS, inline=_jit_inline, call=_jit))
 
 
 _KERNEL_SIG = kernel_signature()
@@ -487,7 +472,7 @@ def _run_record(s, w):
     event budget is the hard bound only (projects_budget False: filippov.engines,
     item 2)."""
     return RunState(Limits(s.t_max, s.sliding, s.max_events, s.zeno_count, s.zeno_span,
-                           s.touch_tol, s.state_scale, s.time_scale, False), w.count,
+                           s.touch_tol, s.state_scale, s.time_scale, False, 1), w.count,
                     w.recent, w.first_sw)
 
 
@@ -623,7 +608,7 @@ _PLAIN = _without_derivatives({"_window": _jit_inline,
                                "_record": _jit_inline,
                                "_event_switch_derivative": _jit_inline,
                                "_enter": _jit_inline,
-                               "_begin": _jit, "_one": _build_run,
+                               "_begin": _jit_inline, "_one": _build_run,
                                "_batch": njit(cache=True, nogil=True)})
 _one_plain, _batch_plain = _PLAIN["_one"], _PLAIN["_batch"]
 

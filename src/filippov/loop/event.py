@@ -38,10 +38,10 @@ from collections import namedtuple
 from .. import rules
 from ..contracts import RunOperations, operations
 from ..system import SLIDING
-from .status import EVENT_LIMIT, GO_ON, NO_SLIDING, OK, TWO_FOLD, ZENO
+from .status import EVENT_LIMIT, GO_ON, NO_SLIDING, OK, SECTION_SLIDING, TWO_FOLD, ZENO
 from .run_state import RING, SWITCHES
 from .interval import as_is
-from .stay import before_stay, make_step_windows
+from .stay import before_stay, make_slides_in, make_step_windows
 
 #: what an event is: a crossing of H or an end of sliding (rules.SWITCH, EXIT_MINUS,
 #: EXIT_PLUS: rules.next_mode's ``ended_by``), or a hit of a section
@@ -64,9 +64,12 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: (docs/decisions.md#kernel-inlined-driver);
 #: record(mode, new_mode, what, t, ctx) -> status: an event recorded, a section hit
 #: (what == SECTION: OK ends the run, GO_ON goes on) or a switch (before the budgets
-#: are asked; GO_ON, or SECTION_SLIDING, nothing recorded, where an entry into sliding
-#: would slide inside one of the engine's sections, which the loop does not see);
-#: speeds(ctx) -> (a, b); exit_state(new_mode, ctx) -> (the state as an array the event
+#: are asked; GO_ON);
+#: speeds(ctx) -> (a, b); fields(ctx) -> (z, F_-, F_+, floor) at the state, arrays, and
+#: the run's state scale (filippov.scale); section_along(k, mode, d, ctx): section k at
+#: z + d times the field of ``mode`` (MINUS, PLUS, SLIDING; d = 0: at z) -- the last two
+#: for the test of a slide inside a section (filippov.loop.stay.make_slides_in), at the
+#: start and at an arrival on H; exit_state(new_mode, ctx) -> (the state as an array the event
 #: may move onto H, grad H and H there, and the state the next stay in new_mode starts
 #: from as it evaluates it: the exact flow over time 0, rules.exit_band);
 #: enter(mode, new_mode, t, shift, band, crossed, ctx): the
@@ -75,14 +78,53 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 RunOps = namedtuple("RunOps", operations(RunOperations))
 
 
-def make_run(ops: RunOps, inline=as_is):
+def make_sliding_section(ops: RunOps, inline=as_is):
+    """``sliding_section(n, ctx) -> k``: the first of the run's n sections the sliding flow
+    at the state (on H) stays in (filippov.loop.stay.make_slides_in on the engine's
+    ``fields`` and ``section_along``), or -1."""
+    slides_in = inline(make_slides_in(ops.fields, ops.section_along))
+
+    def sliding_section(n, ctx):
+        for k in range(n):
+            if slides_in(k, ctx):
+                return k
+        return -1
+    return sliding_section
+
+
+def make_start(ops: RunOps, inline=as_is, call=as_is):
+    """``start(h, touch_tol, sliding, sections, ctx) -> (status, mode, repelling)``: the
+    start's mode, decided by the rule book from H at the start (rules.start_side) and, on
+    H, the normal speeds (rules.start_on_switch; ``repelling``: a start on repelling H);
+    status SECTION_SLIDING for a start that slides inside one of the run's ``sections``
+    sections (:func:`make_sliding_section`), else GO_ON. On the engine's ``speeds``,
+    ``fields`` and ``section_along`` at the start: an engine's ``begin`` asks it."""
+    speeds = ops.speeds
+    # ``call``: the kernel's compiled call (asked at a start on H only)
+    sliding_section = call(make_sliding_section(ops, inline))
+
+    def start(h, touch_tol, sliding, sections, ctx):
+        side = rules.start_side(h, touch_tol)
+        if side != SLIDING:
+            return GO_ON, side, False
+        a, b = speeds(ctx)
+        mode, repelling = rules.start_on_switch(h, a, b, sliding)
+        if mode == SLIDING and sliding_section(sections, ctx) >= 0:
+            return SECTION_SLIDING, mode, repelling
+        return GO_ON, mode, repelling
+    return start
+
+
+def make_run(ops: RunOps, inline=as_is, call=as_is):
     """``run(z0, age0, ctx, rs) -> (status, t, mode)``: the orbit from z0, stay by stay
     and event by event in this module's order, with the rule book and ``ops``, until a
     status ends it (OK at a terminal section hit, NO_RETURN at the end time, or the
     start's, a stay's or an event's); t and ``mode`` where it ended. ``rs``: the run's
     record (:class:`~filippov.loop.run_state.RunState`), counters cleared first."""
-    begin, next_step, window, end_step, record, speeds, exit_state, enter = ops
+    begin, next_step, window, end_step, record, speeds, _, _, exit_state, enter = ops
     step_windows = inline(make_step_windows(window))  # ``inline``: the kernel's, or as is
+    # ``call``: the kernel's compiled call (asked at an arrival on H only)
+    sliding_section = call(make_sliding_section(ops, inline))
 
     def run(z0, age0, ctx, rs):
         limits = rs.limits
@@ -134,8 +176,12 @@ def make_run(ops: RunOps, inline=as_is):
                     z, _, h0, z_next = exit_state(new_mode, ctx)
                 band = rules.exit_band(z, z_next, grad, limits.state_scale)
                 shift = rules.exit_shift(new_mode, h0, limits.touch_tol, drift)
+            # an arrival on H that would slide inside a section is refused there
+            if (new_mode == SLIDING and mode != SLIDING
+                    and sliding_section(limits.sections, ctx) >= 0):
+                return SECTION_SLIDING, t, mode
             status = record(mode, new_mode, what, t, ctx)
-            if status != GO_ON:  # SECTION_SLIDING
+            if status != GO_ON:
                 return status, t, mode
             if new_mode != mode:
                 rs.count[SWITCHES] += 1

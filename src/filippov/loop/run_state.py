@@ -18,9 +18,11 @@ import numpy as np
 #: bound on switches (max_events); the Zeno ring's size and span (rules.note_switch);
 #: H's touch tolerance; the run's state and time scales (filippov.scale); whether the
 #: event budget is also projected from the switching rate (rules.budget_runs_out: the
-#: reference engine, filippov.engines item 2)
+#: reference engine, filippov.engines item 2); the number of the run's sections (an
+#: arrival on H that would slide inside one is refused: filippov.loop.event)
 Limits = namedtuple("Limits", ["t_end", "sliding", "max_events", "zeno_count", "zeno_span",
-                               "touch_tol", "state_scale", "time_scale", "projects_budget"])
+                               "touch_tol", "state_scale", "time_scale", "projects_budget",
+                               "sections"])
 
 #: the record: ``limits`` (:data:`Limits`); ``count`` (int64, positions :data:`COUNT`:
 #: changes of mode so far, entries into the ring so far; an engine may keep counters of

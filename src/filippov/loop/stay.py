@@ -1,20 +1,20 @@
-"""A run's start and its stays -- when a stay may begin, the start's mode, and the
-refusal to slide inside a section (at the start, and at an arrival on H:
-:mod:`filippov.loop.event`) -- written once for both engines.
+"""A run's stays -- when a stay may begin, the test of a slide inside a section (the
+run's refusal at the start and at an arrival on H: :mod:`filippov.loop.event`), the walk
+over a step's windows -- written once for both engines.
 
 Like :mod:`filippov.loop.event` this is plain scalar Python in the subset numba
 compiles: the reference driver (:mod:`filippov.simulate`) calls these functions as they
 are, with its Python operations; the compiled kernel (:mod:`filippov.kernel.driver`)
 compiles them inlined, with its compiled operations (:func:`before_stay`, which the run
 asks by its name, as a rule: compiled into its caller). A function built from operations
-(:func:`make_start`, :func:`make_slides_in`) takes the engine's state ``ctx`` last, as
-the run's operations do.
+(:func:`make_slides_in`) takes the engine's state ``ctx`` last, as the run's operations
+do.
 """
 from __future__ import annotations
 
 from .. import rules
 from ..system import MINUS, PLUS, SLIDING
-from .status import GO_ON, NO_RETURN, NO_SLIDING, SECTION_SLIDING
+from .status import GO_ON, NO_RETURN, NO_SLIDING
 
 
 def before_stay(mode, t, t_end, sliding):
@@ -26,26 +26,6 @@ def before_stay(mode, t, t_end, sliding):
     if mode == SLIDING and not sliding:
         return NO_SLIDING
     return GO_ON
-
-
-def make_start(speeds, slides_in_section):
-    """``start(h, touch_tol, sliding, ctx) -> (status, mode, repelling)``: the start's
-    mode, decided by the rule book from H at the start (rules.start_side) and, on H, the
-    normal speeds (rules.start_on_switch; ``repelling``: a start on repelling H); status
-    SECTION_SLIDING for a start that slides inside a section, else GO_ON. The engine's
-    operations: ``speeds(ctx) -> (a, b)`` at the start, ``slides_in_section(ctx) ->
-    bool`` (:func:`make_slides_in`)."""
-
-    def start(h, touch_tol, sliding, ctx):
-        side = rules.start_side(h, touch_tol)
-        if side != SLIDING:
-            return GO_ON, side, False
-        a, b = speeds(ctx)
-        mode, repelling = rules.start_on_switch(h, a, b, sliding)
-        if mode == SLIDING and slides_in_section(ctx):
-            return SECTION_SLIDING, mode, repelling
-        return GO_ON, mode, repelling
-    return start
 
 
 def make_slides_in(fields, section_along):
