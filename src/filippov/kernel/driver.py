@@ -41,7 +41,7 @@ from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
 from ..loop.event import SECTION, RunOps, make_run, make_start
-from ..loop.run_state import Limits, RunState
+from ..loop.run_state import Limits, RunState, count_switch
 from ..loop.stay import UNRESOLVED, before_stay
 from ..loop.status import GO_ON
 
@@ -97,9 +97,10 @@ def _section_along_at(k, mode, d, at):
 # fastmap.compute_returns builds them.
 
 _GO_ON = GO_ON  # no event yet / the orbit goes on (never a returned status)
-# the run (filippov.loop.event) asks before_stay by its name, as a rule is asked
-# (kernel.base: compiled into its caller)
+# the run (filippov.loop.event) asks before_stay and count_switch by their names, as a
+# rule is asked (kernel.base: compiled into its caller)
 register_jitable(_nrt=False)(before_stay)
+register_jitable(_nrt=False)(count_switch)
 assert _W_SECTION == SECTION
 
 #: the compile-time switch of the dP/dz code: every branch that carries the derivative

@@ -20,12 +20,13 @@ times in ``rs``, is rules.note_switch.
 Before each stay: filippov.loop.stay.before_stay (the end time; sliding the system does
 not build). The order at a switch: the decision (rules.next_mode); sliding that the
 system does not build (NO_SLIDING); the end of a slide (rules.exit_drift, onto_switch, exit_band,
-exit_shift: the exact flow over time 0); the switch recorded (an arrival on H that would
-slide inside a section refused there: SECTION_SLIDING) and counted; the hard
-bound max_events (EVENT_LIMIT); the Zeno ring (rules.note_switch: ZENO); where the run's
-record says so (the reference engine: :mod:`filippov.engines` item 2), the budget
-projected from the switching rate (rules.budget_runs_out); then the next stay's shift and band, dP/dz across the switch and the engine's entry
-into the new mode.
+exit_shift: the exact flow over time 0); an arrival on H that would slide inside a
+section refused there (SECTION_SLIDING); the switch recorded and counted
+(:func:`filippov.loop.run_state.count_switch`: the hard bound max_events, EVENT_LIMIT; the
+Zeno ring, rules.note_switch, ZENO; where the run's record says so -- the reference
+engine: :mod:`filippov.engines` item 2 -- the budget projected from the switching rate,
+rules.budget_runs_out); then the next stay's shift and band, dP/dz across the switch and
+the engine's entry into the new mode.
 
 The event is written in the run's loop, not as a function the loop calls: numba inlines
 a function by copying its whole IR, and the event, its operations inlined, was the
@@ -38,8 +39,8 @@ from collections import namedtuple
 from .. import rules
 from ..contracts import RunOperations, operations
 from ..system import SLIDING
-from .status import EVENT_LIMIT, GO_ON, NO_SLIDING, OK, SECTION_SLIDING, TWO_FOLD, ZENO
-from .run_state import RING, SWITCHES
+from .status import GO_ON, NO_SLIDING, OK, SECTION_SLIDING, TWO_FOLD
+from .run_state import RING, SWITCHES, count_switch
 from .interval import as_is
 from .stay import before_stay, make_slides_in, make_step_windows
 
@@ -183,21 +184,9 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
             status = record(mode, new_mode, what, t, ctx)
             if status != GO_ON:
                 return status, t, mode
-            if new_mode != mode:
-                rs.count[SWITCHES] += 1
-                if rs.count[SWITCHES] == 1:
-                    rs.first_switch[0] = t
-            if rs.count[SWITCHES] > limits.max_events:
-                return EVENT_LIMIT, t, mode
-            entries, zeno = rules.note_switch(rs.ring, rs.count[RING], t, limits.zeno_count,
-                                              limits.zeno_span, limits.time_scale)
-            rs.count[RING] = entries
-            if zeno:
-                return ZENO, t, mode
-            if entries >= limits.zeno_count and limits.projects_budget and \
-                    rules.budget_runs_out(rs.ring, entries, t, limits.zeno_count,
-                                          limits.t_end, rs.count[SWITCHES], limits.max_events):
-                return EVENT_LIMIT, t, mode
+            status = count_switch(rs, t, new_mode != mode)
+            if status != GO_ON:
+                return status, t, mode
             enter(mode, new_mode, t, shift, band, mode != SLIDING and new_mode != mode, ctx)
             mode = new_mode
     return run

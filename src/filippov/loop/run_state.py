@@ -14,6 +14,9 @@ from collections import namedtuple
 
 import numpy as np
 
+from .. import rules
+from .status import EVENT_LIMIT, GO_ON, ZENO
+
 #: the run's fixed limits: its end time; whether the system builds sliding; the hard
 #: bound on switches (max_events); the Zeno ring's size and span (rules.note_switch);
 #: H's touch tolerance; the run's state and time scales (filippov.scale); whether the
@@ -40,3 +43,28 @@ def new_run_state(limits: Limits) -> RunState:
     """A fresh record for one run: counters at zero, an empty ring, no first switch."""
     return RunState(limits, np.zeros(len(COUNT), dtype=np.int64),
                     np.empty(max(int(limits.zeno_count), 1)), np.full(1, np.nan))
+
+
+def count_switch(rs: RunState, t: float, changed: bool) -> int:
+    """The record at a switch at t (``changed``: a change of mode, counted; the run's first
+    one's time kept): GO_ON, or EVENT_LIMIT past the hard bound max_events, ZENO where the
+    Zeno ring says the switches accumulate (rules.note_switch), EVENT_LIMIT where the
+    budget projected from the switching rate runs out (rules.budget_runs_out, where the
+    limits say so). The run (filippov.loop.event) asks it at every switch it records."""
+    limits = rs.limits
+    if changed:
+        rs.count[SWITCHES] += 1
+        if rs.count[SWITCHES] == 1:
+            rs.first_switch[0] = t
+    if rs.count[SWITCHES] > limits.max_events:
+        return EVENT_LIMIT
+    entries, zeno = rules.note_switch(rs.ring, rs.count[RING], t, limits.zeno_count,
+                                      limits.zeno_span, limits.time_scale)
+    rs.count[RING] = entries
+    if zeno:
+        return ZENO
+    if entries >= limits.zeno_count and limits.projects_budget and rules.budget_runs_out(
+            rs.ring, entries, t, limits.zeno_count, limits.t_end, rs.count[SWITCHES],
+            limits.max_events):
+        return EVENT_LIMIT
+    return GO_ON
