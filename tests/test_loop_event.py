@@ -14,10 +14,11 @@ from filippov.models import pseudo_equilibrium
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "filippov"
 
-#: the rules of an event: asked only by filippov.loop.event (rules.accumulates by
-#: rules.note_switch, the Zeno ring)
-EVENT_RULES = {"next_mode", "note_switch", "exit_drift", "onto_switch", "exit_band",
-               "exit_shift"}
+#: the rules of an event: asked only by filippov.loop.event; and those of the run's record
+#: at a switch, only by filippov.loop.run_state.count_switch, which the run asks
+#: (rules.accumulates by rules.note_switch, the Zeno ring)
+EVENT_RULES = {"next_mode", "exit_drift", "onto_switch", "exit_band", "exit_shift"}
+RECORD_RULES = {"note_switch", "budget_runs_out"}
 
 
 def _calls(path):
@@ -33,11 +34,13 @@ def test_the_event_rules_are_asked_only_by_the_loop():
     askers = {}
     for path in SRC.rglob("*.py"):
         for name in _calls(path):
-            if name is not None and name.lstrip("_") in EVENT_RULES:
+            if name is not None and name.lstrip("_") in EVENT_RULES | RECORD_RULES | {
+                    "count_switch"}:
                 askers.setdefault(name.lstrip("_"), set()).add(
                     str(path.relative_to(SRC)))
-    assert askers, "no rule asked at all: the AST walk is broken"
-    assert all(files == {"loop/event.py"} for files in askers.values()), askers
+    assert set(askers) == EVENT_RULES | RECORD_RULES | {"count_switch"}, askers
+    assert all(askers[r] == {"loop/event.py"} for r in EVENT_RULES | {"count_switch"}), askers
+    assert all(askers[r] == {"loop/run_state.py"} for r in RECORD_RULES), askers
     assert {str(p.relative_to(SRC)) for p in SRC.rglob("*.py")
             if "accumulates" in set(_calls(p))} == {"rules.py"}
 
@@ -70,9 +73,10 @@ def test_the_event_and_the_stay_are_written_in_the_run_loop():
     assert [n.name for n in inner] == ["make_run", "run"]
     loops = [n for n in ast.walk(inner[1]) if isinstance(n, ast.While)]
     assert len(loops) == 2 and loops[1] in list(ast.walk(loops[0]))
-    asked = {n.func.attr for n in ast.walk(loops[0])
-             if isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute)}
-    assert EVENT_RULES - {"accumulates"} <= asked
+    asked = {n.func.attr if isinstance(n.func, ast.Attribute) else n.func.id
+             for n in ast.walk(loops[0]) if isinstance(n, ast.Call)
+             and isinstance(n.func, (ast.Attribute, ast.Name))}
+    assert EVENT_RULES | {"count_switch"} <= asked
     steps = [n.func.id for n in ast.walk(loops[1])
              if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)]
     assert steps == ["next_step", "step_windows", "end_step"]  # the walk over the step's
