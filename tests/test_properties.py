@@ -612,6 +612,17 @@ EVENT_XTOL = max(inspect.signature(f).parameters["event_xtol"].default
                  for f in (simulate, compute_returns))
 
 
+def _near_two_fold(state, p, z_entry, tol):
+    """The state a run stopped at "the slide reached a two-fold" lies next to it: its
+    normal speeds a = y, b = x within twice TWO_FOLD_SHARE of their sizes at the slide's
+    entry (rules.at_two_fold) or of the fields' sizes there (rules.tangent_to_both: |grad
+    H| = 1 here), plus tol."""
+    f_minus = np.hypot(np.hypot(p[2], p[3]), state[1])
+    f_plus = np.hypot(np.hypot(p[0], p[1]), state[0])
+    size = max(np.abs(z_entry).max(), f_minus, f_plus)
+    return np.abs(state).max() <= 2 * rules.TWO_FOLD_SHARE * size + tol
+
+
 def _two_fold_run(case, flows, engine, section_level=100.0):
     from filippov import first_returns
 
@@ -663,13 +674,12 @@ def test_an_invisible_two_fold_is_reached_as_its_loop_map_says(flows, case):
             continue
         msg, t, state = _run_error(run)
         assert "the slide reached a two-fold" in msg, f"{where}: {msg}"
-        # stopped where both speeds are within TWO_FOLD_SHARE of their sizes at the
-        # slide's entry, L(state) before the two-fold: the state named is on the slide
+        # stopped L(state) before the two-fold: the state named is on the slide, and
+        # next to the two-fold (_near_two_fold)
         u, v = gs.slide_rate_one(*case.p[:4])
         _close(t + u * state[1] + v * state[0], case.t_star, TOL[flows],
                f"arrival at the two-fold, t + L(state) ({where})")
-        near = 2 * rules.TWO_FOLD_SHARE * np.abs(case.z_slide).max() + TOL[flows]
-        assert np.abs(state).max() <= near, f"{where}: {msg}"
+        assert _near_two_fold(state, case.p, case.z_slide, TOL[flows]), f"{where}: {msg}"
 
 
 # one case of each outcome, whatever the ci profile draws
@@ -707,8 +717,7 @@ def test_near_a_visible_invisible_two_fold_the_orbit_does_what_its_closed_form_s
             assert "the slide reached a two-fold" in msg, f"{where}: {msg}"
             _close(t + u * state[1] + v * state[0], case.t_star, tol,
                    f"arrival at the two-fold, t + L(state) ({where})")
-            near = 2 * rules.TWO_FOLD_SHARE * np.abs(case.z_c).max() + tol
-            assert np.abs(state).max() <= near, f"{where}: {msg}"
+            assert _near_two_fold(state, case.p, case.z_c, tol), f"{where}: {msg}"
             continue
         got = run()
         n, first = int(got.n_switches[0]), float(got.first_switch[0])

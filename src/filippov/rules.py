@@ -317,6 +317,24 @@ def ended_by(mode: int, q: int) -> int:
     return EXIT_MINUS if q == 0 else EXIT_PLUS
 
 
+#: what ended a slide both of whose normal speeds change sign between the same two samples
+#: (:func:`ends_at_two_fold`): the run stops there, as at :func:`at_two_fold`
+TWO_FOLD_EXIT = 4
+
+
+def ends_at_two_fold(mode: int, a_crosses: bool, b_crosses: bool) -> bool:
+    """While sliding, both normal speeds change sign over the same window, from the
+    sample interval a slide's end is found in to the window's last sample: the slide runs
+    into a two-fold within the window's resolution. The sliding field is not Lipschitz
+    there (homogeneous of degree 0 about it, where the fold lines cross), so an
+    integrated step across it may miss it by as much as the whole step, and the exit
+    found at either speed's root is then an artifact of the step (seen: one speed's root
+    3.7e-6 of its size at the slide's entry from the two-fold, past
+    :data:`TWO_FOLD_SHARE`, the other's a sample interval later, in a step of 8.6e-5
+    across it)."""
+    return mode == SLIDING and a_crosses and b_crosses
+
+
 def start_side(H: float, touch_tol: float) -> int:
     """PLUS or MINUS for a start off H (beyond ``touch_tol``); SLIDING (0) for a
     start on H, where the field directions decide (:func:`start_on_switch`)."""
@@ -633,7 +651,8 @@ def geometric_accumulation(recent, entries: int, zeno_count: int):
 #: A slide ends at a two-fold where both normal speeds vanish at its end: each within
 #: TWO_FOLD_SHARE of its size where the slide began (a, b of a slide go to zero linearly
 #: in the distance to a two-fold; at an ordinary exit the other speed is of the order of
-#: its size along the slide, and one located to the integration's accuracy is ~1e-10 of it)
+#: its size along the slide, and one located to the integration's accuracy is ~1e-10 of
+#: it), or of its field's size there (:func:`tangent_to_both`)
 TWO_FOLD_SHARE = 1e-6
 
 
@@ -641,6 +660,23 @@ def at_two_fold(a: float, b: float, a_in: float, b_in: float) -> bool:
     """The slide that began with the normal speeds a_in > 0 > b_in (F_-, F_+ along grad
     H) ends where they are a and b at a two-fold: both tangent to H."""
     return abs(a) <= TWO_FOLD_SHARE * abs(a_in) and abs(b) <= TWO_FOLD_SHARE * abs(b_in)
+
+
+def tangent_to_both(a: float, b: float, grad, f_minus, f_plus) -> bool:
+    """Both fields within TWO_FOLD_SHARE of tangent to H at a slide's end, the normal
+    speeds a = grad H . F_-, b = grad H . F_+ against |grad H| |F_-|, |grad H| |F_+|
+    there (a two-fold, whatever the speeds where the slide began: :func:`at_two_fold`
+    misses one a slide comes to after it began next to it, as after an exit an
+    integrated step across the two-fold made up, whose slide back onto H starts with
+    speeds as small as the step's miss). The shares are cosines: independent of the
+    units of H, the state and time."""
+    g2, m2, p2 = 0.0, 0.0, 0.0
+    for c in range(grad.size):
+        g2 += grad[c] * grad[c]
+        m2 += f_minus[c] * f_minus[c]
+        p2 += f_plus[c] * f_plus[c]
+    return (abs(a) <= TWO_FOLD_SHARE * np.sqrt(g2 * m2)
+            and abs(b) <= TWO_FOLD_SHARE * np.sqrt(g2 * p2))
 
 
 def budget_projection(recent, entries: int, t: float, zeno_count: int, t_end: float):

@@ -45,9 +45,10 @@ from .interval import as_is
 from .stay import before_stay, make_slides_in, make_step_windows
 
 #: what an event is: a crossing of H or an end of sliding (rules.SWITCH, EXIT_MINUS,
-#: EXIT_PLUS: rules.next_mode's ``ended_by``), or a hit of a section
+#: EXIT_PLUS: rules.next_mode's ``ended_by``; rules.TWO_FOLD_EXIT, a slide into a
+#: two-fold), or a hit of a section
 SECTION = 3
-assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
+assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS, rules.TWO_FOLD_EXIT)
 
 #: the engine's operations in a run, in the order of
 #: :class:`filippov.contracts.RunOperations` (the seam; ``ctx``: the engine's state; the
@@ -122,7 +123,7 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
     status ends it (OK at a terminal section hit, NO_RETURN at the end time, or the
     start's, a stay's or an event's); t and ``mode`` where it ended. ``rs``: the run's
     record (:class:`~filippov.loop.run_state.RunState`), counters cleared first."""
-    begin, next_step, window, end_step, record, speeds, _, _, exit_state, enter = ops
+    begin, next_step, window, end_step, record, speeds, fields, _, exit_state, enter = ops
     step_windows = inline(make_step_windows(window))  # ``inline``: the kernel's, or as is
     # ``call``: the kernel's compiled call (asked at an arrival on H only)
     sliding_section = call(make_sliding_section(ops, inline))
@@ -156,6 +157,8 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
                 if status != GO_ON:
                     return status, t, mode
                 continue
+            if what == rules.TWO_FOLD_EXIT:  # both speeds ended in one sample interval
+                return TWO_FOLD, t, mode
             a, b = speeds(ctx)
             new_mode = rules.next_mode(mode, what, a, b)
             if mode == SLIDING and new_mode != SLIDING and rules.at_two_fold(a, b, a_in, b_in):
@@ -169,6 +172,9 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
                 # the end of a slide: a state the slide left off H beyond rounding is
                 # moved onto it; the next stay measures H from the exit's rounding
                 z, grad, h0, z_next = exit_state(new_mode, ctx)
+                _, f_minus, f_plus, _ = fields(ctx)  # both tangent: a two-fold after all
+                if rules.tangent_to_both(a, b, grad, f_minus, f_plus):
+                    return TWO_FOLD, t, mode
                 drift = rules.exit_drift(new_mode, h0, z, grad, limits.touch_tol)
                 if drift:
                     rules.onto_switch(z, h0, grad)
