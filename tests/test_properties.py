@@ -633,8 +633,20 @@ def _two_fold_run(case, flows, engine, section_level=100.0):
                                  direction=+1)
 
 
+#: a case the deep profile drew where a slide into the two-fold missed it by more than
+#: TWO_FOLD_SHARE of its speeds at the slide's entry (the reference engine's exact-flow
+#: run by 3.7e-6, the compiled engine's integrated one by 5.7e-5) and went on through it
+#: until rules.tangent_to_both and rules.ends_at_two_fold stopped it there
+MISSED_TWO_FOLD = gs.TwoFold(
+    np.array([-1.0, -1.25, 1.6282863709984756, 0.96875, 100.0]),
+    np.array([0.16796875, 0.5180156074466642, 0.04232025146484375]), "leaves",
+    0.16015625, 0.9270629233625299, 2, 0.8150937444586587,
+    np.array([-0.04011792265814401, 0.011572398407975776, 0.0]))
+
+
 @pytest.mark.parametrize("flows", FLOWS)
 @FEW
+@example(case=MISSED_TWO_FOLD)
 @example(case=gs.invisible_two_fold_from(-1.0, -1.0, 1.0, 0.3, "zeno"))
 @example(case=gs.invisible_two_fold_from(-1.0, -1.0, 1.0, 0.3, "leaves", 1.0, 0.5, 0.05))
 @example(case=gs.invisible_two_fold_from(-1.0, -1.0, 1.0, 0.3, "slide", 1.0, offset=0.5))

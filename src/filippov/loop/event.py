@@ -18,9 +18,11 @@ is the run's record on both. The Zeno ring, an array of the last ``zeno_count`` 
 times in ``rs``, is rules.note_switch.
 
 Before each stay: filippov.loop.stay.before_stay (the end time; sliding the system does
-not build). The order at a switch: the decision (rules.next_mode); sliding that the
-system does not build (NO_SLIDING); the end of a slide (rules.exit_drift, onto_switch, exit_band,
-exit_shift: the exact flow over time 0); an arrival on H that would slide inside a
+not build). The order at a switch: the decision (rules.next_mode); a slide's end at a
+two-fold (rules.at_two_fold; rules.ends_at_two_fold, the event search's; TWO_FOLD);
+sliding that the system does not build (NO_SLIDING); the end of a slide (both fields
+tangent to H there, rules.tangent_to_both, TWO_FOLD; rules.exit_drift, onto_switch,
+exit_band, exit_shift: the exact flow over time 0); an arrival on H that would slide inside a
 section refused there (SECTION_SLIDING); the switch recorded and counted
 (:func:`filippov.loop.run_state.count_switch`: the hard bound max_events, EVENT_LIMIT; the
 Zeno ring, rules.note_switch, ZENO; where the run's record says so -- the reference
