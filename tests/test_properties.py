@@ -636,7 +636,7 @@ def _two_fold_run(case, flows, engine, section_level=100.0):
 #: a case the deep profile drew where a slide into the two-fold missed it by more than
 #: TWO_FOLD_SHARE of its speeds at the slide's entry (the reference engine's exact-flow
 #: run by 3.7e-6, the compiled engine's integrated one by 5.7e-5) and went on through it
-#: until rules.tangent_to_both and rules.ends_at_two_fold stopped it there
+#: until rules.tangent_to_both stopped it there
 MISSED_TWO_FOLD = gs.TwoFold(
     np.array([-1.0, -1.25, 1.6282863709984756, 0.96875, 100.0]),
     np.array([0.16796875, 0.5180156074466642, 0.04232025146484375]), "leaves",

@@ -177,7 +177,6 @@ def test_the_two_fold_rule_asks_both_speeds():
 
 
 def test_a_slide_end_where_both_fields_are_tangent_to_h_is_a_two_fold_in_any_units():
-    from filippov.system import MINUS, SLIDING
     grad, fm, fp = np.array([0.0, 0.0, 2.0]), np.array([3.0, 4.0, 0.0]), np.array([0.0, 1.0, 0.0])
     # |grad H| |F_-| = 10, |grad H| |F_+| = 2: the shares are cosines
     assert rules.tangent_to_both(9e-6, -1.9e-6, grad, fm, fp)
@@ -186,6 +185,3 @@ def test_a_slide_end_where_both_fields_are_tangent_to_h_is_a_two_fold_in_any_uni
     for k in (1e-3, 1e3):  # H, and with it a and b, in other units
         assert rules.tangent_to_both(9e-6 * k, -1.9e-6 * k, grad * k, fm, fp)
         assert not rules.tangent_to_both(1.1e-5 * k, 0.0, grad * k, fm, fp)
-    assert rules.ends_at_two_fold(SLIDING, True, True)
-    assert not rules.ends_at_two_fold(SLIDING, True, False)
-    assert not rules.ends_at_two_fold(MINUS, True, True)

@@ -317,24 +317,6 @@ def ended_by(mode: int, q: int) -> int:
     return EXIT_MINUS if q == 0 else EXIT_PLUS
 
 
-#: what ended a slide both of whose normal speeds change sign between the same two samples
-#: (:func:`ends_at_two_fold`): the run stops there, as at :func:`at_two_fold`
-TWO_FOLD_EXIT = 4
-
-
-def ends_at_two_fold(mode: int, a_crosses: bool, b_crosses: bool) -> bool:
-    """While sliding, both normal speeds change sign over the same window, from the
-    sample interval a slide's end is found in to the window's last sample: the slide runs
-    into a two-fold within the window's resolution. The sliding field is not Lipschitz
-    there (homogeneous of degree 0 about it, where the fold lines cross), so an
-    integrated step across it may miss it by as much as the whole step, and the exit
-    found at either speed's root is then an artifact of the step (seen: one speed's root
-    3.7e-6 of its size at the slide's entry from the two-fold, past
-    :data:`TWO_FOLD_SHARE`, the other's a sample interval later, in a step of 8.6e-5
-    across it)."""
-    return mode == SLIDING and a_crosses and b_crosses
-
-
 def start_side(H: float, touch_tol: float) -> int:
     """PLUS or MINUS for a start off H (beyond ``touch_tol``); SLIDING (0) for a
     start on H, where the field directions decide (:func:`start_on_switch`)."""
@@ -665,11 +647,13 @@ def at_two_fold(a: float, b: float, a_in: float, b_in: float) -> bool:
 def tangent_to_both(a: float, b: float, grad, f_minus, f_plus) -> bool:
     """Both fields within TWO_FOLD_SHARE of tangent to H at a slide's end, the normal
     speeds a = grad H . F_-, b = grad H . F_+ against |grad H| |F_-|, |grad H| |F_+|
-    there (a two-fold, whatever the speeds where the slide began: :func:`at_two_fold`
-    misses one a slide comes to after it began next to it, as after an exit an
-    integrated step across the two-fold made up, whose slide back onto H starts with
-    speeds as small as the step's miss). The shares are cosines: independent of the
-    units of H, the state and time."""
+    there: a two-fold, whatever the speeds where the slide began. The sliding field is
+    not Lipschitz at a two-fold (homogeneous of degree 0 about it, where the fold lines
+    cross), so an integrated step across it can miss it by far more than its tolerance
+    (seen: the other speed 3.7e-6 and 5.7e-5 of its size where the slide began, past
+    :func:`at_two_fold`'s share, where the slide ran straight into it), and a slide that
+    began next to a two-fold starts with speeds as small as that. The shares are
+    cosines: independent of the units of H, the state and time."""
     g2, m2, p2 = 0.0, 0.0, 0.0
     for c in range(grad.size):
         g2 += grad[c] * grad[c]

@@ -19,7 +19,7 @@ times in ``rs``, is rules.note_switch.
 
 Before each stay: filippov.loop.stay.before_stay (the end time; sliding the system does
 not build). The order at a switch: the decision (rules.next_mode); a slide's end at a
-two-fold (rules.at_two_fold; rules.ends_at_two_fold, the event search's; TWO_FOLD);
+two-fold (rules.at_two_fold: TWO_FOLD);
 sliding that the system does not build (NO_SLIDING); the end of a slide (both fields
 tangent to H there, rules.tangent_to_both, TWO_FOLD; rules.exit_drift, onto_switch,
 exit_band, exit_shift: the exact flow over time 0); an arrival on H that would slide inside a
@@ -47,10 +47,9 @@ from .interval import as_is
 from .stay import before_stay, make_slides_in, make_step_windows
 
 #: what an event is: a crossing of H or an end of sliding (rules.SWITCH, EXIT_MINUS,
-#: EXIT_PLUS: rules.next_mode's ``ended_by``; rules.TWO_FOLD_EXIT, a slide into a
-#: two-fold), or a hit of a section
+#: EXIT_PLUS: rules.next_mode's ``ended_by``), or a hit of a section
 SECTION = 3
-assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS, rules.TWO_FOLD_EXIT)
+assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 
 #: the engine's operations in a run, in the order of
 #: :class:`filippov.contracts.RunOperations` (the seam; ``ctx``: the engine's state; the
@@ -159,8 +158,6 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
                 if status != GO_ON:
                     return status, t, mode
                 continue
-            if what == rules.TWO_FOLD_EXIT:  # both speeds ended in one sample interval
-                return TWO_FOLD, t, mode
             a, b = speeds(ctx)
             new_mode = rules.next_mode(mode, what, a, b)
             if mode == SLIDING and new_mode != SLIDING and rules.at_two_fold(a, b, a_in, b_in):

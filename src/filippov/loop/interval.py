@@ -6,9 +6,7 @@ Between two samples of a stay the search asks, in this order:
 
 1. does a leave function change sign (h: a switch; while sliding, a or b: an exit into
    region - or +: ``rules.leave_pred``, ``rules.ended_by``)? Its root, refined; the
-   earliest of them is the event so far (while sliding, where a and b both change sign
-   from the interval's start to the window's last sample, the slide runs into a
-   two-fold there: ``rules.ends_at_two_fold``, at the earlier root). The root of h is refined beyond the dip after
+   earliest of them is the event so far. The root of h is refined beyond the dip after
    an entry at H (``rules.dips_and_returns``), and again on h itself when found beyond the
    exit's band (:func:`make_leave_root`);
 2. has a leave function an extremum toward its sign change hidden between the samples
@@ -266,10 +264,6 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
                         return st, r, NONE, -1
                     if best_w == NONE or r < best_t:
                         best_t, best_w = r, rules.ended_by(mode, q)
-                if mode == SLIDING and best_w != NONE and rules.ends_at_two_fold(
-                        mode, rules.crosses(pred0, va0, sampled(ctx, F_LEAVE, n)),
-                        rules.crosses(pred1, va1, sampled(ctx, F_LEAVE + 1, n))):
-                    best_w = rules.TWO_FOLD_EXIT  # at the earlier root
                 # 2. an extremum of a leave function hidden between the samples
                 for q in range(nl):
                     if not ((x0 if q == 0 else x1) and rules.asks_hidden_end(
