@@ -659,8 +659,7 @@ def tangent_to_both(a: float, b: float, grad, f_minus, f_plus) -> bool:
         g2 += grad[c] * grad[c]
         m2 += f_minus[c] * f_minus[c]
         p2 += f_plus[c] * f_plus[c]
-    return (abs(a) <= TWO_FOLD_SHARE * np.sqrt(g2 * m2)
-            and abs(b) <= TWO_FOLD_SHARE * np.sqrt(g2 * p2))
+    return at_two_fold(a, b, np.sqrt(g2 * m2), np.sqrt(g2 * p2))
 
 
 def budget_projection(recent, entries: int, t: float, zeno_count: int, t_end: float):
