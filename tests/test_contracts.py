@@ -127,8 +127,9 @@ SEAM_TARGET = 8
 #: event's records, H at the exit and the entry were folded; then the flow over time 0
 #: into the exit's state and the refusal to slide in a section into the record; 10 since
 #: the start and that refusal, the loop's, are built on the run's fields and
-#: section_along, not handed to the loop as factories of their own): never more
-SEAM_NOW = 10
+#: section_along, not handed to the loop as factories of their own; 9 since the speeds
+#: are a part of the pieces the engine evaluates at the state): never more
+SEAM_NOW = 9
 
 
 def _engines_operations():
@@ -166,8 +167,9 @@ WINDOW_NOW = 7
 #: run walks a step's windows itself (make_step_windows' window is the run's); 17 since
 #: the start and the test of a slide inside a section are built from the run's own
 #: operations (its speeds, fields and section_along) and the run refuses such an arrival
-#: on H itself
-OPERATIONS_TARGET, OPERATIONS_NOW = 8, 17
+#: on H itself; 16 since the normal speeds are a part of the pieces at the state
+#: (``pieces``: z, grad H, F_-, F_+, a, b), not an operation of their own
+OPERATIONS_TARGET, OPERATIONS_NOW = 8, 16
 
 
 @pytest.mark.parametrize("engine", ["reference", "compiled"])

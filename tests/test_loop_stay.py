@@ -7,6 +7,7 @@ from numba import njit
 
 from filippov import rules
 from filippov.loop import stay
+from filippov.loop.event import Pieces
 from filippov.loop.status import GO_ON, NO_RETURN, NO_SLIDING, SECTION_SLIDING
 from filippov.system import MINUS, PLUS, SLIDING
 
@@ -27,9 +28,9 @@ def _start(slides):
     lies on H (slides: the sliding flow stays in it) or across it."""
     from filippov.loop.event import RunOps, make_start
     section = (lambda z: z[1]) if slides else (lambda z: z[0] - 0.3)
-    fields, along = _plane(section)
-    return make_start(RunOps(*[None] * 5, lambda ctx: (ctx[0], ctx[1]), fields, along,
-                             None, None))
+    pieces, along = _plane(section)
+    return make_start(RunOps(*[None] * 5, lambda ctx: pieces(ctx)._replace(a=ctx[0], b=ctx[1]),
+                             along, None, None))
 
 
 @pytest.mark.parametrize("h, a, b, sliding, slides, expected", [
@@ -50,10 +51,12 @@ def test_the_start_mode_and_its_refusal_to_slide_in_a_section(h, a, b, sliding, 
 
 def _plane(section):
     """F_- = (1, 1), F_+ = (1, -1) about H = y: sliding along y = 0 with field (1, 0);
-    section_along as the engines' operation (the field of a mode at z + d f)."""
+    the pieces there and section_along as the engines' operations (the field of a mode at
+    z + d f)."""
     z, fm, fp = np.array([0.3, 0.0]), np.array([1.0, 1.0]), np.array([1.0, -1.0])
     fields = {MINUS: fm, PLUS: fp, SLIDING: np.array([1.0, 0.0])}
-    return (lambda ctx: (z, fm, fp, 1.0),
+    grad = np.array([0.0, 1.0])
+    return (lambda ctx: Pieces(z, grad, fm, fp, grad @ fm, grad @ fp, 1.0),
             lambda k, mode, d, ctx: section(z + d * fields[mode]))
 
 

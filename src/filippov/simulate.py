@@ -38,7 +38,7 @@ from .radau_iia import RadauIIA
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
 from .errors import accumulation_detail, run_error
-from .loop.event import SECTION, RunOps, make_run, make_sliding_section, make_start
+from .loop.event import SECTION, Pieces, RunOps, make_run, make_sliding_section, make_start
 from .loop.run_state import RING, SWITCHES, Limits, new_run_state
 from .section import Section  # noqa: F401  (re-exported: filippov.simulate.Section)
 from .loop.stay import UNRESOLVED
@@ -297,10 +297,15 @@ def _root(xtol, fun, lo, hi, vlo, vhi):
     return True, r, fun(r)
 
 
-def _slide_fields(run):
+def _pieces(run):
+    """The pieces at the run's state (loop.event.Pieces): a and b as
+    PiecewiseSystem.normal_speeds sums them."""
     z = np.asarray(run.z, dtype=float)
-    return (z, np.asarray(run.system.field_minus(z), float),
-            np.asarray(run.system.field_plus(z), float), getattr(run, "state_scale", 1.0))
+    system = run.system
+    grad = np.asarray(system.switch_grad(z), float)
+    fm, fp = np.asarray(system.field_minus(z), float), np.asarray(system.field_plus(z), float)
+    return Pieces(z, grad, fm, fp, float(np.sum(grad * fm, axis=0)),
+                  float(np.sum(grad * fp, axis=0)), getattr(run, "state_scale", 1.0))
 
 
 def _section_along(k, mode, d, run):
@@ -312,11 +317,6 @@ def _section_along(k, mode, d, run):
     f = (system.field_minus(z) if mode == MINUS else system.field_plus(z) if mode == PLUS
          else system.sliding_field(z))
     return float(func(z + d * np.asarray(f, float)))
-
-
-def _normal_speeds(run):
-    """(a, b) at the run's state."""
-    return tuple(float(v) for v in run.system.normal_speeds(run.z))
 
 
 #: where a start is asked about, for the run's operations (they read these fields of a
@@ -785,8 +785,7 @@ RUN_OPERATIONS = RunOps(
     window=lambda mode, t0, t1, first, may_split, run: run.window(t0, t1, first, may_split),
     end_step=lambda mode, ta, tb, status, t, run: run.end_step(ta, tb, status),
     record=_record,
-    speeds=_normal_speeds,
-    fields=_slide_fields,
+    pieces=_pieces,
     section_along=_section_along,
     exit_state=_exit_state,
     enter=_enter)

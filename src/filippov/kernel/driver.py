@@ -40,31 +40,32 @@ from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY
                     kernel_signature)  # noqa: F401
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
-from ..loop.event import SECTION, RunOps, make_run, make_start
+from ..loop.event import SECTION, Pieces, RunOps, make_run, make_start
 from ..loop.run_state import Limits, RunState, count_switch
 from ..loop.stay import UNRESOLVED, before_stay
 from ..loop.status import GO_ON
 
 
-# ------------------------------------------------------------------ sliding in the section
-# The run's fields and section_along (the test of a slide inside the section at the start
-# and at an arrival on H, filippov.loop.event.make_sliding_section) at the state w.z;
-# section_along calls _section_along_at with only what it reads
-# (docs/decisions.md#kernel-small-records).
+# ------------------------------------------------------------------ the pieces at the state
+# The run's pieces at the state w.z (at an event, at the start), and section_along (with
+# them, the test of a slide inside the section at the start and at an arrival on H,
+# filippov.loop.event.make_sliding_section); section_along calls _section_along_at with
+# only what it reads (docs/decisions.md#kernel-small-records).
 
 @_jit_inline
-def _event_fields(ctx):
-    """(z, F_-, F_+) at the state w.z, in w.wf and w.wp (grad h left in w.wg), and the
-    run's state scale."""
+def _event_pieces(ctx):
+    """loop.event.Pieces at the state w.z: grad h, F_- and F_+ in w.wg, w.wf, w.wp (what
+    _exit_state and _event_section_along read there), a and b, and the run's state
+    scale."""
     fns, p, s, w = ctx
-    _speeds(w.z, fns, p, w.wg, w.wf, w.wp)
-    return w.z, w.wf, w.wp, s.state_scale
+    a, b = _speeds(w.z, fns, p, w.wg, w.wf, w.wp)
+    return Pieces(w.z, w.wg, w.wf, w.wp, a, b, s.state_scale)
 
 
 @_jit_inline
 def _event_section_along(k, mode, d, ctx):
     """The section at w.z + d (cm F_- + cp F_+), the field of ``mode`` as its weights
-    (Filippov's while sliding, from F_-, F_+ and grad h left by _event_fields); d = 0:
+    (Filippov's while sliding, from F_-, F_+ and grad h left by _event_pieces); d = 0:
     at w.z."""
     fns, p, s, w = ctx
     # the loop passes k and the modes as Python int constants, literals to numba: + 0
@@ -303,14 +304,8 @@ def _at_section(mode, t, ctx):
 
 
 @_jit_inline
-def _event_speeds(ctx):
-    fns, p, s, w = ctx
-    return _speeds(w.z, fns, p, w.wg, w.wf, w.wp)
-
-
-@_jit_inline
 def _exit_state(new_mode, ctx):
-    """The event's state w.z, grad h there (left in w.wg by _event_speeds), h, and the
+    """The event's state w.z, grad h there (left in w.wg by _event_pieces), h, and the
     exact flow of w.z in new_mode over time 0 (its rounding, in w.wz), or w.z itself when
     integrated."""
     fns, p, s, w = ctx
@@ -425,8 +420,8 @@ def _begin(z0, age0, ctx):
 #: the kernel's side of the seam (filippov.contracts.RunOperations): each operation's
 #: function by name
 _RUN_OPS = {"begin": "_begin", "next_step": "_next_step", "window": "_window",
-            "end_step": "_end_step", "record": "_record", "speeds": "_event_speeds",
-            "fields": "_event_fields", "section_along": "_event_section_along",
+            "end_step": "_end_step", "record": "_record", "pieces": "_event_pieces",
+            "section_along": "_event_section_along",
             "exit_state": "_exit_state", "enter": "_enter"}
 
 

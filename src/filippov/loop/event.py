@@ -2,7 +2,7 @@
 what order, against the event budget and the Zeno ring: written once for both engines.
 
 :func:`make_run` builds the run from the engine's own operations (:class:`RunOps`: how
-it starts, follows a stay to its event, evaluates the speeds, h and grad h at the
+it starts, follows a stay to its event, evaluates the pieces, h and grad h at the
 event's state and the exact flow over time 0, records a hit or a switch, keeps the next
 stay's shift, updates dP/dz); what the run itself keeps -- its limits, the switches
 counted, the Zeno ring, the first switch's time -- is the loop's own record
@@ -68,11 +68,11 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: record(mode, new_mode, what, t, ctx) -> status: an event recorded, a section hit
 #: (what == SECTION: OK ends the run, GO_ON goes on) or a switch (before the budgets
 #: are asked; GO_ON);
-#: speeds(ctx) -> (a, b); fields(ctx) -> (z, F_-, F_+, floor) at the state, arrays, and
-#: the run's state scale (filippov.scale); section_along(k, mode, d, ctx): section k at
-#: z + d times the field of ``mode`` (MINUS, PLUS, SLIDING; d = 0: at z) -- the last two
-#: for the test of a slide inside a section (filippov.loop.stay.make_slides_in), at the
-#: start and at an arrival on H; exit_state(new_mode, ctx) -> (the state as an array the event
+#: pieces(ctx) -> :data:`Pieces` (the pieces at the state: the engine evaluates, the loop
+#: decides with them); section_along(k, mode, d, ctx): section k at
+#: z + d times the field of ``mode`` (MINUS, PLUS, SLIDING; d = 0: at z) -- with the
+#: pieces, the test of a slide inside a section (filippov.loop.stay.make_slides_in), at
+#: the start and at an arrival on H; exit_state(new_mode, ctx) -> (the state as an array the event
 #: may move onto H, grad H and H there, and the state the next stay in new_mode starts
 #: from as it evaluates it: the exact flow over time 0, rules.exit_band);
 #: enter(mode, new_mode, t, shift, band, crossed, ctx): the
@@ -80,12 +80,18 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: across a crossing (``crossed``), the engine's bookkeeping
 RunOps = namedtuple("RunOps", operations(RunOperations))
 
+#: what ``pieces(ctx)`` returns, the pieces at the state as the engine evaluates them:
+#: the state z, grad H, F_- and F_+ there (arrays), the normal speeds a = grad H . F_-
+#: and b = grad H . F_+ (the engine's own dot products: the reference's numpy sums, the
+#: kernel's loops), and the run's state scale (filippov.scale)
+Pieces = namedtuple("Pieces", ("z", "grad", "f_minus", "f_plus", "a", "b", "floor"))
+
 
 def make_sliding_section(ops: RunOps, inline=as_is):
     """``sliding_section(n, ctx) -> k``: the first of the run's n sections the sliding flow
     at the state (on H) stays in (filippov.loop.stay.make_slides_in on the engine's
-    ``fields`` and ``section_along``), or -1."""
-    slides_in = inline(make_slides_in(ops.fields, ops.section_along))
+    ``pieces`` and ``section_along``), or -1."""
+    slides_in = inline(make_slides_in(ops.pieces, ops.section_along))
 
     def sliding_section(n, ctx):
         for k in range(n):
@@ -100,9 +106,9 @@ def make_start(ops: RunOps, inline=as_is, call=as_is):
     start's mode, decided by the rule book from H at the start (rules.start_side) and, on
     H, the normal speeds (rules.start_on_switch; ``repelling``: a start on repelling H);
     status SECTION_SLIDING for a start that slides inside one of the run's ``sections``
-    sections (:func:`make_sliding_section`), else GO_ON. On the engine's ``speeds``,
-    ``fields`` and ``section_along`` at the start: an engine's ``begin`` asks it."""
-    speeds = ops.speeds
+    sections (:func:`make_sliding_section`), else GO_ON. On the engine's ``pieces`` and
+    ``section_along`` at the start: an engine's ``begin`` asks it."""
+    pieces = ops.pieces
     # ``call``: the kernel's compiled call (asked at a start on H only)
     sliding_section = call(make_sliding_section(ops, inline))
 
@@ -110,8 +116,8 @@ def make_start(ops: RunOps, inline=as_is, call=as_is):
         side = rules.start_side(h, touch_tol)
         if side != SLIDING:
             return GO_ON, side, False
-        a, b = speeds(ctx)
-        mode, repelling = rules.start_on_switch(h, a, b, sliding)
+        pc = pieces(ctx)
+        mode, repelling = rules.start_on_switch(h, pc.a, pc.b, sliding)
         if mode == SLIDING and sliding_section(sections, ctx) >= 0:
             return SECTION_SLIDING, mode, repelling
         return GO_ON, mode, repelling
@@ -124,7 +130,7 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
     status ends it (OK at a terminal section hit, NO_RETURN at the end time, or the
     start's, a stay's or an event's); t and ``mode`` where it ended. ``rs``: the run's
     record (:class:`~filippov.loop.run_state.RunState`), counters cleared first."""
-    begin, next_step, window, end_step, record, speeds, fields, _, exit_state, enter = ops
+    begin, next_step, window, end_step, record, pieces, _, exit_state, enter = ops
     step_windows = inline(make_step_windows(window))  # ``inline``: the kernel's, or as is
     # ``call``: the kernel's compiled call (asked at an arrival on H only)
     sliding_section = call(make_sliding_section(ops, inline))
@@ -136,7 +142,10 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
         if status != GO_ON:
             return status, t, mode
         # the normal speeds where the current slide began (rules.at_two_fold)
-        a_in, b_in = speeds(ctx) if mode == SLIDING else (0.0, 0.0)
+        a_in, b_in = 0.0, 0.0
+        if mode == SLIDING:
+            pc = pieces(ctx)
+            a_in, b_in = pc.a, pc.b
         while True:
             status = before_stay(mode, t, limits.t_end, limits.sliding)
             if status != GO_ON:
@@ -158,7 +167,8 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
                 if status != GO_ON:
                     return status, t, mode
                 continue
-            a, b = speeds(ctx)
+            pc = pieces(ctx)
+            a, b = pc.a, pc.b
             new_mode = rules.next_mode(mode, what, a, b)
             if mode == SLIDING and new_mode != SLIDING and rules.at_two_fold(a, b, a_in, b_in):
                 return TWO_FOLD, t, mode
@@ -168,12 +178,12 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
                 return NO_SLIDING, t, mode
             shift, band = 0.0, 0.0
             if mode == SLIDING and new_mode != SLIDING:
+                # both fields tangent to H where the slide ends: a two-fold after all
+                if rules.tangent_to_both(a, b, pc.grad, pc.f_minus, pc.f_plus):
+                    return TWO_FOLD, t, mode
                 # the end of a slide: a state the slide left off H beyond rounding is
                 # moved onto it; the next stay measures H from the exit's rounding
                 z, grad, h0, z_next = exit_state(new_mode, ctx)
-                _, f_minus, f_plus, _ = fields(ctx)  # both tangent: a two-fold after all
-                if rules.tangent_to_both(a, b, grad, f_minus, f_plus):
-                    return TWO_FOLD, t, mode
                 drift = rules.exit_drift(new_mode, h0, z, grad, limits.touch_tol)
                 if drift:
                     rules.onto_switch(z, h0, grad)

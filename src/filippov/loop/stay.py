@@ -28,16 +28,18 @@ def before_stay(mode, t, t_end, sliding):
     return GO_ON
 
 
-def make_slides_in(fields, section_along):
+def make_slides_in(pieces, section_along):
     """``slides_in(k, ctx) -> bool``: does the sliding flow at the state (on H) stay in
     section k? rules.slides_in_section from the section's value there and its rates along
     F_-, F_+ and the sliding field, by central differences of the step rules.central_step
-    gives (0: no). The engine's operations: ``fields(ctx) -> (z, F_-, F_+, floor)`` at
-    the state, arrays, and the run's state scale (filippov.scale); ``section_along(k, mode, d, ctx)``: section k at z + d times the field
-    of ``mode`` (MINUS, PLUS, SLIDING; d = 0: at z)."""
+    gives (0: no). The engine's operations: ``pieces(ctx)``, the pieces at the state
+    (filippov.loop.event.Pieces: z, F_-, F_+ and the run's state scale read here);
+    ``section_along(k, mode, d, ctx)``: section k at z + d times the field of ``mode``
+    (MINUS, PLUS, SLIDING; d = 0: at z)."""
 
     def slides_in(k, ctx):
-        z, fm, fp, floor = fields(ctx)
+        pc = pieces(ctx)
+        z, fm, fp, floor = pc.z, pc.f_minus, pc.f_plus, pc.floor
         speed, size = 0.0, floor
         for c in range(z.size):
             speed = max(speed, abs(fm[c]), abs(fp[c]))
