@@ -17,8 +17,11 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "filippov"
 #: the rules of an event: asked only by filippov.loop.event; and those of the run's record
 #: at a switch, only by filippov.loop.run_state.count_switch, which the run asks
 #: (rules.accumulates by rules.note_switch, the Zeno ring)
-EVENT_RULES = {"next_mode", "exit_drift", "onto_switch", "exit_band", "exit_shift"}
-RECORD_RULES = {"note_switch", "budget_runs_out"}
+EVENT_RULES = {"next_mode", "exit_drift", "onto_switch", "exit_band", "exit_shift",
+               "banded_shift"}
+RECORD_RULES = {"note_switch", "budget_runs_out", "step_budget_spent"}
+#: asked by the loop's start (make_start), which an engine's begin calls
+START_RULES = {"carried_age"}
 
 
 def _calls(path):
@@ -34,12 +37,14 @@ def test_the_event_rules_are_asked_only_by_the_loop():
     askers = {}
     for path in SRC.rglob("*.py"):
         for name in _calls(path):
-            if name is not None and name.lstrip("_") in EVENT_RULES | RECORD_RULES | {
-                    "count_switch"}:
+            if name is not None and name.lstrip("_") in EVENT_RULES | RECORD_RULES | (
+                    START_RULES | {"count_switch", "count_step"}):
                 askers.setdefault(name.lstrip("_"), set()).add(
                     str(path.relative_to(SRC)))
-    assert set(askers) == EVENT_RULES | RECORD_RULES | {"count_switch"}, askers
-    assert all(askers[r] == {"loop/event.py"} for r in EVENT_RULES | {"count_switch"}), askers
+    assert set(askers) == EVENT_RULES | RECORD_RULES | START_RULES | {
+        "count_switch", "count_step"}, askers
+    assert all(askers[r] == {"loop/event.py"}
+               for r in EVENT_RULES | START_RULES | {"count_switch", "count_step"}), askers
     assert all(askers[r] == {"loop/run_state.py"} for r in RECORD_RULES), askers
     assert {str(p.relative_to(SRC)) for p in SRC.rglob("*.py")
             if "accumulates" in set(_calls(p))} == {"rules.py"}
@@ -76,10 +81,11 @@ def test_the_event_and_the_stay_are_written_in_the_run_loop():
     asked = {n.func.attr if isinstance(n.func, ast.Attribute) else n.func.id
              for n in ast.walk(loops[0]) if isinstance(n, ast.Call)
              and isinstance(n.func, (ast.Attribute, ast.Name))}
-    assert EVENT_RULES | {"count_switch"} <= asked
-    steps = [n.func.id for n in ast.walk(loops[1])
-             if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)]
-    assert steps == ["next_step", "step_windows", "end_step"]  # the walk over the step's
+    assert EVENT_RULES | {"count_switch", "count_step"} <= asked
+    steps = [n.func.id for n in sorted(
+        (n for n in ast.walk(loops[1]) if isinstance(n, ast.Call)
+         and isinstance(n.func, ast.Name)), key=lambda n: (n.lineno, n.col_offset))]
+    assert steps == ["count_step", "next_step", "step_windows", "end_step"]  # the walk over the step's
     # windows (loop.stay.make_step_windows) on the engine's window
 
 

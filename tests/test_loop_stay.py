@@ -42,9 +42,10 @@ def _start(slides):
 ])
 def test_the_start_mode_and_its_refusal_to_slide_in_a_section(h, a, b, sliding, slides,
                                                              expected):
-    status, mode, repelling = _start(slides)(h, 1e-15, sliding, 1, (a, b))
-    assert _start(True)(h, 1e-15, sliding, 0, (a, b))[0] == GO_ON  # no section
+    status, mode, repelling, age = _start(slides)(h, 1e-15, sliding, 1, 2.5, (a, b))
+    assert _start(True)(h, 1e-15, sliding, 0, 2.5, (a, b))[0] == GO_ON  # no section
     assert (status, mode, repelling) == expected
+    assert age == (2.5 if h != 0.0 else 0.0)  # the age carried off H only (rules.carried_age)
     assert (mode, repelling) == ((rules.start_side(h, 1e-15), False) if h != 0.0
                                  else rules.start_on_switch(h, a, b, sliding))
 

@@ -50,16 +50,17 @@ engine's own budget verdict (item 2). The start is one function too,
 :func:`filippov.loop.event.make_start` (the start mode, ``rules.start_side`` and
 ``rules.start_on_switch``, and the refusal to slide inside a section, whose test
 ``make_sliding_section`` the run asks at an arrival on H too), and so is the check before each stay (the
-run's end time; sliding the system does not build), asked by the run. A stay is written
+run's end time; sliding the system does not build) and the step budget before each step
+(the hard bound ``max_steps``, ``rules.step_budget_spent`` in
+:func:`filippov.loop.run_state.count_step`: integration steps, or exact-flow windows,
+counted alike), asked by the run. A stay is written
 in the run's loop too: its start, then step by step the step, its windows (the step
 searched window by window, ``loop.stay.make_step_windows``: the first the whole step,
 shorter ones where its samples do not resolve what they sample) and the step's end,
 each engine answering with its own stepper. Both share one
 set of status codes (:mod:`filippov.loop.status`), and one table turns a status into its
 exception class and message (:func:`filippov.errors.run_error`, item 10). The
-rest they ask in the same order on each side: the hard bound ``max_steps``
-(``rules.step_budget_spent``: integration steps, or exact-flow windows, counted alike); a
-start on the section up to rounding (``rules.starts_on_section``, the probes of
+rest they ask in the same order on each side: a start on the section up to rounding (``rules.starts_on_section``, the probes of
 ``rules.section_probe``); the exact-flow check
 (``rules.flow_consistent``); non-finite states and fields (an error, or a status; on an
 integration step the guard of ``rules.NON_FINITE_STAGE``);

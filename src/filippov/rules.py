@@ -16,6 +16,15 @@ from .system import MINUS, PLUS, SLIDING
 
 _EPS = float(np.finfo(float).eps)
 
+#: the rules an engine may call itself (tests/test_rule_askers.py): how it computes what it
+#: reports -- a window's length, a difference step, a probe of a section's rounding, a
+#: section's sign change from its direction -- and the estimates its messages and outputs
+#: quote; every other rule is a decision of the method, which the loop (filippov.loop)
+#: asks for both engines
+ENGINE_NUMERICS = ("exact_window", "rate_step", "central_step", "richardson_step",
+                   "section_probe", "section_noise", "section_pred",
+                   "geometric_accumulation", "budget_projection")
+
 _TINY = float(np.finfo(float).tiny)
 
 #: the sign changes events are made of: leaving region + (H >= 0 -> H < 0), leaving

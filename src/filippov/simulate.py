@@ -333,8 +333,9 @@ def _sliding_section(at):
 def _start(at, touch_tol):
     """(status, mode, what the start event is called) of a start at ``at`` (an _At or
     a _Run)."""
-    status, mode, repelling = _START(float(at.system.switch(at.z)), touch_tol,
-                                     at.system.sliding, len(at.sections), at)
+    # a start continues no orbit here (age 0: filippov.engines, the carried age)
+    status, mode, repelling, _ = _START(float(at.system.switch(at.z)), touch_tol,
+                                        at.system.sliding, len(at.sections), 0.0, at)
     return status, mode, ("repelling_start" if repelling else "start")
 
 
@@ -467,10 +468,11 @@ class _Run:
         self.rs = new_run_state(Limits(self.t_end, system.sliding, self.max_events,
                                        self.zeno_count, self.zeno_span, self.touch_tol,
                                        self.state_scale, self.time_scale, True,
-                                       len(sections)))
+                                       len(sections), self.max_steps))
         self.hit_section = None
         self._flow_field = None  # (mode, f, z) at the end of the last exact window
         self.shift = 0.0  # subtracted from H in this stay (rules.exit_shift)
+        self.banded = 0.0  # ... while inside the exit's band (rules.banded_shift)
         self.band = 0.0   # the rounding band of the exit the stay began at (rules.exit_band)
         self.frac_integrated = np.linspace(0.0, 1.0, self.samples_per_step + 1)
         # An exact flow is evaluated EXACT_BLOCK windows at a time: the same sample
@@ -515,8 +517,7 @@ class _Run:
         while sliding a and b)."""
         system = self.system
         if mode != SLIDING:
-            shift = (rules.banded_shift(mode, self.shift, self.band)
-                     if banded and self.band > 0.0 else self.shift)
+            shift = self.banded if banded and self.band > 0.0 else self.shift
             switch = (system.switch if shift == 0.0
                       else (lambda zz, c=shift: system.switch(zz) - c))
             return [switch]
@@ -594,14 +595,11 @@ class _Run:
             raised[name] = max(raised.get(name, 0.0), stepper.atol_used)
 
     def _step(self, stepper):
-        """One step, within the step budget: a run that cannot reach t_end within it
-        stops now, not after minutes (the steps left projected from the mean step)."""
+        """One step (the run asked the step budget before it: filippov.loop.event); a run
+        that cannot reach t_end within the budget stops now, not after minutes (the steps
+        left projected from the mean step)."""
         traj, mode = self.traj, self.mode
         traj.n_steps += 1
-        if rules.step_budget_spent(traj.n_steps, self.max_steps):
-            raise run_error(STEP_LIMIT, self.t, self.z, f", mode {MODE_NAMES[mode]}: step "
-                            f"limit {self.max_steps} hit: the run is too long or the step "
-                            "size collapsed")
         try:
             ta, tb, Z = stepper.step()
         except SimulationError:
@@ -624,14 +622,11 @@ class _Run:
         return ta, tb, Z
 
     def _at_two_fold(self):
-        """Both normal speeds at the state are within rules.TWO_FOLD_SHARE of their sizes
-        |grad H| |F_-|, |grad H| |F_+| (a slide that ran into a two-fold, where its field's
-        steps collapse before any exit is found)."""
-        z = np.asarray(self.z, dtype=float)
-        g = float(np.linalg.norm(self.system.switch_grad(z)))
-        a, b = (float(v) for v in self.system.normal_speeds(z))
-        return rules.at_two_fold(a, b, g * float(np.linalg.norm(self.system.field_minus(z))),
-                                 g * float(np.linalg.norm(self.system.field_plus(z))))
+        """Both fields tangent to H at the state (rules.tangent_to_both, on the pieces
+        there): a slide that ran into a two-fold, where its field's steps collapse before
+        any exit is found."""
+        pc = _pieces(self)
+        return rules.tangent_to_both(pc.a, pc.b, pc.grad, pc.f_minus, pc.f_plus)
 
     def _samples(self, stepper, Z, ta, tb):
         frac = self.frac_exact if stepper.method is None else self.frac_integrated
@@ -713,6 +708,10 @@ class _Run:
             return run_error(ZENO, te, ze, f": {self.zeno_count} switches within "
                                            f"{te - oldest:.3e} time units (Zeno point or "
                                            "chattering below the time resolution)")
+        if status == STEP_LIMIT:
+            return run_error(STEP_LIMIT, te, ze, f", mode {MODE_NAMES[self.mode]}: step "
+                             f"limit {self.max_steps} hit: the run is too long or the step "
+                             "size collapsed")
         if status == EVENT_LIMIT and self.rs.count[SWITCHES] > self.max_events:
             return run_error(EVENT_LIMIT, te, ze, f": event limit {self.max_events} hit "
                                                   "(rapid switching)")
@@ -769,10 +768,10 @@ def _record(mode, new_mode, what, t, run):
     return GO_ON
 
 
-def _enter(mode, new_mode, t, shift, band, crossed, run):
-    """The next stay's shift and band; the mode the run goes on in (dP/dz across a
+def _enter(mode, new_mode, t, shift, banded, band, crossed, run):
+    """The next stay's shifts and band; the mode the run goes on in (dP/dz across a
     crossing: filippov.variational, from the trajectory)."""
-    run.shift, run.band = shift, band
+    run.shift, run.banded, run.band = shift, banded, band
     run.mode = run.traj.mode = new_mode
 
 

@@ -26,14 +26,14 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 from .. import rules
 from ..system import MINUS, PLUS, SLIDING
 from .base import (BAD_START, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN, OK,
-                   STEP_FAILED, STEP_LIMIT, ZENO, _W_NONE, _dot,
+                   STEP_FAILED, ZENO, _W_NONE, _dot,
                    _W_SECTION, _flow_minus, _flow_plus, _jit, _jit_inline, _speeds,
                    _h, _section)
 from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
                      _dop_step, _non_finite_stage)
 from .segment import _zat
 from .scan import (_carry_sample, _find, _flow_follows, _sample)
-from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY,
+from .state import (COUNT_SIZE, N_RING, N_SWITCHES, SEG_BAND, SEG_ENTRY,
                     SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_NEXT_STEP, SEG_SHIFT, SEG_SIZE,
                     SEG_STEP_H, SEG_STEP_T, T_AGE, T_SLID, T_SLIDE_START, TALLY_SIZE, Control, Deriv, Dop,
                     Fill, Orbit, Outputs, RunCtx, Samples, Scratch, Settings, Work,
@@ -41,7 +41,7 @@ from .state import (COUNT_SIZE, N_RING, N_STEPS, N_SWITCHES, SEG_BAND, SEG_ENTRY
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
                          _var_step)
 from ..loop.event import SECTION, Pieces, RunOps, make_run, make_start
-from ..loop.run_state import Limits, RunState, count_switch
+from ..loop.run_state import Limits, RunState, count_step, count_switch
 from ..loop.stay import UNRESOLVED, before_stay
 from ..loop.status import GO_ON
 
@@ -102,6 +102,7 @@ _GO_ON = GO_ON  # no event yet / the orbit goes on (never a returned status)
 # rule is asked (kernel.base: compiled into its caller)
 register_jitable(_nrt=False)(before_stay)
 register_jitable(_nrt=False)(count_switch)
+register_jitable(_nrt=False)(count_step)
 assert _W_SECTION == SECTION
 
 #: the compile-time switch of the dP/dz code: every branch that carries the derivative
@@ -224,18 +225,15 @@ def _start_stay(mode, t, ctx):
 
 @_jit_inline
 def _next_step(mode, ta, first, ctx):
-    """The stay's next step from ta (``first``: the stay begins there, _start_stay),
-    within the step budget: (GO_ON, its end tb), or (STEP_LIMIT, NON_FINITE,
-    STEP_FAILED: why not, ta). An exact flow's step is its window; an integrated one
+    """The stay's next step from ta (``first``: the stay begins there, _start_stay): (GO_ON,
+    its end tb), or (NON_FINITE, STEP_FAILED: why not, ta) (the step budget is the run's:
+    filippov.loop.event). An exact flow's step is its window; an integrated one
     leaves its dense output in w.F."""
     fns, p, s, w = ctx
     if first:
         st = _start_stay(mode, ta, ctx)
         if st != _GO_ON:
             return st, ta
-    w.count[N_STEPS] += 1
-    if rules.step_budget_spent(w.count[N_STEPS], s.max_steps):
-        return STEP_LIMIT, ta
     if w.seg[SEG_INTEGRATED] == 0.0:
         age = ta - w.seg[SEG_ENTRY] + w.tally[T_AGE]
         tb = min(ta + rules.exact_window(age, s.hwin, s.hwin_slow, s.transient), s.t_max)
@@ -341,12 +339,13 @@ def _record(mode, new_mode, what, t, ctx):
 
 
 @_jit_inline
-def _store_exit(new_mode, shift, band, ctx):
-    """The next stay's shift of H: rules.exit_shift, moved by the band while inside it."""
+def _store_exit(shift, banded, band, ctx):
+    """The next stay's shift of H (rules.exit_shift) and the one it measures H from while
+    inside the exit's band (rules.banded_shift: the loop's), and the band."""
     seg = ctx.w.seg
     seg[SEG_EXIT_SHIFT] = shift
     seg[SEG_BAND] = band
-    seg[SEG_SHIFT] = rules.banded_shift(new_mode, shift, band) if band > 0.0 else shift
+    seg[SEG_SHIFT] = banded
 
 
 @_jit_inline
@@ -367,10 +366,10 @@ def _entered(mode, new_mode, t, ctx):
 
 
 @_jit_inline
-def _enter(mode, new_mode, t, shift, band, crossed, ctx):
-    """The orbit goes on in new_mode after the event at t: the next stay's shift and band
+def _enter(mode, new_mode, t, shift, banded, band, crossed, ctx):
+    """The orbit goes on in new_mode after the event at t: the next stay's shifts and band
     (_store_exit), dP/dz across a crossing (``crossed``), the age (_entered)."""
-    _store_exit(new_mode, shift, band, ctx)
+    _store_exit(shift, banded, band, ctx)
     if crossed:
         _event_switch_derivative(mode, new_mode, ctx)
     _entered(mode, new_mode, t, ctx)
@@ -397,7 +396,7 @@ def _begin(z0, age0, ctx):
         w.z[k] = z0[k]
         if not np.isfinite(z0[k]):
             return BAD_START, 0.0, 0
-    st, mode, _ = _start(_h(fns, w.z, p), s.touch_tol, s.sliding, 1, ctx)
+    st, mode, _, age = _start(_h(fns, w.z, p), s.touch_tol, s.sliding, 1, age0, ctx)
     if st != _GO_ON:
         return st, 0.0, mode
     w.touched[0] = False
@@ -409,8 +408,7 @@ def _begin(z0, age0, ctx):
     for k in range(n):
         w.slide_z0[k] = w.z[k]
     w.tally[T_SLIDE_START] = 0.0
-    w.tally[T_AGE] = (0.0 if mode == SLIDING
-                      else rules.carried_age(_h(fns, w.z, p), s.touch_tol, age0))
+    w.tally[T_AGE] = age
     w.seg[SEG_SHIFT] = 0.0
     w.seg[SEG_BAND] = 0.0
     w.seg[SEG_EXIT_SHIFT] = 0.0
@@ -468,7 +466,8 @@ def _run_record(s, w):
     event budget is the hard bound only (projects_budget False: filippov.engines,
     item 2)."""
     return RunState(Limits(s.t_max, s.sliding, s.max_events, s.zeno_count, s.zeno_span,
-                           s.touch_tol, s.state_scale, s.time_scale, False, 1), w.count,
+                           s.touch_tol, s.state_scale, s.time_scale, False, 1, s.max_steps),
+                    w.count,
                     w.recent, w.first_sw)
 
 

@@ -15,7 +15,7 @@ from collections import namedtuple
 from numba import types
 
 from ..loop.run_state import COUNT as _LOOP_COUNT
-from ..loop.run_state import RING, SWITCHES
+from ..loop.run_state import RING, STEPS, SWITCHES
 from .base import _PIECE_ADDRS, _vec
 
 _f8, _i8, _b1 = types.float64, types.int64, types.boolean
@@ -101,11 +101,11 @@ SEG = ("entry", "step_t", "step_h", "integrated", "shift", "band", "exit_shift",
  SEG_RATE_STEP, SEG_LAST_H, SEG_LAST_SPEED2, SEG_NEXT_STEP) = range(len(SEG))
 
 # ----------------------------------------------------------------- w.count (int64)
-# the loop's counters first (filippov.loop.run_state: changes of mode, entries into the
-# Zeno ring w.recent; w.count is the run record's ``count``), then the kernel's own:
-# windows / integration steps
-COUNT = _LOOP_COUNT + ("steps",)
-N_SWITCHES, N_RING, N_STEPS = SWITCHES, RING, len(_LOOP_COUNT)
+# the loop's counters (filippov.loop.run_state: changes of mode, entries into the Zeno
+# ring w.recent, steps; w.count is the run record's ``count``); the kernel keeps none of
+# its own
+COUNT = _LOOP_COUNT
+N_SWITCHES, N_RING, N_STEPS = SWITCHES, RING, STEPS
 
 # ----------------------------------------------------------------- w.tally (float64)
 # time slid, start of the current slide, time already spent in the current mode when the

@@ -18,17 +18,19 @@ is the run's record on both. The Zeno ring, an array of the last ``zeno_count`` 
 times in ``rs``, is rules.note_switch.
 
 Before each stay: filippov.loop.stay.before_stay (the end time; sliding the system does
-not build). The order at a switch: the decision (rules.next_mode); a slide's end at a
-two-fold (rules.at_two_fold: TWO_FOLD);
-sliding that the system does not build (NO_SLIDING); the end of a slide (both fields
-tangent to H there, rules.tangent_to_both, TWO_FOLD; rules.exit_drift, onto_switch,
-exit_band, exit_shift: the exact flow over time 0); an arrival on H that would slide inside a
-section refused there (SECTION_SLIDING); the switch recorded and counted
-(:func:`filippov.loop.run_state.count_switch`: the hard bound max_events, EVENT_LIMIT; the
-Zeno ring, rules.note_switch, ZENO; where the run's record says so -- the reference
-engine: :mod:`filippov.engines` item 2 -- the budget projected from the switching rate,
-rules.budget_runs_out); then the next stay's shift and band, dP/dz across the switch and
-the engine's entry into the new mode.
+not build); before each step, the run's step budget
+(:func:`filippov.loop.run_state.count_step`: rules.step_budget_spent, STEP_LIMIT). The
+order at a switch: the decision (rules.next_mode); sliding that the system does not build
+(NO_SLIDING); the end of a slide: a two-fold (both speeds vanished along the slide,
+rules.at_two_fold, or both fields tangent to H there, rules.tangent_to_both: TWO_FOLD),
+then rules.exit_drift, onto_switch, exit_band, exit_shift (the exact flow over time 0); an
+arrival on H that would slide inside a section refused there (SECTION_SLIDING); the
+switch recorded and counted (:func:`filippov.loop.run_state.count_switch`: the hard bound
+max_events, EVENT_LIMIT; the Zeno ring, rules.note_switch, ZENO; where the run's record
+says so -- the reference engine: :mod:`filippov.engines` item 2 -- the budget projected
+from the switching rate, rules.budget_runs_out); then the next stay's shift, banded shift
+(rules.banded_shift) and band, dP/dz across the switch and the engine's entry into the
+new mode.
 
 The event is written in the run's loop, not as a function the loop calls: numba inlines
 a function by copying its whole IR, and the event, its operations inlined, was the
@@ -42,7 +44,7 @@ from .. import rules
 from ..contracts import RunOperations, operations
 from ..system import SLIDING
 from .status import GO_ON, NO_SLIDING, OK, SECTION_SLIDING, TWO_FOLD
-from .run_state import RING, SWITCHES, count_switch
+from .run_state import RING, STEPS, SWITCHES, count_step, count_switch
 from .interval import as_is
 from .stay import before_stay, make_slides_in, make_step_windows
 
@@ -58,7 +60,8 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: region age0: rules.carried_age), GO_ON or why it cannot start; a stay, in the order the
 #: run holds: per step next_step(mode, ta, first, ctx) -> (status, tb) (the stay begun
 #: at its first step; GO_ON and the step's end, or why there is none: the stay cannot
-#: begin, the step budget, a failed step), window(mode, t0, t1, first, may_split, ctx) ->
+#: begin, a failed step; the run asks the step budget before each step itself,
+#: filippov.loop.run_state.count_step), window(mode, t0, t1, first, may_split, ctx) ->
 #: (status, t, what) (one window of the step sampled and searched: the run searches the
 #: step window by window with it, filippov.loop.stay.make_step_windows), end_step(mode, ta, tb,
 #: status, t, ctx) -> status (GO_ON to the next step; OK at an event, its time t and
@@ -75,8 +78,9 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: the start and at an arrival on H; exit_state(new_mode, ctx) -> (the state as an array the event
 #: may move onto H, grad H and H there, and the state the next stay in new_mode starts
 #: from as it evaluates it: the exact flow over time 0, rules.exit_band);
-#: enter(mode, new_mode, t, shift, band, crossed, ctx): the
-#: orbit goes on in new_mode -- the next stay's shift of H and rounding band, dP/dz
+#: enter(mode, new_mode, t, shift, banded, band, crossed, ctx): the
+#: orbit goes on in new_mode -- the next stay's shift of H, the one it measures H from
+#: inside the exit's rounding band (rules.banded_shift) and the band, dP/dz
 #: across a crossing (``crossed``), the engine's bookkeeping
 RunOps = namedtuple("RunOps", operations(RunOperations))
 
@@ -102,42 +106,42 @@ def make_sliding_section(ops: RunOps, inline=as_is):
 
 
 def make_start(ops: RunOps, inline=as_is, call=as_is):
-    """``start(h, touch_tol, sliding, sections, ctx) -> (status, mode, repelling)``: the
-    start's mode, decided by the rule book from H at the start (rules.start_side) and, on
-    H, the normal speeds (rules.start_on_switch; ``repelling``: a start on repelling H);
-    status SECTION_SLIDING for a start that slides inside one of the run's ``sections``
-    sections (:func:`make_sliding_section`), else GO_ON. On the engine's ``pieces`` and
+    """``start(h, touch_tol, sliding, sections, age0, ctx) -> (status, mode, repelling,
+    age)``: the start's mode, decided by the rule book from H at the start
+    (rules.start_side) and, on H, the normal speeds (rules.start_on_switch;
+    ``repelling``: a start on repelling H); status SECTION_SLIDING for a start that slides
+    inside one of the run's ``sections`` sections (:func:`make_sliding_section`), else
+    GO_ON; ``age``, the time already spent in the start's region by an orbit the start
+    continues (``age0``: rules.carried_age; 0 on H). On the engine's ``pieces`` and
     ``section_along`` at the start: an engine's ``begin`` asks it."""
     pieces = ops.pieces
     # ``call``: the kernel's compiled call (asked at a start on H only)
     sliding_section = call(make_sliding_section(ops, inline))
 
-    def start(h, touch_tol, sliding, sections, ctx):
+    def start(h, touch_tol, sliding, sections, age0, ctx):
         side = rules.start_side(h, touch_tol)
         if side != SLIDING:
-            return GO_ON, side, False
+            return GO_ON, side, False, rules.carried_age(h, touch_tol, age0)
         pc = pieces(ctx)
         mode, repelling = rules.start_on_switch(h, pc.a, pc.b, sliding)
+        age = 0.0 if mode == SLIDING else rules.carried_age(h, touch_tol, age0)
         if mode == SLIDING and sliding_section(sections, ctx) >= 0:
-            return SECTION_SLIDING, mode, repelling
-        return GO_ON, mode, repelling
+            return SECTION_SLIDING, mode, repelling, age
+        return GO_ON, mode, repelling, age
     return start
 
 
 def make_run(ops: RunOps, inline=as_is, call=as_is):
-    """``run(z0, age0, ctx, rs) -> (status, t, mode)``: the orbit from z0, stay by stay
-    and event by event in this module's order, with the rule book and ``ops``, until a
-    status ends it (OK at a terminal section hit, NO_RETURN at the end time, or the
-    start's, a stay's or an event's); t and ``mode`` where it ended. ``rs``: the run's
-    record (:class:`~filippov.loop.run_state.RunState`), counters cleared first."""
+    """``run(z0, age0, ctx, rs) -> (status, t, mode)``: the orbit from z0 in this module's
+    order, until a status ends it (OK at a terminal section hit, NO_RETURN at the end time,
+    or why not); t and ``mode`` where it ended. ``rs``: the record, counters cleared."""
     begin, next_step, window, end_step, record, pieces, _, exit_state, enter = ops
     step_windows = inline(make_step_windows(window))  # ``inline``: the kernel's, or as is
-    # ``call``: the kernel's compiled call (asked at an arrival on H only)
-    sliding_section = call(make_sliding_section(ops, inline))
+    sliding_section = call(make_sliding_section(ops, inline))  # at an arrival on H only
 
     def run(z0, age0, ctx, rs):
         limits = rs.limits
-        rs.count[SWITCHES], rs.count[RING] = 0, 0
+        rs.count[SWITCHES], rs.count[RING], rs.count[STEPS] = 0, 0, 0
         status, t, mode = begin(z0, age0, ctx)
         if status != GO_ON:
             return status, t, mode
@@ -153,10 +157,11 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
             # the stay, step by step, to its event (OK) or to why it ends
             status, ta, first, what = GO_ON, t, True, -1  # what: the event it ends at
             while status == GO_ON:
-                status, tb = next_step(mode, ta, first, ctx)
+                status, tb = count_step(rs), ta  # within the run's step budget, or it stops
+                if status == GO_ON:
+                    status, tb = next_step(mode, ta, first, ctx)
                 if status != GO_ON:
-                    t = ta
-                    break
+                    return status, ta, mode
                 status, t, what = step_windows(mode, ta, tb, first, ctx)
                 status = end_step(mode, ta, tb, status, t, ctx)
                 ta, first = tb, False
@@ -170,16 +175,16 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
             pc = pieces(ctx)
             a, b = pc.a, pc.b
             new_mode = rules.next_mode(mode, what, a, b)
-            if mode == SLIDING and new_mode != SLIDING and rules.at_two_fold(a, b, a_in, b_in):
-                return TWO_FOLD, t, mode
             if new_mode == SLIDING and mode != SLIDING:
                 a_in, b_in = a, b
             if new_mode == SLIDING and not limits.sliding:
                 return NO_SLIDING, t, mode
             shift, band = 0.0, 0.0
             if mode == SLIDING and new_mode != SLIDING:
-                # both fields tangent to H where the slide ends: a two-fold after all
-                if rules.tangent_to_both(a, b, pc.grad, pc.f_minus, pc.f_plus):
+                # a two-fold: both speeds vanished along the slide, or both fields are
+                # tangent to H where it ends
+                if (rules.at_two_fold(a, b, a_in, b_in)
+                        or rules.tangent_to_both(a, b, pc.grad, pc.f_minus, pc.f_plus)):
                     return TWO_FOLD, t, mode
                 # the end of a slide: a state the slide left off H beyond rounding is
                 # moved onto it; the next stay measures H from the exit's rounding
@@ -187,8 +192,7 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
                 drift = rules.exit_drift(new_mode, h0, z, grad, limits.touch_tol)
                 if drift:
                     rules.onto_switch(z, h0, grad)
-                    # what rounding left, and the next stay's start from there (grad H
-                    # as before)
+                    # what rounding left, the next stay's start from there (grad H kept)
                     z, _, h0, z_next = exit_state(new_mode, ctx)
                 band = rules.exit_band(z, z_next, grad, limits.state_scale)
                 shift = rules.exit_shift(new_mode, h0, limits.touch_tol, drift)
@@ -202,6 +206,8 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
             status = count_switch(rs, t, new_mode != mode)
             if status != GO_ON:
                 return status, t, mode
-            enter(mode, new_mode, t, shift, band, mode != SLIDING and new_mode != mode, ctx)
+            banded = rules.banded_shift(new_mode, shift, band) if band > 0.0 else shift
+            enter(mode, new_mode, t, shift, banded, band, mode != SLIDING and new_mode != mode,
+                  ctx)
             mode = new_mode
     return run

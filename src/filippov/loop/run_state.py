@@ -15,28 +15,29 @@ from collections import namedtuple
 import numpy as np
 
 from .. import rules
-from .status import EVENT_LIMIT, GO_ON, ZENO
+from .status import EVENT_LIMIT, GO_ON, STEP_LIMIT, ZENO
 
 #: the run's fixed limits: its end time; whether the system builds sliding; the hard
 #: bound on switches (max_events); the Zeno ring's size and span (rules.note_switch);
 #: H's touch tolerance; the run's state and time scales (filippov.scale); whether the
 #: event budget is also projected from the switching rate (rules.budget_runs_out: the
 #: reference engine, filippov.engines item 2); the number of the run's sections (an
-#: arrival on H that would slide inside one is refused: filippov.loop.event)
+#: arrival on H that would slide inside one is refused: filippov.loop.event); the step
+#: budget (max_steps: rules.step_budget_spent, asked by the run before each step)
 Limits = namedtuple("Limits", ["t_end", "sliding", "max_events", "zeno_count", "zeno_span",
                                "touch_tol", "state_scale", "time_scale", "projects_budget",
-                               "sections"])
+                               "sections", "max_steps"])
 
 #: the record: ``limits`` (:data:`Limits`); ``count`` (int64, positions :data:`COUNT`:
-#: changes of mode so far, entries into the ring so far; an engine may keep counters of
-#: its own after them); ``ring`` (float64, the last zeno_count switch times, entry k at
+#: changes of mode so far, entries into the ring so far, steps so far (an exact flow's
+#: windows, integration steps); an engine may keep counters of its own after them); ``ring`` (float64, the last zeno_count switch times, entry k at
 #: k % zeno_count); ``first_switch`` (float64[1]: the time of the run's first change of
 #: mode, written when it happens)
 RunState = namedtuple("RunState", ["limits", "count", "ring", "first_switch"])
 
 #: the loop's positions in ``count``
-COUNT = ("switches", "ring")
-SWITCHES, RING = range(len(COUNT))
+COUNT = ("switches", "ring", "steps")
+SWITCHES, RING, STEPS = range(len(COUNT))
 
 
 def new_run_state(limits: Limits) -> RunState:
@@ -68,3 +69,11 @@ def count_switch(rs: RunState, t: float, changed: bool) -> int:
             limits.max_events):
         return EVENT_LIMIT
     return GO_ON
+
+
+def count_step(rs: RunState) -> int:
+    """The record at a step about to be taken (an integration step, or an exact flow's
+    window): counted; GO_ON, or STEP_LIMIT once the run's step budget is spent
+    (rules.step_budget_spent). The run (filippov.loop.event) asks it before each step."""
+    rs.count[STEPS] += 1
+    return STEP_LIMIT if rules.step_budget_spent(rs.count[STEPS], rs.limits.max_steps) else GO_ON
