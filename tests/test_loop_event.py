@@ -85,8 +85,9 @@ def test_the_event_and_the_stay_are_written_in_the_run_loop():
     steps = [n.func.id for n in sorted(
         (n for n in ast.walk(loops[1]) if isinstance(n, ast.Call)
          and isinstance(n.func, ast.Name)), key=lambda n: (n.lineno, n.col_offset))]
-    assert steps == ["count_step", "next_step", "step_windows", "end_step"]  # the walk over the step's
-    # windows (loop.stay.make_step_windows) on the engine's window
+    # the step budget, the step, why none (loop.stay.make_failed_step), the walk over the
+    # step's windows (loop.stay.make_step_windows) on the engine's window, the step's end
+    assert steps == ["count_step", "next_step", "failed_step", "step_windows", "end_step"]
 
 
 @pytest.mark.parametrize("zeno_count", [2, 3, 7])

@@ -8,7 +8,8 @@ from numba import njit
 from filippov import rules
 from filippov.loop import stay
 from filippov.loop.event import Pieces
-from filippov.loop.status import GO_ON, NO_RETURN, NO_SLIDING, SECTION_SLIDING
+from filippov.loop.status import (GO_ON, NO_RETURN, NO_SLIDING, NON_FINITE, SECTION_SLIDING,
+                                  STEP_FAILED, TWO_FOLD)
 from filippov.system import MINUS, PLUS, SLIDING
 
 BEFORE = [stay.before_stay, njit(stay.before_stay)]
@@ -137,3 +138,22 @@ def test_a_window_too_short_to_split_is_taken_as_it_is():
     assert not rules.can_split(t, tb, t, tb)
     calls, result = _walk_calls(0.0, ta=t, tb=tb)
     assert calls == [(t, tb, True, False)] and result == (GO_ON, tb, -1)
+
+
+@pytest.mark.parametrize("status, mode, tangent, expected", [
+    (STEP_FAILED, SLIDING, True, TWO_FOLD),     # a slide's steps collapsed at a two-fold
+    (NON_FINITE, SLIDING, True, TWO_FOLD),      # its field 0/0 there
+    (STEP_FAILED, SLIDING, False, STEP_FAILED),  # a failure elsewhere: as it is
+    (STEP_FAILED, MINUS, True, STEP_FAILED),     # in a region: no slide to name
+    (NON_FINITE, PLUS, True, NON_FINITE),
+])
+def test_a_slides_failed_step_is_named_a_two_fold_where_both_fields_are_tangent(
+        status, mode, tangent, expected):
+    # both engines' failed step reaches the run through this one function (the
+    # reference's slide into a two-fold, tests/test_zeno_accumulation.py, is named here)
+    grad = np.array([0.0, 1.0])
+    fm, fp = np.array([1.0, 0.0 if tangent else 1.0]), np.array([2.0, 0.0])
+
+    def pieces(ctx):
+        return Pieces(np.zeros(2), grad, fm, fp, grad @ fm, grad @ fp, 1.0)
+    assert stay.make_failed_step(pieces)(status, mode, None) == expected

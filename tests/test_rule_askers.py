@@ -42,9 +42,6 @@ DECISIONS_IN_ENGINES = {
     ("simulate.py", "on_section_by_value"): "the same test by the section's rounding "
         "measured at probes about the start (section_probe, section_noise)",
     ("kernel/scan.py", "on_section_by_value"): "as the reference's",
-    ("simulate.py", "tangent_to_both"): "the reference's diagnosis of a slide whose "
-        "integration steps collapse (a two-fold reached inside a step, engines.py): the "
-        "kernel reports a failed step instead",
 }
 
 

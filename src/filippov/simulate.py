@@ -42,7 +42,7 @@ from .loop.event import SECTION, Pieces, RunOps, make_run, make_sliding_section,
 from .loop.run_state import RING, SWITCHES, Limits, new_run_state
 from .section import Section  # noqa: F401  (re-exported: filippov.simulate.Section)
 from .loop.stay import UNRESOLVED
-from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
+from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN,
                           NO_SLIDING, OK,
                           ROOT_FAILED, SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO)
 
@@ -492,6 +492,8 @@ class _Run:
             return self.stop("t_end")
         if status == OK:
             return self.stop(f"section:{self.sections[self.hit_section].name}")
+        if status == STEP_FAILED:  # a slide's failed step, not at a two-fold: as raised
+            raise self.failed
         raise self._event_error(status)
 
     # ------------------------------------------------------------------ one stay
@@ -538,7 +540,10 @@ class _Run:
         ``first``: the stay begins (:meth:`start_stay`)."""
         if first:
             self.start_stay()
-        ta, tb, self.step_Z = self._step(self.stepper)
+        step = self._step(self.stepper)
+        if step is None:  # a slide's step failed: the loop asks whether at a two-fold
+            return STEP_FAILED, self.t
+        ta, tb, self.step_Z = step
         if self.dense:
             self.traj.segments.append((ta, tb, self.mode, self.step_Z))
         return GO_ON, tb
@@ -597,16 +602,17 @@ class _Run:
     def _step(self, stepper):
         """One step (the run asked the step budget before it: filippov.loop.event); a run
         that cannot reach t_end within the budget stops now, not after minutes (the steps
-        left projected from the mean step)."""
+        left projected from the mean step). None where a slide's step failed (kept in
+        self.failed, raised unless the loop finds the slide at a two-fold)."""
         traj, mode = self.traj, self.mode
         traj.n_steps += 1
         try:
             ta, tb, Z = stepper.step()
-        except SimulationError:
-            if mode == SLIDING and self._at_two_fold():
-                raise run_error(TWO_FOLD, self.t, self.z, ": the sliding field's steps "
-                                "collapsed where both normal speeds vanish") from None
-            raise
+        except SimulationError as err:
+            if mode != SLIDING:
+                raise
+            self.failed = err
+            return None
         stepper.n_taken += 1
         mean = (tb - stepper.t_start) / stepper.n_taken
         left = ((self.t_end - tb) / mean if stepper.n_taken > PROJECT_AFTER and mean > 0
@@ -620,13 +626,6 @@ class _Run:
                    "small eps): use exact flows or a shorter t_end"
                    if stepper.method is not None else ""))
         return ta, tb, Z
-
-    def _at_two_fold(self):
-        """Both fields tangent to H at the state (rules.tangent_to_both, on the pieces
-        there): a slide that ran into a two-fold, where its field's steps collapse before
-        any exit is found."""
-        pc = _pieces(self)
-        return rules.tangent_to_both(pc.a, pc.b, pc.grad, pc.f_minus, pc.f_plus)
 
     def _samples(self, stepper, Z, ta, tb):
         frac = self.frac_exact if stepper.method is None else self.frac_integrated

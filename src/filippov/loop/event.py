@@ -46,7 +46,7 @@ from ..system import SLIDING
 from .status import GO_ON, NO_SLIDING, OK, SECTION_SLIDING, TWO_FOLD
 from .run_state import RING, STEPS, SWITCHES, count_step, count_switch
 from .interval import as_is
-from .stay import before_stay, make_slides_in, make_step_windows
+from .stay import before_stay, make_failed_step, make_slides_in, make_step_windows
 
 #: what an event is: a crossing of H or an end of sliding (rules.SWITCH, EXIT_MINUS,
 #: EXIT_PLUS: rules.next_mode's ``ended_by``), or a hit of a section
@@ -137,6 +137,7 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
     or why not); t and ``mode`` where it ended. ``rs``: the record, counters cleared."""
     begin, next_step, window, end_step, record, pieces, _, exit_state, enter = ops
     step_windows = inline(make_step_windows(window))  # ``inline``: the kernel's, or as is
+    failed_step = inline(make_failed_step(pieces))
     sliding_section = call(make_sliding_section(ops, inline))  # at an arrival on H only
 
     def run(z0, age0, ctx, rs):
@@ -145,8 +146,7 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
         status, t, mode = begin(z0, age0, ctx)
         if status != GO_ON:
             return status, t, mode
-        # the normal speeds where the current slide began (rules.at_two_fold)
-        a_in, b_in = 0.0, 0.0
+        a_in, b_in = 0.0, 0.0  # the normal speeds where the slide began (rules.at_two_fold)
         if mode == SLIDING:
             pc = pieces(ctx)
             a_in, b_in = pc.a, pc.b
@@ -160,8 +160,8 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
                 status, tb = count_step(rs), ta  # within the run's step budget, or it stops
                 if status == GO_ON:
                     status, tb = next_step(mode, ta, first, ctx)
-                if status != GO_ON:
-                    return status, ta, mode
+                if status != GO_ON:  # no step: why (a slide's failure at a two-fold named)
+                    return failed_step(status, mode, ctx), ta, mode
                 status, t, what = step_windows(mode, ta, tb, first, ctx)
                 status = end_step(mode, ta, tb, status, t, ctx)
                 ta, first = tb, False

@@ -1,6 +1,7 @@
 """A run's stays -- when a stay may begin, the test of a slide inside a section (the
 run's refusal at the start and at an arrival on H: :mod:`filippov.loop.event`), the walk
-over a step's windows -- written once for both engines.
+over a step's windows, a slide's failed step at a two-fold -- written once for both
+engines.
 
 Like :mod:`filippov.loop.event` this is plain scalar Python in the subset numba
 compiles: the reference driver (:mod:`filippov.simulate`) calls these functions as they
@@ -14,7 +15,7 @@ from __future__ import annotations
 
 from .. import rules
 from ..system import MINUS, PLUS, SLIDING
-from .status import GO_ON, NO_RETURN, NO_SLIDING
+from .status import GO_ON, NON_FINITE, NO_RETURN, NO_SLIDING, STEP_FAILED, TWO_FOLD
 
 
 def before_stay(mode, t, t_end, sliding):
@@ -26,6 +27,23 @@ def before_stay(mode, t, t_end, sliding):
     if mode == SLIDING and not sliding:
         return NO_SLIDING
     return GO_ON
+
+
+def make_failed_step(pieces):
+    """``failed_step(status, mode, ctx) -> status``: why a stay's step did not come, as
+    the run reports it -- TWO_FOLD where a slide's step failed (STEP_FAILED, or
+    NON_FINITE: the sliding field is 0/0 there) with both fields tangent to H at the
+    state the step began from (rules.tangent_to_both): a slide into a two-fold, where the
+    steps of its field, not Lipschitz there, collapse before any exit is found; else the
+    status as it is. The engine's operation: ``pieces(ctx)`` at that state."""
+
+    def failed_step(status, mode, ctx):
+        if mode == SLIDING and (status == STEP_FAILED or status == NON_FINITE):
+            pc = pieces(ctx)
+            if rules.tangent_to_both(pc.a, pc.b, pc.grad, pc.f_minus, pc.f_plus):
+                return TWO_FOLD
+        return status
+    return failed_step
 
 
 def make_slides_in(pieces, section_along):
