@@ -128,8 +128,9 @@ SEAM_TARGET = 8
 #: into the exit's state and the refusal to slide in a section into the record; 10 since
 #: the start and that refusal, the loop's, are built on the run's fields and
 #: section_along, not handed to the loop as factories of their own; 9 since the speeds
-#: are a part of the pieces the engine evaluates at the state): never more
-SEAM_NOW = 9
+#: are a part of the pieces the engine evaluates at the state; 8 since a switch is
+#: recorded and entered by one operation): never more
+SEAM_NOW = 8
 
 
 def _engines_operations():
@@ -168,8 +169,9 @@ WINDOW_NOW = 7
 #: the start and the test of a slide inside a section are built from the run's own
 #: operations (its speeds, fields and section_along) and the run refuses such an arrival
 #: on H itself; 16 since the normal speeds are a part of the pieces at the state
-#: (``pieces``: z, grad H, F_-, F_+, a, b), not an operation of their own
-OPERATIONS_TARGET, OPERATIONS_NOW = 8, 16
+#: (``pieces``: z, grad H, F_-, F_+, a, b), not an operation of their own; 15 since a
+#: switch is recorded and entered by one operation (``record``)
+OPERATIONS_TARGET, OPERATIONS_NOW = 8, 15
 
 
 @pytest.mark.parametrize("engine", ["reference", "compiled"])
@@ -253,9 +255,9 @@ def test_an_operation_of_the_wrong_arity_is_named():
     from filippov.contracts import RunOperations, positional_mismatches
     from filippov.loop.event import RunOps
     good = _engines_operations()["reference"]
-    bad = good._replace(enter=lambda mode, new_mode, t, ctx: None)
+    bad = good._replace(record=lambda mode, new_mode, what, t, ctx: None)
     assert positional_mismatches(bad, RunOperations) == [
-        "enter: takes 4 positional parameters, the seam 8"]
+        "record: takes 5 positional parameters, the seam 8"]
     assert positional_mismatches(object(), RunOperations)[0] == "begin: missing"
     assert len(RunOps._fields) > 0
 

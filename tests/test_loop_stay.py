@@ -31,7 +31,7 @@ def _start(slides):
     section = (lambda z: z[1]) if slides else (lambda z: z[0] - 0.3)
     pieces, along = _plane(section)
     return make_start(RunOps(*[None] * 5, lambda ctx: pieces(ctx)._replace(a=ctx[0], b=ctx[1]),
-                             along, None, None))
+                             along, None))
 
 
 @pytest.mark.parametrize("h, a, b, sliding, slides, expected", [

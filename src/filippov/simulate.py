@@ -757,21 +757,18 @@ def _exit_state(new_mode, run):
             float(run.system.switch(run.z)), run._flow_at_zero(new_mode, run.z))
 
 
-def _record(mode, new_mode, what, t, run):
-    """A section hit (:func:`_section_hit`: OK, or GO_ON) or a switch, logged: GO_ON."""
+def _record(mode, new_mode, what, t, shift, banded, band, run):
+    """A section hit (:func:`_section_hit`: OK, or GO_ON) or a switch, logged, after which
+    the run goes on in new_mode with the next stay's shifts and band (dP/dz across a
+    crossing: filippov.variational, from the trajectory): GO_ON."""
     if what == SECTION:
         return _section_hit(mode, t, run)
     kind = ("slide_end" if what != rules.SWITCH
             else "crossing" if new_mode != SLIDING else "slide_start")
     run.traj.events.append(Event(t, kind, run.z.copy(), mode, new_mode))
-    return GO_ON
-
-
-def _enter(mode, new_mode, t, shift, banded, band, crossed, run):
-    """The next stay's shifts and band; the mode the run goes on in (dP/dz across a
-    crossing: filippov.variational, from the trajectory)."""
     run.shift, run.banded, run.band = shift, banded, band
     run.mode = run.traj.mode = new_mode
+    return GO_ON
 
 
 #: the reference driver's side of the seam (filippov.contracts.RunOperations) and its
@@ -785,8 +782,7 @@ RUN_OPERATIONS = RunOps(
     record=_record,
     pieces=_pieces,
     section_along=_section_along,
-    exit_state=_exit_state,
-    enter=_enter)
+    exit_state=_exit_state)
 _RUN = make_run(RUN_OPERATIONS)
 #: the start's mode and its refusal to slide in a section, and that test alone, on the
 #: operations above (filippov.loop.event)

@@ -330,11 +330,17 @@ def _record_switch(mode, new_mode, what, t, ctx):
 
 
 @_jit_inline
-def _record(mode, new_mode, what, t, ctx):
-    """A section hit (_at_section: OK, or GO_ON) or a switch (_record_switch: GO_ON)."""
+def _record(mode, new_mode, what, t, shift, banded, band, ctx):
+    """A section hit (_at_section: OK, or GO_ON) or a switch (_record_switch), after which
+    the orbit goes on in new_mode: the next stay's shifts and band (_store_exit), dP/dz
+    across a crossing (from a region into the other), the age (_entered); GO_ON."""
     if what == SECTION:
         return _at_section(mode, t, ctx)
     _record_switch(mode, new_mode, what, t, ctx)
+    _store_exit(shift, banded, band, ctx)
+    if mode != SLIDING and new_mode != mode:
+        _event_switch_derivative(mode, new_mode, ctx)
+    _entered(mode, new_mode, t, ctx)
     return _GO_ON
 
 
@@ -363,16 +369,6 @@ def _entered(mode, new_mode, t, ctx):
         w.tally[T_AGE] = 0.0  # an entry: the fast transient starts again
     elif mode != SLIDING and s.exact:
         w.tally[T_AGE] += t - w.seg[SEG_ENTRY]  # the stay goes on from here
-
-
-@_jit_inline
-def _enter(mode, new_mode, t, shift, banded, band, crossed, ctx):
-    """The orbit goes on in new_mode after the event at t: the next stay's shifts and band
-    (_store_exit), dP/dz across a crossing (``crossed``), the age (_entered)."""
-    _store_exit(shift, banded, band, ctx)
-    if crossed:
-        _event_switch_derivative(mode, new_mode, ctx)
-    _entered(mode, new_mode, t, ctx)
 
 
 # inlined into the run: as a call it took the run's whole ctx member by member once per
@@ -420,7 +416,7 @@ def _begin(z0, age0, ctx):
 _RUN_OPS = {"begin": "_begin", "next_step": "_next_step", "window": "_window",
             "end_step": "_end_step", "record": "_record", "pieces": "_event_pieces",
             "section_along": "_event_section_along",
-            "exit_state": "_exit_state", "enter": "_enter"}
+            "exit_state": "_exit_state"}
 
 
 def _operations(ns) -> RunOps:
@@ -602,7 +598,6 @@ _PLAIN = _without_derivatives({"_window": _jit_inline,
                                "_end_step": _jit_inline, "_at_section": _jit_inline,
                                "_record": _jit_inline,
                                "_event_switch_derivative": _jit_inline,
-                               "_enter": _jit_inline,
                                "_begin": _jit_inline, "_one": _build_run,
                                "_batch": njit(cache=True, nogil=True)})
 _one_plain, _batch_plain = _PLAIN["_one"], _PLAIN["_batch"]

@@ -25,12 +25,12 @@ order at a switch: the decision (rules.next_mode); sliding that the system does 
 rules.at_two_fold, or both fields tangent to H there, rules.tangent_to_both: TWO_FOLD),
 then rules.exit_drift, onto_switch, exit_band, exit_shift (the exact flow over time 0); an
 arrival on H that would slide inside a section refused there (SECTION_SLIDING); the
-switch recorded and counted (:func:`filippov.loop.run_state.count_switch`: the hard bound
-max_events, EVENT_LIMIT; the Zeno ring, rules.note_switch, ZENO; where the run's record
-says so -- the reference engine: :mod:`filippov.engines` item 2 -- the budget projected
-from the switching rate, rules.budget_runs_out); then the next stay's shift, banded shift
-(rules.banded_shift) and band, dP/dz across the switch and the engine's entry into the
-new mode.
+switch recorded by the engine, with the next stay's shift, banded shift
+(rules.banded_shift) and band, dP/dz across the switch and its entry into the new mode;
+then counted (:func:`filippov.loop.run_state.count_switch`: the hard bound max_events,
+EVENT_LIMIT; the Zeno ring, rules.note_switch, ZENO; where the run's record says so --
+the reference engine: :mod:`filippov.engines` item 2 -- the budget projected from the
+switching rate, rules.budget_runs_out).
 
 The event is written in the run's loop, not as a function the loop calls: numba inlines
 a function by copying its whole IR, and the event, its operations inlined, was the
@@ -68,20 +68,19 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: ``what``; NO_RETURN at the end time, or an error): the stay written in the run, as the
 #: event is, so that the kernel copies no composed stay
 #: (docs/decisions.md#kernel-inlined-driver);
-#: record(mode, new_mode, what, t, ctx) -> status: an event recorded, a section hit
-#: (what == SECTION: OK ends the run, GO_ON goes on) or a switch (before the budgets
-#: are asked; GO_ON);
+#: record(mode, new_mode, what, t, shift, banded, band, ctx) -> status: an event recorded
+#: and passed -- a section hit (what == SECTION: OK ends the run, GO_ON goes on in the
+#: same stay; the rest unused) or a switch, after which the orbit goes on in new_mode
+#: (GO_ON; before the budgets are asked): the next stay's shift of H, the one it
+#: measures H from inside the exit's rounding band (rules.banded_shift) and the band,
+#: dP/dz across a crossing (from a region into the other), the engine's bookkeeping;
 #: pieces(ctx) -> :data:`Pieces` (the pieces at the state: the engine evaluates, the loop
 #: decides with them); section_along(k, mode, d, ctx): section k at
 #: z + d times the field of ``mode`` (MINUS, PLUS, SLIDING; d = 0: at z) -- with the
 #: pieces, the test of a slide inside a section (filippov.loop.stay.make_slides_in), at
 #: the start and at an arrival on H; exit_state(new_mode, ctx) -> (the state as an array the event
 #: may move onto H, grad H and H there, and the state the next stay in new_mode starts
-#: from as it evaluates it: the exact flow over time 0, rules.exit_band);
-#: enter(mode, new_mode, t, shift, banded, band, crossed, ctx): the
-#: orbit goes on in new_mode -- the next stay's shift of H, the one it measures H from
-#: inside the exit's rounding band (rules.banded_shift) and the band, dP/dz
-#: across a crossing (``crossed``), the engine's bookkeeping
+#: from as it evaluates it: the exact flow over time 0, rules.exit_band)
 RunOps = namedtuple("RunOps", operations(RunOperations))
 
 #: what ``pieces(ctx)`` returns, the pieces at the state as the engine evaluates them:
@@ -135,7 +134,7 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
     """``run(z0, age0, ctx, rs) -> (status, t, mode)``: the orbit from z0 in this module's
     order, until a status ends it (OK at a terminal section hit, NO_RETURN at the end time,
     or why not); t and ``mode`` where it ended. ``rs``: the record, counters cleared."""
-    begin, next_step, window, end_step, record, pieces, _, exit_state, enter = ops
+    begin, next_step, window, end_step, record, pieces, _, exit_state = ops
     step_windows = inline(make_step_windows(window))  # ``inline``: the kernel's, or as is
     failed_step = inline(make_failed_step(pieces))
     sliding_section = call(make_sliding_section(ops, inline))  # at an arrival on H only
@@ -168,7 +167,7 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
             if status != OK:
                 return status, t, mode
             if what == SECTION:
-                status = record(mode, mode, what, t, ctx)
+                status = record(mode, mode, what, t, 0.0, 0.0, 0.0, ctx)
                 if status != GO_ON:
                     return status, t, mode
                 continue
@@ -200,14 +199,11 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
             if (new_mode == SLIDING and mode != SLIDING
                     and sliding_section(limits.sections, ctx) >= 0):
                 return SECTION_SLIDING, t, mode
-            status = record(mode, new_mode, what, t, ctx)
-            if status != GO_ON:
-                return status, t, mode
-            status = count_switch(rs, t, new_mode != mode)
-            if status != GO_ON:
-                return status, t, mode
             banded = rules.banded_shift(new_mode, shift, band) if band > 0.0 else shift
-            enter(mode, new_mode, t, shift, banded, band, mode != SLIDING and new_mode != mode,
-                  ctx)
+            status = record(mode, new_mode, what, t, shift, banded, band, ctx)
+            if status == GO_ON:
+                status = count_switch(rs, t, new_mode != mode)
+            if status != GO_ON:
+                return status, t, mode
             mode = new_mode
     return run
