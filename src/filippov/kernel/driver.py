@@ -686,6 +686,8 @@ def _compile_lock():
             fcntl.flock(handle, fcntl.LOCK_UN)
 
 
+# what a cold compile is made of, and what cutting it costs per return:
+# docs/decisions.md#kernel-compile-floor
 def compile_kernel(derivatives: bool = False) -> bool:
     """Compile the kernel (:func:`kernel`) now rather than at its first use; True if it
     was loaded from the cache."""
