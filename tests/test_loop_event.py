@@ -15,8 +15,9 @@ from filippov.models import pseudo_equilibrium
 SRC = Path(__file__).resolve().parents[1] / "src" / "filippov"
 
 #: the rules of an event: asked only by filippov.loop.event; and those of the run's record
-#: at a switch, only by filippov.loop.run_state.count_switch, which the run asks
-#: (rules.accumulates by rules.note_switch, the Zeno ring)
+#: (at a switch, filippov.loop.run_state.count_switch; before a step, count_step), only by
+#: filippov.loop.run_state, which the run asks (rules.accumulates by rules.note_switch, the
+#: Zeno ring)
 EVENT_RULES = {"next_mode", "exit_drift", "onto_switch", "exit_band", "exit_shift",
                "banded_shift"}
 RECORD_RULES = {"note_switch", "budget_runs_out", "step_budget_spent"}

@@ -15,6 +15,7 @@ The spiral: f = ((-y, x) - c (x, y)) / r, c = c+ above y = 0 and c- below: the o
 turns at unit speed with r' = -c, so a half turn takes r from r0 to r0 exp(-c pi) in time
 r0 (1 - exp(-c pi)) / c, and the crossings of y = 0 accumulate at the origin.
 """
+import importlib
 import math
 
 import numpy as np
@@ -162,6 +163,52 @@ def test_a_slide_into_a_two_fold_is_named(engine, start):
                       engine=engine)
     t = float(str(err.value).split("t=")[1].split(",")[0])
     assert t == pytest.approx(3.0 * y0 - 2.0 * x0, abs=1e-9)
+
+
+def _slide_into_nan():
+    # H = y; F_- = (1, 1) up to x = 0.75 and not finite beyond, F_+ = (1, -1): a slide
+    # along y = 0 at speed 1 (a = 1 > 0 > b = -1) into a field that is not finite
+    return FilippovSystem(
+        ("x", "y", "w"), lambda z, p: np.array([1.0 if z[0] < 0.75 else np.nan, 1.0, 0.0]),
+        lambda z, p: np.array([1.0, -1.0, 0.0]), lambda z, p: z[1],
+        lambda z, p: np.array([0.0, 1.0, 0.0]))
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_slide_into_a_field_that_is_not_finite_is_no_two_fold(engine):
+    # the loop names a slide's failure a two-fold only where both fields are tangent to H
+    # (loop.stay.make_failed_step); here they are not: the failure stands
+    with pytest.raises(SimulationError, match="non-finite") as err:
+        first_returns(_slide_into_nan(), [[0.0, 0.0, 0.0]], lambda z, p: z[0] - 100.0, 5.0,
+                      engine=engine)
+    assert "two-fold" not in str(err.value)
+
+
+@pytest.mark.parametrize("at_two_fold", [False, True])
+def test_the_references_failed_slide_step_is_raised_as_it_failed_unless_at_a_two_fold(
+        monkeypatch, at_two_fold):
+    # the reference's integration step fails while sliding (its stepper raises): the run
+    # gets STEP_FAILED, the loop asks the pieces there, and the reference raises the very
+    # exception its stepper raised -- or the two-fold, where both fields are tangent
+    from filippov.errors import run_error
+    from filippov.loop.status import STEP_FAILED
+    sim = importlib.import_module("filippov.simulate")  # the module, not the function
+    failure = run_error(STEP_FAILED, 0.0, np.zeros(3), ": the stepper's own failure")
+    real = sim._IntegratingStepper.step
+
+    def step(self):
+        if self.fun(0.0, np.zeros(3))[1] == 0.0:  # the sliding field (its y-component 0)
+            raise failure
+        return real(self)
+    monkeypatch.setattr(sim._IntegratingStepper, "step", step)
+    monkeypatch.setattr(sim.rules, "tangent_to_both", lambda *args: at_two_fold)
+    with pytest.raises(SimulationError) as err:
+        simulate(_slide_into_nan().python(), [0.0, 0.0, 0.0], 5.0)
+    if at_two_fold:
+        assert "the slide reached a two-fold" in str(err.value)
+        assert "steps collapsed" in str(err.value)
+    else:
+        assert err.value is failure
 
 
 @pytest.mark.parametrize("stiff", [True, False], ids=["radau", "dop853"])

@@ -42,7 +42,7 @@ from .loop.event import SECTION, Pieces, RunOps, make_run, make_sliding_section,
 from .loop.run_state import RING, SWITCHES, Limits, new_run_state
 from .section import Section  # noqa: F401  (re-exported: filippov.simulate.Section)
 from .loop.stay import UNRESOLVED
-from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN,
+from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
                           NO_SLIDING, OK,
                           ROOT_FAILED, SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO)
 
@@ -470,6 +470,7 @@ class _Run:
                                        self.state_scale, self.time_scale, True,
                                        len(sections), self.max_steps))
         self.hit_section = None
+        self.failed = None  # a slide's failed step (_step), raised unless at a two-fold
         self._flow_field = None  # (mode, f, z) at the end of the last exact window
         self.shift = 0.0  # subtracted from H in this stay (rules.exit_shift)
         self.banded = 0.0  # ... while inside the exit's band (rules.banded_shift)
@@ -707,6 +708,9 @@ class _Run:
             return run_error(ZENO, te, ze, f": {self.zeno_count} switches within "
                                            f"{te - oldest:.3e} time units (Zeno point or "
                                            "chattering below the time resolution)")
+        if status == TWO_FOLD and getattr(self, "failed", None) is not None:  # a failed step
+            return run_error(TWO_FOLD, te, ze, ": the sliding field's steps collapsed where "
+                             "both fields are tangent to H")
         if status == STEP_LIMIT:
             return run_error(STEP_LIMIT, te, ze, f", mode {MODE_NAMES[self.mode]}: step "
                              f"limit {self.max_steps} hit: the run is too long or the step "

@@ -333,7 +333,8 @@ def _record_switch(mode, new_mode, what, t, ctx):
 def _record(mode, new_mode, what, t, shift, banded, band, ctx):
     """A section hit (_at_section: OK, or GO_ON) or a switch (_record_switch), after which
     the orbit goes on in new_mode: the next stay's shifts and band (_store_exit), dP/dz
-    across a crossing (from a region into the other), the age (_entered); GO_ON."""
+    across a switch from a region (into the other, or into sliding), the age (_entered);
+    GO_ON."""
     if what == SECTION:
         return _at_section(mode, t, ctx)
     _record_switch(mode, new_mode, what, t, ctx)

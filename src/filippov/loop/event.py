@@ -73,7 +73,8 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: same stay; the rest unused) or a switch, after which the orbit goes on in new_mode
 #: (GO_ON; before the budgets are asked): the next stay's shift of H, the one it
 #: measures H from inside the exit's rounding band (rules.banded_shift) and the band,
-#: dP/dz across a crossing (from a region into the other), the engine's bookkeeping;
+#: dP/dz across a switch from a region (into the other, or into sliding), the engine's
+#: bookkeeping;
 #: pieces(ctx) -> :data:`Pieces` (the pieces at the state: the engine evaluates, the loop
 #: decides with them); section_along(k, mode, d, ctx): section k at
 #: z + d times the field of ``mode`` (MINUS, PLUS, SLIDING; d = 0: at z) -- with the

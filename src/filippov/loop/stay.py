@@ -33,9 +33,12 @@ def make_failed_step(pieces):
     """``failed_step(status, mode, ctx) -> status``: why a stay's step did not come, as
     the run reports it -- TWO_FOLD where a slide's step failed (STEP_FAILED, or
     NON_FINITE: the sliding field is 0/0 there) with both fields tangent to H at the
-    state the step began from (rules.tangent_to_both): a slide into a two-fold, where the
+    state the engine holds (rules.tangent_to_both): a slide into a two-fold, where the
     steps of its field, not Lipschitz there, collapse before any exit is found; else the
-    status as it is. The engine's operation: ``pieces(ctx)`` at that state."""
+    status as it is. The engine's operation: ``pieces(ctx)`` at that state -- the
+    reference's, the step's start; the kernel's, the step's start, or after NON_FINITE
+    the stage's state that was not finite (kernel.dop853._non_finite_stage), nearer the
+    two-fold."""
 
     def failed_step(status, mode, ctx):
         if mode == SLIDING and (status == STEP_FAILED or status == NON_FINITE):
