@@ -120,11 +120,11 @@ def make_start(ops: RunOps, inline=as_is, call=as_is):
 
     def start(h, touch_tol, sliding, sections, age0, ctx):
         side = rules.start_side(h, touch_tol)
+        age = rules.carried_age(h, touch_tol, age0)  # 0 on H (|h| <= touch_tol), as side
         if side != SLIDING:
-            return GO_ON, side, False, rules.carried_age(h, touch_tol, age0)
+            return GO_ON, side, False, age
         pc = pieces(ctx)
         mode, repelling = rules.start_on_switch(h, pc.a, pc.b, sliding)
-        age = 0.0 if mode == SLIDING else rules.carried_age(h, touch_tol, age0)
         if mode == SLIDING and sliding_section(sections, ctx) >= 0:
             return SECTION_SLIDING, mode, repelling, age
         return GO_ON, mode, repelling, age

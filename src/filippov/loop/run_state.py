@@ -31,8 +31,9 @@ Limits = namedtuple("Limits", ["t_end", "sliding", "max_events", "zeno_count", "
 #: the record: ``limits`` (:data:`Limits`); ``count`` (int64, positions :data:`COUNT`:
 #: changes of mode so far, entries into the ring so far, steps so far (an exact flow's
 #: windows, integration steps); an engine may keep counters of its own after them);
-#: ``ring`` (float64, the last zeno_count switch times, entry k at k % zeno_count); ``first_switch`` (float64[1]: the time of the run's first change of
-#: mode, written when it happens)
+#: ``ring`` (float64, the last zeno_count switch times, entry k at k % zeno_count);
+#: ``first_switch`` (float64[1]: the time of the run's first change of mode, written when
+#: it happens)
 RunState = namedtuple("RunState", ["limits", "count", "ring", "first_switch"])
 
 #: the loop's positions in ``count``
