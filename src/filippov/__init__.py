@@ -19,6 +19,7 @@ except PackageNotFoundError:  # running from a source tree without install
 _LAZY = {
     "PiecewiseSystem": "system", "MINUS": "system", "PLUS": "system", "SLIDING": "system",
     "SlowFastModel": "model",
+    "SurfacesSystem": "surfaces", "SurfacesError": "errors",
     "Section": "simulate", "SimulationError": "simulate",
     "ZenoError": "simulate", "EventLimitError": "simulate",
     "SystemContractError": "checks",

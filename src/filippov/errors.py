@@ -36,6 +36,11 @@ class SlidingNotBuiltError(SimulationError):
     """Attracting sliding reached by a system built with ``sliding=False``."""
 
 
+class SurfacesError(SimulationError):
+    """A run on several switching surfaces that no rule it has continues: a corner the
+    corner rule does not settle, a slide that reaches another surface."""
+
+
 class VariationalError(RuntimeError):
     """The variational equations could not be integrated, or a switch or section
     is met tangentially (the derivative does not exist there)."""

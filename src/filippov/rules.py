@@ -833,3 +833,46 @@ def band_probe(r: float, step: float, lo: float, clear: bool):
         a = max(abs(r), _TINY)
         step = 2.0 * (np.nextafter(a, np.inf) - a)
     return False, max(r - step, lo), 2.0 * step
+
+
+# --------------------------------------------------------- several switching surfaces
+# (filippov.several: a run on a filippov.surfaces.SurfacesSystem, stay by stay)
+
+#: an event on one surface is also on another (a corner) when that one's value there is
+#: within touch_tol plus this many event tolerances' worth of its rate along the orbit:
+#: the event time is refined to event_xtol, so the other surface's value at it is known
+#: to |rate| event_xtol only (docs/decisions.md#several-surfaces-as-stays)
+CORNER_XTOLS = 4.0
+
+
+def at_corner(g: float, rate: float, xtol: float, touch_tol: float) -> bool:
+    """Is a surface whose value (oriented: >= 0 on the orbit's side) is ``g`` at an
+    event on another one, changing at ``rate`` there, reached at the same instant?"""
+    return abs(g) <= touch_tol + CORNER_XTOLS * abs(rate) * xtol
+
+
+def through_corner(speeds) -> bool:
+    """The corner rule: an orbit that reaches several surfaces at once goes straight
+    through into the region across all of them when every field of the regions that
+    meet there crosses every one of those surfaces in the orbit's direction
+    (``speeds``: each region's field along each surface's normal, oriented to the
+    orbit's side, flat; < 0 toward the far side): then every Filippov solution crosses
+    them, and only that one goes on. Anything else (a field that turns back: sliding on
+    a surface or their intersection, or a choice between regions) is not settled by
+    this rule."""
+    for v in speeds:
+        if not v < 0.0:
+            return False
+    return True
+
+
+def slide_crosses(a_far: float, b_far: float, v_near: float, v_far: float) -> bool:
+    """A slide on one surface that reaches another goes on across it, sliding on the
+    first beyond, when the first attracts beyond (``a_far > 0 > b_far``: the normal
+    speeds of the fields beside it in the far regions, as :func:`next_mode` reads them)
+    and both sliding fields, this side's and the far side's, cross the second surface
+    toward the far side (``v_near``, ``v_far`` < 0 along its normal oriented to this
+    side): on the first surface the orbit is a one-surface Filippov system that crosses
+    there. Anything else (a slide that leaves there, or one along the intersection) is
+    not settled by this rule."""
+    return a_far > 0.0 > b_far and v_near < 0.0 and v_far < 0.0

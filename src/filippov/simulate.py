@@ -30,7 +30,7 @@ import numpy as np
 from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
-from . import checks, options, rules, variational, views
+from . import checks, options, rules, several, variational, views
 from . import scale as scale_mod
 from .scale import UNIT
 from .loop import interval
@@ -41,6 +41,7 @@ from .errors import accumulation_detail, run_error
 from .loop.event import SECTION, Pieces, RunOps, make_run, make_sliding_section, make_start
 from .loop.run_state import RING, SWITCHES, Limits, new_run_state
 from .section import Section  # noqa: F401  (re-exported: filippov.simulate.Section)
+from .surfaces import SurfacesSystem
 from .loop.stay import UNRESOLVED
 from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
                           NO_SLIDING, OK,
@@ -413,7 +414,7 @@ def simulate(system, z0, t_end: float, *, engine: str = "reference", t0: float =
                 max_events=max_events, max_steps=max_steps, dense=dense,
                 samples_per_step=samples_per_step, touch_tol=touch_tol, event_xtol=event_xtol,
                 zeno_count=zeno_count, zeno_span=zeno_span, stiff=stiff, scale=scale)
-    return run(views.reference_system(system, "simulate"), z0, sections, opts)
+    return run(views.reference_system(system, "simulate", several=True), z0, sections, opts)
 
 
 def _simulate(system: PiecewiseSystem, z0, sections: Sequence[Section], opts: dict) -> Trajectory:
@@ -435,6 +436,8 @@ def _simulate(system: PiecewiseSystem, z0, sections: Sequence[Section], opts: di
         if not isinstance(sec, Section):
             raise TypeError(f"sections[{k}]: expected a filippov.simulate.Section, got "
                             f"{type(sec).__name__}")
+    if isinstance(system, SurfacesSystem):  # several surfaces: stay by stay
+        return several.run(system, z, list(sections), opts, one_stay)
     sc = scale_mod.of_system(system, z, opts.get("scale"))   # never raises: checked next
     checks.check_system(system, z, method=method, floor=sc.state)   # the class's contract
     return _Run(system, z, list(sections), scale_mod.tolerances(opts, sc), sc).go()
@@ -450,18 +453,21 @@ class _Run:
     :meth:`go` runs the shared loop (:data:`_RUN`), :meth:`stay` follows one mode until
     its next event; the functions under "one event" are what the loop does there."""
 
-    def __init__(self, system, z, sections, opts, scale=UNIT):
+    def __init__(self, system, z, sections, opts, scale=UNIT, begun=None):
         self.system, self.sections = system, sections
         self.state_scale = self.time_scale = 1.0
         self.__dict__.update(opts)
         self.traj = Trajectory(system=system, t0=self.t0, z0=z.copy(), t=self.t0, z=z.copy(),
                                scale=scale)
         self.t, self.z = self.t0, z
-        status, self.mode, kind = _start(self, self.touch_tol)
+        if begun is None:
+            status, self.mode, kind = _start(self, self.touch_tol)
+            self.traj.events.append(Event(self.t0, kind, z.copy(), self.mode, self.mode))
+            if status != GO_ON:
+                raise self._event_error(status)
+        else:  # a stay that goes on from a switch the run before it decided (_one_stay)
+            self.mode = begun[0]
         self.traj.mode = self.mode
-        self.traj.events.append(Event(self.t0, kind, z.copy(), self.mode, self.mode))
-        if status != GO_ON:
-            raise self._event_error(status)
         self.preds = [rules.section_pred(sec.direction) for sec in sections]
         self.hits = [0] * len(sections)
         # what the loop keeps: limits, switches, the Zeno ring (filippov.loop.run_state)
@@ -472,9 +478,11 @@ class _Run:
         self.hit_section = None
         self.failed = None  # a slide's failed step (_step), raised unless at a two-fold
         self._flow_field = None  # (mode, f, z) at the end of the last exact window
-        self.shift = 0.0  # subtracted from H in this stay (rules.exit_shift)
-        self.banded = 0.0  # ... while inside the exit's band (rules.banded_shift)
-        self.band = 0.0   # the rounding band of the exit the stay began at (rules.exit_band)
+        # subtracted from H in this stay (rules.exit_shift); ... while inside the exit's
+        # band (rules.banded_shift); the rounding band of the exit the stay began at
+        # (rules.exit_band)
+        self.shift, self.banded, self.band = (0.0, 0.0, 0.0) if begun is None else begun[1:]
+        self.handed_on = False  # the run ended at its first switch (_one_stay)
         self.frac_integrated = np.linspace(0.0, 1.0, self.samples_per_step + 1)
         # An exact flow is evaluated EXACT_BLOCK windows at a time: the same sample
         # spacing, a sixteenth of the Python overhead.
@@ -788,6 +796,39 @@ RUN_OPERATIONS = RunOps(
     section_along=_section_along,
     exit_state=_exit_state)
 _RUN = make_run(RUN_OPERATIONS)
+
+
+def _record_and_hand_on(mode, new_mode, what, t, shift, banded, band, run):
+    """:func:`_record`, and a switch ends the run there (OK, ``run.handed_on``)."""
+    status = _record(mode, new_mode, what, t, shift, banded, band, run)
+    if what == SECTION or status != GO_ON:
+        return status
+    run.handed_on = True
+    return OK
+
+
+#: the shared loop up to its first switch: one stay of a several-surface run
+_RUN_TO_SWITCH = make_run(RUN_OPERATIONS._replace(record=_record_and_hand_on))
+
+
+def one_stay(system, z, sections, opts, scale, begun=None):
+    """One stay of a run on ``system`` (a one-surface view: filippov.several), to its
+    first switch ("switch", the switch recorded and its next mode in ``run.mode``), a
+    terminal section ("section") or the end time ("t_end"): ``(how, run)``; anything
+    else raises as :func:`simulate` does. ``begun``: (mode, shift, banded, band) of a
+    stay that goes on from a switch (else the start decides, as a run's start does);
+    ``opts``: the run's options in its units (filippov.scale.tolerances)."""
+    run = _Run(system, z, list(sections), opts, scale, begun)
+    status, _, _ = _RUN_TO_SWITCH(run.z, 0.0, run, run.rs)
+    if status == OK:
+        return ("switch" if run.handed_on else "section"), run
+    if status == NO_RETURN:
+        return "t_end", run
+    if status == STEP_FAILED:
+        raise run.failed
+    raise run._event_error(status)
+
+
 #: the start's mode and its refusal to slide in a section, and that test alone, on the
 #: operations above (filippov.loop.event)
 _START = make_start(RUN_OPERATIONS)

@@ -49,14 +49,25 @@ def _is_compiled_model(system) -> bool:
     return abi is not None and isinstance(system, abi.CompiledModel)
 
 
-def reference_system(system, capability: str):
+def reference_system(system, capability: str, several: bool = False):
     """The :class:`~filippov.system.PiecewiseSystem` the reference driver runs for
     ``system``: itself, or the ``python()`` view of a system defined once
-    (:class:`~filippov.FilippovSystem`, :class:`~filippov.SymbolicSystem`)."""
+    (:class:`~filippov.FilippovSystem`, :class:`~filippov.SymbolicSystem`); a
+    :class:`~filippov.surfaces.SurfacesSystem` of one surface as one, of several as it
+    is where the capability takes them (``several``), else refused by name."""
+    from .surfaces import SurfacesSystem
     from .system import PiecewiseSystem
 
     if isinstance(system, PiecewiseSystem):
         return system
+    if isinstance(system, SurfacesSystem):
+        if system.m == 1:
+            return system.one_surface()
+        if several:
+            return system
+        raise TypeError(f"system: {capability} does not take several switching surfaces "
+                        f"yet (m = {system.m}); filippov.simulate runs them (engine="
+                        "'reference')")
     if _is_compiled_model(system):
         raise TypeError(f"system: {capability}(engine='reference') cannot run a "
                         "CompiledModel (numba pieces for the compiled engine only); "
@@ -72,8 +83,13 @@ def compiled_model(system, capability: str, section=None, *, direction: int = 0,
                    where=None):
     """The :class:`~filippov.abi.CompiledModel` the compiled engine runs for ``system``
     with the section ``section(z, p) = 0`` (None: a CompiledModel's own section)."""
+    from .surfaces import SurfacesSystem
     from .system import PiecewiseSystem
 
+    if isinstance(system, SurfacesSystem):
+        raise TypeError(f"system: {capability}(engine='compiled') cannot run a "
+                        "SurfacesSystem: the compiled engine takes one switching surface; "
+                        "filippov.simulate runs several (engine='reference')")
     if isinstance(system, PiecewiseSystem):
         raise TypeError(f"system: {capability}(engine='compiled') cannot run a "
                         "PiecewiseSystem (Python functions the compiled kernel cannot "

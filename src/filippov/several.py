@@ -1,0 +1,287 @@
+"""A run on several switching surfaces (a :class:`~filippov.surfaces.SurfacesSystem`),
+stay by stay, on the reference engine.
+
+Each stay is a one-surface problem (:mod:`filippov.surfaces`): in region sigma the
+region's boundary (:func:`~filippov.surfaces.region_view`), while sliding on surface k
+that surface alone (:func:`~filippov.surfaces.slide_view`, the other surfaces watched as
+terminal sections). The engine's run (``one_stay``: :func:`filippov.simulate.one_stay`)
+follows a stay with every rule of the one-surface book -- its event search, grazes,
+sliding, exits and their rounding bands -- up to its first switch, and decides it there
+(cross, slide, leave the slide); this module takes the decision into the next stay's
+view, keeping H the same function near the surface (the orientation ``s``), and keeps
+what spans the whole run: the switches against max_events and the Zeno ring
+(:mod:`filippov.loop.run_state`), the steps against max_steps, the sections' hits, and
+one trajectory whose modes are the run's codes (:func:`~filippov.surfaces.mode_of`).
+
+Where the next stay is not a one-surface problem the run is refused by name
+(:class:`~filippov.errors.SurfacesError`): a start or an event at two surfaces at once
+(a corner) unless every field there crosses them all (:func:`filippov.rules.
+through_corner`: then straight through); a slide on one surface that reaches another,
+unless it slides on across it (:func:`filippov.rules.slide_crosses`).
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import NamedTuple
+
+import numpy as np
+
+from . import checks, rules
+from . import scale as scale_mod
+from .errors import SurfacesError, accumulation_detail, run_error
+from .loop.run_state import RING, Limits, count_switch, new_run_state
+from .loop.status import GO_ON, ZENO
+from .section import Section
+from .surfaces import SurfacesSystem, flip, mode_name, mode_of, region_view, slide_view
+from .system import SLIDING
+
+#: the sections a slide's stay watches the other surfaces with (never a user's name)
+_SURFACE = "\x00surface "
+
+
+class Stay(NamedTuple):
+    """Where a stay is: region ``sigma``, the surface slid on (-1: none), the side of H
+    the region is on in its view (``s``), and what the stay begins with (None: the
+    run's start decides; else its mode in the view, shift, banded shift and band)."""
+    sigma: tuple
+    slide: int
+    s: int
+    begun: tuple | None
+
+
+def check_surfaces(system: SurfacesSystem, z: np.ndarray, floor: float) -> None:
+    """The several-surface pieces' shapes on a batch next to z, and each region's field
+    (one region's view is checked as a one-surface system by the engine's checks)."""
+    zs = checks.probe_states(z, system.dim + 2, floor)
+    system.values(z), system.values(zs), system.grads(z), system.grads(zs)
+    for sigma in _regions(system.m):
+        for zz in (z, zs):
+            f = np.asarray(system.region_field(sigma, zz), dtype=float)
+            if f.shape != zz.shape:
+                raise ValueError(f"field: region {sigma} returned shape {f.shape} for a "
+                                 f"state of shape {zz.shape}")
+
+
+def _regions(m):
+    out = [()]
+    for _ in range(m):
+        out = [r + (s,) for r in out for s in (-1, 1)]
+    return out
+
+
+def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_stay):
+    """The run of :func:`filippov.simulate.simulate` on ``system`` from z (``opts``: its
+    options by name): one trajectory, or the error that stopped it."""
+    sigma = system.region(z)
+    first = region_view(system, sigma, 1)
+    sc = scale_mod.of_system(first, z, opts.get("scale"))
+    check_surfaces(system, z, sc.state)
+    for k in range(system.m):  # each surface's pieces, its gradient among them
+        checks.check_system(slide_view(system, sigma, k, 1), z, method="integrate",
+                            floor=sc.state)
+    o = scale_mod.tolerances(opts, sc)
+    _refuse_corner_start(system, z, sigma, o)
+    rs = new_run_state(Limits(o["t_end"], system.sliding, o["max_events"], o["zeno_count"],
+                              o["zeno_span"], o["touch_tol"], o["state_scale"],
+                              o["time_scale"], True, len(sections), o["max_steps"]))
+    stay, t, z, traj, hits = Stay(sigma, -1, 1, None), o["t0"], z, None, [0] * len(sections)
+    while True:
+        view = (region_view(system, stay.sigma, stay.s) if stay.slide < 0
+                else slide_view(system, stay.sigma, stay.slide, stay.s))
+        steps = 0 if traj is None else traj.n_steps
+        mine = _stay_sections(system, stay, sections, hits, t - o["t0"])
+        how, r = one_stay(view, z, mine, dict(o, t0=t, max_steps=max(o["max_steps"] - steps, 1)),
+                          sc, stay.begun)
+        surface = _event_surface(system, stay, r.z)
+        traj = _merge(traj, r.traj, system, stay, surface)
+        t, z = r.t, r.z
+        for k in range(len(sections)):
+            hits[k] += r.hits[k]
+        if how == "t_end":
+            return _end(traj, "t_end", t, z, stay, surface, system)
+        if how == "section":
+            sec = mine[r.hit_section]
+            if sec.name.startswith(_SURFACE):  # the slide on k reaches surface j
+                stay = _slide_across(system, stay, int(sec.name[len(_SURFACE):]), t, z,
+                                     traj)
+                status = count_switch(rs, t, True)
+                if status != GO_ON:
+                    raise _budget_error(status, rs, o, t, z)
+                continue
+            return _end(traj, f"section:{sec.name}", t, z, stay, surface, system)
+        stay = _next_stay(system, stay, surface, r, o, traj)
+        status = count_switch(rs, t, True)
+        if status != GO_ON:
+            raise _budget_error(status, rs, o, t, z)
+
+
+def _stay_sections(system, stay, sections, hits, elapsed):
+    """The user's sections as a stay that begins ``elapsed`` after the run sees them
+    (min_time counted from the run's start, terminal hits from the run's), and while
+    sliding on k the other surfaces, terminal at their first crossing."""
+    out = []
+    for sec, n in zip(sections, hits):
+        out.append(dataclasses.replace(
+            sec, min_time=max(sec.min_time - elapsed, 0.0),
+            terminal=None if sec.terminal is None else sec.terminal - n))
+    if stay.slide >= 0:
+        for j in range(system.m):
+            if j != stay.slide:
+                out.append(Section(f"{_SURFACE}{j}", _oriented(system, stay.sigma, j),
+                                   direction=-1, terminal=1))
+    return out
+
+
+def _oriented(system, sigma, j):
+    """sigma_j h_j, >= 0 on region sigma's side of surface j."""
+    return lambda z: sigma[j] * system.values(z)[j]
+
+
+def _event_surface(system, stay, z):
+    """The surface a stay's switch is at: the one slid on, or the region's nearest."""
+    if stay.slide >= 0:
+        return stay.slide
+    g = np.asarray(stay.sigma, float) * system.values(np.asarray(z, float))
+    return int(np.argmin(g))
+
+
+def _code(stay, surface, local):
+    """A mode of a stay's view (``local``: its side s, the other side, or SLIDING) as
+    the run's code."""
+    if local == SLIDING:
+        digits = list(stay.sigma)
+        digits[surface] = 0
+        return mode_of(digits)
+    return mode_of(stay.sigma if local == stay.s else flip(stay.sigma, surface))
+
+
+def _merge(traj, sub, system, stay, surface):
+    """The stay's trajectory appended to the run's, its modes as the run's codes."""
+    events = [dataclasses.replace(e, mode_before=_code(stay, surface, e.mode_before),
+                                  mode_after=_code(stay, surface, e.mode_after))
+              for e in sub.events if not e.name.startswith(_SURFACE)]
+    segments = [(ta, tb, _code(stay, surface, mode), Z) for ta, tb, mode, Z in sub.segments]
+    here = mode_name(_code(stay, surface, stay.s if stay.slide < 0 else SLIDING), system.m)
+    if traj is None:
+        traj = dataclasses.replace(sub, system=system, events=[], segments=[], n_steps=0,
+                                   n_windows=0, integrated_modes=set(), stiff_modes=set(),
+                                   atol_raised={})
+    traj.events += events
+    traj.segments += segments
+    traj.n_steps += sub.n_steps
+    traj.n_windows += sub.n_windows
+    if sub.integrated_modes:
+        traj.integrated_modes.add(here)
+    if sub.stiff_modes:
+        traj.stiff_modes.add(here)
+    for v in sub.atol_raised.values():
+        traj.atol_raised[here] = max(traj.atol_raised.get(here, 0.0), v)
+    return traj
+
+
+def _end(traj, status, t, z, stay, surface, system):
+    local = stay.s if stay.slide < 0 else SLIDING
+    traj.status, traj.t, traj.z = status, t, np.array(z, dtype=float)
+    traj.mode = _code(stay, surface, local)
+    return traj
+
+
+def _next_stay(system, stay, a, r, o, traj) -> Stay:
+    """The stay after the switch the last one ended at, on surface a: its view's mode
+    is the engine's decision (``r.mode``), and with it the shift and band it begins with."""
+    begun = (r.mode, r.shift, r.banded, r.band)
+    sigma, s = stay.sigma, stay.s
+    if stay.slide >= 0:  # the slide's end: into its region, or across the surface
+        if r.mode == s:
+            return Stay(sigma, -1, s, begun)
+        return Stay(flip(sigma, a), -1, -s, begun)
+    corner = _corner(system, sigma, a, r.z, o)
+    if corner:
+        return _through(system, stay, [a] + corner, r, traj)
+    if r.mode == SLIDING:
+        return Stay(sigma, a, s, begun)
+    return Stay(flip(sigma, a), -1, -s, begun)
+
+
+def _corner(system, sigma, a, z, o):
+    """The other surfaces the event on surface a is also at (rules.at_corner)."""
+    z = np.asarray(z, dtype=float)
+    h, G = system.values(z), system.grads(z)
+    f = np.asarray(system.region_field(sigma, z), dtype=float)
+    return [j for j in range(system.m) if j != a and rules.at_corner(
+        sigma[j] * h[j], sigma[j] * float(G[j] @ f), o["event_xtol"], o["touch_tol"])]
+
+
+def _through(system, stay, at, r, traj) -> Stay:
+    """A corner of the surfaces ``at``: straight through where rules.through_corner
+    says so (the switch logged as a "corner" into the region across them all), else
+    refused by name."""
+    z = np.asarray(r.z, dtype=float)
+    G = system.grads(z)
+    regions = [stay.sigma]
+    for k in at:
+        regions += [flip(q, k) for q in regions]
+    speeds = np.array([[stay.sigma[k] * float(G[k] @ np.asarray(system.region_field(q, z),
+                                                                  dtype=float))
+                        for k in at] for q in regions])
+    names = ", ".join(f"h{k + 1}" for k in sorted(at))
+    if not rules.through_corner(speeds.ravel()):
+        raise SurfacesError(
+            f"corner at t={r.t!r}, state {z.tolist()}: the orbit reaches {names} at once "
+            f"from region {mode_name(mode_of(stay.sigma), system.m)}, and the fields there "
+            "do not all cross them (normal speeds, a row per region meeting there: "
+            f"{speeds.tolist()}); a corner where sliding or a choice of region may follow "
+            "is not settled by filippov (rules.through_corner)")
+    sigma = stay.sigma
+    for k in at:
+        sigma = flip(sigma, k)
+    last = traj.events[-1]
+    traj.events[-1] = dataclasses.replace(last, kind="corner", mode_after=mode_of(sigma),
+                                          name=names)
+    return Stay(sigma, -1, -stay.s, (-stay.s, 0.0, 0.0, 0.0))
+
+
+def _refuse_corner_start(system, z, sigma, o):
+    g = np.asarray(sigma, float) * system.values(z)
+    on = [k for k in range(system.m) if abs(g[k]) <= o["touch_tol"]]
+    if len(on) > 1:
+        raise SurfacesError(
+            f"start at a corner: state {z.tolist()} is on "
+            f"{', '.join(f'h{k + 1}' for k in on)} at once (|h| <= touch_tol); start "
+            "off the corner, or on one surface")
+
+
+def _slide_across(system, stay, j, t, z, traj) -> Stay:
+    """A slide on k at surface j: on across it where rules.slide_crosses says so (a
+    "crossing" of h_j logged while sliding), else refused by name."""
+    k, s, z = stay.slide, stay.s, np.asarray(z, dtype=float)
+    far = flip(stay.sigma, j)
+    near_view, far_view = (slide_view(system, q, k, s) for q in (stay.sigma, far))
+    a_far, b_far = (float(v) for v in far_view.normal_speeds(z))
+    normal = stay.sigma[j] * system.grads(z)[j]
+    v_near, v_far = (float(normal @ np.asarray(v.sliding_field(z), dtype=float))
+                     for v in (near_view, far_view))
+    if not rules.slide_crosses(a_far, b_far, v_near, v_far):
+        raise _slide_meets(system, stay, j, t, z)
+    before, after = (mode_of(q[:k] + (0,) + q[k + 1:]) for q in (stay.sigma, far))
+    traj.events.append(type(traj.events[0])(t, "crossing", z.copy(), before, after,
+                                            f"h{j + 1}"))
+    return Stay(far, k, s, (SLIDING, 0.0, 0.0, 0.0))
+
+
+def _slide_meets(system, stay, j, t, z):
+    return SurfacesError(
+        f"intersection at t={t!r}, state {np.asarray(z, float).tolist()}: the slide on "
+        f"h{stay.slide + 1} (mode {mode_name(_code(stay, stay.slide, SLIDING), system.m)}) "
+        f"reaches h{j + 1}; what follows there (sliding on the intersection, or a slide "
+        "across it) is not built into filippov yet")
+
+
+def _budget_error(status, rs, o, t, z):
+    if status == ZENO:
+        ratio, t_star = rules.geometric_accumulation(rs.ring, rs.count[RING], o["zeno_count"])
+        detail = (accumulation_detail(ratio, t_star) if ratio == ratio else
+                  f": {o['zeno_count']} switches within the Zeno span")
+        return run_error(ZENO, t, z, detail)
+    return run_error(status, t, z, f": event limit {o['max_events']} hit (rapid switching "
+                                   "between the surfaces)")

@@ -1,0 +1,236 @@
+"""Several switching surfaces (filippov.surfaces, filippov.several; issue 59) on the
+reference engine, against answers computed without the library: the generated
+piecewise-affine crossings of tests/generated_multi.py (expm), orbits of constant and
+affine fields in closed form (a slide, its exit, crossings, a corner), and what must be
+refused by name (a corner the rule does not settle, a slide that reaches another
+surface, a Zeno spiral into a corner, bad definitions, the engines and front doors that
+do not take several surfaces)."""
+import numpy as np
+import pytest
+from hypothesis import given, settings
+
+import filippov
+from filippov import rules
+from filippov.errors import SurfacesError, ZenoError
+from filippov.simulate import Section, simulate
+from filippov.surfaces import (MAX_SURFACES, SurfacesSystem, digits, mode_name, mode_of,
+                               region_view)
+from filippov.system import PiecewiseSystem
+from generated_multi import multi_crossings
+
+#: event times and states of the closed forms below: the integration's error at rtol
+#: 1e-12 over t <= 10 on O(1) states (fields at most linear: DOP853 is exact to rounding
+#: on the constant ones), the events refined to event_xtol 1e-15
+TOL = 1e-10
+
+
+def _planar(fields, h2_offset=2.0):
+    """h1 = y, h2 = x - h2_offset in the plane; ``fields[sigma] = (fx, fy)``: functions of
+    (x, y) or numbers."""
+    def field(sig, z):
+        fx, fy = fields[sig]
+        x, y = z[0], z[1]
+        return np.array([np.broadcast_to(fx(x, y) if callable(fx) else fx, np.shape(x)),
+                         np.broadcast_to(fy(x, y) if callable(fy) else fy, np.shape(x))],
+                        dtype=float)
+
+    def grads(z):
+        zero, one = np.zeros_like(z[0]), np.ones_like(z[0])
+        return np.array([[zero, one], [one, zero]])
+    return SurfacesSystem(("x", "y"), lambda z: np.array([z[1], z[0] - h2_offset]), grads,
+                          field, m=2)
+
+
+def test_mode_codes_are_balanced_ternary_and_one_surface_is_today_s():
+    for m in range(1, 4):
+        for code in range(-(3 ** m - 1) // 2, (3 ** m - 1) // 2 + 1):
+            assert mode_of(digits(code, m)) == code
+    assert [mode_of((d,)) for d in (-1, 0, 1)] == [filippov.MINUS, filippov.SLIDING,
+                                                   filippov.PLUS]
+    assert mode_name(mode_of((1, 0)), 2) == "+0"
+
+
+def test_a_slide_its_exit_and_two_crossings_in_closed_form():
+    # from (0, 0.3) in (+,-) F = (1, -1) to y = 0 at t = 0.3; slides (F_- = (1, 1 - x)
+    # points up while x < 1) at x' = 1 to x = 1 (t = 1), where F_- turns tangent: exits
+    # into (-,-), y = -(t - 1)^2 / 2, to x = 2 (t = 2, y = -1/2); crosses into (-,+),
+    # y' = 1/4, to y = 0 at t = 4; there F_+ = (1, -0.1) points back: slides
+    S = _planar({(1, -1): (1, -1), (-1, -1): (1, lambda x, y: 1 - x),
+                 (-1, 1): (1, 0.25), (1, 1): (1, -0.1)})
+    tr = simulate(S, [0.0, 0.3], 6.0, method="integrate")
+    got = [(e.kind, mode_name(e.mode_before, 2), mode_name(e.mode_after, 2))
+           for e in tr.events]
+    assert got == [("start", "+-", "+-"), ("slide_start", "+-", "0-"),
+                   ("slide_end", "0-", "--"), ("crossing", "--", "-+"),
+                   ("slide_start", "-+", "0+")]
+    want = [(0.0, 0.0, 0.3), (0.3, 0.3, 0.0), (1.0, 1.0, 0.0), (2.0, 2.0, -0.5),
+            (4.0, 4.0, 0.0)]
+    for e, (t, x, y) in zip(tr.events, want):
+        assert abs(e.t - t) <= TOL and np.max(np.abs(e.state - [x, y])) <= TOL
+    assert tr.status == "t_end" and tr.t == 6.0 and mode_name(tr.mode, 2) == "0+"
+    assert np.max(np.abs(tr.z - [6.0, 0.0])) <= TOL
+    # the dense output carries the run's codes: sliding on h1 with h2 < 0 at t = 0.5
+    ts, zs, modes = tr.sample(np.array([0.5, 1.5, 3.0]), include_events=False)
+    assert [mode_name(c, 2) for c in modes] == ["0-", "--", "-+"]
+    assert abs(zs[1, 1] + 0.125) <= TOL
+
+
+@settings(max_examples=8, deadline=None)
+@given(case=multi_crossings())
+def test_generated_crossings_of_two_and_three_surfaces(case):
+    g = case.g
+    n = g.n
+
+    def grads(z):
+        return g.C if np.ndim(z) == 1 else np.repeat(g.C[:, :, None], z.shape[1], axis=2)
+
+    S = SurfacesSystem(tuple(f"z{i}" for i in range(n)),
+                       lambda z: g.C @ z - g.d.reshape((-1,) + (1,) * (np.ndim(z) - 1)),
+                       grads,
+                       {s: (lambda z, a=a: a.A @ z + a.b.reshape((-1,) + (1,) * (np.ndim(z) - 1)))
+                        for s, a in g.fields.items()}, m=g.m)
+    sec = Section("s", lambda z: g.u @ z - g.sigma, direction=1, terminal=1)
+    tr = simulate(S, case.z0, 20.0, method="integrate", sections=[sec])
+    crossings = [e for e in tr.events if e.kind == "crossing"]
+    assert tr.status == "section:s"
+    assert [int(np.argmax(np.abs(np.array(digits(e.mode_after, g.m))
+                                 - digits(e.mode_before, g.m)))) for e in crossings] \
+        == case.surfaces
+    for e, t, zc in zip(crossings, case.times, case.states):
+        assert abs(e.t - t) <= TOL and np.max(np.abs(e.state - zc)) <= TOL
+    assert abs(tr.t - case.time) <= TOL
+    assert np.max(np.abs(tr.z - case.P)) <= TOL * max(1.0, np.abs(case.P).max())
+    assert digits(tr.mode, g.m) == case.regions[-1]
+
+
+def _piecewise(S):
+    f = {s: S.field[s] for s in S.field}
+    return PiecewiseSystem(S.names, f[(-1,)], f[(1,)], lambda z: S.switches(z)[0],
+                           lambda z: S.switch_grads(z)[0])
+
+
+def test_one_surface_is_today_s_system_bit_for_bit():
+    # a relay oscillator, x' = y + 0.3, y' = -x -+ 0.7 (slides on y = 0 while |x| < 0.7,
+    # drifting at x' = 0.3 to the exit): crossings, slides, exits
+    S = SurfacesSystem(("x", "y"), lambda z: np.array([z[1]]), lambda z: np.array(
+        [[np.zeros_like(z[0]), np.ones_like(z[0])]]),
+        {(1,): lambda z: np.array([z[1] + 0.3, -z[0] - 0.7]),
+         (-1,): lambda z: np.array([z[1] + 0.3, -z[0] + 0.7])}, m=1)
+    a = simulate(S, [2.0, 0.5], 12.0, method="integrate")
+    b = simulate(_piecewise(S), [2.0, 0.5], 12.0, method="integrate")
+    assert [(e.t, e.kind, e.mode_before, e.mode_after) for e in a.events] == \
+        [(e.t, e.kind, e.mode_before, e.mode_after) for e in b.events]
+    assert all(np.array_equal(e.state, f.state) for e, f in zip(a.events, b.events))
+    assert np.array_equal(a.z, b.z)
+    assert {e.kind for e in a.events} >= {"crossing", "slide_start", "slide_end"}
+
+
+def test_a_corner_is_crossed_straight_through_where_every_field_crosses():
+    # h1 = y, h2 = x: from (-1, -1) every field points up and right; at t = 1 the orbit
+    # is at the corner (x and y the same numbers throughout); then (++) F = (2, 1)
+    S = _planar({(-1, -1): (1, 1), (1, -1): (1, 3), (-1, 1): (3, 1), (1, 1): (2, 1)},
+                h2_offset=0.0)
+    tr = simulate(S, [-1.0, -1.0], 2.0, method="integrate")
+    corner = [e for e in tr.events if e.kind == "corner"]
+    assert len(corner) == 1 and corner[0].name == "h1, h2"
+    assert abs(corner[0].t - 1.0) <= TOL
+    assert mode_name(corner[0].mode_after, 2) == "++"
+    assert np.max(np.abs(tr.z - [2.0, 1.0])) <= TOL and mode_name(tr.mode, 2) == "++"
+
+
+def test_a_corner_the_rule_does_not_settle_is_refused_by_name():
+    # the same corner, but region (+,-) pushes back down across h1: not every field crosses
+    S = _planar({(-1, -1): (1, 1), (1, -1): (1, -3), (-1, 1): (3, 1), (1, 1): (2, 1)},
+                h2_offset=0.0)
+    with pytest.raises(SurfacesError, match="corner at t=.*h1, h2 at once"):
+        simulate(S, [-1.0, -1.0], 2.0, method="integrate")
+    with pytest.raises(SurfacesError, match="start at a corner"):
+        simulate(S, [0.0, 0.0], 2.0, method="integrate")
+
+
+def test_the_corner_rule():
+    assert rules.through_corner(np.array([-1.0, -2.0, -0.5, -1e-3]))
+    assert not rules.through_corner(np.array([-1.0, -2.0, -0.5, 0.0]))
+    assert not rules.through_corner(np.array([-1.0, np.nan]))
+    assert rules.at_corner(1e-16, 1.0, 1e-15, 0.0)
+    assert not rules.at_corner(1e-12, 1.0, 1e-15, 1e-15)
+    assert rules.slide_crosses(1.0, -1.0, -0.5, -2.0)
+    assert not rules.slide_crosses(1.0, 0.0, -0.5, -2.0)      # not attracting beyond
+    assert not rules.slide_crosses(1.0, -1.0, -0.5, 0.5)      # turned back beyond
+
+
+def test_a_slide_goes_on_across_another_surface_where_it_attracts_beyond():
+    # the slide on y = 0 at x' = 1 reaches x = 2 at t = 0.3 + 1.4; beyond, F_+ = (2, -1)
+    # and F_- = (2, 1) make y = 0 attract again, its sliding field (2, 0)
+    S = _planar({(1, -1): (1, -1), (-1, -1): (1, 1), (-1, 1): (2, 1), (1, 1): (2, -1)})
+    tr = simulate(S, [0.3, 0.3], 3.0, method="integrate")
+    across = [e for e in tr.events if e.kind == "crossing"]
+    assert len(across) == 1 and across[0].name == "h2"
+    assert (mode_name(across[0].mode_before, 2), mode_name(across[0].mode_after, 2)) == \
+        ("0-", "0+")
+    assert abs(across[0].t - 1.7) <= TOL
+    assert np.max(np.abs(tr.z - [2.0 + 2.0 * 1.3, 0.0])) <= TOL and mode_name(tr.mode, 2) == "0+"
+
+
+def test_a_slide_that_reaches_another_surface_is_refused_by_name():
+    # as above, but beyond x = 2 y = 0 repels (F_+ = (1, 1), F_- = (1, -1))
+    S = _planar({(1, -1): (1, -1), (-1, -1): (1, 1), (-1, 1): (1, -1), (1, 1): (1, 1)})
+    with pytest.raises(SurfacesError, match=r"intersection at t=.*slide on h1.*reaches h2") as err:
+        simulate(S, [0.3, 0.3], 6.0, method="integrate")
+    assert abs(float(str(err.value).split("t=")[1].split(",")[0]) - 1.7) <= TOL
+
+
+def test_a_spiral_into_a_corner_stops_as_zeno_not_a_hang():
+    # quadrant fields turning about the origin, each quarter half as long as the last:
+    # infinitely many crossings before t = 2 (1 + 1/2 + 1/4 + ...)
+    S = _planar({(1, 1): (-1, 0.5), (1, -1): (-0.5, -1), (-1, -1): (1, -0.5),
+                 (-1, 1): (0.5, 1)}, h2_offset=0.0)
+    with pytest.raises(ZenoError, match="accumulate geometrically") as err:
+        simulate(S, [1.0, 1e-3], 5.0, method="integrate")
+    # the quarters last 1, then 0.501 halving: the accumulation at 1 + 2 x 0.501
+    msg = str(err.value)
+    t_star = float(msg.split("t* = ")[1].split(" ")[0])
+    assert abs(t_star - 2.002) <= 1e-9
+    assert 1.99 < float(msg.split("t=")[1].split(",")[0]) < t_star
+
+
+def test_sections_count_across_the_stays():
+    # x = 0.5 is crossed while sliding (t = 0.5), x = 1.5 in (-,-) (t = 1.5), x = 3 in
+    # (-,+) (t = 3): terminal at its second hit, min_time skipping the first
+    S = _planar({(1, -1): (1, -1), (-1, -1): (1, lambda x, y: 1 - x),
+                 (-1, 1): (1, 0.25), (1, 1): (1, -0.1)})
+    secs = [Section("x", lambda z: np.cos(np.pi * z[0]), direction=0, terminal=2,
+                    min_time=0.6)]
+    tr = simulate(S, [0.0, 0.3], 6.0, method="integrate", sections=secs)
+    hits = tr.section_hits("x")
+    assert [round(e.t, 9) for e in hits] == [1.5, 2.5] and tr.status == "section:x"
+
+
+def test_bad_definitions_are_refused_by_field():
+    ok = dict(names=("x", "y"), switches=lambda z: np.array([z[0], z[1]]),
+              switch_grads=lambda z: np.array([[1.0, 0.0], [0.0, 1.0]]))
+    with pytest.raises(ValueError, match="^m: .* from 1 to"):
+        SurfacesSystem(**ok, field=lambda s, z: z, m=MAX_SURFACES + 1)
+    with pytest.raises(ValueError, match="field: no field for region"):
+        SurfacesSystem(**ok, field={(1, 1): lambda z: z}, m=2)
+    with pytest.raises(ValueError, match="is not a sign vector"):
+        SurfacesSystem(**ok, field={(1, 2): lambda z: z}, m=2)
+    bad = SurfacesSystem(("x", "y"), lambda z: np.array([z[0]]),
+                         lambda z: np.eye(2), lambda s, z: z, m=2)
+    with pytest.raises(ValueError, match=r"switches: returned shape \(1,\)"):
+        simulate(bad, [1.0, 1.0], 1.0)
+
+
+def test_engines_and_front_doors_that_take_one_surface_refuse_several():
+    S = _planar({s: (1, 1) for s in ((1, 1), (1, -1), (-1, 1), (-1, -1))})
+    with pytest.raises(ValueError, match="simulate is not available"):
+        simulate(S, [-1.0, -1.0], 1.0, engine="compiled")
+    with pytest.raises(TypeError, match="several switching surfaces"):
+        filippov.first_returns(S, np.array([[-1.0, -1.0]]), lambda z: z[0], 1.0)
+    # a SurfacesSystem of one surface is today's system for every front door
+    one = SurfacesSystem(("x", "y"), lambda z: np.array([z[1]]),
+                         lambda z: np.array([[np.zeros_like(z[0]), np.ones_like(z[0])]]),
+                         lambda s, z: np.array([np.ones_like(z[0]), -s[0] * np.ones_like(z[0])]),
+                         m=1)
+    assert isinstance(one.one_surface(), PiecewiseSystem)
+    assert region_view(one, (1,), 1).switch(np.array([0.0, 0.25])) == 0.25
