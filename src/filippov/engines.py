@@ -240,6 +240,18 @@ ASYMMETRIES = (
         ("tests/test_symbolic.py::test_compiled_dpdz_takes_the_generated_flow_jacobians",
          "tests/test_flow_jacobians.py::test_dpdz_from_given_flow_jacobians_is_the_closed_form",
          "tests/test_units.py::test_a_relay_orbit_in_other_units_has_its_period_and_multipliers")),
+    Asymmetry(
+        14, "Several switching surfaces",
+        "``simulate`` runs a ``SurfacesSystem`` stay by stay, each stay the one-surface "
+        "loop on a view of the system (filippov.several; docs/decisions.md D24); the other "
+        "front doors take one surface",
+        "refuses a ``SurfacesSystem`` of several surfaces by name (one of one surface is "
+        "today's system)",
+        "deliberate", "the views reuse every rule of one surface without touching the "
+        "loop the kernel compiles, whose per-return budget and compile time are spent "
+        "(D22, D23); the kernel's own surfaces are issue 59's next part",
+        ("tests/test_several_surfaces.py::test_generated_crossings_of_two_and_three_surfaces",
+         "tests/test_several_surfaces.py::test_engines_and_front_doors_that_take_one_surface_refuse_several")),
 )
 
 

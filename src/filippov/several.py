@@ -15,9 +15,10 @@ one trajectory whose modes are the run's codes (:func:`~filippov.surfaces.mode_o
 
 Where the next stay is not a one-surface problem the run is refused by name
 (:class:`~filippov.errors.SurfacesError`): a start or an event at two surfaces at once
-(a corner) unless every field there crosses them all (:func:`filippov.rules.
-through_corner`: then straight through); a slide on one surface that reaches another,
-unless it slides on across it (:func:`filippov.rules.slide_crosses`).
+(a corner) unless every field there crosses them all
+(:func:`filippov.rules.through_corner`: then straight through); a slide on one surface
+that reaches another, unless it slides on across it
+(:func:`filippov.rules.slide_crosses`).
 """
 from __future__ import annotations
 
