@@ -194,6 +194,24 @@ def test_a_spiral_into_a_corner_stops_as_zeno_not_a_hang():
     assert 1.99 < float(msg.split("t=")[1].split(",")[0]) < t_star
 
 
+def test_a_crossing_hidden_by_a_nearer_surface_is_refused_not_missed():
+    # the orbit runs 1e-9 above h1 = y (F = (1, 0), one DOP853 step to t = 2.2, samples
+    # at x = 0, 0.55, 1.1, ...), so the view's H is h1 at every sample, flat; meanwhile
+    # h2 = (x - 1)^2 - 1e-6 dips below 0 for |x - 1| < 1e-3, between two samples
+    def grads(z):
+        return np.array([[np.zeros_like(z[0]), np.ones_like(z[0])],
+                         [2.0 * (z[0] - 1.0), np.zeros_like(z[0])]])
+    S = SurfacesSystem(("x", "y"), lambda z: np.array([z[1], (z[0] - 1.0) ** 2 - 1e-6]),
+                       grads, lambda s, z: np.array([np.ones_like(z[0]), np.zeros_like(z[0])]),
+                       m=2)
+    with pytest.raises(SurfacesError, match="hidden crossing at t=.*h2 is crossed"):
+        simulate(S, [0.0, 1e-9], 2.2, method="integrate")
+    # samples inside the dip (max_step 1e-3): two crossings, at x = 1 -+ 1e-3
+    tr = simulate(S, [0.0, 1e-9], 2.2, method="integrate", max_step=1e-3)
+    crossings = [e for e in tr.events if e.kind == "crossing"]
+    assert [round(e.t, 12) for e in crossings] == [0.999, 1.001]
+
+
 def test_sections_count_across_the_stays():
     # x = 0.5 is crossed while sliding (t = 0.5), x = 1.5 in (-,-) (t = 1.5), x = 3 in
     # (-,+) (t = 3): terminal at its second hit, min_time skipping the first

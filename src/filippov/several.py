@@ -34,7 +34,7 @@ from .loop.run_state import RING, Limits, count_switch, new_run_state
 from .loop.status import GO_ON, ZENO
 from .section import Section
 from .surfaces import SurfacesSystem, flip, mode_name, mode_of, region_view, slide_view
-from .system import SLIDING
+from .system import PLUS, SLIDING
 
 #: the sections a slide's stay watches the other surfaces with (never a user's name)
 _SURFACE = "\x00surface "
@@ -91,10 +91,11 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
                 else slide_view(system, stay.sigma, stay.slide, stay.s))
         steps = 0 if traj is None else traj.n_steps
         mine = _stay_sections(system, stay, sections, hits, t - o["t0"])
-        how, r = one_stay(view, z, mine, dict(o, t0=t, max_steps=max(o["max_steps"] - steps, 1)),
-                          sc, stay.begun)
+        how, r = one_stay(view, z, mine, dict(o, t0=t, max_steps=max(o["max_steps"] - steps, 1),
+                                             dense=True), sc, stay.begun)
         surface = _event_surface(system, stay, r.z)
-        traj = _merge(traj, r.traj, system, stay, surface)
+        _refuse_hidden_crossing(system, stay, r.traj.segments, o)
+        traj = _merge(traj, r.traj, system, stay, surface, opts["dense"])
         t, z = r.t, r.z
         for k in range(len(sections)):
             hits[k] += r.hits[k]
@@ -156,12 +157,78 @@ def _code(stay, surface, local):
     return mode_of(stay.sigma if local == stay.s else flip(stay.sigma, surface))
 
 
-def _merge(traj, sub, system, stay, surface):
+#: sample intervals per stored segment at which every other surface is checked after a
+#: stay (:func:`_refuse_hidden_crossing`): twice the engine's own (samples_per_step = 4)
+GUARD_SAMPLES = 8
+
+
+def _refuse_hidden_crossing(system, stay, segments, o):
+    """The view of a stay measures only the nearest surface (or the one slid on, the
+    others at their samples as sections): a surface that another one's values hid --
+    crossed and crossed back between samples, or where the nearest one's rate showed no
+    extremum -- would be a silent wrong orbit. Each other surface is asked, on the
+    stay's dense output, what the one-surface engine asks of its H: a sign change at a
+    sample before the stay's event, or an extremum between samples toward it
+    (rules.extremum_between, rules.graze) whose value crosses; found, the run is
+    refused by name."""
+    sig = np.asarray(stay.sigma, dtype=float)[:, None]
+    if not segments:
+        return
+    for n, (ta, tb, _, Z) in enumerate(segments):
+        ts = np.linspace(ta, tb, GUARD_SAMPLES + 1)
+        zs = np.asarray(Z(ts), dtype=float)
+        f = np.asarray(view_field(system, stay, zs), dtype=float)
+        g = sig * system.values(zs)
+        rate = sig * np.einsum("knb,nb->kb", system.grads(zs), f)
+        last = n == len(segments) - 1
+        for j in range(system.m):
+            if j == stay.slide:
+                continue
+            inside = g[j, :-1] if last else g[j]
+            if np.any(inside < -o["touch_tol"]):
+                i = int(np.flatnonzero(inside < -o["touch_tol"])[0])
+                raise _hidden(system, stay, j, ts[i], zs[:, i])
+            for i in np.flatnonzero(rules.extremum_between(PLUS, rate[j, :-1], rate[j, 1:])):
+                tm, gm = _minimum(system, stay, j, Z, ts[i], ts[i + 1])
+                if rules.graze(PLUS, gm, o["touch_tol"]) == rules.GRAZE_CROSSES and not (
+                        last and i == GUARD_SAMPLES - 1 and tm >= ts[-1] - o["event_xtol"]):
+                    raise _hidden(system, stay, j, tm, Z(tm))
+
+
+def view_field(system, stay, zs):
+    """The field of a stay: its region's, or the sliding field on its surface."""
+    if stay.slide < 0:
+        return system.region_field(stay.sigma, zs)
+    return slide_view(system, stay.sigma, stay.slide, stay.s).sliding_field(zs)
+
+
+def _minimum(system, stay, j, Z, lo, hi):
+    """(t, value) of the minimum of sigma_j h_j along Z in [lo, hi] (bounded Brent)."""
+    from scipy.optimize import minimize_scalar
+
+    def g(t):
+        return float(stay.sigma[j] * system.values(np.asarray(Z(t), dtype=float).reshape(-1))[j])
+    res = minimize_scalar(g, bounds=(lo, hi), method="bounded",
+                          options={"xatol": 1e-3 * (hi - lo)})
+    return float(res.x), float(res.fun)
+
+
+def _hidden(system, stay, j, t, z):
+    return SurfacesError(
+        f"hidden crossing at t={float(t)!r}, state {np.asarray(z, float).reshape(-1).tolist()}:"
+        f" h{j + 1} is crossed there while the stay in mode "
+        f"{mode_name(_code(stay, max(stay.slide, 0), stay.s if stay.slide < 0 else SLIDING), system.m)}"
+        " followed another surface nearer; shorten max_step or the sample step so that "
+        "the samples resolve both")
+
+
+def _merge(traj, sub, system, stay, surface, dense=True):
     """The stay's trajectory appended to the run's, its modes as the run's codes."""
     events = [dataclasses.replace(e, mode_before=_code(stay, surface, e.mode_before),
                                   mode_after=_code(stay, surface, e.mode_after))
               for e in sub.events if not e.name.startswith(_SURFACE)]
-    segments = [(ta, tb, _code(stay, surface, mode), Z) for ta, tb, mode, Z in sub.segments]
+    segments = [(ta, tb, _code(stay, surface, mode), Z) for ta, tb, mode, Z in sub.segments
+                if dense]
     here = mode_name(_code(stay, surface, stay.s if stay.slide < 0 else SLIDING), system.m)
     if traj is None:
         traj = dataclasses.replace(sub, system=system, events=[], segments=[], n_steps=0,
