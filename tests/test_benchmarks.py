@@ -589,3 +589,17 @@ def test_compile_cost_keeps_the_spread_of_its_pairs_of_processes(monkeypatch):
     cc.report(ds.assign(runs=("stage", np.ones(ds.sizes["stage"], int))), m)
     assert not m.flags["rpHaveCompileSpread"]
     assert "rpCompileKernelColdFirstQuartile" not in report.read_macros(m.tex())
+
+
+def test_surfaces_cost_times_the_same_return_written_four_ways():
+    """The four returns of the several-surfaces benchmark are the closed form's: y = -8
+    at x = 5 after the slide's exit at x = 1 (y = -(x - 1)^2 / 2), for one surface
+    however written and with a spectator surface (one more stay, one more event); 0 for
+    the tutorial's system (across x = 2 at y = -1/2, y' = 1/4 to y = 0 at x = 4, slides)."""
+    from filippov_paper.benchmarks import surfaces_cost
+
+    ds = surfaces_cost.run(repeat=1, log=lambda s: None)
+    assert list(ds.case.values) == surfaces_cost.CASES
+    np.testing.assert_allclose(ds.return_y.values, [-8.0, -8.0, -8.0, 0.0], atol=1e-10)
+    assert list(ds.events.values) == [4, 4, 5, 6]
+    assert np.all(ds.time.values > 0) and ds.ratio.values[0] == 1.0

@@ -92,7 +92,7 @@ def test_every_python_block_of_the_page_runs(page, tutorial):
 
 def test_the_tutorial_has_the_blocks_it_describes():
     codes = python_blocks(DOCS / "tutorial.md")
-    assert len(codes) == 6
+    assert len(codes) == 7
     assert len(codes[0].strip().splitlines()) <= 30   # the first system fits a screen
 
 
@@ -110,6 +110,18 @@ def test_the_reference_driver_finds_the_relay_orbit(tutorial, relay):
     text = (DOCS / "tutorial.md").read_text()
     assert f"{scope['orbit'].t:.15g}" in text and f"{want['period']:.15g}" in text
     assert "switch_grad does not match a finite difference of switch" in out
+
+
+def test_the_tutorial_s_several_surfaces_follow_their_closed_form(tutorial):
+    """The section on several surfaces: the events the page describes, at the times of
+    the closed form (slide at 0.3, exit at x = 1, across x = 2 at y = -1/2, slide at 4)."""
+    scope, out = tutorial
+    events = scope["run"].events
+    assert [e.kind for e in events] == ["start", "slide_start", "slide_end", "crossing",
+                                       "slide_start"]
+    np.testing.assert_allclose([e.t for e in events], [0.0, 0.3, 1.0, 2.0, 4.0], atol=1e-10)
+    assert abs(events[3].state[1] + 0.5) <= 1e-10
+    assert "crossing     -- -> -+" in out
 
 
 def test_the_compiled_engine_agrees_with_the_reference_driver(tutorial):

@@ -33,7 +33,7 @@ from .errors import SurfacesError, accumulation_detail, run_error
 from .loop.run_state import RING, Limits, count_switch, new_run_state
 from .loop.status import GO_ON, ZENO
 from .section import Section
-from .surfaces import SurfacesSystem, flip, mode_name, mode_of, region_view, slide_view
+from .surfaces import SurfacesSystem, flip, mode_name, mode_of
 from .system import PLUS, SLIDING
 
 #: the sections a slide's stay watches the other surfaces with (never a user's name)
@@ -74,11 +74,11 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
     """The run of :func:`filippov.simulate.simulate` on ``system`` from z (``opts``: its
     options by name): one trajectory, or the error that stopped it."""
     sigma = system.region(z)
-    first = region_view(system, sigma, 1)
+    first = system.view(sigma, 1)
     sc = scale_mod.of_system(first, z, opts.get("scale"))
     check_surfaces(system, z, sc.state)
     for k in range(system.m):  # each surface's pieces, its gradient among them
-        checks.check_system(slide_view(system, sigma, k, 1), z, method="integrate",
+        checks.check_system(system.view(sigma, 1, k), z, method="integrate",
                             floor=sc.state)
     o = scale_mod.tolerances(opts, sc)
     _refuse_corner_start(system, z, sigma, o)
@@ -87,8 +87,7 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
                               o["time_scale"], True, len(sections), o["max_steps"]))
     stay, t, z, traj, hits = Stay(sigma, -1, 1, None), o["t0"], z, None, [0] * len(sections)
     while True:
-        view = (region_view(system, stay.sigma, stay.s) if stay.slide < 0
-                else slide_view(system, stay.sigma, stay.slide, stay.s))
+        view = system.view(stay.sigma, stay.s, None if stay.slide < 0 else stay.slide)
         steps = 0 if traj is None else traj.n_steps
         mine = _stay_sections(system, stay, sections, hits, t - o["t0"])
         how, r = one_stay(view, z, mine, dict(o, t0=t, max_steps=max(o["max_steps"] - steps, 1),
@@ -199,7 +198,7 @@ def view_field(system, stay, zs):
     """The field of a stay: its region's, or the sliding field on its surface."""
     if stay.slide < 0:
         return system.region_field(stay.sigma, zs)
-    return slide_view(system, stay.sigma, stay.slide, stay.s).sliding_field(zs)
+    return system.view(stay.sigma, stay.s, stay.slide).sliding_field(zs)
 
 
 def _minimum(system, stay, j, Z, lo, hi):
@@ -324,7 +323,7 @@ def _slide_across(system, stay, j, t, z, traj) -> Stay:
     "crossing" of h_j logged while sliding), else refused by name."""
     k, s, z = stay.slide, stay.s, np.asarray(z, dtype=float)
     far = flip(stay.sigma, j)
-    near_view, far_view = (slide_view(system, q, k, s) for q in (stay.sigma, far))
+    near_view, far_view = (system.view(q, s, k) for q in (stay.sigma, far))
     a_far, b_far = (float(v) for v in far_view.normal_speeds(z))
     normal = stay.sigma[j] * system.grads(z)[j]
     v_near, v_far = (float(normal @ np.asarray(v.sliding_field(z), dtype=float))

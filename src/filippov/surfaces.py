@@ -110,6 +110,9 @@ class SurfacesSystem:
         elif not callable(f):
             raise TypeError("field: expected field(sigma, z) or a mapping from sign vectors "
                             "to functions f(z)")
+        # the views a run asks for, built once: the engine's contract check of a system
+        # is then made once per view (checks.check_system keeps the systems it passed)
+        object.__setattr__(self, "_views", {})
 
     @property
     def dim(self) -> int:
@@ -143,11 +146,26 @@ class SurfacesSystem:
         """The sign vector of a state (+1 where h_k >= 0)."""
         return tuple(1 if v >= 0 else -1 for v in self.values(np.asarray(z, float)))
 
+    def view(self, sigma: tuple, s: int, only: int | None = None) -> PiecewiseSystem:
+        """:func:`region_view` (``only``: :func:`slide_view` on surface ``only``), built
+        once per system."""
+        key = (tuple(sigma), s, only)
+        if key not in self._views:
+            self._views[key] = region_view(self, key[0], s, only)
+        return self._views[key]
+
     def one_surface(self) -> PiecewiseSystem:
-        """The system of m = 1 as today's :class:`~filippov.system.PiecewiseSystem`."""
+        """The system of m = 1 as today's :class:`~filippov.system.PiecewiseSystem`: its
+        pieces the definition's own, h and its gradient the first (only) row."""
         if self.m != 1:
             raise ValueError(f"one_surface: the system has m = {self.m} surfaces")
-        return region_view(self, (1,), 1)
+        if "one" not in self._views:
+            self._views["one"] = PiecewiseSystem(
+                tuple(self.names), lambda z: self.region_field((-1,), z),
+                lambda z: self.region_field((1,), z), lambda z: self.values(z)[0],
+                lambda z: self.grads(z)[0], sliding=self.sliding, units=dict(self.units),
+                description=self.description, scale=self.scale)
+        return self._views["one"]
 
 
 def _all_regions(m: int) -> list:
