@@ -169,7 +169,7 @@ def test_two_public_system_types():
              and n.endswith("System")}
     assert types == {"FilippovSystem", "SymbolicSystem"}
     for name in ("PiecewiseSystem", "compile_system", "SymbolicSlowFast", "CompiledModel",
-                 "first_returns_compiled"):
+                 "first_returns_compiled", "SurfacesSystem"):
         assert name not in filippov.__all__ and getattr(filippov, name) is not None
 
 

@@ -75,21 +75,25 @@ def test_a_slide_its_exit_and_two_crossings_in_closed_form():
     assert abs(zs[1, 1] + 0.125) <= TOL
 
 
+def _generated(g):
+    """tests/generated_multi.py's draw as a SurfacesSystem, and its section."""
+    def grads(z):
+        return g.C if np.ndim(z) == 1 else np.repeat(g.C[:, :, None], z.shape[1], axis=2)
+
+    def column(v, z):
+        return v.reshape((-1,) + (1,) * (np.ndim(z) - 1))
+
+    S = SurfacesSystem(tuple(f"z{i}" for i in range(g.n)), lambda z: g.C @ z - column(g.d, z),
+                       grads, {s: (lambda z, a=a: a.A @ z + column(a.b, z))
+                               for s, a in g.fields.items()}, m=g.m)
+    return S, Section("s", lambda z: g.u @ z - g.sigma, direction=1, terminal=1)
+
+
 @settings(max_examples=8, deadline=None)
 @given(case=multi_crossings())
 def test_generated_crossings_of_two_and_three_surfaces(case):
     g = case.g
-    n = g.n
-
-    def grads(z):
-        return g.C if np.ndim(z) == 1 else np.repeat(g.C[:, :, None], z.shape[1], axis=2)
-
-    S = SurfacesSystem(tuple(f"z{i}" for i in range(n)),
-                       lambda z: g.C @ z - g.d.reshape((-1,) + (1,) * (np.ndim(z) - 1)),
-                       grads,
-                       {s: (lambda z, a=a: a.A @ z + a.b.reshape((-1,) + (1,) * (np.ndim(z) - 1)))
-                        for s, a in g.fields.items()}, m=g.m)
-    sec = Section("s", lambda z: g.u @ z - g.sigma, direction=1, terminal=1)
+    S, sec = _generated(g)
     tr = simulate(S, case.z0, 20.0, method="integrate", sections=[sec])
     crossings = [e for e in tr.events if e.kind == "crossing"]
     assert tr.status == "section:s"
@@ -101,6 +105,50 @@ def test_generated_crossings_of_two_and_three_surfaces(case):
     assert abs(tr.t - case.time) <= TOL
     assert np.max(np.abs(tr.z - case.P)) <= TOL * max(1.0, np.abs(case.P).max())
     assert digits(tr.mode, g.m) == case.regions[-1]
+
+
+@settings(max_examples=5, deadline=None)
+@given(case=multi_crossings())
+def test_generated_returns_and_dpdz_of_several_surfaces(case):
+    # first_returns gives the closed form's return; dP/dz0 (one saltation matrix per
+    # surface crossed, filippov.variational) the closed form's product of expm and
+    # saltation matrices, to 1e-7 of the factors' norms (the variational integration at
+    # rtol 1e-10, the tolerance tests/test_properties.py holds one surface to)
+    S, sec = _generated(case.g)
+    ret = filippov.first_returns(S, case.z0[None], sec, 20.0, method="integrate")
+    assert np.max(np.abs(ret.state[0] - case.P)) <= TOL * max(1.0, np.abs(case.P).max())
+    assert abs(ret.time[0] - case.time) <= TOL
+    assert ret.n_switches[0] == len(case.surfaces) and ret.sliding_time[0] == 0.0
+    tr = simulate(S, case.z0, 20.0, method="integrate", sections=[sec])
+    J = filippov.return_jacobian(S, tr, sec, section_grad=lambda z: case.g.u)
+    assert np.max(np.abs(J - case.dP)) <= 1e-7 * max(1.0, case.scale)
+
+
+def test_dpdz_through_a_slide_and_across_surfaces_is_the_differences_of_p():
+    # fields linear in the state (so dP/dz is not trivial), a slide on y = 0 that ends at
+    # a visible fold of F_-, a crossing of x = 2, and the return to x = 3: dP/dz0 against
+    # central differences of the return map (step 1e-6, truncation ~1e-12, the returns'
+    # error 1e-12 over the step ~1e-6)
+    S = _planar({(1, -1): (lambda x, y: 1 + 0.1 * y, lambda x, y: -1 - 0.2 * x),
+                 (-1, -1): (lambda x, y: 1 + 0.3 * y, lambda x, y: 1 - x + 0.2 * y),
+                 (-1, 1): (lambda x, y: 1.2 + 0.1 * y, lambda x, y: 0.25 + 0.1 * x),
+                 (1, 1): (1, -0.1)})
+    sec = Section("x=3", lambda z: z[0] - 3.0, direction=1, terminal=1)
+    z0 = np.array([0.0, 0.3])
+    tr = simulate(S, z0, 20.0, method="integrate", sections=[sec])
+    assert [e.kind for e in tr.events] == ["start", "slide_start", "slide_end", "crossing",
+                                           "section"]
+    J = filippov.return_jacobian(S, tr, sec, section_grad=lambda z: np.array([1.0, 0.0]))
+    fd = np.empty((2, 2))
+    for k in range(2):
+        e = np.zeros(2)
+        e[k] = 1e-6
+        up, down = (filippov.first_returns(S, (z0 + sgn * e)[None], sec, 20.0,
+                                           method="integrate").state[0] for sgn in (1, -1))
+        fd[:, k] = (up - down) / 2e-6
+    assert np.max(np.abs(J - fd)) <= 1e-5
+    # the slide forgets where it began: no y0 left in P (the second column is 0)
+    assert np.max(np.abs(J[:, 1])) <= 1e-8
 
 
 def _piecewise(S):
@@ -136,6 +184,9 @@ def test_a_corner_is_crossed_straight_through_where_every_field_crosses():
     assert abs(corner[0].t - 1.0) <= TOL
     assert mode_name(corner[0].mode_after, 2) == "++"
     assert np.max(np.abs(tr.z - [2.0, 1.0])) <= TOL and mode_name(tr.mode, 2) == "++"
+    # neighbours cross the two surfaces in either order: no derivative through a corner
+    with pytest.raises(filippov.VariationalError, match="changes 2 surfaces at once"):
+        filippov.transition_matrix(S, tr)
 
 
 def test_a_corner_the_rule_does_not_settle_is_refused_by_name():
@@ -243,8 +294,13 @@ def test_engines_and_front_doors_that_take_one_surface_refuse_several():
     S = _planar({s: (1, 1) for s in ((1, 1), (1, -1), (-1, 1), (-1, -1))})
     with pytest.raises(ValueError, match="simulate is not available"):
         simulate(S, [-1.0, -1.0], 1.0, engine="compiled")
-    with pytest.raises(TypeError, match="several switching surfaces"):
-        filippov.first_returns(S, np.array([[-1.0, -1.0]]), lambda z: z[0], 1.0)
+    with pytest.raises(TypeError, match="cannot run a SurfacesSystem: the compiled engine "
+                                        "takes one switching surface"):
+        filippov.first_returns(S, np.array([[-1.0, -1.0]]), lambda z, p: z[0], 1.0,
+                               engine="compiled")
+    with pytest.raises(TypeError, match="periodic_orbit expected a FilippovSystem"):
+        filippov.periodic_orbit(S, [-1.0, -1.0], lambda z, p: z[0], t_max=1.0,
+                                engine="reference")
     # a SurfacesSystem of one surface is today's system for every front door
     one = SurfacesSystem(("x", "y"), lambda z: np.array([z[1]]),
                          lambda z: np.array([[np.zeros_like(z[0]), np.ones_like(z[0])]]),

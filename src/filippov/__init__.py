@@ -48,15 +48,15 @@ def __getattr__(name):
 
 
 # the public system types: FilippovSystem (one numeric definition, both engines) and
-# its symbolic front-end SymbolicSystem (SymbolicSystem.slow_fast for a slow-fast model);
-# SurfacesSystem (several switching surfaces, the reference engine's simulate).
+# its symbolic front-end SymbolicSystem (SymbolicSystem.slow_fast for a slow-fast model).
 # What the engines run is built from them and stays importable, not exported:
 # PiecewiseSystem (filippov.system, the reference driver's batch form, also written by
 # hand for the reference engine alone), SlowFastModel (filippov.model), CompiledModel,
 # compile_system and with_section (filippov.abi, filippov.compiled_system: the kernel's
-# model with its section), SymbolicSlowFast (filippov.symbolic).
+# model with its section), SymbolicSlowFast (filippov.symbolic), SurfacesSystem
+# (filippov.surfaces: several switching surfaces with NumPy pieces, the reference engine).
 __all__ = [
-    "FilippovSystem", "SymbolicSystem", "SurfacesSystem",
+    "FilippovSystem", "SymbolicSystem",
     "simulate", "Section", "first_returns", "fixed_points", "periodic_orbit", "PeriodicOrbit",
     "compute_returns", "sweep_returns",
     "transition_matrix", "return_jacobian", "monodromy", "floquet_multipliers",

@@ -19,6 +19,7 @@ from .errors import run_error
 from .loop.status import NO_RETURN
 from .progress import Progress
 from .scale import of_batch
+from .surfaces import SurfacesSystem
 from .simulate import Section, simulate
 from .system import SLIDING
 
@@ -71,15 +72,18 @@ def _reference_section(system, section, direction: int, where, options: dict) ->
 def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
                    where=None, progress: Progress | None = None, **options) -> Returns:
     """:func:`first_returns` on the reference driver."""
-    python = views.reference_system(system, "first_returns")
+    python = views.reference_system(system, "first_returns", several=True)
     section = _reference_section(system, section, direction, where, options)
     system = python
     starts = np.atleast_2d(np.asarray(starts, dtype=float))
+    # a several-surface system's modes are codes: it says which of them slide
+    slid_on = system.slid_on if isinstance(system, SurfacesSystem) else None
     if starts.size and np.all(np.isfinite(starts)):   # one scale, as the compiled engine's
+        measured = _scale_view(system, starts)
         options["scale"] = of_batch(system.scale if options.get("scale") is None
                                     else options["scale"], starts,
-                                    lambda i: (system.field_minus, system.field_plus,
-                                               system.switch_grad))
+                                    lambda i: (measured.field_minus, measured.field_plus,
+                                               measured.switch_grad))
     m = starts.shape[0]
     state = np.empty_like(starts)
     time = np.empty(m)
@@ -98,7 +102,8 @@ def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
         n_switches[i] = len(switches)
         if switches:
             first[i] = switches[0].t - traj.t0
-        sliding[i] = sliding_time(traj.events)
+        sliding[i] = sliding_time(traj.events, None if slid_on is None else
+                                  (lambda mode: slid_on(mode) >= 0))
         if progress is not None:
             progress.step()
     return Returns(state, time, n_switches, sliding, first)
@@ -116,14 +121,27 @@ def _first_returns_compiled(*args, **kwargs):
 RUNS = {views.REFERENCE: _first_returns, views.COMPILED: _first_returns_compiled}
 
 
-def sliding_time(events) -> float:
+def _scale_view(system, starts):
+    """The one-surface system whose pieces measure a batch's units: the system itself,
+    or a several-surface system's view of its first start's region
+    (:mod:`filippov.surfaces`)."""
+    if isinstance(system, SurfacesSystem):
+        return system.view(system.region(starts[0]), 1)
+    return system
+
+
+def sliding_time(events, slides=None) -> float:
     """Time spent sliding along an event log (a stretch open at the start -- a run that
-    starts sliding -- or still open at the end counts), as the compiled engine counts."""
+    starts sliding -- or still open at the end counts), as the compiled engine counts.
+    ``slides(mode)``: whether a mode slides (None: ``mode == SLIDING``, one surface)."""
+    if slides is None:
+        slides = (lambda mode: mode == SLIDING)
     total, since = 0.0, None
     for e in events:
-        if e.mode_after == SLIDING and (e.mode_before != SLIDING or e.kind == "start"):
+        after, before = slides(e.mode_after), slides(e.mode_before)
+        if after and (not before or e.kind == "start"):
             since = e.t
-        elif e.mode_before == SLIDING and e.mode_after != SLIDING and since is not None:
+        elif before and not after and since is not None:
             total += e.t - since
             since = None
     if since is not None:

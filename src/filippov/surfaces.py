@@ -146,6 +146,26 @@ class SurfacesSystem:
         """The sign vector of a state (+1 where h_k >= 0)."""
         return tuple(1 if v >= 0 else -1 for v in self.values(np.asarray(z, float)))
 
+    # ------------------------------------------------ the modes of a run, by their codes
+    def slid_on(self, mode: int) -> int:
+        """The surface a mode slides on (its 0 digit), or -1 in a region."""
+        d = digits(mode, self.m)
+        return d.index(0) if 0 in d else -1
+
+    def beside(self, mode: int):
+        """(k, the region on the + side of surface k, the one on its - side) of a slide."""
+        d = digits(mode, self.m)
+        k = d.index(0)
+        return k, d[:k] + (1,) + d[k + 1:], d[:k] + (-1,) + d[k + 1:]
+
+    def mode_field(self, mode: int, z: np.ndarray) -> np.ndarray:
+        """The field of a mode: its region's, or Filippov's sliding field on the surface
+        it slides on (the convex combination of the fields on either side)."""
+        if self.slid_on(mode) < 0:
+            return self.region_field(digits(mode, self.m), z)
+        k, plus, _ = self.beside(mode)
+        return self.view(plus, 1, k).sliding_field(z)
+
     def view(self, sigma: tuple, s: int, only: int | None = None) -> PiecewiseSystem:
         """:func:`region_view` (``only``: :func:`slide_view` on surface ``only``), built
         once per system."""

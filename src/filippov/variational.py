@@ -12,6 +12,11 @@ switching surface (Filippov's correction for the change of arrival time):
 * the end of sliding: identity (one normal speed is zero there, so the sliding
   field equals the field it leaves into).
 
+On several switching surfaces (:class:`~filippov.surfaces.SurfacesSystem`, modes by
+their codes) the same, with the gradient of the one surface a switch changes; a switch
+that changes two at once (a corner) has no derivative (neighbouring orbits cross them
+in either order) and is refused.
+
 :func:`transition_matrix` is that product over a whole trajectory;
 :func:`return_jacobian` adds the correction for the arrival time at a Poincare
 section, giving the derivative dP/dz0 of a return map (tested against finite
@@ -65,7 +70,61 @@ def reference_view(system, jacobian, capability: str, floor: float | None = None
         jacobian = system.jacobian
         if floor is not None and "floor" in inspect.signature(jacobian).parameters:
             jacobian = functools.partial(jacobian, floor=floor)
-    return views.reference_system(system, capability), jacobian
+    return views.reference_system(system, capability, several=True), jacobian
+
+
+def _modes(system):
+    """(field(mode, z), switch_matrix(before, after, z), the projection of a start that
+    slides(mode, z) or None) of the system a trajectory ran: one surface's, or a
+    :class:`~filippov.surfaces.SurfacesSystem`'s by its mode codes."""
+    from .surfaces import SurfacesSystem
+
+    if isinstance(system, SurfacesSystem):
+        return (system.mode_field, lambda b, a, z: _surfaces_switch_matrix(system, b, a, z),
+                lambda mode, z: _surfaces_start(system, mode, z))
+
+    def start(mode, z):
+        # a start that slides: a perturbation off H comes back onto it along F_+ or F_-
+        # and slides on late, the projection of an arrival from either side
+        # (I + (F_+ - F_-) n^T / (a - b), the same from both)
+        if mode != SLIDING:
+            return None
+        return saltation(system.field(PLUS, z), system.field(SLIDING, z),
+                         system.switch_grad(z))
+    return system.field, lambda b, a, z: switch_matrix(system, b, a, z), start
+
+
+def _surfaces_switch_matrix(system, before: int, after: int, z):
+    """The saltation matrix of a switch of a several-surface run (modes by their codes,
+    filippov.surfaces): across a surface, or onto it to slide, that surface's; None where
+    there is none (no change, the end of a slide); through a corner the flow is not
+    differentiable (VariationalError)."""
+    from .surfaces import digits, mode_name
+
+    m = system.m
+    if before == after or system.slid_on(before) >= 0 and system.slid_on(after) < 0:
+        return None
+    changed = [k for k, (a, b) in enumerate(zip(digits(before, m), digits(after, m)))
+               if a != b]
+    if len(changed) != 1:
+        raise VariationalError(
+            f"a switch from {mode_name(before, m)} to {mode_name(after, m)} changes "
+            f"{len(changed)} surfaces at once (a corner): the flow is not differentiable "
+            "there")
+    grad = np.asarray(system.grads(np.asarray(z, dtype=float)), dtype=float)[changed[0]]
+    return saltation(np.asarray(system.mode_field(before, z), dtype=float),
+                     np.asarray(system.mode_field(after, z), dtype=float), grad)
+
+
+def _surfaces_start(system, mode: int, z):
+    """A several-surface run that starts sliding: the projection of an arrival on its
+    surface (as for one surface), or None in a region."""
+    if system.slid_on(mode) < 0:
+        return None
+    k, plus, _ = system.beside(mode)
+    grad = np.asarray(system.grads(np.asarray(z, dtype=float)), dtype=float)[k]
+    return saltation(np.asarray(system.region_field(plus, z), dtype=float),
+                     np.asarray(system.mode_field(mode, z), dtype=float), grad)
 
 
 #: the relative step of the central differences of a section's gradient: eps^(1/3), where
@@ -118,19 +177,17 @@ def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
     floor = _state_scale(traj)
     system, jacobian = reference_view(system, jacobian, "transition_matrix", floor)
     n = system.dim
-    jac = jacobian or (lambda mode, z: field_jacobian(system, mode, z, floor=floor))
+    field, salt, start = _modes(system)
+    jac = jacobian or (lambda mode, z: fd_jacobian(lambda zz: field(mode, zz), z, 1e-6,
+                                                   floor))
     # the state's error in its own units, the derivative's (dimensionless) as it is
     atols = np.concatenate([np.full(n, atol * floor), np.full(n * n, atol)])
     M = np.eye(n)
     ev = traj.events
     for k, e in enumerate(ev):
-        S = switch_matrix(system, e.mode_before, e.mode_after, e.state)
-        if k == 0 and e.mode_after == SLIDING:
-            # a start that slides: a perturbation off H comes back onto it along F_+ or
-            # F_- and slides on late, the projection of an arrival from either side
-            # (I + (F_+ - F_-) n^T / (a - b), the same from both)
-            S = saltation(system.field(PLUS, e.state), system.field(SLIDING, e.state),
-                          system.switch_grad(e.state))
+        S = salt(e.mode_before, e.mode_after, e.state)
+        if k == 0 and start(e.mode_after, e.state) is not None:
+            S = start(e.mode_after, e.state)
         if S is not None:
             M = S @ M
         t_next = ev[k + 1].t if k + 1 < len(ev) else traj.t
@@ -141,7 +198,7 @@ def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
 
         def rhs(t, z, mode=mode):
             x, Phi = z[:n], z[n:].reshape(n, n)
-            return np.concatenate([system.field(mode, x), (jac(mode, x) @ Phi).ravel()])
+            return np.concatenate([field(mode, x), (jac(mode, x) @ Phi).ravel()])
 
         sol = solve_ivp(rhs, (0.0, dt), np.concatenate([e.state, np.eye(n).ravel()]),
                         method="DOP853", rtol=rtol, atol=atols)
@@ -188,7 +245,7 @@ def return_jacobian(system, traj, section, *, rtol: float = 1e-10, atol: float =
     grad = (np.asarray(section_grad(z), dtype=float) if section_grad is not None else
             fd_jacobian(lambda zz: np.atleast_1d(section.func(zz)), z, SECTION_STEP,
                         floor=floor)[0])
-    f = np.asarray(system.field(traj.mode, z), dtype=float)
+    f = np.asarray(_modes(system)[0](traj.mode, z), dtype=float)
     speed = grad @ f
     if speed == 0:
         raise VariationalError(f"section {section.name!r} is hit tangentially at t={traj.t!r}: "
