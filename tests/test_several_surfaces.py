@@ -223,6 +223,17 @@ def test_a_slide_goes_on_across_another_surface_where_it_attracts_beyond():
     assert np.max(np.abs(tr.z - [2.0 + 2.0 * 1.3, 0.0])) <= TOL and mode_name(tr.mode, 2) == "0+"
 
 
+def test_a_start_that_slides_stays_on_its_surface_across_another():
+    # started on y = 0, the slide is the slide's own stay from its start: at x = 2 the
+    # region's view would measure H on h2 (equally near), where the fields are the same
+    # on both sides (a - b = 0: the sliding field 0/0)
+    S = _planar({(1, -1): (1, -1), (-1, -1): (1, 1), (-1, 1): (1, 1), (1, 1): (1, -1)})
+    tr = simulate(S, [0.3, 0.0], 3.0, method="integrate")
+    assert [(e.kind, mode_name(e.mode_after, 2)) for e in tr.events] == [
+        ("start", "0-"), ("crossing", "0+")]
+    assert abs(tr.events[1].t - 1.7) <= TOL and np.max(np.abs(tr.z - [3.3, 0.0])) <= TOL
+
+
 def test_a_slide_that_reaches_another_surface_is_refused_by_name():
     # as above, but beyond x = 2 y = 0 repels (F_+ = (1, 1), F_- = (1, -1))
     S = _planar({(1, -1): (1, -1), (-1, -1): (1, 1), (-1, 1): (1, -1), (1, 1): (1, 1)})

@@ -70,9 +70,12 @@ def _regions(m):
     return out
 
 
-def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_stay):
+def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_stay,
+        start_mode):
     """The run of :func:`filippov.simulate.simulate` on ``system`` from z (``opts``: its
-    options by name): one trajectory, or the error that stopped it."""
+    options by name): one trajectory, or the error that stopped it. The engine's
+    ``one_stay`` (:func:`filippov.simulate.one_stay`) and ``start_mode``
+    (:func:`filippov.simulate.initial_mode`)."""
     sigma = system.region(z)
     first = system.view(sigma, 1)
     sc = scale_mod.of_system(first, z, opts.get("scale"))
@@ -85,7 +88,8 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
     rs = new_run_state(Limits(o["t_end"], system.sliding, o["max_events"], o["zeno_count"],
                               o["zeno_span"], o["touch_tol"], o["state_scale"],
                               o["time_scale"], True, len(sections), o["max_steps"]))
-    stay, t, z, traj, hits = Stay(sigma, -1, 1, None), o["t0"], z, None, [0] * len(sections)
+    stay, t, z, traj, hits = (_first_stay(system, sigma, first, z, o, start_mode), o["t0"], z,
+                              None, [0] * len(sections))
     while True:
         view = system.view(stay.sigma, stay.s, None if stay.slide < 0 else stay.slide)
         steps = 0 if traj is None else traj.n_steps
@@ -114,6 +118,21 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
         status = count_switch(rs, t, True)
         if status != GO_ON:
             raise _budget_error(status, rs, o, t, z)
+
+
+def _first_stay(system, sigma, first, z, o, start_mode) -> Stay:
+    """The run's first stay: in the start's region, or -- a start on its nearest surface
+    a, decided by the engine's start on the region's view -- sliding on a (the slide's
+    own view: a region's view measures H on whichever surface is nearest, and a slide
+    must stay on its own), or across it. The stay's own start decides again, from the
+    same pieces."""
+    mode, _ = start_mode(first, z, o["touch_tol"])
+    a = _event_surface(system, Stay(sigma, -1, 1, None), z)
+    if mode == SLIDING:
+        return Stay(sigma, a, 1, None)
+    if mode != 1:
+        return Stay(flip(sigma, a), -1, -1, None)
+    return Stay(sigma, -1, 1, None)
 
 
 def _stay_sections(system, stay, sections, hits, elapsed):

@@ -437,7 +437,7 @@ def _simulate(system: PiecewiseSystem, z0, sections: Sequence[Section], opts: di
             raise TypeError(f"sections[{k}]: expected a filippov.simulate.Section, got "
                             f"{type(sec).__name__}")
     if isinstance(system, SurfacesSystem):  # several surfaces: stay by stay
-        return several.run(system, z, list(sections), opts, one_stay)
+        return several.run(system, z, list(sections), opts, one_stay, initial_mode)
     sc = scale_mod.of_system(system, z, opts.get("scale"))   # never raises: checked next
     checks.check_system(system, z, method=method, floor=sc.state)   # the class's contract
     return _Run(system, z, list(sections), scale_mod.tolerances(opts, sc), sc).go()

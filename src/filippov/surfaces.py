@@ -26,6 +26,9 @@ import numpy as np
 from .scale import UNIT
 from .system import PiecewiseSystem
 
+__all__ = ["MAX_SURFACES", "SurfacesSystem", "digits", "flip", "mode_name", "mode_of",
+           "region_view", "slide_view"]
+
 #: the most surfaces a system may have here: a mode's code (3**m values) then fits the
 #: int8 a trajectory samples its modes in (Trajectory.sample)
 MAX_SURFACES = 5
