@@ -8,6 +8,9 @@ do not take several surfaces)."""
 import numpy as np
 import pytest
 from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import generated_systems as gs
 
 import filippov
 from filippov import rules
@@ -89,7 +92,6 @@ def _generated(g):
     return S, Section("s", lambda z: g.u @ z - g.sigma, direction=1, terminal=1)
 
 
-@settings(max_examples=8, deadline=None)
 @given(case=multi_crossings())
 def test_generated_crossings_of_two_and_three_surfaces(case):
     g = case.g
@@ -107,7 +109,7 @@ def test_generated_crossings_of_two_and_three_surfaces(case):
     assert digits(tr.mode, g.m) == case.regions[-1]
 
 
-@settings(max_examples=5, deadline=None)
+@settings(max_examples=max(6, settings.default.max_examples // 2))
 @given(case=multi_crossings())
 def test_generated_returns_and_dpdz_of_several_surfaces(case):
     # first_returns gives the closed form's return; dP/dz0 (one saltation matrix per
@@ -319,3 +321,86 @@ def test_engines_and_front_doors_that_take_one_surface_refuse_several():
                          m=1)
     assert isinstance(one.one_surface(), PiecewiseSystem)
     assert region_view(one, (1,), 1).switch(np.array([0.0, 0.25])) == 0.25
+
+
+# ------------------------------------------------- one surface and a spectator (metamorphic)
+# The one-surface cases of tests/generated_systems.py (closed forms: a crossing of planar
+# or parabolic H, a slide along the linear sliding field out at a visible fold) with a
+# second, planar surface through the orbit whose two sides have the same fields: the orbit
+# is the one-surface closed form's, and the run crosses the spectator (in a region, or
+# while sliding: the slide goes on across it) with one more stay each time. Tolerances as
+# tests/test_properties.py holds integrated flows (1e-9; dP/dz 1e-7 of the factors' norms).
+TOL_INTEGRATED, TOL_JAC = 1e-9, 1e-7
+
+
+def _with_spectator(g, c2, d2):
+    """Generated one-surface system ``g`` and the plane c2 . z = d2 as a SurfacesSystem."""
+    def column(v, z):
+        return v.reshape((-1,) + (1,) * (np.ndim(z) - 1))
+
+    def affine(side):
+        return lambda z: side.A @ z + column(side.b, z)
+
+    def grads(z):
+        ez = g.e @ z
+        g1 = column(g.c, z) + 2.0 * g.k * ez * column(g.e, z)
+        return np.stack([g1, np.broadcast_to(column(c2, z), np.shape(z))])
+
+    minus, plus = affine(g.minus), affine(g.plus)
+    return SurfacesSystem(tuple(f"z{i}" for i in range(g.n)),
+                          lambda z: np.stack([g.h(z), c2 @ z - d2]), grads,
+                          lambda s, z: plus(z) if s[0] > 0 else minus(z), m=2)
+
+
+def _spectator_run(case, q, tilt):
+    g = case.g
+    axis = case.P - case.z0
+    c2 = axis / np.linalg.norm(axis) + 0.3 * tilt
+    c2 /= np.linalg.norm(c2)
+    S = _with_spectator(g, c2, float(c2 @ (case.z0 + q * axis)))
+    sec = Section("s", lambda z: g.h(z) - g.sigma, direction=1, terminal=1)
+    tr = simulate(S, case.z0, gs.T_MAX, method="integrate", sections=[sec])
+    return S, sec, tr
+
+
+def _surface_changed(e):
+    before, after = digits(e.mode_before, 2), digits(e.mode_after, 2)
+    return [k for k in range(2) if before[k] != after[k]]
+
+
+@given(case=gs.crossings(), q=st.floats(0.2, 0.8), tilt=st.lists(
+    st.floats(-1.0, 1.0), min_size=4, max_size=4))
+def test_a_crossing_with_a_spectator_surface_is_the_one_surface_closed_form(case, q, tilt):
+    S, sec, tr = _spectator_run(case, q, np.array(tilt[:case.g.n]))
+    assert tr.status == "section:s"
+    h1 = [e for e in tr.events if e.mode_before != e.mode_after and _surface_changed(e) == [0]]
+    h2 = [e for e in tr.events if e.mode_before != e.mode_after and _surface_changed(e) == [1]]
+    assert len(h2) >= 1
+    if case.start == "below":
+        assert len(h1) == 1 and abs(h1[0].t - case.t1) <= TOL_INTEGRATED
+    else:
+        assert h1 == []
+    assert abs(tr.t - case.time) <= TOL_INTEGRATED
+    assert np.max(np.abs(tr.z - case.P)) <= TOL_INTEGRATED * max(1.0, np.abs(case.P).max())
+    if case.dP is not None:   # the spectator's saltation is the identity
+        J = filippov.return_jacobian(S, tr, sec, section_grad=lambda z: case.g.grad_h(z))
+        assert np.max(np.abs(J - case.dP)) <= TOL_JAC * max(1.0, case.scale)
+
+
+@given(case=gs.slides(), q=st.floats(0.2, 0.8), tilt=st.lists(
+    st.floats(-1.0, 1.0), min_size=4, max_size=4))
+def test_a_slide_with_a_spectator_surface_is_the_one_surface_closed_form(case, q, tilt):
+    S, sec, tr = _spectator_run(case, q, np.array(tilt[:case.g.n]))
+    assert tr.status == "section:s"
+    h1 = [e for e in tr.events if e.mode_before != e.mode_after and 0 in _surface_changed(e)]
+    kinds = [e.kind for e in h1]
+    assert kinds == (["slide_end"] if case.on_h else ["slide_start", "slide_end"]), kinds
+    if not case.on_h:
+        assert abs(h1[0].t - case.t1) <= TOL_INTEGRATED
+    assert abs(h1[-1].t - (case.t1 + case.ts)) <= TOL_INTEGRATED
+    assert any(_surface_changed(e) == [1] for e in tr.events)
+    assert abs(tr.t - case.time) <= TOL_INTEGRATED
+    assert np.max(np.abs(tr.z - case.P)) <= TOL_INTEGRATED * max(1.0, np.abs(case.P).max())
+    if case.dP is not None:
+        J = filippov.return_jacobian(S, tr, sec, section_grad=lambda z: case.g.grad_h(z))
+        assert np.max(np.abs(J - case.dP)) <= TOL_JAC * max(1.0, case.scale)

@@ -85,6 +85,12 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
                             floor=sc.state)
     o = scale_mod.tolerances(opts, sc)
     _refuse_corner_start(system, z, sigma, o)
+    # a start on a surface (|h| <= touch_tol) is on its + side, as for one surface (where
+    # the rules' ties, a repelling start among them, take region +): the first view is
+    # oriented so that its + side is h >= 0 there, whatever sign rounding gave h
+    h = system.values(z)
+    sigma = tuple(1 if abs(h[k]) <= o["touch_tol"] else sigma[k] for k in range(system.m))
+    first = system.view(sigma, 1)
     rs = new_run_state(Limits(o["t_end"], system.sliding, o["max_events"], o["zeno_count"],
                               o["zeno_span"], o["touch_tol"], o["state_scale"],
                               o["time_scale"], True, len(sections), o["max_steps"]))
@@ -199,14 +205,22 @@ def _refuse_hidden_crossing(system, stay, segments, o):
         g = sig * system.values(zs)
         rate = sig * np.einsum("knb,nb->kb", system.grads(zs), f)
         last = n == len(segments) - 1
+        # where a surface is the nearest at a sample, the view's H is that surface there:
+        # the engine's own rules judged it (an exit's band included), this guard does not
+        near = (np.full(ts.size, stay.slide) if stay.slide >= 0
+                else np.argmin(g, axis=0))
         for j in range(system.m):
             if j == stay.slide:
                 continue
-            inside = g[j, :-1] if last else g[j]
-            if np.any(inside < -o["touch_tol"]):
-                i = int(np.flatnonzero(inside < -o["touch_tol"])[0])
+            other = near != j
+            low = (g[j] < -o["touch_tol"]) & other
+            if last:
+                low[-1] = False
+            if np.any(low):
+                i = int(np.flatnonzero(low)[0])
                 raise _hidden(system, stay, j, ts[i], zs[:, i])
-            for i in np.flatnonzero(rules.extremum_between(PLUS, rate[j, :-1], rate[j, 1:])):
+            dips = rules.extremum_between(PLUS, rate[j, :-1], rate[j, 1:]) & other[:-1] & other[1:]
+            for i in np.flatnonzero(dips):
                 tm, gm = _minimum(system, stay, j, Z, ts[i], ts[i + 1])
                 if rules.graze(PLUS, gm, o["touch_tol"]) == rules.GRAZE_CROSSES and not (
                         last and i == GUARD_SAMPLES - 1 and tm >= ts[-1] - o["event_xtol"]):
