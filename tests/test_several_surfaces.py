@@ -404,3 +404,96 @@ def test_a_slide_with_a_spectator_surface_is_the_one_surface_closed_form(case, q
     if case.dP is not None:
         J = filippov.return_jacobian(S, tr, sec, section_grad=lambda z: case.g.grad_h(z))
         assert np.max(np.abs(J - case.dP)) <= TOL_JAC * max(1.0, case.scale)
+
+
+# --------------------------------------------------------------- sliding on an intersection
+def _spatial(fx, fy, intersection=None, fw=None):
+    """z = (x, y, w), h1 = x, h2 = y; ``fx[s1, s2]``, ``fy[s1, s2]``: x' and y' in each
+    region, numbers or functions of w; w' = ``fw[s1, s2]`` (default 1)."""
+    def field(sig, z):
+        one = np.ones_like(z[0])
+        gx, gy = fx[sig], fy[sig]
+        return np.array([gx(z[2]) * one if callable(gx) else gx * one,
+                         gy(z[2]) * one if callable(gy) else gy * one,
+                         (1.0 if fw is None else fw[sig]) * one])
+
+    def grads(z):
+        zero, one = np.zeros_like(z[0]), np.ones_like(z[0])
+        return np.array([[one, zero, zero], [zero, one, zero]])
+    return SurfacesSystem(("x", "y", "w"), lambda z: np.array([z[0], z[1]]), grads, field,
+                          m=2, intersection=intersection)
+
+
+def test_a_decoupled_slide_on_an_intersection_and_its_end_in_closed_form():
+    # x' = -1.5 for x > 0, 0.5 - 0.5 w for x < 0; y' = -0.8 for y > 0, 1.2 for y < 0; w' = 1.
+    # From (0.3, 0.5, 0): onto x = 0 at t = 0.2, slides (y' = -0.8) onto y = 0 at t = 0.625:
+    # both attract, the choices all agree (decoupled: x' = y' = 0); at w = 1 (t = 1) x = 0
+    # stops attracting from below (beta, h1's + weight, reaches 0): on sliding on y = 0 in
+    # x < 0, x = -(t - 1)^2 / 4, to t = 2
+    fx = {(1, 1): -1.5, (1, -1): -1.5, (-1, 1): lambda w: 0.5 - 0.5 * w,
+          (-1, -1): lambda w: 0.5 - 0.5 * w}
+    fy = {(1, 1): -0.8, (-1, 1): -0.8, (1, -1): 1.2, (-1, -1): 1.2}
+    tr = simulate(_spatial(fx, fy), [0.3, 0.5, 0.0], 2.0, method="integrate")
+    got = [(e.kind, mode_name(e.mode_after, 2), e.name) for e in tr.events]
+    assert got == [("start", "++", ""), ("slide_start", "0+", ""),
+                   ("slide_start", "00", "h2"), ("slide_end", "-0", "h1")], got
+    for e, t in zip(tr.events[1:], (0.2, 0.625, 1.0)):
+        assert abs(e.t - t) <= TOL, (e.kind, e.t)
+    assert np.max(np.abs(tr.z - [-0.25, 0.0, 2.0])) <= TOL and mode_name(tr.mode, 2) == "-0"
+    ts, zs, modes = tr.sample(np.array([0.8]), include_events=False)
+    assert mode_name(modes[0], 2) == "00" and np.max(np.abs(zs[:, 0] - [0, 0, 0.8])) <= TOL
+
+
+def test_an_intersection_whose_field_the_system_does_not_settle_is_refused_unless_declared():
+    # the same approach, but x' and y' depend on both signs and w' differs by region: on
+    # x = y = 0 the bilinear field and the two nested choices all have x' = y' = 0 and
+    # differ in w'
+    from scipy.optimize import fsolve
+
+    fx = {(1, 1): -1.5, (1, -1): -1.0, (-1, 1): 0.5, (-1, -1): 1.0}
+    fy = {(1, 1): -0.8, (-1, 1): -0.5, (1, -1): 1.2, (-1, -1): 0.7}
+    fw = {(1, 1): 1.0, (1, -1): 2.0, (-1, 1): 0.5, (-1, -1): 1.5}
+    with pytest.raises(SurfacesError, match="depends on the choice.*intersection='bilinear'"):
+        simulate(_spatial(fx, fy, fw=fw), [0.3, 0.5, 0.0], 2.0, method="integrate")
+    tr = simulate(_spatial(fx, fy, "bilinear", fw), [0.3, 0.5, 0.0], 2.0, method="integrate")
+    entry = [e for e in tr.events if e.name == "h2"][0]
+    # onto x = 0 at t = 0.2 (y = 0.34, w = 0.2); sliding there y' = -0.8 + (-0.5 + 0.8) *
+    # 1.5 / 2 = -0.575 (Filippov between (+,+) and (-,+)), so y = 0 at t = 0.2 + 0.34/0.575
+    assert abs(entry.t - (0.2 + 0.34 / 0.575)) <= TOL
+    # then the bilinear weights (alpha on y > 0, beta on x > 0), solved here by fsolve
+    def tangent(ab):
+        a, b = ab
+        c = {(1, 1): a * b, (-1, 1): a * (1 - b), (1, -1): (1 - a) * b, (-1, -1): (1 - a) * (1 - b)}
+        return [sum(c[r] * fx[r] for r in c), sum(c[r] * fy[r] for r in c)]
+    a, b = fsolve(tangent, [0.5, 0.5], xtol=1e-14)
+    c = {(1, 1): a * b, (-1, 1): a * (1 - b), (1, -1): (1 - a) * b, (-1, -1): (1 - a) * (1 - b)}
+    w_rate = sum(c[r] * fw[r] for r in c)
+    # on x = 0 Filippov's weights are 1/4 on (+,+) and 3/4 on (-,+): w' = 0.625
+    w_entry = 0.2 + (entry.t - 0.2) * (0.25 * 1.0 + 0.75 * 0.5)
+    assert mode_name(tr.mode, 2) == "00"
+    assert np.max(np.abs(tr.z - [0.0, 0.0, w_entry + w_rate * (2.0 - entry.t)])) <= TOL
+
+
+def test_the_bilinear_weights_make_the_field_tangent_to_both_surfaces():
+    from filippov.intersection import bilinear_weights
+
+    rng = np.random.default_rng(5)
+    solved = 0
+    for _ in range(200):
+        # nodally attracting: h1's speeds > 0 on its - side, < 0 on its + side; likewise h2
+        wj = np.array([[1, 1], [-1, -1]]) * rng.uniform(0.2, 2.0, (2, 2))
+        wk = np.array([[1, -1], [1, -1]]) * rng.uniform(0.2, 2.0, (2, 2))
+        w = bilinear_weights(wj, wk)
+        assert w is not None
+        a, b = w
+        c = np.array([[(1 - a) * (1 - b), (1 - a) * b], [a * (1 - b), a * b]])
+        assert abs(np.sum(c * wj)) <= 1e-13 and abs(np.sum(c * wk)) <= 1e-13
+        solved += 1
+    assert solved == 200
+    # every field crosses h1 the same way: no tangent field in the square
+    assert bilinear_weights(np.array([[1.0, 2.0], [0.5, 1.0]]),
+                            np.array([[1.0, -1.0], [1.0, -1.0]])) is None
+    # past an end (h1's + side's speeds turned): the weights continued outside
+    a, b = bilinear_weights(np.array([[1.0, 1.0], [0.5, 0.5]]),
+                            np.array([[1.0, -1.0], [1.0, -1.0]]), extend=True)
+    assert a == pytest.approx(2.0) and b == pytest.approx(0.5)

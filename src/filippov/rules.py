@@ -876,3 +876,23 @@ def slide_crosses(a_far: float, b_far: float, v_near: float, v_far: float) -> bo
     there. Anything else (a slide that leaves there, or one along the intersection) is
     not settled by this rule."""
     return a_far > 0.0 > b_far and v_near < 0.0 and v_far < 0.0
+
+
+def slides_into_intersection(v_near: float, v_far: float) -> bool:
+    """A slide on one surface that reaches another slides on their intersection when the
+    sliding fields on either side of the second push toward it (``v_near`` < 0 < ``v_far``,
+    along its normal oriented to the near side): on the first surface the intersection
+    attracts as a surface of Filippov's, one dimension down."""
+    return v_near < 0.0 < v_far
+
+
+#: the bilinear sliding field on an intersection and the two nested choices agree when
+#: they differ by at most this much relative to the field: the system settles the field
+#: there (a decoupled system's agree to rounding, ~1e-16)
+CHOICE_AGREES = 1e-9
+
+
+def choices_agree(spread: float, size: float) -> bool:
+    """Do the choices of a sliding field on an intersection differ by at most
+    CHOICE_AGREES of the field's size (``spread``: the largest difference)?"""
+    return spread <= CHOICE_AGREES * max(size, 1e-300)

@@ -27,7 +27,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from . import checks, rules
+from . import checks, intersection, rules
 from . import scale as scale_mod
 from .errors import SurfacesError, accumulation_detail, run_error
 from .loop.run_state import RING, Limits, count_switch, new_run_state
@@ -36,18 +36,22 @@ from .section import Section
 from .surfaces import SurfacesSystem, flip, mode_name, mode_of
 from .system import PLUS, SLIDING
 
-#: the sections a slide's stay watches the other surfaces with (never a user's name)
-_SURFACE = "\x00surface "
+#: the sections a slide's stay watches the other surfaces with, and a slide on an
+#: intersection its ends (alpha or beta at 0 or 1: filippov.intersection) -- never a
+#: user's name
+_SURFACE, _END = "\x00surface ", "\x00end "
 
 
 class Stay(NamedTuple):
     """Where a stay is: region ``sigma``, the surface slid on (-1: none), the side of H
-    the region is on in its view (``s``), and what the stay begins with (None: the
-    run's start decides; else its mode in the view, shift, banded shift and band)."""
+    the region is on in its view (``s``), what the stay begins with (None: the run's
+    start decides; else its mode in the view, shift, banded shift and band), and the
+    second surface of an intersection slid on (``pair``; -1: none)."""
     sigma: tuple
     slide: int
     s: int
     begun: tuple | None
+    pair: int = -1
 
 
 def check_surfaces(system: SurfacesSystem, z: np.ndarray, floor: float) -> None:
@@ -97,7 +101,9 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
     stay, t, z, traj, hits = (_first_stay(system, sigma, first, z, o, start_mode), o["t0"], z,
                               None, [0] * len(sections))
     while True:
-        view = system.view(stay.sigma, stay.s, None if stay.slide < 0 else stay.slide)
+        view = (system.intersection_view(stay.sigma, stay.slide, stay.pair)
+                if stay.pair >= 0 else
+                system.view(stay.sigma, stay.s, None if stay.slide < 0 else stay.slide))
         steps = 0 if traj is None else traj.n_steps
         mine = _stay_sections(system, stay, sections, hits, t - o["t0"])
         how, r = one_stay(view, z, mine, dict(o, t0=t, max_steps=max(o["max_steps"] - steps, 1),
@@ -112,9 +118,10 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
             return _end(traj, "t_end", t, z, stay, surface, system)
         if how == "section":
             sec = mine[r.hit_section]
-            if sec.name.startswith(_SURFACE):  # the slide on k reaches surface j
-                stay = _slide_across(system, stay, int(sec.name[len(_SURFACE):]), t, z,
-                                     traj)
+            if sec.name.startswith((_SURFACE, _END)):  # a slide reaches a surface, or ends
+                stay = (_slide_across(system, stay, int(sec.name[len(_SURFACE):]), t, z, traj)
+                        if sec.name.startswith(_SURFACE) else
+                        _intersection_end(system, stay, sec.name[len(_END):], t, z, traj))
                 status = count_switch(rs, t, True)
                 if status != GO_ON:
                     raise _budget_error(status, rs, o, t, z)
@@ -152,10 +159,29 @@ def _stay_sections(system, stay, sections, hits, elapsed):
             terminal=None if sec.terminal is None else sec.terminal - n))
     if stay.slide >= 0:
         for j in range(system.m):
-            if j != stay.slide:
+            if j != stay.slide and j != stay.pair:
                 out.append(Section(f"{_SURFACE}{j}", _oriented(system, stay.sigma, j),
                                    direction=-1, terminal=1))
+    if stay.pair >= 0:
+        for name, func in _ends(system, stay).items():
+            out.append(Section(f"{_END}{name}", func, direction=-1, terminal=1))
     return out
+
+
+def _ends(system, stay):
+    """The ends of a slide on the intersection of h_j and h_k (j = stay.slide, k =
+    stay.pair): alpha (h_j's + side's weight) or beta (h_k's) reaching 0 or 1."""
+    j, k, sigma = stay.slide, stay.pair, stay.sigma
+
+    def weight(z, i, one):
+        zs = np.asarray(z, dtype=float)
+        cols = zs[:, None] if zs.ndim == 1 else zs
+        w = np.array([intersection.weights(system, sigma, j, k, cols[:, c])[i]
+                      for c in range(cols.shape[1])])
+        w = 1.0 - w if one else w
+        return w[0] if zs.ndim == 1 else w
+    return {"a0": lambda z: weight(z, 0, False), "a1": lambda z: weight(z, 0, True),
+            "b0": lambda z: weight(z, 1, False), "b1": lambda z: weight(z, 1, True)}
 
 
 def _oriented(system, sigma, j):
@@ -174,6 +200,10 @@ def _event_surface(system, stay, z):
 def _code(stay, surface, local):
     """A mode of a stay's view (``local``: its side s, the other side, or SLIDING) as
     the run's code."""
+    if stay.pair >= 0:
+        digits = list(stay.sigma)
+        digits[stay.slide] = digits[stay.pair] = 0
+        return mode_of(digits)
     if local == SLIDING:
         digits = list(stay.sigma)
         digits[surface] = 0
@@ -209,8 +239,11 @@ def _refuse_hidden_crossing(system, stay, segments, o):
         # the engine's own rules judged it (an exit's band included), this guard does not
         near = (np.full(ts.size, stay.slide) if stay.slide >= 0
                 else np.argmin(g, axis=0))
+        if stay.pair >= 0 and system.intersection != "bilinear":
+            for i in range(ts.size):   # the choice the system settled at the entry, along
+                _choice_settled(system, stay.sigma, stay.slide, stay.pair, ts[i], zs[:, i])
         for j in range(system.m):
-            if j == stay.slide:
+            if j == stay.slide or j == stay.pair:
                 continue
             other = near != j
             low = (g[j] < -o["touch_tol"]) & other
@@ -228,7 +261,10 @@ def _refuse_hidden_crossing(system, stay, segments, o):
 
 
 def view_field(system, stay, zs):
-    """The field of a stay: its region's, or the sliding field on its surface."""
+    """The field of a stay: its region's, or the sliding field on its surface (or on its
+    intersection)."""
+    if stay.pair >= 0:
+        return intersection.bilinear_field(system, stay.sigma, stay.slide, stay.pair, zs)
     if stay.slide < 0:
         return system.region_field(stay.sigma, zs)
     return system.view(stay.sigma, stay.s, stay.slide).sliding_field(zs)
@@ -258,7 +294,7 @@ def _merge(traj, sub, system, stay, surface, dense=True):
     """The stay's trajectory appended to the run's, its modes as the run's codes."""
     events = [dataclasses.replace(e, mode_before=_code(stay, surface, e.mode_before),
                                   mode_after=_code(stay, surface, e.mode_after))
-              for e in sub.events if not e.name.startswith(_SURFACE)]
+              for e in sub.events if not e.name.startswith((_SURFACE, _END))]
     segments = [(ta, tb, _code(stay, surface, mode), Z) for ta, tb, mode, Z in sub.segments
                 if dense]
     here = mode_name(_code(stay, surface, stay.s if stay.slide < 0 else SLIDING), system.m)
@@ -361,6 +397,8 @@ def _slide_across(system, stay, j, t, z, traj) -> Stay:
     normal = stay.sigma[j] * system.grads(z)[j]
     v_near, v_far = (float(normal @ np.asarray(v.sliding_field(z), dtype=float))
                      for v in (near_view, far_view))
+    if rules.slides_into_intersection(v_near, v_far):
+        return _intersection_start(system, stay, j, t, z, traj)
     if not rules.slide_crosses(a_far, b_far, v_near, v_far):
         raise _slide_meets(system, stay, j, t, z)
     before, after = (mode_of(q[:k] + (0,) + q[k + 1:]) for q in (stay.sigma, far))
@@ -373,8 +411,69 @@ def _slide_meets(system, stay, j, t, z):
     return SurfacesError(
         f"intersection at t={t!r}, state {np.asarray(z, float).tolist()}: the slide on "
         f"h{stay.slide + 1} (mode {mode_name(_code(stay, stay.slide, SLIDING), system.m)}) "
-        f"reaches h{j + 1}; what follows there (sliding on the intersection, or a slide "
-        "across it) is not built into filippov yet")
+        f"reaches h{j + 1}, where it neither crosses (rules.slide_crosses) nor slides on "
+        "the intersection (rules.slides_into_intersection): it leaves the surface there, "
+        "which filippov does not follow")
+
+
+def _intersection_start(system, stay, j, t, z, traj) -> Stay:
+    """A slide on k that reaches surface j, where the slides on either side of j push
+    toward it: on along the intersection, with the bilinear field where the system
+    settles the choice (:func:`_choice_settled`) or declares it, else refused by name."""
+    k = stay.slide
+    _choice_settled(system, stay.sigma, j, k, t, z)
+    inner = Stay(stay.sigma, j, stay.s, (1, 0.0, 0.0, 0.0), pair=k)
+    before = _code(stay, k, SLIDING)
+    traj.events.append(type(traj.events[0])(t, "slide_start", np.asarray(z, float).copy(),
+                                            before, _code(inner, j, 1), f"h{j + 1}"))
+    return inner
+
+
+def _choice_settled(system, sigma, j, k, t, z):
+    """Refuse a slide on the intersection of h_j and h_k at z unless the bilinear field
+    exists there and either agrees with both nested choices (rules.choices_agree: the
+    system settles the field) or the system takes it (``intersection="bilinear"``)."""
+    z = np.asarray(z, dtype=float)
+    fb = intersection.bilinear_field(system, sigma, j, k, z, extend=False)
+    names = f"h{min(j, k) + 1} and h{max(j, k) + 1}"
+    if not np.all(np.isfinite(fb)):
+        raise SurfacesError(
+            f"intersection at t={t!r}, state {z.tolist()}: no bilinear sliding field on "
+            f"{names} there (filippov.intersection: the intersection does not attract)")
+    nested = [intersection.nested_field(system, sigma, a, b, z) for a, b in ((j, k), (k, j))]
+    spread = max(float(np.abs(fb - f).max()) for f in nested)
+    if system.intersection != "bilinear" and not rules.choices_agree(
+            spread, float(np.abs(fb).max())):
+        raise SurfacesError(
+            f"intersection at t={t!r}, state {z.tolist()}: the sliding field on {names} "
+            f"depends on the choice there (bilinear {fb.tolist()}, nested "
+            f"{[f.tolist() for f in nested]}): the system does not settle it; declare "
+            "SurfacesSystem(..., intersection='bilinear') to take Dieci and Lopez's "
+            "bilinear field (filippov.intersection)")
+
+
+def _intersection_end(system, stay, end, t, z, traj) -> Stay:
+    """The end of a slide on an intersection: alpha or beta at 0 or 1 (``end``), the
+    slide going on on the other surface, on the side the weight left; refused by name
+    where that slide does not attract."""
+    j, k = stay.slide, stay.pair
+    gone, keep = (j, k) if end[0] == "a" else (k, j)
+    side = 1 if end[1] == "1" else -1
+    sigma = list(stay.sigma)
+    sigma[gone], sigma[keep] = side, 1
+    sigma = tuple(sigma)
+    a, b = (float(v) for v in system.view(sigma, 1, keep).normal_speeds(np.asarray(z, float)))
+    if not a > 0.0 > b:
+        raise SurfacesError(
+            f"intersection end at t={t!r}, state {np.asarray(z, float).tolist()}: the slide "
+            f"on h{j + 1} and h{k + 1} ends toward h{gone + 1}'s {'+-'[side < 0]} side, where "
+            f"the slide on h{keep + 1} does not attract (a = {a:.3g}, b = {b:.3g}); what "
+            "follows is not built into filippov")
+    after = Stay(sigma, keep, 1, (SLIDING, 0.0, 0.0, 0.0))
+    traj.events.append(type(traj.events[0])(t, "slide_end", np.asarray(z, float).copy(),
+                                            _code(stay, j, 1), _code(after, keep, SLIDING),
+                                            f"h{gone + 1}"))
+    return after
 
 
 def _budget_error(status, rs, o, t, z):

@@ -87,6 +87,10 @@ class SurfacesSystem:
     units: Mapping[str, str] = field(default_factory=dict)
     description: str = ""
     scale: object = UNIT
+    #: the sliding field on an intersection of two surfaces where the system does not
+    #: settle it (filippov.intersection): None (refused there), or "bilinear" (Dieci and
+    #: Lopez's bilinear interpolation)
+    intersection: str | None = None
 
     def __post_init__(self):
         m = self.m
@@ -94,6 +98,9 @@ class SurfacesSystem:
                 1 <= m <= MAX_SURFACES):
             raise ValueError(f"m: the number of switching surfaces must be an integer from 1 "
                              f"to {MAX_SURFACES}, got {m!r}")
+        if self.intersection not in (None, "bilinear"):
+            raise ValueError(f"intersection: expected None or 'bilinear', got "
+                             f"{self.intersection!r}")
         for name in ("switches", "switch_grads"):
             if not callable(getattr(self, name)):
                 raise TypeError(f"{name}: expected a function of the state")
@@ -166,8 +173,30 @@ class SurfacesSystem:
         it slides on (the convex combination of the fields on either side)."""
         if self.slid_on(mode) < 0:
             return self.region_field(digits(mode, self.m), z)
+        d = digits(mode, self.m)
+        if d.count(0) == 2:
+            from .intersection import bilinear_field
+
+            j, k = (i for i, v in enumerate(d) if v == 0)
+            return bilinear_field(self, d, j, k, z)
         k, plus, _ = self.beside(mode)
         return self.view(plus, 1, k).sliding_field(z)
+
+    def intersection_view(self, sigma: tuple, j: int, k: int) -> PiecewiseSystem:
+        """A slide on the intersection of h_j and h_k (beside region ``sigma``'s other
+        digits) as a one-surface system with no surface: both fields the bilinear
+        sliding field (filippov.intersection), H = 1 (never reached), built once."""
+        from .intersection import bilinear_field
+
+        key = ("both", tuple(sigma), j, k)
+        if key not in self._views:
+            def f(z):
+                return bilinear_field(self, sigma, j, k, z)
+            self._views[key] = PiecewiseSystem(
+                tuple(self.names), f, f, lambda z: np.ones(np.shape(z)[1:]),
+                lambda z: np.zeros(np.shape(z)), sliding=self.sliding,
+                units=dict(self.units), description=self.description, scale=self.scale)
+        return self._views[key]
 
     def view(self, sigma: tuple, s: int, only: int | None = None) -> PiecewiseSystem:
         """:func:`region_view` (``only``: :func:`slide_view` on surface ``only``), built

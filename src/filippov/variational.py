@@ -96,16 +96,19 @@ def _modes(system):
 
 def _surfaces_switch_matrix(system, before: int, after: int, z):
     """The saltation matrix of a switch of a several-surface run (modes by their codes,
-    filippov.surfaces): across a surface, or onto it to slide, that surface's; None where
-    there is none (no change, the end of a slide); through a corner the flow is not
-    differentiable (VariationalError)."""
+    filippov.surfaces): across a surface, or onto it to slide (onto an intersection from
+    one of its surfaces too), that surface's; None where there is none (no change, the
+    end of a slide on a surface); through a corner the flow is not differentiable
+    (VariationalError)."""
     from .surfaces import digits, mode_name
 
     m = system.m
-    if before == after or system.slid_on(before) >= 0 and system.slid_on(after) < 0:
+    if before == after:
         return None
     changed = [k for k, (a, b) in enumerate(zip(digits(before, m), digits(after, m)))
                if a != b]
+    if len(changed) == 1 and digits(before, m)[changed[0]] == 0:
+        return None   # the end of a slide on that surface: the identity
     if len(changed) != 1:
         raise VariationalError(
             f"a switch from {mode_name(before, m)} to {mode_name(after, m)} changes "
