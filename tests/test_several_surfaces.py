@@ -258,22 +258,50 @@ def test_a_spiral_into_a_corner_stops_as_zeno_not_a_hang():
     assert 1.99 < float(msg.split("t=")[1].split(",")[0]) < t_star
 
 
-def test_a_crossing_hidden_by_a_nearer_surface_is_refused_not_missed():
-    # the orbit runs 1e-9 above h1 = y (F = (1, 0), one DOP853 step to t = 2.2, samples
-    # at x = 0, 0.55, 1.1, ...), so the view's H is h1 at every sample, flat; meanwhile
-    # h2 = (x - 1)^2 - 1e-6 dips below 0 for |x - 1| < 1e-3, between two samples
+def _dip(depth, scale):
+    """The orbit runs 1e-9 above h1 = y (F = (1, 0): one DOP853 step to t = 2.2, samples at
+    x = 0, 0.55, 1.1, ...), so the view's H is h1 at every sample, flat; meanwhile
+    h2 = scale ((x - 1)^2 - depth) dips below 0 for |x - 1| < sqrt(depth), between two
+    samples."""
     def grads(z):
         return np.array([[np.zeros_like(z[0]), np.ones_like(z[0])],
-                         [2.0 * (z[0] - 1.0), np.zeros_like(z[0])]])
-    S = SurfacesSystem(("x", "y"), lambda z: np.array([z[1], (z[0] - 1.0) ** 2 - 1e-6]),
-                       grads, lambda s, z: np.array([np.ones_like(z[0]), np.zeros_like(z[0])]),
-                       m=2)
-    with pytest.raises(SurfacesError, match="hidden crossing at t=.*h2 is crossed"):
-        simulate(S, [0.0, 1e-9], 2.2, method="integrate")
-    # samples inside the dip (max_step 1e-3): two crossings, at x = 1 -+ 1e-3
-    tr = simulate(S, [0.0, 1e-9], 2.2, method="integrate", max_step=1e-3)
+                         [2.0 * scale * (z[0] - 1.0), np.zeros_like(z[0])]])
+    return SurfacesSystem(("x", "y"), lambda z: np.array([z[1], scale * ((z[0] - 1.0) ** 2
+                                                                          - depth)]),
+                          grads, lambda s, z: np.array([np.ones_like(z[0]),
+                                                        np.zeros_like(z[0])]), m=2)
+
+
+def test_a_crossing_hidden_by_a_nearer_surface_is_found_or_refused_never_missed():
+    # the guard sees the dip on the stay's dense output and runs the stay again with
+    # steps short enough for the engine to sample it: two crossings, at x = 1 -+ 1e-3
+    tr = simulate(_dip(1e-6, 1.0), [0.0, 1e-9], 2.2, method="integrate")
     crossings = [e for e in tr.events if e.kind == "crossing"]
     assert [round(e.t, 12) for e in crossings] == [0.999, 1.001]
+    # a dip 2e-8 wide (depth 1e-10) is seen by the guard but not by the engine's samples
+    # after GUARD_RETRIES runs (steps 8^4 times shorter): refused by name
+    with pytest.raises(SurfacesError, match="hidden crossing at t=.*h2 is crossed"):
+        simulate(_dip(1e-16, 1e6), [0.0, 1e-9], 2.2, method="integrate")
+
+
+def test_a_dip_the_kink_of_the_nearest_surface_hides_is_found():
+    # tests/review (helper, issue 59): y has its minimum -1e-4 at x = 1.9 under F, where
+    # the view's H turns from h1 = y to h2 = 2 - x between two samples: its rate shows no
+    # extremum at the samples; the guard's denser look finds y < 0, the stay runs again
+    one = np.ones_like
+
+    def grads(z):
+        g = np.array([[0.0, 1.0], [1.0, 0.0]])
+        return g if np.ndim(z) == 1 else np.repeat(g[:, :, None], z.shape[1], axis=2)
+    F = lambda z: np.array([one(z[0]), 2.0 * (z[0] - 1.9)])  # noqa: E731
+    G = lambda z: np.array([one(z[0]), -one(z[0])])            # noqa: E731
+    H = lambda z: np.array([one(z[0]), 0 * one(z[0])])         # noqa: E731
+    S = SurfacesSystem(("x", "y"), lambda z: np.array([z[1], z[0] - 2.0]), grads,
+                       {(1, -1): F, (-1, -1): G, (1, 1): H, (-1, 1): H}, m=2)
+    tr = simulate(S, [0.0, 1.9 ** 2 - 1e-4], 3.0, method="integrate")
+    times = [e.t for e in tr.events if e.kind == "crossing"]
+    assert abs(times[0] - 1.89) <= TOL and abs(times[1] - 2.0) <= TOL
+    assert np.max(np.abs(tr.z - [3.0, -0.11])) <= TOL
 
 
 def test_sections_count_across_the_stays():
@@ -461,12 +489,14 @@ def test_an_intersection_whose_field_the_system_does_not_settle_is_refused_unles
     # 1.5 / 2 = -0.575 (Filippov between (+,+) and (-,+)), so y = 0 at t = 0.2 + 0.34/0.575
     assert abs(entry.t - (0.2 + 0.34 / 0.575)) <= TOL
     # then the bilinear weights (alpha on y > 0, beta on x > 0), solved here by fsolve
+    def weights(a, b):
+        return {(1, 1): a * b, (-1, 1): a * (1 - b), (1, -1): (1 - a) * b,
+                (-1, -1): (1 - a) * (1 - b)}
+
     def tangent(ab):
-        a, b = ab
-        c = {(1, 1): a * b, (-1, 1): a * (1 - b), (1, -1): (1 - a) * b, (-1, -1): (1 - a) * (1 - b)}
+        c = weights(*ab)
         return [sum(c[r] * fx[r] for r in c), sum(c[r] * fy[r] for r in c)]
-    a, b = fsolve(tangent, [0.5, 0.5], xtol=1e-14)
-    c = {(1, 1): a * b, (-1, 1): a * (1 - b), (1, -1): (1 - a) * b, (-1, -1): (1 - a) * (1 - b)}
+    c = weights(*fsolve(tangent, [0.5, 0.5], xtol=1e-14))
     w_rate = sum(c[r] * fw[r] for r in c)
     # on x = 0 Filippov's weights are 1/4 on (+,+) and 3/4 on (-,+): w' = 0.625
     w_entry = 0.2 + (entry.t - 0.2) * (0.25 * 1.0 + 0.75 * 0.5)

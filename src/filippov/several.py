@@ -106,21 +106,25 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
                 system.view(stay.sigma, stay.s, None if stay.slide < 0 else stay.slide))
         steps = 0 if traj is None else traj.n_steps
         mine = _stay_sections(system, stay, sections, hits, t - o["t0"])
-        how, r = one_stay(view, z, mine, dict(o, t0=t, max_steps=max(o["max_steps"] - steps, 1),
-                                             dense=True), sc, stay.begun)
+        starts = None if traj is None else just_hit | set(range(len(sections), len(mine)))
+        how, r = _guarded_stay(system, stay, one_stay, view, z, mine, starts, sc,
+                               dict(o, t0=t, max_steps=max(o["max_steps"] - steps, 1),
+                                    dense=True))
         surface = _event_surface(system, stay, r.z)
-        _refuse_hidden_crossing(system, stay, r.traj.segments, o)
         traj = _merge(traj, r.traj, system, stay, surface, opts["dense"])
         t, z = r.t, r.z
         for k in range(len(sections)):
             hits[k] += r.hits[k]
+        # the user's sections this stay hit at its end: no second hit at the next start
+        just_hit = {k for k, sec in enumerate(sections) for e in r.traj.events
+                    if e.kind == "section" and e.name == sec.name and e.t == t}
         if how == "t_end":
             return _end(traj, "t_end", t, z, stay, surface, system)
         if how == "section":
             sec = mine[r.hit_section]
             if sec.name.startswith((_SURFACE, _END)):  # a slide reaches a surface, or ends
-                stay = (_slide_across(system, stay, int(sec.name[len(_SURFACE):]), t, z, traj)
-                        if sec.name.startswith(_SURFACE) else
+                stay = (_slide_across(system, stay, int(sec.name[len(_SURFACE):]), t, z,
+                                      traj, o) if sec.name.startswith(_SURFACE) else
                         _intersection_end(system, stay, sec.name[len(_END):], t, z, traj))
                 status = count_switch(rs, t, True)
                 if status != GO_ON:
@@ -216,48 +220,66 @@ def _code(stay, surface, local):
 GUARD_SAMPLES = 8
 
 
-def _refuse_hidden_crossing(system, stay, segments, o):
+#: how many times a stay is run again with shorter steps where the guard found a surface
+#: crossed between the engine's samples (:func:`_guarded_stay`)
+GUARD_RETRIES = 4
+
+
+def _guarded_stay(system, stay, one_stay, view, z, sections, starts, sc, o):
+    """The engine's run of one stay, checked by :func:`_hidden_crossing`: where a surface
+    was crossed between its samples, the stay is run again from its start with steps
+    no longer than the guard's sample interval there (the engine then samples it four
+    times finer than the guard did), GUARD_RETRIES times at most; then refused by name."""
+    for _ in range(GUARD_RETRIES + 1):
+        how, r = one_stay(view, z, sections, o, sc, stay.begun, starts)
+        found = _hidden_crossing(system, stay, r.traj.segments, o)
+        if found is None:
+            return how, r
+        j, tm, zm, span = found
+        o = dict(o, max_step=min(o["max_step"], span / GUARD_SAMPLES))
+    raise _hidden(system, stay, j, tm, zm)
+
+
+def _hidden_crossing(system, stay, segments, o):
     """The view of a stay measures only the nearest surface (or the one slid on, the
     others at their samples as sections): a surface that another one's values hid --
     crossed and crossed back between samples, or where the nearest one's rate showed no
     extremum -- would be a silent wrong orbit. Each other surface is asked, on the
     stay's dense output, what the one-surface engine asks of its H: a sign change at a
     sample before the stay's event, or an extremum between samples toward it
-    (rules.extremum_between, rules.graze) whose value crosses; found, the run is
-    refused by name."""
+    (rules.extremum_between, rules.graze) whose value crosses. The first found: (the
+    surface, the time and state, the length of the segment it is in), or None."""
     sig = np.asarray(stay.sigma, dtype=float)[:, None]
-    if not segments:
-        return
     for n, (ta, tb, _, Z) in enumerate(segments):
         ts = np.linspace(ta, tb, GUARD_SAMPLES + 1)
         zs = np.asarray(Z(ts), dtype=float)
         f = np.asarray(view_field(system, stay, zs), dtype=float)
         g = sig * system.values(zs)
         rate = sig * np.einsum("knb,nb->kb", system.grads(zs), f)
-        last = n == len(segments) - 1
-        # where a surface is the nearest at a sample, the view's H is that surface there:
-        # the engine's own rules judged it (an exit's band included), this guard does not
-        near = (np.full(ts.size, stay.slide) if stay.slide >= 0
-                else np.argmin(g, axis=0))
+        # the surface the stay began on measures from the exit's rounding band (the
+        # engine's, rules.graze: a dip inside it is the exit's own tangency); the event
+        # at the stay's end, its own
+        band = stay.begun[3] if stay.begun is not None and n == 0 else 0.0
+        entry = int(np.argmin(g[:, 0])) if stay.slide < 0 else -1
+        at_end = ts >= segments[-1][1] - 4.0 * o["event_xtol"]
         if stay.pair >= 0 and system.intersection != "bilinear":
             for i in range(ts.size):   # the choice the system settled at the entry, along
                 _choice_settled(system, stay.sigma, stay.slide, stay.pair, ts[i], zs[:, i])
         for j in range(system.m):
             if j == stay.slide or j == stay.pair:
                 continue
-            other = near != j
-            low = (g[j] < -o["touch_tol"]) & other
-            if last:
-                low[-1] = False
+            tol = o["touch_tol"] + (band if j == entry else 0.0)
+            low = (g[j] < -tol) & ~at_end
             if np.any(low):
                 i = int(np.flatnonzero(low)[0])
-                raise _hidden(system, stay, j, ts[i], zs[:, i])
-            dips = rules.extremum_between(PLUS, rate[j, :-1], rate[j, 1:]) & other[:-1] & other[1:]
+                return j, ts[i], zs[:, i], tb - ta
+            dips = rules.extremum_between(PLUS, rate[j, :-1], rate[j, 1:]) & ~at_end[:-1]
             for i in np.flatnonzero(dips):
                 tm, gm = _minimum(system, stay, j, Z, ts[i], ts[i + 1])
-                if rules.graze(PLUS, gm, o["touch_tol"]) == rules.GRAZE_CROSSES and not (
-                        last and i == GUARD_SAMPLES - 1 and tm >= ts[-1] - o["event_xtol"]):
-                    raise _hidden(system, stay, j, tm, Z(tm))
+                if rules.graze(PLUS, gm, tol) == rules.GRAZE_CROSSES and not (
+                        tm >= segments[-1][1] - 4.0 * o["event_xtol"]):
+                    return j, tm, Z(tm), tb - ta
+    return None
 
 
 def view_field(system, stay, zs):
@@ -282,12 +304,12 @@ def _minimum(system, stay, j, Z, lo, hi):
 
 
 def _hidden(system, stay, j, t, z):
+    mode = _code(stay, max(stay.slide, 0), stay.s if stay.slide < 0 else SLIDING)
     return SurfacesError(
         f"hidden crossing at t={float(t)!r}, state {np.asarray(z, float).reshape(-1).tolist()}:"
-        f" h{j + 1} is crossed there while the stay in mode "
-        f"{mode_name(_code(stay, max(stay.slide, 0), stay.s if stay.slide < 0 else SLIDING), system.m)}"
-        " followed another surface nearer; shorten max_step or the sample step so that "
-        "the samples resolve both")
+        f" h{j + 1} is crossed there while the stay in mode {mode_name(mode, system.m)}"
+        f" followed another surface nearer, and {GUARD_RETRIES} runs of the stay with ever "
+        "shorter steps did not resolve it (a tangency of the two?)")
 
 
 def _merge(traj, sub, system, stay, surface, dense=True):
@@ -339,11 +361,12 @@ def _next_stay(system, stay, a, r, o, traj) -> Stay:
     return Stay(flip(sigma, a), -1, -s, begun)
 
 
-def _corner(system, sigma, a, z, o):
-    """The other surfaces the event on surface a is also at (rules.at_corner)."""
+def _corner(system, sigma, a, z, o, f=None):
+    """The other surfaces the event on surface a is also at (rules.at_corner), the orbit
+    moving along ``f`` (default: region sigma's field)."""
     z = np.asarray(z, dtype=float)
     h, G = system.values(z), system.grads(z)
-    f = np.asarray(system.region_field(sigma, z), dtype=float)
+    f = np.asarray(system.region_field(sigma, z) if f is None else f, dtype=float)
     return [j for j in range(system.m) if j != a and rules.at_corner(
         sigma[j] * h[j], sigma[j] * float(G[j] @ f), o["event_xtol"], o["touch_tol"])]
 
@@ -387,10 +410,17 @@ def _refuse_corner_start(system, z, sigma, o):
             "off the corner, or on one surface")
 
 
-def _slide_across(system, stay, j, t, z, traj) -> Stay:
+def _slide_across(system, stay, j, t, z, traj, o) -> Stay:
     """A slide on k at surface j: on across it where rules.slide_crosses says so (a
     "crossing" of h_j logged while sliding), else refused by name."""
     k, s, z = stay.slide, stay.s, np.asarray(z, dtype=float)
+    slide = system.view(stay.sigma, s, k).sliding_field(z)
+    at = [i for i in _corner(system, stay.sigma, j, z, o, slide) if i != k]
+    if at:
+        raise SurfacesError(
+            f"corner at t={t!r}, state {z.tolist()}: the slide on h{k + 1} reaches "
+            f"{', '.join(f'h{i + 1}' for i in sorted([j] + at))} at once; a slide into a "
+            "corner is not settled by filippov")
     far = flip(stay.sigma, j)
     near_view, far_view = (system.view(q, s, k) for q in (stay.sigma, far))
     a_far, b_far = (float(v) for v in far_view.normal_speeds(z))

@@ -483,6 +483,9 @@ class _Run:
         # (rules.exit_band)
         self.shift, self.banded, self.band = (0.0, 0.0, 0.0) if begun is None else begun[1:]
         self.handed_on = False  # the run ended at its first switch (_one_stay)
+        # the sections its start on is no hit: all of them at a run's start; at a stay
+        # that goes on from a switch (one_stay) those its caller names (hit at that switch)
+        self.start_sections = None
         self.frac_integrated = np.linspace(0.0, 1.0, self.samples_per_step + 1)
         # An exact flow is evaluated EXACT_BLOCK windows at a time: the same sample
         # spacing, a sixteenth of the Python overhead.
@@ -589,6 +592,7 @@ class _Run:
                      self.preds, first, self.touch_tol, self.event_xtol, self.traj,
                      self.band, self._leave(self.mode, banded=False) if self.band > 0.0
                      else None)
+        scan.start_sections = self.start_sections
         if may_split and stepper.method is not None and not scan.resolved():
             return UNRESOLVED, ta, None
         band = self.band
@@ -811,14 +815,18 @@ def _record_and_hand_on(mode, new_mode, what, t, shift, banded, band, run):
 _RUN_TO_SWITCH = make_run(RUN_OPERATIONS._replace(record=_record_and_hand_on))
 
 
-def one_stay(system, z, sections, opts, scale, begun=None):
+def one_stay(system, z, sections, opts, scale, begun=None, start_sections=None):
     """One stay of a run on ``system`` (a one-surface view: filippov.several), to its
     first switch ("switch", the switch recorded and its next mode in ``run.mode``), a
     terminal section ("section") or the end time ("t_end"): ``(how, run)``; anything
     else raises as :func:`simulate` does. ``begun``: (mode, shift, banded, band) of a
     stay that goes on from a switch (else the start decides, as a run's start does);
-    ``opts``: the run's options in its units (filippov.scale.tolerances)."""
+    ``opts``: the run's options in its units (filippov.scale.tolerances);
+    ``start_sections``: the indices of the sections a start on which (up to rounding) is
+    no hit (None: all, as at a run's start) -- a stay that goes on from a switch counts a
+    crossing just after it, unless the stay before already counted it there."""
     run = _Run(system, z, list(sections), opts, scale, begun)
+    run.start_sections = start_sections
     status, _, _ = _RUN_TO_SWITCH(run.z, 0.0, run, run.rs)
     if status == OK:
         return ("switch" if run.handed_on else "section"), run
@@ -906,6 +914,8 @@ class _Scan:
         self.touch_tol, self.xtol, self.traj = touch_tol, xtol, traj
         self.band, self.unbanded = band, unbanded
         self.order = None  # the candidate intervals still to ask (earliest, _unband)
+        # the sections a start on which, up to rounding, is no hit (_Run.start_sections)
+        self.start_sections = None
         # the leave functions as sampled (raw) and as the search reads them (vals: h
         # sampled again unbiased once the band ends, _unband)
         self.raw = [np.asarray(func(zs), dtype=float) for func in leave]
@@ -1066,7 +1076,8 @@ class _Scan:
         sec, zr = self.sections[k], self.Z(r)
         if sec.where is not None and not sec.where(zr):
             return False
-        return not (i == 0 and self.ts[i] == self.traj.t0
+        starts = self.start_sections  # None: every section (the run's own start)
+        return not (i == 0 and self.ts[i] == self.traj.t0 and (starts is None or k in starts)
                     and self._starts_on(sec, self.svals[k], zr))
 
     def _touch(self, tm, mode):
