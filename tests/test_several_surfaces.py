@@ -527,3 +527,25 @@ def test_the_bilinear_weights_make_the_field_tangent_to_both_surfaces():
     a, b = bilinear_weights(np.array([[1.0, 1.0], [0.5, 0.5]]),
                             np.array([[1.0, -1.0], [1.0, -1.0]]), extend=True)
     assert a == pytest.approx(2.0) and b == pytest.approx(0.5)
+
+
+def test_each_surface_is_held_to_its_own_size_where_the_scale_is_measured():
+    # tests/review (helper, issue 59): h2 = 1e6 (x - 10) is the surface nearest the start
+    # x0 = 10 - 1e-7; the orbit crosses h1 = y at x = 5 + 1e-5 with y dipping only 1e-10
+    # below 0. With the scale measured at the start, h2's 2^25 once set touch_tol for both
+    # surfaces, and h1's crossing became a touch; each surface in its own unit, it crosses
+    one = np.ones_like
+
+    def grads(z):
+        g = np.array([[0.0, 1.0], [1e6, 0.0]])
+        return g if np.ndim(z) == 1 else np.repeat(g[:, :, None], z.shape[1], axis=2)
+    F = lambda z: np.array([-one(z[0]), -2.0 * (z[0] - 5.0)])  # noqa: E731
+    G = lambda z: np.array([0 * one(z[0]), -one(z[0])])         # noqa: E731
+    S = SurfacesSystem(("x", "y"), lambda z: np.array([z[1], 1e6 * (z[0] - 10.0)]), grads,
+                       {(1, -1): F, (1, 1): F, (-1, -1): G, (-1, 1): G}, m=2, scale=None)
+    x0 = 10.0 - 1e-7
+    ts = x0 - 5.0
+    tr = simulate(S, [x0, -1e-10 + ts ** 2], ts + 3.0, method="integrate")
+    assert tr.scale.switch == 2.0 ** 25   # the run's unit: h2's, nearest the start
+    assert [e.kind for e in tr.events[1:]] == ["crossing"]
+    assert np.max(np.abs(tr.z - [5.0 + 1e-5, -3.0 - 1e-5])) <= 1e-9

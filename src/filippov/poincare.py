@@ -84,6 +84,11 @@ def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
                                     else options["scale"], starts,
                                     lambda i: (measured.field_minus, measured.field_plus,
                                                measured.switch_grad))
+        if slid_on is not None and options["scale"].how != "declared":
+            # several surfaces: each one's switch scale measured by each run on its own
+            # (filippov.several), the batch's state and time kept
+            options["scale"] = {"state": options["scale"].state,
+                                "time": options["scale"].time}
     m = starts.shape[0]
     state = np.empty_like(starts)
     time = np.empty(m)

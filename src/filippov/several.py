@@ -83,6 +83,8 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
     sigma = system.region(z)
     first = system.view(sigma, 1)
     sc = scale_mod.of_system(first, z, opts.get("scale"))
+    given, system = system, _in_one_unit(system, sigma, z, opts.get("scale"), sc.switch)
+    first = system.view(sigma, 1)
     check_surfaces(system, z, sc.state)
     for k in range(system.m):  # each surface's pieces, its gradient among them
         checks.check_system(system.view(sigma, 1, k), z, method="integrate",
@@ -111,7 +113,7 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
                                dict(o, t0=t, max_steps=max(o["max_steps"] - steps, 1),
                                     dense=True))
         surface = _event_surface(system, stay, r.z)
-        traj = _merge(traj, r.traj, system, stay, surface, opts["dense"])
+        traj = _merge(traj, r.traj, given, stay, surface, opts["dense"])
         t, z = r.t, r.z
         for k in range(len(sections)):
             hits[k] += r.hits[k]
@@ -135,6 +137,29 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
         status = count_switch(rs, t, True)
         if status != GO_ON:
             raise _budget_error(status, rs, o, t, z)
+
+
+def _in_one_unit(system, sigma, z, value, unit):
+    """``system`` with each h_k (and its gradient) in the run's one unit of H, ``unit``:
+    where the switch scale is measured (not declared by the run or the system), each
+    surface's is measured on its own (filippov.scale, a power of two) and h_k multiplied
+    by unit / its own -- exactly, a power of two -- so that touch_tol, the corner and
+    hidden-crossing tests and the views' min hold every surface to its own size, not to
+    the one nearest the start."""
+    parts = scale_mod.declared(system.scale if value is None else value)
+    if isinstance(parts, scale_mod.Scale) or "switch" in parts:
+        return system
+    own = np.array([scale_mod.of_system(system.view(sigma, 1, k), z, value).switch
+                    for k in range(system.m)])
+    c = unit / own
+    if np.all(c == 1.0):
+        return system
+
+    def column(z):
+        return c.reshape((-1,) + (1,) * (np.ndim(z) - 1))
+    return dataclasses.replace(system, switches=lambda z: column(z) * system.switches(z),
+                               switch_grads=lambda z: column(z)[:, None] * system.switch_grads(z)
+                               if np.ndim(z) > 1 else c[:, None] * system.switch_grads(z))
 
 
 def _first_stay(system, sigma, first, z, o, start_mode) -> Stay:
