@@ -244,7 +244,9 @@ ASYMMETRIES = (
         14, "Several switching surfaces",
         "``simulate`` runs a ``SurfacesSystem`` stay by stay, each stay the one-surface "
         "loop on a view of the system (filippov.several; docs/decisions.md D24); "
-        "``first_returns`` and the derivatives (filippov.variational) take it too",
+        "``first_returns`` and the derivatives (filippov.variational) take it too; sliding "
+        "on an intersection of two surfaces by Dieci and Lopez's bilinear field "
+        "(filippov.intersection)",
         "refuses a ``SurfacesSystem`` of several surfaces by name (one of one surface is "
         "today's system)",
         "deliberate", "the views reuse every rule of one surface without touching the "
