@@ -252,7 +252,7 @@ ASYMMETRIES = (
         "deliberate", "the views reuse every rule of one surface without touching the "
         "loop the kernel compiles, whose per-return budget and compile time are spent "
         "(D22, D23); the kernel's own surfaces are issue 59's next part",
-        ("tests/test_several_surfaces.py::test_generated_crossings_of_two_and_three_surfaces",
+        ("tests/test_several_surfaces.py::test_generated_crossings_returns_and_dpdz_of_two_and_three_surfaces",
          "tests/test_several_surfaces.py::test_engines_and_front_doors_that_take_one_surface_refuse_several")),
 )
 
