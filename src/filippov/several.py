@@ -33,7 +33,7 @@ from .errors import SurfacesError, accumulation_detail, run_error
 from .loop.run_state import RING, Limits, count_switch, new_run_state
 from .loop.status import GO_ON, ZENO
 from .section import Section
-from .surfaces import SurfacesSystem, flip, mode_name, mode_of
+from .surfaces import SurfacesSystem, flip, mode_name, mode_of, regions
 from .system import PLUS, SLIDING
 
 #: the sections a slide's stay watches the other surfaces with, and a slide on an
@@ -59,19 +59,12 @@ def check_surfaces(system: SurfacesSystem, z: np.ndarray, floor: float) -> None:
     (one region's view is checked as a one-surface system by the engine's checks)."""
     zs = checks.probe_states(z, system.dim + 2, floor)
     system.values(z), system.values(zs), system.grads(z), system.grads(zs)
-    for sigma in _regions(system.m):
+    for sigma in regions(system.m):
         for zz in (z, zs):
             f = np.asarray(system.region_field(sigma, zz), dtype=float)
             if f.shape != zz.shape:
                 raise ValueError(f"field: region {sigma} returned shape {f.shape} for a "
                                  f"state of shape {zz.shape}")
-
-
-def _regions(m):
-    out = [()]
-    for _ in range(m):
-        out = [r + (s,) for r in out for s in (-1, 1)]
-    return out
 
 
 def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_stay,

@@ -27,7 +27,7 @@ from .scale import UNIT
 from .system import PiecewiseSystem
 
 __all__ = ["MAX_SURFACES", "SurfacesSystem", "digits", "flip", "mode_name", "mode_of",
-           "region_view", "slide_view"]
+           "region_view", "regions", "slide_view"]
 
 #: the most surfaces a system may have here: a mode's code (3**m values) then fits the
 #: int8 a trajectory samples its modes in (Trajectory.sample)
@@ -106,7 +106,7 @@ class SurfacesSystem:
                 raise TypeError(f"{name}: expected a function of the state")
         f = self.field
         if isinstance(f, Mapping):
-            want = set(_all_regions(m))
+            want = set(regions(m))
             keys = {tuple(int(s) for s in k) if np.ndim(k) == 1 else k for k in f}
             if not keys <= want:
                 bad = sorted(map(str, keys - want))[0]
@@ -220,7 +220,8 @@ class SurfacesSystem:
         return self._views["one"]
 
 
-def _all_regions(m: int) -> list:
+def regions(m: int) -> list:
+    """Every sign vector of m surfaces."""
     out = [()]
     for _ in range(m):
         out = [r + (s,) for r in out for s in (-1, 1)]
