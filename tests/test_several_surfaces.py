@@ -335,9 +335,12 @@ def test_engines_and_front_doors_that_take_one_surface_refuse_several():
                                         "takes one switching surface"):
         filippov.first_returns(S, np.array([[-1.0, -1.0]]), lambda z, p: z[0], 1.0,
                                engine="compiled")
-    with pytest.raises(TypeError, match="periodic_orbit expected a FilippovSystem"):
+    with pytest.raises(TypeError, match="periodic_orbit of a SurfacesSystem expected a "
+                                        "filippov.Section"):
         filippov.periodic_orbit(S, [-1.0, -1.0], lambda z, p: z[0], t_max=1.0,
                                 engine="reference")
+    with pytest.raises(TypeError, match="cannot run a SurfacesSystem"):
+        filippov.periodic_orbit(S, [-1.0, -1.0], lambda z, p: z[0], t_max=1.0)
     # a SurfacesSystem of one surface is today's system for every front door
     one = SurfacesSystem(("x", "y"), lambda z: np.array([z[1]]),
                          lambda z: np.array([[np.zeros_like(z[0]), np.ones_like(z[0])]]),
@@ -545,3 +548,35 @@ def test_each_surface_is_held_to_its_own_size_where_the_scale_is_measured():
     assert tr.scale.switch == 2.0 ** 25   # the run's unit: h2's, nearest the start
     assert [e.kind for e in tr.events[1:]] == ["crossing"]
     assert np.max(np.abs(tr.z - [5.0 + 1e-5, -3.0 - 1e-5])) <= 1e-9
+
+
+def test_a_periodic_orbit_across_a_spectator_surface_is_the_relay_s_closed_form():
+    # examples/relay_feedback.py's orbit (x' = A x - b sign(x1)) written with a second
+    # surface x2 = 0, the same fields on both sides: crossed twice a period, it changes
+    # nothing; periodic_orbit (reference engine, Newton on P with dP/dz through both
+    # surfaces' saltation matrices) finds the closed form's point, period and
+    # multipliers (dP/dz from the variational equations at rtol 1e-10)
+    import importlib.util
+
+    from conftest import ROOT
+
+    spec = importlib.util.spec_from_file_location("relay", ROOT / "examples" / "relay_feedback.py")
+    relay = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(relay)
+    A, b = relay.A, relay.b
+
+    def field(s, z):
+        return A @ z + (b * (-1.0 if s[0] > 0 else 1.0)).reshape((-1,) + (1,) * (np.ndim(z) - 1))
+
+    def grads(z):
+        g = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+        return g if np.ndim(z) == 1 else np.repeat(g[:, :, None], z.shape[1], axis=2)
+    S = SurfacesSystem(("x1", "x2", "x3"), lambda z: np.array([z[0], z[1]]), grads, field, m=2)
+    want = relay.closed_form()
+    x0 = want["x0"] if want["x0"][1] > 0 else -want["x0"]   # the upward crossing of x1 = 0
+    po = filippov.periodic_orbit(S, x0 + [0.0, 0.01, -0.01], Section("up", lambda z: z[0],
+                                                                     direction=1),
+                                 engine="reference", t_max=10.0, method="integrate")
+    assert abs(po.period - want["period"]) <= TOL
+    assert np.max(np.abs(po.point - x0)) <= TOL
+    np.testing.assert_allclose(po.multipliers, want["multipliers"], rtol=0, atol=1e-8)

@@ -244,7 +244,8 @@ ASYMMETRIES = (
         14, "Several switching surfaces",
         "``simulate`` runs a ``SurfacesSystem`` stay by stay, each stay the one-surface "
         "loop on a view of the system (filippov.several; docs/decisions.md D24); "
-        "``first_returns`` and the derivatives (filippov.variational) take it too; sliding "
+        "``first_returns``, the derivatives (filippov.variational) and ``periodic_orbit`` "
+        "take it too; sliding "
         "on an intersection of two surfaces by Dieci and Lopez's bilinear field "
         "(filippov.intersection)",
         "refuses a ``SurfacesSystem`` of several surfaces by name (one of one surface is "

@@ -12,12 +12,15 @@ an error, never a silent multiplier.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 from . import views
 from .contracts import DefinedOnce, provides
 from .scale import of_system
+from .section import Section
+from .surfaces import SurfacesSystem
 from .errors import PeriodicOrbitError  # noqa: F401  (re-exported)
 
 
@@ -62,7 +65,13 @@ def _reference_return(system, section, direction: int, where, t_max: float, opti
     scale = options.get("scale")   # the orbit's, fixed at the guess (_orbit_scale)
     python, jac = reference_view(system, None, "periodic_orbit",
                                  floor=getattr(scale, "state", None))
-    sec = system.python_section(section, direction=direction, where=where)
+    if isinstance(section, Section):   # several surfaces: the reference engine's Section
+        sec = section if section.terminal == 1 else dataclasses.replace(section, terminal=1)
+    elif not provides(system, DefinedOnce):
+        raise TypeError(f"section: periodic_orbit of a {type(system).__name__} expected a "
+                        f"filippov.Section, got {type(section).__name__}")
+    else:
+        sec = system.python_section(section, direction=direction, where=where)
 
     def single(z, age):
         traj = simulate(python, z, t_max, sections=[sec], dense=False, **options)
@@ -129,6 +138,15 @@ def _onto_section(value, z: np.ndarray, floor: float = 1.0) -> np.ndarray:
     return z - (s / gg) * g if gg > 0 else z
 
 
+def _one_surface_view(python, z):
+    """The one-surface system whose pieces say what a periodic orbit needs at z (its
+    units, its field there): the system itself, or a several-surface system's view of
+    the region of z (:mod:`filippov.surfaces`)."""
+    if isinstance(python, SurfacesSystem):
+        return python.view(python.region(np.asarray(z, dtype=float)), 1)
+    return python
+
+
 def _field_at(python, z: np.ndarray, touch_tol: float = 1e-15) -> np.ndarray:
     """The field the orbit from z starts with: that of its region, and on H (|h| <=
     touch_tol, e.g. a section on the switching surface) the one both engines start
@@ -137,6 +155,7 @@ def _field_at(python, z: np.ndarray, touch_tol: float = 1e-15) -> np.ndarray:
     annihilates F_+ there, not F_-."""
     from .simulate import initial_mode
 
+    python = _one_surface_view(python, z)
     mode, _ = initial_mode(python, np.asarray(z, dtype=float), touch_tol)
     return np.asarray(python.field(mode, z), dtype=float)
 
@@ -227,8 +246,13 @@ RUNAWAY = 1e3
 def _orbit_scale(python, z, value):
     """The units of every return of one Newton iteration (filippov.scale): ``value``, else
     the system's, the parts left open measured at the guess -- once, so that the
-    tolerances, and with them P, stay the same map at every iterate."""
-    return of_system(python, z, value)
+    tolerances, and with them P, stay the same map at every iterate. (What the runs take,
+    the whole Scale): several surfaces' runs take its state and time scales and measure
+    each surface's switch scale on its own (filippov.several)."""
+    sc = of_system(_one_surface_view(python, z), z, value)
+    if isinstance(python, SurfacesSystem) and sc.how != "declared":
+        return {"state": sc.state, "time": sc.time}, sc
+    return sc, sc
 
 
 def _newton_step(z, Pz, J, guess, floor: float) -> np.ndarray:
@@ -255,7 +279,8 @@ def _newton_step(z, Pz, J, guess, floor: float) -> np.ndarray:
 def _checked_start(system, guess, returns, engine) -> np.ndarray:
     """periodic_orbit's arguments checked (each refused naming it); the guess as a vector."""
     views.checked(engine)
-    if not provides(system, DefinedOnce):   # filippov.contracts
+    if not (isinstance(system, SurfacesSystem)   # several surfaces: the reference engine
+            or provides(system, DefinedOnce)):   # filippov.contracts
         raise TypeError(f"system: periodic_orbit expected a FilippovSystem or a "
                         f"SymbolicSystem (a system defined once: both engines' views), "
                         f"got {type(system).__name__}")
@@ -324,9 +349,9 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
         away from the guess (``RUNAWAY`` times its size).
     """
     z = _checked_start(system, guess, returns, engine)
-    python = views.reference_system(system, "periodic_orbit")
-    sc = _orbit_scale(python, z, options.get("scale"))
-    options = {**options, "scale": sc}
+    python = views.reference_system(system, "periodic_orbit", several=True)
+    runs, sc = _orbit_scale(python, z, options.get("scale"))   # what the runs take; all
+    options = {**options, "scale": runs}
     ret, section_value = _returns(system, section, direction, where, engine, t_max,
                                   int(returns), options)
     for it in range(1, max_iter + 1):
