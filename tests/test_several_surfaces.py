@@ -580,3 +580,29 @@ def test_a_periodic_orbit_across_a_spectator_surface_is_the_relay_s_closed_form(
     assert abs(po.period - want["period"]) <= TOL
     assert np.max(np.abs(po.point - x0)) <= TOL
     np.testing.assert_allclose(po.multipliers, want["multipliers"], rtol=0, atol=1e-8)
+
+
+def test_a_user_section_at_the_instant_a_stay_ends_at_its_own_is_counted_and_changes_nothing():
+    # tests/review (a second helper, issue 59): a user's section crossed at the very
+    # instant a slide reaches another surface (x = 2) or a slide on an intersection ends
+    # (w = 1) took the engine's tie from the stay's own section, and the stay ran on past
+    # its end (an orbit 0.56 off, or no end at all). The stay's own sections win; the
+    # user's is counted there, once
+    S = _planar({(1, -1): (1, -1), (-1, -1): (1, 1), (-1, 1): (2, 1), (1, 1): (2, -1)})
+    for direction in (1, 0):
+        tr = simulate(S, [0.3, 0.3], 3.0, method="integrate",
+                      sections=[Section("x=2", lambda z: z[0] - 2.0, direction=direction)])
+        assert [(e.kind, e.name) for e in tr.events[2:]] == [("section", "x=2"),
+                                                            ("crossing", "h2")]
+        assert abs(tr.events[2].t - 1.7) <= TOL
+        assert np.max(np.abs(tr.z - [4.6, 0.0])) <= TOL
+    fx = {(1, 1): -1.5, (1, -1): -1.5, (-1, 1): lambda w: 0.5 - 0.5 * w,
+          (-1, -1): lambda w: 0.5 - 0.5 * w}
+    fy = {(1, 1): -0.8, (-1, 1): -0.8, (1, -1): 1.2, (-1, -1): 1.2}
+    tr = simulate(_spatial(fx, fy), [0.3, 0.5, 0.0], 2.0, method="integrate",
+                  sections=[Section("w=1", lambda z: z[2] - 1.0, direction=1, terminal=1)])
+    assert tr.status == "section:w=1" and abs(tr.t - 1.0) <= TOL
+    tr = simulate(_spatial(fx, fy), [0.3, 0.5, 0.0], 2.0, method="integrate",
+                  sections=[Section("w=1", lambda z: z[2] - 1.0, direction=1)])
+    assert [e.kind for e in tr.events].count("section") == 1
+    assert np.max(np.abs(tr.z - [-0.25, 0.0, 2.0])) <= TOL and mode_name(tr.mode, 2) == "-0"

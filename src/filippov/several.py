@@ -101,7 +101,11 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
                 system.view(stay.sigma, stay.s, None if stay.slide < 0 else stay.slide))
         steps = 0 if traj is None else traj.n_steps
         mine = _stay_sections(system, stay, sections, hits, t - o["t0"])
-        starts = None if traj is None else just_hit | set(range(len(sections), len(mine)))
+        own = len(mine) - len(sections)   # the stay's own sections come first
+        # the user's sections hit where the last stay ended: no second hit at this start
+        starts = None if traj is None else {
+            own + k for k, sec in enumerate(sections) for e in traj.events
+            if e.kind == "section" and e.name == sec.name and e.t == t} | set(range(own))
         how, r = _guarded_stay(system, stay, one_stay, view, z, mine, starts, sc,
                                dict(o, t0=t, max_steps=max(o["max_steps"] - steps, 1),
                                     dense=True))
@@ -109,15 +113,15 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
         traj = _merge(traj, r.traj, given, stay, surface, opts["dense"])
         t, z = r.t, r.z
         for k in range(len(sections)):
-            hits[k] += r.hits[k]
-        # the user's sections this stay hit at its end: no second hit at the next start
-        just_hit = {k for k, sec in enumerate(sections) for e in r.traj.events
-                    if e.kind == "section" and e.name == sec.name and e.t == t}
+            hits[k] += r.hits[own + k]
         if how == "t_end":
             return _end(traj, "t_end", t, z, stay, surface, system)
         if how == "section":
             sec = mine[r.hit_section]
             if sec.name.startswith((_SURFACE, _END)):  # a slide reaches a surface, or ends
+                done = _tied_hits(sections, hits, stay, r, o, traj)
+                if done is not None:
+                    return _end(traj, f"section:{done}", t, z, stay, surface, system)
                 stay = (_slide_across(system, stay, int(sec.name[len(_SURFACE):]), t, z,
                                       traj, o) if sec.name.startswith(_SURFACE) else
                         _intersection_end(system, stay, sec.name[len(_END):], t, z, traj))
@@ -171,14 +175,13 @@ def _first_stay(system, sigma, first, z, o, start_mode) -> Stay:
 
 
 def _stay_sections(system, stay, sections, hits, elapsed):
-    """The user's sections as a stay that begins ``elapsed`` after the run sees them
-    (min_time counted from the run's start, terminal hits from the run's), and while
-    sliding on k the other surfaces, terminal at their first crossing."""
+    """The stay's own sections -- while sliding on k the other surfaces, terminal at their
+    first crossing; on an intersection its ends -- first, so that they win a tie with a
+    user's section crossed at the same instant (the engine takes the first of sections
+    that cross at one time; a user's is then counted by the next stay, just after its
+    start); then the user's sections as a stay that begins ``elapsed`` after the run sees
+    them (min_time counted from the run's start, terminal hits from the run's)."""
     out = []
-    for sec, n in zip(sections, hits):
-        out.append(dataclasses.replace(
-            sec, min_time=max(sec.min_time - elapsed, 0.0),
-            terminal=None if sec.terminal is None else sec.terminal - n))
     if stay.slide >= 0:
         for j in range(system.m):
             if j != stay.slide and j != stay.pair:
@@ -187,7 +190,38 @@ def _stay_sections(system, stay, sections, hits, elapsed):
     if stay.pair >= 0:
         for name, func in _ends(system, stay).items():
             out.append(Section(f"{_END}{name}", func, direction=-1, terminal=1))
+    for sec, n in zip(sections, hits):
+        out.append(dataclasses.replace(
+            sec, min_time=max(sec.min_time - elapsed, 0.0),
+            terminal=None if sec.terminal is None else sec.terminal - n))
     return out
+
+
+def _tied_hits(sections, hits, stay, r, o, traj):
+    """The user's sections crossed at the instant a stay ended at one of its own (which
+    win the engine's tie): each crossing in its direction within 4 event_xtol either side
+    of the end on the stay's dense output (past ``min_time``, where ``where`` holds) is a
+    hit there, logged before the switch; the name of a terminal one whose hits are
+    reached (the run ends there), else None."""
+    ta, te, _, Z = r.traj.segments[-1]
+    d = 4.0 * o["event_xtol"]
+    z = np.asarray(r.z, dtype=float)
+    mode = _code(stay, stay.slide, 1 if stay.pair >= 0 else SLIDING)
+    for k, sec in enumerate(sections):
+        if te - o["t0"] < sec.min_time or any(
+                e.kind == "section" and e.name == sec.name and e.t == te for e in traj.events):
+            continue
+        before, after = (float(sec.func(np.asarray(Z(t), dtype=float).reshape(-1)))
+                         for t in (max(ta, te - d), te + d))
+        crosses = before < 0.0 <= after if sec.direction > 0 else (
+            before > 0.0 >= after if sec.direction < 0 else (before < 0.0) != (after < 0.0))
+        if not crosses or (sec.where is not None and not sec.where(z)):
+            continue
+        hits[k] += 1
+        traj.events.append(type(traj.events[0])(te, "section", z.copy(), mode, mode, sec.name))
+        if sec.terminal is not None and hits[k] >= sec.terminal:
+            return sec.name
+    return None
 
 
 def _ends(system, stay):
