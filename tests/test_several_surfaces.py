@@ -606,3 +606,53 @@ def test_a_user_section_at_the_instant_a_stay_ends_at_its_own_is_counted_and_cha
                   sections=[Section("w=1", lambda z: z[2] - 1.0, direction=1)])
     assert [e.kind for e in tr.events].count("section") == 1
     assert np.max(np.abs(tr.z - [-0.25, 0.0, 2.0])) <= TOL and mode_name(tr.mode, 2) == "-0"
+
+
+def test_the_ends_of_an_intersection_slide_in_either_order_of_arrival():
+    # tests/review (second helper): a decoupled intersection (every choice agrees, none
+    # declared) reached from either surface first; y' = 1.2 - 0.4 w below y = 0 stops
+    # attracting at w = 3, x' = 0.5 - 0.5 w below x = 0 at w = 1. Exact: x = 0 until t = 1,
+    # then -(t - 1)^2 / 4; y = 0 until t = 3, then -(t - 3)^2 / 5. (The samples a hair past
+    # an end once read "no bilinear field" there and refused the run.)
+    fx = {(1, 1): -1.5, (1, -1): -1.5, (-1, 1): lambda w: 0.5 - 0.5 * w,
+          (-1, -1): lambda w: 0.5 - 0.5 * w}
+    fy = {(1, 1): -0.8, (-1, 1): -0.8, (1, -1): lambda w: 1.2 - 0.4 * w,
+          (-1, -1): lambda w: 1.2 - 0.4 * w}
+    for z0 in ([0.3, 0.5, 0.0], [0.9, 0.16, 0.0]):
+        tr = simulate(_spatial(fx, fy), z0, 4.0, method="integrate")
+        ends = [e for e in tr.events if e.kind == "slide_end"]
+        assert [round(e.t, 12) for e in ends] == [1.0, 3.0], z0
+        assert np.max(np.abs(tr.z - [-2.25, -0.2, 4.0])) <= TOL, z0
+
+
+def test_an_intersection_slide_that_reaches_a_third_surface_is_refused_by_name():
+    def field(sig, z):
+        one = np.ones_like(z[0])
+        return np.array([-1.5 * one if sig[0] > 0 else 0.5 * one,
+                         -0.8 * one if sig[1] > 0 else 1.2 * one, one, one])
+
+    def grads(z):
+        zero, one = np.zeros_like(z[0]), np.ones_like(z[0])
+        return np.array([[one, zero, zero, zero], [zero, one, zero, zero],
+                         [zero, zero, one, zero]])
+    S = SurfacesSystem(("x", "y", "w", "v"), lambda z: np.array([z[0], z[1], z[2] - 1.5]),
+                       grads, field, m=3)
+    with pytest.raises(SurfacesError, match="slide on the intersection of h1 and h2 reaches h3"):
+        simulate(S, [0.3, 0.5, 0.0, 0.0], 3.0, method="integrate")
+
+
+def test_a_hidden_crossing_the_reruns_cannot_resolve_is_refused_at_a_bounded_cost():
+    # the dip of _dip (2e-8 wide) with a third state along for the ride over a long stay:
+    # the reruns' steps are bounded (GUARD_WORK times the first run's, or GUARD_FLOOR), so
+    # the refusal comes after a bounded amount of work (second helper: 149 s at t_end 10
+    # when each rerun took the whole stay 8 times finer)
+    def grads(z):
+        zero = np.zeros_like(z[0])
+        return np.array([[zero, np.ones_like(z[0]), zero],
+                         [2e6 * (z[0] - 1.0), zero, zero]])
+    S = SurfacesSystem(("x", "y", "w"),
+                       lambda z: np.array([z[1], 1e6 * ((z[0] - 1.0) ** 2 - 1e-16)]), grads,
+                       lambda s, z: np.array([np.ones_like(z[0]), np.zeros_like(z[0]),
+                                              np.cos(3 * z[0])]), m=2)
+    with pytest.raises(SurfacesError, match="hidden crossing at t=.*at most 4, 64 times"):
+        simulate(S, [0.0, 1e-9, 0.0], 10.0, method="integrate")

@@ -119,6 +119,9 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
         if how == "section":
             sec = mine[r.hit_section]
             if sec.name.startswith((_SURFACE, _END)):  # a slide reaches a surface, or ends
+                if stay.pair >= 0 and sec.name.startswith(_SURFACE):
+                    raise _intersection_meets(system, stay, int(sec.name[len(_SURFACE):]),
+                                              t, z)
                 done = _tied_hits(sections, hits, stay, r, o, traj)
                 if done is not None:
                     return _end(traj, f"section:{done}", t, z, stay, surface, system)
@@ -273,22 +276,33 @@ GUARD_SAMPLES = 8
 
 
 #: how many times a stay is run again with shorter steps where the guard found a surface
-#: crossed between the engine's samples (:func:`_guarded_stay`)
-GUARD_RETRIES = 4
+#: crossed between the engine's samples, and the most steps those runs may take together:
+#: GUARD_WORK times the first run's, or GUARD_FLOOR (:func:`_guarded_stay`)
+GUARD_RETRIES, GUARD_WORK, GUARD_FLOOR = 4, 64, 20_000
 
 
 def _guarded_stay(system, stay, one_stay, view, z, sections, starts, sc, o):
     """The engine's run of one stay, checked by :func:`_hidden_crossing`: where a surface
     was crossed between its samples, the stay is run again from its start with steps
     no longer than the guard's sample interval there (the engine then samples it four
-    times finer than the guard did), GUARD_RETRIES times at most; then refused by name."""
+    times finer than the guard did), GUARD_RETRIES times at most and within GUARD_WORK
+    times the first run's steps (each run's steps out of the stay's one budget); then
+    refused by name -- a bounded cost, never a run that only seems to hang."""
+    first, spent = None, 0
     for _ in range(GUARD_RETRIES + 1):
         how, r = one_stay(view, z, sections, o, sc, stay.begun, starts)
         found = _hidden_crossing(system, stay, r.traj.segments, o)
         if found is None:
             return how, r
         j, tm, zm, span = found
-        o = dict(o, max_step=min(o["max_step"], span / GUARD_SAMPLES))
+        steps = max(r.traj.n_steps, 1)
+        first, spent = first or steps, spent + steps
+        ahead = steps * max(1.0, o["max_step"] / (span / GUARD_SAMPLES) if np.isfinite(
+            o["max_step"]) else GUARD_SAMPLES)
+        if spent + ahead > max(GUARD_WORK * first, GUARD_FLOOR):
+            break
+        o = dict(o, max_step=min(o["max_step"], span / GUARD_SAMPLES),
+                 max_steps=max(o["max_steps"] - steps, 1))
     raise _hidden(system, stay, j, tm, zm)
 
 
@@ -315,8 +329,9 @@ def _hidden_crossing(system, stay, segments, o):
         entry = int(np.argmin(g[:, 0])) if stay.slide < 0 else -1
         at_end = ts >= segments[-1][1] - 4.0 * o["event_xtol"]
         if stay.pair >= 0 and system.intersection != "bilinear":
-            for i in range(ts.size):   # the choice the system settled at the entry, along
-                _choice_settled(system, stay.sigma, stay.slide, stay.pair, ts[i], zs[:, i])
+            for i in np.flatnonzero(~at_end):   # the choice settled at the entry, along
+                _choice_settled(system, stay.sigma, stay.slide, stay.pair, ts[i], zs[:, i],
+                                extend=True)
         for j in range(system.m):
             if j == stay.slide or j == stay.pair:
                 continue
@@ -360,8 +375,9 @@ def _hidden(system, stay, j, t, z):
     return SurfacesError(
         f"hidden crossing at t={float(t)!r}, state {np.asarray(z, float).reshape(-1).tolist()}:"
         f" h{j + 1} is crossed there while the stay in mode {mode_name(mode, system.m)}"
-        f" followed another surface nearer, and {GUARD_RETRIES} runs of the stay with ever "
-        "shorter steps did not resolve it (a tangency of the two?)")
+        " followed another surface nearer, and runs of the stay with ever shorter steps "
+        f"(at most {GUARD_RETRIES}, {GUARD_WORK} times its steps) did not resolve it (a "
+        "tangency of the two?)")
 
 
 def _merge(traj, sub, system, stay, surface, dense=True):
@@ -438,7 +454,7 @@ def _through(system, stay, at, r, traj) -> Stay:
     names = ", ".join(f"h{k + 1}" for k in sorted(at))
     if not rules.through_corner(speeds.ravel()):
         raise SurfacesError(
-            f"corner at t={r.t!r}, state {z.tolist()}: the orbit reaches {names} at once "
+            f"corner at t={float(r.t)!r}, state {z.tolist()}: the orbit reaches {names} at once "
             f"from region {mode_name(mode_of(stay.sigma), system.m)}, and the fields there "
             "do not all cross them (normal speeds, a row per region meeting there: "
             f"{speeds.tolist()}); a corner where sliding or a choice of region may follow "
@@ -470,7 +486,7 @@ def _slide_across(system, stay, j, t, z, traj, o) -> Stay:
     at = [i for i in _corner(system, stay.sigma, j, z, o, slide) if i != k]
     if at:
         raise SurfacesError(
-            f"corner at t={t!r}, state {z.tolist()}: the slide on h{k + 1} reaches "
+            f"corner at t={float(t)!r}, state {z.tolist()}: the slide on h{k + 1} reaches "
             f"{', '.join(f'h{i + 1}' for i in sorted([j] + at))} at once; a slide into a "
             "corner is not settled by filippov")
     far = flip(stay.sigma, j)
@@ -491,11 +507,19 @@ def _slide_across(system, stay, j, t, z, traj, o) -> Stay:
 
 def _slide_meets(system, stay, j, t, z):
     return SurfacesError(
-        f"intersection at t={t!r}, state {np.asarray(z, float).tolist()}: the slide on "
+        f"intersection at t={float(t)!r}, state {np.asarray(z, float).tolist()}: the slide on "
         f"h{stay.slide + 1} (mode {mode_name(_code(stay, stay.slide, SLIDING), system.m)}) "
         f"reaches h{j + 1}, where it neither crosses (rules.slide_crosses) nor slides on "
         "the intersection (rules.slides_into_intersection): it leaves the surface there, "
         "which filippov does not follow")
+
+
+def _intersection_meets(system, stay, i, t, z):
+    return SurfacesError(
+        f"intersection at t={float(t)!r}, state {np.asarray(z, float).tolist()}: the slide on the "
+        f"intersection of h{min(stay.slide, stay.pair) + 1} and "
+        f"h{max(stay.slide, stay.pair) + 1} reaches h{i + 1}; what follows there (a slide on "
+        "the intersection across it, or on three surfaces) is not built into filippov")
 
 
 def _intersection_start(system, stay, j, t, z, traj) -> Stay:
@@ -511,23 +535,25 @@ def _intersection_start(system, stay, j, t, z, traj) -> Stay:
     return inner
 
 
-def _choice_settled(system, sigma, j, k, t, z):
+def _choice_settled(system, sigma, j, k, t, z, extend=False):
     """Refuse a slide on the intersection of h_j and h_k at z unless the bilinear field
     exists there and either agrees with both nested choices (rules.choices_agree: the
-    system settles the field) or the system takes it (``intersection="bilinear"``)."""
+    system settles the field) or the system takes it (``intersection="bilinear"``).
+    ``extend``: along the slide, its weights continued a hair past the square (the
+    samples at its end)."""
     z = np.asarray(z, dtype=float)
-    fb = intersection.bilinear_field(system, sigma, j, k, z, extend=False)
+    fb = intersection.bilinear_field(system, sigma, j, k, z, extend=extend)
     names = f"h{min(j, k) + 1} and h{max(j, k) + 1}"
     if not np.all(np.isfinite(fb)):
         raise SurfacesError(
-            f"intersection at t={t!r}, state {z.tolist()}: no bilinear sliding field on "
+            f"intersection at t={float(t)!r}, state {z.tolist()}: no bilinear sliding field on "
             f"{names} there (filippov.intersection: the intersection does not attract)")
     nested = [intersection.nested_field(system, sigma, a, b, z) for a, b in ((j, k), (k, j))]
     spread = max(float(np.abs(fb - f).max()) for f in nested)
     if system.intersection != "bilinear" and not rules.choices_agree(
             spread, float(np.abs(fb).max())):
         raise SurfacesError(
-            f"intersection at t={t!r}, state {z.tolist()}: the sliding field on {names} "
+            f"intersection at t={float(t)!r}, state {z.tolist()}: the sliding field on {names} "
             f"depends on the choice there (bilinear {fb.tolist()}, nested "
             f"{[f.tolist() for f in nested]}): the system does not settle it; declare "
             "SurfacesSystem(..., intersection='bilinear') to take Dieci and Lopez's "
@@ -547,7 +573,7 @@ def _intersection_end(system, stay, end, t, z, traj) -> Stay:
     a, b = (float(v) for v in system.view(sigma, 1, keep).normal_speeds(np.asarray(z, float)))
     if not a > 0.0 > b:
         raise SurfacesError(
-            f"intersection end at t={t!r}, state {np.asarray(z, float).tolist()}: the slide "
+            f"intersection end at t={float(t)!r}, state {np.asarray(z, float).tolist()}: the slide "
             f"on h{j + 1} and h{k + 1} ends toward h{gone + 1}'s {'+-'[side < 0]} side, where "
             f"the slide on h{keep + 1} does not attract (a = {a:.3g}, b = {b:.3g}); what "
             "follows is not built into filippov")
