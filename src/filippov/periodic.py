@@ -20,7 +20,7 @@ from . import views
 from .contracts import DefinedOnce, provides
 from .scale import of_system
 from .section import Section
-from .surfaces import SurfacesSystem
+from .surfaces import SurfacesSystem, view_at
 from .errors import PeriodicOrbitError  # noqa: F401  (re-exported)
 
 
@@ -138,15 +138,6 @@ def _onto_section(value, z: np.ndarray, floor: float = 1.0) -> np.ndarray:
     return z - (s / gg) * g if gg > 0 else z
 
 
-def _one_surface_view(python, z):
-    """The one-surface system whose pieces say what a periodic orbit needs at z (its
-    units, its field there): the system itself, or a several-surface system's view of
-    the region of z (:mod:`filippov.surfaces`)."""
-    if isinstance(python, SurfacesSystem):
-        return python.view(python.region(np.asarray(z, dtype=float)), 1)
-    return python
-
-
 def _field_at(python, z: np.ndarray, touch_tol: float = 1e-15) -> np.ndarray:
     """The field the orbit from z starts with: that of its region, and on H (|h| <=
     touch_tol, e.g. a section on the switching surface) the one both engines start
@@ -155,7 +146,7 @@ def _field_at(python, z: np.ndarray, touch_tol: float = 1e-15) -> np.ndarray:
     annihilates F_+ there, not F_-."""
     from .simulate import initial_mode
 
-    python = _one_surface_view(python, z)
+    python = view_at(python, z)
     mode, _ = initial_mode(python, np.asarray(z, dtype=float), touch_tol)
     return np.asarray(python.field(mode, z), dtype=float)
 
@@ -249,7 +240,7 @@ def _orbit_scale(python, z, value):
     tolerances, and with them P, stay the same map at every iterate. (What the runs take,
     the whole Scale): several surfaces' runs take its state and time scales and measure
     each surface's switch scale on its own (filippov.several)."""
-    sc = of_system(_one_surface_view(python, z), z, value)
+    sc = of_system(view_at(python, z), z, value)
     if isinstance(python, SurfacesSystem) and sc.how != "declared":
         return {"state": sc.state, "time": sc.time}, sc
     return sc, sc

@@ -19,7 +19,7 @@ from .errors import run_error
 from .loop.status import NO_RETURN
 from .progress import Progress
 from .scale import of_batch
-from .surfaces import SurfacesSystem
+from .surfaces import SurfacesSystem, view_at
 from .simulate import Section, simulate
 from .system import SLIDING
 
@@ -79,7 +79,7 @@ def _first_returns(system, starts, section, t_max: float, *, direction: int = 0,
     # a several-surface system's modes are codes: it says which of them slide
     slid_on = system.slid_on if isinstance(system, SurfacesSystem) else None
     if starts.size and np.all(np.isfinite(starts)):   # one scale, as the compiled engine's
-        measured = _scale_view(system, starts)
+        measured = view_at(system, starts[0])
         options["scale"] = of_batch(system.scale if options.get("scale") is None
                                     else options["scale"], starts,
                                     lambda i: (measured.field_minus, measured.field_plus,
@@ -124,15 +124,6 @@ def _first_returns_compiled(*args, **kwargs):
 
 #: what runs :func:`first_returns` on each engine
 RUNS = {views.REFERENCE: _first_returns, views.COMPILED: _first_returns_compiled}
-
-
-def _scale_view(system, starts):
-    """The one-surface system whose pieces measure a batch's units: the system itself,
-    or a several-surface system's view of its first start's region
-    (:mod:`filippov.surfaces`)."""
-    if isinstance(system, SurfacesSystem):
-        return system.view(system.region(starts[0]), 1)
-    return system
 
 
 def sliding_time(events, slides=None) -> float:

@@ -27,7 +27,7 @@ from .scale import UNIT
 from .system import PiecewiseSystem
 
 __all__ = ["MAX_SURFACES", "SurfacesSystem", "digits", "flip", "mode_name", "mode_of",
-           "region_view", "regions", "slide_view"]
+           "region_view", "regions", "slide_view", "view_at"]
 
 #: the most surfaces a system may have here: a mode's code (3**m values) then fits the
 #: int8 a trajectory samples its modes in (Trajectory.sample)
@@ -218,6 +218,15 @@ class SurfacesSystem:
                 lambda z: self.grads(z)[0], sliding=self.sliding, units=dict(self.units),
                 description=self.description, scale=self.scale)
         return self._views["one"]
+
+
+def view_at(system, z) -> PiecewiseSystem:
+    """The one-surface system whose pieces say what holds at a state z (its units, its
+    field there): ``system`` itself, or a several-surface system's view of the region
+    of z."""
+    if isinstance(system, SurfacesSystem):
+        return system.view(system.region(np.asarray(z, dtype=float)), 1)
+    return system
 
 
 def regions(m: int) -> list:
