@@ -96,8 +96,9 @@ def test_the_front_doors_take_a_system_by_its_views():
 
 
 def test_several_switching_functions_are_refused_by_name():
-    # issue 59 builds several surfaces; until then a vector of switching functions is
-    # refused as such, not with numba's error about a vector where a scalar goes
+    # several switching functions without a field per sign vector (fields=) are refused
+    # as such, naming what to give, not with numba's error about a vector where a scalar
+    # goes
     import sympy as sp
 
     from filippov import PiecewiseSystem, simulate
@@ -105,7 +106,7 @@ def test_several_switching_functions_are_refused_by_name():
 
     f = lambda z, p: np.array([1.0, 1.0])  # noqa: E731
     with pytest.raises(ValueError, match=r"switch: returned 2 values .*several switching "
-                                         r"surfaces .* not supported"):
+                                         r"surfaces take a field per sign vector"):
         FilippovSystem(("x", "y"), f, f, lambda z, p: np.array([z[0], z[1]]),
                        lambda z, p: np.eye(2))
     x, y = sp.symbols("x y")

@@ -23,16 +23,14 @@ from . import scale as scale_mod
 from .checks import SystemContractError
 from .differences import richardson_jacobian
 from .spelling import one_spelling
+from .batches import flow as _batch_flow, jit as _jit, scalar as _batch_scalar
+from .batches import states as _states, vector as _batch_vector
+from .surfaces import view_at
+from .surfaces_defined import grad_derivative, sliding_jacobian
 from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, always, no_flow
 
 _DOC_PIECE = ("write it for one state z (1-D float array) and the parameter array p, "
               "with numpy and math only (no Python objects, no closures over lists)")
-
-
-def _jit(fn: Callable, piece: str):
-    if not callable(fn):
-        raise TypeError(f"{piece}: expected a function, got {type(fn).__name__}")
-    return fn if hasattr(fn, "py_func") else njit(fn)
 
 
 def _one_surface(switch, n: int, params, probe) -> None:
@@ -349,61 +347,19 @@ def with_section(cm: CompiledModel, section: Callable, *, direction: int = 0,
 
 
 # ----------------------------------------------------------------------------- one definition
-def _batch_vector(user, n: int, piece: str = "a vector piece"):
-    """A vector piece f(z, p) -> (n,) evaluated on (n,) or (n, m) states, compiled; a
-    value of the wrong length is an error, never memory past its end."""
-    wrong = f"{piece} returned the wrong number of values"
-
-    @njit
-    def batch(zs, p):
-        m = zs.shape[1]
-        out = np.empty((n, m))
-        z = np.empty(n)
-        for j in range(m):
-            for i in range(n):
-                z[i] = zs[i, j]
-            v = user(z, p)
-            if len(v) != n:
-                raise ValueError(wrong)
-            for i in range(n):
-                out[i, j] = v[i]
-        return out
-    return batch
-
-
-def _batch_scalar(user, n: int):
-    @njit
-    def batch(zs, p):
-        m = zs.shape[1]
-        out = np.empty(m)
-        z = np.empty(n)
-        for j in range(m):
-            for i in range(n):
-                z[i] = zs[i, j]
-            out[j] = user(z, p)
-        return out
-    return batch
-
-
-def _batch_flow(user, n: int, piece: str = "a flow"):
-    wrong = f"{piece} returned the wrong number of values"
-
-    @njit
-    def batch(z0, taus, p):
-        out = np.empty((n, taus.size))
-        for j in range(taus.size):
-            v = user(z0, taus[j], p)
-            if len(v) != n:
-                raise ValueError(wrong)
-            for i in range(n):
-                out[i, j] = v[i]
-        return out
-    return batch
-
-
-def _states(z, n):
-    z = np.asarray(z, dtype=float)
-    return np.ascontiguousarray(z.reshape(n, -1)), z.shape[1:]
+def _surface_functions(user: dict) -> dict:
+    """The user's functions of several surfaces by piece name (what numba compiles in:
+    filippov.frozen)."""
+    out = {}
+    for piece in ("fields", "switch", "switch_grad", "jacobians"):
+        value = user[piece]
+        if isinstance(value, dict):
+            out.update({f"{piece}[{k!r}]": f for k, f in value.items()})
+        elif isinstance(value, (tuple, list)):
+            out.update({f"{piece}[{k}]": f for k, f in enumerate(value)})
+        elif value is not None:
+            out[piece] = value
+    return out
 
 
 _JAC_MODES = ("minus", "sliding", "plus")   # filippov.system.MODE_NAMES
@@ -440,11 +396,12 @@ class FilippovSystem:
     same results.
     """
 
-    def __init__(self, names, field_minus, field_plus, switch, switch_grad, *, params=(),
-                 flow_minus=None, flow_plus=None, sample_step: float = np.inf,
-                 sliding: bool = True, name: str = "user", jacobians=None,
-                 slow_sample_step: float = np.nan, transient_time: float = np.inf,
-                 probe=None, scale=None, flow_jacobians=None):
+    def __init__(self, names, field_minus=None, field_plus=None, switch=None,
+                 switch_grad=None, *, params=(), flow_minus=None, flow_plus=None,
+                 sample_step: float = np.inf, sliding: bool = True, name: str = "user",
+                 jacobians=None, slow_sample_step: float = np.nan,
+                 transient_time: float = np.inf, probe=None, scale=None, flow_jacobians=None,
+                 fields=None, intersection=None):
         self.names = tuple(str(x) for x in names)
         # the run's units (filippov.scale): checked here, measured at each run's start
         # where not declared (docs/decisions.md#units)
@@ -454,6 +411,17 @@ class FilippovSystem:
         self.slow_sample_step, self.transient_time = float(slow_sample_step), float(transient_time)
         self.params = np.ascontiguousarray(np.asarray(params, dtype=float).reshape(-1))
         self.name, self.sliding, self.sample_step = name, bool(sliding), float(sample_step)
+        self.m, self._surfaces, self.intersection = 1, None, intersection
+        if fields is not None:   # several switching surfaces (filippov.surfaces_defined)
+            field_minus, field_plus, switch, switch_grad, jacobians = self._define_surfaces(
+                fields, field_minus, field_plus, switch, switch_grad, jacobians,
+                flow_minus is not None or flow_plus is not None)
+        elif intersection is not None:
+            raise ValueError("intersection: the sliding field on an intersection of "
+                             "surfaces goes with several surfaces (fields=)")
+        if self._surfaces is None:
+            self._require(field_minus=field_minus, field_plus=field_plus, switch=switch,
+                          switch_grad=switch_grad)
         flow_jacobians = dict(flow_jacobians or {})
         if flow_jacobians and set(flow_jacobians) != {"minus", "plus"}:
             raise ValueError(f"flow_jacobians: give those of both regions ('minus' and "
@@ -465,8 +433,9 @@ class FilippovSystem:
                             switch_grad=switch_grad, flow_minus=flow_minus, flow_plus=flow_plus,
                             flow_jacobian_minus=flow_jacobians.get("minus"),
                             flow_jacobian_plus=flow_jacobians.get("plus"))
-        _one_surface(switch, len(self.names), self.params, probe)
-        jacobians = dict(jacobians or {})
+        if self._surfaces is None:
+            _one_surface(switch, len(self.names), self.params, probe)
+        jacobians = dict(jacobians or {} if self._surfaces is None else {})
         unknown = set(jacobians) - set(_JAC_MODES)
         if unknown:
             raise ValueError(f"jacobians: unknown mode(s) {sorted(unknown)}; expected "
@@ -478,11 +447,58 @@ class FilippovSystem:
         self._frozen = None     # what numba compiles into them (filippov.frozen)
         self._jacobians_checked = set()   # the given Jacobians compared with their fields
 
+    def _require(self, **pieces) -> None:
+        """The pieces of one surface, each named where missing (a generated system has
+        its own: it overrides this)."""
+        missing = [k for k, v in pieces.items() if v is None]
+        if missing:
+            raise TypeError(f"{missing[0]}: missing; one switching surface takes "
+                            f"field_minus, field_plus, switch and switch_grad, several "
+                            f"take fields=, switch and switch_grad")
+
+    def _define_surfaces(self, fields, field_minus, field_plus, switch, switch_grad,
+                         jacobians, exact: bool):
+        """Several switching surfaces (filippov.surfaces_defined): checked and compiled
+        for the reference engine; m = 1 becomes today's one-surface pieces."""
+        from . import surfaces_defined as defined
+
+        if field_minus is not None or field_plus is not None:
+            raise TypeError("fields: give either field_minus and field_plus (one switching "
+                            "surface) or fields (a field per sign vector), not both")
+        if exact:
+            raise ValueError("flow_minus, flow_plus: exact flows take one switching surface; "
+                             "with fields= the fields are integrated")
+        if switch is None or switch_grad is None:
+            raise TypeError(f"{'switch' if switch is None else 'switch_grad'}: missing; "
+                            f"several surfaces take fields=, switch and switch_grad")
+        n = len(self.names)
+        m = defined.count(fields, switch, n, self.params, _probe_state(self._probe, n))
+        regions = defined.region_functions(fields, m)
+        self._user_surfaces = dict(fields=fields, switch=switch, switch_grad=switch_grad,
+                                   jacobians=dict(jacobians or {}))
+        if m == 1:
+            jac = {("minus" if k[0] < 0 else "plus"): f for k, f in (
+                (defined._sign_vector(k, 1), f) for k, f in dict(jacobians or {}).items())}
+            if self.intersection is not None:
+                raise ValueError("intersection: one switching surface has no intersection")
+            one = defined.one_surface(regions, switch, switch_grad)
+            return one["field_minus"], one["field_plus"], one["switch"], one["switch_grad"], jac
+        if self.intersection not in (None, "bilinear"):
+            raise ValueError(f"intersection: expected None or 'bilinear', got "
+                             f"{self.intersection!r}")
+        self.m = m
+        self._surfaces = defined.compile_pieces(self.names, regions, switch, switch_grad,
+                                                jacobians, m)
+        defined.probe(self._surfaces, self.names, self.params, _probe_state(self._probe, n))
+        return None, None, switch, switch_grad, None
+
     def _frozen_unchanged(self) -> None:
         """The values the pieces read from globals and closures (numba compiles them in):
         noted at the first use of an engine, checked at every later one."""
         if self._frozen is None:
             pieces = {k: f for k, f in self._pieces.items() if f is not None}
+            if self._surfaces is not None:   # several surfaces: the user's own functions
+                pieces = _surface_functions(self._user_surfaces)
             pieces.update({f"jacobians[{m!r}]": f for m, f in self._jacobians.items()})
             self._frozen = frozen.record(pieces)
         else:
@@ -517,6 +533,7 @@ class FilippovSystem:
     # -- the engines
     def compiled(self, section, *, direction: int = 0, where=None, probe=None) -> CompiledModel:
         """The compiled engine's model with the section ``section(z, p) = 0``."""
+        self._one_surface_only("the compiled engine")
         self._frozen_unchanged()
         if self._compiled is None:
             self._compiled = dataclasses.replace(compile_system(
@@ -551,10 +568,19 @@ class FilippovSystem:
         return Section(name, func, direction=direction, where=cond, terminal=1,
                        min_time=min_time)
 
+    def _one_surface_only(self, what: str) -> None:
+        if self._surfaces is not None:
+            raise TypeError(f"system: {what} takes one switching surface; this "
+                            f"{type(self).__name__} has m = {self.m} (run it with "
+                            f"engine='reference')")
+
     @property
     def has_jacobians(self) -> bool:
         """Whether :meth:`jacobian` has the Jacobians of both regions' fields (that of
-        sliding may be absent where the system cannot slide)."""
+        sliding may be absent where the system cannot slide); with several surfaces, of
+        every region's."""
+        if self._surfaces is not None:
+            return set(self._surfaces.jacobians) == set(self.python().field)
         return {"minus", "plus"} <= self._jacobian_modes()
 
     def jacobian(self, mode: int, z, *, floor: float | None = None) -> np.ndarray:
@@ -566,6 +592,8 @@ class FilippovSystem:
         from .system import MODE_NAMES
 
         self._frozen_unchanged()
+        if self._surfaces is not None:
+            return self._surfaces_jacobian(mode, z, floor)
         key = MODE_NAMES.get(mode)
         if key == "sliding" and key not in self._jacobian_modes() and self.has_jacobians:
             return self._sliding_jacobian(np.ascontiguousarray(z, dtype=float), floor)
@@ -582,6 +610,31 @@ class FilippovSystem:
             self._jacobians_checked.add(key)
         return J
 
+    def _surfaces_jacobian(self, mode: int, z, floor) -> np.ndarray:
+        """dF/dz of a mode of several surfaces (filippov.surfaces_defined.mode_jacobian),
+        each region's Jacobian compared with differences of its field when first used."""
+        from .surfaces_defined import mode_jacobian
+
+        n, system = len(self.names), self.python()
+        z = np.ascontiguousarray(z, dtype=float)
+        if z.shape != (n,):
+            raise ValueError(f"jacobian: expected one state of shape ({n},), got {z.shape}")
+
+        def region(sigma, zz):
+            if sigma not in self._surfaces.jacobians:
+                raise ValueError(f"jacobian: no Jacobian of region {sigma} was given (have "
+                                 f"{sorted(self._surfaces.jacobians)})")
+            J = np.asarray(self._surfaces.jacobians[sigma](zz, self.params), float)
+            if sigma not in self._jacobians_checked:
+                self._compare_jacobian(f"jacobians[{sigma}]", f"fields[{sigma}]",
+                                       lambda x: system.region_field(sigma, x), zz,
+                                       J.reshape(n, n))
+                self._jacobians_checked.add(sigma)
+            return J.reshape(n, n)
+
+        floor = self._state_scale(z) if floor is None else floor
+        return mode_jacobian(system, region, int(mode), z, floor)
+
     def _check_jacobian(self, key: str, z: np.ndarray, J: np.ndarray) -> None:
         """A Jacobian the user gave, against central differences of its field at the first
         state it is asked at (step eps^(1/3) times the state's size: errors ~1e-10 of the
@@ -590,9 +643,13 @@ class FilippovSystem:
         (that of J, and of F over the state's size)."""
         if key == "sliding":
             return   # Filippov's field off H is the caller's extension: not compared
+        self._compare_jacobian(f"jacobians[{key!r}]", f"field_{key}",
+                               getattr(self.python(), f"field_{key}"), z, J)
+
+    def _compare_jacobian(self, piece: str, field_name: str, field, z, J) -> None:
+        """:meth:`_check_jacobian` of the Jacobian ``piece`` of the field ``field``."""
         from .differences import fd_jacobian
 
-        field = getattr(self.python(), f"field_{key}")
         floor = self._state_scale(z)
         size = max(floor, float(np.abs(z).max()))
         fd = fd_jacobian(field, z, np.cbrt(np.finfo(float).eps), floor).astype(float)
@@ -601,15 +658,15 @@ class FilippovSystem:
         if not np.all(np.isfinite(J)) or bad.any():
             i, k = np.argwhere(bad | ~np.isfinite(J))[0]
             raise SystemContractError(
-                f"jacobians[{key!r}]: at z={z.tolist()} its entry [{i}, {k}] is "
-                f"{float(J[i, k])!r}, central differences of field_{key} give "
+                f"{piece}: at z={z.tolist()} its entry [{i}, {k}] is "
+                f"{float(J[i, k])!r}, central differences of {field_name} give "
                 f"{float(fd[i, k])!r}: a wrong Jacobian gives wrong multipliers and dP/dz "
                 f"(the flow's multiplier stays 1)")
 
     def _state_scale(self, z: np.ndarray) -> float:
         """The state scale (filippov.scale): declared, or measured at z (about 24n
         evaluations: a run passes its own to :meth:`jacobian` as ``floor``)."""
-        return scale_mod.of_system(self.python(), z).state
+        return scale_mod.of_system(view_at(self.python(), z), z).state
 
     def _sliding_jacobian(self, z: np.ndarray, floor: float | None = None) -> np.ndarray:
         """dF_s/dz of Filippov's sliding field F_s = (a F_+ - b F_-)/(a - b), a = g.F_-,
@@ -621,25 +678,11 @@ class FilippovSystem:
             raise ValueError(f"jacobian: expected one state of shape ({n},), got {z.shape}")
         sysp = self.python()
         Fm, Fp = (np.asarray(sysp.field_minus(z), float), np.asarray(sysp.field_plus(z), float))
-        g = np.asarray(sysp.switch_grad(z), dtype=float)
         Jm, Jp = (self._jacobian_value(k, z).reshape(n, n) for k in ("minus", "plus"))
         floor = self._state_scale(z) if floor is None else floor
-        step = np.cbrt(np.finfo(float).eps) * max(floor, float(np.abs(z).max()))
-        Hh = np.empty((n, n))   # Hh[:, k] = d g / d z_k
-        for k in range(n):
-            e = np.zeros(n)
-            e[k] = step
-            Hh[:, k] = (np.asarray(sysp.switch_grad(z + e), float)
-                        - np.asarray(sysp.switch_grad(z - e), float)) / (2 * step)
-        a, b = g @ Fm, g @ Fp
-        if not abs(a - b) > 0:
-            raise ValueError(f"jacobian: no Jacobian of mode 0 (sliding) at z={z.tolist()}: "
-                             f"Filippov's sliding field is not defined where dH.F_- = dH.F_+ "
-                             f"(= {a!r})")
-        da, db = Hh.T @ Fm + Jm.T @ g, Hh.T @ Fp + Jp.T @ g   # gradients of a and b
-        num = a * Fp - b * Fm
-        dnum = np.outer(Fp, da) + a * Jp - np.outer(Fm, db) - b * Jm
-        return dnum / (a - b) - np.outer(num, da - db) / (a - b) ** 2
+        Hh = grad_derivative(sysp.switch_grad, z, floor)
+        return sliding_jacobian(Fm, Fp, np.asarray(sysp.switch_grad(z), dtype=float), Jm, Jp,
+                                Hh, z)
 
     def python(self):
         """The reference driver's PiecewiseSystem (built once, then reused)."""
@@ -650,6 +693,15 @@ class FilippovSystem:
 
     def _build_python(self):
         from .system import MINUS, PLUS, PiecewiseSystem
+
+        if self._surfaces is not None:   # several surfaces: the reference engine's view
+            from .surfaces_defined import reference_system
+
+            return reference_system(self._surfaces, self.names, self.params,
+                                    sliding=self.sliding, scale=self.scale,
+                                    intersection=self.intersection,
+                                    description=f"{self.name} (one definition, m = "
+                                                f"{self.m} surfaces, compiled pieces)")
 
         n, p = len(self.names), self.params
         bp = self._batch_pieces()

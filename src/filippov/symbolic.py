@@ -126,11 +126,11 @@ class SymbolicSystem:
         ``dF/dz`` of "minus", "plus" and (with a sliding field) "sliding".
     """
 
-    def __init__(self, states: Sequence, field_minus, field_plus, switch, *,
+    def __init__(self, states: Sequence, field_minus=None, field_plus=None, switch=None, *,
                  params: Optional[Mapping] = None, time=None, flows: Optional[Mapping] = None,
                  sample_step: float = np.inf, slow_sample_step: float = np.nan,
                  transient_time: float = np.inf, sliding: bool = True, name: str = "user",
-                 scale=None):
+                 scale=None, fields=None, intersection=None):
         self.states = _symbols(states, "states")
         scale_mod.declared(scale)
         self.scale = scale   # the run's units (filippov.scale; None: measured)
@@ -148,6 +148,22 @@ class SymbolicSystem:
             raise SymbolicError(f"params: {sorted(map(str, clash))} are also states")
         self.param_values = values
         allowed = set(self.states) | set(self.param_symbols)
+        self.sample_step, self.sliding, self.name = float(sample_step), bool(sliding), name
+        self.slow_sample_step, self.transient_time = float(slow_sample_step), float(transient_time)
+        self._system = None
+        self._generated: dict = {}   # sources, shared by with_params/with_options copies
+        self.m, self.intersection, self.fields = 1, intersection, None
+        if fields is not None:
+            field_minus, field_plus, switch = self._define_surfaces(
+                fields, field_minus, field_plus, switch, allowed, bool(flows))
+            if self.m > 1:
+                return
+        elif intersection is not None:
+            raise SymbolicError("intersection: the sliding field on an intersection of "
+                                "surfaces goes with several surfaces (fields=)")
+        if field_minus is None or field_plus is None or switch is None:
+            raise SymbolicError("field_minus, field_plus, switch: one switching surface "
+                                "takes all three; several take switch=[...] and fields=")
         self.field_minus = _vector(field_minus, n, "field_minus")
         self.field_plus = _vector(field_plus, n, "field_plus")
         if isinstance(switch, (list, tuple, sp.MatrixBase)) and len(switch) != 1:
@@ -173,8 +189,6 @@ class SymbolicSystem:
             for mode in MODES:
                 self.flows[mode] = _vector(flows[mode], n, f"flows[{mode!r}]")
                 _check_free(self.flows[mode], allowed | {time}, f"flows[{mode!r}]")
-        self.sample_step, self.sliding, self.name = float(sample_step), bool(sliding), name
-        self.slow_sample_step, self.transient_time = float(slow_sample_step), float(transient_time)
         z = sp.Matrix(self.states)
         self.switch_grad = tuple(sp.diff(self.switch, s) for s in self.states)
         grad = sp.Matrix(self.switch_grad)
@@ -187,12 +201,60 @@ class SymbolicSystem:
         if sp.expand(a - b) != 0:
             self.sliding_field = tuple((a * Fp - b * Fm) / (a - b))
             self.jacobians["sliding"] = sp.Matrix(self.sliding_field).jacobian(z)
-        self._system = None
-        self._generated: dict = {}   # sources, shared by with_params/with_options copies
+
+    def _define_surfaces(self, fields, field_minus, field_plus, switch, allowed, flows):
+        """Several switching surfaces: ``switch`` a list of m expressions, ``fields`` a
+        mapping from sign vectors to expressions (or a function of the sign vector giving
+        them); each region's Jacobian differentiated. m = 1 gives today's pieces
+        (field_minus, field_plus, switch)."""
+        from .surfaces import MAX_SURFACES, regions
+
+        if field_minus is not None or field_plus is not None:
+            raise SymbolicError("fields: give either field_minus and field_plus (one "
+                                "switching surface) or fields (a field per sign vector)")
+        if switch is None:
+            raise SymbolicError("switch: missing; several surfaces take switch=[h1, h2, ...]")
+        if flows:
+            raise SymbolicError("flows: exact flows take one switching surface; with "
+                                "fields= the fields are integrated")
+        hs = list(switch) if isinstance(switch, (list, tuple, sp.MatrixBase)) else [switch]
+        m = len(hs)
+        if not 1 <= m <= MAX_SURFACES:
+            raise SymbolicError(f"switch: {m} expressions; from 1 to {MAX_SURFACES} are taken")
+        given = dict(fields) if isinstance(fields, Mapping) else {s: fields(s) for s in
+                                                                   regions(m)}
+        out = {}
+        for key, exprs in given.items():
+            sigma = tuple(int(v) for v in key) if np.ndim(key) == 1 else key
+            if sigma not in regions(m):
+                raise SymbolicError(f"fields: {key!r} is not a sign vector of {m} values +-1")
+            out[sigma] = _vector(exprs, len(self.states), f"fields[{sigma}]")
+            _check_free(out[sigma], allowed, f"fields[{sigma}]")
+        missing = [s for s in regions(m) if s not in out]
+        if missing:
+            raise SymbolicError(f"fields: no field for region {missing[0]} (one per sign "
+                                f"vector: {2 ** m} regions)")
+        if m == 1:
+            return out[(-1,)], out[(1,)], hs[0]
+        if self.intersection not in (None, "bilinear"):
+            raise SymbolicError(f"intersection: expected None or 'bilinear', got "
+                                f"{self.intersection!r}")
+        self.m, self.fields = m, out
+        self.switch = tuple(sp.sympify(h) for h in hs)
+        _check_free(self.switch, allowed, "switch")
+        self.field_minus = self.field_plus = self.sliding_field = None
+        self.time, self.flows = None, {}
+        self.switch_grad = tuple(tuple(sp.diff(h, v) for v in self.states)
+                                 for h in self.switch)
+        z = sp.Matrix(self.states)
+        self.jacobians = {s: sp.Matrix(f).jacobian(z) for s, f in out.items()}
+        return None, None, None
 
     # ------------------------------------------------------------------ code
     def _pieces(self) -> dict:
         n = len(self.states)
+        if self.m > 1:   # several surfaces: by region index (filippov.surfaces.regions)
+            return self._surfaces_pieces()
         pieces = {"field_minus": ("vector", self.field_minus),
                   "field_plus": ("vector", self.field_plus),
                   "switch": ("scalar", (self.switch,)),
@@ -209,12 +271,26 @@ class SymbolicSystem:
                                                                for k in range(n * n)])
         return pieces
 
+    def _surfaces_pieces(self) -> dict:
+        from .surfaces import regions
+
+        n, pieces = len(self.states), {}
+        for i, sigma in enumerate(regions(self.m)):
+            J = self.jacobians[sigma]
+            pieces[f"field_r{i}"] = ("vector", self.fields[sigma])
+            pieces[f"jacobian_r{i}"] = ("matrix", [J[k // n, k % n] for k in range(n * n)])
+        for k, h in enumerate(self.switch):
+            pieces[f"switch_{k}"] = ("scalar", (h,))
+            pieces[f"switch_grad_{k}"] = ("vector", self.switch_grad[k])
+        return pieces
+
     def source(self) -> str:
         """The generated Python source of every piece (what numba compiles)."""
         if "system" not in self._generated:
             self._generated["system"] = codegen.source(
                 f"the system {self.name!r}", self.states, self.param_symbols, self._pieces(),
-                time=self.time) + codegen.jacobian_dispatch("sliding" in self.jacobians)
+                time=self.time) + ("" if self.m > 1 else codegen.jacobian_dispatch(
+                    "sliding" in self.jacobians))
         return self._generated["system"]
 
     def section_source(self, section, where=None) -> str:
@@ -330,7 +406,36 @@ class GeneratedSystem(FilippovSystem):
                          slow_sample_step=symbolic.slow_sample_step,
                          transient_time=symbolic.transient_time,
                          sliding=symbolic.sliding, name=symbolic.name,
-                         scale=symbolic.scale)
+                         scale=symbolic.scale,
+                         fields=symbolic.fields if symbolic.m > 1 else None,
+                         intersection=symbolic.intersection)
+
+    def _require(self, **pieces) -> None:
+        pass   # the generated module has every piece
+
+    def _define_surfaces(self, fields, *given):
+        """Several surfaces: the generated pieces by region index (SymbolicSystem
+        ._surfaces_pieces) as filippov.surfaces_defined's Pieces."""
+        from .surfaces import regions
+        from .surfaces_defined import Pieces, stacked
+
+        mod, m, n = self.mod, self.symbolic.m, len(self.names)
+
+        def jacobian(i):
+            def J(z, p):
+                out = np.empty(n * n)
+                getattr(mod, f"jacobian_r{i}")(np.ascontiguousarray(z, dtype=float), p, out)
+                return out.reshape(n, n)
+            return J
+        sigmas = regions(m)
+        self.m, self._user_surfaces = m, dict(fields=None, switch=None, switch_grad=None,
+                                             jacobians=None)
+        self._surfaces = Pieces(
+            m, {s: getattr(mod, f"field_r{i}_batch") for i, s in enumerate(sigmas)},
+            stacked([getattr(mod, f"switch_{k}_batch") for k in range(m)]),
+            stacked([getattr(mod, f"switch_grad_{k}_batch") for k in range(m)]),
+            {s: jacobian(i) for i, s in enumerate(sigmas)})
+        return None, None, None, None, None
 
     def _user_pieces(self) -> dict:
         raise AssertionError("a generated system has no user pieces")  # never called
@@ -367,6 +472,7 @@ class GeneratedSystem(FilippovSystem):
         function ``section(z, p)`` (``where(z, p)``) like :class:`FilippovSystem`'s."""
         from .abi import always
 
+        self._one_surface_only("the compiled engine")
         if direction not in (-1, 0, 1):
             raise ValueError(f"direction must be -1, 0 or +1, got {direction!r}")
         sec, wh = self._section_pieces(section, where)

@@ -27,8 +27,10 @@ MINUS, SLIDING, PLUS = -1, 0, 1
 #: what a system with several switching functions is told (a FilippovSystem, a
 #: SymbolicSystem or a PiecewiseSystem whose switch gives more than one value per state)
 ONE_SURFACE = ("a system has one switching function h(z), one value per state (region + "
-               "is h >= 0); several switching surfaces (a vector of them, one per "
-               "surface) are not supported by this version of filippov")
+               "is h >= 0); several switching surfaces take a field per sign vector: "
+               "FilippovSystem(names, fields=..., switch=..., switch_grad=...), "
+               "SymbolicSystem(states, switch=[...], fields=...) or "
+               "filippov.surfaces.SurfacesSystem (engine='reference')")
 MODE_NAMES = {MINUS: "minus", SLIDING: "sliding", PLUS: "plus"}
 
 Field = Callable[[np.ndarray], np.ndarray]

@@ -60,6 +60,10 @@ def reference_system(system, capability: str, several: bool = False):
 
     if isinstance(system, PiecewiseSystem):
         return system
+    if provides(system, ReferenceView) and not isinstance(system, SurfacesSystem):
+        system = system.python()   # filippov.contracts; of several surfaces: checked below
+    if isinstance(system, PiecewiseSystem):
+        return system
     if isinstance(system, SurfacesSystem):
         if system.m == 1:
             return system.one_surface()
@@ -72,8 +76,6 @@ def reference_system(system, capability: str, several: bool = False):
         raise TypeError(f"system: {capability}(engine='reference') cannot run a "
                         "CompiledModel (numba pieces for the compiled engine only); "
                         f"use engine='compiled', or {_HOW_TO_COMPILE}")
-    if provides(system, ReferenceView):   # filippov.contracts
-        return system.python()
     raise TypeError(f"system: {capability} expected a PiecewiseSystem, a FilippovSystem, "
                     f"a SymbolicSystem or an object with python() (filippov.contracts."
                     f"ReferenceView), got {type(system).__name__}")
