@@ -203,3 +203,77 @@ def test_what_a_definition_of_several_surfaces_cannot_do_is_refused_by_name():
     with pytest.raises(ValueError, match=r"switch: returned 2 values .*fields="):
         FilippovSystem(("x", "y"), f, f, lambda z, p: np.array([z[0], z[1]]),
                        lambda z, p: np.eye(2))
+
+
+def _symbolic_belt(ex, **kw):
+    import sympy as sp
+
+    x, v, F, V, D, S = sp.symbols("x v F V D S")
+
+    def fields(sigma):
+        stop = S * (x - D) if sigma[1] > 0 else 0
+        return [v, -x - stop + F * sigma[0]]
+    return (x, v), filippov.SymbolicSystem([x, v], switch=[V - v, x - D], fields=fields,
+                                           params={F: ex.F, V: ex.V, D: ex.D, S: ex.S}, **kw)
+
+
+def test_the_belt_with_a_stop_in_sympy_is_its_closed_form_with_exact_jacobians():
+    import sympy as sp
+
+    ex = _example("belt_with_stop")
+    (x, v), sym = _symbolic_belt(ex)
+    assert sym.m == 2 and sym.switch_grad == ((0, -1), (1, 0)) and sym.has_jacobians
+    assert sym.jacobians[(1, 1)] == sp.Matrix([[0, 1], [-1 - sp.Symbol("S"), 0]])
+    want = ex.closed_form()
+    run = simulate(sym, [0.0, ex.V], want[-1][1] + 0.1, method="integrate")
+    assert [(e.kind, mode_name(e.mode_after, 2)) for e in run.events] == [
+        (k, m) for k, _, _, _, m in want]
+    for e, (kind, t, x0, dx, _) in zip(run.events, want):
+        assert abs(e.t - t) <= TOL and np.max(np.abs(e.state - [x0, dx])) <= TOL, kind
+    # the generated pieces give what the hand-written ones give, to the rounding of
+    # two evaluations propagated over t ~ 4 (as above)
+    hand = simulate(_belt(ex), [0.0, ex.V], want[-1][1] + 0.1, method="integrate")
+    for a, b in zip(hand.events, run.events):
+        assert a.kind == b.kind and abs(a.t - b.t) <= 1e-12
+    # each mode's Jacobian (a region's generated; the stick's, on h1 beyond the stop,
+    # Filippov's formula) against central differences of the mode's field
+    S = sym.python()
+    for digits_ in ((1, 1), (-1, 1), (0, 1), (0, -1)):
+        mode, z = filippov.surfaces.mode_of(digits_), np.array([0.6, 0.45])
+        fd = filippov.variational.fd_jacobian(lambda zz: S.mode_field(mode, zz), z, 1e-6)
+        assert np.max(np.abs(sym.jacobian(mode, z) - fd)) <= 1e-8, digits_
+
+
+def test_one_surface_given_as_fields_in_sympy_generates_today_s_source():
+    import sympy as sp
+
+    x, y, c = sp.symbols("x y c")
+    fm, fp = [y + c, -x + 0.7], [y + c, -x - 0.7]
+    today = filippov.SymbolicSystem([x, y], fm, fp, y, params={c: 0.3})
+    fields = filippov.SymbolicSystem([x, y], switch=[y], fields={(-1,): fm, (1,): fp},
+                                     params={c: 0.3})
+    assert fields.m == 1 and fields.source() == today.source()
+
+
+def test_what_a_sympy_definition_of_several_surfaces_cannot_do_is_refused_by_name():
+    import sympy as sp
+
+    from filippov.symbolic import SymbolicError
+
+    x, y, t = sp.symbols("x y t")
+    f = {s: [1, 1] for s in ((-1, -1), (-1, 1), (1, -1), (1, 1))}
+    cases = [(dict(fields=f, switch=[x, y], field_minus=[1, 1]), r"fields: give either"),
+             (dict(fields=f, switch=[x, y], time=t, flows={"minus": [x, y], "plus": [x, y]}),
+              r"flows: exact flows take one switching surface"),
+             (dict(fields={s: f[s] for s in list(f)[:3]}, switch=[x, y]),
+              r"fields: no field for region \(1, 1\)"),
+             (dict(fields=f, switch=[x, y, x + y]), r"fields: .* is not a sign vector of 3"),
+             (dict(fields={**f, (1, 1): [t, 1]}, switch=[x, y]), r"fields\[\(1, 1\)\]"),
+             (dict(fields=f, switch=[x, y], intersection="nearest"), r"intersection:")]
+    for kwargs, match in cases:
+        with pytest.raises(SymbolicError, match=match):
+            filippov.SymbolicSystem([x, y], **kwargs)
+    sym = filippov.SymbolicSystem([x, y], fields=f, switch=[x, y], intersection="bilinear")
+    assert sym.python().intersection == "bilinear"
+    with pytest.raises(TypeError, match=r"the compiled engine takes one switching surface"):
+        filippov.first_returns(sym, np.array([[-1.0, -1.0]]), x - 1, 5.0, engine="compiled")

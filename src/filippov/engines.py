@@ -243,18 +243,23 @@ ASYMMETRIES = (
     Asymmetry(
         14, "Several switching surfaces",
         "``simulate`` runs a ``SurfacesSystem`` stay by stay, each stay the one-surface "
-        "loop on a view of the system (filippov.several; docs/decisions.md D24); "
+        "loop on a view of the system (filippov.several; docs/decisions.md D24), and a "
+        "``FilippovSystem`` or ``SymbolicSystem`` given ``fields=`` as the "
+        "``SurfacesSystem`` of its compiled pieces (filippov.surfaces_defined); "
         "``first_returns``, the derivatives (filippov.variational) and ``periodic_orbit`` "
         "take it too; sliding "
         "on an intersection of two surfaces by Dieci and Lopez's bilinear field "
         "(filippov.intersection)",
-        "refuses a ``SurfacesSystem`` of several surfaces by name (one of one surface is "
-        "today's system)",
+        "refuses a system of several surfaces by name (``SurfacesSystem``, or a "
+        "``FilippovSystem``/``SymbolicSystem`` with ``fields=``); one of one surface is "
+        "today's system",
         "deliberate", "the views reuse every rule of one surface without touching the "
         "loop the kernel compiles, whose per-return budget and compile time are spent "
         "(D22, D23); the kernel's own surfaces are issue 59's next part",
         ("tests/test_several_surfaces.py::test_generated_crossings_returns_and_dpdz_of_two_and_three_surfaces",
-         "tests/test_several_surfaces.py::test_engines_and_front_doors_that_take_one_surface_refuse_several")),
+         "tests/test_several_surfaces.py::test_engines_and_front_doors_that_take_one_surface_refuse_several",
+         "tests/test_surfaces_defined.py::test_one_surface_given_as_fields_is_today_s_system_bit_for_bit",
+         "tests/test_surfaces_defined.py::test_what_a_definition_of_several_surfaces_cannot_do_is_refused_by_name")),
 )
 
 

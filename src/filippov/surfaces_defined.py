@@ -214,13 +214,13 @@ def reference_system(pc: Pieces, names, params: np.ndarray, **options) -> Surfac
                           {s: vector(b) for s, b in pc.fields.items()}, m, **options)
 
 
-def sliding_jacobian(Fm, Fp, g, Jm, Jp, Hh, z) -> np.ndarray:
+def sliding_jacobian(Fm, Fp, g, Jm, Jp, Hh, z, mode: int = 0) -> np.ndarray:
     """dF_s/dz of Filippov's sliding field F_s = (a F_+ - b F_-)/(a - b), a = g.F_-,
     b = g.F_+ (g the surface's gradient), from the fields' Jacobians ``Jm``, ``Jp`` and
     ``Hh[:, k] = d g / d z_k`` (the switching function's Hessian)."""
     a, b = g @ Fm, g @ Fp
     if not abs(a - b) > 0:
-        raise ValueError(f"jacobian: no Jacobian of mode 0 (sliding) at z={z.tolist()}: "
+        raise ValueError(f"jacobian: no Jacobian of mode {mode} (sliding) at z={z.tolist()}: "
                          f"Filippov's sliding field is not defined where dH.F_- = dH.F_+ "
                          f"(= {a!r})")
     da, db = Hh.T @ Fm + Jm.T @ g, Hh.T @ Fp + Jp.T @ g   # gradients of a and b
@@ -257,6 +257,6 @@ def mode_jacobian(system: SurfacesSystem, region_jacobian: Callable, mode: int,
         Fm, Fp = (np.asarray(system.region_field(s, z), float) for s in (minus, plus))
         Hh = grad_derivative(lambda zz: system.grads(zz)[k], z, floor)
         return sliding_jacobian(Fm, Fp, system.grads(z)[k], region_jacobian(minus, z),
-                                region_jacobian(plus, z), Hh, z)
+                                region_jacobian(plus, z), Hh, z, mode)
     return fd_jacobian(lambda zz: system.mode_field(mode, zz), z,
                        np.cbrt(np.finfo(float).eps), floor)
