@@ -162,6 +162,10 @@ def test_one_surface_given_as_fields_is_today_s_system_bit_for_bit(engine):
         assert np.array_equal(x.z, y.z)
 
 
+def _python_helper(z):
+    return z   # a plain Python function: numba cannot compile a piece that calls it
+
+
 def test_what_a_definition_of_several_surfaces_cannot_do_is_refused_by_name():
     ex = _example("belt_with_stop")
     system = _belt(ex)
@@ -187,14 +191,25 @@ def test_what_a_definition_of_several_surfaces_cannot_do_is_refused_by_name():
         (dict(fields={**fields, (1, 1): lambda z, p: z / 0.0}, **two), SystemContractError,
          r"fields\[\(1, 1\)\] must return 2 finite values"),
         (dict(fields=fields, **two, jacobians={(1, 3): f}), ValueError,
-         r"fields: \(1, 3\) is not a sign vector"),
+         r"jacobians: \(1, 3\) is not a sign vector"),
+        (dict(fields=fields, **two, jacobians={"plus": f}), ValueError,
+         r"jacobians: 'plus' is not a sign vector"),
+        (dict(fields={**fields, (1.5, -1): f}, **two), ValueError,
+         r"fields: \(1.5, -1\) is not a sign vector"),
+        (dict(fields={**fields, (1, 1): lambda z, p: _python_helper(z)}, **two), ValueError,
+         r"fields\[\(1, 1\)\]: numba cannot compile it \(Untyped global name "
+         r"'_python_helper'"),
         (dict(field_minus=f, field_plus=f, switch=two["switch"][0]), TypeError,
          r"switch_grad: missing"),
     ]
     for kwargs, error, match in cases:
         with pytest.raises(error, match=match):
             FilippovSystem(("x", "y"), probe=[0.5, 0.5], **kwargs)
-    # a wrong Jacobian of a region, refused when first asked (against its field)
+    # a Jacobian of the wrong shape, or wrong, refused naming it when first asked
+    bad = FilippovSystem(("x", "y"), fields=fields, **two,
+                         jacobians={s: (lambda z, p: np.ones(3)) for s in fields})
+    with pytest.raises(SystemContractError, match=r"jacobians\[\(-1, -1\)\]: returned shape"):
+        bad.jacobian(-4, np.array([-0.5, -0.5]))
     wrong = FilippovSystem(("x", "y"), fields=fields, **two,
                            jacobians={s: (lambda z, p: 2.0 * np.eye(2)) for s in fields})
     with pytest.raises(SystemContractError, match=r"jacobians\[\(-1, -1\)\]: at z="):
@@ -267,7 +282,10 @@ def test_what_a_sympy_definition_of_several_surfaces_cannot_do_is_refused_by_nam
               r"flows: exact flows take one switching surface"),
              (dict(fields={s: f[s] for s in list(f)[:3]}, switch=[x, y]),
               r"fields: no field for region \(1, 1\)"),
-             (dict(fields=f, switch=[x, y, x + y]), r"fields: .* is not a sign vector of 3"),
+             (dict(fields=f, switch=[x, y, x + y]),
+              r"fields: .* is not a sign vector \(a tuple of 3"),
+             (dict(fields={(-1,): [1, 1], (1,): [1, 1]}, switch=[x], intersection="bilinear"),
+              r"intersection: one switching surface has no intersection"),
              (dict(fields={**f, (1, 1): [t, 1]}, switch=[x, y]), r"fields\[\(1, 1\)\]"),
              (dict(fields=f, switch=[x, y], intersection="nearest"), r"intersection:")]
     for kwargs, match in cases:
@@ -277,3 +295,47 @@ def test_what_a_sympy_definition_of_several_surfaces_cannot_do_is_refused_by_nam
     assert sym.python().intersection == "bilinear"
     with pytest.raises(TypeError, match=r"the compiled engine takes one switching surface"):
         filippov.first_returns(sym, np.array([[-1.0, -1.0]]), x - 1, 5.0, engine="compiled")
+
+
+def test_a_value_numba_compiled_in_that_changes_is_refused_not_used_stale():
+    # the pieces of several surfaces are compiled (and run once) when the system is
+    # built: what they read from globals is noted before, and a change refused at the next
+    # run (the one-surface rule, filippov.frozen), for m = 2 and for m = 1 given as fields
+    shift = np.array([0.0])
+    fm = lambda z, p: np.array([1.0, 1.0])  # noqa: E731
+    fp = lambda z, p: np.array([1.0, 0.5])  # noqa: E731
+    two = FilippovSystem(("x", "y"), fields={(-1, -1): fm, (-1, 1): fm, (1, -1): fp,
+                                             (1, 1): fp},
+                         switch=(lambda z, p: z[1] - shift[0], lambda z, p: z[0] + 10.0),
+                         switch_grad=lambda z, p: np.array([[0.0, 1.0], [1.0, 0.0]]))
+    one = FilippovSystem(("x", "y"), fields={(-1,): fm, (1,): fp},
+                         switch=lambda z, p: np.array([z[1] - shift[0]]),
+                         switch_grad=lambda z, p: np.array([[0.0, 1.0]]))
+    shift[0] = 0.5
+    for system in (two, one):
+        with pytest.raises(SystemContractError, match=r"switch.*'shift'.*\[0\.\]"):
+            simulate(system, [0.0, -1.0], 3.0)
+
+
+def test_one_surface_given_as_fields_takes_a_scalar_switch_and_a_gradient_vector():
+    today, _ = _one_surface_pair()
+    plain = FilippovSystem(("x", "y"), fields={(-1,): today._pieces["field_minus"],
+                                               (1,): today._pieces["field_plus"]},
+                           switch=lambda z, p: z[1], switch_grad=lambda z, p: np.array([0.0, 1.0]))
+    a, b = (simulate(s, [1.5, 0.4], 10.0) for s in (today, plain))
+    assert [(e.kind, e.t) for e in a.events] == [(e.kind, e.t) for e in b.events]
+    assert np.array_equal(a.z, b.z)
+
+
+def test_the_monodromy_of_a_period_that_starts_on_a_surface_closes_with_its_switch():
+    # the relay's orbit from its point on x1 = 0 (a start on the surface, the period
+    # closed by the switch from the end mode to the start's): its multipliers
+    relay, system = _relay(False)
+    want = relay.closed_form()
+    x0 = want["x0"] if want["x0"][1] > 0 else -want["x0"]
+    po = filippov.periodic_orbit(system, x0, lambda z, p: z[0], direction=1,
+                                 engine="reference", t_max=10.0, method="integrate")
+    orbit = simulate(system, po.point, po.period, method="integrate")
+    _, mult = filippov.monodromy(system, orbit)
+    np.testing.assert_allclose(np.sort(np.abs(mult))[::-1], np.sort(np.abs(
+        want["multipliers"]))[::-1], rtol=0, atol=1e-7)

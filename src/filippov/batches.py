@@ -11,6 +11,19 @@ import numpy as np
 from numba import njit
 
 
+_DOC_PIECE = ("write it for one state z (1-D float array) and the parameter array p, "
+              "with numpy and math only (no Python objects, no closures over lists)")
+
+
+def cannot_compile(exc: Exception, piece: str) -> ValueError:
+    """numba's failure to compile ``piece`` as one readable line."""
+    lines = [ln.strip() for ln in str(exc).splitlines() if ln.strip()]
+    # numba's first line names the compiler stage; the next one names the problem
+    detail = next((ln for ln in lines if not ln.startswith(("Failed in", "During:"))),
+                  lines[0] if lines else type(exc).__name__)
+    return ValueError(f"{piece}: numba cannot compile it ({detail}); {_DOC_PIECE}")
+
+
 def jit(fn: Callable, piece: str):
     """``fn`` as a numba dispatcher (compiled on first call), itself if it is one."""
     if not callable(fn):

@@ -23,15 +23,12 @@ from . import scale as scale_mod
 from .checks import SystemContractError
 from .differences import richardson_jacobian
 from .spelling import one_spelling
+from .batches import cannot_compile as _cannot_compile
 from .batches import flow as _batch_flow, jit as _jit, scalar as _batch_scalar
 from .batches import states as _states, vector as _batch_vector
 from .surfaces import view_at
 from .surfaces_defined import grad_derivative, sliding_jacobian
 from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, always, no_flow
-
-_DOC_PIECE = ("write it for one state z (1-D float array) and the parameter array p, "
-              "with numpy and math only (no Python objects, no closures over lists)")
-
 
 def _one_surface(switch, n: int, params, probe) -> None:
     """Refuse a ``switch`` that gives several values at a state (several switching
@@ -59,15 +56,6 @@ def _compile(adapter_src: Callable, sig, piece: str):
             return njit(sig)(adapter_src)
     except NumbaError as exc:
         raise _cannot_compile(exc, piece) from None
-
-
-def _cannot_compile(exc: Exception, piece: str) -> ValueError:
-    """numba's failure to compile ``piece`` as one readable line."""
-    lines = [ln.strip() for ln in str(exc).splitlines() if ln.strip()]
-    # numba's first line names the compiler stage; the next one names the problem
-    detail = next((ln for ln in lines if not ln.startswith(("Failed in", "During:"))),
-                  lines[0] if lines else type(exc).__name__)
-    return ValueError(f"{piece}: numba cannot compile it ({detail}); {_DOC_PIECE}")
 
 
 def _vector_piece(fn, piece: str, n: int):
@@ -412,6 +400,8 @@ class FilippovSystem:
         self.params = np.ascontiguousarray(np.asarray(params, dtype=float).reshape(-1))
         self.name, self.sliding, self.sample_step = name, bool(sliding), float(sample_step)
         self.m, self._surfaces, self.intersection = 1, None, intersection
+        self._user_surfaces = None   # several surfaces' pieces as the user gave them
+        self._frozen = None     # what numba compiles into the pieces (filippov.frozen)
         if fields is not None:   # several switching surfaces (filippov.surfaces_defined)
             field_minus, field_plus, switch, switch_grad, jacobians = self._define_surfaces(
                 fields, field_minus, field_plus, switch, switch_grad, jacobians,
@@ -444,7 +434,6 @@ class FilippovSystem:
         self._python = None
         self._compiled = None   # the fields compiled once; each call only adds a section
         self._user = None       # the pieces as numba dispatchers, shared by both engines
-        self._frozen = None     # what numba compiles into them (filippov.frozen)
         self._jacobians_checked = set()   # the given Jacobians compared with their fields
 
     def _require(self, **pieces) -> None:
@@ -472,16 +461,21 @@ class FilippovSystem:
             raise TypeError(f"{'switch' if switch is None else 'switch_grad'}: missing; "
                             f"several surfaces take fields=, switch and switch_grad")
         n = len(self.names)
-        m = defined.count(fields, switch, n, self.params, _probe_state(self._probe, n))
-        regions = defined.region_functions(fields, m)
+        # what numba compiles in, noted before anything is compiled (the pieces are run
+        # once below; for one surface, at the first use of an engine)
         self._user_surfaces = dict(fields=fields, switch=switch, switch_grad=switch_grad,
                                    jacobians=dict(jacobians or {}))
+        self._frozen = frozen.record(_surface_functions(self._user_surfaces))
+        probe = _probe_state(self._probe, n)
+        m = defined.count(fields, switch, n, self.params, probe)
+        regions = defined.region_functions(fields, m)
         if m == 1:
             jac = {("minus" if k[0] < 0 else "plus"): f for k, f in (
-                (defined._sign_vector(k, 1), f) for k, f in dict(jacobians or {}).items())}
+                (defined.sign_vector(k, 1, "jacobians"), f)
+                for k, f in dict(jacobians or {}).items())}
             if self.intersection is not None:
                 raise ValueError("intersection: one switching surface has no intersection")
-            one = defined.one_surface(regions, switch, switch_grad)
+            one = defined.one_surface(regions, switch, switch_grad, probe, self.params)
             return one["field_minus"], one["field_plus"], one["switch"], one["switch_grad"], jac
         if self.intersection not in (None, "bilinear"):
             raise ValueError(f"intersection: expected None or 'bilinear', got "
@@ -497,8 +491,6 @@ class FilippovSystem:
         noted at the first use of an engine, checked at every later one."""
         if self._frozen is None:
             pieces = {k: f for k, f in self._pieces.items() if f is not None}
-            if self._surfaces is not None:   # several surfaces: the user's own functions
-                pieces = _surface_functions(self._user_surfaces)
             pieces.update({f"jacobians[{m!r}]": f for m, f in self._jacobians.items()})
             self._frozen = frozen.record(pieces)
         else:
@@ -625,6 +617,9 @@ class FilippovSystem:
                 raise ValueError(f"jacobian: no Jacobian of region {sigma} was given (have "
                                  f"{sorted(self._surfaces.jacobians)})")
             J = np.asarray(self._surfaces.jacobians[sigma](zz, self.params), float)
+            if J.size != n * n:
+                raise SystemContractError(f"jacobians[{sigma}]: returned shape {J.shape} at "
+                                          f"z={zz.tolist()}, expected ({n}, {n})")
             if sigma not in self._jacobians_checked:
                 self._compare_jacobian(f"jacobians[{sigma}]", f"fields[{sigma}]",
                                        lambda x: system.region_field(sigma, x), zz,

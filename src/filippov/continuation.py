@@ -34,7 +34,7 @@ from scipy.optimize import minimize_scalar
 from .progress import Progress
 # the derivatives live in filippov.variational; fd_jacobian and saltation stay
 # importable from here, where the continuation code and its users reach for them
-from .variational import (VariationalError, _state_scale, fd_jacobian,  # noqa: F401
+from .variational import (VariationalError, _modes, _state_scale, fd_jacobian,  # noqa: F401
                           reference_view, saltation, switch_matrix, transition_matrix)
 from .errors import ContinuationError  # noqa: F401  (re-exported)
 
@@ -272,7 +272,9 @@ def monodromy(system, traj, *, rtol=1e-10, atol=1e-12, jacobian=None):
         # the surface: close the period with the switch from the end mode to the start
         # mode. Saltations of crossings at one point compose (S_bc S_ab = S_ac,
         # S_ba S_ab = I), so a switch logged at t0 or at the end too is not counted twice.
-        S = switch_matrix(system, traj.mode, traj.events[0].mode_after, traj.z)
+        # (the system's own switch: one surface's, or that of the surface a
+        # several-surface run's modes differ on)
+        S = _modes(system)[1](traj.mode, traj.events[0].mode_after, traj.z)
     except VariationalError as exc:
         raise ContinuationError(str(exc)) from exc
     if S is not None:

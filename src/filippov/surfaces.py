@@ -123,6 +123,8 @@ class SurfacesSystem:
         # the views a run asks for, built once: the engine's contract check of a system
         # is then made once per view (checks.check_system keeps the systems it passed)
         object.__setattr__(self, "_views", {})
+        # asked at every evaluation of a field: isinstance on a typing ABC is slow
+        object.__setattr__(self, "_by_region", isinstance(f, Mapping))
 
     @property
     def dim(self) -> int:
@@ -130,7 +132,7 @@ class SurfacesSystem:
 
     def region_field(self, sigma: tuple, z: np.ndarray) -> np.ndarray:
         """``F_sigma(z)``."""
-        if isinstance(self.field, Mapping):
+        if self._by_region:
             return self.field[sigma](z)
         return self.field(sigma, z)
 
@@ -244,15 +246,16 @@ def region_view(system: SurfacesSystem, sigma: tuple, s: int,
     field on side s (H >= 0 for s = +1), and beyond H the field of the region across the
     nearest surface (the argmin; ties: the lowest index). ``s`` keeps H the same function
     near a surface from one view to the next (:mod:`filippov.several`)."""
-    sig = np.asarray(sigma, dtype=float)
+    sig, sigma = np.asarray(sigma, dtype=float), tuple(sigma)
 
     def oriented(z):
         g = _column(sig, np.asarray(z)) * system.values(z)
         return g if only is None else g[only:only + 1]
 
     def nearest(z):
-        k = np.argmin(oriented(z), axis=0)
-        return k if only is None else np.zeros_like(k) + only
+        if only is not None:   # a slide's view: its surface, the others not evaluated
+            return np.full(np.shape(z)[1:], only, dtype=np.intp)
+        return np.argmin(oriented(z), axis=0)
 
     def switch(z):
         return s * np.min(oriented(z), axis=0)
@@ -265,7 +268,7 @@ def region_view(system: SurfacesSystem, sigma: tuple, s: int,
         return s * sig[k] * G[k, :, np.arange(z.shape[1])].T
 
     def inside(z):
-        return system.region_field(tuple(sigma), z)
+        return system.region_field(sigma, z)
 
     def beyond(z):
         k = nearest(z)

@@ -26,6 +26,7 @@ from typing import Callable, Mapping
 
 import numpy as np
 from numba import njit
+from numba.core.errors import NumbaError
 
 from . import batches
 from .differences import fd_jacobian
@@ -46,16 +47,17 @@ class Pieces:
     jacobians: dict
 
 
-def _sign_vector(key, m: int | None) -> tuple:
+def sign_vector(key, m: int | None, what: str = "fields") -> tuple:
+    """``key`` as a sign vector (a tuple of m ints +-1), else refused naming ``what``."""
     try:
-        sigma = tuple(int(s) for s in key)
+        values = [float(s) for s in key]
     except (TypeError, ValueError):
-        sigma = None
-    if sigma is None or any(s not in (-1, 1) for s in sigma) or (m is not None
-                                                                 and len(sigma) != m):
-        what = "values +-1" if m is None else f"{m} values +-1"
-        raise ValueError(f"fields: {key!r} is not a sign vector (a tuple of {what})")
-    return sigma
+        values = None
+    if values is None or any(v not in (-1.0, 1.0) for v in values) or (
+            m is not None and len(values) != m):
+        size = "values +-1" if m is None else f"{m} values +-1"
+        raise ValueError(f"{what}: {key!r} is not a sign vector (a tuple of {size})")
+    return tuple(int(v) for v in values)
 
 
 def count(fields, switch, n: int, params: np.ndarray, probe: np.ndarray) -> int:
@@ -66,7 +68,7 @@ def count(fields, switch, n: int, params: np.ndarray, probe: np.ndarray) -> int:
     if isinstance(fields, Mapping):
         if not fields:
             raise ValueError("fields: no region's field given")
-        lengths = {len(_sign_vector(k, None)) for k in fields}
+        lengths = {len(sign_vector(k, None)) for k in fields}
         if len(lengths) > 1:
             raise ValueError(f"fields: sign vectors of different lengths {sorted(lengths)}")
         found["fields"] = lengths.pop()
@@ -106,7 +108,7 @@ def region_functions(fields, m: int) -> dict:
     """Each region's field as a numba dispatcher ``f(z, p)``, by sign vector; every
     region must have one."""
     if isinstance(fields, Mapping):
-        out = {_sign_vector(k, m): batches.jit(f, f"fields[{k!r}]") for k, f in fields.items()}
+        out = {sign_vector(k, m): batches.jit(f, f"fields[{k!r}]") for k, f in fields.items()}
         missing = [s for s in regions(m) if s not in out]
         if missing:
             raise ValueError(f"fields: no field for region {missing[0]} (one per sign "
@@ -125,15 +127,28 @@ def _row_piece(user, k: int):
     return njit(row)
 
 
-def one_surface(fields: dict, switch, switch_grad) -> dict:
+def _first_row(fn, piece: str, ndim: int, z: np.ndarray, params: np.ndarray):
+    """A piece of m = 1 as one surface's: itself where it gives one surface's shape at z
+    (``ndim`` 0: a value, 1: a gradient), else its first row (an array of one value, a
+    (1, n) matrix)."""
+    user = batches.jit(fn, piece)
+    with np.errstate(all="ignore"):
+        try:
+            got = np.ndim(getattr(fn, "py_func", fn)(z, params))
+        except Exception:   # noqa: BLE001 -- the engines' checks name it when run
+            got = ndim + 1
+    return user if got == ndim else _row_piece(user, 0)
+
+
+def one_surface(fields: dict, switch, switch_grad, z: np.ndarray, params: np.ndarray) -> dict:
     """The pieces of m = 1 as today's one-surface system's (field_minus, field_plus,
-    switch, switch_grad), numba dispatchers."""
-    h = switch[0] if isinstance(switch, (tuple, list)) else _row_piece(
-        batches.jit(switch, "switch"), 0)
-    g = switch_grad[0] if isinstance(switch_grad, (tuple, list)) else _row_piece(
-        batches.jit(switch_grad, "switch_grad"), 0)
+    switch, switch_grad), numba dispatchers; the switch and its gradient as one surface's
+    or as one row of several (asked of them at the probe state z)."""
+    h = switch[0] if isinstance(switch, (tuple, list)) else switch
+    g = switch_grad[0] if isinstance(switch_grad, (tuple, list)) else switch_grad
     return dict(field_minus=fields[(-1,)], field_plus=fields[(1,)],
-                switch=batches.jit(h, "switch"), switch_grad=batches.jit(g, "switch_grad"))
+                switch=_first_row(h, "switch", 0, z, params),
+                switch_grad=_first_row(g, "switch_grad", 1, z, params))
 
 
 def stacked(parts: list):
@@ -167,7 +182,7 @@ def compile_pieces(names, fields: dict, switch, switch_grad, jacobians, m: int) 
     else:
         raise TypeError("switch_grad: expected a function of the (m, n) gradients, or a "
                         "tuple of m functions")
-    jac = {_sign_vector(key, m): batches.jit(J, f"jacobians[{key!r}]")
+    jac = {sign_vector(key, m, "jacobians"): batches.jit(J, f"jacobians[{key!r}]")
            for key, J in dict(jacobians or {}).items()}
     return Pieces(m, vec, hs, gs, jac)
 
@@ -182,7 +197,9 @@ def probe(pc: Pieces, names, params: np.ndarray, z: np.ndarray) -> None:
         try:
             with np.errstate(all="ignore"):
                 v = np.asarray(batch(col, params), dtype=float)
-        except Exception as exc:   # noqa: BLE001 -- numba's or the piece's, named here
+        except NumbaError as exc:
+            raise batches.cannot_compile(exc, piece) from None
+        except Exception as exc:   # noqa: BLE001 -- the piece's own, named here
             line = next((ln for ln in str(exc).splitlines() if ln.strip()), type(exc).__name__)
             raise SystemContractError(f"{piece} failed at z={z.tolist()}: {line} (expected "
                                       f"{size} values)") from None
@@ -215,9 +232,9 @@ def reference_system(pc: Pieces, names, params: np.ndarray, **options) -> Surfac
 
 
 def sliding_jacobian(Fm, Fp, g, Jm, Jp, Hh, z, mode: int = 0) -> np.ndarray:
-    """dF_s/dz of Filippov's sliding field F_s = (a F_+ - b F_-)/(a - b), a = g.F_-,
-    b = g.F_+ (g the surface's gradient), from the fields' Jacobians ``Jm``, ``Jp`` and
-    ``Hh[:, k] = d g / d z_k`` (the switching function's Hessian)."""
+    """``dF_s/dz`` of Filippov's sliding field ``F_s = (a F_+ - b F_-) / (a - b)``,
+    ``a = g.F_-``, ``b = g.F_+`` (g the surface's gradient), from the fields' Jacobians
+    ``Jm``, ``Jp`` and ``Hh[:, k] = d g / d z_k`` (the switching function's Hessian)."""
     a, b = g @ Fm, g @ Fp
     if not abs(a - b) > 0:
         raise ValueError(f"jacobian: no Jacobian of mode {mode} (sliding) at z={z.tolist()}: "

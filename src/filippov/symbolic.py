@@ -208,6 +208,7 @@ class SymbolicSystem:
         them); each region's Jacobian differentiated. m = 1 gives today's pieces
         (field_minus, field_plus, switch)."""
         from .surfaces import MAX_SURFACES, regions
+        from .surfaces_defined import sign_vector
 
         if field_minus is not None or field_plus is not None:
             raise SymbolicError("fields: give either field_minus and field_plus (one "
@@ -225,9 +226,10 @@ class SymbolicSystem:
                                                                    regions(m)}
         out = {}
         for key, exprs in given.items():
-            sigma = tuple(int(v) for v in key) if np.ndim(key) == 1 else key
-            if sigma not in regions(m):
-                raise SymbolicError(f"fields: {key!r} is not a sign vector of {m} values +-1")
+            try:
+                sigma = sign_vector(key, m)
+            except ValueError as exc:
+                raise SymbolicError(str(exc)) from None
             out[sigma] = _vector(exprs, len(self.states), f"fields[{sigma}]")
             _check_free(out[sigma], allowed, f"fields[{sigma}]")
         missing = [s for s in regions(m) if s not in out]
@@ -235,6 +237,8 @@ class SymbolicSystem:
             raise SymbolicError(f"fields: no field for region {missing[0]} (one per sign "
                                 f"vector: {2 ** m} regions)")
         if m == 1:
+            if self.intersection is not None:
+                raise SymbolicError("intersection: one switching surface has no intersection")
             return out[(-1,)], out[(1,)], hs[0]
         if self.intersection not in (None, "bilinear"):
             raise SymbolicError(f"intersection: expected None or 'bilinear', got "
