@@ -287,3 +287,34 @@ def test_an_arrival_that_would_slide_inside_a_section_is_refused_before_it_is_re
     assert kinds[:kinds.index("slide_start")].count("crossing") == 1
     assert abs(arrival.t - out.time[0]) < 1e-12
 
+
+
+# ------------------------------------------------------ two sections crossed at one instant
+@pytest.mark.parametrize("method", ["exact", "integrate"])
+def test_sections_crossed_at_one_instant_are_each_hit(method):
+    # x2 = 0 upward (through (0.5, 0) at t = PERIOD), the same zero set written twice
+    # (x2 and 2 x2 + x2^3) and a different surface through the same point (x1 + x2 =
+    # 0.5, crossed there at the rate 0.5, its root 1e-18 from x2's): each a
+    # hit at that instant, in the order given; the search keeps the first of tied roots,
+    # and the others used to be lost (their crossing lies behind the far side of the first)
+    up = Section("x2", lambda z: z[1], direction=1)
+    twice = Section("2x2+x2^3", lambda z: 2 * z[1] + z[1] ** 3, direction=1)
+    other = Section("x1+x2=0.5", lambda z: z[0] + z[1] - 0.5, direction=1)
+    start = [0.5, -1e-9]
+    tr = simulate(two_centres(), start, PERIOD + 0.5, sections=[up, twice, other],
+                  method=method)
+    hits = [(e.name, e.t) for e in tr.events if e.kind == "section"]
+    assert [n for n, _ in hits][:3] == ["x2", "2x2+x2^3", "x1+x2=0.5"]
+    assert hits[0][1] == hits[1][1] == hits[2][1] == pytest.approx(2e-9, rel=1e-6)
+    # a terminal one among the tied ends the run there, named; the others before it logged
+    stop = dataclasses.replace(twice, terminal=1)
+    tr = simulate(two_centres(), start, PERIOD + 0.5, sections=[up, stop, other],
+                  method=method)
+    assert tr.status == "section:2x2+x2^3" and tr.t == pytest.approx(2e-9, rel=1e-6)
+    assert [e.name for e in tr.events if e.kind == "section"] == ["x2", "2x2+x2^3", "x1+x2=0.5"]
+    # what a hit must satisfy holds for a tied one too: its direction, where, min_time
+    for tied in (dataclasses.replace(twice, direction=-1, terminal=1),
+                 dataclasses.replace(twice, where=lambda z: z[0] < 0, terminal=1),
+                 dataclasses.replace(twice, min_time=1.0, terminal=2)):
+        tr = simulate(two_centres(), start, 3.0, sections=[up, tied], method=method)
+        assert [e.t for e in tr.events if e.name == tied.name][:1] != [tr.events[1].t]

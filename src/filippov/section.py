@@ -24,6 +24,11 @@ class Section:
     section gives the next return, never ``P(z) = z`` at t ~ 1e-17. ``min_time``
     skips crossings that are genuinely close to the start.
 
+    Sections crossed at one instant (the same surface written twice, two surfaces
+    through one point of the orbit) are each hit there, in the order given
+    (:func:`tied_hits`); a terminal one among them ends the run, the hits of those
+    before it logged.
+
     A section may lie on the switching surface H: where the orbit crosses H, or
     arrives on it to slide, the hit is logged there, before the switch. Sliding
     along H inside the section (whatever ``where`` says) is an error, since its
@@ -53,6 +58,35 @@ class Section:
         if not (options.finite(m) and m >= 0):
             raise ValueError(f"Section {self.name!r}: min_time must be a finite number >= 0, "
                              f"got {self.min_time!r}")
+
+
+def tied_hits(sections, first: int, t: float, z, at, t0: float, xtol: float,
+              skip=()) -> list:
+    """The sections crossed at the instant ``t`` of a hit of section ``first`` (-1: of none
+    of these, another event): the event search keeps the first of roots at one instant
+    (``rules.section_first``), and the others' crossings lie behind the far side of its
+    root, where the run goes on -- they are hits there too. A section is one where its
+    values at ``at(t - d)`` and ``at(t + d)`` (the run's dense output; d =
+    ``rules.same_instant``) hold its sign change, ``where`` holds at z and ``min_time``
+    is past (from the run's start t0); not one of ``skip`` (logged there already), not
+    within d of the run's start (a start on a section is no hit). Their indices, in
+    order."""
+    from . import rules
+
+    d = rules.same_instant(xtol, t)
+    if t - d <= t0:
+        return []
+    before = np.asarray(at(t - d), dtype=float).reshape(-1)
+    after = np.asarray(at(t + d), dtype=float).reshape(-1)
+    out = []
+    for k, sec in enumerate(sections):
+        if k == first or k in skip or t - t0 < sec.min_time:
+            continue
+        s0, s1 = (float(np.asarray(sec.func(v)).reshape(-1)[0]) for v in (before, after))
+        if rules.crosses(rules.section_pred(sec.direction), s0, s1) and (
+                sec.where is None or sec.where(z)):
+            out.append(k)
+    return out
 
 
 @dataclass(frozen=True)

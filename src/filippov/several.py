@@ -32,7 +32,7 @@ from . import scale as scale_mod
 from .errors import SurfacesError, accumulation_detail, run_error
 from .loop.run_state import RING, Limits, count_switch, new_run_state
 from .loop.status import GO_ON, ZENO
-from .section import Section
+from .section import Section, tied_hits
 from .surfaces import SurfacesSystem, flip, mode_name, mode_of, regions
 from .system import PLUS, SLIDING
 
@@ -202,29 +202,22 @@ def _stay_sections(system, stay, sections, hits, elapsed):
 
 def _tied_hits(sections, hits, stay, r, o, traj):
     """The user's sections crossed at the instant a stay ended at one of its own (which
-    win the engine's tie): each crossing in its direction within 4 event_xtol either side
-    of the end on the stay's dense output (past ``min_time``, where ``where`` holds) is a
-    hit there, logged before the switch; the name of a terminal one whose hits are
-    reached (the run ends there), else None."""
-    ta, te, _, Z = r.traj.segments[-1]
-    d = 4.0 * o["event_xtol"]
+    win the engine's tie; :func:`filippov.section.tied_hits` on the stay's dense output),
+    each a hit there, logged before the switch -- not one logged there already (the
+    stay's engine logs those its own hit ties with); the name of the first terminal one
+    whose hits are reached (the run ends there), else None."""
+    _, te, _, Z = r.traj.segments[-1]
     z = np.asarray(r.z, dtype=float)
     mode = _code(stay, stay.slide, 1 if stay.pair >= 0 else SLIDING)
-    for k, sec in enumerate(sections):
-        if te - o["t0"] < sec.min_time or any(
-                e.kind == "section" and e.name == sec.name and e.t == te for e in traj.events):
-            continue
-        before, after = (float(sec.func(np.asarray(Z(t), dtype=float).reshape(-1)))
-                         for t in (max(ta, te - d), te + d))
-        crosses = before < 0.0 <= after if sec.direction > 0 else (
-            before > 0.0 >= after if sec.direction < 0 else (before < 0.0) != (after < 0.0))
-        if not crosses or (sec.where is not None and not sec.where(z)):
-            continue
+    logged = {k for k, sec in enumerate(sections) for e in traj.events
+              if e.kind == "section" and e.name == sec.name and e.t == te}
+    for k in tied_hits(sections, -1, te, z, Z, o["t0"], o["event_xtol"], skip=logged):
         hits[k] += 1
-        traj.events.append(type(traj.events[0])(te, "section", z.copy(), mode, mode, sec.name))
-        if sec.terminal is not None and hits[k] >= sec.terminal:
-            return sec.name
-    return None
+        traj.events.append(type(traj.events[0])(te, "section", z.copy(), mode, mode,
+                                                sections[k].name))
+    # the first whose hits are reached: tied here, or by the stay's own engine
+    return next((sec.name for sec, n in zip(sections, hits)
+                 if sec.terminal is not None and n >= sec.terminal), None)
 
 
 def _ends(system, stay):

@@ -40,7 +40,7 @@ from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuilt
 from .errors import accumulation_detail, run_error
 from .loop.event import SECTION, Pieces, RunOps, make_run, make_sliding_section, make_start
 from .loop.run_state import RING, SWITCHES, Limits, new_run_state
-from .section import Section  # noqa: F401  (re-exported: filippov.simulate.Section)
+from .section import Section, tied_hits  # noqa: F401  (filippov.simulate.Section)
 from .surfaces import SurfacesSystem
 from .loop.stay import UNRESOLVED
 from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
@@ -757,12 +757,22 @@ def _no_sliding(t, z) -> SlidingNotBuiltError:
 
 
 def _section_hit(mode, t, run):
-    """Logs the hit; GO_ON, or OK when the section is terminal and hit often enough."""
-    idx = run.hit_section
-    sec = run.sections[idx]
-    run.hits[idx] += 1
-    run.traj.events.append(Event(t, "section", run.z.copy(), mode, mode, sec.name))
-    return OK if sec.terminal is not None and run.hits[idx] >= sec.terminal else GO_ON
+    """Logs the hit, and those of the sections crossed at its instant
+    (:func:`filippov.section.tied_hits`, on the step's dense output), in order; GO_ON, or
+    OK when a terminal one is hit often enough (``hit_section``: the first such)."""
+    ties = [] if len(run.sections) < 2 else tied_hits(
+        run.sections, run.hit_section, t, run.z, run.step_Z, run.traj.t0, run.event_xtol)
+    ended = None
+    for idx in [run.hit_section] + ties:
+        sec = run.sections[idx]
+        run.hits[idx] += 1
+        run.traj.events.append(Event(t, "section", run.z.copy(), mode, mode, sec.name))
+        if ended is None and sec.terminal is not None and run.hits[idx] >= sec.terminal:
+            ended = idx
+    if ended is None:
+        return GO_ON
+    run.hit_section = ended
+    return OK
 
 
 def _exit_state(new_mode, run):
