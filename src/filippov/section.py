@@ -70,7 +70,7 @@ def tied_hits(sections, first: int, t: float, z, at, t0: float, xtol: float,
     ``rules.same_instant``) hold its sign change, ``where`` holds at z and ``min_time``
     is past (from the run's start t0); not one of ``skip`` (logged there already), not
     within d of the run's start (a start on a section is no hit). Their indices, in
-    order."""
+    order (docs/decisions.md#sections-at-one-instant)."""
     from . import rules
 
     d = rules.same_instant(xtol, t)
