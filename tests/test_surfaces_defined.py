@@ -339,3 +339,16 @@ def test_the_monodromy_of_a_period_that_starts_on_a_surface_closes_with_its_swit
     _, mult = filippov.monodromy(system, orbit)
     np.testing.assert_allclose(np.sort(np.abs(mult))[::-1], np.sort(np.abs(
         want["multipliers"]))[::-1], rtol=0, atol=1e-7)
+
+
+def test_a_non_finite_field_is_blamed_on_its_region():
+    # the view a stay runs names its fields field_minus and field_plus; the error names
+    # the region whose field it is (filippov.checks.blamed)
+    f = lambda z, p: np.array([1.0, 1.0])  # noqa: E731
+    two = FilippovSystem(("x", "y"), fields={(-1, -1): f, (-1, 1): f, (1, -1): f,
+                                             (1, 1): lambda z, p: np.array([1.0, np.log(1.6 - z[0])])},
+                         switch=(lambda z, p: z[0] - 1.0, lambda z, p: z[1] + 10.0),
+                         switch_grad=lambda z, p: np.array([[1.0, 0.0], [0.0, 1.0]]))
+    with pytest.raises(filippov.SimulationError, match=r"t=1\.6.*the field of region \(1, 1\) "
+                                                       r"returned a non-finite value"):
+        simulate(two, [0.0, 0.0], 3.0)

@@ -308,23 +308,37 @@ def piece_not_finite_at(system, mode: int, z: np.ndarray, sections=()) -> str | 
         for name, fn in asked:
             try:
                 if not np.all(np.isfinite(np.asarray(fn(z), dtype=float))):
-                    return name
+                    return blamed(name, fn, z)
             except Exception:
-                return name
+                return blamed(name, fn, z)
     return None
+
+
+def blamed(name: str, fn, z) -> str:
+    """How a piece is named to its user: ``name``, or what the piece says it is
+    (``piece_name``: words, or a function of the state giving them -- a view of several
+    surfaces names the region whose field it is, filippov.surfaces)."""
+    label = getattr(fn, "piece_name", None)
+    if label is None:
+        return name
+    try:
+        return label(z) if callable(label) else str(label)
+    except Exception:   # noqa: BLE001 -- naming must not fail where a piece did
+        return name
 
 
 def non_finite_piece(system: PiecewiseSystem, mode: int, z: np.ndarray) -> str:
     """The piece to blame for a non-finite field value of ``mode`` at ``z``."""
     if mode in FIELD_NAMES:
-        return FIELD_NAMES[mode]
+        name = FIELD_NAMES[mode]
+        return blamed(name, getattr(system, name, None), z)
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         for name, fn in (("field_minus", system.field_minus), ("field_plus", system.field_plus),
                          ("switch_grad", system.switch_grad)):
             try:
                 if not np.all(np.isfinite(np.asarray(fn(z), dtype=float))):
-                    return name
+                    return blamed(name, fn, z)
             except Exception:
-                return name
+                return blamed(name, fn, z)
     return ("the sliding field (a F_+ - b F_-)/(a - b), a = dH.F_-, b = dH.F_+ "
             "(built from field_minus, field_plus and switch_grad)")

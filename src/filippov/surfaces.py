@@ -194,6 +194,8 @@ class SurfacesSystem:
         if key not in self._views:
             def f(z):
                 return bilinear_field(self, sigma, j, k, z)
+            f.piece_name = (f"the sliding field on the intersection of h{j + 1} and "
+                            f"h{k + 1} (region {tuple(sigma)}'s fields around it)")
             self._views[key] = PiecewiseSystem(
                 tuple(self.names), f, f, lambda z: np.ones(np.shape(z)[1:]),
                 lambda z: np.zeros(np.shape(z)), sliding=self.sliding,
@@ -280,6 +282,13 @@ def region_view(system: SurfacesSystem, sigma: tuple, s: int,
             out[:, sel] = system.region_field(flip(tuple(sigma), int(j)), z[:, sel])
         return out
 
+    # what a non-finite value is blamed on (filippov.checks.blamed): the region, not the
+    # view's side
+    inside.piece_name = f"the field of region {sigma}"
+    beyond.piece_name = lambda z: (f"the field of region "
+                                   f"{flip(sigma, int(np.ravel(nearest(z))[0]))}")
+    switch.piece_name, switch_grad.piece_name = ("a switching function h_k",
+                                                 "a switching function's gradient")
     plus, minus = (inside, beyond) if s > 0 else (beyond, inside)
     return PiecewiseSystem(tuple(system.names), minus, plus, switch, switch_grad,
                            sliding=system.sliding, units=dict(system.units),
