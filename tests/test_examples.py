@@ -23,7 +23,8 @@ import filippov.surfaces
 from conftest import ROOT
 
 EXAMPLES = ROOT / "examples"
-SCRIPTS = ("relay_feedback", "sliding_segment", "stick_slip", "belt_with_stop")
+SCRIPTS = ("relay_feedback", "sliding_segment", "stick_slip", "belt_with_stop",
+           "two_blocks_on_a_belt")
 RTOL = 1e-12
 TOL = 10 * RTOL
 
@@ -48,6 +49,26 @@ def test_belt_with_stop_events_are_the_closed_form_s():
     for e, (_, t, x, dx, _) in zip(run.events, want):
         assert abs(e.t - t) <= TOL / 0.4
         np.testing.assert_allclose(e.state, [x, dx], rtol=0, atol=TOL)
+
+
+def test_two_blocks_on_a_belt_events_are_the_closed_form_s():
+    """Both blocks stick on the intersection of two surfaces, one is released (the slide
+    on the intersection ends, on the other surface), then the other; both slip, and one
+    sticks again (examples/two_blocks_on_a_belt.py), against the closed form (brentq on
+    harmonic motions, a linear force, and the exponential of the slip of both). States to
+    TOL; times to TOL over the rate the event function crosses at, the smallest 0.2 (the
+    second stick); 5 time units of slip before it, so that one to 10 TOL."""
+    ex = load("two_blocks_on_a_belt")
+    run, want = ex.computed(), ex.closed_form()
+    got = [(e.kind, filippov.surfaces.mode_name(e.mode_after, 2)) for e in run.events]
+    assert got == [(kind, mode) for kind, _, _, mode in want]
+    for e, (_, t, z, _) in zip(run.events, want):
+        assert abs(e.t - t) <= 10 * TOL / 0.2, (e.kind, e.t - t)
+        np.testing.assert_allclose(e.state, z, rtol=0, atol=10 * TOL)
+    # the stay on the intersection: both carried at V, every choice of its field the same
+    ts, zs, modes = run.sample(np.array([1.0]), include_events=False)
+    assert filippov.surfaces.mode_name(modes[0], 2) == "00"
+    np.testing.assert_allclose(zs[:, 0], ex.closed_form(orbit=True)(1.0), rtol=0, atol=TOL)
 
 
 def test_relay_feedback_orbit_and_multipliers():
@@ -117,8 +138,8 @@ def test_example_uses_the_public_api_only(name):
     assert ast.get_docstring(tree) and "Run: python examples/" in ast.get_docstring(tree)
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom) and node.module.startswith("filippov"):
-            # several switching surfaces are written as a filippov.surfaces.SurfacesSystem
-            # (the reference engine's form) until FilippovSystem takes them (issue 59)
+            # filippov.surfaces too: a mode's name on several surfaces, and the
+            # reference engine's hand-written SurfacesSystem
             public = {"filippov": filippov.__all__,
                       "filippov.surfaces": filippov.surfaces.__all__}
             assert node.module in public, f"{name}: imports from {node.module}"
