@@ -90,7 +90,7 @@ def main():
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     ax.plot(ts, exact[[1, 3]].T, "-", color="0.7", lw=3, label=["closed form", None])
     ax.plot(ts[::8], z[[1, 3]].T, ".", label=[f"simulate: $\\dot x_{i}$" for i in (1, 2)])
-    ax.set(xlabel="time $t$", ylabel="velocity $\\dot x_i$", title="stick on two, one, slip")
+    ax.set(xlabel="time $t$", ylabel="velocity $\\dot x_i$", title="both stick, then block 2, then neither")
     ax.legend(loc="lower left")
     if "agg" not in plt.get_backend().lower():   # a window when run with a display
         plt.show()
