@@ -32,10 +32,9 @@ from filippov.surfaces import mode_name
 K, KC, V, F = 1.0, 0.5, 0.5, 1.0
 
 
-def _field(sigma, z, p):
-    k, kc, f = p[0], p[1], p[3]
-    return np.array([z[1], -k * z[0] + kc * (z[2] - z[0]) + f * sigma[0],
-                     z[3], -k * z[2] - kc * (z[2] - z[0]) + f * sigma[1]])
+def _field(sigma, z, p):   # p = (k, k_c, V, F)
+    return np.array([z[1], -p[0] * z[0] + p[1] * (z[2] - z[0]) + p[3] * sigma[0],
+                     z[3], -p[0] * z[2] - p[1] * (z[2] - z[0]) + p[3] * sigma[1]])
 
 
 SYSTEM = FilippovSystem(("x1", "x1'", "x2", "x2'"), fields=_field, params=(K, KC, V, F),
@@ -85,12 +84,13 @@ def main():
         print(f"{e.kind:12s} {mode_name(e.mode_after, 2):>4s} {e.t:18.15f} {t - e.t:15.1e} "
               f"{np.abs(e.state - z).max():14.1e}")
     ts = np.linspace(0.0, want[-1][1], 400)
-    exact, z = np.array([closed_form(orbit=True)(t) for t in ts]).T, run.sample(
-        ts[::8], include_events=False)[1]
+    exact = np.array([closed_form(orbit=True)(t) for t in ts]).T
+    z = run.sample(ts[::8], include_events=False)[1]
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     ax.plot(ts, exact[[1, 3]].T, "-", color="0.7", lw=3, label=["closed form", None])
     ax.plot(ts[::8], z[[1, 3]].T, ".", label=[f"simulate: $\\dot x_{i}$" for i in (1, 2)])
-    ax.set(xlabel="time $t$", ylabel="velocity $\\dot x_i$", title="both stick, then block 2, then neither")
+    ax.set(xlabel="time $t$", ylabel="velocity $\\dot x_i$",
+           title="both stick, then block 2, then neither")
     ax.legend(loc="lower left")
     if "agg" not in plt.get_backend().lower():   # a window when run with a display
         plt.show()
