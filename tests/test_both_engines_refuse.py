@@ -22,7 +22,7 @@ import pytest
 from numba import njit
 
 from filippov import (FilippovSystem, PeriodicOrbitError, SimulationError,
-                      SystemContractError, periodic_orbit, simulate)
+                      SystemContractError, first_returns, periodic_orbit, simulate)
 from filippov.fastmap import (FLOW_OFF_FIELD, NON_FINITE, compute_returns, failure,
                               first_returns_compiled)
 from filippov.system import MINUS, MODE_NAMES
@@ -170,6 +170,25 @@ def test_a_nan_from_a_field_is_named_by_the_compiled_engine():
     with pytest.raises(SimulationError, match="field_minus returned a non-finite value"):
         simulate(system.python(), [0.0, 0.0, 1.0], 10.0,
                  sections=[system.python_section(lambda z, p: z[0] - 5.0)])
+
+
+def _nan_band(z, p):
+    return np.array([1.0, np.nan if 0.5 < z[0] < 10.0 else 0.0])   # NaN for 0.5 < x < 10
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_field_nan_in_a_band_stops_the_run_at_its_edge_never_a_number(engine):
+    # tests/review (a helper, issue 59's second session): a field NaN only in a band: a
+    # trial step whose stages all fall in it took the guard's constant for each (the
+    # error estimate of a constant field is 0) and was accepted -- a state of 1e268, and
+    # past the band a return at x = 100 "found". A step that met the guard is never
+    # accepted: the step shrinks to the band's edge x = 0.5 (t = 0.5) and the run stops
+    # there naming the field
+    system = FilippovSystem(("x", "y"), _nan_band, _nan_band, lambda z, p: z[1] + 10.0,
+                            lambda z, p: np.array([0.0, 1.0]))
+    with pytest.raises(SimulationError, match=r"non-finite .* t=0\.(5|49999999).*field_plus "
+                                              r"returned a non-finite value"):
+        first_returns(system, [[0.0, 0.3]], lambda z, p: z[0] - 100.0, 300.0, engine=engine)
 
 
 def test_a_nan_from_a_field_on_the_way_to_a_periodic_orbit_is_named():

@@ -64,29 +64,46 @@ def tied_hits(sections, first: int, t: float, z, at, t0: float, xtol: float,
               skip=()) -> list:
     """The sections crossed at the instant ``t`` of a hit of section ``first`` (-1: of none
     of these, another event): the event search keeps the first of roots at one instant
-    (``rules.section_first``), and the others' crossings lie behind the far side of its
-    root, where the run goes on -- they are hits there too. A section is one where its
-    values at ``at(t - d)`` and ``at(t + d)`` (the run's dense output; d =
-    ``rules.same_instant``) hold its sign change, ``where`` holds at z and ``min_time``
-    is past (from the run's start t0); not one of ``skip`` (logged there already), not
-    within d of the run's start (a start on a section is no hit). Their indices, in
-    order (docs/decisions.md#sections-at-one-instant)."""
+    (``rules.section_first``), and the others' crossings lie behind the hit's state z,
+    where the run goes on -- they are hits there too. A section is one whose value at
+    ``at(t - d)`` (the run's dense output; d = ``rules.same_instant``) and at z holds its
+    sign change, where ``where`` holds at z and ``min_time`` is past (from the run's start
+    t0); not one of ``skip`` (logged there already), not within d of the run's start (a
+    start on a section is no hit). One whose root rounding puts a hair beyond z is not:
+    the search finds it next, just after t, so that no crossing is counted twice. Their
+    indices, in order (docs/decisions.md#sections-at-one-instant)."""
     from . import rules
 
     d = rules.same_instant(xtol, t)
     if t - d <= t0:
         return []
     before = np.asarray(at(t - d), dtype=float).reshape(-1)
-    after = np.asarray(at(t + d), dtype=float).reshape(-1)
+    z = np.asarray(z, dtype=float).reshape(-1)
     out = []
     for k, sec in enumerate(sections):
         if k == first or k in skip or t - t0 < sec.min_time:
             continue
-        s0, s1 = (float(np.asarray(sec.func(v)).reshape(-1)[0]) for v in (before, after))
+        s0, s1 = (float(np.asarray(sec.func(v)).reshape(-1)[0]) for v in (before, z))
         if rules.crosses(rules.section_pred(sec.direction), s0, s1) and (
                 sec.where is None or sec.where(z)):
             out.append(k)
     return out
+
+
+def hit_within(sections, events, t: float, xtol: float) -> set:
+    """The indices of ``sections`` hit (a "section" event of ``events`` by name) within
+    ``rules.same_instant`` before t: a crossing counted there is not a tie of a hit at t
+    (:func:`tied_hits`' ``skip``), so that roots rounding puts a hair apart are each
+    counted once."""
+    from . import rules
+
+    d, names = rules.same_instant(xtol, t), set()
+    for e in reversed(events):
+        if e.t < t - d:
+            break
+        if e.kind == "section":
+            names.add(e.name)
+    return {k for k, sec in enumerate(sections) if sec.name in names}
 
 
 @dataclass(frozen=True)

@@ -32,7 +32,7 @@ from . import scale as scale_mod
 from .errors import SurfacesError, accumulation_detail, run_error
 from .loop.run_state import RING, Limits, count_switch, new_run_state
 from .loop.status import GO_ON, ZENO
-from .section import Section, tied_hits
+from .section import Section, hit_within, tied_hits
 from .surfaces import SurfacesSystem, flip, mode_name, mode_of, regions
 from .system import PLUS, SLIDING
 
@@ -209,8 +209,7 @@ def _tied_hits(sections, hits, stay, r, o, traj):
     _, te, _, Z = r.traj.segments[-1]
     z = np.asarray(r.z, dtype=float)
     mode = _code(stay, stay.slide, 1 if stay.pair >= 0 else SLIDING)
-    logged = {k for k, sec in enumerate(sections) for e in traj.events
-              if e.kind == "section" and e.name == sec.name and e.t == te}
+    logged = hit_within(sections, traj.events, te, o["event_xtol"])
     for k in tied_hits(sections, -1, te, z, Z, o["t0"], o["event_xtol"], skip=logged):
         hits[k] += 1
         traj.events.append(type(traj.events[0])(te, "section", z.copy(), mode, mode,

@@ -40,7 +40,7 @@ from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuilt
 from .errors import accumulation_detail, run_error
 from .loop.event import SECTION, Pieces, RunOps, make_run, make_sliding_section, make_start
 from .loop.run_state import RING, SWITCHES, Limits, new_run_state
-from .section import Section, tied_hits  # noqa: F401  (filippov.simulate.Section)
+from .section import Section, hit_within, tied_hits  # noqa: F401  (.Section)
 from .surfaces import SurfacesSystem
 from .loop.stay import UNRESOLVED
 from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
@@ -148,6 +148,11 @@ def _one_blas_thread():
     return _blas_controller().limit(limits=1, user_api="blas")
 
 
+#: how much shorter a step that met the non-finite guard is tried again: scipy's least
+#: factor for a rejected step (its MIN_FACTOR)
+_SHRINK = 0.2
+
+
 class _IntegratingStepper:
     """DOP853 (explicit), or Radau IIA (implicit, for a stiff field), with dense output.
     Events are located on the dense output, and the state at an event is the dense
@@ -191,16 +196,38 @@ class _IntegratingStepper:
         return run_error(NON_FINITE, tt, zz, f" ({self.piece(zz)} returned a non-finite "
                                              f"value there{more})")
 
+    def _not_on_the_guard(self, s, msg):
+        """A DOP853 step whose stages met the non-finite guard (rules.NON_FINITE_STAGE) is
+        never accepted: where several stages take its constant, the error estimate (zero
+        for a constant field) passes it. Taken back and tried again shorter, as scipy
+        rejects a step, until none meets it or the step size collapses (then failed,
+        named by step())."""
+        if self.non_finite is None or not hasattr(s, "K") or s.status == "failed":
+            return msg
+        while np.any(s.K[:, 0] == rules.NON_FINITE_STAGE):
+            h = abs(s.h_previous) * _SHRINK
+            s.t, s.y, s.f = s.t_old, s.y_old, self.f_before
+            s.status, s.h_abs = "running", h
+            if not h >= 10 * np.abs(np.nextafter(s.t, np.inf) - s.t):
+                s.status = "failed"
+                return "the step size collapsed on a non-finite field value"
+            msg = s.step()
+            if s.status == "failed":
+                return msg
+        return msg
+
     def step(self):
         s = self.solver
         ta = s.t
         self.non_finite = None
+        self.f_before = getattr(s, "f", None)   # the field at ta (_not_on_the_guard)
         if self.noise is not None and s.step_size is not None:
             # RadauIIA reads its atol afresh in every step
             s.atol = np.maximum(self.atol, NOISE_STEPS * s.step_size * self.noise)
             self.atol_used = max(self.atol_used, float(np.max(s.atol)))
         with _one_blas_thread() if self.method is RadauIIA else contextlib.nullcontext():
             msg = s.step()
+            msg = self._not_on_the_guard(s, msg)
         if s.status == "failed":
             if self.non_finite is not None:  # the step size collapsed on a NaN or inf
                 raise self._non_finite(*self.non_finite, more=f"; {self.method.__name__} "
@@ -761,9 +788,10 @@ def _section_hit(mode, t, run):
     (:func:`filippov.section.tied_hits`, on the step's dense output), in order; GO_ON, or
     OK when a terminal one is hit often enough (``hit_section``: the first such)."""
     ties = [] if len(run.sections) < 2 else tied_hits(
-        run.sections, run.hit_section, t, run.z, run.step_Z, run.traj.t0, run.event_xtol)
+        run.sections, run.hit_section, t, run.z, run.step_Z, run.traj.t0, run.event_xtol,
+        skip=hit_within(run.sections, run.traj.events, t, run.event_xtol))
     ended = None
-    for idx in [run.hit_section] + ties:
+    for idx in sorted([run.hit_section] + ties):   # one instant: in the order given
         sec = run.sections[idx]
         run.hits[idx] += 1
         run.traj.events.append(Event(t, "section", run.z.copy(), mode, mode, sec.name))

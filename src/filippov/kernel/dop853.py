@@ -183,7 +183,10 @@ def _dop_step(mode, t, h_abs, ctl, fns, p, fl, d):
             err = 0.0
         else:
             err = abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * n)
-        if err < 1.0:
+        # a step whose stages met the non-finite guard is never accepted (where several
+        # take its constant, the error estimate, zero for a constant field, passes it)
+        guard = _met_guard(K)
+        if err < 1.0 and not guard:
             if err == 0.0:
                 factor = _MAX_FACTOR
             else:
@@ -192,8 +195,19 @@ def _dop_step(mode, t, h_abs, ctl, fns, p, fl, d):
                 factor = min(1.0, factor)
             return True, t_new, h, h_abs * factor
         q = _SAFETY * err ** _ERR_EXP
-        h_abs *= q if q > _MIN_FACTOR else _MIN_FACTOR  # max(MIN_FACTOR, q), NaN -> MIN_FACTOR
+        # max(MIN_FACTOR, q), NaN -> MIN_FACTOR; the guard met: MIN_FACTOR
+        h_abs *= q if q > _MIN_FACTOR and not guard else _MIN_FACTOR
         rejected = True
+
+
+@_jit
+def _met_guard(K):
+    """A stage of the step (K[1:], the field at its end among them) took the non-finite
+    guard's constant (_checked_field fills its row with it)."""
+    for s in range(1, _NS + 1):
+        if K[s, 0] == rules.NON_FINITE_STAGE:
+            return True
+    return False
 
 
 @_jit
