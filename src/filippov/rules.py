@@ -578,9 +578,10 @@ def can_split(ta: float, tb: float, t0: float, t1: float) -> bool:
 
 #: the non-finite guard both engines keep on an integration step: a non-finite field value
 #: at a stay's first evaluation is an error (NON_FINITE); on a trial stage it is replaced
-#: by this huge finite value, so the error norm rejects the step and the step shrinks (a
-#: NaN norm loops scipy's step control forever); a step size that collapses on it ends
-#: the run NON_FINITE, naming the stage's state, not STEP_FAILED
+#: by this huge finite value (a NaN norm loops scipy's step control forever), and a step
+#: that met it is rejected and shrinks -- never accepted, whatever its error norm (where
+#: several stages take this one constant, the estimate, zero for a constant, passes); a
+#: step size that collapses on it ends the run NON_FINITE, naming the stage's state
 NON_FINITE_STAGE = 1e300
 
 
