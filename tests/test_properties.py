@@ -39,7 +39,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import generated_systems as gs
-from filippov import return_jacobian, rules, simulate
+from filippov import Section, return_jacobian, rules, simulate
 from filippov.fastmap import compute_returns
 from filippov.poincare import sliding_time
 
@@ -123,6 +123,50 @@ def test_a_crossing_and_the_return_agree_with_the_closed_form(engine, flows, cas
     _close(got["P"], case.P, tol, "P(z0)")
     if case.dP is not None:
         _close(_jac(got), case.dP, TOL_JAC, "dP/dz", scale=max(1.0, case.scale))
+
+
+@pytest.mark.parametrize("flows", FLOWS)
+@given(case=gs.crossings())
+def test_a_section_that_does_not_end_the_run_is_hit_once_per_crossing(flows, case):
+    """The return's section, not terminal, run just past the closed form's return: one
+    hit there. The run goes on from the hit's state, a start on the section up to
+    rounding (docs/decisions.md#start-on-section): an exact flow re-evaluated there may
+    round back to the near side, and that is no second crossing. The reference engine
+    (the compiled one ends at its section's first hit); no second return fits in 1e-6
+    (|dh/dt| >= 0.2)."""
+    fs = gs.system(case.g.n, flows == "exact")
+    gs.load(fs, case.g.p)
+    sec = dataclasses.replace(fs.python_section(gs.section, direction=1), terminal=None)
+    traj = simulate(fs.python(), case.z0, case.time + 1e-6, sections=[sec], dense=False,
+                    method=flows)
+    hits = [e for e in traj.events if e.kind == "section"]
+    assert len(hits) == 1, [e.t for e in hits]
+    _close(hits[0].t - traj.t0, case.time, TOL[flows], "return time")
+    _close(hits[0].state, case.P, TOL[flows], "P(z0)")
+
+
+@pytest.mark.parametrize("flows", FLOWS)
+@given(case=gs.crossings(), c=st.floats(0.25, 4.0))
+def test_a_section_given_twice_is_hit_once_each_at_the_return(flows, case, c):
+    """The return's section and its function times c > 0 (one zero set; roots that
+    rounding may separate by an ulp): each hit once, at the closed form's return, and
+    at one instant -- in the order given where rounding puts both behind the hit, else
+    the earlier root first (section.tied_hits). The reference engine (the compiled one
+    takes one section); the run ends just after the return, where no second one fits
+    (|dh/dt| >= 0.2)."""
+    fs = gs.system(case.g.n, flows == "exact")
+    gs.load(fs, case.g.p)
+    sec = dataclasses.replace(fs.python_section(gs.section, direction=1), terminal=None)
+    twice = Section("twice", lambda z: c * sec.func(z), direction=1)
+    traj = simulate(fs.python(), case.z0, case.time + 1e-6, sections=[sec, twice],
+                    dense=False, method=flows)
+    hits = [e for e in traj.events if e.kind == "section"]
+    assert sorted(e.name for e in hits) == sorted([sec.name, "twice"]), hits
+    assert abs(hits[0].t - hits[1].t) <= rules.same_instant(1e-15, hits[0].t)
+    if hits[0].t == hits[1].t:
+        assert [e.name for e in hits] == [sec.name, "twice"]
+    _close(hits[0].t - traj.t0, case.time, TOL[flows], "return time")
+    _close(hits[0].state, case.P, TOL[flows], "P(z0)")
 
 
 # ----------------------------------------------------------------------------- sliding

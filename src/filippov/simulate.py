@@ -510,9 +510,11 @@ class _Run:
         # (rules.exit_band)
         self.shift, self.banded, self.band = (0.0, 0.0, 0.0) if begun is None else begun[1:]
         self.handed_on = False  # the run ended at its first switch (_one_stay)
-        # the sections its start on is no hit: all of them at a run's start; at a stay
-        # that goes on from a switch (one_stay) those its caller names (hit at that switch)
-        self.start_sections = None
+        # the sections a start on which is no hit, the instant and the state of that
+        # start: all of them at a run's start; at a stay that goes on from a switch
+        # (one_stay) those its caller names (hit at that switch); at a stay that goes on
+        # from a section hit, the sections hit at that instant (_section_hit)
+        self.start_sections, self.start_t, self.start_z = None, self.t0, z.copy()
         self.frac_integrated = np.linspace(0.0, 1.0, self.samples_per_step + 1)
         # An exact flow is evaluated EXACT_BLOCK windows at a time: the same sample
         # spacing, a sixteenth of the Python overhead.
@@ -569,6 +571,9 @@ class _Run:
     # loop.stay.make_step_windows), end_step.
     def start_stay(self):
         """The stay in the current mode begins: its stepper and leave functions."""
+        if self.t != self.start_t:  # begun after the instant of the start: on no section
+            self.start_t, self.start_sections = self.t, set()
+        self.start_z = self.z.copy()
         self.stepper = self._stepper(self.mode)
         self.leave_now = self._leave(self.mode)
         self.steps_in_mode = 0
@@ -619,7 +624,7 @@ class _Run:
                      self.preds, first, self.touch_tol, self.event_xtol, self.traj,
                      self.band, self._leave(self.mode, banded=False) if self.band > 0.0
                      else None)
-        scan.start_sections = self.start_sections
+        scan.start_sections, scan.start = self.start_sections, (self.start_t, self.start_z)
         if may_split and stepper.method is not None and not scan.resolved():
             return UNRESOLVED, ta, None
         band = self.band
@@ -790,14 +795,20 @@ def _section_hit(mode, t, run):
     ties = [] if len(run.sections) < 2 else tied_hits(
         run.sections, run.hit_section, t, run.z, run.step_Z, run.traj.t0, run.event_xtol,
         skip=hit_within(run.sections, run.traj.events, t, run.event_xtol))
-    ended = None
-    for idx in sorted([run.hit_section] + ties):   # one instant: in the order given
+    ended, hit = None, sorted([run.hit_section] + ties)   # one instant: in the order given
+    for idx in hit:
         sec = run.sections[idx]
         run.hits[idx] += 1
         run.traj.events.append(Event(t, "section", run.z.copy(), mode, mode, sec.name))
         if ended is None and sec.terminal is not None and run.hits[idx] >= sec.terminal:
             ended = idx
     if ended is None:
+        # the run goes on from the hit's state, on these sections: an exact flow that
+        # rounds it back a hair is no second crossing (rules.starts_on_section)
+        if t != run.start_t:
+            run.start_t, run.start_sections = t, set()
+        if run.start_sections is not None:
+            run.start_sections = set(run.start_sections) | set(hit)
         return GO_ON
     run.hit_section = ended
     return OK
@@ -952,8 +963,9 @@ class _Scan:
         self.touch_tol, self.xtol, self.traj = touch_tol, xtol, traj
         self.band, self.unbanded = band, unbanded
         self.order = None  # the candidate intervals still to ask (earliest, _unband)
-        # the sections a start on which, up to rounding, is no hit (_Run.start_sections)
-        self.start_sections = None
+        # the sections a start on which, up to rounding, is no hit, and the instant and
+        # state of that start (_Run.start_sections)
+        self.start_sections, self.start = None, (traj.t0, traj.z0)
         # the leave functions as sampled (raw) and as the search reads them (vals: h
         # sampled again unbiased once the band ends, _unband)
         self.raw = [np.asarray(func(zs), dtype=float) for func in leave]
@@ -1110,12 +1122,13 @@ class _Scan:
 
     def _counts(self, k, i, r, mode):
         """The crossing of section k at r is a hit: ``where`` holds there, and it is not
-        the run's start on the section up to rounding."""
+        a start on the section up to rounding (the run's, or a stay's that goes on from
+        a hit of k)."""
         sec, zr = self.sections[k], self.Z(r)
         if sec.where is not None and not sec.where(zr):
             return False
         starts = self.start_sections  # None: every section (the run's own start)
-        return not (i == 0 and self.ts[i] == self.traj.t0 and (starts is None or k in starts)
+        return not (i == 0 and self.ts[i] == self.start[0] and (starts is None or k in starts)
                     and self._starts_on(sec, self.svals[k], zr))
 
     def _touch(self, tm, mode):
@@ -1138,7 +1151,7 @@ class _Scan:
         z_first = np.asarray(self.zs[:, 0], dtype=float)
         z_root = np.asarray(zr, dtype=float).reshape(-1)
         return (rules.starts_on_section(float(sv[0]), z_first, float(sec.func(zr)), z_root,
-                                        np.asarray(self.traj.z0, dtype=float).reshape(-1),
+                                        np.asarray(self.start[1], dtype=float).reshape(-1),
                                         self.traj.scale.state)
                 or _in_section_rounding(sec.func, float(sv[0]), z_first, z_root))
 
