@@ -17,6 +17,8 @@ refused with the wrong words: a field with too few values, a switching gradient 
 wrong sign, a NaN from a field, Jacobians given for the two fields only, a piece numba
 cannot compile, an exact flow that does not follow its own field.
 """
+import re
+
 import numpy as np
 import pytest
 from numba import njit
@@ -189,6 +191,47 @@ def test_a_field_nan_in_a_band_stops_the_run_at_its_edge_never_a_number(engine):
     with pytest.raises(SimulationError, match=r"non-finite .* t=0\.(5|49999999).*field_plus "
                                               r"returned a non-finite value"):
         first_returns(system, [[0.0, 0.3]], lambda z, p: z[0] - 100.0, 300.0, engine=engine)
+
+
+def _uniform(z, p):
+    return np.array([1.0, 0.0])
+
+
+def _band_only_the_interpolant_meets():
+    """(lo, hi): a band of x inside one DOP853 step of the uniform flow x' = 1 from the
+    origin, about the interpolant's extra stage at c = 0.2 of the step, between two of
+    its twelve stages (c = 0.118 and 0.25): the step, taken on the reference engine."""
+    from filippov import dop853_tableau
+
+    clean = FilippovSystem(("x", "y"), _uniform, _uniform, lambda z, p: z[1] + 10.0,
+                           lambda z, p: np.array([0.0, 1.0]))
+    traj = simulate(clean.python(), np.array([0.0, 0.3]), 60.0, dense=True)
+    ta, tb = max((seg[:2] for seg in traj.segments), key=lambda ab: ab[1] - ab[0])
+    lo, hi = 0.195, 0.205
+    nodes = np.asarray(dop853_tableau.C)[:dop853_tableau.N_STAGES]
+    assert not np.any((nodes > lo - 0.04) & (nodes < hi + 0.04))   # the step's stages miss it
+    return ta + lo * (tb - ta), ta + hi * (tb - ta)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_nan_band_only_the_interpolant_meets_stops_the_run_never_a_number(engine):
+    # a band thinner than a step, met only by the dense output's extra stages: they took
+    # the guard's constant, the interpolant was ~1e300, a "crossing" was found on it and
+    # the run went on at a state of -5.8e270 (both engines; simulate ended "t_end" there
+    # without a word). The step is now rejected like one whose stages met the guard, and
+    # where the shorter steps step over the band, the orbit found is asked at the time
+    # the stage met it: the run stops in the band naming the field
+    lo, hi = _band_only_the_interpolant_meets()
+
+    def banded(z, p):
+        return np.array([1.0, np.nan if lo < z[0] < hi else 0.0])
+
+    system = FilippovSystem(("x", "y"), banded, banded, lambda z, p: z[1] + 10.0,
+                            lambda z, p: np.array([0.0, 1.0]))
+    with pytest.raises(SimulationError, match="field_plus returned a non-finite") as err:
+        first_returns(system, [[0.0, 0.3]], lambda z, p: z[0] - 50.0, 300.0, engine=engine)
+    t = float(re.search(r"t=([-0-9.e+]+)", str(err.value)).group(1))
+    assert lo <= t <= hi, (t, lo, hi)
 
 
 def test_a_nan_from_a_field_on_the_way_to_a_periodic_orbit_is_named():

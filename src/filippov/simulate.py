@@ -165,6 +165,9 @@ class _IntegratingStepper:
         calls = [0]
         self.atol, self.noise, self.atol_used = atol, noise, atol
         self.fun, self.piece, self.non_finite = fun, piece, None
+        # the earliest time a trial stage met the non-finite guard at that the orbit has
+        # not yet passed (_passed_suspect)
+        self.suspect = np.inf
         self.n_taken, self.t_start = 0, t  # steps taken by this stepper, since t_start
 
         def checked(tt, zz):
@@ -196,44 +199,64 @@ class _IntegratingStepper:
         return run_error(NON_FINITE, tt, zz, f" ({self.piece(zz)} returned a non-finite "
                                              f"value there{more})")
 
-    def _not_on_the_guard(self, s, msg):
-        """A DOP853 step whose stages met the non-finite guard (rules.NON_FINITE_STAGE) is
-        never accepted: where several stages take its constant, the error estimate (zero
-        for a constant field) passes it. Taken back and tried again shorter, as scipy
-        rejects a step, until none meets it or the step size collapses (then failed,
-        named by step())."""
-        if self.non_finite is None or not hasattr(s, "K") or s.status == "failed":
-            return msg
-        while np.any(s.K[:, 0] == rules.NON_FINITE_STAGE):
+    def _guarded_step(self, s):
+        """One step of the solver s and its dense output: (scipy's message, the dense
+        output; None once failed). A DOP853 step whose stages met the non-finite guard
+        (rules.NON_FINITE_STAGE) is never accepted: where several stages take its
+        constant, the error estimate (zero for a constant field) passes it; nor one whose
+        interpolant's extra stages (taken by dense_output()) met it, which made the dense
+        output ~1e300. Taken back and tried again shorter, as scipy rejects a step, until
+        none meets it or the step size collapses (then failed, named by step())."""
+        msg = s.step()
+        while s.status != "failed":
+            dense = s.dense_output()
+            if self.non_finite is None or not np.any(
+                    getattr(s, "K_extended", s.K)[:, 0] == rules.NON_FINITE_STAGE):
+                return msg, dense
             h = abs(s.h_previous) * _SHRINK
             s.t, s.y, s.f = s.t_old, s.y_old, self.f_before
             s.status, s.h_abs = "running", h
             if not h >= 10 * np.abs(np.nextafter(s.t, np.inf) - s.t):
                 s.status = "failed"
-                return "the step size collapsed on a non-finite field value"
+                return "the step size collapsed on a non-finite field value", None
             msg = s.step()
-            if s.status == "failed":
-                return msg
-        return msg
+        return msg, None
 
     def step(self):
         s = self.solver
         ta = s.t
         self.non_finite = None
-        self.f_before = getattr(s, "f", None)   # the field at ta (_not_on_the_guard)
+        self.f_before = getattr(s, "f", None)   # the field at ta (_guarded_step)
         if self.noise is not None and s.step_size is not None:
             # RadauIIA reads its atol afresh in every step
             s.atol = np.maximum(self.atol, NOISE_STEPS * s.step_size * self.noise)
             self.atol_used = max(self.atol_used, float(np.max(s.atol)))
-        with _one_blas_thread() if self.method is RadauIIA else contextlib.nullcontext():
-            msg = s.step()
-            msg = self._not_on_the_guard(s, msg)
+        if self.method is RadauIIA:  # no guard stages: its collocation is solved
+            with _one_blas_thread():
+                msg = s.step()
+            dense = None if s.status == "failed" else s.dense_output()
+        else:
+            msg, dense = self._guarded_step(s)
         if s.status == "failed":
             if self.non_finite is not None:  # the step size collapsed on a NaN or inf
                 raise self._non_finite(*self.non_finite, more=f"; {self.method.__name__} "
                                        f"could not step past it from t={float(ta)!r}")
             raise run_error(STEP_FAILED, ta, s.y, f": {self.method.__name__} failed: {msg}")
-        return ta, s.t, s.dense_output()
+        if self.non_finite is not None:
+            self.suspect = min(self.suspect, float(self.non_finite[0]))
+        if self.suspect <= s.t:
+            self._passed_suspect(dense)
+        return ta, s.t, dense
+
+    def _passed_suspect(self, dense):
+        """The step passed a time a trial stage met the non-finite guard at: the field on
+        the orbit found, there, is finite (the suspect cleared), or the orbit runs through a
+        non-finite field, an error: a band of NaN a shorter step may have stepped over
+        (docs/decisions.md#named-edges, (5))."""
+        t, self.suspect = self.suspect, np.inf
+        z = np.asarray(dense(t), dtype=float)
+        if not np.all(np.isfinite(np.asarray(self.fun(t, z), dtype=float))):
+            raise self._non_finite(t, z, more="; the orbit found runs through it")
 
 
 # --------------------------------------------------------------------------- crossings

@@ -25,6 +25,7 @@ _B = np.ascontiguousarray(_dop.B, dtype=np.float64)
 _E3 = np.ascontiguousarray(_dop.E3, dtype=np.float64)
 _E5 = np.ascontiguousarray(_dop.E5, dtype=np.float64)
 _D = np.ascontiguousarray(_dop.D, dtype=np.float64)
+_C = np.ascontiguousarray(_dop.C, dtype=np.float64)   # the stages' nodes (K[_NS]: 1)
 _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
 _ERR_EXP = -1.0 / (7 + 1)  # error estimator order 7
 
@@ -130,9 +131,11 @@ def _dop_step(mode, t, h_abs, ctl, fns, p, fl, d):
     """One accepted step of scipy's DOP853 (RungeKutta._step_impl) from d.y, its field
     d.f (ctl: state.Control; d: state.Dop).
 
-    Returns (ok, t_new, h, h_abs_next); K holds the stages, ynew the new state,
-    K[_NS] the field there. On failure (the step size collapsed): (False, t, the last
-    step tried, h_abs), K holding that step's stages (see _non_finite_stage)."""
+    Returns (ok, t_new, h, h_abs_next, t_guard); K holds the stages, ynew the new
+    state, K[_NS] the field there; t_guard: the time of the first stage of a trial that
+    met the non-finite guard (inf: none), where the orbit found is asked again
+    (driver._next_step). On failure (the step size collapsed): (False, t, the last step
+    tried, h_abs, t_guard), K holding that step's stages (see _non_finite_stage)."""
     t_bound, max_step, rtol, atol = ctl.t_bound, ctl.max_step, ctl.rtol, ctl.atol
     y, f, K, ynew, scale = d.y, d.f, d.K, d.ynew, d.scale
     stages = Stages(K, d.ytmp)
@@ -144,9 +147,10 @@ def _dop_step(mode, t, h_abs, ctl, fns, p, fl, d):
     elif h_abs < min_step:
         h_abs = min_step
     rejected = False
+    t_guard = np.inf
     while True:
         if not h_abs >= min_step:  # also stops a NaN step size
-            return False, t, h, h_abs
+            return False, t, h, h_abs, t_guard
         h = h_abs
         t_new = t + h
         if t_new - t_bound > 0.0:
@@ -183,41 +187,51 @@ def _dop_step(mode, t, h_abs, ctl, fns, p, fl, d):
             err = 0.0
         else:
             err = abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * n)
-        # a step whose stages met the non-finite guard is never accepted (where several
-        # take its constant, the error estimate, zero for a constant field, passes it)
-        guard = _met_guard(K)
-        if err < 1.0 and not guard:
+        # a step whose stages met the non-finite guard is never accepted, nor one whose
+        # interpolant's extra stages (taken here for _dop_dense) did (_met_guard)
+        guard = _met_guard(K, 1, _NS + 1)
+        if err < 1.0 and guard == 0:
+            for s in range(_NS + 1, _NSE):
+                _stage(s, mode, y, h, stages, fns, p, fl)
+            guard = _met_guard(K, _NS + 1, _NSE)
+        if guard != 0 and t_guard == np.inf:
+            t_guard = t + _C[guard] * h
+        if err < 1.0 and guard == 0:
             if err == 0.0:
                 factor = _MAX_FACTOR
             else:
                 factor = min(_MAX_FACTOR, _SAFETY * err ** _ERR_EXP)
             if rejected:
                 factor = min(1.0, factor)
-            return True, t_new, h, h_abs * factor
+            return True, t_new, h, h_abs * factor, t_guard
         q = _SAFETY * err ** _ERR_EXP
-        # max(MIN_FACTOR, q), NaN -> MIN_FACTOR; the guard met: MIN_FACTOR
-        h_abs *= q if q > _MIN_FACTOR and not guard else _MIN_FACTOR
+        h_abs *= q if q > _MIN_FACTOR and guard == 0 else _MIN_FACTOR   # NaN q: MIN too
         rejected = True
 
 
 @_jit
-def _met_guard(K):
-    """A stage of the step (K[1:], the field at its end among them) took the non-finite
-    guard's constant (_checked_field fills its row with it)."""
-    for s in range(1, _NS + 1):
+def _met_guard(K, first, stop):
+    """A stage of the step among K[first:stop] (K[1:_NS + 1]: the stages, the field at
+    its end among them; K[_NS + 1:]: the interpolant's) took the non-finite guard's
+    constant (_checked_field fills its row with it): the first such stage, or 0. Where
+    several stages take the constant, the error estimate (zero for a constant field)
+    passes the step; where the interpolant's do, the dense output, and the events on
+    it, are ~1e300 (docs/decisions.md#named-edges (4), (5))."""
+    for s in range(first, stop):
         if K[s, 0] == rules.NON_FINITE_STAGE:
-            return True
-    return False
+            return s
+    return 0
 
 
 @_jit
 def _non_finite_stage(y, h, K, out):
     """After a failed step from y over h (stages in K): True if a stage met a non-finite
     field value (_checked_field put rules.NON_FINITE_STAGE in its row), with that
-    stage's state in out."""
+    stage's state in out (the interpolant's stages last: those of an earlier trial of
+    the step may be left there)."""
     n = y.size
     found = 0
-    for s in range(1, _NS + 1):
+    for s in range(1, _NSE):
         hit = True
         for k in range(n):
             if K[s, k] != rules.NON_FINITE_STAGE:
@@ -238,14 +252,11 @@ def _non_finite_stage(y, h, K, out):
 
 
 @_jit
-def _dop_dense(mode, h, fns, p, fl, d):
-    """DOP853._dense_output_impl of the step h from d.y_old to d.y: extra stages and the
-    interpolant d.F (7, n)."""
+def _dop_dense(h, d):
+    """DOP853._dense_output_impl of the step h from d.y_old to d.y: the interpolant d.F
+    (7, n), of the extra stages _dop_step took before it accepted the step."""
     y_old, y, f_old, f, K, F = d.y_old, d.y, d.f_old, d.f, d.K, d.F
-    stages = Stages(K, d.ytmp)
     n = y.size
-    for s in range(_NS + 1, _NSE):
-        _stage(s, mode, y_old, h, stages, fns, p, fl)
     for k in range(n):
         dy = y[k] - y_old[k]
         F[0, k] = dy

@@ -29,13 +29,13 @@ from .base import (BAD_START, FLOW_OFF_FIELD, NON_FINITE, NO_RETURN, OK,
                    STEP_FAILED, ZENO, _W_NONE, _dot,
                    _W_SECTION, _flow_minus, _flow_plus, _jit, _jit_inline, _speeds,
                    _h, _section)
-from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dop_dense, _dop_initial_step,
-                     _dop_step, _non_finite_stage)
+from .dop853 import (_FIRST_CALL, _NI, _NS, _NSE, _checked_field, _dense_eval, _dop_dense,
+                     _dop_initial_step, _dop_step, _non_finite_stage)
 from .segment import _zat
 from .scan import (_carry_sample, _find, _flow_follows, _sample)
 from .state import (COUNT_SIZE, N_RING, N_SWITCHES, SEG_BAND, SEG_ENTRY,
                     SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_NEXT_STEP, SEG_SHIFT, SEG_SIZE,
-                    SEG_STEP_H, SEG_STEP_T, T_AGE, T_SLID, T_SLIDE_START, TALLY_SIZE, Control, Deriv, Dop,
+                    SEG_STEP_H, SEG_SUSPECT, SEG_STEP_T, T_AGE, T_SLID, T_SLIDE_START, TALLY_SIZE, Control, Deriv, Dop,
                     Fill, Orbit, Outputs, RunCtx, Samples, Scratch, Settings, Work,
                     kernel_signature)  # noqa: F401
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
@@ -212,6 +212,7 @@ def _start_stay(mode, t, ctx):
         w.seg[SEG_INTEGRATED] = 0.0
         return _GO_ON
     w.seg[SEG_INTEGRATED] = 1.0
+    w.seg[SEG_SUSPECT] = np.inf
     for k in range(n):
         w.y[k] = w.z[k]
     fl = Fill(w.wg, w.wf, w.wp)
@@ -226,9 +227,10 @@ def _start_stay(mode, t, ctx):
 @_jit_inline
 def _next_step(mode, ta, first, ctx):
     """The stay's next step from ta (``first``: the stay begins there, _start_stay): (GO_ON,
-    its end tb), or (NON_FINITE, STEP_FAILED: why not, ta) (the step budget is the run's:
-    filippov.loop.event). An exact flow's step is its window; an integrated one
-    leaves its dense output in w.F."""
+    its end tb), or (NON_FINITE, STEP_FAILED: why not, ta; or NON_FINITE and the time
+    in the step where the orbit's field is not finite, _passed_suspect) (the step budget
+    is the run's: filippov.loop.event). An exact flow's step is its window; an
+    integrated one leaves its dense output in w.F."""
     fns, p, s, w = ctx
     if first:
         st = _start_stay(mode, ta, ctx)
@@ -240,7 +242,7 @@ def _next_step(mode, ta, first, ctx):
         return _GO_ON, (np.nextafter(ta, np.inf) if tb == ta else tb)
     fl = Fill(w.wg, w.wf, w.wp)
     d = Dop(w.y, w.f, w.y_old, w.f_old, w.K, w.ynew, w.ytmp, w.scale, w.F)
-    ok, tb, hstep, h_next = _dop_step(
+    ok, tb, hstep, h_next, t_guard = _dop_step(
         mode, ta, w.seg[SEG_NEXT_STEP], Control(s.t_max, s.max_step, s.rtol, s.atol),
         fns, p, fl, d)
     w.seg[SEG_NEXT_STEP] = h_next
@@ -251,10 +253,31 @@ def _next_step(mode, ta, first, ctx):
         w.f_old[k] = w.f[k]
         w.y[k] = w.ynew[k]
         w.f[k] = w.K[_NS, k]
-    _dop_dense(mode, hstep, fns, p, fl, d)
+    _dop_dense(hstep, d)
     w.seg[SEG_STEP_T] = ta
     w.seg[SEG_STEP_H] = tb - ta
+    t_s = min(w.seg[SEG_SUSPECT], t_guard)
+    w.seg[SEG_SUSPECT] = t_s
+    if t_s <= tb and _passed_suspect(mode, ta, tb, fl, ctx) != _GO_ON:
+        return NON_FINITE, t_s   # the orbit passed a time a stage met the guard at
     return _GO_ON, tb
+
+
+@_jit
+def _passed_suspect(mode, ta, tb, fl, ctx):
+    """The step [ta, tb] passed SEG_SUSPECT, a time a trial stage met the non-finite
+    guard at: the field on the orbit found, there, is finite (GO_ON, the suspect
+    cleared), or the orbit runs through a non-finite field (NON_FINITE, its state in
+    w.z): a band of NaN a shorter step may have stepped over (D16 (5))."""
+    fns, p, s, w = ctx
+    t = w.seg[SEG_SUSPECT]
+    w.seg[SEG_SUSPECT] = np.inf
+    _dense_eval(t, ta, tb - ta, w.y_old, w.F, w.ytmp)
+    if _checked_field(w.ytmp, mode, _FIRST_CALL, fns, p, fl, w.ynew):
+        return _GO_ON
+    for k in range(w.z.size):
+        w.z[k] = w.ytmp[k]
+    return NON_FINITE
 
 
 @_jit_inline

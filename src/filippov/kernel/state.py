@@ -94,11 +94,13 @@ Deriv = namedtuple("Deriv", ["M", "Mt", "KV", "KP", "ys", "jv", "jo", "jz1", "jz
 # give the rates of a and b along the orbit in the current window (rules.rate_step; 0:
 # none); SEG_LAST_H, SEG_LAST_SPEED2: outside sliding, h and |f|^2 at the last sample of
 # the last window (the next window's first sample: scan._carry_sample); SEG_NEXT_STEP:
-# the size DOP853 proposes for the stay's next step.
+# the size DOP853 proposes for the stay's next step; SEG_SUSPECT: the earliest time of
+# the stay a trial stage met the non-finite guard at that the orbit has not yet passed
+# (inf: none; there the orbit's own field is asked, driver._next_step).
 SEG = ("entry", "step_t", "step_h", "integrated", "shift", "band", "exit_shift",
-       "rate_step", "last_h", "last_speed2", "next_step")
+       "rate_step", "last_h", "last_speed2", "next_step", "suspect")
 (SEG_ENTRY, SEG_STEP_T, SEG_STEP_H, SEG_INTEGRATED, SEG_SHIFT, SEG_BAND, SEG_EXIT_SHIFT,
- SEG_RATE_STEP, SEG_LAST_H, SEG_LAST_SPEED2, SEG_NEXT_STEP) = range(len(SEG))
+ SEG_RATE_STEP, SEG_LAST_H, SEG_LAST_SPEED2, SEG_NEXT_STEP, SEG_SUSPECT) = range(len(SEG))
 
 # ----------------------------------------------------------------- w.count (int64)
 # the loop's counters (filippov.loop.run_state: changes of mode, entries into the Zeno
