@@ -26,7 +26,7 @@ from .spelling import one_spelling
 from .batches import cannot_compile as _cannot_compile
 from .batches import flow as _batch_flow, jit as _jit, scalar as _batch_scalar
 from .batches import states as _states, vector as _batch_vector
-from .surfaces import view_at
+from .surfaces import check_intersection, view_at
 from .surfaces_defined import grad_derivative, sliding_jacobian
 from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, always, no_flow
 
@@ -473,13 +473,10 @@ class FilippovSystem:
             jac = {("minus" if k[0] < 0 else "plus"): f for k, f in (
                 (defined.sign_vector(k, 1, "jacobians"), f)
                 for k, f in dict(jacobians or {}).items())}
-            if self.intersection is not None:
-                raise ValueError("intersection: one switching surface has no intersection")
+            check_intersection(self.intersection, m)
             one = defined.one_surface(regions, switch, switch_grad, probe, self.params)
             return one["field_minus"], one["field_plus"], one["switch"], one["switch_grad"], jac
-        if self.intersection not in (None, "bilinear"):
-            raise ValueError(f"intersection: expected None or 'bilinear', got "
-                             f"{self.intersection!r}")
+        check_intersection(self.intersection, m)
         self.m = m
         self._surfaces = defined.compile_pieces(self.names, regions, switch, switch_grad,
                                                 jacobians, m)

@@ -98,9 +98,8 @@ class SurfacesSystem:
                 1 <= m <= MAX_SURFACES):
             raise ValueError(f"m: the number of switching surfaces must be an integer from 1 "
                              f"to {MAX_SURFACES}, got {m!r}")
-        if self.intersection not in (None, "bilinear"):
-            raise ValueError(f"intersection: expected None or 'bilinear', got "
-                             f"{self.intersection!r}")
+        if self.intersection not in INTERSECTIONS:
+            check_intersection(self.intersection, m)
         for name in ("switches", "switch_grads"):
             if not callable(getattr(self, name)):
                 raise TypeError(f"{name}: expected a function of the state")
@@ -239,6 +238,27 @@ def regions(m: int) -> list:
     for _ in range(m):
         out = [r + (s,) for r in out for s in (-1, 1)]
     return out
+
+
+#: the sliding fields on an intersection a system may name (SurfacesSystem.intersection)
+INTERSECTIONS = (None, "bilinear")
+
+
+def check_intersection(choice, m: int) -> None:
+    """``intersection`` as every definition of several surfaces takes it: one of
+    INTERSECTIONS, and None for one surface (which has no intersection); ValueError."""
+    if choice not in INTERSECTIONS:
+        raise ValueError(f"intersection: expected None or 'bilinear', got {choice!r}")
+    if m == 1 and choice is not None:
+        raise ValueError("intersection: one switching surface has no intersection")
+
+
+def check_regions(keys, m: int) -> None:
+    """A field for every region of m surfaces among the sign vectors ``keys``."""
+    missing = [s for s in regions(m) if s not in set(keys)]
+    if missing:
+        raise ValueError(f"fields: no field for region {missing[0]} (one per sign vector: "
+                         f"{2 ** m} regions)")
 
 
 def region_view(system: SurfacesSystem, sigma: tuple, s: int,

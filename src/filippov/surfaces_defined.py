@@ -31,7 +31,7 @@ from numba.core.errors import NumbaError
 from . import batches
 from .differences import fd_jacobian
 from .errors import SystemContractError
-from .surfaces import MAX_SURFACES, SurfacesSystem, digits, regions
+from .surfaces import MAX_SURFACES, SurfacesSystem, check_regions, digits, regions
 
 
 @dataclass(frozen=True)
@@ -109,10 +109,7 @@ def region_functions(fields, m: int) -> dict:
     region must have one."""
     if isinstance(fields, Mapping):
         out = {sign_vector(k, m): batches.jit(f, f"fields[{k!r}]") for k, f in fields.items()}
-        missing = [s for s in regions(m) if s not in out]
-        if missing:
-            raise ValueError(f"fields: no field for region {missing[0]} (one per sign "
-                             f"vector: {2 ** m} regions)")
+        check_regions(out, m)
         return out
     if not callable(fields):
         raise TypeError("fields: expected a mapping from sign vectors to f(z, p), or a "

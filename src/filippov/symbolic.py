@@ -207,7 +207,7 @@ class SymbolicSystem:
         mapping from sign vectors to expressions (or a function of the sign vector giving
         them); each region's Jacobian differentiated. m = 1 gives today's pieces
         (field_minus, field_plus, switch)."""
-        from .surfaces import MAX_SURFACES, regions
+        from .surfaces import MAX_SURFACES, check_intersection, check_regions, regions
         from .surfaces_defined import sign_vector
 
         if field_minus is not None or field_plus is not None:
@@ -232,17 +232,13 @@ class SymbolicSystem:
                 raise SymbolicError(str(exc)) from None
             out[sigma] = _vector(exprs, len(self.states), f"fields[{sigma}]")
             _check_free(out[sigma], allowed, f"fields[{sigma}]")
-        missing = [s for s in regions(m) if s not in out]
-        if missing:
-            raise SymbolicError(f"fields: no field for region {missing[0]} (one per sign "
-                                f"vector: {2 ** m} regions)")
+        try:
+            check_regions(out, m)
+            check_intersection(self.intersection, m)
+        except ValueError as exc:
+            raise SymbolicError(str(exc)) from None
         if m == 1:
-            if self.intersection is not None:
-                raise SymbolicError("intersection: one switching surface has no intersection")
             return out[(-1,)], out[(1,)], hs[0]
-        if self.intersection not in (None, "bilinear"):
-            raise SymbolicError(f"intersection: expected None or 'bilinear', got "
-                                f"{self.intersection!r}")
         self.m, self.fields = m, out
         self.switch = tuple(sp.sympify(h) for h in hs)
         _check_free(self.switch, allowed, "switch")
