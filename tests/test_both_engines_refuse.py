@@ -234,6 +234,41 @@ def test_a_nan_band_only_the_interpolant_meets_stops_the_run_never_a_number(engi
     assert lo <= t <= hi, (t, lo, hi)
 
 
+def _band_past(z, p):
+    return np.array([1.0, np.nan if p[0] < z[0] < p[1] else 0.0])
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("lo", [3.9645569620253163, 5.346835443037975, 3.0])
+def test_a_nan_band_past_the_return_never_stops_the_return(engine, lo):
+    # (a review) the orbit found was asked at a suspect's time as soon as a step passed
+    # it, before the step's events were searched: a band 0.2 past the return section,
+    # which the orbit never reaches, refused the return on both engines. The step is now
+    # searched up to that time, and an event before it stands; x' = 1 returns at t = lo - 0.2
+    system = FilippovSystem(("x", "y"), _band_past, _band_past, lambda z, p: z[1] + 100.0,
+                            lambda z, p: np.array([0.0, 1.0]),
+                            params=np.array([lo, lo + 0.05, lo - 0.2]))
+    got = first_returns(system, [[0.0, 0.3]], lambda z, p: z[0] - p[2], 300.0, engine=engine)
+    assert got.time[0] == pytest.approx(lo - 0.2, abs=1e-12)
+
+
+def _stiff_banded(z, p):
+    return np.array([1.0, -1e5 * (z[1] - np.sin(z[0])) + (np.nan if 5.0 < z[0] < 5.5 else 0.0)])
+
+
+def test_a_nan_band_on_a_stiff_stay_is_named_not_a_crash():
+    # (a review) Radau IIA, which takes the stiff stay over, evaluates its stages in one
+    # call: the suspect's time was an array (a TypeError), and then LAPACK refused the
+    # Newton matrix the guard's values filled (a ValueError). The run stops at the
+    # band's edge x = 5 naming the field
+    system = FilippovSystem(("x", "y"), _stiff_banded, _stiff_banded,
+                            lambda z, p: z[1] + 100.0, lambda z, p: np.array([0.0, 1.0]))
+    with pytest.raises(SimulationError, match="field_plus returned a non-finite") as err:
+        simulate(system.python(), [0.0, 0.0], 20.0, method="integrate")
+    x = float(re.search(r"state \[([-0-9.e+]+),", str(err.value)).group(1))
+    assert 4.99 < x < 5.5, str(err.value)
+
+
 def test_a_nan_from_a_field_on_the_way_to_a_periodic_orbit_is_named():
     system = _runs_into_nan()
     with pytest.raises(PeriodicOrbitError, match="field_minus returned a non-finite"):

@@ -318,3 +318,36 @@ def test_sections_crossed_at_one_instant_are_each_hit(method):
                  dataclasses.replace(twice, min_time=1.0, terminal=2)):
         tr = simulate(two_centres(), start, 3.0, sections=[up, tied], method=method)
         assert [e.t for e in tr.events if e.name == tied.name][:1] != [tr.events[1].t]
+
+
+# A generated crossing (tests/generated_systems.py, n = 3, exact flows) whose section is
+# H itself: the section's root is refined 3 ulps before the switch's, the stay after the
+# hit begins on the section, and the switch a few ulps later began another stay whose
+# exact flow rounded h back below 0 -- the one crossing logged twice, and terminal=2
+# ending the run at it (found by a review). A stay begun at the instant of a hit
+# (section.one_instant) begins on the sections hit there.
+_ON_H_Z0 = [0.5258970501378047, 0.5633646867779194, 0.09671951379978269]
+_ON_H_P = [-1.300930314488954, -0.8103100225202343, 0.3808851164732415, 0.25159340921751805, 0.3370655768973355, -0.7062627830383769, -0.691309376377082, 1.457001599417387, 0.775368712817658, -1.6710556806469135, -0.7434773240818368, 0.42636077825530366, 0.9811458608474195, -0.5393460874251095, 1.4417703540010979e-177, 0.0, 1.0, -6.103515625e-05, 0.34951555992841477, -0.4062774114347447, 1.5575070096246764, 1.0192087747726375, 0.5497150170038141, 2.154208086927612e-05, -1.3960039078050622e-05, 1.000008391928591, 3.9188053777928736e-05, -0.2287212802547814, 0.13749335803517698, 0.6420570730975844, -1.1652468447166164, 0.4883754099713282, 0.4883754099713282, 0.0, 1.1, -1.1, -1.6865829403201364, -0.16980054047829105, -1.7345447367744333, 0.9212158350637241, -0.30784431461077555, -0.017721698858204186, 1.1066353626835752, 0.5904223394499298, 0.2929721352328225, -0.41324437102353534, 0.1226014657623799, 0.2937238081353744, -1.2090814602366813, -1.2825049908003128, -0.23851986746011858, 0.9083703901347742, -1.5859241413906917e-27, -0.1682521255234254, 0.5493468601886463, 1.514614332772363, -0.38855768555000336, -0.5038457819189139, -0.15820558351432806, 1.0, 1.2047119093186345, 0.02206771739965316, 0.21126992058442517, -0.2931264525455987, 0.6827943896246345, 0.21598585905113676, 0.5606147724692138, 0.11914061115926865, 1.1406176271948352, 0.7448733362550107, 0.7448733362550107, 0.3156153101390069, 0.5102122928010393, -0.5102122928010393, 0.0, 1.0122029770986494, -1.0526049499354895, 2.6754996974846286, -0.8885930307949229, -0.456822106404832, -0.04142449423403339, -6.0528482444146294e-120, 0.0, 0.0, 0.0, 0.0, 0.6707180572122433]
+
+
+@pytest.mark.parametrize("method", ["exact", "integrate"])
+def test_a_section_on_h_is_hit_once_where_the_switch_follows_a_few_ulps_later(method):
+    import generated_systems as gs
+
+    fs = gs.system(3, method == "exact")
+    gs.load(fs, np.array(_ON_H_P))
+    on_h = dataclasses.replace(fs.python_section(gs.switch, direction=0), terminal=None,
+                               name="H")
+    traj = simulate(fs.python(), np.array(_ON_H_Z0), 3.0, sections=[on_h], dense=False,
+                    method=method)
+    kinds = [(e.kind, e.name) for e in traj.events if e.kind != "start"]
+    assert kinds[:2] == [("section", "H"), ("crossing", "")], kinds
+    hits = [e.t for e in traj.events if e.kind == "section"]
+    crossings = [e.t for e in traj.events if e.kind == "crossing"]
+    assert len(hits) == len(crossings), (hits, crossings)   # one hit per crossing of H
+    twice = dataclasses.replace(on_h, terminal=2)
+    traj2 = simulate(fs.python(), np.array(_ON_H_Z0), 3.0, sections=[twice], dense=False,
+                     method=method)
+    assert traj2.status == ("t_end" if len(hits) < 2 else "section:H"), traj2.status
+    if len(hits) >= 2:
+        assert traj2.t == pytest.approx(hits[1], abs=1e-12)

@@ -90,6 +90,15 @@ def tied_hits(sections, first: int, t: float, z, at, t0: float, xtol: float,
     return out
 
 
+def one_instant(t0: float, t: float, xtol: float) -> bool:
+    """t is the instant t0 to the solver (``rules.same_instant``): a stay that begins a
+    few ulps after a section hit -- at a switch the search refined just past it -- still
+    begins on that section."""
+    from . import rules
+
+    return abs(t - t0) <= rules.same_instant(xtol, max(abs(t0), abs(t)))
+
+
 def hit_within(sections, events, t: float, xtol: float) -> set:
     """The indices of ``sections`` hit (a "section" event of ``events`` by name) within
     ``rules.same_instant`` before t: a crossing counted there is not a tie of a hit at t

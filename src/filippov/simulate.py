@@ -40,7 +40,7 @@ from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuilt
 from .errors import accumulation_detail, run_error
 from .loop.event import SECTION, Pieces, RunOps, make_run, make_sliding_section, make_start
 from .loop.run_state import RING, SWITCHES, Limits, new_run_state
-from .section import Section, hit_within, tied_hits  # noqa: F401  (.Section)
+from .section import Section, hit_within, one_instant, tied_hits  # noqa: F401  (.Section)
 from .surfaces import SurfacesSystem
 from .loop.stay import UNRESOLVED
 from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
@@ -153,6 +153,16 @@ def _one_blas_thread():
 _SHRINK = 0.2
 
 
+def _first_not_finite(tt, zz, v):
+    """(time, state) of the first stage whose field value v is not finite: of a scalar
+    call, or of Radau IIA's vectorized one (times and states in columns)."""
+    zz = np.array(zz, dtype=float)
+    if zz.ndim == 1:
+        return float(np.asarray(tt).reshape(-1)[0]), zz
+    j = int(np.argmax(~np.all(np.isfinite(np.asarray(v).reshape(zz.shape)), axis=0)))
+    return float(tt if np.ndim(tt) == 0 else np.asarray(tt).reshape(-1)[j]), zz[:, j].copy()
+
+
 class _IntegratingStepper:
     """DOP853 (explicit), or Radau IIA (implicit, for a stiff field), with dense output.
     Events are located on the dense output, and the state at an event is the dense
@@ -166,8 +176,9 @@ class _IntegratingStepper:
         self.atol, self.noise, self.atol_used = atol, noise, atol
         self.fun, self.piece, self.non_finite = fun, piece, None
         # the earliest time a trial stage met the non-finite guard at that the orbit has
-        # not yet passed (_passed_suspect)
-        self.suspect = np.inf
+        # not yet passed (_passed_suspect); where the orbit found runs through a field not
+        # finite, that time and state (the next step raises there)
+        self.suspect, self.not_finite_at = np.inf, None
         self.n_taken, self.t_start = 0, t  # steps taken by this stepper, since t_start
 
         def checked(tt, zz):
@@ -184,7 +195,7 @@ class _IntegratingStepper:
                 if calls[0] == 1:
                     raise self._non_finite(tt, zz)
                 if self.non_finite is None:  # the first in this step: near the orbit
-                    self.non_finite = (tt, np.array(zz, dtype=float))
+                    self.non_finite = _first_not_finite(tt, zz, v)
                 v = np.full(np.shape(v), rules.NON_FINITE_STAGE)
             return v
 
@@ -225,6 +236,9 @@ class _IntegratingStepper:
     def step(self):
         s = self.solver
         ta = s.t
+        if self.not_finite_at is not None:  # no event before it: the run stops there
+            raise self._non_finite(*self.not_finite_at, more="; the orbit found runs "
+                                                             "through it")
         self.non_finite = None
         self.f_before = getattr(s, "f", None)   # the field at ta (_guarded_step)
         if self.noise is not None and s.step_size is not None:
@@ -232,8 +246,14 @@ class _IntegratingStepper:
             s.atol = np.maximum(self.atol, NOISE_STEPS * s.step_size * self.noise)
             self.atol_used = max(self.atol_used, float(np.max(s.atol)))
         if self.method is RadauIIA:  # no guard stages: its collocation is solved
-            with _one_blas_thread():
-                msg = s.step()
+            try:
+                with _one_blas_thread():
+                    msg = s.step()
+            except ValueError:  # LAPACK refuses a Newton matrix the guard's values filled
+                if self.non_finite is None:
+                    raise
+                raise self._non_finite(*self.non_finite, more=f"; RadauIIA could not step "
+                                       f"past it from t={float(ta)!r}") from None
             dense = None if s.status == "failed" else s.dense_output()
         else:
             msg, dense = self._guarded_step(s)
@@ -243,20 +263,23 @@ class _IntegratingStepper:
                                        f"could not step past it from t={float(ta)!r}")
             raise run_error(STEP_FAILED, ta, s.y, f": {self.method.__name__} failed: {msg}")
         if self.non_finite is not None:
-            self.suspect = min(self.suspect, float(self.non_finite[0]))
+            self.suspect = min(self.suspect, self.non_finite[0])
         if self.suspect <= s.t:
-            self._passed_suspect(dense)
+            return ta, self._passed_suspect(dense, s.t), dense
         return ta, s.t, dense
 
-    def _passed_suspect(self, dense):
+    def _passed_suspect(self, dense, tb):
         """The step passed a time a trial stage met the non-finite guard at: the field on
         the orbit found, there, is finite (the suspect cleared), or the orbit runs through a
-        non-finite field, an error: a band of NaN a shorter step may have stepped over
-        (docs/decisions.md#named-edges, (5))."""
+        non-finite field -- a band of NaN a shorter step may have stepped over
+        (docs/decisions.md#named-edges, (5)). The end of the step the run searches: tb, or
+        that time, where the next step raises unless an event before it ends the stay."""
         t, self.suspect = self.suspect, np.inf
         z = np.asarray(dense(t), dtype=float)
-        if not np.all(np.isfinite(np.asarray(self.fun(t, z), dtype=float))):
-            raise self._non_finite(t, z, more="; the orbit found runs through it")
+        if np.all(np.isfinite(np.asarray(self.fun(t, z), dtype=float))):
+            return tb
+        self.not_finite_at = (t, z)
+        return t
 
 
 # --------------------------------------------------------------------------- crossings
@@ -533,11 +556,13 @@ class _Run:
         # (rules.exit_band)
         self.shift, self.banded, self.band = (0.0, 0.0, 0.0) if begun is None else begun[1:]
         self.handed_on = False  # the run ended at its first switch (_one_stay)
-        # the sections a start on which is no hit, the instant and the state of that
-        # start: all of them at a run's start; at a stay that goes on from a switch
-        # (one_stay) those its caller names (hit at that switch); at a stay that goes on
-        # from a section hit, the sections hit at that instant (_section_hit)
-        self.start_sections, self.start_t, self.start_z = None, self.t0, z.copy()
+        # the sections a start on which is no hit, the instant they were hit at, and the
+        # time and state of the stay's start: all of them at a run's start; at a stay that
+        # goes on from a switch (one_stay) those its caller names (hit at that switch); at
+        # a stay that begins at the instant of a section hit (one_instant: also after a
+        # switch refined a few ulps past it), the sections hit then (_section_hit)
+        self.start_sections, self.start_instant = None, self.t0
+        self.start_t, self.start_z = self.t0, z.copy()
         self.frac_integrated = np.linspace(0.0, 1.0, self.samples_per_step + 1)
         # An exact flow is evaluated EXACT_BLOCK windows at a time: the same sample
         # spacing, a sixteenth of the Python overhead.
@@ -594,9 +619,9 @@ class _Run:
     # loop.stay.make_step_windows), end_step.
     def start_stay(self):
         """The stay in the current mode begins: its stepper and leave functions."""
-        if self.t != self.start_t:  # begun after the instant of the start: on no section
-            self.start_t, self.start_sections = self.t, set()
-        self.start_z = self.z.copy()
+        if not one_instant(self.start_instant, self.t, self.event_xtol):
+            self.start_instant, self.start_sections = self.t, set()   # on no section
+        self.start_t, self.start_z = self.t, self.z.copy()
         self.stepper = self._stepper(self.mode)
         self.leave_now = self._leave(self.mode)
         self.steps_in_mode = 0
@@ -753,10 +778,12 @@ class _Run:
         if h * spectral_radius(field, self.t, self.z, floor=self.state_scale) <= 1.0:
             return stepper
         self.traj.stiff_modes.add(MODE_NAMES[self.mode])
-        return _IntegratingStepper(field, self.z, self.t, self.t_end, self.rtol, self.atol,
-                                   self.max_step, method=RadauIIA, piece=stepper.piece,
-                                   noise=field_noise(field, self.t, self.z,
-                                                     self.state_scale))
+        stiff = _IntegratingStepper(field, self.z, self.t, self.t_end, self.rtol, self.atol,
+                                    self.max_step, method=RadauIIA, piece=stepper.piece,
+                                    noise=field_noise(field, self.t, self.z,
+                                                      self.state_scale))
+        stiff.suspect = stepper.suspect   # a time not yet passed goes with the stay
+        return stiff
 
     # ------------------------------------------------------------------ one event
     def _event_error(self, status):
@@ -828,8 +855,8 @@ def _section_hit(mode, t, run):
     if ended is None:
         # the run goes on from the hit's state, on these sections: an exact flow that
         # rounds it back a hair is no second crossing (rules.starts_on_section)
-        if t != run.start_t:
-            run.start_t, run.start_sections = t, set()
+        if not one_instant(run.start_instant, t, run.event_xtol):
+            run.start_instant, run.start_sections = t, set()
         if run.start_sections is not None:
             run.start_sections = set(run.start_sections) | set(hit)
         return GO_ON

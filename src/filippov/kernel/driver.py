@@ -35,7 +35,7 @@ from .segment import _zat
 from .scan import (_carry_sample, _find, _flow_follows, _sample)
 from .state import (COUNT_SIZE, N_RING, N_SWITCHES, SEG_BAND, SEG_ENTRY,
                     SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_NEXT_STEP, SEG_SHIFT, SEG_SIZE,
-                    SEG_STEP_H, SEG_SUSPECT, SEG_STEP_T, T_AGE, T_SLID, T_SLIDE_START, TALLY_SIZE, Control, Deriv, Dop,
+                    SEG_NOT_FINITE, SEG_STEP_H, SEG_SUSPECT, SEG_STEP_T, T_AGE, T_SLID, T_SLIDE_START, TALLY_SIZE, Control, Deriv, Dop,
                     Fill, Orbit, Outputs, RunCtx, Samples, Scratch, Settings, Work,
                     kernel_signature)  # noqa: F401
 from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_derivative,
@@ -205,6 +205,8 @@ def _start_stay(mode, t, ctx):
     integrated field is not finite there."""
     fns, p, s, w = ctx
     n = w.z.size
+    w.seg[SEG_SUSPECT] = np.inf
+    w.seg[SEG_NOT_FINITE] = np.inf
     if mode != SLIDING and s.exact:
         for k in range(n):
             w.za[k] = w.z[k]
@@ -212,7 +214,6 @@ def _start_stay(mode, t, ctx):
         w.seg[SEG_INTEGRATED] = 0.0
         return _GO_ON
     w.seg[SEG_INTEGRATED] = 1.0
-    w.seg[SEG_SUSPECT] = np.inf
     for k in range(n):
         w.y[k] = w.z[k]
     fl = Fill(w.wg, w.wf, w.wp)
@@ -227,15 +228,18 @@ def _start_stay(mode, t, ctx):
 @_jit_inline
 def _next_step(mode, ta, first, ctx):
     """The stay's next step from ta (``first``: the stay begins there, _start_stay): (GO_ON,
-    its end tb), or (NON_FINITE, STEP_FAILED: why not, ta; or NON_FINITE and the time
-    in the step where the orbit's field is not finite, _passed_suspect) (the step budget
-    is the run's: filippov.loop.event). An exact flow's step is its window; an
+    its end tb -- or the time in it where the orbit's field is not finite,
+    _passed_suspect), or (NON_FINITE, STEP_FAILED: why not, ta) (the step budget is the
+    run's: filippov.loop.event). An exact flow's step is its window; an
     integrated one leaves its dense output in w.F."""
     fns, p, s, w = ctx
     if first:
         st = _start_stay(mode, ta, ctx)
         if st != _GO_ON:
             return st, ta
+    if w.seg[SEG_NOT_FINITE] <= ta:  # the orbit ran through a field not finite there
+        _dense_eval(ta, w.seg[SEG_STEP_T], w.seg[SEG_STEP_H], w.y_old, w.F, w.z)
+        return NON_FINITE, ta
     if w.seg[SEG_INTEGRATED] == 0.0:
         age = ta - w.seg[SEG_ENTRY] + w.tally[T_AGE]
         tb = min(ta + rules.exact_window(age, s.hwin, s.hwin_slow, s.transient), s.t_max)
@@ -259,7 +263,11 @@ def _next_step(mode, ta, first, ctx):
     t_s = min(w.seg[SEG_SUSPECT], t_guard)
     w.seg[SEG_SUSPECT] = t_s
     if t_s <= tb and _passed_suspect(mode, ta, tb, fl, ctx) != _GO_ON:
-        return NON_FINITE, t_s   # the orbit passed a time a stage met the guard at
+        # the orbit passed a time a stage met the guard at, where its field is not
+        # finite: the run searches the step up to there (an event before it stands),
+        # and the next step stops it there
+        w.seg[SEG_NOT_FINITE] = t_s
+        return _GO_ON, t_s
     return _GO_ON, tb
 
 
@@ -267,16 +275,14 @@ def _next_step(mode, ta, first, ctx):
 def _passed_suspect(mode, ta, tb, fl, ctx):
     """The step [ta, tb] passed SEG_SUSPECT, a time a trial stage met the non-finite
     guard at: the field on the orbit found, there, is finite (GO_ON, the suspect
-    cleared), or the orbit runs through a non-finite field (NON_FINITE, its state in
-    w.z): a band of NaN a shorter step may have stepped over (D16 (5))."""
+    cleared), or the orbit runs through a non-finite field (NON_FINITE): a band of NaN
+    a shorter step may have stepped over (D16 (5))."""
     fns, p, s, w = ctx
     t = w.seg[SEG_SUSPECT]
     w.seg[SEG_SUSPECT] = np.inf
     _dense_eval(t, ta, tb - ta, w.y_old, w.F, w.ytmp)
     if _checked_field(w.ytmp, mode, _FIRST_CALL, fns, p, fl, w.ynew):
         return _GO_ON
-    for k in range(w.z.size):
-        w.z[k] = w.ytmp[k]
     return NON_FINITE
 
 

@@ -96,11 +96,14 @@ Deriv = namedtuple("Deriv", ["M", "Mt", "KV", "KP", "ys", "jv", "jo", "jz1", "jz
 # the last window (the next window's first sample: scan._carry_sample); SEG_NEXT_STEP:
 # the size DOP853 proposes for the stay's next step; SEG_SUSPECT: the earliest time of
 # the stay a trial stage met the non-finite guard at that the orbit has not yet passed
-# (inf: none; there the orbit's own field is asked, driver._next_step).
+# (inf: none; there the orbit's own field is asked, driver._next_step); SEG_NOT_FINITE:
+# where it was not finite (inf: nowhere), the end of the step searched, where the next
+# step stops the run.
 SEG = ("entry", "step_t", "step_h", "integrated", "shift", "band", "exit_shift",
-       "rate_step", "last_h", "last_speed2", "next_step", "suspect")
+       "rate_step", "last_h", "last_speed2", "next_step", "suspect", "not_finite")
 (SEG_ENTRY, SEG_STEP_T, SEG_STEP_H, SEG_INTEGRATED, SEG_SHIFT, SEG_BAND, SEG_EXIT_SHIFT,
- SEG_RATE_STEP, SEG_LAST_H, SEG_LAST_SPEED2, SEG_NEXT_STEP, SEG_SUSPECT) = range(len(SEG))
+ SEG_RATE_STEP, SEG_LAST_H, SEG_LAST_SPEED2, SEG_NEXT_STEP, SEG_SUSPECT,
+ SEG_NOT_FINITE) = range(len(SEG))
 
 # ----------------------------------------------------------------- w.count (int64)
 # the loop's counters (filippov.loop.run_state: changes of mode, entries into the Zeno

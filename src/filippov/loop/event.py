@@ -59,8 +59,8 @@ assert SECTION not in (rules.SWITCH, rules.EXIT_MINUS, rules.EXIT_PLUS)
 #: begin(z0, age0, ctx) -> (status, t, mode): the run's start from z0 (its age in its
 #: region age0: rules.carried_age), GO_ON or why it cannot start; a stay, in the order the
 #: run holds: per step next_step(mode, ta, first, ctx) -> (status, tb) (the stay begun
-#: at its first step; GO_ON and the step's end, or why there is none and where: the stay
-#: cannot begin, a failed step; the run asks the step budget before each step itself,
+#: at its first step; GO_ON and the step's end, or why there is none: the stay cannot
+#: begin, a failed step; the run asks the step budget before each step itself,
 #: filippov.loop.run_state.count_step), window(mode, t0, t1, first, may_split, ctx) ->
 #: (status, t, what) (one window of the step sampled and searched: the run searches the
 #: step window by window with it, filippov.loop.stay.make_step_windows), end_step(mode, ta, tb,
@@ -160,8 +160,8 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
                 status, tb = count_step(rs), ta  # within the run's step budget, or it stops
                 if status == GO_ON:
                     status, tb = next_step(mode, ta, first, ctx)
-                if status != GO_ON:  # no step: why (a slide's failure at a two-fold named),
-                    return failed_step(status, mode, ctx), tb, mode   # and where
+                if status != GO_ON:  # no step: why (a slide's failure at a two-fold named)
+                    return failed_step(status, mode, ctx), ta, mode
                 status, t, what = step_windows(mode, ta, tb, first, ctx)
                 status = end_step(mode, ta, tb, status, t, ctx)
                 ta, first = tb, False
