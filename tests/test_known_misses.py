@@ -40,7 +40,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from filippov import FilippovSystem, first_returns, periodic_orbit, simulate
+from filippov import (MINUS, PLUS, FilippovSystem, PiecewiseSystem, Section, SimulationError,
+                      first_returns, periodic_orbit, simulate)
 
 ENGINES = ("reference", "compiled")
 XA = np.arcsin(0.9)   # sin x >= 0.9 on [XA, pi - XA] + 2 pi k
@@ -213,3 +214,64 @@ def test_a_limit_cycle_of_order_one_has_its_multiplier(engine):
 @pytest.mark.parametrize("engine", ENGINES)
 def test_a_small_limit_cycle_has_the_multiplier_of_a_large_one(engine):
     assert _multiplier(1e-5, engine) == pytest.approx(MULTIPLIER, rel=1e-6)
+
+
+# ------------------------------------------------------------------- found 2026-12-05
+# A review of the day's mends found two older limits of the window search, not mended:
+# each runs, fails today and turns the suite red the day it is mended.
+
+C_FAR = 12345.678   # region -: a rotation about (-C_FAR, 0); region +: about the origin
+
+
+def _rotation(c):
+    def flow(z0, tau):
+        tau = np.asarray(tau, dtype=float)
+        u, v = z0[0] + c, z0[1]
+        return np.stack([np.cos(tau) * u - np.sin(tau) * v - c,
+                         np.sin(tau) * u + np.cos(tau) * v])
+    return (lambda z: np.stack([-z[1], z[0] + c])), flow
+
+
+@_miss("a section crossed in the sample interval where the switch after it is found as a "
+       "hidden extremum of h: the samples past H follow the old mode's flow, which turns "
+       "back within 1/C_FAR, and the section's sign change is never sampled")
+@pytest.mark.parametrize("method, sample_step", [("exact", 0.05), ("integrate", 0.01)])
+def test_a_section_crossed_just_before_a_switch_found_between_samples_is_hit(method,
+                                                                            sample_step):
+    # from (0.5, 0) the orbit reaches H = {x1 = 0} at t = pi/2, circles about (-C_FAR, 0)
+    # in region - and is back on H after 2 pi - 1/C_FAR, crossing x1 = -0.1 upwards
+    # 4e-3 before: x1(tau) = C_FAR (cos tau - 1) - 0.5 sin tau from (0, 0.5)
+    (fp, flp), (fm, flm) = _rotation(0.0), _rotation(C_FAR)
+    system = PiecewiseSystem(names=("x1", "x2"), field_minus=fm, field_plus=fp,
+                             switch=lambda z: z[0],
+                             switch_grad=lambda z: np.stack([np.ones_like(z[0]),
+                                                             np.zeros_like(z[1])]),
+                             flows={PLUS: flp, MINUS: flm}, sample_step=sample_step)
+    x1 = lambda tau: C_FAR * (np.cos(tau) - 1.0) - 0.5 * np.sin(tau)
+    want = np.pi / 2 + brentq(lambda tau: x1(tau) + 0.1, 1.5 * np.pi, 2 * np.pi - 2 / C_FAR,
+                              xtol=1e-15)
+    section = Section("x1=-0.1", lambda z: z[0] + 0.1, direction=1)
+    traj = simulate(system, [0.5, 0.0], 9.0, sections=[section], method=method, dense=False)
+    hits = [e.t for e in traj.events if e.kind == "section"]
+    assert hits and hits[0] == pytest.approx(want, abs=1e-9), (hits, want)
+
+
+def _band(z, p):
+    return np.array([1.0, np.nan if p[0] < z[0] < p[1] else 0.0])
+
+
+@_miss("a return in the sample interval before the first sample whose field is not "
+       "finite: the window is cut at that sample (D16 (1)) and the return with it")
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_return_just_before_a_nan_band_stands(engine):
+    # x' = 1, the field NaN for 2.2861 < x < 2.3361, the return section at x = 2.0861
+    lo = 2.2860759493670884
+    system = FilippovSystem(("x", "y"), _band, _band, lambda z, p: z[1] + 100.0,
+                            lambda z, p: np.array([0.0, 1.0]),
+                            params=np.array([lo, lo + 0.05, lo - 0.2]))
+    try:
+        got = first_returns(system, [[0.0, 0.3]], lambda z, p: z[0] - p[2], 300.0,
+                            engine=engine)
+    except SimulationError as err:
+        pytest.fail(f"refused: {err}")
+    assert got.time[0] == pytest.approx(lo - 0.2, abs=1e-12)
