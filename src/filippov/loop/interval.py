@@ -17,7 +17,9 @@ Between two samples of a stay the search asks, in this order:
    (``rules.graze``, ``rules.speed_graze``): an exit or switch at the function's root
    before it (the earliest event wins), or a touch, recorded when it comes before any
    event, in time order;
-3. each section that changes sign, in order: its root is the event when it comes first
+3. each section that changes sign, in order (where step 2 found the event, between the
+   first sample and that event: the samples past it follow the old mode's field, which
+   turned back there): its root is the event when it comes first
    (``rules.section_first``: not before its min_time; before the event so far, or at its
    instant when that is a switch or an exit -- a section on H is hit where the orbit
    arrives on H) and the engine counts it there (``where`` holds, and it is not the run's
@@ -228,8 +230,8 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
     """``window_event(ctx, mode) -> (status, t, what, k)``: the earliest event over a
     window's intervals (this module's docstring) on the engine's :data:`WindowOps`; a
     leave function's root compiled by ``call``, a hidden extremum by ``inline``."""
-    window, sampled, counts, touch, unband = (
-        ops.window, ops.sampled, ops.counts, ops.touch, ops.unband)
+    window, sampled, value, counts, touch, unband = (
+        ops.window, ops.sampled, ops.value, ops.counts, ops.touch, ops.unband)
     refine = call(make_refine(ops.root, ops.value))
     extremum = inline(make_extremum(ops))
     leave_root = call(make_leave_root(ops, refine, extremum))
@@ -254,6 +256,7 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
                 continue
             if hit:
                 best_t, best_w, best_k, touch_0, touch_1 = math.inf, NONE, -1, math.inf, math.inf
+                hidden = False  # the event so far ends a hidden extremum (step 2)
                 # 1. the leave functions' crossings: the earliest
                 for q in range(nl):
                     if not (c0 if q == 0 else c1):
@@ -273,19 +276,23 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
                     if st != OK:
                         return st, r, NONE, -1
                     if kind == GRAZE_CROSSES and (best_w == NONE or r < best_t):
-                        best_t, best_w = r, rules.ended_by(mode, q)
+                        best_t, best_w, hidden = r, rules.ended_by(mode, q), True
                     elif kind == GRAZE_TOUCHES:
                         touch_0, touch_1 = (r, touch_1) if q == 0 else (touch_0, r)
                 for tm in (min(touch_0, touch_1), max(touch_0, touch_1)):
                     if tm < best_t:  # a touch before any exit, in time order: P has a kink
                         touch(ctx, tm, mode)
-                # 3. the sections in order: a hit that comes first, or at a switch
+                # 3. the sections in order: a hit that comes first, or at a switch (asked
+                # at a hidden extremum's crossing itself: the samples past it turned back)
                 for k in range(len(w.preds)):
                     pred, t_min = w.preds[k], w.t_mins[k]
                     sa, sb = sampled(ctx, F_SECTION + k, i), sampled(ctx, F_SECTION + k, i + 1)
+                    tb = sampled(ctx, F_TIME, i + 1)
+                    if hidden and not rules.crosses(pred, sa, sb):
+                        tb, sb = best_t, value(ctx, F_SECTION + k, best_t, mode)
                     if rules.crosses(pred, sa, sb):
                         ok, r = refine(ctx, F_SECTION + k, pred, sampled(ctx, F_TIME, i),
-                                       sampled(ctx, F_TIME, i + 1), sa, sb, mode)
+                                       tb, sa, sb, mode)
                         if not ok:
                             return ROOT_FAILED, r, NONE, -1
                         if (rules.section_first(r, t_min, best_t, best_w == SECTION, w.xtol)
