@@ -257,6 +257,38 @@ def test_a_section_crossed_just_before_a_switch_found_between_samples_is_hit(met
     assert hits and hits[0] == pytest.approx(want, abs=1e-9), (hits, want)
 
 
+def _rotation_field(z, p):
+    return np.array([-z[1], z[0] + p[0]])
+
+
+def _rotation_flow(z0, tau, p):
+    u, v = z0[0] + p[0], z0[1]
+    return np.array([np.cos(tau) * u - np.sin(tau) * v - p[0],
+                     np.sin(tau) * u + np.cos(tau) * v])
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_the_same_return_before_a_switch_found_between_samples_on_both_engines(engine):
+    # the case above as a return to x1 = -0.1 (upwards) on both engines: region - about
+    # (-C_FAR, 0), region + about the origin
+    def plus(z, p):
+        return np.array([-z[1], z[0]])
+
+    def plus_flow(z0, tau, p):
+        return np.array([np.cos(tau) * z0[0] - np.sin(tau) * z0[1],
+                         np.sin(tau) * z0[0] + np.cos(tau) * z0[1]])
+
+    system = FilippovSystem(("x1", "x2"), _rotation_field, plus, lambda z, p: z[0],
+                            lambda z, p: np.array([1.0, 0.0]), params=np.array([C_FAR]),
+                            flow_minus=_rotation_flow, flow_plus=plus_flow, sample_step=0.05)
+    x1 = lambda tau: C_FAR * (np.cos(tau) - 1.0) - 0.5 * np.sin(tau)
+    want = np.pi / 2 + brentq(lambda tau: x1(tau) + 0.1, 1.5 * np.pi, 2 * np.pi - 2 / C_FAR,
+                              xtol=1e-15)
+    got = first_returns(system, [[0.5, 0.0]], lambda z, p: z[0] + 0.1, 9.0, direction=1,
+                        engine=engine)
+    assert got.time[0] == pytest.approx(want, abs=1e-9)
+
+
 def _band(z, p):
     return np.array([1.0, np.nan if p[0] < z[0] < p[1] else 0.0])
 
