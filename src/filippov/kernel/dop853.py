@@ -20,6 +20,9 @@ _NI = _dop.INTERPOLATOR_POWER    # 7
 # _checked_field's first_call, as numpy booleans: a literal True/False would compile it
 # twice (see base: codes handed to helpers)
 _FIRST_CALL, _TRIAL = np.bool_(True), np.bool_(False)
+# the rows of K _met_guard searches, as numpy integers for the same reason: the stages
+# (the field at the step's end among them), then the interpolant's extra stages
+_STAGE_1, _EXTRA_1, _EXTRA_END = np.int64(1), np.int64(_NS + 1), np.int64(_NSE)
 _A = np.ascontiguousarray(_dop.A, dtype=np.float64)
 _B = np.ascontiguousarray(_dop.B, dtype=np.float64)
 _E3 = np.ascontiguousarray(_dop.E3, dtype=np.float64)
@@ -189,11 +192,11 @@ def _dop_step(mode, t, h_abs, ctl, fns, p, fl, d):
             err = abs(h) * e5 / np.sqrt((e5 + 0.01 * e3) * n)
         # a step whose stages met the non-finite guard is never accepted, nor one whose
         # interpolant's extra stages (taken here for _dop_dense) did (_met_guard)
-        guard = _met_guard(K, 1, _NS + 1)
+        guard = _met_guard(K, _STAGE_1, _EXTRA_1)
         if err < 1.0 and guard == 0:
             for s in range(_NS + 1, _NSE):
                 _stage(s, mode, y, h, stages, fns, p, fl)
-            guard = _met_guard(K, _NS + 1, _NSE)
+            guard = _met_guard(K, _EXTRA_1, _EXTRA_END)
         if guard != 0 and t_guard == np.inf:
             t_guard = t + _C[guard] * h
         if err < 1.0 and guard == 0:
