@@ -287,12 +287,12 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
                 for k in range(len(w.preds)):
                     pred, t_min = w.preds[k], w.t_mins[k]
                     sa, sb = sampled(ctx, F_SECTION + k, i), sampled(ctx, F_SECTION + k, i + 1)
-                    tb = sampled(ctx, F_TIME, i + 1)
+                    tb = math.inf   # the interval's end, read only for a crossing
                     if hidden and not rules.crosses(pred, sa, sb):
                         tb, sb = best_t, value(ctx, F_SECTION + k, best_t, mode)
                     if rules.crosses(pred, sa, sb):
                         ok, r = refine(ctx, F_SECTION + k, pred, sampled(ctx, F_TIME, i),
-                                       tb, sa, sb, mode)
+                                       min(tb, sampled(ctx, F_TIME, i + 1)), sa, sb, mode)
                         if not ok:
                             return ROOT_FAILED, r, NONE, -1
                         if (rules.section_first(r, t_min, best_t, best_w == SECTION, w.xtol)
