@@ -255,7 +255,8 @@ def check_intersection(choice, m: int) -> None:
 
 def check_regions(keys, m: int) -> None:
     """A field for every region of m surfaces among the sign vectors ``keys``."""
-    missing = [s for s in regions(m) if s not in set(keys)]
+    given = set(keys)
+    missing = [s for s in regions(m) if s not in given]
     if missing:
         raise ValueError(f"fields: no field for region {missing[0]} (one per sign vector: "
                          f"{2 ** m} regions)")
