@@ -36,6 +36,8 @@ declared by the system or measured at the start):
 A limitation found later and not yet mended would be marked xfail(strict=True) here: it
 runs, it fails, and it turns the suite red the day a change mends it.
 """
+import re
+
 import numpy as np
 import pytest
 from scipy.optimize import brentq
@@ -293,8 +295,6 @@ def _band(z, p):
     return np.array([1.0, np.nan if p[0] < z[0] < p[1] else 0.0])
 
 
-@_miss("a return in the sample interval before the first sample whose field is not "
-       "finite: the window is cut at that sample (D16 (1)) and the return with it")
 @pytest.mark.parametrize("engine", ENGINES)
 def test_a_return_just_before_a_nan_band_stands(engine):
     # x' = 1, the field NaN for 2.2861 < x < 2.3361, the return section at x = 2.0861
@@ -308,3 +308,46 @@ def test_a_return_just_before_a_nan_band_stands(engine):
     except SimulationError as err:
         pytest.fail(f"refused: {err}")
     assert got.time[0] == pytest.approx(lo - 0.2, abs=1e-12)
+
+
+# The mend of the test above (docs/decisions.md#past-a-non-finite-sample): the interval
+# before the first sample that is not finite is searched in sub-windows that halve the
+# bracket to the field's edge. x' = 1 from x = 0: the return to x = lo - d is at
+# t = lo - d exactly; the band (lo, lo + 0.05) starts at t = lo. The band's positions
+# fall at different places among the samples and the steps' stages.
+BAND_STARTS = (2.2860759493670884, 2.71, 3.0, 3.9645569620253163, 4.4, 5.346835443037975)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("lo", BAND_STARTS)
+def test_a_return_any_distance_before_a_nan_band_stands(engine, lo):
+    system = FilippovSystem(("x", "y"), _band, _band, lambda z, p: z[1] + 100.0,
+                            lambda z, p: np.array([0.0, 1.0]),
+                            params=np.array([lo, lo + 0.05, 0.0]))
+    for d in (0.3, 0.01, 1e-6, 1e-10):
+        system.params[2] = lo - d
+        got = first_returns(system, [[0.0, 0.3]], lambda z, p: z[0] - p[2], 300.0,
+                            engine=engine)
+        assert got.time[0] == pytest.approx(lo - d, abs=1e-12), d
+
+
+#: bands a sample meets and no stage of a step does (the three stopped 0.019-0.027 past
+#: the edge, at that sample), and half-lines (the steps' stages meet them)
+STOPPING_BANDS = ([(lo, lo + 0.05) for lo in BAND_STARTS[::3] + BAND_STARTS[-1:]]
+                  + [(lo, np.inf) for lo in BAND_STARTS])
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("band", STOPPING_BANDS)
+def test_a_run_into_a_nan_band_stops_at_its_edge(engine, band):
+    # no event before the field turns non-finite: the run stops at its edge, to the
+    # event tolerance and the time's rounding (a band thinner than the steps that no
+    # sample meets either passes unseen: D16 (5))
+    lo, hi = band
+    system = FilippovSystem(("x", "y"), _band, _band, lambda z, p: z[1] + 100.0,
+                            lambda z, p: np.array([0.0, 1.0]),
+                            params=np.array([lo, hi, lo + 1.0]))
+    with pytest.raises(SimulationError, match="field_plus returned a non-finite") as err:
+        first_returns(system, [[0.0, 0.3]], lambda z, p: z[0] - p[2], 300.0, engine=engine)
+    t = float(re.search(r"t=([-0-9.e+]+)", str(err.value)).group(1))
+    assert abs(t - lo) <= 1e-12, (t, lo)   # x = t up to the integration's rounding

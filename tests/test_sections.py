@@ -351,3 +351,27 @@ def test_a_section_on_h_is_hit_once_where_the_switch_follows_a_few_ulps_later(me
     assert traj2.status == ("t_end" if len(hits) < 2 else "section:H"), traj2.status
     if len(hits) >= 2:
         assert traj2.t == pytest.approx(hits[1], abs=1e-12)
+
+
+def test_a_section_found_again_within_its_own_instant_is_refused_not_counted():
+    # defence in depth behind the start on a section after a hit (D25): section hits
+    # count against no budget, so the same crossing found again an ulp later would be
+    # logged twice, and where it rounded the same state each time the run crawled on an
+    # ulp per hit (a hang). The reference's record of a hit refuses it, naming the section
+    from types import SimpleNamespace
+
+    from filippov.simulate import GO_ON, _section_hit
+
+    sec = Section("x=0", lambda z: z[0])
+    traj = SimpleNamespace(events=[], t0=0.0)
+    run = SimpleNamespace(sections=[sec], hit_section=0, traj=traj, event_xtol=1e-15,
+                          z=np.array([0.0, 1.0]), step_Z=None, hits=[0],
+                          start_instant=-1.0, start_sections=None)
+    t = 1.2345
+    assert _section_hit(MINUS, t, run) == GO_ON and run.hits == [1]   # logged, goes on
+    assert [e.kind for e in traj.events] == ["section"]
+    with pytest.raises(SimulationError, match="section 'x=0' crossed again at the instant"):
+        _section_hit(MINUS, np.nextafter(t, 2.0), run)
+    assert run.hits == [1] and len(traj.events) == 1
+    # a crossing of the same section later than its instant is a hit
+    assert _section_hit(MINUS, t + 1e-9, run) == GO_ON and run.hits == [2]

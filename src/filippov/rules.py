@@ -10,6 +10,8 @@ only in how they step, sample and store). Modes are the integers of :mod:`filipp
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .system import MINUS, PLUS, SLIDING
@@ -22,7 +24,7 @@ _EPS = float(np.finfo(float).eps)
 #: quote; every other rule is a decision of the method, which the loop (filippov.loop)
 #: asks for both engines
 ENGINE_NUMERICS = ("exact_window", "rate_step", "central_step", "richardson_step",
-                   "section_probe", "section_noise", "section_pred",
+                   "section_probe", "section_noise", "section_pred", "cut_midpoint",
                    "geometric_accumulation", "budget_projection")
 
 _TINY = float(np.finfo(float).tiny)
@@ -574,6 +576,18 @@ def can_split(ta: float, tb: float, t0: float, t1: float) -> bool:
     t0's rounding."""
     d = (t1 - t0) / SPLIT
     return d >= (tb - ta) / SPLIT ** MAX_SPLITS and t0 + d > t0
+
+
+def cut_midpoint(lo: float, hi: float, xtol: float) -> float:
+    """The end of the next sub-window an engine samples past a window's first sample that
+    is not finite (at hi; the samples up to lo finite, no event among them): the middle
+    of [lo, hi], or NaN once the bracket is within xtol and the rounding of hi -- the run
+    then stops at hi. The sub-windows [lo, mid] are sampled as the window was and searched
+    for an event before the field's edge (docs/decisions.md#past-a-non-finite-sample)."""
+    mid = lo + 0.5 * (hi - lo)
+    if hi - lo <= xtol + 4.0 * _EPS * abs(hi) or not lo < mid < hi:
+        return math.nan
+    return mid
 
 
 #: the non-finite guard both engines keep on an integration step: a non-finite field value

@@ -842,9 +842,16 @@ def _section_hit(mode, t, run):
     """Logs the hit, and those of the sections crossed at its instant
     (:func:`filippov.section.tied_hits`, on the step's dense output), in order; GO_ON, or
     OK when a terminal one is hit often enough (``hit_section``: the first such)."""
+    just_hit = hit_within(run.sections, run.traj.events, t, run.event_xtol)
+    if run.hit_section in just_hit:
+        # the same crossing found again within its own instant: the run would not advance
+        # (section hits count against no budget) -- refused, never counted twice
+        raise run_error(ROOT_FAILED, t, run.z, f"; section "
+                        f"{run.sections[run.hit_section].name!r} crossed again at the "
+                        "instant of its last hit; the run does not advance past it")
     ties = [] if len(run.sections) < 2 else tied_hits(
         run.sections, run.hit_section, t, run.z, run.step_Z, run.traj.t0, run.event_xtol,
-        skip=hit_within(run.sections, run.traj.events, t, run.event_xtol))
+        skip=just_hit)
     ended, hit = None, sorted([run.hit_section] + ties)   # one instant: in the order given
     for idx in hit:
         sec = run.sections[idx]
@@ -1055,6 +1062,7 @@ class _Scan:
         """The samples before k only: an event among them stands (past an event the
         samples follow this mode's field, not the orbit); with none, :meth:`earliest`
         stops the run at sample k."""
+        self.cut_at, self.n_sampled = self.ts[k], self.ts.size
         self.ts, self.zs = self.ts[:k], self.zs[:, :k]
         self.vals, self.raw = [v[:k] for v in self.vals], [v[:k] for v in self.raw]
         self.svals = [v[:k] for v in self.svals]
@@ -1116,16 +1124,57 @@ class _Scan:
 
     def earliest(self):
         """(t, z, what, section index) of the earliest event in the segment, or None; and
-        the band still in force after it."""
-        if self.not_finite is not None and self.ts.size < 2:
+        the band still in force after it. Past a sample that is not finite, the interval
+        up to it is searched in sub-windows (:meth:`_past_cut`)."""
+        if self.not_finite is not None and self.ts.size < 1:
             raise self._non_finite(*self.not_finite[1:])
+        found, scan = self._search(), self
+        if found is None and self.not_finite is not None:
+            found, scan = self._past_cut()
+        if found is None:
+            return None, scan.band
+        r, what, k = found
+        return (r, np.asarray(self.Z(r), dtype=float).reshape(-1).copy(), what, k), scan.band
+
+    def _search(self):
+        """(t, what, section index) of the earliest event on the samples, or None."""
+        if self.ts.size < 2:
+            return None
         self.cand = self.candidates()
         _, r, what, k = _window_event(self, self.mode)
-        if what == interval.NONE and self.not_finite is not None:
-            raise self._non_finite(*self.not_finite[1:])
-        if what == interval.NONE:
-            return None, self.band
-        return (r, np.asarray(self.Z(r), dtype=float).reshape(-1).copy(), what, k), self.band
+        return None if what == interval.NONE else (r, what, k)
+
+    def _past_cut(self):
+        """The interval before the first sample that was not finite, with no event up to
+        it: sub-windows [lo, mid] sampled as this window was, the bracket halved
+        (rules.cut_midpoint) to the field's edge; an event before it stands, else the run
+        stops at the last sample found not finite (docs/decisions.md#past-a-non-finite-sample;
+        the kernel's driver._past_cut). (event or None, the last scan: its band)."""
+        scan, not_finite = self, self.not_finite
+        lo, hi = self.ts[-1], self.cut_at
+        frac = np.linspace(0.0, 1.0, self.n_sampled)
+        first = self.first and self.ts.size == 1
+        mid = rules.cut_midpoint(lo, hi, self.xtol)
+        while mid == mid:
+            ts = lo + frac * (mid - lo)
+            ts[-1] = mid
+            scan = _Scan(self.system, self.mode, self.Z, ts, self.Z(ts), scan.leave,
+                         self.sections, self.preds, first, self.touch_tol, self.xtol,
+                         self.traj, scan.band, self.unbanded)
+            scan.start_sections, scan.start = self.start_sections, self.start
+            if scan.not_finite is not None and scan.not_finite[0] == 0:
+                not_finite = scan.not_finite   # lo's own sample: the edge is there
+                break
+            found = scan._search()
+            if found is not None:
+                return found, scan
+            if scan.not_finite is None:
+                lo = mid
+            else:
+                not_finite, lo, hi = scan.not_finite, scan.ts[-1], scan.cut_at
+            first = False
+            mid = rules.cut_midpoint(lo, hi, self.xtol)
+        raise self._non_finite(*not_finite[1:])
 
     # -------------------------------------------- the event search's operations on it
     # The walk over the window's intervals, the questions of each and every decision

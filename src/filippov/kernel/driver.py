@@ -152,10 +152,10 @@ def _window(mode, ta, tb, first, may_split, ctx):
     bad, speed2_a = _sample(mode, ta, tb, frac, k0, o, sm, sc)
     # a sample whose state or value is not finite (bad >= 0) ends the samples searched:
     # an event before it stands (past an event the samples follow this mode's field, not
-    # the orbit), and with none the run stops there (_stop_non_finite)
-    piece = bad >= 0 and _all_finite(sc.wz)  # a piece's value, not the state
-    if bad >= 0 and bad < 2:
-        return _stop_non_finite(bad, piece, ta, mode, o, sm, w)
+    # the orbit); with none, the interval up to it is searched in sub-windows (_past_cut)
+    # and with none there the run stops at the field's edge (_stop_non_finite)
+    if bad == 0:  # at ta (or where the rates a step ahead of it were evaluated)
+        return _stop_non_finite(sm.ts[0], ta, mode, o, sc, w)
     # an exact flow (SEG_INTEGRATED == 0) must follow its field over the window: from the
     # state at ta (w.z) to that at tb (w.ynew), the field at tb left in w.wf by the last
     # sample; else the run stops at ta (w.z)
@@ -164,7 +164,14 @@ def _window(mode, ta, tb, first, may_split, ctx):
         return FLOW_OFF_FIELD, ta, _W_NONE
     if bad < 0 and may_split and not exact and not _resolved(mode, ns, sm):
         return UNRESOLVED, ta, _W_NONE
-    st, te, what = _find(mode, ns if bad < 0 else bad, first, s, o, sm, sc)
+    t_stop = ta
+    if bad < 0 or bad >= 2:
+        st, te, what = _find(mode, ns if bad < 0 else bad, first, s, o, sm, sc)
+    else:
+        st, te, what = OK, ta, _W_NONE
+    if st == OK and what == _W_NONE and bad >= 1:
+        st, te, what, t_stop = _past_cut(mode, sm.ts[bad - 1], sm.ts[bad],
+                                         first and bad == 1, s, o, sm, sc)
     # P is not differentiable where the orbit touches H
     if _DERIVATIVES and s.jac and w.touched[0]:
         for i in range(w.z.size):
@@ -173,7 +180,7 @@ def _window(mode, ta, tb, first, may_split, ctx):
     if st != OK:
         return st, ta, _W_NONE
     if what == _W_NONE and bad >= 0:
-        return _stop_non_finite(bad, piece, ta, mode, o, sm, w)
+        return _stop_non_finite(t_stop, ta, mode, o, sc, w)
     if what == _W_NONE:
         for c in range(w.z.size):
             w.z[c] = w.ynew[c]
@@ -183,13 +190,50 @@ def _window(mode, ta, tb, first, may_split, ctx):
 
 
 @_jit_inline
-def _stop_non_finite(bad, piece, ta, mode, o, sm, w):
-    """NON_FINITE: at sample ``bad`` (its time; the state there in w.z) where a piece's
-    value was not finite, or at ta (w.z the last finite state) where the state was not."""
-    if piece:
-        _zat(sm.ts[bad], mode, o, w.z)
-        return NON_FINITE, sm.ts[bad], _W_NONE
-    return NON_FINITE, ta, _W_NONE
+def _stop_non_finite(t, ta, mode, o, sc, w):
+    """NON_FINITE: at t (the state there in w.z) where a piece's value was not finite, or
+    at ta (w.z the last finite state) where the state was not."""
+    _zat(t, mode, o, sc.wz)
+    if not _all_finite(sc.wz):
+        return NON_FINITE, ta, _W_NONE
+    for c in range(w.z.size):
+        w.z[c] = sc.wz[c]
+    return NON_FINITE, t, _W_NONE
+
+
+#: _sample from a sub-window's first sample: an int64 as _window's k0 is, so that
+#: _sample is compiled once (docs/decisions.md#kernel-codes-are-numpy-integers)
+_ALL_SAMPLES = np.int64(0)
+
+
+@_jit  # a call: the path past a non-finite sample is rare
+def _past_cut(mode, lo, hi, first, s, o, sm, sc):
+    """The interval [lo, hi] of a window whose sample at hi was not finite, with no event
+    up to lo: searched in sub-windows [lo, mid] sampled as the window was, halving the
+    bracket (rules.cut_midpoint) to the field's edge -- an event before it stands
+    (docs/decisions.md#past-a-non-finite-sample). (status, t, what, t_stop): the event,
+    or _W_NONE and the time the run stops at (the last sample found not finite)."""
+    exact = mode != SLIDING and o.seg[SEG_INTEGRATED] == 0.0
+    frac = s.frac_ex if exact else s.frac_in
+    ns = frac.size
+    t_stop = hi  # where the last sample not finite was (the rates: a step ahead of it)
+    mid = rules.cut_midpoint(lo, hi, o.xtol)
+    while mid == mid:
+        bad, _ = _sample(mode, lo, mid, frac, _ALL_SAMPLES, o, sm, sc)
+        if bad == 0:  # lo's own sample (the rates a step ahead of it): the edge is there
+            return OK, lo, _W_NONE, sm.ts[0]
+        if bad < 0 or bad >= 2:
+            st, te, what = _find(mode, ns if bad < 0 else bad, first, s, o, sm, sc)
+            if st != OK or what != _W_NONE:
+                return st, te, what, t_stop
+        if bad < 0:
+            lo = mid
+        else:  # the bracket by the samples' times (the rates' a step ahead would widen it)
+            t_stop = sm.ts[bad]
+            lo, hi = sm.ts[bad - 1], (lo + frac[bad] * (mid - lo) if bad < ns - 1 else mid)
+        first = False
+        mid = rules.cut_midpoint(lo, hi, o.xtol)
+    return OK, lo, _W_NONE, t_stop
 
 
 # ------------------------------------------------------------------ a stay's operations
