@@ -558,10 +558,9 @@ def test_a_start_at_the_origin_on_the_section_is_no_return(flows):
 # Issue 57 (1): a piece (switch, switch_grad, the section) that turns NaN where the orbit
 # goes stops the run with a SimulationError naming it, where it went there: never a number
 # (before the mend both engines returned, the NaN samples showing no sign change). The
-# piece is met at samples: with exact flows one sample step (SAMPLE_STEP) apart; with
-# integrated flows an integration step's (DOP853 at rtol 1e-12 on these fields: <= 0.07
-# measured; NAN_STEP allows 3.5 times that), or a trial stage that straddles the entry.
-NAN_STEP = {"exact": gs.SAMPLE_STEP, "integrate": 0.25}
+# piece is met at samples (with exact flows one sample step, SAMPLE_STEP, apart; with
+# integrated flows an integration step's, <= 0.07 here), and the interval before the first
+# such sample is searched to the edge (D26): the run stops where the orbit enters.
 # each dimension's NaN structure costs ~3-5 s to build (its pieces compiled for both
 # engines): the ci profile draws 3-D systems only, deep all of DIMS
 NAN_DIMS = gs.DIMS if os.environ.get("HYPOTHESIS_PROFILE") == "deep" else (3,)
@@ -592,12 +591,15 @@ def _run_error(call):
 def test_a_piece_that_turns_nan_on_the_way_stops_the_run_by_name(flows, piece, data):
     """A crossing system whose switch, switch_grad or section is 0 * sqrt(level - m.z):
     the orbit enters m.z > level (transversally) at t_nan, before its switch or return.
-    Both engines raise naming that piece, at a time from t_nan to t_nan + one sample or
-    integration step, at the closed-form state of that time on the stay the orbit met the
-    NaN in -- inside the NaN region. (Not the orbit of the NaN-free system: where its
-    switch or return comes within that sample, the system, H or the section NaN there,
-    has none; seen in the deep profile, a switch 0.069 after t_nan with samples 0.08
-    apart, the state named 0.0089 from the NaN-free orbit's.)"""
+    Both engines raise naming that piece at t_nan -- the interval before the first sample
+    that is not finite is searched to the field's edge (docs/decisions.md
+    #past-a-non-finite-sample; it stopped at that sample, up to one sample or integration
+    step past t_nan) -- to the tolerance of a state's error over the entry's rate m.z'
+    >= RATE, at the closed-form state of that time on the stay the orbit met the NaN in.
+    (Not the orbit of the NaN-free system: where its switch or return comes within a
+    sample, the system, H or the section NaN there, has none; seen in the deep profile, a
+    switch 0.069 after t_nan with samples 0.08 apart, the state named 0.0089 from the
+    NaN-free orbit's.)"""
     from filippov import first_returns
 
     region = data.draw(gs.nan_regions(NAN_DIMS, (piece,)), label="region")
@@ -611,7 +613,7 @@ def test_a_piece_that_turns_nan_on_the_way_stops_the_run_by_name(flows, piece, d
         # the reference names the section by its Section's name
         assert f"({region.piece} returned a non-finite value" in msg \
             or f"({region.piece} 'section' returned a non-finite value" in msg, where
-        assert -TOL[flows] <= t - region.t_nan <= NAN_STEP[flows], \
+        assert abs(t - region.t_nan) <= TOL[flows] / gs.RATE, \
             f"t - t_nan = {t - region.t_nan}: {where}"
         _close(state, region.stay(t), TOL[flows], f"the state named ({where})")
         assert region.m @ state - region.level > -TOL[flows], where
