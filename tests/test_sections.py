@@ -353,25 +353,44 @@ def test_a_section_on_h_is_hit_once_where_the_switch_follows_a_few_ulps_later(me
         assert traj2.t == pytest.approx(hits[1], abs=1e-12)
 
 
-def test_a_section_found_again_within_its_own_instant_is_refused_not_counted():
+def test_a_section_found_again_and_again_at_one_instant_is_refused():
     # defence in depth behind the start on a section after a hit (D25): section hits
-    # count against no budget, so the same crossing found again an ulp later would be
-    # logged twice, and where it rounded the same state each time the run crawled on an
-    # ulp per hit (a hang). The reference's record of a hit refuses it, naming the section
+    # count against no budget, so a run that found one crossing again an ulp later each
+    # time, rounding the same state, crawled on an ulp per hit (a hang). The reference's
+    # record of a hit refuses a section hit more than REHITS_AT_INSTANT times within one
+    # instant, naming it; two hits there are an orbit's (next test)
     from types import SimpleNamespace
 
-    from filippov.simulate import GO_ON, _section_hit
+    from filippov.simulate import GO_ON, REHITS_AT_INSTANT, _section_hit
 
-    sec = Section("x=0", lambda z: z[0])
     traj = SimpleNamespace(events=[], t0=0.0)
-    run = SimpleNamespace(sections=[sec], hit_section=0, traj=traj, event_xtol=1e-15,
-                          z=np.array([0.0, 1.0]), step_Z=None, hits=[0],
-                          start_instant=-1.0, start_sections=None)
+    run = SimpleNamespace(sections=[Section("x=0", lambda z: z[0])], hit_section=0,
+                          traj=traj, event_xtol=1e-15, z=np.array([0.0, 1.0]),
+                          step_Z=None, hits=[0], start_instant=-1.0, start_sections=None)
     t = 1.2345
-    assert _section_hit(MINUS, t, run) == GO_ON and run.hits == [1]   # logged, goes on
-    assert [e.kind for e in traj.events] == ["section"]
-    with pytest.raises(SimulationError, match="section 'x=0' crossed again at the instant"):
-        _section_hit(MINUS, np.nextafter(t, 2.0), run)
-    assert run.hits == [1] and len(traj.events) == 1
-    # a crossing of the same section later than its instant is a hit
-    assert _section_hit(MINUS, t + 1e-9, run) == GO_ON and run.hits == [2]
+    for k in range(REHITS_AT_INSTANT):
+        assert _section_hit(MINUS, t, run) == GO_ON and run.hits == [k + 1]
+        t = np.nextafter(t, 2.0)
+    with pytest.raises(SimulationError, match=f"section 'x=0' hit {REHITS_AT_INSTANT + 1} "
+                                              "times within one instant"):
+        _section_hit(MINUS, t, run)
+    assert run.hits == [REHITS_AT_INSTANT] and len(traj.events) == REHITS_AT_INSTANT
+    # a crossing of the same section past that instant is a hit
+    assert _section_hit(MINUS, t + 1e-9, run) == GO_ON and run.hits == [REHITS_AT_INSTANT + 1]
+
+
+@pytest.mark.parametrize("e", [0.0, 1e-16, 1e-15, 3e-15, 1e-14])
+def test_an_orbit_through_a_corner_on_a_section_crosses_it_twice_or_once(e):
+    # (a review of the refusal above, in its first form: any second hit within one
+    # instant) H = {x = 0}, F_- = (1, -1), F_+ = (1, 1) from (-1, 1 - e): the orbit comes
+    # down to y = -e at x = 0 and back up, crossing y = 0 at t = 1 -+ e -- twice (once
+    # for e = 0: the corner on the section); it was refused for e = 1e-16 .. 3e-15
+    from filippov import FilippovSystem
+
+    fs = FilippovSystem(("x", "y"), lambda z, p: np.array([1.0, -1.0]),
+                        lambda z, p: np.array([1.0, 1.0]), lambda z, p: z[0],
+                        lambda z, p: np.array([1.0, 0.0])).python()
+    tr = simulate(fs, [-1.0, 1.0 - e], 2.0, sections=[Section("y0", lambda z: z[1])])
+    hits = [ev.t for ev in tr.events if ev.kind == "section"]
+    assert len(hits) in (1, 2) and all(abs(h - 1.0) <= e + 1e-15 for h in hits), hits
+    assert tr.z == pytest.approx([1.0, 1.0 - e], abs=1e-14)

@@ -115,6 +115,19 @@ def hit_within(sections, events, t: float, xtol: float) -> set:
     return {k for k, sec in enumerate(sections) if sec.name in names}
 
 
+def hits_at_instant(name: str, events, t: float, xtol: float) -> int:
+    """How many times the section ``name`` was hit (a "section" event of ``events``)
+    within ``rules.same_instant`` before t."""
+    from . import rules
+
+    d, count = rules.same_instant(xtol, t), 0
+    for e in reversed(events):
+        if e.t < t - d:
+            break
+        count += e.kind == "section" and e.name == name
+    return count
+
+
 @dataclass(frozen=True)
 class Returns:
     """First returns of ``starts`` (shape ``(m, dim)``) to one section."""

@@ -40,7 +40,7 @@ from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuilt
 from .errors import accumulation_detail, run_error
 from .loop.event import SECTION, Pieces, RunOps, make_run, make_sliding_section, make_start
 from .loop.run_state import RING, SWITCHES, Limits, new_run_state
-from .section import Section, hit_within, one_instant, tied_hits  # noqa: F401  (.Section)
+from .section import Section, hit_within, hits_at_instant, one_instant, tied_hits  # noqa: F401  (.Section)
 from .surfaces import SurfacesSystem
 from .loop.stay import UNRESOLVED
 from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
@@ -725,11 +725,13 @@ class _Run:
         ts = ta + frac * (tb - ta)
         ts[-1] = tb
         zs = Z(ts)
-        if not np.all(np.isfinite(zs)):
+        if not np.all(np.isfinite(zs[:, 0])):
             raise run_error(NON_FINITE, ta, self.z, f", mode {MODE_NAMES[self.mode]}: the "
                             f"state turns non-finite before t={tb!r} (the state given: the "
                             "last finite one)")
-        if stepper.method is None:
+        # a state not finite further on cuts the samples there (_Scan: an event before
+        # it stands), as a piece's value does; the flow is checked on a finite window
+        if stepper.method is None and np.all(np.isfinite(zs[:, -1])):
             self._check_flow(ta, tb, zs[:, -1])
         return ts, zs
 
@@ -838,20 +840,26 @@ def _no_sliding(t, z) -> SlidingNotBuiltError:
                                        "it with sliding=True to follow sliding")
 
 
+#: how many hits of one section within one instant (rules.same_instant) a run may log
+#: before it is refused as not advancing (_section_hit)
+REHITS_AT_INSTANT = 8
+
+
 def _section_hit(mode, t, run):
     """Logs the hit, and those of the sections crossed at its instant
     (:func:`filippov.section.tied_hits`, on the step's dense output), in order; GO_ON, or
     OK when a terminal one is hit often enough (``hit_section``: the first such)."""
-    just_hit = hit_within(run.sections, run.traj.events, t, run.event_xtol)
-    if run.hit_section in just_hit:
-        # the same crossing found again within its own instant: the run would not advance
-        # (section hits count against no budget) -- refused, never counted twice
-        raise run_error(ROOT_FAILED, t, run.z, f"; section "
-                        f"{run.sections[run.hit_section].name!r} crossed again at the "
-                        "instant of its last hit; the run does not advance past it")
+    name = run.sections[run.hit_section].name
+    if hits_at_instant(name, run.traj.events, t, run.event_xtol) >= REHITS_AT_INSTANT:
+        # section hits count against no budget: a run that finds one crossing again and
+        # again at one instant would not advance (an orbit may cross a section twice
+        # within rounding, at a corner: not refused)
+        raise run_error(EVENT_LIMIT, t, run.z, f"; section {name!r} hit "
+                        f"{REHITS_AT_INSTANT + 1} times within one instant: the run does "
+                        "not advance past it")
     ties = [] if len(run.sections) < 2 else tied_hits(
         run.sections, run.hit_section, t, run.z, run.step_Z, run.traj.t0, run.event_xtol,
-        skip=just_hit)
+        skip=hit_within(run.sections, run.traj.events, t, run.event_xtol))
     ended, hit = None, sorted([run.hit_section] + ties)   # one instant: in the order given
     for idx in hit:
         sec = run.sections[idx]
@@ -1046,7 +1054,8 @@ class _Scan:
         and state where the piece gave it (the rates of a and b evaluate them a step
         ahead), or None. A NaN sample shows no sign change: a switch or a section hit
         there would be missed, not found (the kernel: scan._sample)."""
-        sampled = self.raw + self.svals + ([self.D] if self.D is not None else [])
+        state = np.where(np.all(np.isfinite(self.zs), axis=0), 0.0, np.nan)
+        sampled = [state] + self.raw + self.svals + ([self.D] if self.D is not None else [])
         ahead = len(sampled)
         sampled += list(self.R) if self.R is not None else []
         first = None
@@ -1083,8 +1092,8 @@ class _Scan:
         above their rounding where 64 ulps of the samples fall short of it (measured at
         the samples only then: :func:`_rounding`; engines.py asymmetry 12)."""
         ts, n = self.ts, self.ts.size
-        if self.not_finite is not None:  # cut short: searched as it is (earliest)
-            return True
+        if self.not_finite is not None:  # cut short: searched as it is (earliest; a
+            return True                  # shorter window may miss what the cut met)
         if self.mode == SLIDING:
             judged = [(v, v, False, func) for v, func in zip(self.raw, self.leave)]
         else:
@@ -1127,7 +1136,7 @@ class _Scan:
         the band still in force after it. Past a sample that is not finite, the interval
         up to it is searched in sub-windows (:meth:`_past_cut`)."""
         if self.not_finite is not None and self.ts.size < 1:
-            raise self._non_finite(*self.not_finite[1:])
+            raise self._stop(*self.not_finite[1:], None)
         found, scan = self._search(), self
         if found is None and self.not_finite is not None:
             found, scan = self._past_cut()
@@ -1153,14 +1162,15 @@ class _Scan:
         scan, not_finite = self, self.not_finite
         lo, hi = self.ts[-1], self.cut_at
         frac = np.linspace(0.0, 1.0, self.n_sampled)
-        first = self.first and self.ts.size == 1
+        # the stay's first sample, while lo stays there: clamped as it is there
+        t_first = lo if self.first and self.ts.size == 1 else -np.inf
         mid = rules.cut_midpoint(lo, hi, self.xtol)
         while mid == mid:
             ts = lo + frac * (mid - lo)
             ts[-1] = mid
             scan = _Scan(self.system, self.mode, self.Z, ts, self.Z(ts), scan.leave,
-                         self.sections, self.preds, first, self.touch_tol, self.xtol,
-                         self.traj, scan.band, self.unbanded)
+                         self.sections, self.preds, lo == t_first, self.touch_tol,
+                         self.xtol, self.traj, scan.band, self.unbanded)
             scan.start_sections, scan.start = self.start_sections, self.start
             if scan.not_finite is not None and scan.not_finite[0] == 0:
                 not_finite = scan.not_finite   # lo's own sample: the edge is there
@@ -1172,9 +1182,17 @@ class _Scan:
                 lo = mid
             else:
                 not_finite, lo, hi = scan.not_finite, scan.ts[-1], scan.cut_at
-            first = False
             mid = rules.cut_midpoint(lo, hi, self.xtol)
-        raise self._non_finite(*not_finite[1:])
+        raise self._stop(*not_finite[1:], lo)
+
+    def _stop(self, t, z, lo):
+        """The run's end past the last finite sample lo (None: none): where a piece's
+        value was not finite (t, z), or at lo where the state itself was not."""
+        if np.all(np.isfinite(z)) or lo is None:
+            return self._non_finite(t, z)
+        return run_error(NON_FINITE, lo, self.Z(lo), f", mode {MODE_NAMES[self.mode]}: the "
+                         f"state turns non-finite after t={lo!r}, within the event tolerance "
+                         "(the state given: the last finite one)")
 
     # -------------------------------------------- the event search's operations on it
     # The walk over the window's intervals, the questions of each and every decision

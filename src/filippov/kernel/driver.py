@@ -155,7 +155,7 @@ def _window(mode, ta, tb, first, may_split, ctx):
     # the orbit); with none, the interval up to it is searched in sub-windows (_past_cut)
     # and with none there the run stops at the field's edge (_stop_non_finite)
     if bad == 0:  # at ta (or where the rates a step ahead of it were evaluated)
-        return _stop_non_finite(sm.ts[0], ta, mode, o, sc, w)
+        return _stop_non_finite(sm.ts[0], ta, ta, mode, o, sc, w)
     # an exact flow (SEG_INTEGRATED == 0) must follow its field over the window: from the
     # state at ta (w.z) to that at tb (w.ynew), the field at tb left in w.wf by the last
     # sample; else the run stops at ta (w.z)
@@ -179,8 +179,8 @@ def _window(mode, ta, tb, first, may_split, ctx):
                 w.deriv.M[i, j] = np.nan
     if st != OK:
         return st, ta, _W_NONE
-    if what == _W_NONE and bad >= 0:
-        return _stop_non_finite(t_stop, ta, mode, o, sc, w)
+    if what == _W_NONE and bad >= 0:  # te: the last finite sample (_past_cut)
+        return _stop_non_finite(t_stop, te, ta, mode, o, sc, w)
     if what == _W_NONE:
         for c in range(w.z.size):
             w.z[c] = w.ynew[c]
@@ -190,12 +190,14 @@ def _window(mode, ta, tb, first, may_split, ctx):
 
 
 @_jit_inline
-def _stop_non_finite(t, ta, mode, o, sc, w):
+def _stop_non_finite(t, t_last, ta, mode, o, sc, w):
     """NON_FINITE: at t (the state there in w.z) where a piece's value was not finite, or
-    at ta (w.z the last finite state) where the state was not."""
+    where the state was not at t_last, the last finite sample before it (at ta: w.z)."""
     _zat(t, mode, o, sc.wz)
     if not _all_finite(sc.wz):
-        return NON_FINITE, ta, _W_NONE
+        if t_last != ta:
+            _zat(t_last, mode, o, w.z)
+        return NON_FINITE, t_last, _W_NONE
     for c in range(w.z.size):
         w.z[c] = sc.wz[c]
     return NON_FINITE, t, _W_NONE
@@ -217,13 +219,14 @@ def _past_cut(mode, lo, hi, first, s, o, sm, sc):
     frac = s.frac_ex if exact else s.frac_in
     ns = frac.size
     t_stop = hi  # where the last sample not finite was (the rates: a step ahead of it)
+    t_first = lo if first else -np.inf  # the stay's first sample, while lo stays there
     mid = rules.cut_midpoint(lo, hi, o.xtol)
     while mid == mid:
         bad, _ = _sample(mode, lo, mid, frac, _ALL_SAMPLES, o, sm, sc)
         if bad == 0:  # lo's own sample (the rates a step ahead of it): the edge is there
             return OK, lo, _W_NONE, sm.ts[0]
-        if bad < 0 or bad >= 2:
-            st, te, what = _find(mode, ns if bad < 0 else bad, first, s, o, sm, sc)
+        if bad < 0 or bad >= 2:  # from the stay's first sample: clamped as it is there
+            st, te, what = _find(mode, ns if bad < 0 else bad, lo == t_first, s, o, sm, sc)
             if st != OK or what != _W_NONE:
                 return st, te, what, t_stop
         if bad < 0:
@@ -231,7 +234,6 @@ def _past_cut(mode, lo, hi, first, s, o, sm, sc):
         else:  # the bracket by the samples' times (the rates' a step ahead would widen it)
             t_stop = sm.ts[bad]
             lo, hi = sm.ts[bad - 1], (lo + frac[bad] * (mid - lo) if bad < ns - 1 else mid)
-        first = False
         mid = rules.cut_midpoint(lo, hi, o.xtol)
     return OK, lo, _W_NONE, t_stop
 
