@@ -453,3 +453,33 @@ def test_a_return_before_an_exact_flow_turns_non_finite_stands(engine, lo):
                       lambda z, p: z[0] - p[2], 300.0, engine=engine)
     t = float(re.search(r"t=([-0-9.e+]+)", str(err.value)).group(1))
     assert abs(t - lo) <= 1e-12, (t, lo)
+
+
+def test_no_piece_is_asked_at_a_state_that_is_not_finite():
+    # (a second review) the reference evaluated the pieces on every sample of the window,
+    # those past a state that was not finite too: a switch that indexes a table by the
+    # state (a PiecewiseSystem's numpy pieces) raised IndexError there, unnamed. The
+    # samples now end before that state (as the kernel's do): the hit at x = 2.9 before
+    # the flow's NaN band (3, 3.2), and with the section past it the run stops at 3.0
+    table = np.zeros(100)
+
+    def flow(z0, tau):
+        x = z0[0] + np.asarray(tau, dtype=float)
+        band = (3.0 < x) & (x < 3.2)
+        return np.stack([np.where(band, np.nan, x), np.where(band, np.nan, z0[1] + 0 * x)])
+
+    def uniform(z):
+        return np.stack([np.ones_like(z[0]), np.zeros_like(z[1])])
+
+    system = PiecewiseSystem(
+        ("x", "y"), uniform, uniform, lambda z: z[1] + 100 + table[np.floor(z[0]).astype(int)],
+        lambda z: np.stack([np.zeros_like(z[0]), np.ones_like(z[1])]),
+        flows={PLUS: flow, MINUS: flow}, sample_step=0.1)
+    tr = simulate(system, np.array([0.0, 0.3]), 300.0,
+                  sections=[Section("s", lambda z: z[0] - 2.9, terminal=1)])
+    assert tr.t == pytest.approx(2.9, abs=1e-12) and tr.z == pytest.approx([2.9, 0.3])
+    with pytest.raises(SimulationError, match=r"state turns non-finite after t=3\.0") as err:
+        simulate(system, np.array([0.0, 0.3]), 300.0,
+                 sections=[Section("s", lambda z: z[0] - 4.0, terminal=1)])
+    t = float(re.search(r"at t=([-0-9.e+]+)", str(err.value)).group(1))
+    assert abs(t - 3.0) <= 1e-12

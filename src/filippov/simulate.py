@@ -1023,6 +1023,13 @@ class _Scan:
 
     def __init__(self, system, mode, Z, ts, zs, leave, sections, preds, first, touch_tol,
                  xtol, traj, band, unbanded):
+        # the pieces never see a state that is not finite: the samples end before the
+        # first such (the kernel's scan._sample tests the state first), and the window
+        # is cut there (_cut; sample 0 is finite: _Run._samples)
+        self.ts_all, finite = ts, np.all(np.isfinite(zs), axis=0)
+        k_state = ts.size if finite.all() else int(np.argmin(finite))
+        state_cut = None if k_state == ts.size else (k_state, ts[k_state], zs[:, k_state])
+        ts, zs = ts[:k_state], zs[:, :k_state]
         self.system, self.mode, self.Z, self.ts, self.zs = system, mode, Z, ts, zs
         self.leave, self.sections, self.preds, self.first = leave, sections, preds, first
         self.touch_tol, self.xtol, self.traj = touch_tol, xtol, traj
@@ -1045,7 +1052,7 @@ class _Scan:
                                       traj.scale.state)
             if self.rates is not None:
                 self.R = self.rates(ts)
-        self.not_finite = self._first_not_finite()
+        self.not_finite = self._first_not_finite() or state_cut
         if self.not_finite is not None:
             self._cut(self.not_finite[0])
 
@@ -1054,8 +1061,7 @@ class _Scan:
         and state where the piece gave it (the rates of a and b evaluate them a step
         ahead), or None. A NaN sample shows no sign change: a switch or a section hit
         there would be missed, not found (the kernel: scan._sample)."""
-        state = np.where(np.all(np.isfinite(self.zs), axis=0), 0.0, np.nan)
-        sampled = [state] + self.raw + self.svals + ([self.D] if self.D is not None else [])
+        sampled = self.raw + self.svals + ([self.D] if self.D is not None else [])
         ahead = len(sampled)
         sampled += list(self.R) if self.R is not None else []
         first = None
@@ -1071,7 +1077,7 @@ class _Scan:
         """The samples before k only: an event among them stands (past an event the
         samples follow this mode's field, not the orbit); with none, :meth:`earliest`
         stops the run at sample k."""
-        self.cut_at, self.n_sampled = self.ts[k], self.ts.size
+        self.cut_at, self.n_sampled = self.ts_all[k], self.ts_all.size
         self.ts, self.zs = self.ts[:k], self.zs[:, :k]
         self.vals, self.raw = [v[:k] for v in self.vals], [v[:k] for v in self.raw]
         self.svals = [v[:k] for v in self.svals]
@@ -1191,7 +1197,7 @@ class _Scan:
         if np.all(np.isfinite(z)) or lo is None:
             return self._non_finite(t, z)
         return run_error(NON_FINITE, lo, self.Z(lo), f", mode {MODE_NAMES[self.mode]}: the "
-                         f"state turns non-finite after t={lo!r}, within the event tolerance "
+                         f"state turns non-finite after t={float(lo)!r}, within the event tolerance "
                          "(the state given: the last finite one)")
 
     # -------------------------------------------- the event search's operations on it
