@@ -483,3 +483,16 @@ def test_no_piece_is_asked_at_a_state_that_is_not_finite():
                  sections=[Section("s", lambda z: z[0] - 4.0, terminal=1)])
     t = float(re.search(r"at t=([-0-9.e+]+)", str(err.value)).group(1))
     assert abs(t - 3.0) <= 1e-12
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_finite_values_whose_sum_overflows_are_finite(engine):
+    # (a review) the kernel tested a sample's values by their sum: h = y + 1e308 and a
+    # section 1e308 cos x, each finite, sum to inf, and the compiled engine refused at
+    # t = 0 blaming the field; the reference returned. x' = 1: the return at pi / 2
+    f = lambda z, p: np.array([1.0, 0.0])   # noqa: E731
+    system = FilippovSystem(("x", "y"), f, f, lambda z, p: z[1] + 1e308,
+                            lambda z, p: np.array([0.0, 1.0]))
+    got = first_returns(system, [[0.0, 0.0]], lambda z, p: 1e308 * np.cos(z[0]), 10.0,
+                        direction=-1, engine=engine)
+    assert got.time[0] == pytest.approx(np.pi / 2, abs=1e-12)

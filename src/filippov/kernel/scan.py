@@ -19,6 +19,16 @@ from .state import (SEG_BAND, SEG_EXIT_SHIFT, SEG_INTEGRATED, SEG_LAST_H, SEG_LA
 from .roots import _brentq_f
 
 
+@_jit_inline
+def _not_finite(a, b, c):
+    """One of a, b, c is not finite: their sum asked first (one comparison where each term
+    is: the samples' path), the terms only where it is not -- finite terms whose sum
+    overflows are finite (the reference tests each array)."""
+    if np.isfinite(a + b + c):
+        return False
+    return not (np.isfinite(a) and np.isfinite(b) and np.isfinite(c))
+
+
 @_jit
 def _sample(mode, ta, tb, frac, k0, o, sm, sc):
     """Samples of one window at the fractions frac of [ta, tb] (sm: state.Samples): times
@@ -52,13 +62,13 @@ def _sample(mode, ta, tb, frac, k0, o, sm, sc):
             vals[1, k] = b
             if k == 0:  # one difference step for the window (wf, wp: F_-, F_+ at wz)
                 sg[SEG_RATE_STEP] = rules.rate_step(wz, wf, wp, a, b, o.floor)
-            if not np.isfinite(svals[k] + a + b):  # one test: finite where each term is
-                return k, speed2_a                  # (or on overflow)
+            if _not_finite(svals[k], a, b):
+                return k, speed2_a
             if sg[SEG_RATE_STEP] > 0.0:  # (overwrites wz: the state at tk + the step)
                 da, db = _rates(tk, a, b, mode, o, sc)
                 dvals[0, k] = da
                 dvals[1, k] = db
-                if not np.isfinite(da + db):  # stopped where the rates evaluated a, b
+                if _not_finite(da, db, 0.0):  # stopped where the rates evaluated a, b
                     ts[k] = tk + sg[SEG_RATE_STEP]
                     return k, speed2_a
         else:
@@ -70,7 +80,7 @@ def _sample(mode, ta, tb, frac, k0, o, sm, sc):
             else:
                 _field_minus(fns, wz, p, wf)
             dvals[0, k] = _dot(wg, wf)
-            if not np.isfinite(svals[k] + hk + dvals[0, k]):
+            if _not_finite(svals[k], hk, dvals[0, k]):
                 return k, speed2_a
             if k == 0:
                 speed2_a = _dot(wf, wf)
