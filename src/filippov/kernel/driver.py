@@ -165,10 +165,7 @@ def _window(mode, ta, tb, first, may_split, ctx):
     if bad < 0 and may_split and not exact and not _resolved(mode, ns, sm):
         return UNRESOLVED, ta, _W_NONE
     t_stop = ta
-    if bad < 0 or bad >= 2:
-        st, te, what = _find(mode, ns if bad < 0 else bad, first, s, o, sm, sc)
-    else:
-        st, te, what = OK, ta, _W_NONE
+    st, te, what = _find(mode, ns if bad < 0 else bad, first, s, o, sm, sc)  # bad = 1: none
     if st == OK and what == _W_NONE and bad >= 1:
         st, te, what, t_stop = _past_cut(mode, sm.ts[bad - 1], sm.ts[bad],
                                          first and bad == 1, s, o, sm, sc)
