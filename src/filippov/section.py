@@ -99,33 +99,27 @@ def one_instant(t0: float, t: float, xtol: float) -> bool:
     return abs(t - t0) <= rules.same_instant(xtol, max(abs(t0), abs(t)))
 
 
-def hit_within(sections, events, t: float, xtol: float) -> set:
-    """The indices of ``sections`` hit (a "section" event of ``events`` by name) within
-    ``rules.same_instant`` before t: a crossing counted there is not a tie of a hit at t
-    (:func:`tied_hits`' ``skip``), so that roots rounding puts a hair apart are each
-    counted once."""
+def names_hit_within(events, t: float, xtol: float) -> list:
+    """The names of the sections hit (the "section" events of ``events``) within
+    ``rules.same_instant`` before t, once per hit, newest first."""
     from . import rules
 
-    d, names = rules.same_instant(xtol, t), set()
+    d, names = rules.same_instant(xtol, t), []
     for e in reversed(events):
         if e.t < t - d:
             break
         if e.kind == "section":
-            names.add(e.name)
+            names.append(e.name)
+    return names
+
+
+def hit_within(sections, events, t: float, xtol: float) -> set:
+    """The indices of ``sections`` hit within ``rules.same_instant`` before t
+    (:func:`names_hit_within`): a crossing counted there is not a tie of a hit at t
+    (:func:`tied_hits`' ``skip``), so that roots rounding puts a hair apart are each
+    counted once."""
+    names = set(names_hit_within(events, t, xtol))
     return {k for k, sec in enumerate(sections) if sec.name in names}
-
-
-def hits_at_instant(name: str, events, t: float, xtol: float) -> int:
-    """How many times the section ``name`` was hit (a "section" event of ``events``)
-    within ``rules.same_instant`` before t."""
-    from . import rules
-
-    d, count = rules.same_instant(xtol, t), 0
-    for e in reversed(events):
-        if e.t < t - d:
-            break
-        count += e.kind == "section" and e.name == name
-    return count
 
 
 @dataclass(frozen=True)

@@ -40,7 +40,7 @@ from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuilt
 from .errors import accumulation_detail, run_error
 from .loop.event import SECTION, Pieces, RunOps, make_run, make_sliding_section, make_start
 from .loop.run_state import RING, SWITCHES, Limits, new_run_state
-from .section import Section, hit_within, hits_at_instant, one_instant, tied_hits  # noqa: F401  (.Section)
+from .section import Section, hit_within, names_hit_within, one_instant, tied_hits  # noqa: F401  (.Section)
 from .surfaces import SurfacesSystem
 from .loop.stay import UNRESOLVED
 from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
@@ -850,7 +850,7 @@ def _section_hit(mode, t, run):
     (:func:`filippov.section.tied_hits`, on the step's dense output), in order; GO_ON, or
     OK when a terminal one is hit often enough (``hit_section``: the first such)."""
     name = run.sections[run.hit_section].name
-    if hits_at_instant(name, run.traj.events, t, run.event_xtol) >= REHITS_AT_INSTANT:
+    if names_hit_within(run.traj.events, t, run.event_xtol).count(name) >= REHITS_AT_INSTANT:
         # section hits count against no budget: a run that finds one crossing again and
         # again at one instant would not advance (an orbit may cross a section twice
         # within rounding, at a corner: not refused)
@@ -1077,7 +1077,6 @@ class _Scan:
         """The samples before k only: an event among them stands (past an event the
         samples follow this mode's field, not the orbit); with none, :meth:`earliest`
         stops the run at sample k."""
-        self.cut_at, self.n_sampled = self.ts_all[k], self.ts_all.size
         self.ts, self.zs = self.ts[:k], self.zs[:, :k]
         self.vals, self.raw = [v[:k] for v in self.vals], [v[:k] for v in self.raw]
         self.svals = [v[:k] for v in self.svals]
@@ -1166,8 +1165,8 @@ class _Scan:
         stops at the last sample found not finite (docs/decisions.md#past-a-non-finite-sample;
         the kernel's driver._past_cut). (event or None, the last scan: its band)."""
         scan, not_finite = self, self.not_finite
-        lo, hi = self.ts[-1], self.cut_at
-        frac = np.linspace(0.0, 1.0, self.n_sampled)
+        lo, hi = self.ts[-1], self.ts_all[not_finite[0]]
+        frac = np.linspace(0.0, 1.0, self.ts_all.size)   # as _Run sampled the window
         # the stay's first sample, while lo stays there: clamped as it is there
         t_first = lo if self.first and self.ts.size == 1 else -np.inf
         mid = rules.cut_midpoint(lo, hi, self.xtol)
@@ -1187,7 +1186,8 @@ class _Scan:
             if scan.not_finite is None:
                 lo = mid
             else:
-                not_finite, lo, hi = scan.not_finite, scan.ts[-1], scan.cut_at
+                not_finite = scan.not_finite
+                lo, hi = scan.ts[-1], scan.ts_all[not_finite[0]]
             mid = rules.cut_midpoint(lo, hi, self.xtol)
         raise self._stop(*not_finite[1:], lo)
 
