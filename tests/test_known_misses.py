@@ -397,10 +397,6 @@ def test_a_switch_just_after_a_stay_begins_before_a_nan_h_is_found(engine, sampl
     assert got.state[0, 1] == pytest.approx(-d / 2, abs=1e-12)
 
 
-@_miss("a window cut at a sample that is not finite is searched as it is: too few "
-       "samples are left to judge whether they resolve h (rules.resolves asks five), and "
-       "shortening it, as an unresolved window is, samples again past a thin band the cut "
-       "met (D26)")
 @pytest.mark.parametrize("engine", ENGINES)
 def test_an_excursion_between_samples_before_a_nan_section_is_found(engine):
     # (the same review; older than the mend) th' = 1, x' = 1 where sin(th) >= 0.9 (x =

@@ -32,6 +32,9 @@ DECISIONS_IN_ENGINES = {
         "rounding floor (engines.py asymmetry 12); the window seam reports one sample at a "
         "time",
     ("kernel/driver.py", "resolves"): "as the reference's, with no floor",
+    ("simulate.py", "cut_resolves"): "whether a window cut at a sample that is not finite "
+        "keeps samples enough for resolves to judge: asked with it, on the same arrays",
+    ("kernel/driver.py", "cut_resolves"): "as the reference's",
     ("simulate.py", "flow_consistent"): "an exact flow follows its field over a window: "
         "from the states and field values the engine's sampling evaluated",
     ("kernel/scan.py", "flow_consistent"): "as the reference's",

@@ -344,6 +344,14 @@ def test_rounding_and_short_windows_are_resolved():
     assert rules.resolves(np.array([0.0, 5.0, -3.0, 1.0]), np.zeros(4), ts, 4, True, 0.0)  # < 5
 
 
+def test_a_cut_window_is_judged_only_with_five_samples_kept():
+    # kept samples of a window of n cut at one not finite (-1: not cut); a window of
+    # fewer than five is never judged (samples_per_step < 4), cut or not
+    assert rules.cut_resolves(-1, 17)
+    assert [rules.cut_resolves(k, 17) for k in range(2, 7)] == [False] * 3 + [True] * 2
+    assert rules.cut_resolves(2, 4) and rules.cut_resolves(3, 4)
+
+
 def test_the_last_run_of_five_is_judged_too():
     """Runs of five from sample 0 at a stride of 4, and the last five: with 7 samples a
     wiggle in samples 4..6 is seen."""

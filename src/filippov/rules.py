@@ -578,6 +578,14 @@ def can_split(ta: float, tb: float, t0: float, t1: float) -> bool:
     return d >= (tb - ta) / SPLIT ** MAX_SPLITS and t0 + d > t0
 
 
+def cut_resolves(kept: int, n: int) -> bool:
+    """Whether the ``kept`` samples of a window of n cut at its sample ``kept`` (that one
+    not finite; -1: not cut) may be judged by :func:`resolves`: not when fewer than the
+    five it judges are left of a window that had them (the window is then shortened,
+    its windows ending at the cut: docs/decisions.md#past-a-non-finite-sample)."""
+    return kept < 0 or kept >= 5 or n < 5
+
+
 def cut_midpoint(lo: float, hi: float, xtol: float) -> float:
     """The end of the next sub-window an engine samples past a window's first sample that
     is not finite (at hi; the samples up to lo finite, no event among them): the middle

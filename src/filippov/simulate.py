@@ -674,7 +674,10 @@ class _Run:
                      else None)
         scan.start_sections, scan.start = self.start_sections, (self.start_t, self.start_z)
         if may_split and stepper.method is not None and not scan.resolved():
-            return UNRESOLVED, ta, None
+            # a window cut at a sample not finite: its shorter windows end there
+            # (loop.stay.make_step_windows)
+            cut = scan.not_finite
+            return UNRESOLVED, (ta if cut is None else scan.ts_all[cut[0]]), None
         band = self.band
         found = self._scan(scan, ta, tb)
         if found is None:
@@ -1097,8 +1100,11 @@ class _Scan:
         above their rounding where 64 ulps of the samples fall short of it (measured at
         the samples only then: :func:`_rounding`; engines.py asymmetry 12)."""
         ts, n = self.ts, self.ts.size
-        if self.not_finite is not None:  # cut short: searched as it is (earliest; a
-            return True                  # shorter window may miss what the cut met)
+        # cut at a sample not finite: with none kept before it the interval up to it is
+        # searched (_past_cut); with too few to judge, shorter windows up to it
+        if self.not_finite is not None and (
+                n < 2 or not rules.cut_resolves(n, self.ts_all.size)):
+            return n < 2
         if self.mode == SLIDING:
             judged = [(v, v, False, func) for v, func in zip(self.raw, self.leave)]
         else:

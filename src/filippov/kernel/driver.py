@@ -113,8 +113,9 @@ _DERIVATIVES = True
 
 @_jit_inline
 def _resolved(mode, ns, sm):
-    """The window's samples resolve its leave functions and its section (rules.resolves;
-    h with its slopes dh/dt; rounding as 64 ulps of the samples: engines.py asymmetry 12)."""
+    """The window's first ns samples resolve its leave functions and its section
+    (rules.resolves; h with its slopes dh/dt; rounding as 64 ulps of the samples:
+    engines.py asymmetry 12)."""
     return (rules.resolves(sm.vals[0], sm.dvals[0], sm.ts, ns, mode != SLIDING, 0.0)
             and (mode != SLIDING
                  or rules.resolves(sm.vals[1], sm.vals[1], sm.ts, ns, False, 0.0))
@@ -162,8 +163,12 @@ def _window(mode, ta, tb, first, may_split, ctx):
     if bad < 0 and exact and not _flow_follows(w.z, w.ynew, tb - ta, speed2_a, w.wf,
                                                s.state_scale):
         return FLOW_OFF_FIELD, ta, _W_NONE
-    if bad < 0 and may_split and not exact and not _resolved(mode, ns, sm):
-        return UNRESOLVED, ta, _W_NONE
+    # a window cut at sample bad >= 2: unresolved where the samples kept are too few to
+    # judge (rules.cut_resolves) or do not resolve; its shorter windows end at the cut
+    # (loop.stay.make_step_windows). Cut at sample 1, none is kept: _past_cut below
+    if may_split and not exact and bad != 1 and not (
+            rules.cut_resolves(bad, ns) and _resolved(mode, ns if bad < 0 else bad, sm)):
+        return UNRESOLVED, (ta if bad < 0 else sm.ts[bad]), _W_NONE
     t_stop = ta
     st, te, what = _find(mode, ns if bad < 0 else bad, first, s, o, sm, sc)  # bad = 1: none
     if st == OK and what == _W_NONE and bad >= 1:

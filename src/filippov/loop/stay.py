@@ -91,16 +91,23 @@ def make_step_windows(window):
     most). The engine's operation: ``window(mode, t0, t1, first, may_split, ctx) ->
     (status, t, what)``, its status UNRESOLVED (only when ``may_split``, and never for an
     exact flow's step: the model's own window), GO_ON (no event: the orbit goes on from
-    t1) or the event's."""
+    t1) or the event's. With UNRESOLVED, t is t0, or the time of a sample that was not
+    finite, the window cut there: the windows then end there at the latest until one
+    has reached it (the shorter windows' samples could step over a thin band of the
+    field's edge the cut met: docs/decisions.md#past-a-non-finite-sample)."""
 
     def walk(mode, ta, tb, first, ctx):
-        t0, t1 = ta, tb
+        t0, t1, cap = ta, tb, tb
         while True:
             st, t, what = window(mode, t0, t1, first, rules.can_split(ta, tb, t0, t1), ctx)
             if st == UNRESOLVED:
-                t1 = rules.window_end(t0, (t1 - t0) / rules.SPLIT, tb)
+                if t > t0:
+                    cap = min(cap, t)
+                t1 = rules.window_end(t0, (t1 - t0) / rules.SPLIT, cap)
             elif st != GO_ON or t1 >= tb:
                 return st, t, what
             else:
-                t0, t1, first = t1, rules.window_end(t1, (t1 - t0) * rules.SPLIT, tb), False
+                if t1 >= cap:  # the cut's sample reached, finite this time: on to tb
+                    cap = tb
+                t0, t1, first = t1, rules.window_end(t1, (t1 - t0) * rules.SPLIT, cap), False
     return walk
