@@ -417,6 +417,72 @@ def test_an_excursion_between_samples_before_a_nan_section_is_found(engine):
     assert got.time[0] == pytest.approx(40.55, abs=1e-12)
 
 
+def _ramped_section(z, p):
+    # sin(th) - c(th), c falling smoothly from 2 to 0.5 about th = p[0]; NaN past p[1]
+    th = z[0]
+    if th > p[1]:
+        return np.nan
+    return np.sin(th) - (0.5 + 0.75 * (1.0 - np.tanh((th - p[0]) / 5.0)))
+
+
+def _first_upward_root(ramp):
+    def s(t):
+        return _ramped_section(np.array([t]), np.array([ramp, np.inf]))
+    ts = np.arange(0.0, ramp + 100.0, 1e-3)
+    v = np.array([s(t) for t in ts])
+    i = int(np.flatnonzero((v[:-1] < 0) & (v[1:] >= 0))[0])
+    return brentq(s, ts[i], ts[i + 1], xtol=1e-15)
+
+
+def _ramp_returns(engine, ramp, edge):
+    system = FilippovSystem(("th", "x"), lambda z, p: np.array([1.0, 0.0]),
+                            lambda z, p: np.array([1.0, 1.0]), lambda z, p: z[1] - 1.0,
+                            lambda z, p: np.array([0.0, 1.0]), params=np.array([ramp, edge]))
+    return first_returns(system, [[0.0, 0.0]], _ramped_section, 3000.0, direction=1,
+                         engine=engine)
+
+
+@_miss("sampling aliases a section: the reference's windows on DOP853's long steps over a "
+       "constant field sample sin(th) about 2 pi k apart, where rules.resolves sees a "
+       "smooth function (its parabolas predict the samples), and a return between two "
+       "samples is lost; no NaN anywhere (a max_step of 1 finds it; D16 (5))")
+def test_a_section_the_reference_s_windows_alias_is_found():
+    # (the same review) the reference returns 258.198: the crossing at 252.465 lies
+    # between samples of a window judged resolved; the compiled engine's windows find it
+    got = _ramp_returns("reference", 250.0, 1e6)
+    assert got.time[0] == pytest.approx(_first_upward_root(250.0), abs=1e-9)
+
+
+def _excursion_returns(engine, lo):
+    # th' = 1, x' = 1 where sin(th) >= 0.9; the section th = lo - 0.01, NaN on (lo, lo + 5)
+    system = FilippovSystem(("th", "x"), lambda z, p: np.array([1.0, 0.0]),
+                            lambda z, p: np.array([1.0, 1.0]),
+                            lambda z, p: np.sin(z[0]) - 0.9,
+                            lambda z, p: np.array([np.cos(z[0]), 0.0]),
+                            params=np.array([lo - 0.01, lo, lo + 5.0]))
+    return first_returns(system, [[0.0, 0.0]],
+                         lambda z, p: np.nan if p[1] < z[0] < p[2] else z[0] - p[0], 400.0,
+                         direction=1, engine=engine)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_the_excursions_before_a_nan_section_are_found_wherever_it_begins(engine):
+    # (the same review) the excursion test below at 23 positions of the band: before the
+    # mend 11 of them (band from 37 to 47) lost two switches on each engine (x short by
+    # 0.9); the switches and x = the time spent where sin(th) >= 0.9, in closed form
+    a = np.arcsin(0.9)
+    for lo in np.arange(30.0, 53.0):
+        r = lo - 0.01
+        k = np.arange(int(r / (2 * np.pi)) + 2)
+        enter, leave = 2 * np.pi * k + a, 2 * np.pi * k + np.pi - a
+        n = int(np.sum(enter < r) + np.sum(leave < r))
+        x = float(np.sum(np.clip(np.minimum(leave, r) - enter, 0.0, None)))
+        got = _excursion_returns(engine, lo)
+        assert got.n_switches[0] == n, lo
+        assert got.state[0, 1] == pytest.approx(x, abs=1e-9), lo
+        assert got.time[0] == pytest.approx(r, abs=1e-12), lo
+
+
 # (the review of the mend) an exact flow whose state is not finite: the reference refused
 # the whole window at its start (a return up to 0.81 after it lost) while the compiled
 # engine searched to the edge, and both stopped at the window's start, up to 1.1 before

@@ -157,3 +157,45 @@ def test_a_slides_failed_step_is_named_a_two_fold_where_both_fields_are_tangent(
     def pieces(ctx):
         return Pieces(np.zeros(2), grad, fm, fp, grad @ fm, grad @ fp, 1.0)
     assert stay.make_failed_step(pieces)(status, mode, None) == expected
+
+
+def _cut_walk(cut_at, resolved_length, ns=5, ta=0.0, tb=1.0):
+    """The windows make_step_windows asks for on [ta, tb] when every state from ``cut_at``
+    on is not finite: a window of ``ns`` samples cut at its sample k >= 1 is unresolved
+    while it may split and k < 5 (rules.cut_resolves), with the cut's time; an uncut one
+    is unresolved while longer than ``resolved_length``; a window that keeps the cut
+    stops the run there (NON_FINITE, as the engines' search past it does)."""
+    calls = []
+
+    def window(mode, t0, t1, first, may_split, ctx):
+        calls.append((t0, t1, may_split))
+        ts = [t0 + j * (t1 - t0) / (ns - 1) for j in range(ns - 1)] + [t1]
+        k = next((j for j, t in enumerate(ts) if t >= cut_at), -1)
+        if k == 0:
+            return NON_FINITE, t0, -1
+        if may_split and k > 0 and not rules.cut_resolves(k, ns):
+            return stay.UNRESOLVED, ts[k], -1
+        if may_split and k < 0 and t1 - t0 > resolved_length:
+            return stay.UNRESOLVED, t0, -1
+        return (NON_FINITE, cut_at, -1) if k > 0 else (GO_ON, t1, -1)
+
+    return calls, stay.make_step_windows(window)(PLUS, ta, tb, True, None)
+
+
+@pytest.mark.parametrize("cut_at", [0.3, 0.26, 0.51, 0.9999])
+@pytest.mark.parametrize("resolved_length", [1.0, 0.01])
+def test_a_cut_window_is_approached_without_creeping(cut_at, resolved_length):
+    # five samples a window: a window to the cut keeps four, too few to judge. Before
+    # rules.to_cut each window to the cut was shortened again and the walk crept on by
+    # 1/16 of what was left, down to the shortest window; now the window to the cut is
+    # no longer than the last one searched, and is searched as it is
+    calls, result = _cut_walk(cut_at, resolved_length)
+    assert result == (NON_FINITE, cut_at, -1)
+    t0, t1, may = calls[-1]
+    assert not may and t0 < cut_at <= t1
+    before = calls[-2]
+    assert before[1] == t0 and t1 - t0 <= before[1] - before[0]
+    # the windows an uncut walk of the step would ask, and a dozen to the cut (without
+    # rules.to_cut: 69 to 140)
+    uncut, _ = _walk_calls(resolved_length)
+    assert len(calls) <= len(uncut) + 12

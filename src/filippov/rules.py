@@ -580,10 +580,26 @@ def can_split(ta: float, tb: float, t0: float, t1: float) -> bool:
 
 def cut_resolves(kept: int, n: int) -> bool:
     """Whether the ``kept`` samples of a window of n cut at its sample ``kept`` (that one
-    not finite; -1: not cut) may be judged by :func:`resolves`: not when fewer than the
-    five it judges are left of a window that had them (the window is then shortened,
-    its windows ending at the cut: docs/decisions.md#past-a-non-finite-sample)."""
+    not finite; -1: not cut) may be judged as an uncut window's are (:func:`resolves`):
+    five or more kept, or a window of fewer than five (never judged). Else the window is
+    shortened, its windows ending at the cut (docs/decisions.md#past-a-non-finite-sample,
+    :func:`to_cut`)."""
     return kept < 0 or kept >= 5 or n < 5
+
+
+def to_cut(t0: float, cap: float, last: float) -> tuple:
+    """The end of a window from t0 that the step's walk would end at ``cap``, the time of
+    a sample found not finite, and whether it may be split: a window no longer than
+    ``last``, the last one searched (0: none yet), is searched as it is (its samples as
+    dense as that one's, which were judged; those to the cut cannot be: the last is not
+    finite); a longer one ends ``last`` short of the cut, all its samples before it, so
+    that the one after it is no longer than ``last``
+    (docs/decisions.md#past-a-non-finite-sample)."""
+    if cap - t0 <= last:
+        return cap, False
+    if last > 0.0:
+        return cap - last, True
+    return cap, True
 
 
 def cut_midpoint(lo: float, hi: float, xtol: float) -> float:

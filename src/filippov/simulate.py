@@ -1100,11 +1100,9 @@ class _Scan:
         above their rounding where 64 ulps of the samples fall short of it (measured at
         the samples only then: :func:`_rounding`; engines.py asymmetry 12)."""
         ts, n = self.ts, self.ts.size
-        # cut at a sample not finite: with none kept before it the interval up to it is
-        # searched (_past_cut); with too few to judge, shorter windows up to it
-        if self.not_finite is not None and (
-                n < 2 or not rules.cut_resolves(n, self.ts_all.size)):
-            return n < 2
+        # cut at a sample not finite: with too few kept to judge, shorter windows up to it
+        if self.not_finite is not None and not rules.cut_resolves(n, self.ts_all.size):
+            return False
         if self.mode == SLIDING:
             judged = [(v, v, False, func) for v, func in zip(self.raw, self.leave)]
         else:

@@ -163,12 +163,13 @@ def _window(mode, ta, tb, first, may_split, ctx):
     if bad < 0 and exact and not _flow_follows(w.z, w.ynew, tb - ta, speed2_a, w.wf,
                                                s.state_scale):
         return FLOW_OFF_FIELD, ta, _W_NONE
-    # a window cut at sample bad >= 2: unresolved where the samples kept are too few to
-    # judge (rules.cut_resolves) or do not resolve; its shorter windows end at the cut
-    # (loop.stay.make_step_windows). Cut at sample 1, none is kept: _past_cut below
-    if may_split and not exact and bad != 1 and not (
+    # a window cut at sample bad: unresolved where the samples kept are too few to judge
+    # (rules.cut_resolves) or do not resolve; its shorter windows end at the cut's
+    # sample time (loop.stay.make_step_windows; ts[bad] is where a rate a step ahead of
+    # it was not finite)
+    if may_split and not exact and not (
             rules.cut_resolves(bad, ns) and _resolved(mode, ns if bad < 0 else bad, sm)):
-        return UNRESOLVED, (ta if bad < 0 else sm.ts[bad]), _W_NONE
+        return UNRESOLVED, (ta if bad < 0 else _sample_time(ta, tb, frac, bad)), _W_NONE
     t_stop = ta
     st, te, what = _find(mode, ns if bad < 0 else bad, first, s, o, sm, sc)  # bad = 1: none
     if st == OK and what == _W_NONE and bad >= 1:
@@ -189,6 +190,12 @@ def _window(mode, ta, tb, first, may_split, ctx):
         return (NO_RETURN if tb >= s.t_max else _GO_ON), tb, _W_NONE
     _zat(te, mode, o, w.z)
     return OK, te, what
+
+
+@_jit_inline
+def _sample_time(ta, tb, frac, k):
+    """The time of sample k of the window [ta, tb] (as scan._sample places it)."""
+    return ta + frac[k] * (tb - ta) if k < frac.size - 1 else tb
 
 
 @_jit_inline

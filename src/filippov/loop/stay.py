@@ -94,20 +94,28 @@ def make_step_windows(window):
     t1) or the event's. With UNRESOLVED, t is t0, or the time of a sample that was not
     finite, the window cut there: the windows then end there at the latest until one
     has reached it (the shorter windows' samples could step over a thin band of the
-    field's edge the cut met: docs/decisions.md#past-a-non-finite-sample)."""
+    field's edge the cut met), the window to it no longer than the last one searched
+    (rules.to_cut: docs/decisions.md#past-a-non-finite-sample)."""
 
     def walk(mode, ta, tb, first, ctx):
-        t0, t1, cap = ta, tb, tb
+        # cap: where the windows end at the latest (a cut's time, else tb); last: the
+        # length of the last window searched
+        t0, t1, cap, cut, last = ta, tb, tb, False, 0.0
         while True:
-            st, t, what = window(mode, t0, t1, first, rules.can_split(ta, tb, t0, t1), ctx)
+            split = True
+            if cut and t1 == cap:  # a window to the cut (rules.to_cut)
+                t1, split = rules.to_cut(t0, cap, last)
+            st, t, what = window(mode, t0, t1, first,
+                                 split and rules.can_split(ta, tb, t0, t1), ctx)
             if st == UNRESOLVED:
                 if t > t0:
-                    cap = min(cap, t)
+                    cap, cut = min(cap, t), True
                 t1 = rules.window_end(t0, (t1 - t0) / rules.SPLIT, cap)
             elif st != GO_ON or t1 >= tb:
                 return st, t, what
             else:
                 if t1 >= cap:  # the cut's sample reached, finite this time: on to tb
-                    cap = tb
+                    cap, cut = tb, False
+                last = t1 - t0
                 t0, t1, first = t1, rules.window_end(t1, (t1 - t0) * rules.SPLIT, cap), False
     return walk
