@@ -201,8 +201,9 @@ def test_the_corner_rule():
     assert rules.through_corner(np.array([-1.0, -2.0, -0.5, -1e-3]))
     assert not rules.through_corner(np.array([-1.0, -2.0, -0.5, 0.0]))
     assert not rules.through_corner(np.array([-1.0, np.nan]))
-    assert rules.at_corner(1e-16, 1.0, 1e-15, 0.0)
-    assert not rules.at_corner(1e-12, 1.0, 1e-15, 1e-15)
+    assert rules.at_corner(1e-16, -1.0, 1e-15, 0.0)
+    assert not rules.at_corner(1e-12, -1.0, 1e-15, 1e-15)
+    assert not rules.at_corner(1e-16, 1.0, 1e-15, 0.0)   # moving away from it
     assert rules.slide_crosses(1.0, -1.0, -0.5, -2.0)
     assert not rules.slide_crosses(1.0, 0.0, -0.5, -2.0)      # not attracting beyond
     assert not rules.slide_crosses(1.0, -1.0, -0.5, 0.5)      # turned back beyond
@@ -708,3 +709,21 @@ def test_a_slide_over_a_narrow_dip_of_another_surface_is_not_passed_silently():
         assert "hidden crossing" in str(err) and "h2" in str(err)
         return
     assert tr.z[0] == pytest.approx(3.0 + w, abs=TOL)
+
+
+@pytest.mark.parametrize("d", [1e-16, 1e-15, 1e-14, -1e-15, -1e-14, -1e-12])
+def test_an_orbit_passing_a_corner_within_rounding_goes_through(d):
+    # (a review) h1 = y, h2 = x; every field crosses both upward: (1, 1) in (-,-),
+    # (3, 1) in (+,-) (h1 +), (1, 2) in (-,+), (2, 1) in (+,+). From (-1, -1 - d) the
+    # orbit meets both within 1e-14: at d = 1e-15 the stay after the corner began a
+    # rounding short of h1 and read it as a crossing back (refused: "from region ++");
+    # at d = -1e-14 h1, just crossed, counted at the corner with h2 (refused: the field
+    # of (+,-) leaves h1). Closed form: d > 0, h2 at t = 1, h1 at 1 + d/2, so z(3) =
+    # (4 - d/2, 2 - d/2); d = -e < 0, h1 at 1 - e, h2 at 1 - 2e/3, z(3) = (4 + 4e/3, 2 + e)
+    S = _planar({(-1, -1): (1, 1), (1, -1): (3, 1), (-1, 1): (1, 2), (1, 1): (2, 1)},
+                h2_offset=0.0)
+    tr = simulate(S, [-1.0, -1.0 - d], 3.0, method="integrate")
+    e = -d
+    want = [4.0 - d / 2, 2.0 - d / 2] if d > 0 else [4.0 + 4 * e / 3, 2.0 + e]
+    assert tr.mode == mode_of((1, 1))
+    assert tr.z == pytest.approx(want, abs=1e-14)

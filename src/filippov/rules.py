@@ -886,8 +886,11 @@ CORNER_XTOLS = 4.0
 
 def at_corner(g: float, rate: float, xtol: float, touch_tol: float) -> bool:
     """Is a surface whose value (oriented: >= 0 on the orbit's side) is ``g`` at an
-    event on another one, changing at ``rate`` there, reached at the same instant?"""
-    return abs(g) <= touch_tol + CORNER_XTOLS * abs(rate) * xtol
+    event on another one, changing at ``rate`` there, reached at the same instant? Not
+    one the orbit moves away from (rate > 0: one it has just crossed, a rounding behind
+    it; the region across the event's surface may turn back to it, a switch of its own
+    at that instant): such a corner was refused as one the fields do not all cross."""
+    return rate <= 0.0 and abs(g) <= touch_tol + CORNER_XTOLS * abs(rate) * xtol
 
 
 def through_corner(speeds) -> bool:

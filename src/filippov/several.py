@@ -430,7 +430,7 @@ def _next_stay(system, stay, a, r, o, traj) -> Stay:
         return Stay(flip(sigma, a), -1, -s, begun)
     corner = _corner(system, sigma, a, r.z, o)
     if corner:
-        return _through(system, stay, [a] + corner, r, traj)
+        return _through(system, stay, [a] + corner, r, traj, o)
     if r.mode == SLIDING:
         return Stay(sigma, a, s, begun)
     return Stay(flip(sigma, a), -1, -s, begun)
@@ -446,10 +446,14 @@ def _corner(system, sigma, a, z, o, f=None):
         sigma[j] * h[j], sigma[j] * float(G[j] @ f), o["event_xtol"], o["touch_tol"])]
 
 
-def _through(system, stay, at, r, traj) -> Stay:
+def _through(system, stay, at, r, traj, o) -> Stay:
     """A corner of the surfaces ``at``: straight through where rules.through_corner
     says so (the switch logged as a "corner" into the region across them all), else
-    refused by name."""
+    refused by name. The event's state is on the far side of the surface it was found
+    on; another one it is at may be a rounding short of it: the next stay measures H
+    from there (rules.exit_shift, as after a sliding exit), not a crossing back at once
+    (which refused a corner passed 1e-15 from its point as one reached from the far
+    region)."""
     z = np.asarray(r.z, dtype=float)
     G = system.grads(z)
     regions = [stay.sigma]
@@ -472,7 +476,10 @@ def _through(system, stay, at, r, traj) -> Stay:
     last = traj.events[-1]
     traj.events[-1] = dataclasses.replace(last, kind="corner", mode_after=mode_of(sigma),
                                           name=names)
-    return Stay(sigma, -1, -stay.s, (-stay.s, 0.0, 0.0, 0.0))
+    s = -stay.s
+    h0 = s * float(np.min(np.asarray(sigma, dtype=float) * system.values(z)))
+    shift = rules.exit_shift(s, h0, o["touch_tol"], False)
+    return Stay(sigma, -1, s, (s, shift, shift, 0.0))
 
 
 def _refuse_corner_start(system, z, sigma, o):
