@@ -353,11 +353,13 @@ def view_field(system, stay, zs):
 
 def _minimum(system, stay, j, Z, lo, hi):
     """(t, value) of the minimum of sigma_j h_j along Z in [lo, hi], whose rate changes
-    sign there from - to +: the root of the rate (brentq, to the rounding of t), where a
-    dip as narrow as its depth allows is seen below 0 (a bounded minimisation to a
-    thousandth of [lo, hi] stopped up to 1e-4 from a dip 3e-5 wide, and a crossing of it
-    was passed silently)."""
-    from scipy.optimize import brentq
+    sign there from - to +: the lowest of a bounded minimisation (to a thousandth of
+    [lo, hi]: it finds the deepest of several dips) and the roots of the rate (brentq, to
+    the rounding of t) over [lo, hi] and about the minimisation's point -- a dip as
+    narrow as its depth allows is seen below 0 there (the minimisation alone stopped up
+    to 1e-4 from a dip 3e-5 wide, and a crossing of it was passed silently; the rate's
+    root alone can be a shallow minimum beside a deep dip)."""
+    from scipy.optimize import brentq, minimize_scalar
 
     def state(t):
         return np.asarray(Z(t), dtype=float).reshape(-1)
@@ -369,12 +371,20 @@ def _minimum(system, stay, j, Z, lo, hi):
 
     def g(t):
         return float(stay.sigma[j] * system.values(state(t))[j])
-    ra, rb = rate(lo), rate(hi)
-    if not (ra <= 0.0 <= rb):   # the rates sampled saw it, these not: the lower end
-        return (lo, g(lo)) if g(lo) <= g(hi) else (hi, g(hi))
-    tm = brentq(rate, lo, hi, xtol=4.0 * np.finfo(float).eps * max(abs(lo), abs(hi)),
-                rtol=4.0 * np.finfo(float).eps)
-    return float(tm), g(tm)
+    res = minimize_scalar(g, bounds=(lo, hi), method="bounded",
+                          options={"xatol": 1e-3 * (hi - lo)})
+    found = [(float(res.x), float(res.fun))]
+    near = 2e-3 * (hi - lo)
+    eps = np.finfo(float).eps
+    for a, b in ((lo, hi), (max(lo, res.x - near), min(hi, res.x + near))):
+        ra, rb = rate(a), rate(b)
+        if ra <= 0.0 <= rb:   # bracketed (a rate not finite inside: brentq refuses)
+            try:
+                tm = brentq(rate, a, b, xtol=4.0 * eps * max(abs(a), abs(b)), rtol=4.0 * eps)
+            except ValueError:
+                continue
+            found.append((float(tm), g(tm)))
+    return min(found, key=lambda tg: tg[1])
 
 
 def _hidden(system, stay, j, t, z):
@@ -450,10 +460,10 @@ def _through(system, stay, at, r, traj, o) -> Stay:
     """A corner of the surfaces ``at``: straight through where rules.through_corner
     says so (the switch logged as a "corner" into the region across them all), else
     refused by name. The event's state is on the far side of the surface it was found
-    on; another one it is at may be a rounding short of it: the next stay measures H
-    from there (rules.exit_shift, as after a sliding exit), not a crossing back at once
-    (which refused a corner passed 1e-15 from its point as one reached from the far
-    region)."""
+    on; another one it is at may be short of it by what rules.at_corner takes: the next
+    stay measures H from there (rules.exit_shift), not a crossing back at once (which
+    refused a corner passed 1e-15 from its point as one reached from the far region,
+    or slid there for no time)."""
     z = np.asarray(r.z, dtype=float)
     G = system.grads(z)
     regions = [stay.sigma]
@@ -476,9 +486,19 @@ def _through(system, stay, at, r, traj, o) -> Stay:
     last = traj.events[-1]
     traj.events[-1] = dataclasses.replace(last, kind="corner", mode_after=mode_of(sigma),
                                           name=names)
+    # a corner surface a rounding short of the state (within touch_tol): the next stay
+    # measures H from there; farther short (rules.at_corner takes up to a few event
+    # tolerances' worth of its rate), the view's H would read it as a switch at once --
+    # a slide for no time, or a failed one: refused by name
     s = -stay.s
-    h0 = s * float(np.min(np.asarray(sigma, dtype=float) * system.values(z)))
-    shift = rules.exit_shift(s, h0, o["touch_tol"], False)
+    short = float(np.min(np.asarray(sigma, dtype=float) * system.values(z)))
+    if short < -o["touch_tol"]:
+        raise SurfacesError(
+            f"corner at t={float(r.t)!r}, state {z.tolist()}: the orbit passes {names} "
+            f"at once from region {mode_name(mode_of(stay.sigma), system.m)}, but the "
+            f"event's state is {-short!r} short of one of them (more than touch_tol "
+            f"{o['touch_tol']!r}): where the passage lands is not settled (rules.at_corner)")
+    shift = rules.exit_shift(s, s * short, o["touch_tol"], False)
     return Stay(sigma, -1, s, (s, shift, shift, 0.0))
 
 
