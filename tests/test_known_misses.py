@@ -453,16 +453,8 @@ def test_a_section_the_reference_s_windows_alias_is_found():
     assert got.time[0] == pytest.approx(_first_upward_root(250.0), abs=1e-9)
 
 
-def _excursion_returns(engine, lo):
-    # th' = 1, x' = 1 where sin(th) >= 0.9; the section th = lo - 0.01, NaN on (lo, lo + 5)
-    system = FilippovSystem(("th", "x"), lambda z, p: np.array([1.0, 0.0]),
-                            lambda z, p: np.array([1.0, 1.0]),
-                            lambda z, p: np.sin(z[0]) - 0.9,
-                            lambda z, p: np.array([np.cos(z[0]), 0.0]),
-                            params=np.array([lo - 0.01, lo, lo + 5.0]))
-    return first_returns(system, [[0.0, 0.0]],
-                         lambda z, p: np.nan if p[1] < z[0] < p[2] else z[0] - p[0], 400.0,
-                         direction=1, engine=engine)
+def _excursion_section(z, p):
+    return np.nan if p[1] < z[0] < p[2] else z[0] - p[0]
 
 
 @pytest.mark.parametrize("engine", ENGINES)
@@ -470,6 +462,13 @@ def test_the_excursions_before_a_nan_section_are_found_wherever_it_begins(engine
     # (the same review) the excursion test below at 23 positions of the band: before the
     # mend 11 of them (band from 37 to 47) lost two switches on each engine (x short by
     # 0.9); the switches and x = the time spent where sin(th) >= 0.9, in closed form
+    # th' = 1, x' = 1 where sin(th) >= 0.9; the section th = lo - 0.01, NaN on (lo, lo + 5)
+    # (one system, its parameters set for each band: its pieces compiled once)
+    system = FilippovSystem(("th", "x"), lambda z, p: np.array([1.0, 0.0]),
+                            lambda z, p: np.array([1.0, 1.0]),
+                            lambda z, p: np.sin(z[0]) - 0.9,
+                            lambda z, p: np.array([np.cos(z[0]), 0.0]),
+                            params=np.zeros(3))
     a = np.arcsin(0.9)
     for lo in np.arange(30.0, 53.0):
         r = lo - 0.01
@@ -477,7 +476,9 @@ def test_the_excursions_before_a_nan_section_are_found_wherever_it_begins(engine
         enter, leave = 2 * np.pi * k + a, 2 * np.pi * k + np.pi - a
         n = int(np.sum(enter < r) + np.sum(leave < r))
         x = float(np.sum(np.clip(np.minimum(leave, r) - enter, 0.0, None)))
-        got = _excursion_returns(engine, lo)
+        system.params[:] = [r, lo, lo + 5.0]
+        got = first_returns(system, [[0.0, 0.0]], _excursion_section, 400.0, direction=1,
+                            engine=engine)
         assert got.n_switches[0] == n, lo
         assert got.state[0, 1] == pytest.approx(x, abs=1e-9), lo
         assert got.time[0] == pytest.approx(r, abs=1e-12), lo
