@@ -397,6 +397,19 @@ def test_a_switch_just_after_a_stay_begins_before_a_nan_h_is_found(engine, sampl
     assert got.state[0, 1] == pytest.approx(-d / 2, abs=1e-12)
 
 
+def _excursion_system(params):
+    # th' = 1, x' = 1 where sin(th) >= 0.9 (x: the time spent in region +)
+    return FilippovSystem(("th", "x"), lambda z, p: np.array([1.0, 0.0]),
+                          lambda z, p: np.array([1.0, 1.0]), lambda z, p: np.sin(z[0]) - 0.9,
+                          lambda z, p: np.array([np.cos(z[0]), 0.0]),
+                          params=np.array(params, dtype=float))
+
+
+def _excursion_section(z, p):
+    # th = p[0], NaN on (p[1], p[2])
+    return np.nan if p[1] < z[0] < p[2] else z[0] - p[0]
+
+
 @pytest.mark.parametrize("engine", ENGINES)
 def test_an_excursion_between_samples_before_a_nan_section_is_found(engine):
     # (the same review; older than the mend) th' = 1, x' = 1 where sin(th) >= 0.9 (x =
@@ -404,14 +417,8 @@ def test_an_excursion_between_samples_before_a_nan_section_is_found(engine):
     # th < 45.56) has x = 7 (pi - 2 asin 0.9) and 14 switches -- both engines give x =
     # 5.41 and 12: an excursion [32.54, 33.44] lies between two of the three samples kept
     # of the window [32.50, 47.59]
-    system = FilippovSystem(("th", "x"), lambda z, p: np.array([1.0, 0.0]),
-                            lambda z, p: np.array([1.0, 1.0]),
-                            lambda z, p: np.sin(z[0]) - 0.9,
-                            lambda z, p: np.array([np.cos(z[0]), 0.0]),
-                            params=np.array([40.55, 40.56, 45.56]))
-    got = first_returns(system, [[0.0, 0.0]],
-                        lambda z, p: np.nan if p[1] < z[0] < p[2] else z[0] - p[0], 400.0,
-                        direction=1, engine=engine)
+    got = first_returns(_excursion_system([40.55, 40.56, 45.56]), [[0.0, 0.0]],
+                        _excursion_section, 400.0, direction=1, engine=engine)
     assert got.n_switches[0] == 14
     assert got.state[0, 1] == pytest.approx(7 * (np.pi - 2 * np.arcsin(0.9)), abs=1e-9)
     assert got.time[0] == pytest.approx(40.55, abs=1e-12)
@@ -453,22 +460,14 @@ def test_a_section_the_reference_s_windows_alias_is_found():
     assert got.time[0] == pytest.approx(_first_upward_root(250.0), abs=1e-9)
 
 
-def _excursion_section(z, p):
-    return np.nan if p[1] < z[0] < p[2] else z[0] - p[0]
-
-
 @pytest.mark.parametrize("engine", ENGINES)
 def test_the_excursions_before_a_nan_section_are_found_wherever_it_begins(engine):
-    # (the same review) the excursion test below at 23 positions of the band: before the
+    # (the same review) the excursion test above at 23 positions of the band: before the
     # mend 11 of them (band from 37 to 47) lost two switches on each engine (x short by
-    # 0.9); the switches and x = the time spent where sin(th) >= 0.9, in closed form
-    # th' = 1, x' = 1 where sin(th) >= 0.9; the section th = lo - 0.01, NaN on (lo, lo + 5)
-    # (one system, its parameters set for each band: its pieces compiled once)
-    system = FilippovSystem(("th", "x"), lambda z, p: np.array([1.0, 0.0]),
-                            lambda z, p: np.array([1.0, 1.0]),
-                            lambda z, p: np.sin(z[0]) - 0.9,
-                            lambda z, p: np.array([np.cos(z[0]), 0.0]),
-                            params=np.zeros(3))
+    # 0.9); the switches and x = the time spent where sin(th) >= 0.9, in closed form; the
+    # section th = lo - 0.01, NaN on (lo, lo + 5) (one system, its parameters set for
+    # each band: its pieces compiled once)
+    system = _excursion_system(np.zeros(3))
     a = np.arcsin(0.9)
     for lo in np.arange(30.0, 53.0):
         r = lo - 0.01

@@ -676,8 +676,7 @@ class _Run:
         if may_split and stepper.method is not None and not scan.resolved():
             # a window cut at a sample not finite: its shorter windows end there
             # (loop.stay.make_step_windows)
-            cut = scan.not_finite
-            return UNRESOLVED, (ta if cut is None else scan.ts_all[cut[0]]), None
+            return UNRESOLVED, (ta if scan.not_finite is None else scan.cut_time), None
         band = self.band
         found = self._scan(scan, ta, tb)
         if found is None:
@@ -1086,6 +1085,11 @@ class _Scan:
         self.D = None if self.D is None else self.D[:k]
         self.R = None if self.R is None else tuple(r[:k] for r in self.R)
 
+    @property
+    def cut_time(self):
+        """The time of the sample the window is cut at (not finite)."""
+        return self.ts_all[self.not_finite[0]]
+
     def _non_finite(self, t, z):
         z = np.asarray(z, dtype=float).reshape(-1)
         piece = checks.piece_not_finite_at(
@@ -1169,7 +1173,7 @@ class _Scan:
         stops at the last sample found not finite (docs/decisions.md#past-a-non-finite-sample;
         the kernel's driver._past_cut). (event or None, the last scan: its band)."""
         scan, not_finite = self, self.not_finite
-        lo, hi = self.ts[-1], self.ts_all[not_finite[0]]
+        lo, hi = self.ts[-1], self.cut_time
         frac = np.linspace(0.0, 1.0, self.ts_all.size)   # as _Run sampled the window
         # the stay's first sample, while lo stays there: clamped as it is there
         t_first = lo if self.first and self.ts.size == 1 else -np.inf
@@ -1191,7 +1195,7 @@ class _Scan:
                 lo = mid
             else:
                 not_finite = scan.not_finite
-                lo, hi = scan.ts[-1], scan.ts_all[not_finite[0]]
+                lo, hi = scan.ts[-1], scan.cut_time
             mid = rules.cut_midpoint(lo, hi, self.xtol)
         raise self._stop(*not_finite[1:], lo)
 

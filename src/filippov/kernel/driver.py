@@ -242,7 +242,7 @@ def _past_cut(mode, lo, hi, first, s, o, sm, sc):
             lo = mid
         else:  # the bracket by the samples' times (the rates' a step ahead would widen it)
             t_stop = sm.ts[bad]
-            lo, hi = sm.ts[bad - 1], (lo + frac[bad] * (mid - lo) if bad < ns - 1 else mid)
+            lo, hi = sm.ts[bad - 1], _sample_time(lo, mid, frac, bad)
         mid = rules.cut_midpoint(lo, hi, o.xtol)
     return OK, lo, _W_NONE, t_stop
 
