@@ -13,7 +13,7 @@ from filippov import rules
 from filippov.loop import interval, refine
 from filippov.loop.interval import (F_LEAVE, F_RATE, F_SECTION, F_TIME, F_UNBANDED, NONE, OK,
                                     SECTION, make_window_event)
-from filippov.loop.status import ROOT_FAILED
+from filippov.loop.status import CUT, ROOT_FAILED
 from filippov.system import MINUS, PLUS, SLIDING
 
 SRC = Path(interval.__file__).resolve().parents[1]
@@ -82,7 +82,7 @@ class Engine:
         if F_RATE <= f < F_UNBANDED:
             self.asked.append(("extremum", f))
             if self.fail == ("extremum", f):
-                return False, lo, math.nan
+                return False, lo, g(lo)
             d0 = g(lo)
             r = self._bisect(lambda t: (g(t) > 0) != (d0 > 0), lo, hi)
             return True, r, g(r)
@@ -90,7 +90,7 @@ class Engine:
             return False, lo, vlo
         self.asked.append(("root", f))
         if self.fail == f or (g(lo) > 0) == (g(hi) > 0):
-            return False, lo, math.nan
+            return False, lo, g(lo)
         r = self._bisect(lambda t: (g(t) > 0) == (g(hi) > 0), lo, hi)
         return True, r, g(r)
 
@@ -217,8 +217,23 @@ def test_a_failed_question_ends_the_search_with_its_status():
     c = Engine({F_LEAVE: lambda t: 1.0 - t, F_RATE: lambda t: -1.0,
                 F_SECTION: lambda t: t - 0.5}, T2, sections=[(rules.TO_NONNEG, 0.0, True)],
                fail=F_LEAVE)
-    assert EVENT(c, PLUS)[:1] == (ROOT_FAILED,) and EVENT(c, PLUS)[2:] == (NONE, -1)
+    assert EVENT(c, PLUS)[:1] == (ROOT_FAILED,) and EVENT(c, PLUS)[2:] == (NONE, 0)
     assert c.asked[0] == ("root", F_LEAVE) and ("root", F_SECTION) not in c.asked
+
+
+@pytest.mark.parametrize("mode", [PLUS, MINUS])
+def test_a_value_not_finite_between_the_samples_ends_the_search_with_a_cut(mode):
+    # h's hidden extremum at t = 1 lies where h is not finite: nothing is decided on it
+    # (rules.graze would read NaN as no crossing), the search ends with CUT at its time
+    # and the interval it is in, 0 of [0, 2, 4]; a section crossing before it in that
+    # interval is left to the engine's search up to the cut
+    sign = 1.0 if mode == PLUS else -1.0
+    c = Engine({F_LEAVE: lambda t: math.nan if 0.9 < t < 1.1 else sign * ((t - 1) ** 2 - 0.25),
+                F_RATE: lambda t: sign * 2 * (t - 1), F_SECTION: lambda t: t - 0.5},
+               [0.0, 2.0, 4.0], sections=[(rules.TO_NONNEG, 0.0, True)])
+    st, t, what, k = EVENT(c, mode)
+    assert (st, what, k) == (CUT, NONE, 0) and abs(t - 1.0) < 1e-12
+    assert ("root", F_SECTION) not in c.asked
 
 
 def test_a_just_entered_modes_start_sample_is_clamped_inside():

@@ -68,6 +68,17 @@ class DatasetError(ValueError):
     truncated, written by something else, or of another scene)."""
 
 
+class ValueNotFinite(Exception):
+    """Inside the reference engine only, never raised to a caller: a function of time on
+    a segment was not finite at ``t``, which stops the root finder asking it (scipy's
+    brentq would go on with NaN); the event search turns it into its CUT there
+    (filippov.loop.interval)."""
+
+    def __init__(self, t):
+        super().__init__(t)
+        self.t = t
+
+
 # ------------------------------------------------------------------ a run's end status
 # What a run that ends with a status of filippov.loop.status raises, one table for both
 # engines: the reference driver raises it where its run stops, the compiled engine's front

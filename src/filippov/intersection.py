@@ -41,12 +41,22 @@ def _speeds(system, sigma, j, k, z):
     return F @ G[j], F @ G[k], F
 
 
+#: how far past the square [0, 1]^2 the weights are continued (``extend``): the ends of a
+#: slide are their roots at 0 or 1, which a step past an end brackets; farther on the
+#: continued weights run to a pole (where the two speeds along a surface are equal) and
+#: the field, a sum of huge terms, is rounding: a stage there gave w' = 1.0625 for 1,
+#: accepted, and the end came 3.9e-4 late (a review). Past it: no field (NaN), a step
+#: whose stage meets it is rejected and shortened.
+EXTEND_MAX = 1.0
+
+
 def bilinear_weights(wj: np.ndarray, wk: np.ndarray, extend: bool = False):
     """(alpha, beta) that make the bilinear field tangent to both surfaces (``wj[a, b]``,
     ``wk[a, b]``: the fields' speeds along each gradient): the one pair in [0, 1]^2, or
     None where there is none or more than one; ``extend``: the real pair nearest the
-    square, also outside it (the weights continued past the ends of a slide, where they
-    cross 0 or 1 smoothly: the ends are the roots of the weights, found as sections)."""
+    square, also outside it by up to EXTEND_MAX (the weights continued past the ends of
+    a slide, where they cross 0 or 1 smoothly: the ends are the roots of the weights,
+    found as sections)."""
     def alpha_of(beta):
         a0 = (1 - beta) * wj[0, 0] + beta * wj[0, 1]
         a1 = (1 - beta) * wj[1, 0] + beta * wj[1, 1]
@@ -73,7 +83,9 @@ def bilinear_weights(wj: np.ndarray, wk: np.ndarray, extend: bool = False):
         return inside[0] if len(inside) == 1 else None
     if not found:
         return None
-    return min(found, key=lambda w: max(-w[0], w[0] - 1.0, -w[1], w[1] - 1.0, 0.0))
+    outside = lambda w: max(-w[0], w[0] - 1.0, -w[1], w[1] - 1.0, 0.0)  # noqa: E731
+    nearest = min(found, key=outside)
+    return nearest if outside(nearest) <= EXTEND_MAX else None
 
 
 def bilinear_field(system, sigma, j, k, z, extend=True):

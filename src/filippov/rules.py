@@ -893,6 +893,21 @@ def at_corner(g: float, rate: float, xtol: float, touch_tol: float) -> bool:
     return rate <= 0.0 and abs(g) <= touch_tol + CORNER_XTOLS * abs(rate) * xtol
 
 
+def left_band(g: float, speed: float, xtol: float, touch_tol: float) -> float:
+    """The band a slide allows the surface it has just left at the end of a slide on an
+    intersection (``g``: that surface's value there, oriented to the side the orbit
+    leaves to): the slide on the intersection kept the rounding the event that began
+    sliding on it left (the state a hair past it, up to what :func:`at_corner` takes,
+    ``speed`` the largest normal speed of the fields meeting there), which reads as a
+    crossing back at the next stay's first sample where it exceeds touch_tol. 0 where g
+    is on the orbit's side; NaN (refuse) where it is short by more than such a rounding."""
+    if g >= 0.0:
+        return 0.0
+    if -g <= touch_tol + CORNER_XTOLS * abs(speed) * xtol:
+        return -g
+    return math.nan
+
+
 def through_corner(speeds) -> bool:
     """The corner rule: an orbit that reaches several surfaces at once goes straight
     through into the region across all of them when every field of the regions that

@@ -45,13 +45,16 @@ _SURFACE, _END = "\x00surface ", "\x00end "
 class Stay(NamedTuple):
     """Where a stay is: region ``sigma``, the surface slid on (-1: none), the side of H
     the region is on in its view (``s``), what the stay begins with (None: the run's
-    start decides; else its mode in the view, shift, banded shift and band), and the
-    second surface of an intersection slid on (``pair``; -1: none)."""
+    start decides; else its mode in the view, shift, banded shift and band), the
+    second surface of an intersection slid on (``pair``; -1: none), and the surface a
+    slide left as it began at an intersection's end with the rounding band the guard
+    allows it on the stay's first segment (``left``: rules.left_band; -1: none)."""
     sigma: tuple
     slide: int
     s: int
     begun: tuple | None
     pair: int = -1
+    left: tuple = (-1, 0.0)
 
 
 def check_surfaces(system: SurfacesSystem, z: np.ndarray, floor: float) -> None:
@@ -127,7 +130,7 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
                     return _end(traj, f"section:{done}", t, z, stay, surface, system)
                 stay = (_slide_across(system, stay, int(sec.name[len(_SURFACE):]), t, z,
                                       traj, o) if sec.name.startswith(_SURFACE) else
-                        _intersection_end(system, stay, sec.name[len(_END):], t, z, traj))
+                        _intersection_end(system, stay, sec.name[len(_END):], t, z, traj, o))
                 status = count_switch(rs, t, True)
                 if status != GO_ON:
                     raise _budget_error(status, rs, o, t, z)
@@ -327,7 +330,8 @@ def _hidden_crossing(system, stay, segments, o):
         for j in range(system.m):
             if j == stay.slide or j == stay.pair:
                 continue
-            tol = o["touch_tol"] + (band if j == entry else 0.0)
+            tol = o["touch_tol"] + (band if j == entry else 0.0) + (
+                stay.left[1] if n == 0 and j == stay.left[0] else 0.0)
             low = (g[j] < -tol) & ~at_end
             if np.any(low):
                 i = int(np.flatnonzero(low)[0])
@@ -594,10 +598,13 @@ def _choice_settled(system, sigma, j, k, t, z, extend=False):
             "bilinear field (filippov.intersection)")
 
 
-def _intersection_end(system, stay, end, t, z, traj) -> Stay:
+def _intersection_end(system, stay, end, t, z, traj, o) -> Stay:
     """The end of a slide on an intersection: alpha or beta at 0 or 1 (``end``), the
     slide going on on the other surface, on the side the weight left; refused by name
-    where that slide does not attract."""
+    where that slide does not attract. The surface left may lie a rounding behind the
+    state, which the slide on the intersection kept from its start: the guard allows it
+    that much at the next stay's start (rules.left_band), and refuses by name where it
+    is more."""
     j, k = stay.slide, stay.pair
     gone, keep = (j, k) if end[0] == "a" else (k, j)
     side = 1 if end[1] == "1" else -1
@@ -611,11 +618,31 @@ def _intersection_end(system, stay, end, t, z, traj) -> Stay:
             f"on h{j + 1} and h{k + 1} ends toward h{gone + 1}'s {'+-'[side < 0]} side, where "
             f"the slide on h{keep + 1} does not attract (a = {a:.3g}, b = {b:.3g}); what "
             "follows is not built into filippov")
-    after = Stay(sigma, keep, 1, (SLIDING, 0.0, 0.0, 0.0))
+    zf = np.asarray(z, dtype=float)
+    normal = system.grads(zf)[gone]
+    speed = max(abs(float(normal @ np.asarray(system.region_field(q, zf), dtype=float)))
+                for q in _around(sigma, (gone, keep)))
+    band = rules.left_band(side * float(system.values(zf)[gone]), speed, o["event_xtol"],
+                           o["touch_tol"])
+    if band != band:
+        raise SurfacesError(
+            f"intersection end at t={float(t)!r}, state {zf.tolist()}: the slide on h{j + 1} "
+            f"and h{k + 1} ends toward h{gone + 1}'s {'+-'[side < 0]} side, but the state is "
+            f"{-side * float(system.values(zf)[gone])!r} short of h{gone + 1}: more than "
+            "the rounding an event leaves (rules.left_band)")
+    after = Stay(sigma, keep, 1, (SLIDING, 0.0, 0.0, 0.0), left=(gone, band))
     traj.events.append(type(traj.events[0])(t, "slide_end", np.asarray(z, float).copy(),
                                             _code(stay, j, 1), _code(after, keep, SLIDING),
                                             f"h{gone + 1}"))
     return after
+
+
+def _around(sigma, surfaces):
+    """The regions that meet where the surfaces given are all 0, near region sigma."""
+    regions = [tuple(sigma)]
+    for k in surfaces:
+        regions += [flip(q, k) for q in regions]
+    return regions
 
 
 def _budget_error(status, rs, o, t, z):

@@ -37,14 +37,14 @@ from .loop import interval
 from .radau_iia import RadauIIA
 from .system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 from .errors import SimulationError, EventLimitError, ZenoError, SlidingNotBuiltError  # noqa: F401  (re-exported)
-from .errors import accumulation_detail, run_error
+from .errors import ValueNotFinite, accumulation_detail, run_error
 from .loop.event import SECTION, Pieces, RunOps, make_run, make_sliding_section, make_start
 from .loop.run_state import RING, SWITCHES, Limits, new_run_state
 from .section import Section, hit_within, names_hit_within, one_instant, tied_hits  # noqa: F401  (.Section)
 from .surfaces import SurfacesSystem
 from .loop.stay import UNRESOLVED
-from .loop.status import (EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN, TWO_FOLD,
-                          NO_SLIDING, OK,
+from .loop.status import (CUT, EVENT_LIMIT, FLOW_OFF_FIELD, GO_ON, NON_FINITE, NO_RETURN,
+                          TWO_FOLD, NO_SLIDING, OK,
                           ROOT_FAILED, SECTION_SLIDING, STEP_FAILED, STEP_LIMIT, ZENO)
 
 
@@ -357,18 +357,22 @@ def _bracket_root(xtol, fun, ta, tb):
         r = brentq(fun, ta, tb, xtol=xtol, rtol=4 * np.finfo(float).eps,
                    maxiter=rules.BRENT_MAXITER)
     except ValueError:  # no sign change between fun(ta) and fun(tb)
-        return False, ta, math.nan
+        return False, ta, fun(ta)
     return True, r, fun(r)
 
 
 def _root(xtol, fun, lo, hi, vlo, vhi):
     """The reference's root finder (loop.interval.WindowOps' ``root``): scipy's brentq on
     ``fun`` in [lo, hi]; with the samples' values vlo, vhi handed (not NaN), the bracket
-    pinned to them where ``fun`` at the ends lost their sign change (_brent)."""
-    if math.isnan(vlo):
-        return _bracket_root(xtol, fun, lo, hi)
-    r = _brent(fun, lo, hi, vlo, vhi, xtol)
-    return True, r, fun(r)
+    pinned to them where ``fun`` at the ends lost their sign change (_brent). Not ok, at
+    the time and with NaN, where ``fun`` was not finite (loop.refine: CUT)."""
+    try:
+        if math.isnan(vlo):
+            return _bracket_root(xtol, fun, lo, hi)
+        r = _brent(fun, lo, hi, vlo, vhi, xtol)
+        return True, r, fun(r)
+    except ValueNotFinite as cut:
+        return False, cut.t, math.nan
 
 
 def _pieces(run):
@@ -1013,6 +1017,13 @@ def _in_section_rounding(func, s0, z0, zr) -> bool:
     return rules.on_section_by_value(s0, noise)
 
 
+def _finite_at(t, v):
+    """v, a function's value at t, or ValueNotFinite where it is not finite."""
+    if not math.isfinite(v):
+        raise ValueNotFinite(t)
+    return v
+
+
 class _Scan:
     """One segment as :meth:`earliest` examines it: the values at the samples of the
     functions whose sign change leaves the mode (``leave``), of dH/dt (in a region) or
@@ -1119,15 +1130,15 @@ class _Scan:
         return True
 
     def _along(self, func):
-        """``func`` of the state as a function of time on the segment (a non-finite
-        value between the samples stops the run, as at a sample)."""
+        """``func`` of the state as a function of time on the segment; a value not finite
+        raises ValueNotFinite, which the search's operations turn into NaN (the loop then
+        searches up to it as past a sample not finite: :meth:`earliest`)."""
         Z = self.Z
 
         def along(tt):
-            z = Z(tt)
-            v = float(func(z))
+            v = float(func(Z(tt)))
             if not math.isfinite(v):
-                raise self._non_finite(tt, z)
+                raise ValueNotFinite(tt)
             return v
         return along
 
@@ -1150,33 +1161,46 @@ class _Scan:
         up to it is searched in sub-windows (:meth:`_past_cut`)."""
         if self.not_finite is not None and self.ts.size < 1:
             raise self._stop(*self.not_finite[1:], None)
-        found, scan = self._search(), self
-        if found is None and self.not_finite is not None:
-            found, scan = self._past_cut()
+        (found, cut), scan = self._search(), self
+        if cut is not None:  # a value between samples i and i + 1 not finite, at t
+            i, t = cut
+            found, scan = self._past_cut(self.ts[i], t, (i, t, self.Z(t)),
+                                         self.first and i == 0)
+        elif found is None and self.not_finite is not None:
+            found, scan = self._past_cut(self.ts[-1], self.cut_time, self.not_finite,
+                                         self.first and self.ts.size == 1)
         if found is None:
             return None, scan.band
         r, what, k = found
         return (r, np.asarray(self.Z(r), dtype=float).reshape(-1).copy(), what, k), scan.band
 
     def _search(self):
-        """(t, what, section index) of the earliest event on the samples, or None."""
+        """((t, what, section index) of the earliest event on the samples, or None;
+        None, or (i, t) where a value asked between samples i and i + 1 was not finite
+        at t: the search ends there, loop.interval's CUT)."""
         if self.ts.size < 2:
-            return None
+            return None, None
         self.cand = self.candidates()
-        _, r, what, k = _window_event(self, self.mode)
-        return None if what == interval.NONE else (r, what, k)
+        st, r, what, k = _window_event(self, self.mode)
+        if st == CUT:
+            return None, (k, r)
+        if st != OK:  # (its root finder raises instead: _Run._scan names the failure)
+            raise ValueError(f"the event search ended with status {st}")
+        return (None if what == interval.NONE else (r, what, k)), None
 
-    def _past_cut(self):
-        """The interval before the first sample that was not finite, with no event up to
-        it: sub-windows [lo, mid] sampled as this window was, the bracket halved
-        (rules.cut_midpoint) to the field's edge; an event before it stands, else the run
-        stops at the last sample found not finite (docs/decisions.md#past-a-non-finite-sample;
-        the kernel's driver._past_cut). (event or None, the last scan: its band)."""
-        scan, not_finite = self, self.not_finite
-        lo, hi = self.ts[-1], self.cut_time
+    def _past_cut(self, lo, hi, not_finite, first):
+        """The interval [lo, hi] before the first sample, or value between samples, that
+        was not finite (``not_finite``: (k, t, z) as :meth:`_first_not_finite`'s), with
+        no event up to lo: sub-windows [lo, mid] sampled as this window was, the bracket
+        halved (rules.cut_midpoint) to the field's edge; an event before it stands, else
+        the run stops at the last one found not finite
+        (docs/decisions.md#past-a-non-finite-sample; the kernel's driver._past_cut).
+        ``first``: lo is the stay's first sample. (event or None, the last scan: its
+        band)."""
+        scan = self
         frac = np.linspace(0.0, 1.0, self.ts_all.size)   # as _Run sampled the window
         # the stay's first sample, while lo stays there: clamped as it is there
-        t_first = lo if self.first and self.ts.size == 1 else -np.inf
+        t_first = lo if first else -np.inf
         mid = rules.cut_midpoint(lo, hi, self.xtol)
         while mid == mid:
             ts = lo + frac * (mid - lo)
@@ -1188,10 +1212,13 @@ class _Scan:
             if scan.not_finite is not None and scan.not_finite[0] == 0:
                 not_finite = scan.not_finite   # lo's own sample: the edge is there
                 break
-            found = scan._search()
-            if found is not None:
+            found, cut = scan._search()
+            if cut is not None:  # a value between the sub-window's samples, not finite
+                i, t = cut
+                not_finite, lo, hi = (i, t, self.Z(t)), scan.ts[i], t
+            elif found is not None:
                 return found, scan
-            if scan.not_finite is None:
+            elif scan.not_finite is None:
                 lo = mid
             else:
                 not_finite = scan.not_finite
@@ -1242,11 +1269,14 @@ class _Scan:
             if self.mode != SLIDING:
                 return self._dH
             q = f - interval.F_RATE
-            return lambda tt: float(self.rates(tt)[q])
+            return lambda tt: _finite_at(tt, float(self.rates(tt)[q]))
         return self._along(self.leave[f])
 
     def _value(self, f, t, mode):
-        return self._function(f)(t)
+        try:
+            return self._function(f)(t)
+        except ValueNotFinite:
+            return math.nan
 
     def _root(self, f, lo, hi, vlo, vhi, mode):
         return _root(self.xtol, self._function(f), lo, hi, vlo, vhi)

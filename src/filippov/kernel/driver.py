@@ -43,7 +43,7 @@ from .derivative import (_apply, _flow_jacobian, _section_derivative, _switch_de
 from ..loop.event import SECTION, Pieces, RunOps, make_run, make_start
 from ..loop.run_state import Limits, RunState, count_step, count_switch
 from ..loop.stay import UNRESOLVED, before_stay
-from ..loop.status import GO_ON
+from ..loop.status import CUT, GO_ON
 
 
 # ------------------------------------------------------------------ the pieces at the state
@@ -170,9 +170,12 @@ def _window(mode, ta, tb, first, may_split, ctx):
     if may_split and not exact and not (
             rules.cut_resolves(bad, ns) and _resolved(mode, ns if bad < 0 else bad, sm)):
         return UNRESOLVED, (ta if bad < 0 else _sample_time(ta, tb, frac, bad)), _W_NONE
-    t_stop = ta
-    st, te, what = _find(mode, ns if bad < 0 else bad, first, s, o, sm, sc)  # bad = 1: none
-    if st == OK and what == _W_NONE and bad >= 1:
+    t_stop, cut = ta, bad >= 0
+    st, te, what, i = _find(mode, ns if bad < 0 else bad, first, s, o, sm, sc)  # bad = 1: none
+    if st == CUT:  # a value not finite between samples i and i + 1, at te: searched to it
+        st, te, what, t_stop = _past_cut(mode, sm.ts[i], te, first and i == 0, s, o, sm, sc)
+        cut = True
+    elif st == OK and what == _W_NONE and bad >= 1:
         st, te, what, t_stop = _past_cut(mode, sm.ts[bad - 1], sm.ts[bad],
                                          first and bad == 1, s, o, sm, sc)
     # P is not differentiable where the orbit touches H
@@ -182,7 +185,7 @@ def _window(mode, ta, tb, first, may_split, ctx):
                 w.deriv.M[i, j] = np.nan
     if st != OK:
         return st, ta, _W_NONE
-    if what == _W_NONE and bad >= 0:  # te: the last finite sample (_past_cut)
+    if what == _W_NONE and cut:  # te: the last finite sample (_past_cut)
         return _stop_non_finite(t_stop, te, ta, mode, o, sc, w)
     if what == _W_NONE:
         for c in range(w.z.size):
@@ -219,11 +222,12 @@ _ALL_SAMPLES = np.int64(0)
 
 @_jit  # a call: the path past a non-finite sample is rare
 def _past_cut(mode, lo, hi, first, s, o, sm, sc):
-    """The interval [lo, hi] of a window whose sample at hi was not finite, with no event
-    up to lo: searched in sub-windows [lo, mid] sampled as the window was, halving the
-    bracket (rules.cut_midpoint) to the field's edge -- an event before it stands
-    (docs/decisions.md#past-a-non-finite-sample). (status, t, what, t_stop): the event,
-    or _W_NONE and the time the run stops at (the last sample found not finite)."""
+    """The interval [lo, hi] of a window whose sample at hi was not finite (or a value
+    between its samples: CUT), with no event up to lo: searched in sub-windows [lo, mid]
+    sampled as the window was, halving the bracket (rules.cut_midpoint) to the field's
+    edge -- an event before it stands (docs/decisions.md#past-a-non-finite-sample).
+    (status, t, what, t_stop): the event, or _W_NONE and the time the run stops at (the
+    last sample or value found not finite)."""
     exact = mode != SLIDING and o.seg[SEG_INTEGRATED] == 0.0
     frac = s.frac_ex if exact else s.frac_in
     ns = frac.size
@@ -235,7 +239,11 @@ def _past_cut(mode, lo, hi, first, s, o, sm, sc):
         if bad == 0:  # lo's own sample (the rates a step ahead of it): the edge is there
             return OK, lo, _W_NONE, sm.ts[0]
         if bad < 0 or bad >= 2:  # from the stay's first sample: clamped as it is there
-            st, te, what = _find(mode, ns if bad < 0 else bad, lo == t_first, s, o, sm, sc)
+            st, te, what, i = _find(mode, ns if bad < 0 else bad, lo == t_first, s, o, sm, sc)
+            if st == CUT:  # a value between samples i and i + 1 not finite, at te
+                t_stop, lo, hi = te, sm.ts[i], te
+                mid = rules.cut_midpoint(lo, hi, o.xtol)
+                continue
             if st != OK or what != _W_NONE:
                 return st, te, what, t_stop
         if bad < 0:

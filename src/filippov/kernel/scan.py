@@ -275,7 +275,8 @@ _window_event = _jit(make_window_event(WINDOW_OPERATIONS, call=_jit, inline=_jit
 @_jit_inline
 def _find(mode, ns, first, s, o, sm, sc):
     """The earliest event on the samples (the one event search of loop.interval); (status,
-    t, what). A touch of H on the way (no event) sets sm.touched[0]."""
-    st, t, what, _ = _window_event(Walk(first, o, sm, sc, ns, s.touch_tol, s.min_time,
+    t, what, i): i the sample interval a status other than OK arose in (CUT: a value not
+    finite at t there). A touch of H on the way (no event) sets sm.touched[0]."""
+    st, t, what, i = _window_event(Walk(first, o, sm, sc, ns, s.touch_tol, s.min_time,
                                         s.sec_pred), mode)
-    return st, t, what
+    return st, t, what, i

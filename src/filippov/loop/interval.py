@@ -41,10 +41,15 @@ inlined (``inline="always"``), so this module is plain scalar Python in the subs
 compiles (what the split costs: docs/decisions.md#window-seam).
 
 An event is ``(status, t, what, k)``: ``status`` OK or the engine's failure code (the
-reference raises instead, so its operations always return OK); ``what`` one of
+reference raises instead, so its operations return OK or CUT); ``what`` one of
 :data:`NONE`, ``rules.SWITCH``, ``rules.EXIT_MINUS``, ``rules.EXIT_PLUS``,
 :data:`SECTION` (the kernel's codes); ``k`` the index of the section hit (-1 for any
-other event).
+other event), or with a status other than OK the sample interval it arose in. CUT: a
+function asked between samples i and i + 1 was not finite at t (a root finder met it, or
+the value at a hidden extremum): nothing is decided on it, and the engine searches
+[ts[i], t] as the interval before a sample that is not finite
+(docs/decisions.md#past-a-non-finite-sample): an event before t stands, else the run
+stops at the field's edge.
 """
 from __future__ import annotations
 
@@ -57,7 +62,7 @@ from .. import rules
 from ..rules import GRAZE_CROSSES, GRAZE_NONE, GRAZE_TOUCHES
 from ..system import SLIDING
 from .refine import make_refine
-from .status import ROOT_FAILED
+from .status import CUT, ROOT_FAILED
 
 #: the status of an operation that succeeded (the kernel's OK)
 OK = 0
@@ -114,13 +119,14 @@ def as_is(f):
 def make_extremum(ops: WindowOps):
     """``extremum(ctx, f, i, mode) -> (status, t)``: the root of the rate f between samples
     i and i + 1 (an extremum of the function it is the rate of), on the engine's root
-    finder with the samples' values handed (:data:`WindowOps`' ``root``)."""
+    finder with the samples' values handed (:data:`WindowOps`' ``root``); CUT where the
+    rate was not finite at t."""
     sampled, root = ops.sampled, ops.root
 
     def extremum(ctx, f, i, mode):
-        ok, tm, _ = root(ctx, f, sampled(ctx, F_TIME, i), sampled(ctx, F_TIME, i + 1),
-                         sampled(ctx, f, i), sampled(ctx, f, i + 1), mode)
-        return (OK if ok else ROOT_FAILED), tm
+        ok, tm, fm = root(ctx, f, sampled(ctx, F_TIME, i), sampled(ctx, F_TIME, i + 1),
+                          sampled(ctx, f, i), sampled(ctx, f, i + 1), mode)
+        return (OK if ok else CUT if math.isnan(fm) else ROOT_FAILED), tm
 
     return extremum
 
@@ -133,6 +139,7 @@ def make_leave_root(ops: WindowOps, refine, extremum):
     exit's band is in force is probed back toward the bracket's start
     (``rules.band_probe``) to a time out of the band (``rules.clears_band``) and refined
     again from there on h itself (r stands if none clears, or if that refinement fails).
+    CUT at the time where h, asked between the samples, was not finite.
     ``refine``: the loop's refinement on the engine's root finder (loop.refine);
     ``extremum``: :func:`make_extremum`'s."""
     sampled, value = ops.sampled, ops.value
@@ -143,22 +150,29 @@ def make_leave_root(ops: WindowOps, refine, extremum):
         if (first and i == 0 and mode != SLIDING and rules.dips_and_returns(
                 mode, sampled(ctx, F_RATE, 0), sampled(ctx, F_RATE, 1))):
             st, tm = extremum(ctx, F_RATE, 0, mode)
+            if st == CUT:
+                return st, tm
             if st == OK:
                 hm = value(ctx, F_LEAVE, tm, mode)
+                if math.isnan(hm):
+                    return CUT, tm
                 if not rules.after(pred, hm):  # next to the entry h is noise (rules)
                     lo, vlo = tm, hm
-        ok, r = refine(ctx, F_LEAVE + q, pred, lo, sampled(ctx, F_TIME, i + 1), vlo, vb, mode)
-        if not ok or band == 0.0 or mode == SLIDING:
-            return (OK if ok else ROOT_FAILED), r
+        st, r = refine(ctx, F_LEAVE + q, pred, lo, sampled(ctx, F_TIME, i + 1), vlo, vb, mode)
+        if st != OK or band == 0.0 or mode == SLIDING:
+            return st, r
         tq, step, done, clear = r, 0.0, False, False
         while not done:
-            clear = rules.clears_band(mode, value(ctx, F_LEAVE, tq, mode), band)
+            hq = value(ctx, F_LEAVE, tq, mode)
+            if math.isnan(hq):
+                return CUT, tq
+            clear = rules.clears_band(mode, hq, band)
             done, tq, step = rules.band_probe(tq, step, lo, clear)
         if not clear:
             return OK, r
-        ok, r2 = refine(ctx, F_UNBANDED, pred, tq, r, value(ctx, F_UNBANDED, tq, mode),
+        st, r2 = refine(ctx, F_UNBANDED, pred, tq, r, value(ctx, F_UNBANDED, tq, mode),
                         value(ctx, F_UNBANDED, r, mode), mode)
-        return OK, (r2 if ok else r)
+        return (st, r2) if st == CUT else (OK, (r2 if st == OK else r))
 
     return leave_root
 
@@ -168,7 +182,8 @@ def make_hidden_end(ops: WindowOps, refine, extremum):
     leave function q hidden between samples i and i + 1 (va: its value at i as read),
     judged by ``rules.graze`` in a region, ``rules.speed_graze`` while sliding: the
     function's root before it (GRAZE_CROSSES), the extremum's time (GRAZE_TOUCHES), or
-    GRAZE_NONE. ``refine``, ``extremum``: as :func:`make_leave_root`'s."""
+    GRAZE_NONE; CUT (status) where the function was not finite there: no judgement on a
+    NaN. ``refine``, ``extremum``: as :func:`make_leave_root`'s."""
     sampled, value = ops.sampled, ops.value
 
     def hidden_end(ctx, q, i, mode, w, band, va):
@@ -178,14 +193,16 @@ def make_hidden_end(ops: WindowOps, refine, extremum):
         if st != OK:
             return st, tm, GRAZE_NONE
         vm = value(ctx, F_LEAVE + q, tm, mode)
+        if math.isnan(vm):
+            return CUT, tm, GRAZE_NONE
         if mode == SLIDING:
             kind = rules.speed_graze(pred, vm, sampled(ctx, F_RATE + q, i),
                                      sampled(ctx, F_RATE + q, i + 1), tb - ta, w.touch_tol)
         else:
             kind = rules.graze(mode, vm, w.touch_tol, band)
         if kind == GRAZE_CROSSES:
-            ok, r = refine(ctx, F_LEAVE + q, pred, ta, tm, va, vm, mode)
-            return (OK if ok else ROOT_FAILED), r, kind
+            st, r = refine(ctx, F_LEAVE + q, pred, ta, tm, va, vm, mode)
+            return st, r, kind
         return OK, tm, kind
 
     return hidden_end
@@ -240,10 +257,9 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
 
     def window_event(ctx, mode):
         w = window(ctx)
-        n, band, nl = w.last, w.band, (2 if mode == SLIDING else 1)
-        clamp_at = 0 if w.first else -1
+        n, band, clamp_at = w.last, w.band, (0 if w.first else -1)
         pred0, pred1 = rules.leave_pred(mode, 0), rules.leave_pred(mode, 1)
-        i = 0
+        i, nl = 0, (2 if mode == SLIDING else 1)
         while i < n:
             if not asks(w.cand, i):
                 i += 1
@@ -264,7 +280,7 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
                     st, r = leave_root(ctx, q, i, mode, w.first, band, va0 if q == 0 else va1,
                                        vb0 if q == 0 else vb1)
                     if st != OK:
-                        return st, r, NONE, -1
+                        return st, r, NONE, i
                     if best_w == NONE or r < best_t:
                         best_t, best_w = r, rules.ended_by(mode, q)
                 # 2. an extremum of a leave function hidden between the samples
@@ -274,7 +290,7 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
                         continue
                     st, r, kind = hidden_end(ctx, q, i, mode, w, band, va0 if q == 0 else va1)
                     if st != OK:
-                        return st, r, NONE, -1
+                        return st, r, NONE, i
                     if kind == GRAZE_CROSSES and (best_w == NONE or r < best_t):
                         best_t, best_w, hidden = r, rules.ended_by(mode, q), True
                     elif kind == GRAZE_TOUCHES:
@@ -282,19 +298,20 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
                 for tm in (min(touch_0, touch_1), max(touch_0, touch_1)):
                     if tm < best_t:  # a touch before any exit, in time order: P has a kink
                         touch(ctx, tm, mode)
-                # 3. the sections in order: a hit that comes first, or at a switch (asked
-                # at a hidden extremum's crossing itself: the samples past it turned back)
+                # 3. the sections in order: a hit first, or at a switch (hidden: at its time)
                 for k in range(len(w.preds)):
                     pred, t_min = w.preds[k], w.t_mins[k]
                     sa, sb = sampled(ctx, F_SECTION + k, i), sampled(ctx, F_SECTION + k, i + 1)
                     tb = math.inf   # the interval's end, read only for a crossing
                     if hidden and not rules.crosses(pred, sa, sb):
                         tb, sb = best_t, value(ctx, F_SECTION + k, best_t, mode)
+                        if math.isnan(sb):
+                            return CUT, best_t, NONE, i
                     if rules.crosses(pred, sa, sb):
-                        ok, r = refine(ctx, F_SECTION + k, pred, sampled(ctx, F_TIME, i),
+                        st, r = refine(ctx, F_SECTION + k, pred, sampled(ctx, F_TIME, i),
                                        min(tb, sampled(ctx, F_TIME, i + 1)), sa, sb, mode)
-                        if not ok:
-                            return ROOT_FAILED, r, NONE, -1
+                        if st != OK:
+                            return st, r, NONE, i
                         if (rules.section_first(r, t_min, best_t, best_w == SECTION, w.xtol)
                                 and counts(ctx, k, i, r, mode)):
                             best_t, best_w, best_k = r, SECTION, k

@@ -14,6 +14,10 @@ tb). Its event time r is:
 4. then walked to the far side of the crossing (``rules.far_side``, ``far_side_probe``):
    a root finder may stop a hair before the sign flips.
 
+A value of f that is not finite where the root finder or the walk evaluated it ends the
+refinement with CUT and that time: the window is searched up to there as past a sample
+that is not finite (docs/decisions.md#past-a-non-finite-sample), not decided on a NaN.
+
 Plain scalar Python in the subset numba compiles: the reference runs it with its
 callables, the kernel compiles it with its selectors of the segment's functions.
 """
@@ -22,18 +26,21 @@ from __future__ import annotations
 import math
 
 from .. import rules
+from .status import CUT, OK, ROOT_FAILED
 
 
 def make_refine(root, value_at):
-    """``refine(ctx, f, pred, ta, tb, va, vb, mode) -> (ok, r)``: the event time of f's
-    sign change ``pred`` between ta and tb (this module's docstring), from the engine's
-    operations on its state ``ctx``:
+    """``refine(ctx, f, pred, ta, tb, va, vb, mode) -> (status, r)``: the event time of
+    f's sign change ``pred`` between ta and tb (this module's docstring): OK, or
+    ROOT_FAILED, or CUT where f was not finite at r; from the engine's operations on its
+    state ``ctx``:
 
     * ``root(ctx, f, ta, tb, vlo, vhi, mode) -> (ok, r, fr)``: f's root in [ta, tb] and
-      f's value there (the one the root finder evaluated last); not ok when f at the
-      ends shows no sign change, unless the samples' values vlo, vhi are handed (NaN:
-      none) and the engine pins the bracket to them (loop.interval.WindowOps);
-    * ``value_at(ctx, f, t, mode)``: f at t.
+      f's value there (the one the root finder evaluated last; not ok with fr NaN where
+      f was not finite at r); not ok when f at the ends shows no sign change, unless the
+      samples' values vlo, vhi are handed (NaN: none) and the engine pins the bracket to
+      them (loop.interval.WindowOps);
+    * ``value_at(ctx, f, t, mode)``: f at t (NaN where it is not finite).
     """
 
     def refine(ctx, f, pred, ta, tb, va, vb, mode):
@@ -44,18 +51,22 @@ def make_refine(root, value_at):
         else:
             ok, r, fr = root(ctx, f, ta, tb, math.nan, math.nan, mode)
             if not ok:
+                if math.isnan(fr):
+                    return CUT, r
                 fa = value_at(ctx, f, ta, mode)
                 if rules.after(pred, fa):  # clamped start, true value past: at once
                     r, fr = ta, fa
                 else:
                     ok, r, fr = root(ctx, f, ta, tb, va, vb, mode)
                     if not ok:
-                        return False, r
+                        return (CUT if math.isnan(fr) else ROOT_FAILED), r
         done, step = False, 0.0
         while not done:  # to the far side of the crossing (rules.far_side_probe)
+            if math.isnan(fr):
+                return CUT, r
             done, r, step = rules.far_side_probe(r, step, tb, rules.after(pred, fr))
             if not done:
                 fr = value_at(ctx, f, r, mode)
-        return True, r
+        return OK, r
 
     return refine

@@ -5,6 +5,10 @@ exceptions (:mod:`filippov.errors`). Plain integers: numba compiles them as lite
 from __future__ import annotations
 
 GO_ON = -1         # the orbit goes on (never a run's final status)
+# a value not finite met between two samples (a root finder's, a hidden extremum's):
+# the window's search ends there and the engine searches up to it as past a sample not
+# finite (never a run's final status; loop.interval, loop.refine)
+CUT = -3
 OK = 0
 NO_RETURN = 1      # t_max reached before the section
 EVENT_LIMIT = 2    # more than max_events switches
