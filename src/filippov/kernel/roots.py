@@ -22,7 +22,9 @@ def _brentq_f(sel, xa, xb, maxiter, mode, o, sc):
     xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
     fpre = _fval(sel, xpre, mode, o, sc)
     fcur = _fval(sel, xcur, mode, o, sc)
-    if np.isnan(fpre) or np.isnan(fcur):
+    if np.isnan(fpre):  # (where it was not finite, with NaN: loop.refine's CUT)
+        return xpre, fpre, False
+    if np.isnan(fcur):
         return xcur, fcur, False
     if fpre == 0.0:
         return xpre, fpre, True
