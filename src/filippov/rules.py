@@ -701,7 +701,9 @@ def tangent_to_both(a: float, b: float, grad, f_minus, f_plus) -> bool:
     (seen: the other speed 3.7e-6 and 5.7e-5 of its size where the slide began, past
     :func:`at_two_fold`'s share, where the slide ran straight into it), and a slide that
     began next to a two-fold starts with speeds as small as that. The shares are
-    cosines: independent of the units of H, the state and time."""
+    cosines: independent of the units of H and time, and of one unit for every
+    component of the state -- not of components in units far apart (an ordinary fold
+    exit was refused with y in units 1e7 smaller than x: tests/test_known_misses.py)."""
     g2, m2, p2 = 0.0, 0.0, 0.0
     for c in range(grad.size):
         g2 += grad[c] * grad[c]
