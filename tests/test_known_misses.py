@@ -572,12 +572,12 @@ _PEAK = 16 * np.pi + np.pi / 2          # the excursion's peak (th' = 1: its tim
 _UP = _PEAK - (np.pi / 2 - np.arcsin(0.999))   # its upward crossing
 
 
-def _nan_h_system(section_at, lo, hi):
+def _nan_h_system(section_at, lo, hi, bad=np.nan):
     return FilippovSystem(
         ("th", "x"), lambda z, p: np.array([1.0, 0.0]), lambda z, p: np.array([1.0, 1.0]),
-        lambda z, p: np.nan if p[1] < z[0] < p[2] else np.sin(z[0]) - 0.999,
+        lambda z, p: p[3] if p[1] < z[0] < p[2] else np.sin(z[0]) - 0.999,
         lambda z, p: np.array([np.cos(z[0]), 0.0]),
-        params=np.array([section_at, lo, hi]))
+        params=np.array([section_at, lo, hi, bad]))
 
 
 @pytest.mark.parametrize("engine", ENGINES)
@@ -593,6 +593,16 @@ def test_a_band_of_h_met_between_samples_stops_the_run_at_its_edge(engine, lo, h
                       lambda z, p: z[0] - p[0], 400.0, direction=1, engine=engine)
     t = float(re.search(r"at t=([-0-9.e+]+)", str(err.value)).group(1))
     assert abs(t - edge) <= 1e-9, (t, edge)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("bad", [-np.inf, np.inf])
+def test_an_infinite_h_between_samples_is_not_finite_too(engine, bad):
+    # (review of the mend) h = -inf on the band at the peak: the compiled engine took
+    # it for a number (18 switches, no error) where NaN was caught
+    with pytest.raises(SimulationError, match="mode plus \\(switch returned a non-finite"):
+        first_returns(_nan_h_system(60.0, _PEAK - 0.01, _PEAK + 0.01, bad), [[0.0, 0.0]],
+                      lambda z, p: z[0] - p[0], 400.0, direction=1, engine=engine)
 
 
 @pytest.mark.parametrize("engine", ENGINES)
@@ -702,3 +712,42 @@ def test_a_clock_in_small_units_leaves_the_other_components_their_accuracy(engin
     got = first_returns(system, [[0.0, 4.0, 1e9]], lambda z, p: z[2] / 1e9 - 3.0, 20.0,
                         direction=1, engine=engine)
     assert got.state[0, :2] == pytest.approx(want, abs=1e-10)
+
+
+# ------------------------------------------------------------- users' models, their inputs
+# A review of the front doors with users' own models (2026-12-06). Mended:
+def test_a_piece_that_reads_p_beyond_params_is_refused_by_name():
+    # compiled, numba reads past the array (0 here) and both engines ran another system
+    from filippov.checks import SystemContractError
+    with pytest.raises(SystemContractError, match="field_minus: IndexError.*params of 0"):
+        FilippovSystem(("x", "v"), lambda z, p: np.array([z[1], -p[0] * z[0] + 1.0]),
+                       lambda z, p: np.array([z[1], -z[0] - 1.0]), lambda z, p: z[1],
+                       lambda z, p: np.array([0.0, 1.0]))
+    with pytest.raises(SystemContractError, match="field_plus: IndexError.*params of 1"):
+        FilippovSystem(("x",), lambda z, p: np.array([p[0]]), lambda z, p: np.array([-p[1]]),
+                       lambda z, p: z[0], lambda z, p: np.array([1.0]), params=[2.0])
+
+
+@pytest.mark.parametrize("bad", [{"tol": 10.0}, {"tol": 0.0}, {"tol": float("nan")},
+                                 {"max_iter": 0}, {"max_iter": 2.5}])
+def test_periodic_orbit_names_a_tolerance_or_an_iteration_count_out_of_range(bad):
+    # tol 10 returned the guess as the orbit; max_iter 0 an UnboundLocalError
+    with pytest.raises(ValueError, match=f"^{next(iter(bad))}: "):
+        periodic_orbit(_relay_in_units(np.ones(3)), [0.0, 0.5, -0.2],
+                       lambda z, p: z[0] / p[0], direction=1, t_max=20.0, **bad)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_batch_gives_the_same_returns_in_any_order_of_its_starts(engine):
+    # two starts tied for the largest component: the batch's scale was measured at the
+    # first of them, and swapping them moved both returns by 2e-13
+    system = FilippovSystem(
+        ("x1", "x2", "x3"),
+        lambda z, p: np.array([z[1], z[2], -z[0] - 3 * z[1] - 3 * z[2] + p[0]]),
+        lambda z, p: np.array([z[1], z[2], -z[0] - 3 * z[1] - 3 * z[2] - p[0]]),
+        lambda z, p: z[0], lambda z, p: np.array([1.0, 0.0, 0.0]), params=[0.01])
+    a, b = [0.0, 0.01, 0.009009273926518705], [0.0, -0.01, -0.003763370959790291]
+    one = first_returns(system, [a, b], lambda z, p: z[0], 100.0, direction=1, engine=engine)
+    two = first_returns(system, [b, a], lambda z, p: z[0], 100.0, direction=1, engine=engine)
+    assert np.array_equal(one.time, two.time[::-1])
+    assert np.array_equal(one.state, two.state[::-1])

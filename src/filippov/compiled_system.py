@@ -30,6 +30,29 @@ from .surfaces import check_intersection, view_at
 from .surfaces_defined import grad_derivative, sliding_jacobian
 from .abi import FIELD_SIG, FLOW_SIG, SCALAR_SIG, WHERE_SIG, CompiledModel, always, no_flow
 
+def _params_in_range(pieces: dict, n: int, params, probe) -> None:
+    """Refuse a piece that reads ``p`` beyond ``params`` (params= forgotten, or one value
+    too few), run once as Python at the probe state: compiled, numba does not check the
+    index and reads whatever lies past the array, a silent other system (a review). Only
+    an IndexError is judged here; any other failure is left to the engines' checks."""
+    z = np.full(n, 0.5) if probe is None else np.asarray(probe, dtype=float).reshape(-1)
+    p = np.asarray(params, dtype=float)
+    for name, fn in pieces.items():
+        if not callable(fn) or name.startswith("flow_jacobian"):
+            continue
+        args = (z, 0.0, p) if name.startswith("flow") else (z, p)
+        try:
+            with np.errstate(all="ignore"):
+                getattr(fn, "py_func", fn)(*args)
+        except IndexError as exc:
+            raise SystemContractError(
+                f"{name}: IndexError at z={z.tolist()} with params of {p.size} value(s) "
+                f"({exc}): it reads p (or z) beyond its size; give every parameter a piece "
+                "reads in params=") from None
+        except Exception:   # noqa: BLE001 -- not this check's to judge
+            continue
+
+
 def _one_surface(switch, n: int, params, probe) -> None:
     """Refuse a ``switch`` that gives several values at a state (several switching
     surfaces) by name, before numba's error about a vector where a scalar goes; a switch
@@ -425,6 +448,7 @@ class FilippovSystem:
                             flow_jacobian_plus=flow_jacobians.get("plus"))
         if self._surfaces is None:
             _one_surface(switch, len(self.names), self.params, probe)
+        _params_in_range(self._pieces, len(self.names), self.params, probe)
         jacobians = dict(jacobians or {} if self._surfaces is None else {})
         unknown = set(jacobians) - set(_JAC_MODES)
         if unknown:

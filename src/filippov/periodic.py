@@ -338,7 +338,16 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
         return is the start itself (a path shorter than ``SHORTEST_PATH`` of the state's
         size: the start a hair before the section by rounding), or an iterate that ran
         away from the guess (``RUNAWAY`` times its size).
+    ValueError
+        ``tol`` not in (0, 1e-3] or ``max_iter`` not a positive integer (a review: tol 10
+        returned the guess as the orbit, max_iter 0 an UnboundLocalError).
     """
+    if not (isinstance(tol, (int, float)) and 0.0 < tol <= 1e-3):
+        raise ValueError(f"tol: the relative residual Newton stops at, in (0, 1e-3]; got "
+                         f"{tol!r}")
+    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) \
+            or max_iter < 1:
+        raise ValueError(f"max_iter: a positive integer, got {max_iter!r}")
     z = _checked_start(system, guess, returns, engine)
     python = views.reference_system(system, "periodic_orbit", several=True)
     runs, sc = _orbit_scale(python, z, options.get("scale"))   # what the runs take; all

@@ -236,13 +236,23 @@ def of_batch(value, starts, pieces) -> Scale:
         if not len(finite):
             return measure(np.zeros(0), state=state)
         norms = np.max(np.abs(starts[finite]), axis=1) if starts.shape[1] else np.zeros(len(finite))
-        rows = sorted({int(finite[np.argmin(norms)]), int(finite[np.argmax(norms)])})
+        rows = sorted({_by_value(starts, finite[norms == norms.min()]),
+                       _by_value(starts, finite[norms == norms.max()])})
         found = [measure_system(starts[i], *pieces(i), state) for i in rows]
         bad = [s for s in found if s.how.startswith(OUT_OF_RANGE)]
         return bad[0] if bad else Scale(min(s.state for s in found),
                                         min(s.time for s in found),
                                         min(s.switch for s in found), "measured")
     return resolve(value, measure_at)
+
+
+def _by_value(starts, rows) -> int:
+    """The first of the tied ``rows`` of ``starts`` in the order of their values (last
+    component first), not of their places: a batch's scale, and so every return of it, is
+    the same in any order of its starts (a review: two starts tied for the largest, the
+    first of them measured, and swapping them moved both returns by 2e-13)."""
+    rows = np.asarray(rows)
+    return int(rows[np.lexsort(starts[rows].T)[0]])
 
 
 def declared(value, field: str = "scale"):

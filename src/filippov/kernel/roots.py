@@ -22,9 +22,9 @@ def _brentq_f(sel, xa, xb, maxiter, mode, o, sc):
     xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
     fpre = _fval(sel, xpre, mode, o, sc)
     fcur = _fval(sel, xcur, mode, o, sc)
-    if np.isnan(fpre):  # (where it was not finite, with NaN: loop.refine's CUT)
+    if not np.isfinite(fpre):  # (where it was not finite, with it: loop.refine's CUT)
         return xpre, fpre, False
-    if np.isnan(fcur):
+    if not np.isfinite(fcur):
         return xcur, fcur, False
     if fpre == 0.0:
         return xpre, fpre, True
@@ -71,6 +71,6 @@ def _brentq_f(sel, xa, xb, maxiter, mode, o, sc):
         else:
             xcur += delta if sbis > 0 else -delta
         fcur = _fval(sel, xcur, mode, o, sc)
-        if np.isnan(fcur):
+        if not np.isfinite(fcur):
             return xcur, fcur, False
     return xcur, fcur, False

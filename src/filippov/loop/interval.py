@@ -130,7 +130,7 @@ def make_extremum(ops: WindowOps):
     def extremum(ctx, w, f, i, mode):
         ok, tm, fm = root(ctx, f, w.ts[i], w.ts[i + 1], w.dvals[f - F_RATE, i],
                           w.dvals[f - F_RATE, i + 1], mode)
-        return (OK if ok else CUT if math.isnan(fm) else ROOT_FAILED), tm
+        return (OK if ok else CUT if not math.isfinite(fm) else ROOT_FAILED), tm
 
     return extremum
 
@@ -158,7 +158,7 @@ def make_leave_root(ops: WindowOps, refine, extremum):
                 return st, tm
             if st == OK:
                 hm = value(ctx, F_LEAVE, tm, mode)
-                if math.isnan(hm):
+                if not math.isfinite(hm):
                     return CUT, tm
                 if not rules.after(pred, hm):  # next to the entry h is noise (rules)
                     lo, vlo = tm, hm
@@ -168,7 +168,7 @@ def make_leave_root(ops: WindowOps, refine, extremum):
         tq, step, done, clear = r, 0.0, False, False
         while not done:
             hq = value(ctx, F_LEAVE, tq, mode)
-            if math.isnan(hq):
+            if not math.isfinite(hq):
                 return CUT, tq
             clear = rules.clears_band(mode, hq, band)
             done, tq, step = rules.band_probe(tq, step, lo, clear)
@@ -197,7 +197,7 @@ def make_hidden_end(ops: WindowOps, refine, extremum):
         if st != OK:
             return st, tm, GRAZE_NONE
         vm = value(ctx, F_LEAVE + q, tm, mode)
-        if math.isnan(vm):
+        if not math.isfinite(vm):
             return CUT, tm, GRAZE_NONE
         if mode == SLIDING:
             kind = rules.speed_graze(pred, vm, w.dvals[q, i], w.dvals[q, i + 1], tb - ta,
@@ -305,7 +305,7 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
                     tb = math.inf   # the interval's end, read only for a crossing
                     if hidden and not rules.crosses(pred, sa, sb):
                         tb, sb = best_t, value(ctx, F_SECTION + k, best_t, mode)
-                        if math.isnan(sb):
+                        if not math.isfinite(sb):
                             return CUT, best_t, NONE, i
                     if rules.crosses(pred, sa, sb):
                         st, r = refine(ctx, F_SECTION + k, pred, w.ts[i], min(tb, w.ts[i + 1]),

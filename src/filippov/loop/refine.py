@@ -51,7 +51,7 @@ def make_refine(root, value_at):
         else:
             ok, r, fr = root(ctx, f, ta, tb, math.nan, math.nan, mode)
             if not ok:
-                if math.isnan(fr):
+                if not math.isfinite(fr):
                     return CUT, r
                 fa = value_at(ctx, f, ta, mode)
                 if rules.after(pred, fa):  # clamped start, true value past: at once
@@ -59,10 +59,10 @@ def make_refine(root, value_at):
                 else:
                     ok, r, fr = root(ctx, f, ta, tb, va, vb, mode)
                     if not ok:
-                        return (CUT if math.isnan(fr) else ROOT_FAILED), r
+                        return (CUT if not math.isfinite(fr) else ROOT_FAILED), r
         done, step = False, 0.0
         while not done:  # to the far side of the crossing (rules.far_side_probe)
-            if math.isnan(fr):
+            if not math.isfinite(fr):
                 return CUT, r
             done, r, step = rules.far_side_probe(r, step, tb, rules.after(pred, fr))
             if not done:
