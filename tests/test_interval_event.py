@@ -38,24 +38,17 @@ class Engine:
         self.skip, self.from_i = None, 0
 
     def window(self):
-        nl = 2 if F_LEAVE + 1 in self.funcs else 1
         return interval.Window(len(self.ts) - 1, self.first, self.band, self.rates, 1e-9, XTOL,
                                tuple(s[0] for s in self.sections),
-                               tuple(s[1] for s in self.sections), self._cand(),
-                               np.array(self.ts, dtype=float),
-                               np.array([self.samples(F_LEAVE + q) for q in range(nl)]),
-                               np.array([self.samples(F_RATE + q) for q in range(2)]),
-                               [self.samples(F_SECTION + k) for k in range(len(self.sections))])
-
-    def samples(self, f):
-        return np.array([self.sampled(f, j) for j in range(len(self.ts))])
+                               tuple(s[1] for s in self.sections), self._cand())
 
     def _cand(self):
         if self.skip is None:
             return None
         mode, nl = self.skip, 2 if self.skip == SLIDING else 1
 
-        samples = self.samples
+        def samples(f):
+            return np.array([self.sampled(f, j) for j in range(len(self.ts))])
         mask = interval.candidate_mask(
             mode, [samples(F_LEAVE + q) for q in range(nl)],
             [samples(F_RATE + q) for q in range(nl)],
@@ -112,8 +105,8 @@ class Engine:
         self.funcs[F_LEAVE], self.band, self.from_i = self.unbanded, 0.0, i
 
 
-OPS = interval.WindowOps(Engine.window, Engine.value, Engine.root, Engine.counts,
-                         Engine.touch, Engine.unband)
+OPS = interval.WindowOps(Engine.window, Engine.sampled, Engine.value, Engine.root,
+                         Engine.counts, Engine.touch, Engine.unband)
 EVENT = make_window_event(OPS)
 #: a window of one sample interval [0, 2]
 T2 = (0.0, 2.0)
@@ -416,12 +409,12 @@ def test_a_switch_beyond_the_band_is_refined_again_from_the_first_probe_out_of_i
                                           interval.make_extremum(OPS))
     c = Engine({F_LEAVE: lambda t: 0.5 - t, F_UNBANDED: lambda t: 0.4 - t,
                 F_RATE: lambda t: -1.0}, T2, band=0.1)
-    st, t = leave_root(c, c.window(), 0, 0, PLUS, 0.1, 0.5, -1.5)
+    st, t = leave_root(c, 0, 0, PLUS, False, 0.1, 0.5, -1.5)
     assert st == OK and abs(t - 0.4) < 1e-12
     assert c.asked == [("root", F_LEAVE), ("root", F_UNBANDED)]
     c = Engine({F_LEAVE: lambda t: 0.15 - t, F_UNBANDED: lambda t: 0.05 - t,
                 F_RATE: lambda t: -1.0}, T2, band=0.1)
-    st, t = leave_root(c, c.window(), 0, 0, PLUS, 0.1, 0.15, -1.85)
+    st, t = leave_root(c, 0, 0, PLUS, False, 0.1, 0.15, -1.85)
     assert st == OK and abs(t - 0.15) < 1e-12 and c.asked == [("root", F_LEAVE)]
 
 

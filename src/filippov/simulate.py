@@ -1054,7 +1054,7 @@ class _Scan:
         # the leave functions as sampled (raw) and as the search reads them (vals: h
         # sampled again unbiased once the band ends, _unband)
         self.raw = [np.asarray(func(zs), dtype=float) for func in leave]
-        self.vals = np.array(self.raw, dtype=float).reshape(len(self.raw), -1)
+        self.vals = list(self.raw)
         self.D = None
         if mode != SLIDING:  # dH/dt along the mode's field: extrema of H are its roots
             self.D = np.asarray(system.speed_of_switch(mode, zs), dtype=float)
@@ -1091,7 +1091,7 @@ class _Scan:
         samples follow this mode's field, not the orbit); with none, :meth:`earliest`
         stops the run at sample k."""
         self.ts, self.zs = self.ts[:k], self.zs[:, :k]
-        self.vals, self.raw = self.vals[:, :k], [v[:k] for v in self.raw]
+        self.vals, self.raw = [v[:k] for v in self.vals], [v[:k] for v in self.raw]
         self.svals = [v[:k] for v in self.svals]
         self.D = None if self.D is None else self.D[:k]
         self.R = None if self.R is None else tuple(r[:k] for r in self.R)
@@ -1244,16 +1244,20 @@ class _Scan:
 
     def _window(self):
         t0 = self.traj.t0
-        if self.mode != SLIDING:  # dH/dt (the rate of the one leave function)
-            dvals = self.D[None, :]
-        elif self.R is not None:  # the rates of a and b
-            dvals = np.array(self.R, dtype=float).reshape(2, -1)
-        else:
-            dvals = np.full((2, self.ts.size), math.nan)
         return interval.Window(self.ts.size - 1, self.first, self.band, self.rates is not None,
                                self.touch_tol, self.xtol, self.preds,
-                               tuple(t0 + sec.min_time for sec in self.sections), self.cand,
-                               self.ts, self.vals, dvals, self.svals)
+                               tuple(t0 + sec.min_time for sec in self.sections), self.cand)
+
+    def _sampled(self, f, i):
+        if f == interval.F_TIME:
+            return self.ts[i]
+        if f >= interval.F_SECTION:
+            return self.svals[f - interval.F_SECTION][i]
+        if f >= interval.F_RATE:
+            if self.mode != SLIDING:
+                return self.D[i]
+            return math.nan if self.R is None else self.R[f - interval.F_RATE][i]
+        return self.vals[f][i]
 
     def _function(self, f):
         """Function f (the loop's code) of time on the segment."""
@@ -1316,7 +1320,8 @@ class _Scan:
 #: what this engine reports of a window to the event search (the window seam:
 #: filippov.contracts.WindowOperations), and that one search (filippov.loop.interval)
 WINDOW_OPERATIONS = interval.WindowOps(
-    _Scan._window, _Scan._value, _Scan._root, _Scan._counts, _Scan._touch, _Scan._unband)
+    _Scan._window, _Scan._sampled, _Scan._value, _Scan._root, _Scan._counts, _Scan._touch,
+    _Scan._unband)
 _window_event = interval.make_window_event(WINDOW_OPERATIONS)
 
 # the event search and what is done at an event speak the same codes

@@ -7,8 +7,8 @@ from numba import types
 from numba.extending import overload
 
 from .. import rules
-from ..loop.interval import (F_LEAVE, F_RATE, F_UNBANDED, Window, WindowOps, asks,
-                             make_window_event)
+from ..loop.interval import (F_LEAVE, F_RATE, F_SECTION, F_TIME, F_UNBANDED, Window, WindowOps,
+                             asks, make_window_event)
 from ..system import MINUS, PLUS, SLIDING
 from .base import (OK, ROOT_FAILED, _MAXITER_EVENT, _MAXITER_EXTREMUM, _S_A, _S_B, _S_DA, _S_DB, _S_H,
                    _S_SEC, _dot, _jit, _jit_inline, _speeds, _field_minus, _field_plus,
@@ -156,12 +156,10 @@ def _sel(f, mode):
 @_jit_inline
 def _window_of(ctx):
     """The window as the search sees it: one section, which the run may hit from t = 0 +
-    min_time on; every interval asked (cand None: the kernel finds no candidates ahead);
-    its samples, the arrays _sample filled."""
-    sg, sm = ctx.o.seg, ctx.sm
+    min_time on; every interval asked (cand None: the kernel finds no candidates ahead)."""
+    sg = ctx.o.seg
     return Window(ctx.ns - 1, ctx.first, sg[SEG_BAND], sg[SEG_RATE_STEP] > 0.0,
-                  ctx.touch_tol, ctx.o.xtol, (ctx.sec_pred,), (ctx.min_time,), None,
-                  sm.ts, sm.vals, sm.dvals, (sm.svals,))
+                  ctx.touch_tol, ctx.o.xtol, (ctx.sec_pred,), (ctx.min_time,), None)
 
 
 @overload(asks, inline="always")
@@ -171,6 +169,18 @@ def _asks(cand, i):
     if isinstance(cand, types.NoneType):
         return lambda cand, i: True
     return lambda cand, i: cand[i]
+
+
+@_jit_inline
+def _sampled(ctx, f, i):
+    sm = ctx.sm
+    if f == F_TIME:
+        return sm.ts[i]
+    if f >= F_SECTION:
+        return sm.svals[i]
+    if f >= F_RATE:
+        return sm.dvals[f - F_RATE, i]
+    return sm.vals[f, i]
 
 
 @_jit_inline
@@ -256,7 +266,7 @@ def _unband(ctx, i, mode):
 
 #: what the kernel reports of a window to the event search (the window seam:
 #: filippov.contracts.WindowOperations)
-WINDOW_OPERATIONS = WindowOps(_window_of, _value, _root, _counts, _touch, _unband)
+WINDOW_OPERATIONS = WindowOps(_window_of, _sampled, _value, _root, _counts, _touch, _unband)
 #: the one event search (loop.interval) on them: a call, its operations inlined, the root
 #: of a leave function a call of its own (docs/decisions.md#kernel-inlined-driver)
 _window_event = _jit(make_window_event(WINDOW_OPERATIONS, call=_jit, inline=_jit_inline))

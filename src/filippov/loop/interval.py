@@ -85,18 +85,15 @@ F_TIME, F_LEAVE, F_RATE, F_UNBANDED, F_SECTION = -1, 0, 2, 4, 5
 #: (``preds``) and the earliest time it may be hit (``t_mins``); and ``cand``, which
 #: intervals the walk asks (a mask, one entry per interval: the reference flags those
 #: where its array operations saw a sign change, :func:`candidate_mask`; None: every
-#: one, the kernel's; the search tests each one it asks again: :func:`asks`); and its
-#: samples, the data the search reads: the times ``ts``, the leave functions
-#: ``vals[q, i]`` and their rates ``dvals[q, i]`` (NaN where not sampled), the sections
-#: ``svals[k][i]``
+#: one, the kernel's; the search tests each one it asks again: :func:`asks`)
 Window = namedtuple("Window", (
-    "last", "first", "band", "rates", "touch_tol", "xtol", "preds", "t_mins", "cand",
-    "ts", "vals", "dvals", "svals"))
+    "last", "first", "band", "rates", "touch_tol", "xtol", "preds", "t_mins", "cand"))
 
 #: The engine's operations on a window, each a function of its state ``ctx``:
 #:
-#: * ``window(ctx) -> Window``: the window with its samples;
-#: * ``value(ctx, f, t, mode)``: f (the codes above) at time t on the window;
+#: * ``window(ctx) -> Window``;
+#: * ``sampled(ctx, f, i)``: function f (the codes above) at sample i;
+#: * ``value(ctx, f, t, mode)``: f at time t on the window;
 #: * ``root(ctx, f, lo, hi, vlo, vhi, mode) -> (ok, t, f(t))``: the engine's root finder on
 #:   f in [lo, hi]; not ok where f at the ends shows no sign change, unless the loop
 #:   hands the samples' values there (vlo, vhi; NaN: none), to which the reference pins
@@ -110,8 +107,7 @@ Window = namedtuple("Window", (
 #: * ``unband(ctx, i, mode)``: the band ends; h is sampled again unbiased from sample i
 #:   on (none when i is past the last sample), and the window's ``cand`` found again.
 WindowOps = namedtuple("WindowOps", (
-    "window", "value", "root", "counts", "touch", "unband"))
-
+    "window", "sampled", "value", "root", "counts", "touch", "unband"))
 
 
 def as_is(f):
@@ -121,22 +117,22 @@ def as_is(f):
 
 
 def make_extremum(ops: WindowOps):
-    """``extremum(ctx, w, f, i, mode) -> (status, t)``: the root of the rate f between samples
+    """``extremum(ctx, f, i, mode) -> (status, t)``: the root of the rate f between samples
     i and i + 1 (an extremum of the function it is the rate of), on the engine's root
     finder with the samples' values handed (:data:`WindowOps`' ``root``); CUT where the
     rate was not finite at t."""
-    root = ops.root
+    sampled, root = ops.sampled, ops.root
 
-    def extremum(ctx, w, f, i, mode):
-        ok, tm, fm = root(ctx, f, w.ts[i], w.ts[i + 1], w.dvals[f - F_RATE, i],
-                          w.dvals[f - F_RATE, i + 1], mode)
+    def extremum(ctx, f, i, mode):
+        ok, tm, fm = root(ctx, f, sampled(ctx, F_TIME, i), sampled(ctx, F_TIME, i + 1),
+                          sampled(ctx, f, i), sampled(ctx, f, i + 1), mode)
         return (OK if ok else CUT if not math.isfinite(fm) else ROOT_FAILED), tm
 
     return extremum
 
 
 def make_leave_root(ops: WindowOps, refine, extremum):
-    """``leave_root(ctx, w, q, i, mode, band, va, vb) -> (status, t)``: the sign
+    """``leave_root(ctx, q, i, mode, first, band, va, vb) -> (status, t)``: the sign
     change of leave function q between samples i and i + 1 (va, vb as read there). The
     root of h in the first interval of a stay entered at H, where h dips and returns
     (``rules.dips_and_returns``), is refined beyond the extremum of h; one found while the
@@ -146,14 +142,14 @@ def make_leave_root(ops: WindowOps, refine, extremum):
     CUT at the time where h, asked between the samples, was not finite.
     ``refine``: the loop's refinement on the engine's root finder (loop.refine);
     ``extremum``: :func:`make_extremum`'s."""
-    value = ops.value
+    sampled, value = ops.sampled, ops.value
 
-    def leave_root(ctx, w, q, i, mode, band, va, vb):
+    def leave_root(ctx, q, i, mode, first, band, va, vb):
         pred = rules.leave_pred(mode, q)
-        lo, vlo = w.ts[i], va
-        if (w.first and i == 0 and mode != SLIDING and rules.dips_and_returns(
-                mode, w.dvals[0, 0], w.dvals[0, 1])):
-            st, tm = extremum(ctx, w, F_RATE, 0, mode)
+        lo, vlo = sampled(ctx, F_TIME, i), va
+        if (first and i == 0 and mode != SLIDING and rules.dips_and_returns(
+                mode, sampled(ctx, F_RATE, 0), sampled(ctx, F_RATE, 1))):
+            st, tm = extremum(ctx, F_RATE, 0, mode)
             if st == CUT:
                 return st, tm
             if st == OK:
@@ -162,7 +158,7 @@ def make_leave_root(ops: WindowOps, refine, extremum):
                     return CUT, tm
                 if not rules.after(pred, hm):  # next to the entry h is noise (rules)
                     lo, vlo = tm, hm
-        st, r = refine(ctx, F_LEAVE + q, pred, lo, w.ts[i + 1], vlo, vb, mode)
+        st, r = refine(ctx, F_LEAVE + q, pred, lo, sampled(ctx, F_TIME, i + 1), vlo, vb, mode)
         if st != OK or band == 0.0 or mode == SLIDING:
             return st, r
         tq, step, done, clear = r, 0.0, False, False
@@ -188,20 +184,20 @@ def make_hidden_end(ops: WindowOps, refine, extremum):
     function's root before it (GRAZE_CROSSES), the extremum's time (GRAZE_TOUCHES), or
     GRAZE_NONE; CUT (status) where the function was not finite there: no judgement on a
     NaN. ``refine``, ``extremum``: as :func:`make_leave_root`'s."""
-    value = ops.value
+    sampled, value = ops.sampled, ops.value
 
     def hidden_end(ctx, q, i, mode, w, band, va):
         pred = rules.leave_pred(mode, q)
-        ta, tb = w.ts[i], w.ts[i + 1]
-        st, tm = extremum(ctx, w, F_RATE + q, i, mode)
+        ta, tb = sampled(ctx, F_TIME, i), sampled(ctx, F_TIME, i + 1)
+        st, tm = extremum(ctx, F_RATE + q, i, mode)
         if st != OK:
             return st, tm, GRAZE_NONE
         vm = value(ctx, F_LEAVE + q, tm, mode)
         if not math.isfinite(vm):
             return CUT, tm, GRAZE_NONE
         if mode == SLIDING:
-            kind = rules.speed_graze(pred, vm, w.dvals[q, i], w.dvals[q, i + 1], tb - ta,
-                                     w.touch_tol)
+            kind = rules.speed_graze(pred, vm, sampled(ctx, F_RATE + q, i),
+                                     sampled(ctx, F_RATE + q, i + 1), tb - ta, w.touch_tol)
         else:
             kind = rules.graze(mode, vm, w.touch_tol, band)
         if kind == GRAZE_CROSSES:
@@ -219,25 +215,29 @@ def make_candidate(ops: WindowOps):
     stay just began, else -1: c0, c1), a
     hidden extremum of one (x0, x1), a section's -- and whether any does (``hit``). Each
     function by a constant code: the kernel asks this of every interval."""
+    sampled = ops.sampled
+
     def candidate(ctx, i, mode, w, clamp_at, pred0, pred1):
-        va0, vb0 = w.vals[0, i], w.vals[0, i + 1]
+        va0, vb0 = sampled(ctx, F_LEAVE, i), sampled(ctx, F_LEAVE, i + 1)
         if i == clamp_at:
             va0 = rules.clamp(pred0, va0)
-        da, db = w.dvals[0, i], w.dvals[0, i + 1]
+        da, db = sampled(ctx, F_RATE, i), sampled(ctx, F_RATE, i + 1)
         va1, vb1, c1, x1 = 0.0, 0.0, False, False
         if mode != SLIDING:
             x0 = rules.extremum_between(mode, da, db)
         else:
             x0 = w.rates and rules.speed_extremum_between(pred0, da, db)
-            va1, vb1 = w.vals[1, i], w.vals[1, i + 1]
+            va1, vb1 = sampled(ctx, F_LEAVE + 1, i), sampled(ctx, F_LEAVE + 1, i + 1)
             if i == clamp_at:
                 va1 = rules.clamp(pred1, va1)
             c1 = rules.crosses(pred1, va1, vb1)
-            x1 = w.rates and rules.speed_extremum_between(pred1, w.dvals[1, i], w.dvals[1, i + 1])
+            x1 = w.rates and rules.speed_extremum_between(
+                pred1, sampled(ctx, F_RATE + 1, i), sampled(ctx, F_RATE + 1, i + 1))
         c0 = rules.crosses(pred0, va0, vb0)
         cs = False
         for k in range(len(w.preds)):
-            cs = cs or rules.crosses(w.preds[k], w.svals[k][i], w.svals[k][i + 1])
+            cs = cs or rules.crosses(w.preds[k], sampled(ctx, F_SECTION + k, i),
+                                     sampled(ctx, F_SECTION + k, i + 1))
         return (c0 or c1 or x0 or x1 or cs), va0, vb0, va1, vb1, c0, c1, x0, x1
 
     return candidate
@@ -247,8 +247,8 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
     """``window_event(ctx, mode) -> (status, t, what, k)``: the earliest event over a
     window's intervals (this module's docstring) on the engine's :data:`WindowOps`; a
     leave function's root compiled by ``call``, a hidden extremum by ``inline``."""
-    window, value, counts, touch, unband = (
-        ops.window, ops.value, ops.counts, ops.touch, ops.unband)
+    window, sampled, value, counts, touch, unband = (
+        ops.window, ops.sampled, ops.value, ops.counts, ops.touch, ops.unband)
     refine = call(make_refine(ops.root, ops.value))
     extremum = inline(make_extremum(ops))
     leave_root = call(make_leave_root(ops, refine, extremum))
@@ -277,7 +277,7 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
                 for q in range(nl):
                     if not (c0 if q == 0 else c1):
                         continue
-                    st, r = leave_root(ctx, w, q, i, mode, band, va0 if q == 0 else va1,
+                    st, r = leave_root(ctx, q, i, mode, w.first, band, va0 if q == 0 else va1,
                                        vb0 if q == 0 else vb1)
                     if st != OK:
                         return st, r, NONE, i
@@ -301,15 +301,15 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
                 # 3. the sections in order: a hit first, or at a switch (hidden: at its time)
                 for k in range(len(w.preds)):
                     pred, t_min = w.preds[k], w.t_mins[k]
-                    sa, sb = w.svals[k][i], w.svals[k][i + 1]
+                    sa, sb = sampled(ctx, F_SECTION + k, i), sampled(ctx, F_SECTION + k, i + 1)
                     tb = math.inf   # the interval's end, read only for a crossing
                     if hidden and not rules.crosses(pred, sa, sb):
                         tb, sb = best_t, value(ctx, F_SECTION + k, best_t, mode)
                         if not math.isfinite(sb):
                             return CUT, best_t, NONE, i
                     if rules.crosses(pred, sa, sb):
-                        st, r = refine(ctx, F_SECTION + k, pred, w.ts[i], min(tb, w.ts[i + 1]),
-                                       sa, sb, mode)
+                        st, r = refine(ctx, F_SECTION + k, pred, sampled(ctx, F_TIME, i),
+                                       min(tb, sampled(ctx, F_TIME, i + 1)), sa, sb, mode)
                         if st != OK:
                             return st, r, NONE, i
                         if (rules.section_first(r, t_min, best_t, best_w == SECTION, w.xtol)
@@ -318,7 +318,7 @@ def make_window_event(ops: WindowOps, call=as_is, inline=as_is):
                 if best_w != NONE:
                     return OK, best_t, best_w, best_k
             i += 1
-        if band > 0.0 and rules.clears_band(mode, w.vals[0, n], band):
+        if band > 0.0 and rules.clears_band(mode, sampled(ctx, F_LEAVE, n), band):
             unband(ctx, n + 1, mode)  # no sample after the last one to take again
         return OK, math.inf, NONE, -1
 
