@@ -284,6 +284,17 @@ def _checked_start(system, guess, returns, engine) -> np.ndarray:
     return z
 
 
+def _check_newton(tol, max_iter) -> None:
+    """Newton's options, each named where out of range (a review: tol 10 returned the
+    guess as the orbit, max_iter 0 an UnboundLocalError)."""
+    if not (isinstance(tol, (int, float)) and 0.0 < tol <= 1e-3):
+        raise ValueError(f"tol: the relative residual Newton stops at, in (0, 1e-3]; got "
+                         f"{tol!r}")
+    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) \
+            or max_iter < 1:
+        raise ValueError(f"max_iter: a positive integer, got {max_iter!r}")
+
+
 def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
                    returns: int = 1, engine: str = "compiled", t_max: float,
                    tol: float = 1e-12, max_iter: int = 20, **options) -> PeriodicOrbit:
@@ -315,11 +326,11 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
     t_max : float
         Longest time a return may take.
     tol : float
-        Converged when ``max |P(z) - z| <= tol (S + max |z|)``, S the state scale
+        In (0, 1e-3]: converged when ``max |P(z) - z| <= tol (S + max |z|)``, S the state scale
         (:mod:`filippov.scale`: the system's, or measured at the guess, and kept for
         every return of the iteration, so that P is one map).
     max_iter : int
-        Newton steps at most.
+        Newton steps at most (a positive integer).
     **options
         For the engine (``rtol``, ``atol``, ``min_time``, ...); ``atol``, ``touch_tol``
         and ``event_xtol`` in units of the scale's S, G and T, and ``scale=``
@@ -338,16 +349,8 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
         return is the start itself (a path shorter than ``SHORTEST_PATH`` of the state's
         size: the start a hair before the section by rounding), or an iterate that ran
         away from the guess (``RUNAWAY`` times its size).
-    ValueError
-        ``tol`` not in (0, 1e-3] or ``max_iter`` not a positive integer (a review: tol 10
-        returned the guess as the orbit, max_iter 0 an UnboundLocalError).
     """
-    if not (isinstance(tol, (int, float)) and 0.0 < tol <= 1e-3):
-        raise ValueError(f"tol: the relative residual Newton stops at, in (0, 1e-3]; got "
-                         f"{tol!r}")
-    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) \
-            or max_iter < 1:
-        raise ValueError(f"max_iter: a positive integer, got {max_iter!r}")
+    _check_newton(tol, max_iter)
     z = _checked_start(system, guess, returns, engine)
     python = views.reference_system(system, "periodic_orbit", several=True)
     runs, sc = _orbit_scale(python, z, options.get("scale"))   # what the runs take; all
