@@ -435,6 +435,10 @@ def test_a_slide_with_a_spectator_surface_is_the_one_surface_closed_form(case, q
 
 
 # --------------------------------------------------------------- sliding on an intersection
+#: y' = -0.8 above y = 0 and 1.2 below, whatever x: y = 0 attracts (the fy of _spatial)
+_Y_ATTRACTS = {(1, 1): -0.8, (-1, 1): -0.8, (1, -1): 1.2, (-1, -1): 1.2}
+
+
 def _spatial(fx, fy, intersection=None, fw=None):
     """z = (x, y, w), h1 = x, h2 = y; ``fx[s1, s2]``, ``fy[s1, s2]``: x' and y' in each
     region, numbers or functions of w; w' = ``fw[s1, s2]`` (default 1)."""
@@ -460,7 +464,7 @@ def test_a_decoupled_slide_on_an_intersection_and_its_end_in_closed_form():
     # x < 0, x = -(t - 1)^2 / 4, to t = 2
     fx = {(1, 1): -1.5, (1, -1): -1.5, (-1, 1): lambda w: 0.5 - 0.5 * w,
           (-1, -1): lambda w: 0.5 - 0.5 * w}
-    fy = {(1, 1): -0.8, (-1, 1): -0.8, (1, -1): 1.2, (-1, -1): 1.2}
+    fy = _Y_ATTRACTS
     tr = simulate(_spatial(fx, fy), [0.3, 0.5, 0.0], 2.0, method="integrate")
     got = [(e.kind, mode_name(e.mode_after, 2), e.name) for e in tr.events]
     assert got == [("start", "++", ""), ("slide_start", "0+", ""),
@@ -603,7 +607,7 @@ def test_a_user_section_at_the_instant_a_stay_ends_at_its_own_is_counted_and_cha
         assert np.max(np.abs(tr.z - [4.6, 0.0])) <= TOL
     fx = {(1, 1): -1.5, (1, -1): -1.5, (-1, 1): lambda w: 0.5 - 0.5 * w,
           (-1, -1): lambda w: 0.5 - 0.5 * w}
-    fy = {(1, 1): -0.8, (-1, 1): -0.8, (1, -1): 1.2, (-1, -1): 1.2}
+    fy = _Y_ATTRACTS
     tr = simulate(_spatial(fx, fy), [0.3, 0.5, 0.0], 2.0, method="integrate",
                   sections=[Section("w=1", lambda z: z[2] - 1.0, direction=1, terminal=1)])
     assert tr.status == "section:w=1" and abs(tr.t - 1.0) <= TOL
@@ -641,7 +645,7 @@ def test_an_intersection_slide_that_ends_toward_the_side_it_came_from_goes_on():
     # ("hidden crossing"); rules.left_band allows it that rounding there
     fx = {(1, 1): lambda w: -5.0 + 5.0 * w / 3.0, (1, -1): lambda w: -5.0 + 5.0 * w / 3.0,
           (-1, 1): 2.0, (-1, -1): 2.0}
-    fy = {(1, 1): -0.8, (-1, 1): -0.8, (1, -1): 1.2, (-1, -1): 1.2}
+    fy = _Y_ATTRACTS
     system = _spatial(fx, fy)
     for x0 in np.linspace(0.05, 0.95, 19):
         tr = simulate(system, [x0, 0.5, 0.0], 3.5, method="integrate")
@@ -659,7 +663,7 @@ def test_a_step_past_an_intersection_slide_s_end_does_not_meet_the_weights_pole(
     # intersection.EXTEND_MAX past the square, no farther
     fx = {(1, 1): lambda w: -1.5 + 0.5 * w, (1, -1): lambda w: -1.5 + 0.5 * w,
           (-1, 1): 0.5, (-1, -1): 0.5}
-    fy = {(1, 1): -0.8, (-1, 1): -0.8, (1, -1): 1.2, (-1, -1): 1.2}
+    fy = _Y_ATTRACTS
     system = _spatial(fx, fy)
     for x0 in np.linspace(0.1, 0.9, 17):
         tr = simulate(system, [x0, 0.5, 0.0], 4.0, method="integrate")

@@ -470,9 +470,7 @@ def _through(system, stay, at, r, traj, o) -> Stay:
     or slid there for no time)."""
     z = np.asarray(r.z, dtype=float)
     G = system.grads(z)
-    regions = [stay.sigma]
-    for k in at:
-        regions += [flip(q, k) for q in regions]
+    regions = _around(stay.sigma, at)
     speeds = np.array([[stay.sigma[k] * float(G[k] @ np.asarray(system.region_field(q, z),
                                                                   dtype=float))
                         for k in at] for q in regions])
@@ -610,28 +608,27 @@ def _intersection_end(system, stay, end, t, z, traj, o) -> Stay:
     side = 1 if end[1] == "1" else -1
     sigma = list(stay.sigma)
     sigma[gone], sigma[keep] = side, 1
-    sigma = tuple(sigma)
-    a, b = (float(v) for v in system.view(sigma, 1, keep).normal_speeds(np.asarray(z, float)))
+    sigma, zf = tuple(sigma), np.asarray(z, dtype=float)
+    a, b = (float(v) for v in system.view(sigma, 1, keep).normal_speeds(zf))
     if not a > 0.0 > b:
         raise SurfacesError(
-            f"intersection end at t={float(t)!r}, state {np.asarray(z, float).tolist()}: the slide "
+            f"intersection end at t={float(t)!r}, state {zf.tolist()}: the slide "
             f"on h{j + 1} and h{k + 1} ends toward h{gone + 1}'s {'+-'[side < 0]} side, where "
             f"the slide on h{keep + 1} does not attract (a = {a:.3g}, b = {b:.3g}); what "
             "follows is not built into filippov")
-    zf = np.asarray(z, dtype=float)
     normal = system.grads(zf)[gone]
     speed = max(abs(float(normal @ np.asarray(system.region_field(q, zf), dtype=float)))
                 for q in _around(sigma, (gone, keep)))
-    band = rules.left_band(side * float(system.values(zf)[gone]), speed, o["event_xtol"],
-                           o["touch_tol"])
+    g = side * float(system.values(zf)[gone])   # oriented to the side the orbit leaves to
+    band = rules.left_band(g, speed, o["event_xtol"], o["touch_tol"])
     if band != band:
         raise SurfacesError(
             f"intersection end at t={float(t)!r}, state {zf.tolist()}: the slide on h{j + 1} "
             f"and h{k + 1} ends toward h{gone + 1}'s {'+-'[side < 0]} side, but the state is "
-            f"{-side * float(system.values(zf)[gone])!r} short of h{gone + 1}: more than "
-            "the rounding an event leaves (rules.left_band)")
+            f"{-g!r} short of h{gone + 1}: more than the rounding an event leaves "
+            "(rules.left_band)")
     after = Stay(sigma, keep, 1, (SLIDING, 0.0, 0.0, 0.0), left=(gone, band))
-    traj.events.append(type(traj.events[0])(t, "slide_end", np.asarray(z, float).copy(),
+    traj.events.append(type(traj.events[0])(t, "slide_end", zf.copy(),
                                             _code(stay, j, 1), _code(after, keep, SLIDING),
                                             f"h{gone + 1}"))
     return after

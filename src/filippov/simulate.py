@@ -1136,10 +1136,7 @@ class _Scan:
         Z = self.Z
 
         def along(tt):
-            v = float(func(Z(tt)))
-            if not math.isfinite(v):
-                raise ValueNotFinite(tt)
-            return v
+            return _finite_at(tt, float(func(Z(tt))))
         return along
 
     @functools.cached_property
