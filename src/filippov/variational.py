@@ -150,13 +150,6 @@ def _state_scale(traj) -> float:
     return 1.0 if scale is None else float(scale.state)
 
 
-def _component_scales(traj, n: int) -> np.ndarray:
-    """Each component's scale in the run of ``traj`` (filippov.scale): the steps of the
-    differences along a component and its absolute tolerance grow from it."""
-    scale = getattr(traj, "scale", None)
-    return np.ones(n) if scale is None else scale.of_components(n)
-
-
 def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
                       jacobian: Optional[Callable] = None) -> np.ndarray:
     """dz(t_end)/dz0 along ``traj`` (a Trajectory of :func:`filippov.simulate`):
@@ -184,15 +177,14 @@ def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
     -------
     ndarray, shape (n, n)
     """
-    system, jacobian = reference_view(system, jacobian, "transition_matrix",
-                                      _state_scale(traj))
+    floor = _state_scale(traj)
+    system, jacobian = reference_view(system, jacobian, "transition_matrix", floor)
     n = system.dim
     field, salt, start = _modes(system)
-    floors = _component_scales(traj, n)
     jac = jacobian or (lambda mode, z: fd_jacobian(lambda zz: field(mode, zz), z, 1e-6,
-                                                   floors))
+                                                   floor))
     # the state's error in its own units, the derivative's (dimensionless) as it is
-    atols = np.concatenate([atol * floors, np.full(n * n, atol)])
+    atols = np.concatenate([np.full(n, atol * floor), np.full(n * n, atol)])
     M = np.eye(n)
     ev = traj.events
     for k, e in enumerate(ev):
@@ -249,12 +241,13 @@ def return_jacobian(system, traj, section, *, rtol: float = 1e-10, atol: float =
     if traj.status != f"section:{section.name}":
         raise VariationalError(f"the trajectory ended with status {traj.status!r}, not at a "
                                f"hit of section {section.name!r}")
-    system, jacobian = reference_view(system, jacobian, "return_jacobian", _state_scale(traj))
+    floor = _state_scale(traj)
+    system, jacobian = reference_view(system, jacobian, "return_jacobian", floor)
     Phi = transition_matrix(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
     z = np.asarray(traj.z, dtype=float)
     grad = (np.asarray(section_grad(z), dtype=float) if section_grad is not None else
             fd_jacobian(lambda zz: np.atleast_1d(section.func(zz)), z, SECTION_STEP,
-                        floor=_component_scales(traj, z.size))[0])
+                        floor=floor)[0])
     f = np.asarray(_modes(system)[0](traj.mode, z), dtype=float)
     speed = grad @ f
     if speed == 0:
