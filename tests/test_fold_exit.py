@@ -197,7 +197,7 @@ def test_the_return_in_the_exits_first_window_is_located_at_h_zero(engine):
     c, L = CASES[0]
     p, z0, want = _case(c, L)
     ze = ZSTAR + R @ np.array([0.0, 0.0, want["te"]])    # the exit, closed form
-    band = rules.exit_band(ze, flow_plus(ze, 0.0, p), switch_grad(ze, p))
+    band = rules.exit_band(ze, flow_plus(ze, 0.0, p), switch_grad(ze, p), 1.0, np.ones(3))
     assert band / want["slope"] > 2e-11
     # the time slid is t_e - t_1 + T - t_r: an error of the return shows there
     slid = _run(engine, "exact", c, L)[4]
@@ -210,11 +210,16 @@ def test_the_exit_band_is_the_flows_rounding_scale(band_of):
     z, grad = np.array([0.0, -0.38256777, 0.56876841]), np.array([1.0, 0.0, 0.0])
     eps = np.finfo(float).eps
     # an integrated stay (the state itself at tau = 0): 16 roundings of |z|, times |grad|
-    assert band_of(z, z.copy(), grad) == pytest.approx(16 * eps * np.linalg.norm(z))
+    one = np.ones(3)   # one scale for every component (filippov.scale): Euclidean
+    assert band_of(z, z.copy(), grad, 1.0, one) == pytest.approx(16 * eps * np.linalg.norm(z))
     # a closed form that rounds z by 1.1e-15 at tau = 0 (FOLD_EXIT's): 16 of those
     zf = z + np.array([-1.1e-15, 0.0, 0.0])
-    assert band_of(z, zf, 2 * grad) == pytest.approx(16 * 2 * 1.1e-15)
-    assert band_of(z, zf, 2 * grad) > 1.1e-15 * 2   # H's reading at tau = 0 lies inside
+    assert band_of(z, zf, 2 * grad, 1.0, one) == pytest.approx(16 * 2 * 1.1e-15)
+    assert band_of(z, zf, 2 * grad, 1.0, one) > 1.1e-15 * 2   # H's reading lies inside
+    # x in units 1e-9 of the others (its scale 1e-9): the band in H's units is the same
+    D, s = np.array([1e-9, 1.0, 1.0]), np.array([2.0 ** -30, 1.0, 1.0])
+    assert band_of(z * D, zf * D, 2 * grad / D, 1.0, s) == pytest.approx(
+        band_of(z, zf, 2 * grad, 1.0, one), rel=0.2)
 
 
 @pytest.mark.parametrize("mode", [PLUS, MINUS])

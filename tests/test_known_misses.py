@@ -623,13 +623,12 @@ def test_a_return_before_a_band_of_h_met_between_samples_stands(engine, before):
 # ------------------------------------------------------------------------------- units
 # A review of results against the units of the state's components (2026-12-06): one
 # factor for all of them changes nothing (state and time from 1e-9 to 1e9, both engines,
-# closed forms to 1e-10), but components in units far apart did, on both engines alike.
-# The run measures one state scale S, the start's largest component (filippov.scale), so
-# a component large in its units sets the tolerances of all the others, and the tests of
-# a two-fold and of a flow tangent to a section are Euclidean cosines, which change with
-# the components' units. A scale per component is the mend; until then each is pinned.
-# (Measuring those two tests against sum |n_k f_k| instead was tried: for H of one
-# component that sum is |n.f| itself, and a two-fold was no longer found.)
+# closed forms to 1e-10), but components in units far apart did, on both engines alike:
+# one state scale S (the start's largest component) set every component's tolerances,
+# H's scale and the difference steps, and the tests of a two-fold and of a flow tangent
+# to a section were Euclidean cosines. Mended by a scale per component where the
+# components spread (filippov.scale.component_scales, docs/decisions.md D19): every test
+# below failed before, on both engines.
 def _fold_exit_system(dx, dy):
     # h = y; F_+ = (1, -1), F_- = (1, 1 - x), x and y in units dx, dy: from (0, 0.5) a
     # slide to the visible fold of F_- at x = 1 (F_+ crosses H there at speed -1: no
@@ -640,9 +639,6 @@ def _fold_exit_system(dx, dy):
         lambda z, p: np.array([0.0, 1.0 / p[1]]), params=np.array([dx, dy]))
 
 
-@_miss("a cosine in mixed units: rules.tangent_to_both compares the normal speeds with "
-       "|grad H| |F|, and with y in units 1e7 smaller than x an ordinary fold exit is "
-       "refused as 'the slide reached a two-fold' (both engines)")
 @pytest.mark.parametrize("engine", ENGINES)
 @pytest.mark.parametrize("dx, dy", [(1.0, 1e-9), (1e9, 1.0)])
 def test_a_fold_exit_is_no_two_fold_in_any_units(engine, dx, dy):
@@ -665,9 +661,6 @@ def _relay_in_units(D):
                           params=np.array(D, dtype=float))
 
 
-@_miss("a cosine in mixed units: periodic.floquet_from_return refuses the relay's orbit "
-       "as 'the flow is tangent to the section' (|n.f|/(|n||f|) = 1.3e-10) with its "
-       "components in units 1, 1e-9, 1e9 (both engines)")
 @pytest.mark.parametrize("engine", ENGINES)
 def test_a_periodic_orbit_in_components_of_units_far_apart_has_its_multipliers(engine):
     D = np.array([1.0, 1e-9, 1e9])
@@ -679,10 +672,8 @@ def test_a_periodic_orbit_in_components_of_units_far_apart_has_its_multipliers(e
     assert np.abs(po.multipliers) == pytest.approx(np.abs(one.multipliers), abs=1e-7)
 
 
-# Not mended (one state scale for every component: a scale per component is the mend):
-@_miss("one state scale for all components: a constant component in units 1e9 smaller "
-       "makes S = 2^30 and touch_tol 1e-6 of H, so a start at v = -1e-7 is taken to be on H "
-       "and sent into region +: t = 4.88 and one switch for t = 2.094 and none (both engines)")
+# Mended by a scale per component (filippov.scale.component_scales): each component's
+# absolute tolerance and H's scale G from the components' own extents at the start.
 @pytest.mark.parametrize("engine", ENGINES)
 def test_a_component_that_takes_no_part_does_not_move_the_orbit(engine):
     # x'' + x = sign(x') (repelling on v = 0 for |x| < 1), w' = 0 at w = 1e9; from
@@ -697,9 +688,6 @@ def test_a_component_that_takes_no_part_does_not_move_the_orbit(engine):
     assert got.time[0] == pytest.approx(te, abs=1e-9)
 
 
-@_miss("one state scale for all components: atol times S, S from a clock component in "
-       "units 1e9 smaller, leaves x and v of a relay an absolute tolerance of ~1e-5: errors "
-       "7.7e-6 (defaults) and 1.4e-3 (rtol 1e-10, atol 1e-12) for 5.6e-13 (both engines)")
 @pytest.mark.parametrize("engine", ENGINES)
 def test_a_clock_in_small_units_leaves_the_other_components_their_accuracy(engine):
     # x'' + x = -sign(x'), u' = 1 in units 1e9 smaller; from (0, 4): one switch at
@@ -712,6 +700,142 @@ def test_a_clock_in_small_units_leaves_the_other_components_their_accuracy(engin
     got = first_returns(system, [[0.0, 4.0, 1e9]], lambda z, p: z[2] / 1e9 - 3.0, 20.0,
                         direction=1, engine=engine)
     assert got.state[0, :2] == pytest.approx(want, abs=1e-10)
+
+
+def _relay_oscillator(D):
+    # x'' + x = -sign(x'), the velocity w = D x' in units 1/D, with its exact flows
+    def field(c):
+        return lambda z, p: np.array([z[1] / p[0], p[0] * (c - z[0])])
+
+    def flow(c):
+        def f(z, tau, p):
+            x0, v0 = z[0] - c, z[1] / p[0]
+            co, si = np.cos(tau), np.sin(tau)
+            return np.array([c + x0 * co + v0 * si, p[0] * (v0 * co - x0 * si)])
+        return f
+    return FilippovSystem(("x", "w"), field(1.0), field(-1.0), lambda z, p: z[1] / p[0],
+                          lambda z, p: np.array([0.0, 1.0 / p[0]]), params=np.array([D]),
+                          flow_minus=flow(1.0), flow_plus=flow(-1.0), sample_step=0.1)
+
+
+@pytest.mark.parametrize("D", [1.0, 1e-9, 1e9])
+def test_dpdz_through_exact_flows_with_a_velocity_in_units_far_apart(D):
+    # from (0, 3): x = -1 + sqrt(10) sin(t + phi) to v = 0 at x = -1 + sqrt(10), then
+    # around +1 to x = 1 going down; dP/dz in x and x' = [[0, 0], [-1, -3] / sqrt(10)]
+    # (was off by 2.4e-4 at D = 1e-9: Richardson's steps from the state scale of w)
+    from filippov import compute_returns
+    cm = _relay_oscillator(D).compiled(lambda z, p: z[0] - 1.0, direction=-1)
+    got = compute_returns(cm, np.array([[0.0, 3.0 * D]]), 20.0, jacobian=True)
+    assert got.status[0] == 0
+    T = np.diag([1.0, D])
+    J = np.linalg.solve(T, got.jacobian[0] @ T)
+    want = np.array([[0.0, 0.0], [-1.0, -3.0]]) / np.sqrt(10.0)
+    assert J == pytest.approx(want, abs=1e-9)
+    assert got.state[0] / [1.0, D] == pytest.approx([1.0, 2.0 - np.sqrt(10.0)],
+                                                    abs=1e-12)
+
+
+def test_one_unit_for_every_component_keeps_one_scale():
+    # components are measured one by one only where they spread: the relay of the
+    # tutorial in one unit, natural or 1e6 times as small, runs at one scale as before
+    for D in (np.ones(3), np.full(3, 1e-6)):
+        sc = simulate(_relay_in_units(D), np.array([0.0, 0.5, -0.2]) * D, 0.1).scale
+        assert sc.components is None
+    sc = simulate(_relay_in_units([1.0, 1e-9, 1e9]), [0.0, 0.5e-9, -0.2e9], 0.1).scale
+    assert sc.components is not None and sc.components[1] < 1e-6 < 1e6 < sc.components[2]
+
+
+# An independent review of the mend found three regressions, each now a test (the review's
+# scripts r8, r22, r4, r6; failing with the mend's first measurement):
+def _drag_relay(D):
+    # x'' = -sign(x) - v|v|, the velocity w = D v in units 1/D: from rest at (1, 0),
+    # v = -tanh t to x = 0 at t1 = acosh(e), then v' = 1 + v^2 to x = -0.1 going down
+    def field(sign):
+        return lambda z, p: np.array([z[1] / p[0],
+                                      p[0] * (sign - (z[1] / p[0]) * abs(z[1] / p[0]))])
+    return FilippovSystem(("x", "w"), field(1.0), field(-1.0), lambda z, p: z[0],
+                          lambda z, p: np.array([1.0, 0.0]), params=np.array([D]))
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("D", [1.0, 1e-9, 1e9])
+def test_a_start_at_rest_of_a_nearly_nilpotent_field_keeps_its_accuracy(engine, D):
+    # the Jacobian at rest is nilpotent, its probes read a spectral radius of 1.5e-8,
+    # over whose time the velocity's scale became 2^26, S and T too: events to 1e-9 (for
+    # 1e-13); the start's own rate (sqrt|x''| / |x|) is 1
+    t1 = np.arccosh(np.e)
+    phi = np.arctan(-np.tanh(t1))
+    s = -np.arccos(np.cos(phi) * np.exp(0.1)) - phi
+    got = first_returns(_drag_relay(D), [[1.0, 0.0]], lambda z, p: z[0] + 0.1, 50.0,
+                        direction=-1, engine=engine)
+    assert got.time[0] == pytest.approx(t1 + s, abs=1e-11)
+    assert got.state[0, 1] / D == pytest.approx(np.tan(s + phi), abs=1e-11)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_weak_linear_part_does_not_stretch_the_run_s_time(engine):
+    # x'' = -sign(x) - 1e-8 x' from rest: spectral radius 1e-8 made T = 2^26 and the
+    # return 1.4e-9 late; against scipy's DOP853 at rtol 2.5e-14 over the two pieces (x = 0
+    # near t = sqrt(2), then x = -0.1 near s = sqrt(2) - sqrt(1.8))
+    from scipy.integrate import solve_ivp
+
+    def piece(sign, z0, t0, level):
+        hit = lambda t, z: z[0] - level   # noqa: E731
+        hit.terminal, hit.direction = True, -1
+        sol = solve_ivp(lambda t, z: [z[1], sign - 1e-8 * z[1]], (t0, t0 + 10.0), z0,
+                        method="DOP853", rtol=2.5e-14, atol=1e-16, events=hit)
+        return sol.t_events[0][0], sol.y_events[0][0]
+    t_cross, z_cross = piece(-1.0, [1.0, 0.0], 0.0, 0.0)
+    t_ret, _ = piece(1.0, z_cross, t_cross, -0.1)
+
+    def field(sign):
+        return lambda z, p: np.array([z[1], sign - 1e-8 * z[1]])
+    system = FilippovSystem(("x", "v"), field(1.0), field(-1.0), lambda z, p: z[0],
+                            lambda z, p: np.array([1.0, 0.0]))
+    assert simulate(system, [1.0, 0.0], 0.01).scale.components is None
+    got = first_returns(system, [[1.0, 0.0]], lambda z, p: z[0] + 0.1, 20.0, direction=-1,
+                        engine=engine)
+    assert t_ret == pytest.approx(2.0 * np.sqrt(2.0) - np.sqrt(1.8), abs=1e-7)
+    assert got.time[0] == pytest.approx(t_ret, abs=1e-12)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_guess_with_a_component_small_only_there_converges(engine):
+    # van der Pol with c' = x^2 - c: the guess's c = 1e-7 gave c a scale 1e7 times
+    # smaller than on the orbit (c = 1.38), and Newton's runaway test, in the metric of
+    # the scales, refused the first step; in the state's own size it converges as from c = 1
+    f = lambda z, p: np.array([z[1], -z[0] + (1 - z[0] ** 2) * z[1], z[0] ** 2 - z[2]])  # noqa
+    system = FilippovSystem(("x", "v", "c"), f, f, lambda z, p: z[0] - 10.0,
+                            lambda z, p: np.array([1.0, 0.0, 0.0]))
+    runs = [periodic_orbit(system, [0.0, 2.0, c], lambda z, p: z[0], direction=1,
+                           engine=engine, t_max=50.0) for c in (1e-7, 1.0)]
+    assert runs[0].period == pytest.approx(runs[1].period, abs=1e-11)
+    assert runs[0].point == pytest.approx(runs[1].point, abs=1e-10)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("dy, C", [
+    (1e-9, 1e5), (1e-9, 1e6),
+    pytest.param(1.0, 1e14, marks=_miss(
+        "the Jacobian's probes step from the largest component's size (1.5e6 along x for "
+        "a constant of 1e14): the coupling dF_y/dx reads 1.5e6 and lifts y's scale to "
+        "2^20, and the fold exit is refused as a two-fold (loud; it slid through the fold "
+        "silently before the scales per component)"))])
+def test_a_large_constant_component_does_not_widen_the_band_after_an_exit(engine, dy, C):
+    # H = y / dy; F_- = (1, dy (x - 1)(x - 2), 0, -q), F_+ = (1, -dy, 0, -q), a constant
+    # w = C: a slide from x = 1 to its fold at x = 2, then y/dy = (x-2)^2 (2x-5)... back on H
+    # at x = 3.5 and sliding to x = 4 (2.5 slid in all). The band after the fold exit
+    # (rules.exit_band, Euclidean) swallowed the return to H: y/dy = 0.355 or 3.55 at x = 4
+    fm = lambda z, p: np.array([1.0, p[0] * (z[0] - 1) * (z[0] - 2), 0.0, -z[3]])  # noqa
+    fp = lambda z, p: np.array([1.0, -p[0], 0.0, -z[3]])  # noqa
+    system = FilippovSystem(("x", "y", "w", "q"), fm, fp, lambda z, p: z[1] / p[0],
+                            lambda z, p: np.array([0.0, 1.0 / p[0], 0.0, 0.0]),
+                            params=np.array([dy]))
+    got = first_returns(system, [[0.0, 0.0, C, 1.0]], lambda z, p: z[0] - 4.0, 20.0,
+                        direction=1, engine=engine)
+    assert got.time[0] == pytest.approx(4.0, abs=1e-9)
+    assert got.state[0, 1] / dy == pytest.approx(0.0, abs=1e-9)
+    assert got.sliding_time[0] == pytest.approx(2.5, abs=1e-9)
 
 
 # ------------------------------------------------------------- users' models, their inputs
@@ -751,3 +875,75 @@ def test_a_batch_gives_the_same_returns_in_any_order_of_its_starts(engine):
     two = first_returns(system, [b, a], lambda z, p: z[0], 100.0, direction=1, engine=engine)
     assert np.array_equal(one.time, two.time[::-1])
     assert np.array_equal(one.state, two.state[::-1])
+
+
+def _relay():
+    return _relay_in_units(np.ones(3))
+
+
+@pytest.mark.parametrize("name, bad", [("event_xtol", 1.0), ("touch_tol", 1e-3)])
+@pytest.mark.parametrize("engine", ENGINES)
+def test_an_event_tolerance_near_the_scale_itself_is_refused_by_name(engine, name, bad):
+    # event_xtol = 1 moved the relay's return from 4.021 to 4.037 with no word
+    with pytest.raises(ValueError, match=f"^{name} must be .* <= 1e-06"):
+        first_returns(_relay(), [[0.0, 0.5, -0.2]], lambda z, p: z[0], 20.0, direction=1,
+                      engine=engine, **{name: bad})
+
+
+def test_a_flag_given_as_a_string_is_refused_not_read_as_true():
+    # "no" is a non-empty string: Python reads it as true, and the run slid, kept its
+    # trajectory or computed dP/dz against the user's word
+    from filippov import compute_returns
+    with pytest.raises(ValueError, match="^sliding must be True or False, got 'no'"):
+        FilippovSystem(("x",), lambda z, p: np.array([1.0]), lambda z, p: np.array([-1.0]),
+                       lambda z, p: z[0], lambda z, p: np.array([1.0]), sliding="no")
+    with pytest.raises(ValueError, match="^dense must be True or False, got 'no'"):
+        simulate(_relay(), [0.0, 0.5, -0.2], 1.0, dense="no")
+    cm = _relay().compiled(lambda z, p: z[0], direction=1)
+    with pytest.raises(ValueError, match="^jacobian must be True or False, got 'no'"):
+        compute_returns(cm, np.array([[0.0, 0.5, -0.2]]), 20.0, jacobian="no")
+    assert simulate(_relay(), [0.0, 0.5, -0.2], 1.0, dense=0).t == 1.0   # 0 and 1 stand
+
+
+@pytest.mark.parametrize("own", [{"iterations": 2}, {"keep": 3}, {"jacobian": False}])
+def test_periodic_orbit_refuses_an_option_that_would_make_its_map_another(own):
+    # iterations=2 went through to the engine, and Newton iterated on another map
+    with pytest.raises(ValueError, match=f"^{next(iter(own))}: periodic_orbit sets it"):
+        periodic_orbit(_relay(), [0.0, 0.5, -0.2], lambda z, p: z[0], direction=1,
+                       t_max=20.0, **own)
+
+
+# ------------------------------------------------------------ a gradient wrong on the way
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_slide_on_a_gradient_right_only_at_the_start_is_refused_not_returned(engine):
+    # the review's case: switch_grad right where it was checked, wrong where the orbit
+    # meets H; the wrong normal speeds made a crossing a slide that left H. With the
+    # true gradient the orbit returns to y = -2 at x = 4, t = 4 (both engines); with the
+    # wrong one it is refused by name at the section, where it returned at t = 1.898
+    from filippov.checks import SystemContractError
+    from test_end_status import _gradient_right_at_start_only as system
+    section = lambda z, p: z[1] + 2.0   # noqa: E731
+    good = first_returns(system(good=True), [[-1.0, 0.0]], section, 20.0, direction=-1,
+                         engine=engine)
+    assert good.time[0] == pytest.approx(4.0, abs=1e-9)
+    assert good.state[0] == pytest.approx([4.0, -2.0], abs=1e-9)
+    with pytest.raises(SystemContractError, match="^the slide left H far beyond"):
+        first_returns(system(), [[-1.0, 0.0]], section, 20.0, direction=-1, engine=engine)
+    # and a run that ends inside such a slide (the reference's trajectory)
+    if engine == "reference":
+        with pytest.raises(SystemContractError, match="^the slide left H far beyond"):
+            simulate(system(), [-1.0, 0.0], 1.0)
+
+
+@pytest.mark.parametrize("rtol, t_end", [(1e-4, 10.0), (1e-3, 10.0), (1e-6, 100.0)])
+def test_a_slide_on_a_curved_surface_at_loose_tolerances_is_not_taken_for_a_wrong_gradient(
+        rtol, t_end):
+    # sliding on the unit circle (the right gradient): its integration drifts off H by
+    # about rtol per unit of time (H = -2.75e-6 after 100 at rtol 1e-6), which a limit of
+    # 1e-6 of H's size refused (an independent review); the limit grows with rtol
+    system = FilippovSystem(("x", "y"), lambda z, p: np.array([z[0] - z[1], z[0] + z[1]]),
+                            lambda z, p: np.array([-z[0] - z[1], z[0] - z[1]]),
+                            lambda z, p: z[0] ** 2 + z[1] ** 2 - 1.0,
+                            lambda z, p: np.array([2.0 * z[0], 2.0 * z[1]]))
+    traj = simulate(system, [1.0, 0.0], t_end, rtol=rtol, atol=1e-2 * rtol)
+    assert traj.z == pytest.approx([np.cos(t_end), np.sin(t_end)], abs=10 * rtol * t_end)

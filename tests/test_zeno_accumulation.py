@@ -226,9 +226,16 @@ def test_the_two_fold_rule_asks_both_speeds():
 def test_a_slide_end_where_both_fields_are_tangent_to_h_is_a_two_fold_in_any_units():
     grad, fm, fp = np.array([0.0, 0.0, 2.0]), np.array([3.0, 4.0, 0.0]), np.array([0.0, 1.0, 0.0])
     # |grad H| |F_-| = 10, |grad H| |F_+| = 2: the shares are cosines
-    assert rules.tangent_to_both(9e-6, -1.9e-6, grad, fm, fp)
-    assert not rules.tangent_to_both(1.1e-5, 0.0, grad, fm, fp)   # F_- not tangent
-    assert not rules.tangent_to_both(0.0, 2.1e-6, grad, fm, fp)   # F_+ not tangent
+    ONE = np.ones(3)
+    assert rules.tangent_to_both(9e-6, -1.9e-6, grad, fm, fp, ONE, 1.0)
+    assert not rules.tangent_to_both(1.1e-5, 0.0, grad, fm, fp, ONE, 1.0)   # F_- not tangent
+    assert not rules.tangent_to_both(0.0, 2.1e-6, grad, fm, fp, ONE, 1.0)   # F_+ not tangent
     for k in (1e-3, 1e3):  # H, and with it a and b, in other units
-        assert rules.tangent_to_both(9e-6 * k, -1.9e-6 * k, grad * k, fm, fp)
-        assert not rules.tangent_to_both(1.1e-5 * k, 0.0, grad * k, fm, fp)
+        assert rules.tangent_to_both(9e-6 * k, -1.9e-6 * k, grad * k, fm, fp, ONE, 1.0)
+        assert not rules.tangent_to_both(1.1e-5 * k, 0.0, grad * k, fm, fp, ONE, 1.0)
+    # a component in other units (z_1 = D y_1): its scale D keeps the cosines
+    for D in (1e-9, 1e9):
+        T, s = np.array([1.0, D, 1.0]), np.array([1.0, D, 1.0])
+        floor = s.max()
+        assert rules.tangent_to_both(9e-6, -1.9e-6, grad / T, fm * T, fp * T, s, floor)
+        assert not rules.tangent_to_both(1.1e-5, 0.0, grad / T, fm * T, fp * T, s, floor)

@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 from numba.core.errors import NumbaError
 
-from . import frozen
+from . import frozen, options
 from . import scale as scale_mod
 from .checks import SystemContractError
 from .differences import richardson_jacobian
@@ -338,7 +338,8 @@ def compile_system(names, field_minus, field_plus, switch, switch_grad, *, secti
         section=_scalar_piece(section, "section"),
         section_where=_where_piece(section_where, "section_where"),
         section_direction=int(section_direction), sample_step=float(sample_step),
-        sliding=bool(sliding), exact=exact, parameters={}, frozen_reads=reads,
+        sliding=options.flag("sliding", sliding), exact=exact, parameters={},
+        frozen_reads=reads,
         **{k: _flow_matrix_piece(user[k], k, n) if flow_jac else None
            for k in ("flow_jacobian_minus", "flow_jacobian_plus")})
     _check_shapes(cm, _probe_state(probe, n))
@@ -421,7 +422,8 @@ class FilippovSystem:
         self._probe = probe   # where both engines' pieces are run once when built
         self.slow_sample_step, self.transient_time = float(slow_sample_step), float(transient_time)
         self.params = np.ascontiguousarray(np.asarray(params, dtype=float).reshape(-1))
-        self.name, self.sliding, self.sample_step = name, bool(sliding), float(sample_step)
+        self.name, self.sliding, self.sample_step = (name, options.flag("sliding", sliding),
+                                                     float(sample_step))
         self.m, self._surfaces, self.intersection = 1, None, intersection
         self._user_surfaces = None   # several surfaces' pieces as the user gave them
         self._frozen = None     # what numba compiles into the pieces (filippov.frozen)

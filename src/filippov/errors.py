@@ -90,7 +90,8 @@ def _run_errors():
             s.NO_SLIDING: SlidingNotBuiltError, s.STEP_FAILED: SimulationError,
             s.ROOT_FAILED: SimulationError, s.BAD_START: ValueError,
             s.SECTION_SLIDING: SimulationError, s.FLOW_OFF_FIELD: SimulationError,
-            s.TWO_FOLD: SimulationError}
+            s.TWO_FOLD: SimulationError, s.NO_NORMAL: SimulationError,
+            s.SLID_OFF_H: SystemContractError}
 
 
 #: status -> the exception class a run that ends with it raises

@@ -308,12 +308,14 @@ def _settings(cmodel: CompiledModel, t_max, *, rtol, atol, max_step, max_events,
         t_max=float(t_max), exact=bool(cmodel.exact), hwin=float(hwin),
         hwin_slow=float(hwin_slow), transient=float(cmodel.transient_time),
         sec_pred=int(_section_pred(cmodel.section_direction)), sliding=bool(cmodel.sliding),
-        frac_ex=frac_ex, frac_in=frac_in, rtol=float(rtol), atol=float(atol),
+        frac_ex=frac_ex, frac_in=frac_in, rtol=float(rtol),
+        # atol per component (filippov.scale: each component's scale), one number or n
+        atol=np.array(np.broadcast_to(np.asarray(atol, dtype=float), (len(cmodel.names),))),
         touch_tol=float(touch_tol), xtol=float(event_xtol), zeno_span=float(zeno_span),
         max_step=float(max_step), min_time=float(min_time), max_events=int(max_events),
         max_steps=int(max_steps), zeno_count=int(zeno_count), jac=jac_mode, flow_jac=flow_jac,
         iterations=int(iterations), state_scale=float(scale.state),
-        time_scale=float(scale.time))
+        time_scale=float(scale.time), scales=scale.of_components(len(cmodel.names)))
 
 
 def _outputs(starts, keep: int, jacobian: bool) -> Outputs:
@@ -486,9 +488,11 @@ def _returns(cmodel: CompiledModel, pieces, params, starts, ages, t_max, *, rtol
     workers = _checked_workers(workers)
     options.check(rtol=rtol, atol=atol, max_step=max_step, max_events=max_events,
                   max_steps=max_steps, samples_per_step=samples_per_step, touch_tol=touch_tol,
-                  event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span)
+                  event_xtol=event_xtol, zeno_count=zeno_count, zeno_span=zeno_span,
+                  jacobian=jacobian)
     _check_options(cmodel, t_max, iterations, keep, min_time)
-    settings = _settings(cmodel, t_max, rtol=rtol, atol=atol * scale.state, max_step=max_step,
+    settings = _settings(cmodel, t_max, rtol=rtol,
+                         atol=atol * scale.of_components(starts.shape[1]), max_step=max_step,
                          max_events=max_events, max_steps=max_steps,
                          samples_per_step=samples_per_step, touch_tol=touch_tol * scale.switch,
                          event_xtol=event_xtol * scale.time, zeno_count=zeno_count,

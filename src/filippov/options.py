@@ -21,6 +21,13 @@ NUMBERS = {
     "event_xtol": (0.0, True, False),
     "zeno_span": (0.0, False, False),
 }
+#: the largest value of the options that have one: an event's time and a touch of H are
+#: tolerances of the event rules, which a value near the scale itself (T, G) silently
+#: turns into other events (a review: event_xtol = 1 moved a relay's return from 4.021 to
+#: 4.037 with no word)
+UPPER = {"touch_tol": 1e-6, "event_xtol": 1e-6}
+#: the options that are True or False (a string "no" is refused, not read as true)
+FLAGS = ("stiff", "dense", "jacobian", "sliding")
 #: the least value of each integer option; zeno_count: the Zeno ring compares the
 #: newest switch with the zeno_count-th before it, so one switch is no accumulation
 INTEGERS = {
@@ -51,16 +58,27 @@ def finite(v) -> bool:
     return x is not None and math.isfinite(x)
 
 
+def flag(name: str, v) -> bool:
+    """``v`` as True or False: a bool, or the integers 0 and 1; anything else (a string
+    such as "no", which Python reads as true) refused naming ``name``."""
+    if isinstance(v, (bool, np.bool_)) or (isinstance(v, (int, np.integer)) and v in (0, 1)):
+        return bool(v)
+    raise ValueError(f"{name} must be True or False, got {v!r}")
+
+
 def check(**opts) -> None:
-    """Refuse any of ``opts`` (the names above, and ``stiff``) out of range, naming it."""
+    """Refuse any of ``opts`` (the names above) out of range, naming it."""
     for name, v in opts.items():
         if name in NUMBERS:
             low, strict, allow_inf = NUMBERS[name]
             x = number(v)
             ok = (x is not None and not math.isnan(x) and (allow_inf or math.isfinite(x))
                   and (x > low if strict else x >= low))
-            if not ok:
+            high = UPPER.get(name, math.inf)
+            if not ok or x > high:
                 bound = f"> {low}" if strict else f">= {low}"
+                if high < math.inf:
+                    bound += f" and <= {high:g} (in units of the run's scale, filippov.scale)"
                 raise ValueError(f"{name} must be a {'' if allow_inf else 'finite '}number "
                                  f"{bound}, got {v!r}")
         elif name in INTEGERS:
@@ -68,8 +86,7 @@ def check(**opts) -> None:
             if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) \
                     or v < low:
                 raise ValueError(f"{name} must be an integer >= {low}, got {v!r}")
-        elif name == "stiff":
-            if not isinstance(v, (bool, np.bool_)):
-                raise ValueError(f"stiff must be True or False, got {v!r}")
+        elif name in FLAGS:
+            flag(name, v)
         else:
             raise TypeError(f"unknown solver option {name!r}")

@@ -114,28 +114,38 @@ def _finite_derivative(J: np.ndarray, z: np.ndarray) -> None:
             "dP/dz and the reference derives it along the slide; filippov.engines, item 11)")
 
 
-def _section_normal(value, z: np.ndarray, floor: float = 1.0) -> np.ndarray:
+def _section_normal(value, z: np.ndarray, floor: float = 1.0, r=None) -> np.ndarray:
     """The gradient of the section function at z by central differences (step eps^(1/3)
     times the state's size, at least ``floor``, the state scale: ~1e-11 relative for a
-    section that varies on that size)."""
-    h = np.cbrt(np.finfo(float).eps) * max(floor, float(np.abs(z).max()))
+    section that varies on that size; along component k times ``r[k]``, its scale over
+    the state scale, filippov.scale: 1 for all in a run of one scale)."""
+    r = _ratios(r, z.size)
+    h = np.cbrt(np.finfo(float).eps) * max(floor, float(np.abs(z / r).max())) * r
     g = np.empty(z.size)
     for k in range(z.size):
         e = np.zeros(z.size)
-        e[k] = h
-        g[k] = (value(z + e) - value(z - e)) / (2 * h)
+        e[k] = h[k]
+        g[k] = (value(z + e) - value(z - e)) / (2 * h[k])
     return g
 
 
-def _onto_section(value, z: np.ndarray, floor: float = 1.0) -> np.ndarray:
+def _ratios(r, n: int) -> np.ndarray:
+    """Each component's scale over the state scale (powers of two, at most 1; ones where
+    the run has one scale): the metric in which periodic_orbit measures distances."""
+    return np.ones(n) if r is None else np.asarray(r, dtype=float)
+
+
+def _onto_section(value, z: np.ndarray, floor: float = 1.0, r=None) -> np.ndarray:
     """z moved along the section's gradient onto it (one Newton step on the section
-    function: exact for a planar section, O(offset^2) off for a curved one)."""
+    function: exact for a planar section, O(offset^2) off for a curved one), the gradient
+    in the metric of the components' scales (``r``, :func:`_ratios`)."""
     s = value(z)
     if s == 0.0 or not np.isfinite(s):
         return z
-    g = _section_normal(value, z, floor)
+    r = _ratios(r, z.size)
+    g = _section_normal(value, z, floor, r) * r
     gg = float(g @ g)
-    return z - (s / gg) * g if gg > 0 else z
+    return z - (s / gg) * g * r if gg > 0 else z
 
 
 def _field_at(python, z: np.ndarray, touch_tol: float = 1e-15) -> np.ndarray:
@@ -164,7 +174,7 @@ def _complement(v: np.ndarray) -> np.ndarray:
 
 
 def floquet_from_return(J: np.ndarray, f: np.ndarray, *, normal=None,
-                        tol: float = 1e-6) -> np.ndarray:
+                        tol: float = 1e-6, r=None) -> np.ndarray:
     """Floquet multipliers from dP/dz at a fixed point with the field ``f`` there: the
     flow's 1 first, then the multipliers of the section's chart by decreasing modulus.
     Refused when ``|dP/dz f| > tol |dP/dz| |f|`` (the derivative does not annihilate the
@@ -180,9 +190,16 @@ def floquet_from_return(J: np.ndarray, f: np.ndarray, *, normal=None,
     triangular and M ((n-1) x (n-1), the derivative of P in the chart Q) has exactly the
     eigenvalues of dP/dz but the flow's, whatever the small residual d of dP/dz f.
     Without it, Q spans the complement of f, which is exact when dP/dz f = 0 and
-    off by ``O(|dP/dz f|)`` otherwise."""
+    off by ``O(|dP/dz f|)`` otherwise. ``r``: each component's scale over the state
+    scale (filippov.scale; None: one scale): the tests and the chart in their metric
+    (dP/dz similar to diag(1/r) J diag(r), f as f / r, the normal as normal r), so that
+    components in units far apart neither pass a drift nor refuse a crossing."""
     J, f = np.asarray(J, dtype=float), np.asarray(f, dtype=float)
     n = f.size
+    r = _ratios(r, n)
+    J, f = J * r[None, :] / r[:, None], f / r
+    if normal is not None:
+        normal = np.asarray(normal, dtype=float) * r
     scale = max(np.abs(J).max(), 1.0) * np.abs(f).max()
     if not (np.all(np.isfinite(J)) and scale > 0):
         raise PeriodicOrbitError("dP/dz is not finite at the fixed point (a tangential "
@@ -218,9 +235,10 @@ def floquet_from_return(J: np.ndarray, f: np.ndarray, *, normal=None,
 SHORTEST_PATH = 1e-9
 
 
-def _refuse_the_start_itself(z, period, f, floor: float = 1.0) -> None:
-    path = period * float(np.abs(f).max())
-    if not path > SHORTEST_PATH * (floor + float(np.abs(z).max())):
+def _refuse_the_start_itself(z, period, f, floor: float = 1.0, r=None) -> None:
+    r = _ratios(r, np.size(z))
+    path = period * float(np.abs(f / r).max())
+    if not path > SHORTEST_PATH * (floor + float(np.abs(z / r).max())):
         raise PeriodicOrbitError(
             f"the return from {z.tolist()} came back after t = {period:.3g} (a path of "
             f"length {path:.3g}): the start itself, a hair before the section by the "
@@ -255,6 +273,8 @@ def _newton_step(z, Pz, J, guess, floor: float) -> np.ndarray:
     except np.linalg.LinAlgError:
         raise PeriodicOrbitError(f"dP/dz - I is singular at {z.tolist()}: a multiplier "
                                  "1 besides the flow's (a bifurcation)") from None
+    # in the state's own size, not each component's: a component small at the guess
+    # may be large on the orbit (a review: c = 1e-7 at the guess, 1.38 on the orbit)
     g = np.asarray(guess, dtype=float).reshape(-1)
     size = max(floor, float(np.abs(g).max()))
     away = float(np.abs(new - g).max()) / size
@@ -284,9 +304,20 @@ def _checked_start(system, guess, returns, engine) -> np.ndarray:
     return z
 
 
-def _check_newton(tol, max_iter) -> None:
+#: options of the engines' return calls that periodic_orbit sets itself (P is one return
+#: of the section, with its derivative): given, they would make P another map
+OWN_OPTIONS = ("iterations", "keep", "jacobian", "sections", "dense", "start_age")
+
+
+def _check_newton(tol, max_iter, options=()) -> None:
     """Newton's options, each named where out of range (a review: tol 10 returned the
-    guess as the orbit, max_iter 0 an UnboundLocalError)."""
+    guess as the orbit, max_iter 0 an UnboundLocalError, iterations=2 went to the engine
+    and broke Newton's map)."""
+    own = sorted(set(options) & set(OWN_OPTIONS))
+    if own:
+        raise ValueError(f"{own[0]}: periodic_orbit sets it itself (one return of the "
+                         f"section a time, with its derivative); give returns= for an "
+                         f"orbit that meets the section more than once")
     if not (isinstance(tol, (int, float)) and 0.0 < tol <= 1e-3):
         raise ValueError(f"tol: the relative residual Newton stops at, in (0, 1e-3]; got "
                          f"{tol!r}")
@@ -350,27 +381,28 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
         size: the start a hair before the section by rounding), or an iterate that ran
         away from the guess (``RUNAWAY`` times its size).
     """
-    _check_newton(tol, max_iter)
+    _check_newton(tol, max_iter, options)
     z = _checked_start(system, guess, returns, engine)
     python = views.reference_system(system, "periodic_orbit", several=True)
     runs, sc = _orbit_scale(python, z, options.get("scale"))   # what the runs take; all
     options = {**options, "scale": runs}
     ret, section_value = _returns(system, section, direction, where, engine, t_max,
                                   int(returns), options)
+    r = sc.of_components(z.size) / sc.state   # powers of two: the metric of the scales
     for it in range(1, max_iter + 1):
         Pz, period, J = ret(z)
-        residual = float(np.abs(Pz - z).max())
-        if residual <= tol * (sc.state + np.abs(z).max()):
+        residual = float(np.abs((Pz - z) / r).max())
+        if residual <= tol * (sc.state + np.abs(z / r).max()):
             f = _field_at(python, z, options.get("touch_tol", 1e-15) * sc.switch)
-            _refuse_the_start_itself(z, period, f, sc.state)
+            _refuse_the_start_itself(z, period, f, sc.state, r)
             mult = floquet_from_return(J, f, normal=_section_normal(section_value, z,
-                                                                    sc.state))
-            return PeriodicOrbit(z, period, mult, J, it - 1, residual)
+                                                                    sc.state, r), r=r)
+            return PeriodicOrbit(z, period, mult, J, it - 1, float(np.abs(Pz - z).max()))
         z = _newton_step(z, Pz, J, guess, sc.state)
         # the fixed point lies on the section, and so does the next iterate up to the
         # error of dP/dz times the step (1e-10 x 1e-3 from variational equations at rtol
         # 1e-10): back onto it, or an iterate a hair before the section "returns" at once
         # and Newton converges to that (tests/test_properties.py)
-        z = _onto_section(section_value, z, sc.state)
+        z = _onto_section(section_value, z, sc.state, r)
     raise PeriodicOrbitError(f"Newton did not converge in {max_iter} steps (last residual "
                              f"{residual:.3g} at {z.tolist()})")

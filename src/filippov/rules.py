@@ -336,6 +336,39 @@ def start_side(H: float, touch_tol: float) -> int:
     return SLIDING
 
 
+#: a slide may leave H by this share of H's size at the state (the sum of |dH/dz_k| times
+#: the larger of |z_k| and the component's scale) before it is refused, or by
+#: SLIDE_DRIFT_RTOLS times the integration's rtol where that is larger: the sliding field
+#: keeps H constant wherever grad H is H's gradient, and its integration drifts by its
+#: errors only -- 5.7e-14 after a million explicit sliding steps of the Hopf example at
+#: rtol 1e-12, and on a curved H about rtol per unit of time slid (a circle: H = -2.75e-6
+#: after 100 at rtol 1e-6, a review) -- while a switch_grad right where it was checked
+#: and wrong along the slide left H by 0.07
+SLIDE_DRIFT_SHARE = 1e-6
+SLIDE_DRIFT_RTOLS = 1e4
+
+
+def slid_off(h: float, z, grad, scales, rtol: float) -> bool:
+    """A state reached by sliding whose H is beyond the drift a slide's integration
+    makes (SLIDE_DRIFT_SHARE of H's size there, or SLIDE_DRIFT_RTOLS times ``rtol``;
+    ``scales``: each component's, filippov.scale); a value not finite is another
+    status's."""
+    size = 0.0
+    for k in range(z.size):
+        size += abs(grad[k]) * max(abs(z[k]), scales[k])
+    return abs(h) > max(SLIDE_DRIFT_SHARE, SLIDE_DRIFT_RTOLS * rtol) * size
+
+
+def no_normal(grad) -> bool:
+    """grad H is 0 in every component (a start on H there has no side to decide on: a
+    switch that does not depend on the state ran silently in region + before, a review
+    found)."""
+    for k in range(grad.size):
+        if grad[k] != 0.0:
+            return False
+    return True
+
+
 def start_on_switch(H: float, a: float, b: float, sliding: bool) -> tuple[int, bool]:
     """The mode a start on H begins in, and whether H repels there (either side
     is a solution; region + is taken). A start that rounding puts a hair on the
@@ -441,7 +474,7 @@ def flow_consistent(dz: float, dt: float, speed_a: float, speed_b: float,
     return dz <= FLOW_SPEED_FACTOR * dt * max(speed_a, speed_b) + 1e3 * _EPS * max(floor, size)
 
 
-def exit_band(z, z_flow, grad, floor: float = 1.0) -> float:
+def exit_band(z, z_flow, grad, floor: float, scales) -> float:
     """The rounding of H along the stay that begins at the sliding exit ``z``: H cannot
     be read closer to its value at z than this while the orbit is still next to z.
     The stay's states are z + d(tau), d the rounding of the flow that gives them (for
@@ -457,12 +490,18 @@ def exit_band(z, z_flow, grad, floor: float = 1.0) -> float:
     |grad| max(eps |z|, |z_flow - z|) (p99 5.5), but 43 times |grad| eps |z| alone.
     At the fold exit of FOLD_EXIT (tests/test_properties.py) H read -1.1e-15 at tau = 0,
     where z = 0.68 and |z*| = 10: the flow's own rounding, and 7 roundings of |z|.
-    ``floor``: the state scale (filippov.scale) below which the cap does not shrink."""
+    ``floor``: the state scale (filippov.scale) below which the cap does not shrink;
+    the norms in the metric of the components' ``scales`` (ratios scales / floor, powers
+    of two: 1 for a run of one scale, whose arithmetic is the Euclidean one's bit for
+    bit), so that a large constant component beside a small one does not make the band
+    swallow a crossing (a review: an exit's band of 0.36 in H's units)."""
     g2, z2, d2 = 0.0, 0.0, 0.0
     for k in range(z.size):
-        g2 += grad[k] * grad[k]
-        z2 += z[k] * z[k]
-        d2 += (z_flow[k] - z[k]) * (z_flow[k] - z[k])
+        r = scales[k] / floor
+        g, y, e = grad[k] * r, z[k] / r, (z_flow[k] - z[k]) / r
+        g2 += g * g
+        z2 += y * y
+        d2 += e * e
     # a closed form that misses its own start by more than EXIT_BAND_FLOW_MAX of the
     # state's size is no rounding to step over (eps = 1e6 in the Hopf example: the band
     # would swallow genuine crossings and the run drift to y ~ 1e16 without a word):
@@ -692,7 +731,7 @@ def at_two_fold(a: float, b: float, a_in: float, b_in: float) -> bool:
     return abs(a) <= TWO_FOLD_SHARE * abs(a_in) and abs(b) <= TWO_FOLD_SHARE * abs(b_in)
 
 
-def tangent_to_both(a: float, b: float, grad, f_minus, f_plus) -> bool:
+def tangent_to_both(a: float, b: float, grad, f_minus, f_plus, scales, floor: float) -> bool:
     """Both fields within TWO_FOLD_SHARE of tangent to H at a slide's end, the normal
     speeds a = grad H . F_-, b = grad H . F_+ against |grad H| |F_-|, |grad H| |F_+|
     there: a two-fold, whatever the speeds where the slide began. The sliding field is
@@ -701,14 +740,19 @@ def tangent_to_both(a: float, b: float, grad, f_minus, f_plus) -> bool:
     (seen: the other speed 3.7e-6 and 5.7e-5 of its size where the slide began, past
     :func:`at_two_fold`'s share, where the slide ran straight into it), and a slide that
     began next to a two-fold starts with speeds as small as that. The shares are
-    cosines: independent of the units of H and time, and of one unit for every
-    component of the state -- not of components in units far apart (an ordinary fold
-    exit was refused with y in units 1e7 smaller than x: tests/test_known_misses.py)."""
+    cosines in the metric of the components' ``scales`` (filippov.scale; ``floor``, the
+    largest, the state scale): grad H times them, the fields over them, so that they are
+    independent of the units of H, of time and of each component (an ordinary fold exit
+    was refused as a two-fold with y in units 1e7 smaller than x, in the Euclidean
+    metric). The ratios ``scales / floor`` are powers of two, 1 for a run of one scale:
+    its arithmetic is the Euclidean one's, bit for bit."""
     g2, m2, p2 = 0.0, 0.0, 0.0
     for c in range(grad.size):
-        g2 += grad[c] * grad[c]
-        m2 += f_minus[c] * f_minus[c]
-        p2 += f_plus[c] * f_plus[c]
+        r = scales[c] / floor
+        g, m, p = grad[c] * r, f_minus[c] / r, f_plus[c] / r
+        g2 += g * g
+        m2 += m * m
+        p2 += p * p
     return at_two_fold(a, b, np.sqrt(g2 * m2), np.sqrt(g2 * p2))
 
 

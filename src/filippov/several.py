@@ -85,7 +85,7 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
     for k in range(system.m):  # each surface's pieces, its gradient among them
         checks.check_system(system.view(sigma, 1, k), z, method="integrate",
                             floor=sc.state)
-    o = scale_mod.tolerances(opts, sc)
+    o = scale_mod.tolerances(opts, sc, np.asarray(z).size)
     _refuse_corner_start(system, z, sigma, o)
     # a start on a surface (|h| <= touch_tol) is on its + side, as for one surface (where
     # the rules' ties, a repelling start among them, take region +): the first view is
@@ -95,7 +95,8 @@ def run(system: SurfacesSystem, z: np.ndarray, sections: list, opts: dict, one_s
     first = system.view(sigma, 1)
     rs = new_run_state(Limits(o["t_end"], system.sliding, o["max_events"], o["zeno_count"],
                               o["zeno_span"], o["touch_tol"], o["state_scale"],
-                              o["time_scale"], True, len(sections), o["max_steps"]))
+                              o["time_scale"], True, len(sections), o["max_steps"],
+                              o["rtol"]))
     stay, t, z, traj, hits = (_first_stay(system, sigma, first, z, o, start_mode), o["t0"], z,
                               None, [0] * len(sections))
     while True:

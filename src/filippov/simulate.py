@@ -173,7 +173,7 @@ class _IntegratingStepper:
     def __init__(self, fun, z, t, t_end, rtol, atol, max_step, method=DOP853,
                  piece=lambda zz: "the field", noise=None):
         calls = [0]
-        self.atol, self.noise, self.atol_used = atol, noise, atol
+        self.atol, self.noise, self.atol_used = atol, noise, float(np.max(atol))
         self.fun, self.piece, self.non_finite = fun, piece, None
         # the earliest time a trial stage met the non-finite guard at that the orbit has
         # not yet passed (_passed_suspect); where the orbit found runs through a field not
@@ -383,7 +383,8 @@ def _pieces(run):
     grad = np.asarray(system.switch_grad(z), float)
     fm, fp = np.asarray(system.field_minus(z), float), np.asarray(system.field_plus(z), float)
     return Pieces(z, grad, fm, fp, float(np.sum(grad * fm, axis=0)),
-                  float(np.sum(grad * fp, axis=0)), getattr(run, "state_scale", 1.0))
+                  float(np.sum(grad * fp, axis=0)), float(system.switch(z)),
+                  getattr(run, "state_scale", 1.0), getattr(run, "scales", np.ones(z.size)))
 
 
 def _section_along(k, mode, d, run):
@@ -508,7 +509,7 @@ def _simulate(system: PiecewiseSystem, z0, sections: Sequence[Section], opts: di
     if not (np.isfinite(t0) and np.isfinite(t_end) and t_end >= t0):
         raise ValueError(f"need finite t0 <= t_end, got t0={t0!r}, t_end={t_end!r}")
     options.check(**{k: v for k, v in opts.items() if k not in ("t0", "t_end", "method",
-                                                                   "dense", "scale")})
+                                                                   "scale")})
     for k, sec in enumerate(sections):
         if not isinstance(sec, Section):
             raise TypeError(f"sections[{k}]: expected a filippov.simulate.Section, got "
@@ -517,7 +518,8 @@ def _simulate(system: PiecewiseSystem, z0, sections: Sequence[Section], opts: di
         return several.run(system, z, list(sections), opts, one_stay, initial_mode)
     sc = scale_mod.of_system(system, z, opts.get("scale"))   # never raises: checked next
     checks.check_system(system, z, method=method, floor=sc.state)   # the class's contract
-    return _Run(system, z, list(sections), scale_mod.tolerances(opts, sc), sc).go()
+    return _Run(system, z, list(sections), scale_mod.tolerances(opts, sc, z.size),
+                sc).go()
 
 
 #: what runs :func:`simulate` on each engine (the compiled one has no trajectory
@@ -534,6 +536,8 @@ class _Run:
         self.system, self.sections = system, sections
         self.state_scale = self.time_scale = 1.0
         self.__dict__.update(opts)
+        # each component's scale (filippov.scale): the metric of the two-fold's cosines
+        self.scales = scale.of_components(np.asarray(z).size)
         self.traj = Trajectory(system=system, t0=self.t0, z0=z.copy(), t=self.t0, z=z.copy(),
                                scale=scale)
         self.t, self.z = self.t0, z
@@ -551,7 +555,7 @@ class _Run:
         self.rs = new_run_state(Limits(self.t_end, system.sliding, self.max_events,
                                        self.zeno_count, self.zeno_span, self.touch_tol,
                                        self.state_scale, self.time_scale, True,
-                                       len(sections), self.max_steps))
+                                       len(sections), self.max_steps, self.rtol))
         self.hit_section = None
         self.failed = None  # a slide's failed step (_step), raised unless at a two-fold
         self._flow_field = None  # (mode, f, z) at the end of the last exact window
@@ -694,7 +698,7 @@ class _Run:
     def _note_tolerance(self, stepper):
         """At the end of a stay: how far the noise floor lifted Radau IIA's atol (the
         stepper keeps the largest; a stay ends with the stepper that lifted it)."""
-        if stepper.method is RadauIIA and stepper.atol_used > self.atol:
+        if stepper.method is RadauIIA and stepper.atol_used > np.max(self.atol):
             raised, name = self.traj.atol_raised, MODE_NAMES[self.mode]
             raised[name] = max(raised.get(name, 0.0), stepper.atol_used)
 
@@ -801,6 +805,8 @@ class _Run:
             return _no_sliding(te, ze)
         if status == SECTION_SLIDING:
             _refuse_sliding_in_sections(self.system, self.sections, ze, te)
+        if not hasattr(self, "rs"):   # at the start, before the run's record exists
+            return run_error(status, te, ze)
         ring, entries = self.rs.ring, self.rs.count[RING]
         if status == ZENO:
             ratio, t_star = rules.geometric_accumulation(ring, entries, self.zeno_count)

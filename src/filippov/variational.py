@@ -150,6 +150,13 @@ def _state_scale(traj) -> float:
     return 1.0 if scale is None else float(scale.state)
 
 
+def _component_scales(traj, n: int) -> np.ndarray:
+    """Each component's scale in the run of ``traj`` (filippov.scale): the steps of the
+    differences along a component and its absolute tolerance grow from it."""
+    scale = getattr(traj, "scale", None)
+    return np.ones(n) if scale is None else scale.of_components(n)
+
+
 def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
                       jacobian: Optional[Callable] = None) -> np.ndarray:
     """dz(t_end)/dz0 along ``traj`` (a Trajectory of :func:`filippov.simulate`):
@@ -177,14 +184,15 @@ def transition_matrix(system, traj, *, rtol: float = 1e-10, atol: float = 1e-12,
     -------
     ndarray, shape (n, n)
     """
-    floor = _state_scale(traj)
-    system, jacobian = reference_view(system, jacobian, "transition_matrix", floor)
+    system, jacobian = reference_view(system, jacobian, "transition_matrix",
+                                      _state_scale(traj))
     n = system.dim
     field, salt, start = _modes(system)
+    floors = _component_scales(traj, n)
     jac = jacobian or (lambda mode, z: fd_jacobian(lambda zz: field(mode, zz), z, 1e-6,
-                                                   floor))
+                                                   floors))
     # the state's error in its own units, the derivative's (dimensionless) as it is
-    atols = np.concatenate([np.full(n, atol * floor), np.full(n * n, atol)])
+    atols = np.concatenate([atol * floors, np.full(n * n, atol)])
     M = np.eye(n)
     ev = traj.events
     for k, e in enumerate(ev):
@@ -241,13 +249,12 @@ def return_jacobian(system, traj, section, *, rtol: float = 1e-10, atol: float =
     if traj.status != f"section:{section.name}":
         raise VariationalError(f"the trajectory ended with status {traj.status!r}, not at a "
                                f"hit of section {section.name!r}")
-    floor = _state_scale(traj)
-    system, jacobian = reference_view(system, jacobian, "return_jacobian", floor)
+    system, jacobian = reference_view(system, jacobian, "return_jacobian", _state_scale(traj))
     Phi = transition_matrix(system, traj, rtol=rtol, atol=atol, jacobian=jacobian)
     z = np.asarray(traj.z, dtype=float)
     grad = (np.asarray(section_grad(z), dtype=float) if section_grad is not None else
             fd_jacobian(lambda zz: np.atleast_1d(section.func(zz)), z, SECTION_STEP,
-                        floor=floor)[0])
+                        floor=_component_scales(traj, z.size))[0])
     f = np.asarray(_modes(system)[0](traj.mode, z), dtype=float)
     speed = grad @ f
     if speed == 0:

@@ -76,7 +76,7 @@ def _flow_quotient(mode, za, k, d, tau, fns, p, dv):
 def _flow_jacobian(mode, za, tau, fns, p, dv, exact):
     """dv.Mt = d flow(za, tau) / d za: the model's flow Jacobian (``exact``), else column
     by column by Richardson's extrapolation of two central differences of the closed-form
-    flow (rules.richardson_step from the state scale up, and half of it)."""
+    flow (rules.richardson_step from the component's scale up, and half of it)."""
     n = za.size
     if exact:
         if mode == PLUS:
@@ -88,7 +88,7 @@ def _flow_jacobian(mode, za, tau, fns, p, dv, exact):
                 dv.Mt[i, k] = dv.Jm[i * n + k]
         return
     for k in range(n):
-        d = rules.richardson_step(max(dv.floor, abs(za[k])))
+        d = rules.richardson_step(max(dv.floors[k], abs(za[k])))
         _flow_quotient(mode, za, k, d, tau, fns, p, dv)
         for i in range(za.size):
             dv.Mt[i, k] = dv.jz1[i]
@@ -199,7 +199,7 @@ def _section_derivative(mode, fns, p, z, fl, dv):
     _flow_jacobian)."""
     _checked_field(z, mode, _TRIAL, fns, p, fl, dv.jf1)
     for k in range(z.size):
-        d = rules.richardson_step(max(dv.floor, abs(z[k])))
+        d = rules.richardson_step(max(dv.floors[k], abs(z[k])))
         coarse = _section_quotient(fns, p, z, k, d)
         dv.jz1[k] = (4.0 * _section_quotient(fns, p, z, k, 0.5 * d) - coarse) / 3.0
     _rank_one(dv.M, dv.jf1, dv.jz1, -_dot(dv.jz1, dv.jf1))

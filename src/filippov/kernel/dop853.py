@@ -106,7 +106,7 @@ def _dop_initial_step(mode, t0, ctl, fns, p, fl, d):
         return 0.0
     n = y0.size
     for k in range(n):
-        scale[k] = atol + abs(y0[k]) * rtol
+        scale[k] = atol[k] + abs(y0[k]) * rtol
     d0 = _rms(y0, scale)
     d1 = _rms(f0, scale)
     if d0 < 1e-5 or d1 < 1e-5:
@@ -173,7 +173,7 @@ def _dop_step(mode, t, h_abs, ctl, fns, p, fl, d):
         _checked_field(ynew, mode, _TRIAL, fns, p, fl, K[_NS])
         # error norm (DOP853._estimate_error_norm)
         for k in range(n):
-            scale[k] = atol + max(abs(y[k]), abs(ynew[k])) * rtol
+            scale[k] = atol[k] + max(abs(y[k]), abs(ynew[k])) * rtol
         e5, e3 = 0.0, 0.0
         for k in range(n):
             a5, a3 = 0.0, 0.0

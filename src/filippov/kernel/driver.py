@@ -55,11 +55,11 @@ from ..loop.status import CUT, GO_ON
 @_jit_inline
 def _event_pieces(ctx):
     """loop.event.Pieces at the state w.z: grad h, F_- and F_+ in w.wg, w.wf, w.wp (what
-    _exit_state and _event_section_along read there), a and b, and the run's state
-    scale."""
+    _exit_state and _event_section_along read there), a and b, H, and the run's state
+    scale and its components'."""
     fns, p, s, w = ctx
     a, b = _speeds(w.z, fns, p, w.wg, w.wf, w.wp)
-    return Pieces(w.z, w.wg, w.wf, w.wp, a, b, s.state_scale)
+    return Pieces(w.z, w.wg, w.wf, w.wp, a, b, _h(fns, w.z, p), s.state_scale, s.scales)
 
 
 @_jit_inline
@@ -555,7 +555,8 @@ def _run_record(s, w):
     event budget is the hard bound only (projects_budget False: filippov.engines,
     item 2)."""
     return RunState(Limits(s.t_max, s.sliding, s.max_events, s.zeno_count, s.zeno_span,
-                           s.touch_tol, s.state_scale, s.time_scale, False, 1, s.max_steps),
+                           s.touch_tol, s.state_scale, s.time_scale, False, 1, s.max_steps,
+                           s.rtol),
                     w.count,
                     w.recent, w.first_sw)
 
@@ -600,7 +601,7 @@ def _batch(fns, params, starts, ages, s, out):
         deriv = Deriv(np.zeros((n, n)), np.zeros((n, n)), np.zeros((_NS, n)),
                       np.zeros((_NS, n, n)), np.zeros(n), np.zeros(n), np.zeros(n),
                       np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n * n),
-                      s.state_scale)
+                      s.state_scale, s.scales)
     else:
         deriv = 0  # the build without the dP/dz code carries no derivative
     w = Work(ts, vals, dvals, svals, recent, seg, za, y, f, y_old, f_old, K, ynew, ytmp, scale,

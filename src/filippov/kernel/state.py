@@ -26,14 +26,15 @@ _f8, _i8, _b1 = types.float64, types.int64, types.boolean
 #: limits as compute_returns' options; iterations: returns per start; jac: dP/dz (0 none,
 #: 1 Jacobian-vector products by differences, 2 the model's Jacobians); flow_jac: an exact
 #: stay's dP/dz from the model's flow Jacobians (else Richardson); the run's state and
-#: time scales (filippov.scale: the floors of the rules, atol etc. already scaled)
+#: time scales (filippov.scale: the floors of the rules, atol etc. already scaled; atol
+#: per component); each component's scale (the steps of dP/dz's differences)
 SETTINGS = (
     ("t_max", _f8), ("exact", _b1), ("hwin", _f8), ("hwin_slow", _f8), ("transient", _f8),
     ("sec_pred", _i8), ("sliding", _b1), ("frac_ex", _vec), ("frac_in", _vec), ("rtol", _f8),
-    ("atol", _f8), ("touch_tol", _f8), ("xtol", _f8), ("zeno_span", _f8), ("max_step", _f8),
+    ("atol", _vec), ("touch_tol", _f8), ("xtol", _f8), ("zeno_span", _f8), ("max_step", _f8),
     ("min_time", _f8), ("max_events", _i8), ("max_steps", _i8), ("zeno_count", _i8),
     ("jac", _i8), ("flow_jac", _b1), ("iterations", _i8), ("state_scale", _f8),
-    ("time_scale", _f8))
+    ("time_scale", _f8), ("scales", _vec))
 
 #: what a batch returns, per start (m) -- fastmap.BatchReturns' fields: state (m, n), time,
 #: n_switches, sliding_time, status, first_switch, sliding_displacement (m, n), orbit
@@ -78,9 +79,10 @@ Work = namedtuple("Work", [
 
 #: dP/dz's arrays: the derivative so far (M), workspaces, the variational stages; a record
 #: of their own (docs/decisions.md#kernel-small-records); the run's state scale, from which
-#: the central differences step (filippov.scale)
+#: the central differences step (filippov.scale), and each component's (Richardson's
+#: steps along one component)
 Deriv = namedtuple("Deriv", ["M", "Mt", "KV", "KP", "ys", "jv", "jo", "jz1", "jz2", "jf1",
-                             "jf2", "Jm", "floor"])
+                             "jf2", "Jm", "floor", "floors"])
 
 # ----------------------------------------------------------------- w.seg (float64)
 # The current segment of the orbit and its stay. The state on it is the exact flow from

@@ -43,7 +43,8 @@ from collections import namedtuple
 from .. import rules
 from ..contracts import RunOperations, operations
 from ..system import SLIDING
-from .status import GO_ON, NO_SLIDING, OK, SECTION_SLIDING, TWO_FOLD
+from .status import (GO_ON, NO_NORMAL, NO_RETURN, NO_SLIDING, OK, SECTION_SLIDING,
+                     SLID_OFF_H, TWO_FOLD)
 from .run_state import RING, STEPS, SWITCHES, count_step, count_switch
 from .interval import as_is
 from .stay import before_stay, make_failed_step, make_slides_in, make_step_windows
@@ -87,8 +88,9 @@ RunOps = namedtuple("RunOps", operations(RunOperations))
 #: what ``pieces(ctx)`` returns, the pieces at the state as the engine evaluates them:
 #: the state z, grad H, F_- and F_+ there (arrays), the normal speeds a = grad H . F_-
 #: and b = grad H . F_+ (the engine's own dot products: the reference's numpy sums, the
-#: kernel's loops), and the run's state scale (filippov.scale)
-Pieces = namedtuple("Pieces", ("z", "grad", "f_minus", "f_plus", "a", "b", "floor"))
+#: kernel's loops), H there, the run's state scale and each component's (filippov.scale)
+Pieces = namedtuple("Pieces", ("z", "grad", "f_minus", "f_plus", "a", "b", "h", "floor",
+                               "scales"))
 
 
 def make_sliding_section(ops: RunOps, inline=as_is):
@@ -124,11 +126,25 @@ def make_start(ops: RunOps, inline=as_is, call=as_is):
         if side != SLIDING:
             return GO_ON, side, False, age
         pc = pieces(ctx)
+        if rules.no_normal(pc.grad):
+            return NO_NORMAL, side, False, age
         mode, repelling = rules.start_on_switch(h, pc.a, pc.b, sliding)
         if mode == SLIDING and sliding_section(sections, ctx) >= 0:
             return SECTION_SLIDING, mode, repelling, age
         return GO_ON, mode, repelling, age
     return start
+
+
+def make_left_h(pieces):
+    """``left_h(mode, ctx, limits) -> bool``: the state a slide hands out (a section's
+    hit, the run's end) lies off H beyond the slide's integration error (rules.slid_off:
+    a switch_grad wrong along the slide); False outside a slide."""
+    def left_h(mode, ctx, limits):
+        if mode != SLIDING:
+            return False
+        pc = pieces(ctx)
+        return rules.slid_off(pc.h, pc.z, pc.grad, pc.scales, limits.rtol)
+    return left_h
 
 
 def make_run(ops: RunOps, inline=as_is, call=as_is):
@@ -138,6 +154,7 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
     begin, next_step, window, end_step, record, pieces, _, exit_state = ops
     step_windows = inline(make_step_windows(window))  # ``inline``: the kernel's, or as is
     failed_step = inline(make_failed_step(pieces))
+    left_h = inline(make_left_h(pieces))
     sliding_section = call(make_sliding_section(ops, inline))  # at an arrival on H only
 
     def run(z0, age0, ctx, rs):
@@ -154,8 +171,7 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
             status = before_stay(mode, t, limits.t_end, limits.sliding)
             if status != GO_ON:
                 return status, t, mode
-            # the stay, step by step, to its event (OK) or to why it ends
-            status, ta, first, what = GO_ON, t, True, -1  # what: the event it ends at
+            status, ta, first, what = GO_ON, t, True, -1  # the stay to its event (what)
             while status == GO_ON:
                 status, tb = count_step(rs), ta  # within the run's step budget, or it stops
                 if status == GO_ON:
@@ -165,6 +181,8 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
                 status, t, what = step_windows(mode, ta, tb, first, ctx)
                 status = end_step(mode, ta, tb, status, t, ctx)
                 ta, first = tb, False
+            if (status == NO_RETURN or what == SECTION) and left_h(mode, ctx, limits):
+                return SLID_OFF_H, t, mode
             if status != OK:
                 return status, t, mode
             if what == SECTION:
@@ -181,20 +199,21 @@ def make_run(ops: RunOps, inline=as_is, call=as_is):
                 return NO_SLIDING, t, mode
             shift, band = 0.0, 0.0
             if mode == SLIDING and new_mode != SLIDING:
-                # a two-fold: both speeds vanished along the slide, or both fields are
-                # tangent to H where it ends
+                if rules.slid_off(pc.h, pc.z, pc.grad, pc.scales, limits.rtol):
+                    return SLID_OFF_H, t, mode
+                # a two-fold: both speeds vanished along the slide, or both fields tangent
                 if (rules.at_two_fold(a, b, a_in, b_in)
-                        or rules.tangent_to_both(a, b, pc.grad, pc.f_minus, pc.f_plus)):
+                        or rules.tangent_to_both(a, b, pc.grad, pc.f_minus, pc.f_plus,
+                                                 pc.scales, pc.floor)):
                     return TWO_FOLD, t, mode
-                # the end of a slide: a state the slide left off H beyond rounding is
-                # moved onto it; the next stay measures H from the exit's rounding
+                # a state left off H beyond rounding is moved onto it (H: rules.exit_band)
                 z, grad, h0, z_next = exit_state(new_mode, ctx)
                 drift = rules.exit_drift(new_mode, h0, z, grad, limits.touch_tol)
                 if drift:
                     rules.onto_switch(z, h0, grad)
                     # what rounding left, the next stay's start from there (grad H kept)
                     z, _, h0, z_next = exit_state(new_mode, ctx)
-                band = rules.exit_band(z, z_next, grad, limits.state_scale)
+                band = rules.exit_band(z, z_next, grad, limits.state_scale, pc.scales)
                 shift = rules.exit_shift(new_mode, h0, limits.touch_tol, drift)
             # an arrival on H that would slide inside a section is refused there
             if (new_mode == SLIDING and mode != SLIDING

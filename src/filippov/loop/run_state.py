@@ -23,10 +23,11 @@ from .status import EVENT_LIMIT, GO_ON, STEP_LIMIT, ZENO
 #: event budget is also projected from the switching rate (rules.budget_runs_out: the
 #: reference engine, filippov.engines item 2); the number of the run's sections (an
 #: arrival on H that would slide inside one is refused: filippov.loop.event); the step
-#: budget (max_steps: rules.step_budget_spent, asked by the run before each step)
+#: budget (max_steps: rules.step_budget_spent, asked by the run before each step); the
+#: integration's relative tolerance (how far a slide may drift off H: rules.slid_off)
 Limits = namedtuple("Limits", ["t_end", "sliding", "max_events", "zeno_count", "zeno_span",
                                "touch_tol", "state_scale", "time_scale", "projects_budget",
-                               "sections", "max_steps"])
+                               "sections", "max_steps", "rtol"])
 
 #: the record: ``limits`` (:data:`Limits`); ``count`` (int64, positions :data:`COUNT`:
 #: changes of mode so far, entries into the ring so far, steps so far (an exact flow's

@@ -22,6 +22,8 @@ BAD_START = 9      # non-finite start point
 SECTION_SLIDING = 10  # the orbit slides inside the section (a section on H)
 FLOW_OFF_FIELD = 11  # an exact flow moved the state farther than its field allows
 TWO_FOLD = 12      # a slide ran into a two-fold: both fields tangent to H at once
+NO_NORMAL = 13     # a start on H where grad H is 0: no side of H to decide on
+SLID_OFF_H = 14    # a slide left H far beyond its integration's error (a wrong switch_grad)
 
 STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event limit",
           STEP_LIMIT: "step limit", ZENO: "accumulation of switches (Zeno)",
@@ -34,4 +36,10 @@ STATUS = {OK: "ok", NO_RETURN: "no return within t_max", EVENT_LIMIT: "event lim
                            "switching surface): its crossings there would be rounding noise",
           FLOW_OFF_FIELD: "the exact flow does not follow its field",
           TWO_FOLD: "the slide reached a two-fold (both fields tangent to H): the Filippov "
-                    "solution does not go on uniquely from there"}
+                    "solution does not go on uniquely from there",
+          NO_NORMAL: "the start lies on H where switch_grad is 0: H has no normal there "
+                     "(a switch that does not depend on the state, or a singular point of "
+                     "H), so no side of it can be decided",
+          SLID_OFF_H: "the slide left H far beyond its integration's error: switch_grad is "
+                      "not the gradient of switch along the slide (right where it was "
+                      "checked, wrong here), or the tolerances are too loose for it"}

@@ -43,7 +43,8 @@ def make_failed_step(pieces):
     def failed_step(status, mode, ctx):
         if mode == SLIDING and (status == STEP_FAILED or status == NON_FINITE):
             pc = pieces(ctx)
-            if rules.tangent_to_both(pc.a, pc.b, pc.grad, pc.f_minus, pc.f_plus):
+            if rules.tangent_to_both(pc.a, pc.b, pc.grad, pc.f_minus, pc.f_plus, pc.scales,
+                                     pc.floor):
                 return TWO_FOLD
         return status
     return failed_step
