@@ -58,7 +58,7 @@ def _plane(section):
     z, fm, fp = np.array([0.3, 0.0]), np.array([1.0, 1.0]), np.array([1.0, -1.0])
     fields = {MINUS: fm, PLUS: fp, SLIDING: np.array([1.0, 0.0])}
     grad = np.array([0.0, 1.0])
-    return (lambda ctx: Pieces(z, grad, fm, fp, grad @ fm, grad @ fp, 1.0),
+    return (lambda ctx: Pieces(z, grad, fm, fp, grad @ fm, grad @ fp, 0.0, 1.0, np.ones(2)),
             lambda k, mode, d, ctx: section(z + d * fields[mode]))
 
 
@@ -155,7 +155,7 @@ def test_a_slides_failed_step_is_named_a_two_fold_where_both_fields_are_tangent(
     fm, fp = np.array([1.0, 0.0 if tangent else 1.0]), np.array([2.0, 0.0])
 
     def pieces(ctx):
-        return Pieces(np.zeros(2), grad, fm, fp, grad @ fm, grad @ fp, 1.0)
+        return Pieces(np.zeros(2), grad, fm, fp, grad @ fm, grad @ fp, 0.0, 1.0, np.ones(2))
     assert stay.make_failed_step(pieces)(status, mode, None) == expected
 
 

@@ -352,7 +352,7 @@ def slid_off(h: float, z, grad, scales, rtol: float) -> bool:
     """A state reached by sliding whose H is beyond the drift a slide's integration
     makes (SLIDE_DRIFT_SHARE of H's size there, or SLIDE_DRIFT_RTOLS times ``rtol``;
     ``scales``: each component's, filippov.scale); a value not finite is another
-    status's."""
+    status's. docs/decisions.md#wrong-on-the-way"""
     size = 0.0
     for k in range(z.size):
         size += abs(grad[k]) * max(abs(z[k]), scales[k])
@@ -740,8 +740,8 @@ def tangent_to_both(a: float, b: float, grad, f_minus, f_plus, scales, floor: fl
     (seen: the other speed 3.7e-6 and 5.7e-5 of its size where the slide began, past
     :func:`at_two_fold`'s share, where the slide ran straight into it), and a slide that
     began next to a two-fold starts with speeds as small as that. The shares are
-    cosines in the metric of the components' ``scales`` (filippov.scale; ``floor``, the
-    largest, the state scale): grad H times them, the fields over them, so that they are
+    cosines in the metric of the components' ``scales`` (filippov.scale; ``floor``: the
+    state scale): grad H times them, the fields over them, so that they are
     independent of the units of H, of time and of each component (an ordinary fold exit
     was refused as a two-fold with y in units 1e7 smaller than x, in the Euclidean
     metric). The ratios ``scales / floor`` are powers of two, 1 for a run of one scale:
