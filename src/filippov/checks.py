@@ -135,7 +135,7 @@ def flow_check(flow, field, z0, sample_step: float, piece: str, of: str) -> None
     ``z0`` along its ``field`` (Richardson's extrapolation of two forward differences,
     2 D(tau/2) - D(tau), at one of FLOW_STEPS times the shorter of a sample step and the
     field's own time; within FLOW_FIELD_SHARE of
-    |F| + |z0| / sample_step). A flow of the other region, or in other units of time, ran
+    ``|F| + |z0| / sample_step``). A flow of the other region, or in other units of time, ran
     before with the speed check of the run (FLOW_OFF_FIELD) only, which allows a factor
     of 100: a review found returns at t = 1.416 and 3.590 for 1.795 with no word. Checked
     at a run's first start, where the parameters are the run's (a system may be built

@@ -380,6 +380,8 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
         return is the start itself (a path shorter than ``SHORTEST_PATH`` of the state's
         size: the start a hair before the section by rounding), or an iterate that ran
         away from the guess (``RUNAWAY`` times its size).
+    ValueError
+        A ``tol``, ``max_iter`` or option out of range (``OWN_OPTIONS``), named.
     """
     _check_newton(tol, max_iter, options)
     z = _checked_start(system, guess, returns, engine)
@@ -399,10 +401,8 @@ def periodic_orbit(system, guess, section, *, direction: int = 0, where=None,
                                                                     sc.state, r), r=r)
             return PeriodicOrbit(z, period, mult, J, it - 1, float(np.abs(Pz - z).max()))
         z = _newton_step(z, Pz, J, guess, sc.state)
-        # the fixed point lies on the section, and so does the next iterate up to the
-        # error of dP/dz times the step (1e-10 x 1e-3 from variational equations at rtol
-        # 1e-10): back onto it, or an iterate a hair before the section "returns" at once
-        # and Newton converges to that (tests/test_properties.py)
+        # onto the section (off it by dP/dz's error times the step), or an iterate a hair
+        # before it "returns" at once and Newton converges there (test_properties.py)
         z = _onto_section(section_value, z, sc.state, r)
     raise PeriodicOrbitError(f"Newton did not converge in {max_iter} steps (last residual "
                              f"{residual:.3g} at {z.tolist()})")

@@ -336,8 +336,8 @@ def start_side(H: float, touch_tol: float) -> int:
     return SLIDING
 
 
-#: a slide may leave H by this share of H's size at the state (the sum of |dH/dz_k| times
-#: the larger of |z_k| and the component's scale) before it is refused, or by
+#: a slide may leave H by this share of H's size at the state (the sum of ``|dH/dz_k|``
+#: times the larger of ``|z_k|`` and the component's scale) before it is refused, or by
 #: SLIDE_DRIFT_RTOLS times the integration's rtol where that is larger: the sliding field
 #: keeps H constant wherever grad H is H's gradient, and its integration drifts by its
 #: errors only -- 5.7e-14 after a million explicit sliding steps of the Hopf example at

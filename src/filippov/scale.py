@@ -327,7 +327,7 @@ SPREAD = 2.0 ** 10
 
 
 def component_scales(z0, fields, jacobians, S: float):
-    """The scale of each component of a start ``z0`` (``fields``: F_- and F_+ there,
+    """The scale of each component of a start ``z0`` (``fields``: ``F_-`` and ``F_+`` there,
     ``jacobians``: their Jacobians, :func:`field_jacobian`), or None where one scale
     ``S`` serves them all.
 
@@ -367,9 +367,9 @@ def component_scales(z0, fields, jacobians, S: float):
 
 def _coupled(parts, jacobians, rho: float) -> np.ndarray:
     """``parts`` lifted where the fields' coupling says a component is larger: a
-    component k that component j drives at |dF_k/dz_j| moves by |dF_k/dz_j| s_j / rho in
-    the system's time, so its scale is at least that (a power of two, at most the
-    largest). A start next to an equilibrium has components small only by where it
+    component k that component j drives at ``|dF_k/dz_j|`` moves by
+    ``|dF_k/dz_j| s_j / rho`` in the system's time, so its scale is at least that (a
+    power of two, at most the largest). A start next to an equilibrium has components small only by where it
     lies -- (1, 1e-13) next to the focus (1, 0), whose y grows to 0.5 -- and their
     extents alone gave y a scale of 1e-13, an atol of 1e-27 and a step limit (an
     independent review's test); a component in units of its own (a velocity in units
