@@ -21,13 +21,15 @@ import re
 
 import numpy as np
 import pytest
+import scipy.linalg
 from numba import njit
 
 from filippov import (FilippovSystem, PeriodicOrbitError, SimulationError,
                       SystemContractError, first_returns, periodic_orbit, simulate)
+from filippov.checks import flow_check
 from filippov.fastmap import (FLOW_OFF_FIELD, NON_FINITE, compute_returns, failure,
                               first_returns_compiled)
-from filippov.system import MINUS, MODE_NAMES
+from filippov.system import MINUS, MODE_NAMES, PLUS, SLIDING, PiecewiseSystem
 
 ZETA, V, K = -0.05, 0.5, 1.0
 ENGINES = ("compiled", "reference")
@@ -365,6 +367,154 @@ def test_an_exact_flow_off_its_field_is_refused_at_the_start(engine, case):
     with pytest.raises(SystemContractError, match=rf"^{name} does not follow field_{mode} "
                                                    rf"at the start state"):
         _planar_return(_planar(flow_minus, flow_plus), engine)
+
+
+def _rotation(speed):
+    # the rotation z' = (-y, x) at ``speed`` times its rate: speed 1 is the field's flow
+    def flow(z0, tau, p):
+        c, s = np.cos(speed * tau), np.sin(speed * tau)
+        return np.array([c * z0[0] - s * z0[1], s * z0[0] + c * z0[1]])
+    return flow
+
+
+def _turning(flow, sample_step):
+    # the rotation on both sides of H = y + 2, which the circle of radius 1 never meets
+    def field(z, p):
+        return np.array([-z[1], z[0]])
+    return FilippovSystem(("x", "y"), field, field, lambda z, p: z[1] + 2.0,
+                          lambda z, p: np.array([0.0, 1.0]), flow_minus=flow,
+                          flow_plus=flow, sample_step=sample_step, name="turning")
+
+
+def _first_window(system, z0, engine):
+    """A run of ``system`` from z0 over 1e-3 (no section met): its end state."""
+    def section(z, p):
+        return z[0] - 1e9
+    if engine == "compiled":
+        out = compute_returns(system.compiled(section), [z0], 1e-3)
+        return out.state[0]
+    return simulate(system.python(), z0, 1e-3, dense=False).z
+
+
+# flows twice their fields' speed where the start's size over sample_step hid them from a
+# tolerance of 1e-4 (|F| + |z0| / sample_step) (a review): beside an offset of 1000, and
+# with a sample step of 1e-5 (eps / 4 of a slow-fast system at eps = 4e-5)
+FAST_TWICE = {
+    "offset 1000": (_drift, lambda flow: _planar(flow, _drift(SLOW)), [1000.0, -0.5]),
+    "sample step 1e-5": (_rotation, lambda flow: _turning(flow, 1e-5), [1.0, 0.0]),
+    # (a review of the mend) the smallest tau's rounding allowance passed these
+    "sample step 2.5e-9": (_rotation, lambda flow: _turning(flow, 2.5e-9), [1.0, 0.0]),
+}
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("case", FAST_TWICE)
+def test_a_flow_at_twice_its_speed_is_refused_whatever_the_start_s_size(engine, case):
+    flow, build, z0 = FAST_TWICE[case]
+    mode = "minus"
+    name = {"reference": f"flows\\[{mode.upper()}\\]", "compiled": f"flow_{mode}"}[engine]
+    with pytest.raises(SystemContractError, match=rf"^{name} does not follow field_{mode} "
+                                                   rf"at the start state"):
+        _first_window(build(flow(2.0)), z0, engine)
+    # the right flow at the same start and sample step runs, along its closed form
+    z = _first_window(build(flow(1.0)), z0, engine)
+    want = flow(1.0)(np.array(z0), 1e-3, None)
+    np.testing.assert_allclose(z, want, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+@pytest.mark.parametrize("d", [1e-8, 1e-10])
+def test_a_right_flow_about_a_far_equilibrium_runs_from_next_to_the_origin(engine, d):
+    # the stick-slip flows about c = (1, 0, 1) round by eps |c|, not eps |z0|: refused at
+    # z0 = (d, d, d) by a rounding allowance of the start's size (a review); and the start's
+    # own rate there (its velocity over a position of 1e-8) made T 1.2e-4 for 1
+    z0 = [d, d, d]
+    system = stick_slip(exact=True)
+    if engine == "compiled":
+        out = compute_returns(system.compiled(_section, direction=-1), [z0], 1.0)
+        assert out.status[0] == 1   # no return within 1: ran to its end
+        return
+    traj = simulate(system.python(), z0, 1.0, dense=False)
+    assert traj.status == "t_end" and traj.scale.time == 1.0
+
+
+def _expm_flow(A, c=0.0):
+    return lambda z, t: c + scipy.linalg.expm(A * t) @ (z - c)
+
+
+_STIFF = np.array([[1.0, 0.3], [0.2, 1.0]]) @ np.diag([-1.0, -1e6]) @ np.linalg.inv(
+    np.array([[1.0, 0.3], [0.2, 1.0]]))
+# right flows the check must pass: (flow, field, start, sample_step)
+RIGHT_FLOWS = {
+    # a fast mode at rate 1e6 barely excited, with a sample step that does not resolve it:
+    # the field's own time at the start hid it (refused, a review)
+    "stiff mode of amplitude 1e-7": (_expm_flow(_STIFF), lambda z: _STIFF @ z,
+                                     np.array([[1.0, 0.3], [0.2, 1.0]]) @ [1.0, 1e-7], 0.05),
+    # a relaxation in time 1e-11 from 1e-11 away (the pseudo-equilibrium's sliding flow at
+    # theta eps = 1e-11), where the flow is at its end for every tau of a sample step
+    "relaxation in 1e-11": (lambda z, t: z * np.exp(-t / 1e-11), lambda z: -z / 1e-11,
+                            np.array([-1e-11]), 2.5e-3),
+    "relaxation to 1 from next to 0": (lambda z, t: 1.0 + (z - 1.0) * np.exp(-t),
+                                       lambda z: 1.0 - z, np.array([1e-9, 1e-9]), 0.05),
+}
+# wrong flows it must refuse
+WRONG = {
+    "twice the speed": lambda z, t: _rotation(2.0)(z, t, None),
+    "backwards": lambda z, t: _rotation(-1.0)(z, t, None),
+    "another field's": lambda z, t: z + t * np.array([1.0, 0.0]),
+}
+
+
+@pytest.mark.parametrize("case", RIGHT_FLOWS)
+def test_a_right_flow_passes_the_start_check(case):
+    flow, field, z0, sample_step = RIGHT_FLOWS[case]
+    flow_check(flow, field, np.asarray(z0, dtype=float), sample_step, "flow", "field")
+
+
+@pytest.mark.parametrize("sample_step", [0.05, 1e-5, 2.5e-9])
+@pytest.mark.parametrize("case", WRONG)
+def test_a_wrong_flow_is_refused_at_any_sample_step(case, sample_step):
+    with pytest.raises(SystemContractError, match="^flow does not follow field"):
+        flow_check(WRONG[case], lambda z: np.array([-z[1], z[0]]), np.array([1.0, 0.0]),
+                   sample_step, "flow", "field")
+
+
+def test_a_slow_component_s_error_is_not_hidden_by_a_fast_one():
+    # the Hopf model's region + flow at twice its rotation, started off the slow manifold
+    # at eps = 1e-6 (|F_y| = 5e5): a tolerance of 1e-4 of the largest speed passed it,
+    # and the run returned (0.661, -0.337, 0.661) for (-0.732, -0.116, -0.732) (a review)
+    import dataclasses
+    from filippov.models import hopf
+    right = hopf.model(1e-6, 0.0).full()
+    twice = hopf.model(1e-6, 0.0, omega=2.0 * 8.0 * np.pi).full().flows[PLUS]
+    wrong = dataclasses.replace(right, flows={**right.flows, PLUS: twice})
+    with pytest.raises(SystemContractError, match=r"^flows\[PLUS\] does not follow"):
+        simulate(wrong, [0.5, 0.5, 0.0], 0.1, dense=False)
+    traj = simulate(right, [0.5, 0.5, 0.0], 0.1, dense=False)
+    assert traj.status == "t_end"
+
+
+def _circle(speed):
+    # sliding on the unit circle H = x^2 + y^2 - 1, pushed onto it from both sides while
+    # turning: the sliding field is the rotation (-y, x), and ``speed`` 1 its flow
+    turn = _rotation(speed)
+    return PiecewiseSystem(
+        ("x", "y"), lambda z: np.stack([-z[1] + z[0], z[0] + z[1]]),
+        lambda z: np.stack([-z[1] - z[0], z[0] - z[1]]), lambda z: z[0] ** 2 + z[1] ** 2 - 1.0,
+        lambda z: np.stack([2.0 * z[0], 2.0 * z[1]]),
+        flows={SLIDING: lambda z0, tau: turn(z0, tau, None)}, sample_step=0.05)
+
+
+@pytest.mark.parametrize("start", [[1.0, 0.0], [0.0, 0.5], [0.01, 0.0], [-3.0, 4.0]])
+def test_an_exact_sliding_flow_off_the_sliding_field_is_refused(start):
+    # the reference engine's only (the compiled engine integrates every slide): a sliding
+    # flow at twice its speed returned (cos 2, sin 2) for (cos 1, sin 1) with no word (a
+    # review); it is now checked where the run first slides (from inside, on H, outside)
+    with pytest.raises(SystemContractError, match=r"^flows\[SLIDING\] does not follow the "
+                                                   r"sliding field at the run's first slide"):
+        simulate(_circle(2.0), start, 6.0, dense=False)
+    traj = simulate(_circle(1.0), [1.0, 0.0], 1.0, dense=False)
+    np.testing.assert_allclose(traj.z, [np.cos(1.0), np.sin(1.0)], rtol=0, atol=1e-12)
 
 
 @pytest.mark.parametrize("engine", ENGINES)

@@ -735,6 +735,41 @@ def test_dpdz_through_exact_flows_with_a_velocity_in_units_far_apart(D):
                                                     abs=1e-12)
 
 
+def _duffing_relay(U):
+    # x' = v, v' = -x - 0.3 x^3 + 0.2 (1 - v^2) v - sign(x), no exact flows and no
+    # Jacobians (dP/dz by central differences along the variational columns), the
+    # velocity V = v / U in units U
+    def field(c):
+        def f(z, p):
+            x, v = z[0], z[1] * p[0]
+            return np.array([v, (-x - 0.3 * x ** 3 + 0.2 * (1.0 - v * v) * v + c) / p[0]])
+        return f
+    return FilippovSystem(("x", "V"), field(1.0), field(-1.0), lambda z, p: z[0],
+                          lambda z, p: np.array([1.0, 0.0]), params=np.array([U]))
+
+
+@pytest.mark.parametrize("U", [1e-6, 1e-9])
+def test_dpdz_of_integrated_stays_with_a_velocity_in_units_far_apart(U):
+    # the compiled engine's variational columns by central differences stepped from the
+    # largest component's scale: x moved by 6e3 (x in [-0.5, 0.5]), dP/dz -3.5e3 for
+    # -0.486 at U = 1e-9 (7e-3 off at 1e-6); the same return in units 1 is the reference
+    from filippov import compute_returns
+
+    def dpdz(u):
+        cm = _duffing_relay(u).compiled(lambda z, p: z[1], direction=-1)
+        got = compute_returns(cm, np.array([[-0.5, 1.0 / u]]), 20.0, jacobian=True)
+        assert got.status[0] == 0
+        T = np.diag([1.0, 1.0 / u])
+        return np.linalg.solve(T, got.jacobian[0] @ T)
+    from filippov.variational import return_jacobian
+    system = _duffing_relay(1.0)
+    section = system.python_section(lambda z, p: z[1], direction=-1)
+    traj = simulate(system.python(), [-0.5, 1.0], 20.0, sections=[section], dense=False)
+    want = return_jacobian(system.python(), traj, section)   # the reference engine's
+    assert dpdz(1.0) == pytest.approx(want, rel=1e-7, abs=1e-9)
+    assert dpdz(U) == pytest.approx(want, rel=1e-7, abs=1e-9)
+
+
 def test_one_unit_for_every_component_keeps_one_scale():
     # components are measured one by one only where they spread: the relay of the
     # tutorial in one unit, natural or 1e6 times as small, runs at one scale as before

@@ -393,7 +393,8 @@ def compute_returns(cmodel: CompiledModel, starts, t_max: float, *, rtol: float 
     pieces = _pieces(cmodel)
     scale = batch_scale(cmodel, starts, scale)
     if starts.shape[0]:   # the reference driver's start check, once a model
-        check_compiled(cmodel, starts[0], floor=scale.state)
+        check_compiled(cmodel, starts[0], floor=scale.state,
+                       scales=scale.of_components(starts.shape[1]))
     params = np.ascontiguousarray(np.atleast_2d(np.asarray(cmodel.params, dtype=float)))
     return _returns(cmodel, pieces, params, starts, ages, t_max, rtol=rtol, atol=atol,
                     max_step=max_step, max_events=max_events, max_steps=max_steps,
@@ -466,7 +467,8 @@ def sweep_returns(cmodels, starts, t_max: float, *, start_age=0.0, workers=None,
     pieces = _pieces(first)  # before check_compiled calls them (see compute_returns)
     scale = batch_scale(cmodels, starts, options.pop("scale", None))
     for i, c in enumerate(cmodels):  # once a model object (checks.check_compiled)
-        check_compiled(c, starts[i], floor=scale.state)
+        check_compiled(c, starts[i], floor=scale.state,
+                       scales=scale.of_components(starts.shape[1]))
     defaults = {name: par.default for name, par in
                 inspect.signature(compute_returns).parameters.items()
                 if par.kind is par.KEYWORD_ONLY and name not in ("start_age", "workers")}

@@ -266,7 +266,7 @@ def measure_system(z0, field_minus, field_plus, switch_grad, state=None) -> Scal
     # S stays the scale measured for all: the rules' rounding floors grow from it, and
     # the largest component's (a fast integral of 2^18 beside a state of size 1) made
     # them lose a touch of H between samples (tests/test_sliding_exit_hidden.py)
-    rho = system_rate(z0, jacobians)
+    rho = system_rate(z0, jacobians, out.state)
     return Scale(out.state, power_of_two(1.0 / rho),
                  _switch_scale(grad, np.array(parts)), sized.how, parts)
 
@@ -283,7 +283,7 @@ def spectral_rate(jacobians) -> float:
     return rho if math.isfinite(rho) else 0.0
 
 
-def _own_rate(z0, jacobians) -> float:
+def _own_rate(z0, jacobians, floor: float = 0.0) -> float:
     """The rate at which the start's largest component changes by its own size:
     ``|F_k| / |z0_k|`` to first order, ``sqrt(|(J F)_k| / |z0_k|)`` to second (J F the
     state's acceleration: a position at rest driven through its velocity), the faster over
@@ -293,32 +293,36 @@ def _own_rate(z0, jacobians) -> float:
     time every component's motion made S and T 2^26, events found to 1e-8 (a review);
     its largest component, x at rest, changes in time 1. Not every component's: one at
     a rounding of 0 (1e-82, a generated start) changes by its own size at once, and its
-    rate said nothing of the orbit's time (T = 1e-81). 0 where the largest component is
-    0 or does not move."""
+    rate said nothing of the orbit's time (T = 1e-81). Its size at least ``floor``, the
+    scale measured for all (the fields' length up to 1): next to the origin, (1e-8, 1e-8,
+    1e-8) of a spiral about (1, 0, 1), the position's rate through its velocity was
+    sqrt(1 / 1e-8) and T 1.2e-4 for 1 (a review). 0 where the largest component is 0 or
+    does not move."""
     z0 = np.abs(np.asarray(z0, dtype=float).reshape(-1))
     if not z0.size or not np.all(np.isfinite(z0)) or not z0.max() > 0.0:
         return 0.0
     k = int(np.argmax(z0))
+    size = max(z0[k], floor)
     rate = 0.0
     for f, J in jacobians:
         f = np.asarray(f, dtype=float).reshape(-1)
         if f.shape != z0.shape or J.shape != (z0.size, z0.size):
             continue
         with np.errstate(all="ignore"):
-            first = abs(f[k]) / z0[k]
-            second = math.sqrt(abs(float(J[k] @ f)) / z0[k])
+            first = abs(f[k]) / size
+            second = math.sqrt(abs(float(J[k] @ f)) / size)
         for r in (first, second):
             if math.isfinite(r):
                 rate = max(rate, r)
     return rate
 
 
-def system_rate(z0, jacobians) -> float:
+def system_rate(z0, jacobians, floor: float = 0.0) -> float:
     """The rate the component scales measure motion in: the larger of the fields'
     spectral radius (:func:`spectral_rate`) and the start's own rate (:func:`_own_rate`);
     the shorter time, so that no component's motion is measured over a time longer than
     the largest component takes to change. 0 where neither is."""
-    return max(spectral_rate(jacobians), _own_rate(z0, jacobians))
+    return max(spectral_rate(jacobians), _own_rate(z0, jacobians, floor))
 
 
 #: components whose measured scales spread beyond this factor are measured one by one
@@ -346,7 +350,7 @@ def component_scales(z0, fields, jacobians, S: float):
     component), dP/dz off by 2.4e-4 (Richardson's steps from a scale 1e9 times the
     component's): docs/decisions.md#units."""
     z0 = np.abs(np.asarray(z0, dtype=float).reshape(-1))
-    rho = system_rate(z0, jacobians)
+    rho = system_rate(z0, jacobians, S)
     if rho == 0.0:
         return None   # no time of the system's own to measure the motion in
     extent = np.where(np.isfinite(z0), z0, 0.0)

@@ -517,7 +517,8 @@ def _simulate(system: PiecewiseSystem, z0, sections: Sequence[Section], opts: di
     if isinstance(system, SurfacesSystem):  # several surfaces: stay by stay
         return several.run(system, z, list(sections), opts, one_stay, initial_mode)
     sc = scale_mod.of_system(system, z, opts.get("scale"))   # never raises: checked next
-    checks.check_system(system, z, method=method, floor=sc.state)   # the class's contract
+    checks.check_system(system, z, method=method, floor=sc.state,   # the class's contract
+                        scales=sc.of_components(z.size))
     return _Run(system, z, list(sections), scale_mod.tolerances(opts, sc, z.size),
                 sc).go()
 
@@ -538,6 +539,7 @@ class _Run:
         self.__dict__.update(opts)
         # each component's scale (filippov.scale): the metric of the two-fold's cosines
         self.scales = scale.of_components(np.asarray(z).size)
+        self.slide_checked = False   # an exact sliding flow: checked where first used
         self.traj = Trajectory(system=system, t0=self.t0, z0=z.copy(), t=self.t0, z=z.copy(),
                                scale=scale)
         self.t, self.z = self.t0, z
@@ -600,6 +602,9 @@ class _Run:
     def _stepper(self, mode):
         system, t, z = self.system, self.t, self.z
         if self.flows_exactly(mode):
+            if mode == SLIDING and not self.slide_checked:   # where a slide first begins
+                checks.sliding_flow_check(system, z, t, self.scales)
+                self.slide_checked = True
             h = min(EXACT_BLOCK * system.sample_step, self.max_step, self.t_end - self.t0)
             return _ExactStepper(system.flows[mode], z, t, self.t_end, h,
                                  slow_window(system.slow_sample_step, h, self.max_step,
