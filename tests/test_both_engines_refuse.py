@@ -456,6 +456,10 @@ RIGHT_FLOWS = {
                             np.array([-1e-11]), 2.5e-3),
     "relaxation to 1 from next to 0": (lambda z, t: 1.0 + (z - 1.0) * np.exp(-t),
                                        lambda z: 1.0 - z, np.array([1e-9, 1e-9]), 0.05),
+    # an equilibrium at 1e12 approached at rate 1e-12, written with expm1 (the docs'
+    # advice: with exp, lambda t rounds away below 1e-16 and the flow stands still)
+    "a far equilibrium with expm1": (lambda z, t: z + (z - 1e12) * np.expm1(-1e-12 * t),
+                                     lambda z: -1e-12 * (z - 1e12), np.array([1.0]), 1.0),
 }
 # wrong flows it must refuse
 WRONG = {
@@ -477,6 +481,19 @@ def test_a_wrong_flow_is_refused_at_any_sample_step(case, sample_step):
     with pytest.raises(SystemContractError, match="^flow does not follow field"):
         flow_check(WRONG[case], lambda z: np.array([-z[1], z[0]]), np.array([1.0, 0.0]),
                    sample_step, "flow", "field")
+
+
+@pytest.mark.parametrize("x0", [0.9, 1.0])
+def test_a_flow_that_stands_still_where_its_field_moves_is_refused(x0):
+    # x'' = -(x - 0.3) released from rest, its flow with the sin terms forgotten: its
+    # derivative at 0 is rounding noise from 0.3 + (x0 - 0.3) (an ulp off x0 = 0.9), which
+    # grew as 1 / tau until the rounding allowance passed it, and the run returned v = 0
+    # for -0.505 (a review); at x0 = 1 exactly 0, refused
+    def flow(z, t):
+        return np.array([0.3 + (z[0] - 0.3) * np.cos(t), z[1] * np.cos(t)])
+    with pytest.raises(SystemContractError, match="^flow does not follow field"):
+        flow_check(flow, lambda z: np.array([z[1], 0.3 - z[0]]), np.array([x0, 0.0]), 0.05,
+                   "flow", "field")
 
 
 def test_a_slow_component_s_error_is_not_hidden_by_a_fast_one():

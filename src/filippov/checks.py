@@ -233,6 +233,10 @@ def _flow_disagreement(flow, field, z0, F, s, size, sample_step):
         rounding = FLOW_ROUNDING_ULPS * np.finfo(float).eps * reach / tau
         if np.all(np.abs(d - F) <= share + rounding):
             return None
+        # a derivative within its rounding is 0: a flow that stands still where its field
+        # moves (its sin terms forgotten) settles there, not on noise growing as 1 / tau
+        # until the rounding allowance passes it (a review)
+        d = np.where(np.abs(d) <= rounding, 0.0, d)
         change = np.max(np.abs(d - last) / s) if last is not None else np.inf
         if change <= FLOW_SETTLED * min(np.max(np.abs(d - F) / s), np.max(np.abs(d) / s)):
             return d, tau   # settled away from the field: a wrong flow, not a coarse step
