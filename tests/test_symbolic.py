@@ -245,6 +245,17 @@ def test_with_params_shares_the_generated_pieces():
                               eps=eps, params={}), "eps: the small parameter"),
     (lambda: SymbolicSlowFast((x1,), (y,), [1], [-1], [x1 - y], [x1 - y], y,
                               eps=eps, params={eps: 0.0}).full(), "eps: the slow-fast system"),
+    # a jump inside a region (sign, Heaviside): the printer's raw error about its
+    # derivative before
+    (lambda: SymbolicSystem((x1, x2), [x2, -x1 - sp.sign(x2)], [x2, -x1], x1),
+     r"field_minus: sign\(x2\) jumps inside a region"),
+    (lambda: SymbolicSystem((x1, x2), [x2, -x1], [x2, -x1 + sp.Heaviside(x2 - 1)], x1),
+     r"field_plus: Heaviside\(x2 - 1\) jumps inside a region"),
+    (lambda: SymbolicSystem((x1, x2), [x2, -x1], [x2, -x1], x1 + sp.floor(x2)),
+     r"switch: floor\(x2\) jumps"),
+    # a kink has no Jacobian formula: named where the module is generated
+    (lambda: SymbolicSystem((x1, x2), [x2, -x1 - sp.Abs(x2)], [x2, -x1], x1).module(),
+     r"jacobian_minus: cannot be written as code .*kink"),
 ])
 def test_bad_definitions_are_refused_naming_the_piece(build, match):
     with pytest.raises(SymbolicError, match=match):

@@ -29,6 +29,8 @@ import sympy as sp
 from sympy.printing.numpy import NumPyPrinter
 from sympy.printing.pycode import PythonCodePrinter
 
+from .errors import SymbolicError
+
 #: piece kinds -> (signature name in filippov.abi, arguments)
 KINDS = {"vector": ("FIELD_SIG", "_z, _p, _out"), "matrix": ("FIELD_SIG", "_z, _p, _out"),
          "scalar": ("SCALAR_SIG", "_z, _p"), "where": ("WHERE_SIG", "_z, _p"),
@@ -71,10 +73,21 @@ class _NumPyPrinter(NumPyPrinter):
         return repr(float(expr))
 
 
-def _body(exprs: Sequence, head: list[str], printer=_Printer) -> tuple[list[str], list[str]]:
+def _body(exprs: Sequence, head: list[str], printer=_Printer,
+          name: str = "a piece") -> tuple[list[str], list[str]]:
     reps, reduced = sp.cse(list(exprs), symbols=sp.numbered_symbols("c_"))
     pr = printer()
-    return head + [f"{s} = {pr.doprint(e)}" for s, e in reps], [pr.doprint(e) for e in reduced]
+    try:
+        return (head + [f"{s} = {pr.doprint(e)}" for s, e in reps],
+                [pr.doprint(e) for e in reduced])
+    except NotImplementedError as exc:   # sympy's PrintMethodNotImplementedError
+        # a kink's derivative (|x|: re and im of a complex symbol; Max, Min) has no code:
+        # the printer's raw error named neither the piece nor what to write instead
+        what = str(exc).splitlines()[0]
+        raise SymbolicError(
+            f"{name}: cannot be written as code ({what}). A field with a kink (Abs, Max, "
+            f"Min) has no Jacobian formula there: write the kink as a switching surface, "
+            f"or give the system without it") from None
 
 
 _BATCH = {
@@ -136,7 +149,7 @@ def source(title: str, states: Sequence, params: Sequence, pieces: dict,
         head += [f"{s} = _p[{i}]" for i, s in enumerate(params)]
         if flow:
             head.append(f"{time} = _tau")
-        lines, res = _body(list(exprs), head)
+        lines, res = _body(list(exprs), head, name=name)
         out += ["", f"@njit({sig}, cache=True)", f"def {name}({args}):"]
         out += ["    " + ln for ln in lines]
         if kind in ("scalar", "where"):
@@ -249,7 +262,7 @@ def numpy_source(title: str, functions: Sequence) -> str:
                 head.append(f"{syms} = {arg}")
             else:
                 head += [f"{s} = {arg}[{i}]" for i, s in enumerate(syms)]
-        lines, res = _body(list(exprs), head, _NumPyPrinter)
+        lines, res = _body(list(exprs), head, _NumPyPrinter, name)
         out += ["", f"def {name}({', '.join(a for a, _ in args)}):"]
         out += ["    " + ln for ln in lines]
         out.append(f"    return _out([{', '.join(res)}], {tuple(shape)!r}, {like})")

@@ -75,6 +75,23 @@ def _check_free(exprs, allowed: set, piece: str) -> None:
                                 f"nor a parameter)")
 
 
+#: functions that jump: inside a region's field or in the switch, a discontinuity the
+#: engines neither locate nor slide along (a review: sign and Heaviside in a field ended
+#: in the printer's raw error about their derivatives)
+JUMPS = (sp.sign, sp.Heaviside, sp.DiracDelta, sp.floor, sp.ceiling, sp.frac)
+
+
+def _check_smooth(exprs, piece: str) -> None:
+    """Refuse a piece that jumps inside a region (:data:`JUMPS`), naming it."""
+    for e in exprs:
+        jumps = sorted({str(a) for a in sp.sympify(e).atoms(*JUMPS)})
+        if jumps:
+            raise SymbolicError(
+                f"{piece}: {jumps[0]} jumps inside a region, where the engines neither "
+                f"locate the jump nor slide along it: write it as a switching surface "
+                f"(switch=..., or several surfaces with fields=...)")
+
+
 _OPTIONS = {"sample_step": float, "slow_sample_step": float, "transient_time": float,
             "sliding": bool, "scale": lambda v: v}
 
@@ -175,6 +192,7 @@ class SymbolicSystem:
         for piece, exprs in (("field_minus", self.field_minus),
                              ("field_plus", self.field_plus), ("switch", (self.switch,))):
             _check_free(exprs, allowed, piece)
+            _check_smooth(exprs, piece)
         self.time = None
         self.flows = {}
         if flows:
@@ -232,6 +250,7 @@ class SymbolicSystem:
                 raise SymbolicError(str(exc)) from None
             out[sigma] = _vector(exprs, len(self.states), f"fields[{sigma}]")
             _check_free(out[sigma], allowed, f"fields[{sigma}]")
+            _check_smooth(out[sigma], f"fields[{sigma}]")
         try:
             check_regions(out, m)
             check_intersection(self.intersection, m)
@@ -242,6 +261,7 @@ class SymbolicSystem:
         self.m, self.fields = m, out
         self.switch = tuple(sp.sympify(h) for h in hs)
         _check_free(self.switch, allowed, "switch")
+        _check_smooth(self.switch, "switch")
         self.field_minus = self.field_plus = self.sliding_field = None
         self.time, self.flows = None, {}
         self.switch_grad = tuple(tuple(sp.diff(h, v) for v in self.states)
