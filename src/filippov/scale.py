@@ -106,8 +106,8 @@ PROBE_REACH = 20
 
 def _column(field, z0, f0, k: int, size: float) -> np.ndarray:
     """``dF/dz_k`` near z0 (a column of F's Jacobian), by the shortest step ``2^j`` along
-    coordinate k (j by bisection, from ``sqrt(eps) size`` up to ``2^MAX_EXPONENT``: a
-    dozen evaluations) that changes F by ``sqrt(eps) |F(z0)|``, above its rounding; 0
+    coordinate k (j by bisection, from ``sqrt(eps) |z0_k|`` up to ``2^PROBE_REACH`` times
+    the start's ``size``: a dozen evaluations) that changes F by ``sqrt(eps) |F(z0)|``, above its rounding; 0
     where no step does, or F is not finite."""
     root, target = math.sqrt(np.finfo(float).eps), math.sqrt(np.finfo(float).eps) * _inf_norm(f0)
     zero = np.zeros(np.shape(f0))
@@ -122,7 +122,10 @@ def _column(field, z0, f0, k: int, size: float) -> np.ndarray:
         c = _inf_norm(d)
         return (c, d) if math.isfinite(c) else (math.inf, zero)
 
-    lo = max(-MAX_EXPONENT, math.frexp(root * size)[1] - 1) if size > 0.0 else -MAX_EXPONENT
+    # from the component's own size, not the start's: beside a constant of 1e14 a step
+    # from the start's size (1.5e6) read a secant for the derivative, dF_y/dx 1.5e6
+    own = abs(float(z0[k]))
+    lo = max(-MAX_EXPONENT, math.frexp(root * own)[1] - 1) if own > 0.0 else -MAX_EXPONENT
     # probes stay within 2^PROBE_REACH of the start's size (or of 1): a piece written for
     # its own range (an angle wrapped by a loop) is never asked at 2^300
     hi = min(MAX_EXPONENT, math.frexp(max(size, 1.0))[1] + PROBE_REACH)
